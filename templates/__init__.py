@@ -1,0 +1,1 @@
+"""Worksheet templates shipped with workbook (installed as package data)."""

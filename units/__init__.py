@@ -1,0 +1,1 @@
+"""pint definition files shipped with workbook (installed as package data)."""

@@ -1,0 +1,60 @@
+"""workbook: unit-checked worksheets that write live Excel workbooks.
+
+    >>> import workbook
+    >>> sheet = workbook.load("concave-cam")
+    >>> sheet.evaluate("h1", phi=[0, 5])          # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .errors import WorkbookError
+
+__version__ = "0.1.0"
+__all__ = ["load", "list_templates", "template_path", "Sheet", "WorkbookError", "__version__"]
+
+
+def list_templates() -> dict[str, Path]:
+    """Installed templates: name -> path."""
+    from importlib import resources
+
+    root = resources.files("workbook.templates")
+    out = {}
+    for entry in root.iterdir():
+        if entry.name.endswith(".toml"):
+            out[entry.name[: -len(".toml")]] = Path(str(entry))
+    return dict(sorted(out.items()))
+
+
+def template_path(name_or_path: str | Path) -> Path:
+    """Resolve a template name (``concave-cam``) or a path to a .toml file."""
+    from .errors import TemplateError
+
+    text = str(name_or_path)
+    if text.endswith(".toml") or "/" in text or "\\" in text:
+        path = Path(text)
+        if not path.is_file():
+            raise TemplateError(f"no template file {text}")
+        return path
+    found = list_templates()
+    if text not in found:
+        raise TemplateError(f"no template named '{text}' (installed: {', '.join(found)})")
+    return found[text]
+
+
+def load(name_or_path: str | Path):
+    """Load a template by name or path and check its units; returns a :class:`Sheet`."""
+    from .sheet import Sheet
+    from .template import load_spec
+
+    path = template_path(name_or_path)
+    return Sheet(load_spec(path))
+
+
+def __getattr__(name):
+    if name == "Sheet":
+        from .sheet import Sheet
+
+        return Sheet
+    raise AttributeError(name)

@@ -1,0 +1,103 @@
+"""Solver blocks: numerical procedures that a template may call by name.
+
+A template names a block in ``[blocks]`` as ``local_name = "module.function"``;
+the engine imports ``workbook.blocks.<module>`` only when a requested output
+needs it (so scipy is imported only by scenes that solve something). Only
+functions registered with one of the decorators below can be reached, so a
+template cannot call arbitrary Python.
+
+Three kinds:
+
+* ``@block(args={...}, returns="mm")``: called inside expressions like a
+  function. It receives magnitudes (floats or numpy arrays) in the declared
+  units, in the declared order, and returns a magnitude in ``returns``.
+  With ``vectorized=False`` the engine calls it once per element.
+* ``@table_block``: ``func(sheet) -> pandas.DataFrame``; headers carry units as
+  ``"name [unit]"``. Used for tables that are values, not formulas (benchmarks,
+  ODE histories).
+* ``@findings_block``: ``func(sheet) -> list[Finding]``; shown by
+  ``workbook check`` and in the Checks sheet.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from ..errors import TemplateError
+
+_REGISTRY: dict[str, "Block"] = {}
+
+
+@dataclass
+class Block:
+    ref: str
+    func: Callable[..., Any]
+    kind: str  # "function" | "table" | "findings" | "bench"
+    args: dict[str, str] = field(default_factory=dict)
+    returns: str = ""
+    vectorized: bool = True
+
+    @property
+    def doc(self) -> str:
+        return (self.func.__doc__ or "").strip().splitlines()[0] if self.func.__doc__ else ""
+
+
+@dataclass
+class Finding:
+    """One line of a check report: a number the engine found, and what it means."""
+
+    topic: str
+    what: str
+    value: float | None = None
+    unit: str = ""
+    verdict: str = "info"  # "ok" | "info" | "warning" | "fail"
+    note: str = ""
+
+
+def _ref(func: Callable) -> str:
+    module = func.__module__.rsplit(".", 1)[-1]
+    return f"{module}.{func.__name__}"
+
+
+def block(args: dict[str, str], returns: str, vectorized: bool = True):
+    """Register a function block (see module docstring)."""
+
+    def wrap(func):
+        _REGISTRY[_ref(func)] = Block(_ref(func), func, "function", dict(args), returns, vectorized)
+        return func
+
+    return wrap
+
+
+def _simple(kind: str):
+    def deco(func):
+        _REGISTRY[_ref(func)] = Block(_ref(func), func, kind)
+        return func
+
+    return deco
+
+
+table_block = _simple("table")
+findings_block = _simple("findings")
+bench_block = _simple("bench")
+
+
+def get(ref: str, kind: str | None = None) -> Block:
+    """Import ``workbook.blocks.<module>`` and return the registered block ``module.function``."""
+    module, _, name = ref.partition(".")
+    if not module.isidentifier() or not name.isidentifier():
+        raise TemplateError(f"block {ref!r} must be named 'module.function'")
+    try:
+        importlib.import_module(f"{__name__}.{module}")
+    except ModuleNotFoundError as exc:
+        if exc.name == f"{__name__}.{module}":
+            raise TemplateError(f"no block module '{module}' (looked for workbook/blocks/{module}.py)") from None
+        raise
+    blk = _REGISTRY.get(ref)
+    if blk is None:
+        raise TemplateError(f"block module '{module}' has no registered block '{name}'")
+    if kind is not None and blk.kind != kind:
+        raise TemplateError(f"block {ref!r} is a {blk.kind} block, not a {kind} block")
+    return blk

@@ -1,0 +1,203 @@
+"""Checks: printed values from the source paper, and findings of solver blocks."""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import units as un
+from .blocks import Finding
+from .errors import TemplateError, WorkbookError
+from .template import PrintedSpec
+
+
+@dataclass
+class PrintedRow:
+    name: str
+    at: float
+    value: float
+    unit: str
+    line: int
+
+
+@dataclass
+class CheckRow:
+    source: str  # title of the printed set
+    role: str  # check | information
+    name: str
+    argument: str
+    at: float | None
+    unit: str
+    printed: float
+    computed: float | None
+    tolerance: float | None
+    rel_tolerance: float | None
+    verdict: str  # pass | FAIL | misprint | info | error
+    note: str = ""
+
+    @property
+    def abs_error(self) -> float | None:
+        return None if self.computed is None else abs(self.computed - self.printed)
+
+    @property
+    def rel_error(self) -> float | None:
+        if self.computed is None or self.printed == 0:
+            return None
+        return abs(self.computed - self.printed) / abs(self.printed)
+
+
+@dataclass
+class Report:
+    sheet: str
+    rows: list[CheckRow] = field(default_factory=list)
+    findings: list[Finding] = field(default_factory=list)
+    unused_inputs: list[str] = field(default_factory=list)
+
+    @property
+    def failed(self) -> list[CheckRow]:
+        return [r for r in self.rows if r.verdict in ("FAIL", "error")]
+
+    @property
+    def ok(self) -> bool:
+        return not self.failed and not any(f.verdict == "fail" for f in self.findings)
+
+    def text(self) -> str:
+        """The report as readable text (what ``workbook check`` prints)."""
+        lines = [f"checks of {self.sheet}"]
+        by_source: dict[str, list[CheckRow]] = {}
+        for r in self.rows:
+            by_source.setdefault(r.source, []).append(r)
+        for source, rows in by_source.items():
+            role = rows[0].role
+            n_ok = sum(r.verdict in ("pass", "misprint", "info") for r in rows)
+            lines.append("")
+            lines.append(f"{source} ({'information' if role == 'information' else 'checked'}): "
+                         f"{n_ok} of {len(rows)} reproduced")
+            lines.append(f"  {'name':<8}{'at':>8}  {'printed':>12}  {'computed':>12}  "
+                         f"{'abs err':>10}  {'rel err':>9}  verdict")
+            for r in rows:
+                comp = "-" if r.computed is None else f"{r.computed:.6g}"
+                ae = "-" if r.abs_error is None else f"{r.abs_error:.2e}"
+                re_ = "-" if r.rel_error is None else f"{100 * r.rel_error:.3f}%"
+                at = "" if r.at is None else f"{r.at:g}"
+                lines.append(f"  {r.name:<8}{at:>8}  {r.printed:>12.6g}  {comp:>12}  {ae:>10}  "
+                             f"{re_:>9}  {r.verdict}{'  ' + r.note if r.note else ''}")
+        if self.findings:
+            lines.append("")
+            lines.append("findings:")
+            topic = None
+            for f in self.findings:
+                if f.topic != topic:
+                    topic = f.topic
+                    lines.append(f"  [{topic}]")
+                val = "" if f.value is None else f" = {f.value:.6g}{(' ' + f.unit) if f.unit else ''}"
+                note = f" ({f.note})" if f.note else ""
+                lines.append(f"    {f.verdict:<7} {f.what}{val}{note}")
+        if self.unused_inputs:
+            lines.append("")
+            lines.append("inputs that no output uses: " + ", ".join(self.unused_inputs))
+        lines.append("")
+        bad = self.failed
+        lines.append("result: " + ("all printed values reproduced" if not bad else
+                                   f"{len(bad)} printed value(s) NOT reproduced"))
+        return "\n".join(lines)
+
+
+def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
+    """Read a printed-values CSV: name, argument value, value, unit ('#' lines are comments)."""
+    try:
+        text = Path(spec.file).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise TemplateError(f"cannot read printed values {spec.file}: {exc.strerror}") from None
+    rows, header = [], None
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        cells = next(csv.reader([line]))
+        if header is None:
+            header = cells
+            continue
+        if len(cells) != 4:
+            raise TemplateError(f"{spec.file}:{number}: expected name, argument, value, unit")
+        try:
+            at = float(cells[1]) if cells[1].strip() else math.nan
+            rows.append(PrintedRow(cells[0].strip(), at, float(cells[2]), cells[3].strip(), number))
+        except ValueError:
+            raise TemplateError(f"{spec.file}:{number}: not a number in {line!r}") from None
+    return rows
+
+
+def run_checks(sheet) -> Report:
+    """Compare every printed value with the engine, and collect block findings."""
+    report = Report(sheet.name)
+    for spec in sheet.spec.printed:
+        for row in read_printed(spec):
+            report.rows.append(_check_row(sheet, spec, row))
+    report.findings = collect_findings(sheet)
+    report.unused_inputs = sheet.unused_inputs()
+    return report
+
+
+def collect_findings(sheet) -> list[Finding]:
+    from . import blocks
+
+    out: list[Finding] = []
+    for entry in sheet.spec.findings:
+        ref = entry.get("block")
+        if not isinstance(ref, str):
+            raise TemplateError("[[findings]] needs block = \"module.function\"", file=sheet.file)
+        try:
+            out.extend(blocks.get(ref, "findings").func(sheet))
+        except WorkbookError as err:
+            out.append(Finding(entry.get("title", ref), f"{ref} could not run", None, "",
+                               "fail", str(err)))
+    return out
+
+
+def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
+    misprint = next((m for m in spec.misprints if m.name == row.name and m.at == row.at), None)
+    base = dict(source=spec.title, role=spec.role, name=row.name, argument=spec.argument,
+                at=None if math.isnan(row.at) else row.at, unit=row.unit, printed=row.value,
+                tolerance=spec.tolerance, rel_tolerance=spec.rel_tolerance)
+    try:
+        if spec.argument and not math.isnan(row.at):
+            q = sheet.evaluate(row.name, **{spec.argument: row.at})
+        else:
+            q = sheet.evaluate(row.name)
+        computed = float(q.to(un.unit(row.unit)).magnitude)
+    except WorkbookError as err:
+        return CheckRow(**base, computed=None, verdict="error", note=str(err))
+    ok = within(computed, row.value, spec.tolerance, spec.rel_tolerance)
+    if spec.role == "information":
+        return CheckRow(**base, computed=computed, verdict="info",
+                        note="" if ok else "outside the stated deviation")
+    if misprint is not None:
+        if ok:
+            return CheckRow(**base, computed=computed, verdict="pass",
+                            note="declared a misprint, but it is reproduced")
+        if misprint.corrected is not None and not within(
+                computed, misprint.corrected, spec.tolerance, spec.rel_tolerance):
+            return CheckRow(**base, computed=computed, verdict="FAIL",
+                            note=f"misprint, and the corrected {misprint.corrected:g} is not "
+                                 "reproduced either")
+        return CheckRow(**base, computed=computed, verdict="misprint", note=misprint.note)
+    return CheckRow(**base, computed=computed, verdict="pass" if ok else "FAIL")
+
+
+def within(computed: float, printed: float, tol: float | None, rel: float | None) -> bool:
+    """True if computed agrees with printed within the absolute or the relative tolerance."""
+    if tol is None and rel is None:
+        tol = 0.5 * 10 ** -_decimals(printed)
+    ok = False
+    if tol is not None:
+        ok = abs(computed - printed) <= tol * (1 + 1e-9)
+    if rel is not None and not ok:
+        ok = abs(computed - printed) <= rel * abs(printed)
+    return ok
+
+
+def _decimals(value: float) -> int:
+    text = repr(value)
+    return len(text.split(".")[1]) if "." in text and "e" not in text else 0

@@ -1,0 +1,79 @@
+"""Error types the engine raises for user mistakes.
+
+Every error carries where it happened (template file, line, definition) so that
+the command line can print one actionable paragraph instead of a traceback.
+"""
+
+from __future__ import annotations
+
+
+class WorkbookError(Exception):
+    """Base class: a user-facing error with a location."""
+
+    kind = "error"
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | None = None,
+        line: int | None = None,
+        definition: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.message = message
+        self.file = file
+        self.line = line
+        self.definition = definition
+
+    def located(self, *, file=None, line=None, definition=None) -> "WorkbookError":
+        """Fill in location fields that are still unknown; returns self."""
+        self.file = self.file or file
+        self.line = self.line or line
+        self.definition = self.definition or definition
+        return self
+
+    def __str__(self) -> str:
+        where = []
+        if self.file:
+            where.append(f"{self.file}:{self.line}" if self.line else self.file)
+        if self.definition:
+            where.append(f"in '{self.definition}'")
+        prefix = ", ".join(where)
+        return f"{prefix}: {self.kind}: {self.message}" if prefix else f"{self.kind}: {self.message}"
+
+
+class TemplateError(WorkbookError):
+    """The worksheet text is malformed: syntax, unknown names, bad structure."""
+
+    kind = "template error"
+
+
+class UnitError(WorkbookError):
+    """Dimensions do not agree."""
+
+    kind = "unit error"
+
+
+class DomainError(WorkbookError):
+    """A formula left its mathematical domain (sqrt of a negative, 0/0, ...)."""
+
+    kind = "domain error"
+
+
+class InputError(WorkbookError):
+    """A value given by the user (input override, --set, argument) is unusable."""
+
+    kind = "input error"
+
+
+class LimitError(WorkbookError):
+    """A documented resource limit was hit (size, depth, iterations, time)."""
+
+    kind = "limit exceeded"
+
+
+class CheckFailed(WorkbookError):
+    """Printed values are not reproduced."""
+
+    kind = "check failed"

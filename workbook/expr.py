@@ -1,0 +1,252 @@
+"""The expression language: a small tree parsed safely from worksheet text.
+
+Text is parsed with ``ast.parse(mode="eval")`` and only a whitelist of node types
+is turned into the engine's own nodes; nothing is ever evaluated by Python.
+``^`` is the power operator (as in Mathcad and Excel).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from dataclasses import dataclass
+
+from .errors import LimitError, TemplateError
+
+MAX_TEXT = 20_000
+MAX_DEPTH = 200
+
+
+@dataclass(frozen=True)
+class Node:
+    """Base of all expression nodes."""
+
+
+@dataclass(frozen=True)
+class Number(Node):
+    value: float
+
+
+@dataclass(frozen=True)
+class Text(Node):
+    """A string literal: allowed only as the right side of ``choice == "..."``."""
+
+    value: str
+
+
+@dataclass(frozen=True)
+class Name(Node):
+    id: str
+
+
+@dataclass(frozen=True)
+class Unary(Node):
+    op: str  # '-' or '+' or 'not'
+    operand: Node
+
+
+@dataclass(frozen=True)
+class Binary(Node):
+    op: str  # + - * / ^
+    left: Node
+    right: Node
+
+
+@dataclass(frozen=True)
+class Compare(Node):
+    """A (possibly chained) comparison: ``0 <= phi <= 22``."""
+
+    ops: tuple[str, ...]
+    operands: tuple[Node, ...]
+
+
+@dataclass(frozen=True)
+class Logic(Node):
+    op: str  # 'and' / 'or'
+    values: tuple[Node, ...]
+
+
+@dataclass(frozen=True)
+class Call(Node):
+    func: str
+    args: tuple[Node, ...]
+
+
+#: Built-in functions: name -> number of arguments (None: one or more).
+FUNCTIONS: dict[str, int | None] = {
+    "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1, "atan2": 2,
+    "sinh": 1, "cosh": 1, "tanh": 1,
+    "sqrt": 1, "exp": 1, "ln": 1, "log10": 1, "abs": 1,
+    "min": None, "max": None, "sign": 1, "floor": 1, "ceil": 1,
+}
+
+_BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "^"}
+_CMPOPS = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
+_IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def is_identifier(text: str) -> bool:
+    """Names allowed in worksheets: a letter, then letters, digits, underscores."""
+    return bool(_IDENT.match(text)) and not text.startswith("__")
+
+
+def parse(text: str, *, what: str = "expression") -> Node:
+    """Parse worksheet expression text into a tree (raises TemplateError)."""
+    if not isinstance(text, str):
+        raise TemplateError(f"{what}: expected an expression as text, got {type(text).__name__}")
+    if len(text) > MAX_TEXT:
+        raise LimitError(f"{what}: expression is {len(text)} characters long (limit {MAX_TEXT})")
+    source = text.replace("^", "**").strip()
+    if not source:
+        raise TemplateError(f"{what}: empty expression")
+    if source.count("(") > MAX_DEPTH:
+        # The parser itself recurses; refuse absurd nesting before it does.
+        depth = _paren_depth(source)
+        if depth > MAX_DEPTH:
+            raise LimitError(f"{what}: parentheses nested {depth} deep (limit {MAX_DEPTH})")
+    try:
+        tree = ast.parse(source, mode="eval")
+    except SyntaxError as exc:
+        col = f" at column {exc.offset}" if exc.offset else ""
+        raise TemplateError(f"{what}: cannot parse {text!r}{col}: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise LimitError(f"{what}: expression nested too deeply") from None
+    return _convert(tree.body, text, what, 0)
+
+
+def _paren_depth(source: str) -> int:
+    depth = best = 0
+    for ch in source:
+        if ch == "(":
+            depth += 1
+            best = max(best, depth)
+        elif ch == ")":
+            depth -= 1
+    return best
+
+
+def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
+    if depth > MAX_DEPTH:
+        raise LimitError(f"{what}: expression nested more than {MAX_DEPTH} deep")
+    d = depth + 1
+    if isinstance(node, ast.Constant):
+        if isinstance(node.value, bool) or not isinstance(node.value, (int, float, str)):
+            raise TemplateError(f"{what}: {node.value!r} is not allowed in {text!r}")
+        if isinstance(node.value, str):
+            return Text(node.value)
+        return Number(float(node.value))
+    if isinstance(node, ast.Name):
+        if not is_identifier(node.id):
+            raise TemplateError(f"{what}: name {node.id!r} is not allowed in {text!r}")
+        return Name(node.id)
+    if isinstance(node, ast.UnaryOp):
+        ops = {ast.USub: "-", ast.UAdd: "+", ast.Not: "not"}
+        if type(node.op) not in ops:
+            raise TemplateError(f"{what}: operator not allowed in {text!r}")
+        return Unary(ops[type(node.op)], _convert(node.operand, text, what, d))
+    if isinstance(node, ast.BinOp):
+        if type(node.op) not in _BINOPS:
+            raise TemplateError(
+                f"{what}: operator {type(node.op).__name__} not allowed in {text!r} "
+                "(use + - * / ^)"
+            )
+        return Binary(
+            _BINOPS[type(node.op)],
+            _convert(node.left, text, what, d),
+            _convert(node.right, text, what, d),
+        )
+    if isinstance(node, ast.Compare):
+        ops = []
+        for op in node.ops:
+            if type(op) not in _CMPOPS:
+                raise TemplateError(f"{what}: comparison not allowed in {text!r}")
+            ops.append(_CMPOPS[type(op)])
+        operands = [node.left, *node.comparators]
+        return Compare(tuple(ops), tuple(_convert(o, text, what, d) for o in operands))
+    if isinstance(node, ast.BoolOp):
+        op = "and" if isinstance(node.op, ast.And) else "or"
+        return Logic(op, tuple(_convert(v, text, what, d) for v in node.values))
+    if isinstance(node, ast.Call):
+        if not isinstance(node.func, ast.Name) or not is_identifier(node.func.id):
+            raise TemplateError(f"{what}: only plain function calls like f(x) are allowed in {text!r}")
+        if node.keywords:
+            raise TemplateError(f"{what}: keyword arguments are not allowed in {text!r}")
+        if any(isinstance(a, ast.Starred) for a in node.args):
+            raise TemplateError(f"{what}: starred arguments are not allowed in {text!r}")
+        return Call(node.func.id, tuple(_convert(a, text, what, d) for a in node.args))
+    kind = type(node).__name__
+    raise TemplateError(f"{what}: {kind} is not allowed in worksheet expressions ({text!r})")
+
+
+def walk(node: Node):
+    """Yield every node of the tree, parents first."""
+    yield node
+    if isinstance(node, Unary):
+        yield from walk(node.operand)
+    elif isinstance(node, Binary):
+        yield from walk(node.left)
+        yield from walk(node.right)
+    elif isinstance(node, Compare):
+        for o in node.operands:
+            yield from walk(o)
+    elif isinstance(node, Logic):
+        for v in node.values:
+            yield from walk(v)
+    elif isinstance(node, Call):
+        for a in node.args:
+            yield from walk(a)
+
+
+def names(node: Node) -> set[str]:
+    """Names a tree refers to (variables and called functions)."""
+    found = set()
+    for n in walk(node):
+        if isinstance(n, Name):
+            found.add(n.id)
+        elif isinstance(n, Call):
+            found.add(n.func)
+    return found
+
+
+def to_text(node: Node) -> str:
+    """Print a tree back as worksheet text (fully parenthesised where needed)."""
+    return _text(node, 0)
+
+
+_PREC = {"or": 1, "and": 2, "not": 3, "cmp": 4, "+": 5, "-": 5, "*": 6, "/": 6, "neg": 7, "^": 8}
+
+
+def _text(node: Node, parent: int) -> str:
+    if isinstance(node, Number):
+        v = node.value
+        s = repr(int(v)) if v.is_integer() and abs(v) < 1e15 else repr(v)
+        return s
+    if isinstance(node, Text):
+        return '"' + node.value.replace('"', "") + '"'
+    if isinstance(node, Name):
+        return node.id
+    if isinstance(node, Call):
+        return f"{node.func}({', '.join(_text(a, 0) for a in node.args)})"
+    if isinstance(node, Unary):
+        if node.op == "not":
+            s, p = "not " + _text(node.operand, _PREC["not"]), _PREC["not"]
+        else:
+            s, p = node.op + _text(node.operand, _PREC["neg"]), _PREC["neg"]
+    elif isinstance(node, Binary):
+        p = _PREC[node.op]
+        if node.op == "^":
+            s = f"{_text(node.left, p + 1)}^{_text(node.right, p)}"
+        else:
+            s = f"{_text(node.left, p)} {node.op} {_text(node.right, p + 1)}"
+    elif isinstance(node, Compare):
+        p = _PREC["cmp"]
+        parts = [_text(node.operands[0], p + 1)]
+        for op, o in zip(node.ops, node.operands[1:]):
+            parts += [op, _text(o, p + 1)]
+        s = " ".join(parts)
+    elif isinstance(node, Logic):
+        p = _PREC[node.op]
+        s = f" {node.op} ".join(_text(v, p + 1) for v in node.values)
+    else:  # pragma: no cover
+        raise TypeError(node)
+    return f"({s})" if p < parent else s

@@ -1,0 +1,360 @@
+"""The Sheet: a loaded template with input values, evaluated lazily."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pint
+
+from . import expr as ex
+from . import typecheck as tc
+from . import units as un
+from .errors import DomainError, InputError, TemplateError, WorkbookError
+from .numeric import Evaluator
+from .template import ColumnSpec, RangeSpec, SheetSpec, check_input_value, range_values
+
+
+@dataclass
+class Column:
+    """One evaluated table column: values in ``unit``."""
+
+    title: str
+    unit: pint.Unit
+    values: np.ndarray
+    typed: tc.T | None  # None for the range variable itself
+    text: str
+
+
+@dataclass
+class TableData:
+    name: str
+    title: str
+    var: str
+    var_unit: pint.Unit
+    columns: list[Column]  # the first is the range variable
+
+
+class Sheet:
+    """A worksheet: inputs, definitions, tables. Evaluation follows only what is asked."""
+
+    def __init__(self, spec: SheetSpec, values: dict[str, Any] | None = None,
+                 typer: tc.Typer | None = None):
+        self.spec = spec
+        self.values = dict(values) if values is not None else {
+            n: i.value for n, i in spec.inputs.items()}
+        input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+        self.typer = typer or tc.Typer(spec, input_units)
+        self._memo: dict[str, object] = {}
+        self.evaluator = Evaluator(self.typer, self._scalar_value, self._describe)
+        if typer is None:
+            self.check_units()
+
+    # -- construction ---------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def file(self) -> str:
+        return str(self.spec.path)
+
+    def check_units(self) -> None:
+        """Infer the unit of every definition, table column and chart series (load time)."""
+        for name, d in self.spec.definitions.items():
+            self._located(lambda: self.typer.function(name) if d.is_function
+                          else self.typer.scalar(name), d)
+        for t in self.spec.tables:
+            if t.range is not None:
+                for col in t.columns:
+                    self._typed_column(col, t.range.var, f"table {t.name}")
+        for c in self.spec.charts:
+            for s in c.series:
+                if s.table is None:
+                    rng = s.range or c.range
+                    if rng is None:
+                        raise TemplateError(f"chart {c.name}: a series needs a range",
+                                            file=self.file, line=c.line)
+                    self._typed_column(s.y, rng.var, f"chart {c.name}")
+
+    def _located(self, thunk, d):
+        try:
+            return thunk()
+        except WorkbookError as err:
+            raise err.located(file=self.file, line=d.line, definition=d.name) from None
+
+    def with_inputs(self, **changes) -> "Sheet":
+        """A new Sheet with some inputs replaced (``"40 mm"``, a pint Quantity, or a number)."""
+        values = dict(self.values)
+        for name, raw in changes.items():
+            spec = self.spec.inputs.get(name)
+            if spec is None:
+                known = ", ".join(self.spec.inputs)
+                raise InputError(f"'{name}' is not an input of {self.name} (inputs: {known})",
+                                 file=self.file)
+            values[name] = coerce_input(spec, raw, file=self.file)
+        return Sheet(self.spec, values, self.typer)
+
+    # -- evaluation -------------------------------------------------------------------
+    def evaluate(self, name: str, *args, **kwargs) -> pint.Quantity | str:
+        """Evaluate a definition (or an input) by name; function arguments by name or position.
+
+        Plain numbers are taken in the unit the template declares for the argument.
+        """
+        Q = un.registry().Quantity
+        if name in self.spec.inputs:
+            return self.values[name]
+        if name == "pi" and name not in self.spec.definitions:
+            return Q(math.pi, "")
+        d = self.spec.definitions.get(name)
+        if d is None:
+            if name in self.spec.blocks:
+                raise InputError(f"'{name}' is a block; evaluate a definition that calls it")
+            raise InputError(f"'{name}' is not defined in {self.name}", file=self.file)
+        try:
+            if not d.is_function:
+                if args or kwargs:
+                    raise InputError(f"'{name}' takes no arguments")
+                return Q(self._scalar_value(name, "definition"), self.typer.scalar(name).unit)
+            f = self.typer.function(name)
+            env = self._bind(name, d.params, args, kwargs)
+            out = self.evaluator.function(name)(env)
+            return Q(np.asarray(out, dtype=float) if np.ndim(out) else float(out), f.unit)
+        except WorkbookError as err:
+            raise err.located(file=self.file, line=d.line, definition=name) from None
+
+    def _bind(self, fname: str, params, args, kwargs) -> dict:
+        if len(args) > len(params):
+            raise InputError(f"{fname}() takes {len(params)} argument(s), got {len(args)}")
+        given = dict(zip(params, args))
+        for k, v in kwargs.items():
+            if k not in params:
+                raise InputError(f"{fname}() has no argument '{k}' (arguments: {', '.join(params)})")
+            if k in given:
+                raise InputError(f"{fname}(): argument '{k}' given twice")
+            given[k] = v
+        missing = [p for p in params if p not in given]
+        if missing:
+            raise InputError(f"{fname}() needs argument(s) {', '.join(missing)}")
+        return {p: self.argument_magnitude(p, given[p]) for p in params}
+
+    def argument_magnitude(self, param: str, value) -> np.ndarray | float:
+        """Magnitude of an argument value in its binding unit (degrees as plain numbers)."""
+        spec = self.spec.arguments[param]
+        if isinstance(value, pint.Quantity):
+            try:
+                mag = value.to(spec.unit).magnitude
+            except pint.DimensionalityError:
+                raise InputError(f"argument {param} = {value:~} is not in {un.dims(spec.unit)} "
+                                 f"({un.pretty(spec.unit)})") from None
+        elif isinstance(value, str):
+            return self.argument_magnitude(param, un.quantity(value, str(spec.unit), what=param))
+        else:
+            try:
+                mag = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                raise InputError(f"argument {param}: cannot read {value!r} as numbers") from None
+        mag = np.asarray(mag, dtype=float)
+        return float(mag) if mag.ndim == 0 else mag
+
+    def _scalar_value(self, name: str, kind: str):
+        if kind == "input":
+            return float(self.values[name].magnitude)
+        if kind == "choice":
+            return self.values[name]
+        if kind == "builtin":
+            return math.pi
+        if name not in self._memo:
+            d = self.spec.definitions[name]
+            try:
+                value = self.evaluator.compile(self.typer.scalar(name))({})
+            except WorkbookError as err:
+                raise err.located(file=self.file, line=d.line, definition=name) from None
+            if np.ndim(value) == 0:
+                value = float(value)
+                if not math.isfinite(value):
+                    raise DomainError(f"{name} is not a finite number ({value}); "
+                                      f"its formula is {d.text}", file=self.file, line=d.line,
+                                      definition=name)
+            self._memo[name] = value
+        return self._memo[name]
+
+    def _describe(self, fname: str, params, env) -> str:
+        parts = []
+        for p in params:
+            v = env.get(p)
+            spec = self.spec.arguments[p]
+            unit = un.pretty(spec.unit)
+            arr = np.atleast_1d(np.asarray(v, dtype=float))
+            if arr.size == 0:
+                continue
+            if arr.size == 1 or arr.min() == arr.max():
+                parts.append(f"{p} = {arr.flat[0]:.6g} {unit}".rstrip())
+            else:
+                parts.append(f"{p} from {arr.min():.6g} to {arr.max():.6g} {unit} "
+                             f"({arr.size} points)".replace("  ", " "))
+        return "for " + ", ".join(parts) if parts else ""
+
+    # -- tables ---------------------------------------------------------------------------
+    def range_values(self, rng: RangeSpec, what: str = "range") -> np.ndarray:
+        """The values of a range (numbers in the argument's declared unit)."""
+        spec = self.spec.arguments.get(rng.var)
+        nums = []
+        for node in (rng.first, rng.second, rng.last):
+            if node is None:
+                nums.append(None)
+                continue
+            t = self.typer.expression(node, {}, what)
+            v = float(self.evaluator.compile(t)({}))
+            if t.unit.dimensionality:
+                if spec is None:
+                    raise TemplateError(f"{what}: range bound has units but '{rng.var}' has "
+                                        "no declared unit")
+                v *= un.factor(t.unit, spec.unit)
+            elif spec is not None and spec.unit != t.unit and not (
+                    t.unit == un.registry().dimensionless):
+                v *= un.factor(t.unit, spec.unit)
+            nums.append(v)
+        return range_values(nums[0], nums[1], nums[2], what=what)
+
+    def _scope(self, var: str) -> dict:
+        spec = self.spec.arguments.get(var)
+        return {var: spec.binding_unit if spec else un.registry().dimensionless}
+
+    def column_node(self, col: ColumnSpec, var: str) -> ex.Node:
+        """A bare function name as a column means that function of the range variable."""
+        node = col.node
+        if isinstance(node, ex.Name):
+            d = self.spec.definitions.get(node.id)
+            if d is not None and d.is_function and len(d.params) == 1:
+                return ex.Call(node.id, (ex.Name(var),))
+        return node
+
+    def _typed_column(self, col: ColumnSpec, var: str, what: str) -> tc.T:
+        try:
+            t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
+            if col.unit is not None:
+                t = self.typer._convert(t, col.unit, f"column '{col.text}' shown in "
+                                        f"{un.pretty(col.unit)}")
+            return t
+        except WorkbookError as err:
+            raise err.located(file=self.file, definition=what) from None
+
+    def column(self, col: ColumnSpec, var: str, values: np.ndarray, what: str) -> Column:
+        t = self._typed_column(col, var, what)
+        fn = self.evaluator.compile(t)
+        try:
+            out = fn({var: values})
+        except WorkbookError as err:
+            raise err.located(file=self.file, definition=what) from None
+        out = np.broadcast_to(np.asarray(out, dtype=float), values.shape).copy()
+        bad = ~np.isfinite(out)
+        if bad.any():
+            raise DomainError(f"column '{col.text}' is not a finite number for {var} = "
+                              f"{values[bad][0]:g} ({bad.sum()} points)", file=self.file,
+                              definition=what)
+        return Column(col.title, t.unit, out, t, col.text)
+
+    def table_data(self, name: str) -> TableData:
+        """Evaluate one template table (only what it needs)."""
+        spec = next((t for t in self.spec.tables if t.name == name), None)
+        if spec is None:
+            raise InputError(f"no table '{name}' in {self.name} (tables: "
+                             f"{', '.join(t.name for t in self.spec.tables)})")
+        if spec.range is None:
+            raise InputError(f"table '{name}' is computed by a block; use sheet.block_table()")
+        what = f"table {name}"
+        values = self.range_values(spec.range, what)
+        var = spec.range.var
+        arg = self.spec.arguments.get(var)
+        var_unit = arg.unit if arg else un.registry().dimensionless
+        cols = [Column(var, var_unit, values, None, var)]
+        cols += [self.column(c, var, values, what) for c in spec.columns]
+        return TableData(name, spec.title, var, var_unit, cols)
+
+    def table(self, name: str):
+        """A table as a pandas DataFrame, the unit in every column header: ``"h1 [mm]"``."""
+        import pandas as pd
+
+        spec = next((t for t in self.spec.tables if t.name == name), None)
+        if spec is not None and spec.block:
+            return self.block_table(spec.block)
+        data = self.table_data(name)
+        return pd.DataFrame({header(c.title, c.unit): c.values for c in data.columns})
+
+    def block_table(self, ref: str):
+        from . import blocks
+
+        return blocks.get(ref, "table").func(self)
+
+    def write_xlsx(self, path, **options) -> Path:
+        """Write the workbook (atomically); returns the path written."""
+        from .xlsx import write_workbook
+
+        return write_workbook(self, Path(path), **options)
+
+    def check(self):
+        """Compare with the printed values; returns a :class:`workbook.checks.Report`."""
+        from .checks import run_checks
+
+        return run_checks(self)
+
+    def unused_inputs(self) -> list[str]:
+        """Inputs that no table, chart, printed value or definition in use needs."""
+        used: set[str] = set()
+        roots: list[ex.Node] = []
+        for t in self.spec.tables:
+            roots += [c.node for c in t.columns]
+        for c in self.spec.charts:
+            roots += [s.y.node for s in c.series if s.table is None]
+        for p in self.spec.printed:
+            roots += [ex.Name(n) for n in _printed_names(p)]
+        for r in self.spec.relations:
+            roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
+        for node in roots:
+            used |= tc.dependencies(self.spec, node)
+        return [n for n in self.spec.inputs if n not in used]
+
+    def _repr_html_(self) -> str:
+        from .notebook import sheet_html
+
+        return sheet_html(self)
+
+
+def _printed_names(p) -> set[str]:
+    try:
+        from .checks import read_printed
+
+        return {row.name for row in read_printed(p)}
+    except WorkbookError:
+        return set()
+
+
+def header(title: str, unit: pint.Unit) -> str:
+    u = un.pretty(unit)
+    return f"{title} [{u}]" if u else title
+
+
+def coerce_input(spec, raw, *, file: str | None = None):
+    """Turn a user-given value into the input's declared unit (with a clear error)."""
+    if spec.options:
+        value = str(raw)
+        if value not in spec.options:
+            raise InputError(f"{spec.name} = {value!r} is not one of {', '.join(spec.options)}",
+                             file=file, definition=spec.name)
+        return value
+    q = un.quantity(raw, str(spec.unit) if spec.unit.dimensionless else None, what=spec.name)
+    if isinstance(raw, (int, float)) and not isinstance(raw, bool):
+        q = un.registry().Quantity(float(raw), spec.unit)
+    try:
+        q = q.to(spec.unit)
+    except pint.DimensionalityError:
+        raise InputError(
+            f"{spec.name} = {raw!s} is {un.dims(q.units)}, but {spec.name} is "
+            f"{un.dims(spec.unit)} ({un.pretty(spec.unit) or 'dimensionless'})",
+            file=file, definition=spec.name) from None
+    check_input_value(spec, q)
+    return q

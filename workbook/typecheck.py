@@ -1,0 +1,464 @@
+"""Unit inference: turn an expression tree into a typed tree with units resolved.
+
+Every node gets the pint unit its value is in; every place where two units must
+agree (sums, comparisons, piecewise branches, function arguments) gets an
+explicit conversion factor. Both back ends (numpy and Excel) read this typed
+tree, so the unit logic lives only here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import pint
+
+from . import expr as ex
+from . import units as un
+from .errors import TemplateError, UnitError, WorkbookError
+from .template import Definition, SheetSpec
+
+
+@dataclass(eq=False)
+class T:
+    unit: pint.Unit
+    boolean: bool = field(default=False, kw_only=True)
+
+
+@dataclass(eq=False)
+class TConst(T):
+    value: float = 0.0
+
+
+@dataclass(eq=False)
+class TText(T):
+    value: str = ""
+
+
+@dataclass(eq=False)
+class TParam(T):
+    name: str = ""
+
+
+@dataclass(eq=False)
+class TRef(T):
+    """A scalar: an input, a scalar definition, or the built-in pi."""
+
+    name: str = ""
+    kind: str = "input"  # input | definition | builtin
+
+
+@dataclass(eq=False)
+class TScale(T):
+    child: T = None
+    factor: float = 1.0
+
+
+@dataclass(eq=False)
+class TUnary(T):
+    op: str = "-"
+    child: T = None
+
+
+@dataclass(eq=False)
+class TBinary(T):
+    op: str = "+"
+    left: T = None
+    right: T = None
+
+
+@dataclass(eq=False)
+class TCompare(T):
+    ops: tuple = ()
+    operands: tuple = ()
+
+
+@dataclass(eq=False)
+class TLogic(T):
+    op: str = "and"
+    values: tuple = ()
+
+
+@dataclass(eq=False)
+class TFunc(T):
+    func: str = ""
+    args: tuple = ()
+
+
+@dataclass(eq=False)
+class TCall(T):
+    """Call of a user function; args are already in the parameters' binding units."""
+
+    name: str = ""
+    args: tuple = ()
+
+
+@dataclass(eq=False)
+class TBlock(T):
+    name: str = ""
+    ref: str = ""
+    args: tuple = ()
+
+
+@dataclass(eq=False)
+class TPiecewise(T):
+    conditions: tuple = ()  # None for 'otherwise'
+    values: tuple = ()
+    texts: tuple = ()
+
+
+@dataclass
+class TypedFunction:
+    name: str
+    params: tuple[str, ...]
+    param_units: tuple[pint.Unit, ...]
+    body: T
+
+    @property
+    def unit(self) -> pint.Unit:
+        return self.body.unit
+
+
+_ANGLE_IN = {"sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "ln", "log10"}
+_INVERSE = {"asin", "acos", "atan"}
+
+
+class Typer:
+    """Types the definitions of one sheet (lazily, each once, with cycle detection)."""
+
+    def __init__(self, spec: SheetSpec, input_units: dict[str, pint.Unit | None]):
+        self.spec = spec
+        self.input_units = input_units
+        self.scalars: dict[str, T] = {}
+        self.functions: dict[str, TypedFunction] = {}
+        self._stack: list[str] = []
+        self.dimensionless = un.registry().dimensionless
+
+    # -- public -------------------------------------------------------------------
+    def scalar(self, name: str) -> T:
+        """Typed body of a scalar definition."""
+        if name not in self.scalars:
+            d = self._definition(name)
+            if d.is_function:
+                raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
+            body = self._typed_body(d, {})
+            if d.unit is not None:
+                body = self._convert(body, d.unit, f"the declared unit of '{name}'")
+            self.scalars[name] = body
+        return self.scalars[name]
+
+    def function(self, name: str) -> TypedFunction:
+        if name not in self.functions:
+            d = self._definition(name)
+            scope = {p: self.spec.arguments[p].binding_unit for p in d.params}
+            body = self._typed_body(d, scope)
+            if d.unit is not None:
+                body = self._convert(body, d.unit, f"the declared unit of '{name}'")
+            self.functions[name] = TypedFunction(name, d.params, tuple(scope.values()), body)
+        return self.functions[name]
+
+    def expression(self, node: ex.Node, scope: dict[str, pint.Unit], what: str) -> T:
+        """Type a free expression (a table column, a chart series) in a scope of parameters."""
+        try:
+            return self._t(node, scope)
+        except WorkbookError as err:
+            raise err.located(definition=what) from None
+
+    def unit_of(self, name: str) -> pint.Unit:
+        if name in self.spec.inputs:
+            u = self.input_units[name]
+            if u is None:
+                raise TemplateError(f"'{name}' is a choice, not a number")
+            return u
+        d = self._definition(name)
+        return self.function(name).unit if d.is_function else self.scalar(name).unit
+
+    # -- internals ----------------------------------------------------------------
+    def _definition(self, name: str) -> Definition:
+        d = self.spec.definitions.get(name)
+        if d is None:
+            raise TemplateError(f"unknown name '{name}'")
+        return d
+
+    def _typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
+        if d.name in self._stack:
+            cycle = " -> ".join(self._stack[self._stack.index(d.name):] + [d.name])
+            raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=d.name)
+        self._stack.append(d.name)
+        try:
+            if d.branches is None:
+                return self._t(d.body, scope)
+            return self._piecewise(d, scope)
+        except WorkbookError as err:
+            raise err.located(file=str(self.spec.path), line=d.line, definition=d.name) from None
+        finally:
+            self._stack.pop()
+
+    def _piecewise(self, d: Definition, scope) -> T:
+        conds, values, texts = [], [], []
+        first_unit = None
+        for b in d.branches:
+            v = self._t(b.value, scope)
+            if v.boolean:
+                raise TemplateError(f"piece {b.text!r} has a condition as its value")
+            if first_unit is None:
+                first_unit = v.unit
+            else:
+                v = self._convert(v, first_unit, f"piece {b.text!r} (first piece is in {un.dims(first_unit)})")
+            c = None
+            if b.condition is not None:
+                c = self._t(b.condition, scope)
+                if not c.boolean:
+                    raise TemplateError(f"the condition of piece {b.text!r} is not a comparison")
+            conds.append(c)
+            values.append(v)
+            texts.append(b.text)
+        return TPiecewise(first_unit, conditions=tuple(conds), values=tuple(values), texts=tuple(texts))
+
+    def _convert(self, t: T, target: pint.Unit, where: str) -> T:
+        if t.unit == target:
+            return t
+        if t.unit.dimensionality != target.dimensionality:
+            raise UnitError(
+                f"{where}: {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}) cannot be converted "
+                f"to {un.dims(target)} ({un.pretty(target) or '1'})"
+            )
+        f = un.factor(t.unit, target)
+        if f == 1.0:
+            return _with_unit(t, target)
+        return TScale(target, child=t, factor=f)
+
+    def _plain(self, t: T, where: str) -> T:
+        """Convert to a plain number (radians for angles); refuse dimensioned values."""
+        if t.boolean:
+            raise TemplateError(f"{where}: a comparison cannot be used as a number")
+        if t.unit.dimensionality:
+            raise UnitError(f"{where} needs a dimensionless argument, got {un.dims(t.unit)} "
+                            f"({un.pretty(t.unit)})")
+        return self._convert(t, self.dimensionless, where)
+
+    def _number(self, t: T, where: str) -> T:
+        if t.boolean:
+            raise TemplateError(f"{where}: a comparison cannot be used as a number")
+        return t
+
+    def _t(self, node: ex.Node, scope: dict[str, pint.Unit]) -> T:
+        if isinstance(node, ex.Number):
+            return TConst(self.dimensionless, value=node.value)
+        if isinstance(node, ex.Text):
+            return TText(self.dimensionless, value=node.value)
+        if isinstance(node, ex.Name):
+            return self._name(node.id, scope)
+        if isinstance(node, ex.Unary):
+            child = self._t(node.operand, scope)
+            if node.op == "not":
+                if not child.boolean:
+                    raise TemplateError("'not' needs a comparison")
+                return TUnary(child.unit, op="not", child=child, boolean=True)
+            self._number(child, f"'{node.op}'")
+            if node.op == "+":
+                return child
+            if isinstance(child, TConst):
+                return TConst(child.unit, value=-child.value)
+            return TUnary(child.unit, op="-", child=child)
+        if isinstance(node, ex.Binary):
+            return self._binary(node, scope)
+        if isinstance(node, ex.Compare):
+            return self._compare(node, scope)
+        if isinstance(node, ex.Logic):
+            vals = tuple(self._t(v, scope) for v in node.values)
+            if not all(v.boolean for v in vals):
+                raise TemplateError(f"'{node.op}' joins comparisons, not numbers")
+            return TLogic(self.dimensionless, op=node.op, values=vals, boolean=True)
+        if isinstance(node, ex.Call):
+            return self._call(node, scope)
+        raise TemplateError(f"unsupported expression {node!r}")  # pragma: no cover
+
+    def _name(self, name: str, scope) -> T:
+        if name in scope:
+            return TParam(scope[name], name=name)
+        if name in self.spec.inputs:
+            u = self.input_units[name]
+            if u is None:
+                return TRef(self.dimensionless, name=name, kind="choice")
+            return TRef(u, name=name, kind="input")
+        if name in self.spec.definitions:
+            d = self.spec.definitions[name]
+            if d.is_function:
+                raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}: "
+                                    f"write {name}({', '.join(d.params)})")
+            return TRef(self.scalar(name).unit, name=name, kind="definition")
+        if name == "pi":
+            return TRef(self.dimensionless, name="pi", kind="builtin")
+        if name in self.spec.arguments:
+            raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
+        if name in ex.FUNCTIONS or name in self.spec.blocks:
+            raise TemplateError(f"'{name}' is a function: call it as {name}(...)")
+        raise TemplateError(f"unknown name '{name}'")
+
+    def _binary(self, node: ex.Binary, scope) -> T:
+        left = self._number(self._t(node.left, scope), f"'{node.op}'")
+        right = self._number(self._t(node.right, scope), f"'{node.op}'")
+        op = node.op
+        if isinstance(left, TText) or isinstance(right, TText):
+            raise TemplateError("text can only be compared with a choice input (==)")
+        if op in "+-":
+            if right.unit.dimensionality != left.unit.dimensionality:
+                self._mismatch(op, left, right)
+            right = self._convert(right, left.unit, "sum")
+            if isinstance(left, TConst) and isinstance(right, TConst):
+                v = left.value + right.value if op == "+" else left.value - right.value
+                return TConst(left.unit, value=v)
+            return TBinary(left.unit, op=op, left=left, right=right)
+        if op == "*":
+            if isinstance(left, TConst) and isinstance(right, TConst):
+                return TConst(left.unit * right.unit, value=left.value * right.value)
+            return TBinary(left.unit * right.unit, op=op, left=left, right=right)
+        if op == "/":
+            if isinstance(left, TConst) and isinstance(right, TConst) and right.value != 0:
+                return TConst(left.unit / right.unit, value=left.value / right.value)
+            return TBinary(left.unit / right.unit, op=op, left=left, right=right)
+        # power
+        if not right.unit.dimensionless or right.unit.dimensionality:
+            raise UnitError(f"an exponent must be dimensionless, got {un.dims(right.unit)}")
+        right = self._convert(right, self.dimensionless, "exponent")
+        if left.unit.dimensionality:
+            if not isinstance(right, TConst):
+                raise UnitError(
+                    f"{un.dims(left.unit)} raised to a variable power has no fixed unit; "
+                    "make the base dimensionless (e.g. divide by a reference value)"
+                )
+            n = right.value
+            if abs(n) > 1000:
+                raise UnitError(f"exponent {n:g} of a dimensioned value is out of range")
+            return TBinary(left.unit**n, op="^", left=left, right=right)
+        left = self._convert(left, self.dimensionless, "base of a power")
+        if isinstance(left, TConst) and isinstance(right, TConst):
+            try:
+                v = math.pow(left.value, right.value)
+            except (OverflowError, ValueError):
+                raise TemplateError(
+                    f"{left.value:g}^{right.value:g} is not a finite number") from None
+            return TConst(self.dimensionless, value=v)
+        return TBinary(self.dimensionless, op="^", left=left, right=right)
+
+    def _mismatch(self, op, left, right):
+        verb = "add" if op == "+" else "subtract"
+        raise UnitError(
+            f"cannot {verb} {un.dims(right.unit)} ({un.pretty(right.unit)}) "
+            f"{'to' if op == '+' else 'from'} {un.dims(left.unit)} ({un.pretty(left.unit)})"
+        )
+
+    def _compare(self, node: ex.Compare, scope) -> T:
+        ops = list(node.operands)
+        typed = [self._t(o, scope) for o in ops]
+        texts = [isinstance(t, TText) for t in typed]
+        if any(texts):
+            if len(typed) != 2 or node.ops[0] not in ("==", "!=") or sum(texts) != 1:
+                raise TemplateError("text can only be compared with a choice input: law == \"stepped\"")
+            other = typed[1] if texts[0] else typed[0]
+            if not (isinstance(other, TRef) and other.kind == "choice"):
+                raise TemplateError("text can only be compared with a choice input")
+            opts = self.spec.inputs[other.name].options
+            text = (typed[0] if texts[0] else typed[1]).value
+            if text not in opts:
+                raise TemplateError(f"{text!r} is not one of the options of '{other.name}': "
+                                    f"{', '.join(opts)}")
+            return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
+        first = typed[0]
+        out = [first]
+        for t in typed[1:]:
+            self._number(t, "comparison")
+            if t.unit.dimensionality != first.unit.dimensionality:
+                raise UnitError(f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
+                                f"with {un.dims(t.unit)} ({un.pretty(t.unit)})")
+            out.append(self._convert(t, first.unit, "comparison"))
+        return TCompare(self.dimensionless, ops=node.ops, operands=tuple(out), boolean=True)
+
+    def _call(self, node: ex.Call, scope) -> T:
+        name = node.func
+        args = [self._t(a, scope) for a in node.args]
+        for a in args:
+            self._number(a, f"argument of {name}()")
+        if name in self.spec.definitions:
+            d = self.spec.definitions[name]
+            if not d.is_function:
+                raise TemplateError(f"'{name}' is not a function; write {name} without brackets")
+            if len(args) != len(d.params):
+                raise TemplateError(f"{name}() takes {len(d.params)} argument(s) "
+                                    f"({', '.join(d.params)}), got {len(args)}")
+            f = self.function(name)
+            conv = tuple(
+                self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
+                for i, (a, u) in enumerate(zip(args, f.param_units))
+            )
+            return TCall(f.unit, name=name, args=conv)
+        if name in self.spec.blocks:
+            from . import blocks
+
+            blk = blocks.get(self.spec.blocks[name], "function")
+            if len(args) != len(blk.args):
+                raise TemplateError(f"{name}() takes {len(blk.args)} argument(s) "
+                                    f"({', '.join(blk.args)}), got {len(args)}")
+            conv = tuple(
+                self._convert(a, un.unit(u), f"argument '{p}' of {name}()")
+                for a, (p, u) in zip(args, blk.args.items())
+            )
+            return TBlock(un.unit(blk.returns), name=name, ref=blk.ref, args=conv)
+        if name not in ex.FUNCTIONS:
+            raise TemplateError(f"unknown function '{name}'")
+        want = ex.FUNCTIONS[name]
+        if want is not None and len(args) != want:
+            raise TemplateError(f"{name}() takes {want} argument(s), got {len(args)}")
+        if want is None and not args:
+            raise TemplateError(f"{name}() needs at least one argument")
+        dl = self.dimensionless
+        if name in _ANGLE_IN:
+            return TFunc(dl, func=name, args=(self._plain(args[0], f"{name}()"),))
+        if name in _INVERSE:
+            return TFunc(dl, func=name, args=(self._plain(args[0], f"{name}()"),))
+        if name == "atan2":
+            y, x = args
+            x = self._convert(x, y.unit, "atan2(y, x): x and y")
+            return TFunc(dl, func=name, args=(y, x))
+        if name == "sqrt":
+            return TFunc(args[0].unit**0.5, func=name, args=(args[0],))
+        if name in ("abs", "floor", "ceil"):
+            return TFunc(args[0].unit, func=name, args=(args[0],))
+        if name == "sign":
+            return TFunc(dl, func=name, args=(args[0],))
+        if name in ("min", "max"):
+            first = args[0]
+            rest = [self._convert(a, first.unit, f"{name}() arguments") for a in args[1:]]
+            return TFunc(first.unit, func=name, args=(first, *rest))
+        raise TemplateError(f"unknown function '{name}'")  # pragma: no cover
+
+    def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
+        where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
+        return self._convert(a, unit, where)
+
+
+def _with_unit(t: T, unit: pint.Unit) -> T:
+    """Same node, relabelled with an equal unit (factor exactly 1)."""
+    if isinstance(t, TConst):
+        return TConst(unit, value=t.value)
+    return TScale(unit, child=t, factor=1.0)
+
+
+def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
+    """Names of inputs/definitions/blocks an expression needs, transitively."""
+    out: set[str] = set()
+    todo = [n for n in ex.names(node) if n not in scope]
+    while todo:
+        n = todo.pop()
+        if n in out:
+            continue
+        out.add(n)
+        d = spec.definitions.get(n)
+        if d is None:
+            continue
+        bodies = [d.body] if d.body is not None else [
+            x for b in d.branches for x in (b.value, b.condition) if x is not None]
+        for body in bodies:
+            todo.extend(m for m in ex.names(body) if m not in d.params)
+    return out

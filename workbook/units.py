@@ -1,0 +1,102 @@
+"""The one shared pint registry, with the project's definition files loaded."""
+
+from __future__ import annotations
+
+import functools
+import math
+from importlib import resources
+
+import pint
+
+from .errors import InputError
+
+
+@functools.lru_cache(maxsize=None)
+def registry() -> pint.UnitRegistry:
+    """Return the shared registry (created on first use: it costs ~0.1 s)."""
+    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+    for entry in sorted(resources.files("workbook.unitdefs").iterdir(), key=lambda p: p.name):
+        if entry.name.endswith(".txt"):
+            with resources.as_file(entry) as path:
+                ureg.load_definitions(str(path))
+    pint.set_application_registry(ureg)
+    return ureg
+
+
+def quantity(value, unit: str | None = None, *, what: str = "value") -> pint.Quantity:
+    """Parse ``"20 mm"``, a number, or a pint quantity into a Quantity of the shared registry.
+
+    ``unit`` is the unit a plain number is taken in.
+    """
+    ureg = registry()
+    if isinstance(value, pint.Quantity):
+        return ureg.Quantity(value.magnitude, str(value.units))
+    if isinstance(value, bool):
+        raise InputError(f"{what}: expected a number with a unit, got {value!r}")
+    if isinstance(value, (int, float)):
+        return ureg.Quantity(float(value), unit or "")
+    if isinstance(value, str):
+        text = value.strip()
+        if not text:
+            raise InputError(f"{what}: empty value")
+        try:
+            q = ureg.Quantity(text)
+        except Exception as exc:  # pint raises many types for unparsable text
+            raise InputError(f"{what}: cannot read {value!r} as a quantity ({exc})") from None
+        if not isinstance(q, pint.Quantity):
+            q = ureg.Quantity(float(q), "")
+        if unit and q.dimensionless and str(q.units) == "dimensionless":
+            q = ureg.Quantity(q.magnitude, unit)
+        return q
+    try:
+        import numpy as np
+
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{what}: cannot read {value!r} as a quantity") from None
+    return ureg.Quantity(arr, unit or "")
+
+
+def unit(text: str, *, what: str = "unit") -> pint.Unit:
+    """Parse a unit string ('' or '1' for dimensionless)."""
+    ureg = registry()
+    text = (text or "").strip()
+    if text in ("", "1", "-"):
+        return ureg.dimensionless
+    try:
+        q = ureg.Quantity(1, text)
+        return q.units
+    except Exception as exc:
+        raise InputError(f"{what}: unknown unit {text!r} ({exc})") from None
+
+
+def factor(src: pint.Unit, dst: pint.Unit) -> float:
+    """Multiplier that converts a magnitude in ``src`` into ``dst`` (raises on mismatch)."""
+    if src == dst:
+        return 1.0
+    return float(registry().Quantity(1.0, src).to(dst).magnitude)
+
+
+def dims(u: pint.Unit) -> str:
+    """Human-readable dimensionality, e.g. '[length]' or 'dimensionless'."""
+    d = u.dimensionality
+    return "dimensionless" if not d else str(d)
+
+
+def is_angle(u: pint.Unit) -> bool:
+    """True for units that pint treats as angles (radian, degree, turn...)."""
+    ureg = registry()
+    return u.dimensionless and (u == ureg.radian or "radian" in str(u) or "degree" in str(u)
+                                or "revolution" in str(u) or "turn" in str(u))
+
+
+def pretty(u: pint.Unit) -> str:
+    """Compact unit text for headers: 'mm', 'm/s', 'm/s^2'."""
+    if u == registry().dimensionless:
+        return ""
+    text = f"{u:~C}"
+    return text.replace("**", "^").replace("°", "deg")
+
+
+def close(a: float, b: float, rel: float = 1e-12) -> bool:
+    return math.isclose(a, b, rel_tol=rel, abs_tol=0.0)
