@@ -1,0 +1,163 @@
+"""Command line: ``workbook list | run | check | bench``.
+
+Exit status: 0 success, 1 printed values not reproduced (check), 2 bad input
+(template, units, values, paths). No traceback for user mistakes unless --debug.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="workbook", description="Unit-checked engineering "
+                                "worksheets that write live Excel workbooks.")
+    p.add_argument("--debug", action="store_true", help="show Python tracebacks")
+    p.add_argument("--version", action="store_true", help="print the version")
+    sub = p.add_subparsers(dest="command")
+    sub.add_parser("list", help="list the installed templates")
+
+    def sheet_args(sp):
+        sp.add_argument("name", help="template name (see 'workbook list') or path to a .toml file")
+        sp.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help='override an input, e.g. --set R3="40 mm" (repeatable)')
+
+    run = sub.add_parser("run", help="compute a worksheet and write its Excel workbook")
+    sheet_args(run)
+    run.add_argument("--out", help="output .xlsx (default reports/NAME.xlsx)")
+    run.add_argument("--force", action="store_true", help="overwrite a file that is not an xlsx")
+    run.add_argument("--csv", metavar="TABLE", action="append", default=[],
+                     help="also write table TABLE as CSV beside the workbook (repeatable)")
+    chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
+    sheet_args(chk)
+    bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
+    sheet_args(bench)
+    bench.add_argument("--quick", action="store_true", help="a small, fast version")
+    return p
+
+
+def parse_sets(items: list[str]) -> dict[str, str]:
+    from .errors import InputError
+
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise InputError(f"--set {item!r}: write NAME=VALUE, e.g. --set R3=\"40 mm\"")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def load_sheet(args):
+    import workbook
+
+    sheet = workbook.load(args.name)
+    sets = parse_sets(args.set)
+    if sets:
+        sheet = sheet.with_inputs(**sets)
+    return sheet
+
+
+def _command_line(args) -> str:
+    parts = ["workbook", "run", args.name]
+    for item in args.set:
+        name, _, value = item.partition("=")
+        parts.append(f'--set {name}="{value}"' if " " in value else f"--set {item}")
+    return " ".join(parts)
+
+
+def cmd_list(args) -> int:
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    import workbook
+
+    for name, path in workbook.list_templates().items():
+        try:
+            title = tomllib.loads(path.read_text(encoding="utf-8")).get("sheet", {}).get("title", "")
+        except Exception:  # a broken template still gets listed
+            title = "(cannot read)"
+        print(f"{name}\t{title}")
+    return EXIT_OK
+
+
+def cmd_run(args) -> int:
+    sheet = load_sheet(args)
+    out = Path(args.out) if args.out else Path("reports") / f"{sheet.name}.xlsx"
+    if not args.out:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    report = sheet.check()
+    sheet.write_xlsx(out, force=args.force, command=_command_line(args), report=report)
+    for table in args.csv:
+        from .atomic import replacing
+
+        path = out.with_name(f"{out.stem}.{table}.csv")
+        with replacing(path) as tmp:
+            sheet.table(table).to_csv(tmp, index=False)
+        print(f"wrote {path}")
+    n_checked = sum(r.role == "check" for r in report.rows)
+    n_ok = sum(r.role == "check" and r.verdict in ("pass", "misprint") for r in report.rows)
+    summary = f"{len(sheet.spec.tables)} tables, {len(sheet.spec.charts)} charts"
+    if n_checked:
+        summary += f", {n_ok} of {n_checked} printed values reproduced"
+    print(f"wrote {out}: {summary}")
+    return EXIT_OK
+
+
+def cmd_check(args) -> int:
+    sheet = load_sheet(args)
+    report = sheet.check()
+    print(report.text())
+    return EXIT_OK if report.ok else EXIT_CHECK
+
+
+def cmd_bench(args) -> int:
+    from . import blocks
+    from .errors import InputError
+
+    sheet = load_sheet(args)
+    ref = sheet.spec.meta.get("bench")
+    if not ref:
+        raise InputError(f"{sheet.name} declares no benchmark ([sheet] bench = \"module.func\")")
+    import pandas as pd
+
+    df = blocks.get(ref, "bench").func(sheet, quick=args.quick)
+    with pd.option_context("display.max_rows", 500, "display.width", 200,
+                           "display.max_columns", 50):
+        print(df.to_string(index=False))
+    return EXIT_OK
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    if args.version:
+        from . import __version__
+
+        print(__version__)
+        return EXIT_OK
+    if not args.command:
+        _parser().print_help()
+        return EXIT_INPUT
+    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}[args.command]
+    from .errors import WorkbookError
+
+    try:
+        return handler(args)
+    except WorkbookError as err:
+        if args.debug:
+            raise
+        print(f"workbook: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("workbook: interrupted; no output file was changed", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,507 @@
+"""Write a Sheet as an Excel workbook: live formulas with cached values, native charts.
+
+Layout: Inputs (editable cells with defined names), Definitions (scalar formulas),
+one sheet per table group (range tables as live formulas, block tables as values),
+Charts, Checks (printed vs computed, findings), About.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from . import expr as ex
+from . import typecheck as tc
+from . import units as un
+from .atomic import check_target, replacing
+from .errors import LimitError, WorkbookError
+from .excel import ExcelPrinter, NotLive, excel_name
+from .sheet import header
+
+MAX_ROWS = 1_048_576
+ROW_TOKEN = "\x00"
+
+
+@dataclass
+class ColumnCells:
+    sheet: str
+    col: int
+    first_row: int  # 0-based
+    last_row: int
+    title: str
+
+
+def _col_letter(col: int) -> str:
+    letters = ""
+    col += 1
+    while col:
+        col, rem = divmod(col - 1, 26)
+        letters = chr(65 + rem) + letters
+    return letters
+
+
+def _ref(sheet: str, col: int, row: int, absolute: bool = True) -> str:
+    d = "$" if absolute else ""
+    return f"'{sheet}'!{d}{_col_letter(col)}{d}{row + 1}"
+
+
+def _range_ref(c: ColumnCells) -> list:
+    return [c.sheet, c.first_row, c.col, c.last_row, c.col]
+
+
+class WorkbookWriter:
+    def __init__(self, sheet, path: Path, command: str | None = None):
+        import xlsxwriter
+
+        self.sheet = sheet
+        self.path = path
+        self.command = command or f"workbook run {sheet.name}"
+        self.wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
+        self.wb.set_properties({"title": sheet.spec.title, "comments": sheet.spec.source,
+                                "author": "workbook " + __version__})
+        self.printer = ExcelPrinter(sheet.typer)
+        self.fmt = self._formats()
+        self.columns: dict[tuple, ColumnCells] = {}
+        self.block_columns: dict[tuple[str, str], ColumnCells] = {}
+        self.sheets: dict[str, object] = {}
+        self.rows: dict[str, int] = {}
+        self.not_live: list[str] = []
+        self.formula_cells = 0
+
+    def _formats(self):
+        add = self.wb.add_format
+        return {
+            "title": add({"bold": True, "font_size": 13}),
+            "header": add({"bold": True, "bottom": 1, "text_wrap": True, "valign": "top"}),
+            "input": add({"bg_color": "#FFF2CC", "font_color": "#0000FF", "border": 1,
+                          "num_format": "General"}),
+            "value": add({"num_format": "0.000###"}),
+            "number": add({"num_format": "General"}),
+            "note": add({"italic": True, "font_color": "#595959"}),
+            "pct": add({"num_format": "0.000%"}),
+            "sci": add({"num_format": "0.00E+00"}),
+            "pass": add({"font_color": "#006100", "bg_color": "#C6EFCE"}),
+            "fail": add({"font_color": "#9C0006", "bg_color": "#FFC7CE"}),
+            "wrap": add({"text_wrap": True, "valign": "top"}),
+        }
+
+    def ws(self, name: str):
+        if name not in self.sheets:
+            self.sheets[name] = self.wb.add_worksheet(name[:31])
+            self.rows[name] = 0
+        return self.sheets[name]
+
+    # -- inputs and definitions -------------------------------------------------------
+    def write_inputs(self, needed: set[str]) -> None:
+        ws = self.ws("Inputs")
+        ws.write_row(0, 0, ["Name", "Value", "Unit", "Note"], self.fmt["header"])
+        ws.set_column(0, 0, 12)
+        ws.set_column(1, 1, 14)
+        ws.set_column(2, 2, 10)
+        ws.set_column(3, 3, 70)
+        row = 1
+        for name, spec in self.sheet.spec.inputs.items():
+            value = self.sheet.values[name]
+            ws.write_string(row, 0, name)
+            if spec.options:
+                ws.write_string(row, 1, value, self.fmt["input"])
+                ws.data_validation(row, 1, row, 1, {"validate": "list", "source": list(spec.options)})
+                unit_text = ""
+            else:
+                ws.write_number(row, 1, float(value.magnitude), self.fmt["input"])
+                unit_text = spec.label or un.pretty(spec.unit)
+            ws.write_string(row, 2, unit_text)
+            note = spec.note
+            if name not in needed:
+                note = (note + "; " if note else "") + "not used by any output of this workbook"
+            ws.write_string(row, 3, note)
+            xname = excel_name(name)
+            self.wb.define_name(xname, f"=Inputs!$B${row + 1}")
+            if xname != name:
+                ws.write_comment(row, 0, f"Defined name {xname} (Excel reads '{name}' as a cell "
+                                 "reference or function)")
+            row += 1
+        ws.write_string(row + 1, 0, "Yellow cells are inputs: change them and the workbook "
+                        "recalculates.", self.fmt["note"])
+
+    def write_definitions(self, needed: set[str]) -> None:
+        defs = [d for n, d in self.sheet.spec.definitions.items()
+                if not d.is_function and n in needed]
+        if not defs:
+            return
+        ws = self.ws("Definitions")
+        ws.write_row(0, 0, ["Name", "Value", "Unit", "Formula (worksheet)", "Note"],
+                     self.fmt["header"])
+        ws.set_column(0, 0, 12)
+        ws.set_column(1, 1, 16)
+        ws.set_column(3, 3, 50)
+        ws.set_column(4, 4, 50)
+        for row, d in enumerate(defs, start=1):
+            t = self.sheet.typer.scalar(d.name)
+            value = self.sheet._scalar_value(d.name, "definition")
+            ws.write_string(row, 0, d.name)
+            self._write_cell(ws, row, 1, t, {}, float(value), self.fmt["number"], d.name)
+            ws.write_string(row, 2, un.pretty(t.unit))
+            ws.write_string(row, 3, d.text)
+            ws.write_string(row, 4, d.note)
+            self.wb.define_name(excel_name(d.name), f"=Definitions!$B${row + 1}")
+
+    def _write_cell(self, ws, row, col, t: tc.T, subst, value: float, fmt, what: str) -> bool:
+        try:
+            formula = self.printer.formula(t, subst)
+        except NotLive as why:
+            ws.write_number(row, col, value, fmt)
+            ws.write_comment(row, col, f"A value, not a formula: {why}")
+            self.not_live.append(what)
+            return False
+        ws.write_formula(row, col, formula, fmt, value)
+        self.formula_cells += 1
+        return True
+
+    # -- range tables -------------------------------------------------------------------
+    def write_range_table(self, spec) -> None:
+        data = self.sheet.table_data(spec.name)
+        n = len(data.columns[0].values)
+        ws = self.ws(spec.sheet)
+        start = self.rows[spec.sheet]
+        if start + n + 3 > MAX_ROWS:
+            raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds "
+                             f"{MAX_ROWS:,}. Write it as CSV instead (workbook run --csv)")
+        ws.write_string(start, 0, spec.title, self.fmt["title"])
+        heads = [header(c.title, c.unit) for c in data.columns]
+        ws.write_row(start + 1, 0, heads, self.fmt["header"])
+        first = start + 2
+        var_col = data.columns[0].values
+        for i in range(n):
+            ws.write_number(first + i, 0, float(var_col[i]), self.fmt["number"])
+        var_ref = f"$A${ROW_TOKEN}"
+        for j, col in enumerate(data.columns[1:], start=1):
+            self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n)
+            self.columns[(spec.range.text, spec.sheet, col.text, str(col.unit))] = ColumnCells(
+                spec.sheet, j, first, first + n - 1, col.title)
+        self.columns[(spec.range.text, spec.sheet, data.var, "var")] = ColumnCells(
+            spec.sheet, 0, first, first + n - 1, data.var)
+        ws.set_column(0, len(data.columns) - 1, 13)
+        self.rows[spec.sheet] = first + n + 2
+
+    def _write_column(self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n):
+        fmt = self.fmt["value"]
+        try:
+            template = self.printer.formula(col.typed, {var: var_ref})
+        except NotLive as why:
+            for i in range(n):
+                ws.write_number(first + i, j, float(col.values[i]), fmt)
+            ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
+            self.not_live.append(f"{table}.{col.text}")
+            return
+        pieces = template.split(ROW_TOKEN)
+        write = ws.write_formula
+        values = col.values.tolist()
+        for i in range(n):
+            row = first + i
+            write(row, j, str(row + 1).join(pieces), fmt, values[i])
+        self.formula_cells += n
+
+    # -- block tables --------------------------------------------------------------------
+    def write_block_table(self, spec) -> None:
+        df = self.sheet.block_table(spec.block)
+        ws = self.ws(spec.sheet)
+        start = self.rows[spec.sheet]
+        n = len(df)
+        if start + n + 3 > MAX_ROWS:
+            raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}")
+        ws.write_string(start, 0, spec.title, self.fmt["title"])
+        ws.write_row(start + 1, 0, [str(c) for c in df.columns], self.fmt["header"])
+        ws.write_comment(start + 1, 0, f"Values computed by the solver block {spec.block}; "
+                         "not live formulas (rerun workbook to update).")
+        first = start + 2
+        for j, name in enumerate(df.columns):
+            col = df[name].tolist()
+            for i, v in enumerate(col):
+                self._write_value(ws, first + i, j, v)
+            self.block_columns[(spec.name, str(name))] = ColumnCells(
+                spec.sheet, j, first, first + n - 1, str(name))
+        ws.set_column(0, max(0, len(df.columns) - 1), 14)
+        self.rows[spec.sheet] = first + n + 2
+
+    def _write_value(self, ws, row, col, v):
+        if v is None:
+            return
+        if isinstance(v, (bool, np.bool_)):
+            ws.write_boolean(row, col, bool(v))
+        elif isinstance(v, (int, float, np.integer, np.floating)):
+            v = float(v)
+            if math.isfinite(v):
+                ws.write_number(row, col, v, self.fmt["number"])
+            else:
+                ws.write_string(row, col, str(v))
+        else:
+            ws.write_string(row, col, str(v))
+
+    # -- charts ---------------------------------------------------------------------------
+    def chart_series_cells(self, chart, s) -> tuple[ColumnCells, ColumnCells]:
+        if s.table is not None:
+            try:
+                return (self.block_columns[(s.table, s.x_column)],
+                        self.block_columns[(s.table, s.y_column)])
+            except KeyError:
+                raise WorkbookError(f"chart {chart.name}: table '{s.table}' has no column "
+                                    f"'{s.x_column}' or '{s.y_column}'") from None
+        rng = s.range or chart.range
+        target = "Chart data"
+        for key, cells in self.columns.items():
+            if key[0] == rng.text and key[2] == s.y.text and (
+                    s.y.unit is None or key[3] == str(s.y.unit)):
+                xcells = self.columns[(rng.text, key[1], rng.var, "var")]
+                return xcells, cells
+        # not in any table: write a chart data block
+        from .template import TableSpec
+
+        name = f"{chart.name}_{len(self.columns)}"
+        spec = TableSpec(name, f"Data of {chart.title}: {s.name}", rng, [s.y], target)
+        self.sheet.spec.tables.append(spec)
+        try:
+            self.write_range_table(spec)
+        finally:
+            self.sheet.spec.tables.remove(spec)
+        return (self.columns[(rng.text, target, rng.var, "var")],
+                self.columns[(rng.text, target, s.y.text, str(
+                    self.sheet._typed_column(s.y, rng.var, chart.name).unit))])
+
+    def write_charts(self) -> None:
+        if not self.sheet.spec.charts:
+            return
+        # Resolve (and if needed write) every series' data before the Charts sheet exists,
+        # so the data sheets come before it in the workbook.
+        cells = {(chart.name, i): self.chart_series_cells(chart, s)
+                 for chart in self.sheet.spec.charts for i, s in enumerate(chart.series)}
+        ws = self.ws("Charts")
+        row = 0
+        for chart in self.sheet.spec.charts:
+            c = self.wb.add_chart({"type": "scatter", "subtype": "straight"})
+            for i, s in enumerate(chart.series):
+                xcells, ycells = cells[(chart.name, i)]
+                line = {"width": 2.0}
+                if s.line == "dash":
+                    line["dash_type"] = "dash"
+                elif s.line == "dot":
+                    line["dash_type"] = "round_dot"
+                elif s.line == "none":
+                    line = {"none": True}
+                opts = {"name": s.name, "categories": _range_ref(xcells),
+                        "values": _range_ref(ycells), "line": line,
+                        "marker": {"type": "circle", "size": 4} if s.marker else {"type": "none"}}
+                if s.axis == "secondary":
+                    opts["y2_axis"] = True
+                c.add_series(opts)
+            c.set_title({"name": chart.title})
+            xaxis = {"name": chart.x_title or (chart.x.title if chart.x else ""),
+                     "label_position": "low",
+                     "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}}}
+            yaxis = {"name": chart.y_title,
+                     "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}}}
+            if chart.log_x:
+                xaxis["log_base"] = 10
+            if chart.log_y:
+                yaxis["log_base"] = 10
+            size = {"width": 760, "height": 430}
+            if chart.equal_axes:
+                lo, hi = self._common_span(chart)
+                for axis in (xaxis, yaxis):
+                    axis.update({"min": lo, "max": hi})
+                size = {"width": 620, "height": 620}
+                c.set_plotarea({"layout": {"x": 0.12, "y": 0.1, "width": 0.76, "height": 0.76}})
+            c.set_x_axis(xaxis)
+            c.set_y_axis(yaxis)
+            if any(s.axis == "secondary" for s in chart.series):
+                c.set_y2_axis({"name": chart.y2_title})
+            c.set_legend({"position": "bottom"})
+            c.set_size(size)
+            ws.insert_chart(row, 0, c)
+            row += int(size["height"] / 20) + 2
+
+    def _common_span(self, chart) -> tuple[float, float]:
+        values = []
+        for s in chart.series:
+            if s.table is not None:
+                df = self.sheet.block_table_cached(s.table) if hasattr(
+                    self.sheet, "block_table_cached") else None
+                if df is not None:
+                    values += [df[s.x_column].to_numpy(), df[s.y_column].to_numpy()]
+            else:
+                rng = s.range or chart.range
+                x = self.sheet.range_values(rng, chart.name)
+                col = self.sheet.column(s.y, rng.var, x, chart.name)
+                xcol = self.sheet.column(s.x, rng.var, x, chart.name) if s.x else None
+                values += [col.values, xcol.values if xcol else x]
+        if not values:
+            return (0.0, 1.0)
+        allv = np.concatenate([np.asarray(v, dtype=float) for v in values])
+        lo, hi = float(np.nanmin(allv)), float(np.nanmax(allv))
+        pad = 0.05 * (hi - lo or 1.0)
+        return _nice(lo - pad, floor=True), _nice(hi + pad, floor=False)
+
+    # -- checks and about ------------------------------------------------------------------
+    def write_checks(self, report) -> None:
+        ws = self.ws("Checks")
+        heads = ["Source", "Name", "At", "Unit", "Printed", "Computed", "Abs error",
+                 "Rel error", "Tolerance", "Verdict", "Note"]
+        ws.write_row(0, 0, heads, self.fmt["header"])
+        ws.set_column(0, 0, 34)
+        ws.set_column(4, 8, 12)
+        ws.set_column(9, 9, 10)
+        ws.set_column(10, 10, 80)
+        row = 1
+        for r in report.rows:
+            ws.write_string(row, 0, r.source)
+            ws.write_string(row, 1, r.name)
+            if r.at is not None:
+                ws.write_number(row, 2, r.at)
+            ws.write_string(row, 3, r.unit)
+            ws.write_number(row, 4, r.printed, self.fmt["number"])
+            live = False
+            if r.computed is not None:
+                live = self._write_checked_value(ws, row, r)
+            E, F = f"E{row + 1}", f"F{row + 1}"
+            if r.computed is not None:
+                ws.write_formula(row, 6, f"=ABS({F}-{E})", self.fmt["sci"], abs(r.computed - r.printed))
+                if r.printed != 0:
+                    ws.write_formula(row, 7, f"=ABS({F}-{E})/ABS({E})", self.fmt["pct"],
+                                     abs(r.computed - r.printed) / abs(r.printed))
+                self.formula_cells += 1 + (r.printed != 0)
+            tol_text = (f"{r.tolerance:g}" if r.tolerance is not None else
+                        f"{100 * r.rel_tolerance:g}%" if r.rel_tolerance is not None else "")
+            ws.write_string(row, 8, tol_text)
+            fmt = self.fmt["pass"] if r.verdict in ("pass", "misprint", "info") else self.fmt["fail"]
+            if live and r.role == "check" and r.verdict in ("pass", "FAIL") and r.tolerance:
+                ws.write_formula(row, 9, f'=IF(G{row + 1}<={r.tolerance!r},"pass","FAIL")', fmt,
+                                 r.verdict)
+                self.formula_cells += 1
+            else:
+                ws.write_string(row, 9, r.verdict, fmt)
+            ws.write_string(row, 10, r.note)
+            row += 1
+        if report.findings:
+            row += 1
+            ws.write_string(row, 0, "Findings", self.fmt["title"])
+            ws.write_row(row + 1, 0, ["Topic", "What", "", "Unit", "Value", "", "", "", "",
+                                      "Verdict", "Note"], self.fmt["header"])
+            row += 2
+            for f in report.findings:
+                ws.write_string(row, 0, f.topic)
+                ws.write_string(row, 1, f.what, self.fmt["wrap"])
+                ws.write_string(row, 3, f.unit)
+                if f.value is not None and math.isfinite(f.value):
+                    ws.write_number(row, 4, float(f.value), self.fmt["number"])
+                fmt = self.fmt["fail"] if f.verdict in ("fail", "warning") else self.fmt["pass"]
+                ws.write_string(row, 9, f.verdict, fmt)
+                ws.write_string(row, 10, f.note, self.fmt["wrap"])
+                row += 1
+        if report.unused_inputs:
+            row += 1
+            ws.write_string(row, 0, "Inputs that no output uses: " + ", ".join(report.unused_inputs),
+                            self.fmt["note"])
+        ws.freeze_panes(1, 0)
+
+    def _write_checked_value(self, ws, row, r) -> bool:
+        """Computed value as a live formula: the function at the printed argument, in its unit."""
+        node = ex.Name(r.name)
+        if r.at is not None and r.argument:
+            node = ex.Call(r.name, (ex.Number(float(r.at)),))
+        try:
+            t = self.sheet.typer.expression(node, {}, f"check {r.name}")
+            t = self.sheet.typer._convert(t, un.unit(r.unit), "check")
+            self._write_cell_plain(ws, row, 5, t, r.computed)
+            return True
+        except NotLive:
+            ws.write_number(row, 5, r.computed, self.fmt["number"])
+            return False
+        except WorkbookError:
+            ws.write_number(row, 5, r.computed, self.fmt["number"])
+            return False
+
+    def _write_cell_plain(self, ws, row, col, t, value):
+        formula = self.printer.formula(t, {})
+        ws.write_formula(row, col, formula, self.fmt["number"], value)
+        self.formula_cells += 1
+
+    def write_about(self) -> None:
+        ws = self.ws("About")
+        spec = self.sheet.spec
+        ws.set_column(0, 0, 22)
+        ws.set_column(1, 1, 110)
+        rows = [
+            ("Worksheet", spec.title),
+            ("Template", spec.name),
+            ("Source", spec.source),
+            ("Description", spec.description),
+            ("Engine", f"workbook {__version__}"),
+            ("Regenerate with", self.command),
+            ("Live formulas", f"{self.formula_cells} cells recalculate when an input changes"),
+            ("Values, not formulas", ", ".join(sorted(set(self.not_live))) or "none"),
+            ("Units", "Every column header names its unit; input cells are in the unit beside them."),
+            ("Macros", "none"),
+        ]
+        rows += [(str(k), str(v)) for k, v in spec.meta.get("about", {}).items()]
+        ws.write_string(0, 0, spec.title, self.fmt["title"])
+        for i, (k, v) in enumerate(rows, start=2):
+            ws.write_string(i, 0, k, self.fmt["header"])
+            ws.write_string(i, 1, v, self.fmt["wrap"])
+
+
+def _nice(x: float, floor: bool) -> float:
+    if x == 0:
+        return 0.0
+    mag = 10 ** math.floor(math.log10(abs(x)))
+    step = mag / 2
+    return (math.floor if floor else math.ceil)(x / step) * step
+
+
+def needed_names(sheet) -> set[str]:
+    """Inputs and definitions the workbook's tables, charts and checks depend on."""
+    roots: list[ex.Node] = []
+    for t in sheet.spec.tables:
+        if t.range is not None:
+            roots += [sheet.column_node(c, t.range.var) for c in t.columns]
+            roots += [n for n in (t.range.first, t.range.second, t.range.last) if n is not None]
+    for c in sheet.spec.charts:
+        for s in c.series:
+            if s.table is None:
+                rng = s.range or c.range
+                roots.append(sheet.column_node(s.y, rng.var))
+    for p in sheet.spec.printed:
+        from .checks import read_printed
+
+        roots += [ex.Name(r.name) for r in read_printed(p)]
+    out: set[str] = set()
+    for node in roots:
+        out |= tc.dependencies(sheet.spec, node)
+    return out
+
+
+def write_workbook(sheet, path: Path, *, force: bool = False, command: str | None = None,
+                   report=None) -> Path:
+    """Write ``sheet`` to ``path`` atomically (the old file survives any failure)."""
+    path = Path(path)
+    check_target(path, force=force)
+    if report is None:
+        report = sheet.check()
+    with replacing(path) as tmp:
+        w = WorkbookWriter(sheet, tmp, command)
+        needed = needed_names(sheet)
+        w.write_inputs(needed)
+        w.write_definitions(needed)
+        for t in sheet.spec.tables:
+            if t.block:
+                w.write_block_table(t)
+            else:
+                w.write_range_table(t)
+        w.write_charts()
+        w.write_checks(report)
+        w.write_about()
+        w.wb.close()
+    return path
