@@ -43,8 +43,17 @@ def recalculate(xlsx: Path, out_dir: Path | None = None, timeout: float = 180) -
     src_dir = Path(tempfile.mkdtemp(prefix="recalc-src-"))
     src = src_dir / Path(xlsx).name
     shutil.copy(xlsx, src)
-    cmd = [exe, f"-env:UserInstallation={profile.as_uri()}", "--headless", "--norestore",
-           "--convert-to", "xlsx:Calc MS Excel 2007 XML", "--outdir", str(out_dir), str(src)]
+    cmd = [
+        exe,
+        f"-env:UserInstallation={profile.as_uri()}",
+        "--headless",
+        "--norestore",
+        "--convert-to",
+        "xlsx:Calc MS Excel 2007 XML",
+        "--outdir",
+        str(out_dir),
+        str(src),
+    ]
     try:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     finally:
@@ -77,5 +86,10 @@ def cell_values(xlsx: Path) -> dict[tuple[str, str], object]:
     import openpyxl
 
     wb = openpyxl.load_workbook(xlsx, data_only=True)
-    return {(ws.title, c.coordinate): c.value for ws in wb.worksheets for row in ws.iter_rows()
-            for c in row if c.value is not None}
+    return {
+        (ws.title, c.coordinate): c.value
+        for ws in wb.worksheets
+        for row in ws.iter_rows()
+        for c in row
+        if c.value is not None
+    }

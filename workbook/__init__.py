@@ -1,8 +1,8 @@
 """workbook: unit-checked worksheets that write live Excel workbooks.
 
-    >>> import workbook
-    >>> sheet = workbook.load("concave-cam")
-    >>> sheet.evaluate("h1", phi=[0, 5])          # doctest: +SKIP
+>>> import workbook
+>>> sheet = workbook.load("concave-cam")
+>>> sheet.evaluate("h1", phi=[0, 5])          # doctest: +SKIP
 """
 
 from __future__ import annotations

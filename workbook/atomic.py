@@ -14,7 +14,9 @@ from .errors import InputError
 def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None:
     """Refuse a directory, a missing parent folder, or an existing file of another kind."""
     if path.is_dir():
-        raise InputError(f"output path {path} is a directory; give a file name like {path}/report.{kind}")
+        raise InputError(
+            f"output path {path} is a directory; give a file name like {path}/report.{kind}"
+        )
     if not path.parent.exists():
         raise InputError(f"output folder {path.parent} does not exist")
     if path.exists() and not force and kind == "xlsx" and not _is_xlsx(path):

@@ -73,17 +73,23 @@ class Report:
             role = rows[0].role
             n_ok = sum(r.verdict in ("pass", "misprint", "info") for r in rows)
             lines.append("")
-            lines.append(f"{source} ({'information' if role == 'information' else 'checked'}): "
-                         f"{n_ok} of {len(rows)} reproduced")
-            lines.append(f"  {'name':<8}{'at':>8}  {'printed':>12}  {'computed':>12}  "
-                         f"{'abs err':>10}  {'rel err':>9}  verdict")
+            lines.append(
+                f"{source} ({'information' if role == 'information' else 'checked'}): "
+                f"{n_ok} of {len(rows)} reproduced"
+            )
+            lines.append(
+                f"  {'name':<8}{'at':>8}  {'printed':>12}  {'computed':>12}  "
+                f"{'abs err':>10}  {'rel err':>9}  verdict"
+            )
             for r in rows:
                 comp = "-" if r.computed is None else f"{r.computed:.6g}"
                 ae = "-" if r.abs_error is None else f"{r.abs_error:.2e}"
                 re_ = "-" if r.rel_error is None else f"{100 * r.rel_error:.3f}%"
                 at = "" if r.at is None else f"{r.at:g}"
-                lines.append(f"  {r.name:<8}{at:>8}  {r.printed:>12.6g}  {comp:>12}  {ae:>10}  "
-                             f"{re_:>9}  {r.verdict}{'  ' + r.note if r.note else ''}")
+                lines.append(
+                    f"  {r.name:<8}{at:>8}  {r.printed:>12.6g}  {comp:>12}  {ae:>10}  "
+                    f"{re_:>9}  {r.verdict}{'  ' + r.note if r.note else ''}"
+                )
         if self.findings:
             lines.append("")
             lines.append("findings:")
@@ -92,7 +98,9 @@ class Report:
                 if f.topic != topic:
                     topic = f.topic
                     lines.append(f"  [{topic}]")
-                val = "" if f.value is None else f" = {f.value:.6g}{(' ' + f.unit) if f.unit else ''}"
+                val = (
+                    "" if f.value is None else f" = {f.value:.6g}{(' ' + f.unit) if f.unit else ''}"
+                )
                 note = f" ({f.note})" if f.note else ""
                 lines.append(f"    {f.verdict:<7} {f.what}{val}{note}")
         if self.unused_inputs:
@@ -100,8 +108,14 @@ class Report:
             lines.append("inputs that no output uses: " + ", ".join(self.unused_inputs))
         lines.append("")
         bad = self.failed
-        lines.append("result: " + ("all printed values reproduced" if not bad else
-                                   f"{len(bad)} printed value(s) NOT reproduced"))
+        lines.append(
+            "result: "
+            + (
+                "all printed values reproduced"
+                if not bad
+                else f"{len(bad)} printed value(s) NOT reproduced"
+            )
+        )
         return "\n".join(lines)
 
 
@@ -147,20 +161,29 @@ def collect_findings(sheet) -> list[Finding]:
     for entry in sheet.spec.findings:
         ref = entry.get("block")
         if not isinstance(ref, str):
-            raise TemplateError("[[findings]] needs block = \"module.function\"", file=sheet.file)
+            raise TemplateError('[[findings]] needs block = "module.function"', file=sheet.file)
         try:
             out.extend(blocks.get(ref, "findings").func(sheet))
         except WorkbookError as err:
-            out.append(Finding(entry.get("title", ref), f"{ref} could not run", None, "",
-                               "fail", str(err)))
+            out.append(
+                Finding(entry.get("title", ref), f"{ref} could not run", None, "", "fail", str(err))
+            )
     return out
 
 
 def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
     misprint = next((m for m in spec.misprints if m.name == row.name and m.at == row.at), None)
-    base = dict(source=spec.title, role=spec.role, name=row.name, argument=spec.argument,
-                at=None if math.isnan(row.at) else row.at, unit=row.unit, printed=row.value,
-                tolerance=spec.tolerance, rel_tolerance=spec.rel_tolerance)
+    base = dict(
+        source=spec.title,
+        role=spec.role,
+        name=row.name,
+        argument=spec.argument,
+        at=None if math.isnan(row.at) else row.at,
+        unit=row.unit,
+        printed=row.value,
+        tolerance=spec.tolerance,
+        rel_tolerance=spec.rel_tolerance,
+    )
     try:
         if spec.argument and not math.isnan(row.at):
             q = sheet.evaluate(row.name, **{spec.argument: row.at})
@@ -171,17 +194,29 @@ def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
         return CheckRow(**base, computed=None, verdict="error", note=str(err))
     ok = within(computed, row.value, spec.tolerance, spec.rel_tolerance)
     if spec.role == "information":
-        return CheckRow(**base, computed=computed, verdict="info",
-                        note="" if ok else "outside the stated deviation")
+        return CheckRow(
+            **base,
+            computed=computed,
+            verdict="info",
+            note="" if ok else "outside the stated deviation",
+        )
     if misprint is not None:
         if ok:
-            return CheckRow(**base, computed=computed, verdict="pass",
-                            note="declared a misprint, but it is reproduced")
+            return CheckRow(
+                **base,
+                computed=computed,
+                verdict="pass",
+                note="declared a misprint, but it is reproduced",
+            )
         if misprint.corrected is not None and not within(
-                computed, misprint.corrected, spec.tolerance, spec.rel_tolerance):
-            return CheckRow(**base, computed=computed, verdict="FAIL",
-                            note=f"misprint, and the corrected {misprint.corrected:g} is not "
-                                 "reproduced either")
+            computed, misprint.corrected, spec.tolerance, spec.rel_tolerance
+        ):
+            return CheckRow(
+                **base,
+                computed=computed,
+                verdict="FAIL",
+                note=f"misprint, and the corrected {misprint.corrected:g} is not reproduced either",
+            )
         return CheckRow(**base, computed=computed, verdict="misprint", note=misprint.note)
     return CheckRow(**base, computed=computed, verdict="pass" if ok else "FAIL")
 

@@ -14,8 +14,10 @@ EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="workbook", description="Unit-checked engineering "
-                                "worksheets that write live Excel workbooks.")
+    p = argparse.ArgumentParser(
+        prog="workbook",
+        description="Unit-checked engineering worksheets that write live Excel workbooks.",
+    )
     p.add_argument("--debug", action="store_true", help="show Python tracebacks")
     p.add_argument("--version", action="store_true", help="print the version")
     sub = p.add_subparsers(dest="command")
@@ -23,15 +25,25 @@ def _parser() -> argparse.ArgumentParser:
 
     def sheet_args(sp):
         sp.add_argument("name", help="template name (see 'workbook list') or path to a .toml file")
-        sp.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help='override an input, e.g. --set R3="40 mm" (repeatable)')
+        sp.add_argument(
+            "--set",
+            action="append",
+            default=[],
+            metavar="NAME=VALUE",
+            help='override an input, e.g. --set R3="40 mm" (repeatable)',
+        )
 
     run = sub.add_parser("run", help="compute a worksheet and write its Excel workbook")
     sheet_args(run)
     run.add_argument("--out", help="output .xlsx (default reports/NAME.xlsx)")
     run.add_argument("--force", action="store_true", help="overwrite a file that is not an xlsx")
-    run.add_argument("--csv", metavar="TABLE", action="append", default=[],
-                     help="also write table TABLE as CSV beside the workbook (repeatable)")
+    run.add_argument(
+        "--csv",
+        metavar="TABLE",
+        action="append",
+        default=[],
+        help="also write table TABLE as CSV beside the workbook (repeatable)",
+    )
     chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
     sheet_args(chk)
     bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
@@ -47,7 +59,7 @@ def parse_sets(items: list[str]) -> dict[str, str]:
     for item in items:
         name, sep, value = item.partition("=")
         if not sep or not name.strip() or not value.strip():
-            raise InputError(f"--set {item!r}: write NAME=VALUE, e.g. --set R3=\"40 mm\"")
+            raise InputError(f'--set {item!r}: write NAME=VALUE, e.g. --set R3="40 mm"')
         out[name.strip()] = value.strip()
     return out
 
@@ -80,7 +92,9 @@ def cmd_list(args) -> int:
 
     for name, path in workbook.list_templates().items():
         try:
-            title = tomllib.loads(path.read_text(encoding="utf-8")).get("sheet", {}).get("title", "")
+            title = (
+                tomllib.loads(path.read_text(encoding="utf-8")).get("sheet", {}).get("title", "")
+            )
         except Exception:  # a broken template still gets listed
             title = "(cannot read)"
         print(f"{name}\t{title}")
@@ -124,12 +138,13 @@ def cmd_bench(args) -> int:
     sheet = load_sheet(args)
     ref = sheet.spec.meta.get("bench")
     if not ref:
-        raise InputError(f"{sheet.name} declares no benchmark ([sheet] bench = \"module.func\")")
+        raise InputError(f'{sheet.name} declares no benchmark ([sheet] bench = "module.func")')
     import pandas as pd
 
     df = blocks.get(ref, "bench").func(sheet, quick=args.quick)
-    with pd.option_context("display.max_rows", 500, "display.width", 200,
-                           "display.max_columns", 50):
+    with pd.option_context(
+        "display.max_rows", 500, "display.width", 200, "display.max_columns", 50
+    ):
         print(df.to_string(index=False))
     return EXIT_OK
 
@@ -144,7 +159,9 @@ def main(argv: list[str] | None = None) -> int:
     if not args.command:
         _parser().print_help()
         return EXIT_INPUT
-    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}[args.command]
+    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}[
+        args.command
+    ]
     from .errors import WorkbookError
 
     try:

@@ -26,7 +26,7 @@ class WorkbookError(Exception):
         self.line = line
         self.definition = definition
 
-    def located(self, *, file=None, line=None, definition=None) -> "WorkbookError":
+    def located(self, *, file=None, line=None, definition=None) -> WorkbookError:
         """Fill in location fields that are still unknown; returns self."""
         self.file = self.file or file
         self.line = self.line or line
@@ -40,7 +40,9 @@ class WorkbookError(Exception):
         if self.definition:
             where.append(f"in '{self.definition}'")
         prefix = ", ".join(where)
-        return f"{prefix}: {self.kind}: {self.message}" if prefix else f"{self.kind}: {self.message}"
+        return (
+            f"{prefix}: {self.kind}: {self.message}" if prefix else f"{self.kind}: {self.message}"
+        )
 
 
 class TemplateError(WorkbookError):

@@ -18,9 +18,41 @@ _R1C1 = re.compile(r"^([Rr][0-9]*)?([Cc][0-9]*)?$")
 # Excel function names that a defined name must not shadow (LibreOffice reads
 # some of them without brackets), plus the boolean literals.
 _RESERVED = {
-    "pi", "e", "true", "false", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt",
-    "exp", "ln", "log", "log10", "abs", "sign", "int", "min", "max", "if", "and", "or", "not",
-    "na", "sum", "rand", "row", "column", "index", "degrees", "radians", "power", "mod",
+    "pi",
+    "e",
+    "true",
+    "false",
+    "sin",
+    "cos",
+    "tan",
+    "asin",
+    "acos",
+    "atan",
+    "atan2",
+    "sqrt",
+    "exp",
+    "ln",
+    "log",
+    "log10",
+    "abs",
+    "sign",
+    "int",
+    "min",
+    "max",
+    "if",
+    "and",
+    "or",
+    "not",
+    "na",
+    "sum",
+    "rand",
+    "row",
+    "column",
+    "index",
+    "degrees",
+    "radians",
+    "power",
+    "mod",
 }
 
 
@@ -44,9 +76,23 @@ def number(value: float) -> str:
 
 
 _FUNCS = {
-    "sin": "SIN", "cos": "COS", "tan": "TAN", "asin": "ASIN", "acos": "ACOS", "atan": "ATAN",
-    "sinh": "SINH", "cosh": "COSH", "tanh": "TANH", "sqrt": "SQRT", "exp": "EXP", "ln": "LN",
-    "log10": "LOG10", "abs": "ABS", "sign": "SIGN", "min": "MIN", "max": "MAX",
+    "sin": "SIN",
+    "cos": "COS",
+    "tan": "TAN",
+    "asin": "ASIN",
+    "acos": "ACOS",
+    "atan": "ATAN",
+    "sinh": "SINH",
+    "cosh": "COSH",
+    "tanh": "TANH",
+    "sqrt": "SQRT",
+    "exp": "EXP",
+    "ln": "LN",
+    "log10": "LOG10",
+    "abs": "ABS",
+    "sign": "SIGN",
+    "min": "MIN",
+    "max": "MAX",
 }
 _CMP = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "=", "!=": "<>"}
 

@@ -74,10 +74,26 @@ class Call(Node):
 
 #: Built-in functions: name -> number of arguments (None: one or more).
 FUNCTIONS: dict[str, int | None] = {
-    "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1, "atan2": 2,
-    "sinh": 1, "cosh": 1, "tanh": 1,
-    "sqrt": 1, "exp": 1, "ln": 1, "log10": 1, "abs": 1,
-    "min": None, "max": None, "sign": 1, "floor": 1, "ceil": 1,
+    "sin": 1,
+    "cos": 1,
+    "tan": 1,
+    "asin": 1,
+    "acos": 1,
+    "atan": 1,
+    "atan2": 2,
+    "sinh": 1,
+    "cosh": 1,
+    "tanh": 1,
+    "sqrt": 1,
+    "exp": 1,
+    "ln": 1,
+    "log10": 1,
+    "abs": 1,
+    "min": None,
+    "max": None,
+    "sign": 1,
+    "floor": 1,
+    "ceil": 1,
 }
 
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "^"}
@@ -147,8 +163,7 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
     if isinstance(node, ast.BinOp):
         if type(node.op) not in _BINOPS:
             raise TemplateError(
-                f"{what}: operator {type(node.op).__name__} not allowed in {text!r} "
-                "(use + - * / ^)"
+                f"{what}: operator {type(node.op).__name__} not allowed in {text!r} (use + - * / ^)"
             )
         return Binary(
             _BINOPS[type(node.op)],
@@ -168,7 +183,9 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
         return Logic(op, tuple(_convert(v, text, what, d) for v in node.values))
     if isinstance(node, ast.Call):
         if not isinstance(node.func, ast.Name) or not is_identifier(node.func.id):
-            raise TemplateError(f"{what}: only plain function calls like f(x) are allowed in {text!r}")
+            raise TemplateError(
+                f"{what}: only plain function calls like f(x) are allowed in {text!r}"
+            )
         if node.keywords:
             raise TemplateError(f"{what}: keyword arguments are not allowed in {text!r}")
         if any(isinstance(a, ast.Starred) for a in node.args):

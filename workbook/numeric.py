@@ -7,7 +7,7 @@ float magnitudes (no pint in the hot path) and attaches the unit at the end.
 from __future__ import annotations
 
 import operator
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -18,21 +18,44 @@ Env = dict[str, object]
 Fn = Callable[[Env], object]
 
 _MATH = {
-    "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos,
-    "atan": np.arctan, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "sqrt": np.sqrt,
-    "exp": np.exp, "ln": np.log, "log10": np.log10, "abs": np.abs,
-    "sign": np.sign, "floor": np.floor, "ceil": np.ceil,
+    "sin": np.sin,
+    "cos": np.cos,
+    "tan": np.tan,
+    "asin": np.arcsin,
+    "acos": np.arccos,
+    "atan": np.arctan,
+    "sinh": np.sinh,
+    "cosh": np.cosh,
+    "tanh": np.tanh,
+    "sqrt": np.sqrt,
+    "exp": np.exp,
+    "ln": np.log,
+    "log10": np.log10,
+    "abs": np.abs,
+    "sign": np.sign,
+    "floor": np.floor,
+    "ceil": np.ceil,
 }
-_CMP = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge,
-        "==": operator.eq, "!=": operator.ne}
+_CMP = {
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "==": operator.eq,
+    "!=": operator.ne,
+}
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}
 
 
 class Evaluator:
     """Compiles typed trees of one sheet; scalar values are memoised per sheet."""
 
-    def __init__(self, typer: tc.Typer, scalar_value: Callable[[str, str], object],
-                 describe_args: Callable[[str, tuple, dict], str]):
+    def __init__(
+        self,
+        typer: tc.Typer,
+        scalar_value: Callable[[str, str], object],
+        describe_args: Callable[[str, tuple, dict], str],
+    ):
         self.typer = typer
         self.scalar_value = scalar_value  # (name, kind) -> magnitude in the ref's unit
         self.describe_args = describe_args
@@ -42,7 +65,9 @@ class Evaluator:
         """Compiled user function: env of its parameters -> magnitude in its unit."""
         if name not in self._functions:
             f = self.typer.function(name)
-            self._functions[name] = _checked(name, f.params, self.compile(f.body), self.describe_args)
+            self._functions[name] = _checked(
+                name, f.params, self.compile(f.body), self.describe_args
+            )
         return self._functions[name]
 
     def compile(self, t: tc.T) -> Fn:
@@ -136,8 +161,9 @@ class Evaluator:
         if isinstance(t, tc.TBlock):
             return self._block(t)
         if isinstance(t, tc.TPiecewise):
-            return _piecewise(t, [None if k is None else c(k) for k in t.conditions],
-                              [c(v) for v in t.values])
+            return _piecewise(
+                t, [None if k is None else c(k) for k in t.conditions], [c(v) for v in t.values]
+            )
         raise TypeError(t)  # pragma: no cover
 
     def _block(self, t: tc.TBlock) -> Fn:
@@ -208,17 +234,26 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
             where = describe(name, params, miss.env)
             raise InputError(
                 f"{name}: no piece applies {where}; its pieces are: " + "; ".join(miss.texts),
-                definition=name) from None
+                definition=name,
+            ) from None
         if isinstance(out, np.ndarray):
             bad = ~np.isfinite(out)
             if bad.any():
-                sub = {p: (env[p][bad] if isinstance(env[p], np.ndarray) and env[p].shape == out.shape
-                           else env[p]) for p in params}
-                raise DomainError(f"{name} is not a finite number {describe(name, params, sub)}",
-                                  definition=name)
+                sub = {
+                    p: (
+                        env[p][bad]
+                        if isinstance(env[p], np.ndarray) and env[p].shape == out.shape
+                        else env[p]
+                    )
+                    for p in params
+                }
+                raise DomainError(
+                    f"{name} is not a finite number {describe(name, params, sub)}", definition=name
+                )
         elif isinstance(out, float) and not np.isfinite(out):
-            raise DomainError(f"{name} is not a finite number {describe(name, params, env)}",
-                              definition=name)
+            raise DomainError(
+                f"{name} is not a finite number {describe(name, params, env)}", definition=name
+            )
         return out
 
     return run

@@ -41,11 +41,13 @@ class TableData:
 class Sheet:
     """A worksheet: inputs, definitions, tables. Evaluation follows only what is asked."""
 
-    def __init__(self, spec: SheetSpec, values: dict[str, Any] | None = None,
-                 typer: tc.Typer | None = None):
+    def __init__(
+        self, spec: SheetSpec, values: dict[str, Any] | None = None, typer: tc.Typer | None = None
+    ):
         self.spec = spec
-        self.values = dict(values) if values is not None else {
-            n: i.value for n, i in spec.inputs.items()}
+        self.values = (
+            dict(values) if values is not None else {n: i.value for n, i in spec.inputs.items()}
+        )
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
         self.typer = typer or tc.Typer(spec, input_units)
         self._memo: dict[str, object] = {}
@@ -65,8 +67,10 @@ class Sheet:
     def check_units(self) -> None:
         """Infer the unit of every definition, table column and chart series (load time)."""
         for name, d in self.spec.definitions.items():
-            self._located(lambda: self.typer.function(name) if d.is_function
-                          else self.typer.scalar(name), d)
+            try:
+                self.typer.function(name) if d.is_function else self.typer.scalar(name)
+            except WorkbookError as err:
+                raise err.located(file=self.file, line=d.line, definition=d.name) from None
         for t in self.spec.tables:
             if t.range is not None:
                 for col in t.columns:
@@ -76,25 +80,21 @@ class Sheet:
                 if s.table is None:
                     rng = s.range or c.range
                     if rng is None:
-                        raise TemplateError(f"chart {c.name}: a series needs a range",
-                                            file=self.file, line=c.line)
+                        raise TemplateError(
+                            f"chart {c.name}: a series needs a range", file=self.file, line=c.line
+                        )
                     self._typed_column(s.y, rng.var, f"chart {c.name}")
 
-    def _located(self, thunk, d):
-        try:
-            return thunk()
-        except WorkbookError as err:
-            raise err.located(file=self.file, line=d.line, definition=d.name) from None
-
-    def with_inputs(self, **changes) -> "Sheet":
+    def with_inputs(self, **changes) -> Sheet:
         """A new Sheet with some inputs replaced (``"40 mm"``, a pint Quantity, or a number)."""
         values = dict(self.values)
         for name, raw in changes.items():
             spec = self.spec.inputs.get(name)
             if spec is None:
                 known = ", ".join(self.spec.inputs)
-                raise InputError(f"'{name}' is not an input of {self.name} (inputs: {known})",
-                                 file=self.file)
+                raise InputError(
+                    f"'{name}' is not an input of {self.name} (inputs: {known})", file=self.file
+                )
             values[name] = coerce_input(spec, raw, file=self.file)
         return Sheet(self.spec, values, self.typer)
 
@@ -132,7 +132,9 @@ class Sheet:
         given = dict(zip(params, args))
         for k, v in kwargs.items():
             if k not in params:
-                raise InputError(f"{fname}() has no argument '{k}' (arguments: {', '.join(params)})")
+                raise InputError(
+                    f"{fname}() has no argument '{k}' (arguments: {', '.join(params)})"
+                )
             if k in given:
                 raise InputError(f"{fname}(): argument '{k}' given twice")
             given[k] = v
@@ -148,8 +150,10 @@ class Sheet:
             try:
                 mag = value.to(spec.unit).magnitude
             except pint.DimensionalityError:
-                raise InputError(f"argument {param} = {value:~} is not in {un.dims(spec.unit)} "
-                                 f"({un.pretty(spec.unit)})") from None
+                raise InputError(
+                    f"argument {param} = {value:~} is not in {un.dims(spec.unit)} "
+                    f"({un.pretty(spec.unit)})"
+                ) from None
         elif isinstance(value, str):
             return self.argument_magnitude(param, un.quantity(value, str(spec.unit), what=param))
         else:
@@ -176,9 +180,12 @@ class Sheet:
             if np.ndim(value) == 0:
                 value = float(value)
                 if not math.isfinite(value):
-                    raise DomainError(f"{name} is not a finite number ({value}); "
-                                      f"its formula is {d.text}", file=self.file, line=d.line,
-                                      definition=name)
+                    raise DomainError(
+                        f"{name} is not a finite number ({value}); its formula is {d.text}",
+                        file=self.file,
+                        line=d.line,
+                        definition=name,
+                    )
             self._memo[name] = value
         return self._memo[name]
 
@@ -194,8 +201,10 @@ class Sheet:
             if arr.size == 1 or arr.min() == arr.max():
                 parts.append(f"{p} = {arr.flat[0]:.6g} {unit}".rstrip())
             else:
-                parts.append(f"{p} from {arr.min():.6g} to {arr.max():.6g} {unit} "
-                             f"({arr.size} points)".replace("  ", " "))
+                parts.append(
+                    f"{p} from {arr.min():.6g} to {arr.max():.6g} {unit} "
+                    f"({arr.size} points)".replace("  ", " ")
+                )
         return "for " + ", ".join(parts) if parts else ""
 
     # -- tables ---------------------------------------------------------------------------
@@ -211,11 +220,15 @@ class Sheet:
             v = float(self.evaluator.compile(t)({}))
             if t.unit.dimensionality:
                 if spec is None:
-                    raise TemplateError(f"{what}: range bound has units but '{rng.var}' has "
-                                        "no declared unit")
+                    raise TemplateError(
+                        f"{what}: range bound has units but '{rng.var}' has no declared unit"
+                    )
                 v *= un.factor(t.unit, spec.unit)
-            elif spec is not None and spec.unit != t.unit and not (
-                    t.unit == un.registry().dimensionless):
+            elif (
+                spec is not None
+                and spec.unit != t.unit
+                and not (t.unit == un.registry().dimensionless)
+            ):
                 v *= un.factor(t.unit, spec.unit)
             nums.append(v)
         return range_values(nums[0], nums[1], nums[2], what=what)
@@ -237,8 +250,9 @@ class Sheet:
         try:
             t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
             if col.unit is not None:
-                t = self.typer._convert(t, col.unit, f"column '{col.text}' shown in "
-                                        f"{un.pretty(col.unit)}")
+                t = self.typer._convert(
+                    t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}"
+                )
             return t
         except WorkbookError as err:
             raise err.located(file=self.file, definition=what) from None
@@ -253,17 +267,22 @@ class Sheet:
         out = np.broadcast_to(np.asarray(out, dtype=float), values.shape).copy()
         bad = ~np.isfinite(out)
         if bad.any():
-            raise DomainError(f"column '{col.text}' is not a finite number for {var} = "
-                              f"{values[bad][0]:g} ({bad.sum()} points)", file=self.file,
-                              definition=what)
+            raise DomainError(
+                f"column '{col.text}' is not a finite number for {var} = "
+                f"{values[bad][0]:g} ({bad.sum()} points)",
+                file=self.file,
+                definition=what,
+            )
         return Column(col.title, t.unit, out, t, col.text)
 
     def table_data(self, name: str) -> TableData:
         """Evaluate one template table (only what it needs)."""
         spec = next((t for t in self.spec.tables if t.name == name), None)
         if spec is None:
-            raise InputError(f"no table '{name}' in {self.name} (tables: "
-                             f"{', '.join(t.name for t in self.spec.tables)})")
+            raise InputError(
+                f"no table '{name}' in {self.name} (tables: "
+                f"{', '.join(t.name for t in self.spec.tables)})"
+            )
         if spec.range is None:
             raise InputError(f"table '{name}' is computed by a block; use sheet.block_table()")
         what = f"table {name}"
@@ -343,8 +362,11 @@ def coerce_input(spec, raw, *, file: str | None = None):
     if spec.options:
         value = str(raw)
         if value not in spec.options:
-            raise InputError(f"{spec.name} = {value!r} is not one of {', '.join(spec.options)}",
-                             file=file, definition=spec.name)
+            raise InputError(
+                f"{spec.name} = {value!r} is not one of {', '.join(spec.options)}",
+                file=file,
+                definition=spec.name,
+            )
         return value
     q = un.quantity(raw, str(spec.unit) if spec.unit.dimensionless else None, what=spec.name)
     if isinstance(raw, (int, float)) and not isinstance(raw, bool):
@@ -355,6 +377,8 @@ def coerce_input(spec, raw, *, file: str | None = None):
         raise InputError(
             f"{spec.name} = {raw!s} is {un.dims(q.units)}, but {spec.name} is "
             f"{un.dims(spec.unit)} ({un.pretty(spec.unit) or 'dimensionless'})",
-            file=file, definition=spec.name) from None
+            file=file,
+            definition=spec.name,
+        ) from None
     check_input_value(spec, q)
     return q

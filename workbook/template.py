@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+
 try:
     import tomllib
 except ImportError:  # Python 3.10
@@ -25,8 +26,16 @@ from .errors import InputError, LimitError, TemplateError, WorkbookError
 MAX_RANGE_POINTS = 2_000_000
 
 SECTIONS = {
-    "sheet", "inputs", "arguments", "definitions", "blocks", "tables", "charts", "printed",
-    "relations", "findings",
+    "sheet",
+    "inputs",
+    "arguments",
+    "definitions",
+    "blocks",
+    "tables",
+    "charts",
+    "printed",
+    "relations",
+    "findings",
 }
 
 
@@ -303,7 +312,7 @@ def parse_branch(text: str, *, what: str) -> Branch:
             f"{what}: piece {text!r} must read 'VALUE if CONDITION' (or 'VALUE otherwise')"
         )
     m = matches[0]
-    value, cond = stripped[: m.start()], stripped[m.end():]
+    value, cond = stripped[: m.start()], stripped[m.end() :]
     return Branch(ex.parse(value, what=what), ex.parse(cond, what=what), stripped)
 
 
@@ -358,15 +367,21 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
 
     def claim(key: str, section: str, line):
         if not ex.is_identifier(key):
-            raise TemplateError(f"'{key}' is not a valid name (letters, digits, _)", line=line,
-                                definition=key)
+            raise TemplateError(
+                f"'{key}' is not a valid name (letters, digits, _)", line=line, definition=key
+            )
         if key in ex.FUNCTIONS:
             raise TemplateError(
                 f"'{key}' shadows the built-in function {key}(); choose another name",
-                line=line, definition=key)
+                line=line,
+                definition=key,
+            )
         if key in seen:
-            raise TemplateError(f"'{key}' is defined twice (in [{seen[key]}] and [{section}])",
-                                line=line, definition=key)
+            raise TemplateError(
+                f"'{key}' is defined twice (in [{seen[key]}] and [{section}])",
+                line=line,
+                definition=key,
+            )
         seen[key] = section
 
     inputs: dict[str, InputSpec] = {}
@@ -386,12 +401,19 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         if isinstance(raw, str):
             raw = {"unit": raw}
         if not isinstance(raw, dict):
-            raise TemplateError("an argument is declared as { unit = \"deg\", note = \"...\" }",
-                                line=line, definition=key)
+            raise TemplateError(
+                'an argument is declared as { unit = "deg", note = "..." }',
+                line=line,
+                definition=key,
+            )
         try:
-            arguments[key] = ArgumentSpec(key, un.unit(raw.get("unit", ""), what=key),
-                                          str(raw.get("note", "")), line,
-                                          bool(raw.get("plain", False)))
+            arguments[key] = ArgumentSpec(
+                key,
+                un.unit(raw.get("unit", ""), what=key),
+                str(raw.get("note", "")),
+                line,
+                bool(raw.get("plain", False)),
+            )
         except WorkbookError as err:
             raise err.located(line=line, definition=key) from None
 
@@ -400,8 +422,11 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         line = find_line(text, key, "blocks")
         claim(key, "blocks", line)
         if not isinstance(raw, str) or not re.match(r"^[a-z_][a-z0-9_]*\.[a-z_][a-z0-9_]*$", raw):
-            raise TemplateError("a block is named as 'module.function' (e.g. 'r0.direct')",
-                                line=line, definition=key)
+            raise TemplateError(
+                "a block is named as 'module.function' (e.g. 'r0.direct')",
+                line=line,
+                definition=key,
+            )
         blocks[key] = raw
 
     definitions: dict[str, Definition] = {}
@@ -409,8 +434,9 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         line = find_line(text, key, "definitions")
         m = _SIGNATURE.match(key)
         if not m:
-            raise TemplateError(f"cannot read definition name {key!r} (write 'f(x, y)' or 'x')",
-                                line=line)
+            raise TemplateError(
+                f"cannot read definition name {key!r} (write 'f(x, y)' or 'x')", line=line
+            )
         dname = m.group(1)
         params = tuple(p.strip() for p in m.group(2).split(",")) if m.group(2) else ()
         if m.group(2) is not None and not m.group(2).strip():
@@ -422,7 +448,10 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             if p not in arguments:
                 raise TemplateError(
                     f"parameter '{p}' has no declared unit: add it to [arguments] "
-                    f"(e.g. {p} = {{ unit = \"deg\" }})", line=line, definition=dname)
+                    f'(e.g. {p} = {{ unit = "deg" }})',
+                    line=line,
+                    definition=dname,
+                )
         if len(set(params)) != len(params):
             raise TemplateError("a parameter is repeated", line=line, definition=dname)
         try:
@@ -432,8 +461,11 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
 
     for pname in arguments:
         if pname in inputs or pname in definitions:
-            raise TemplateError(f"argument '{pname}' has the name of an input or definition",
-                                line=arguments[pname].line, definition=pname)
+            raise TemplateError(
+                f"argument '{pname}' has the name of an input or definition",
+                line=arguments[pname].line,
+                definition=pname,
+            )
 
     tables = [_table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
     charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
@@ -478,7 +510,9 @@ def _list(data: dict, key: str) -> list:
     if isinstance(value, dict):
         value = [value]
     if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-        raise TemplateError(f"[[{key}]] must be an array of tables", line=_section_line(text="", key=key))
+        raise TemplateError(
+            f"[[{key}]] must be an array of tables", line=_section_line(text="", key=key)
+        )
     return value
 
 
@@ -486,7 +520,9 @@ def _input(key: str, raw, line) -> InputSpec:
     if isinstance(raw, (str, int, float)) and not isinstance(raw, bool):
         raw = {"value": raw}
     if not isinstance(raw, dict) or "value" not in raw:
-        raise TemplateError('an input is written  R1 = "20 mm"  or  R1 = { value = "20 mm", note = "..." }')
+        raise TemplateError(
+            'an input is written  R1 = "20 mm"  or  R1 = { value = "20 mm", note = "..." }'
+        )
     options = tuple(str(o) for o in raw.get("options", ()))
     note = str(raw.get("note", ""))
     if options:
@@ -501,11 +537,17 @@ def _input(key: str, raw, line) -> InputSpec:
             q = q.to(target)
         except pint.DimensionalityError:
             raise InputError(f"value {raw['value']!r} cannot be shown in {raw['unit']!r}") from None
-    spec = InputSpec(key, q, q.units, note,
-                     minimum=_quantity_or_none(raw.get("min"), key),
-                     maximum=_quantity_or_none(raw.get("max"), key),
-                     positive=bool(raw.get("positive", False)), line=line,
-                     label=str(raw.get("label", "")))
+    spec = InputSpec(
+        key,
+        q,
+        q.units,
+        note,
+        minimum=_quantity_or_none(raw.get("min"), key),
+        maximum=_quantity_or_none(raw.get("max"), key),
+        positive=bool(raw.get("positive", False)),
+        line=line,
+        label=str(raw.get("label", "")),
+    )
     check_input_value(spec, q)
     return spec
 
@@ -519,8 +561,10 @@ def check_input_value(spec: InputSpec, q: pint.Quantity) -> None:
         raise InputError(f"{spec.name} = {q} is not a finite number", definition=spec.name)
     if spec.positive and np.any(mag <= 0):
         raise InputError(f"{spec.name} = {q:~} must be positive", definition=spec.name)
-    for bound, ok, word in ((spec.minimum, lambda a, b: a >= b, "at least"),
-                            (spec.maximum, lambda a, b: a <= b, "at most")):
+    for bound, ok, word in (
+        (spec.minimum, lambda a, b: a >= b, "at least"),
+        (spec.maximum, lambda a, b: a <= b, "at most"),
+    ):
         if bound is None:
             continue
         try:
@@ -541,7 +585,9 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
         elif "pieces" in raw:
             raw = raw["pieces"]
         else:
-            raise TemplateError('a definition with a note is written { expr = "...", note = "..." }')
+            raise TemplateError(
+                'a definition with a note is written { expr = "...", note = "..." }'
+            )
     display = un.unit(unit_text, what=name) if unit_text is not None else None
     what = name
     if isinstance(raw, list):
@@ -551,8 +597,9 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
         for b in branches[:-1]:
             if b.condition is None:
                 raise TemplateError("'otherwise' must be the last piece")
-        return Definition(name, params, None, branches, " | ".join(b.text for b in branches),
-                          note, display, line)
+        return Definition(
+            name, params, None, branches, " | ".join(b.text for b in branches), note, display, line
+        )
     if isinstance(raw, (int, float)) and not isinstance(raw, bool):
         raw = repr(raw)
     if not isinstance(raw, str):
@@ -560,10 +607,13 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
     return Definition(name, params, ex.parse(raw, what=what), None, raw, note, display, line)
 
 
-def _column(text: str, unit_text, default_var: str | None, what: str, title: str = "") -> ColumnSpec:
+def _column(
+    text: str, unit_text, default_var: str | None, what: str, title: str = ""
+) -> ColumnSpec:
     node = ex.parse(text, what=what)
-    return ColumnSpec(text, node, un.unit(unit_text, what=what) if unit_text is not None else None,
-                      title or text)
+    return ColumnSpec(
+        text, node, un.unit(unit_text, what=what) if unit_text is not None else None, title or text
+    )
 
 
 def _columns(raw, default_var, what) -> list[ColumnSpec]:
@@ -571,14 +621,17 @@ def _columns(raw, default_var, what) -> list[ColumnSpec]:
     if isinstance(raw, dict):
         raw = [{"expr": k, "unit": v} for k, v in raw.items()]
     if not isinstance(raw, list):
-        raise TemplateError(f"{what}: columns are {{ h1 = \"mm\", v1 = \"m/s\" }}")
+        raise TemplateError(f'{what}: columns are {{ h1 = "mm", v1 = "m/s" }}')
     for item in raw:
         if isinstance(item, str):
             item = {"expr": item}
         if not isinstance(item, dict) or "expr" not in item:
-            raise TemplateError(f"{what}: a column is {{ expr = \"h1\", unit = \"mm\" }}")
-        cols.append(_column(str(item["expr"]), item.get("unit"), default_var, what,
-                            str(item.get("title", ""))))
+            raise TemplateError(f'{what}: a column is {{ expr = "h1", unit = "mm" }}')
+        cols.append(
+            _column(
+                str(item["expr"]), item.get("unit"), default_var, what, str(item.get("title", ""))
+            )
+        )
     return cols
 
 
@@ -590,8 +643,15 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
         cols = _columns(raw.get("columns", []), rng.var if rng else None, f"table {name}")
         if not raw.get("block") and rng is None:
             raise TemplateError(f"table {name} needs a range (or a block)")
-        return TableSpec(name, str(raw.get("title", name)), rng, cols,
-                         str(raw.get("sheet", "Listing")), raw.get("block"), line)
+        return TableSpec(
+            name,
+            str(raw.get("title", name)),
+            rng,
+            cols,
+            str(raw.get("sheet", "Listing")),
+            raw.get("block"),
+            line,
+        )
     except WorkbookError as err:
         raise err.located(line=line, definition=f"table {name}") from None
 
@@ -622,20 +682,35 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
         series = []
         for s in raw.get("series", []):
             if not isinstance(s, dict):
-                raise TemplateError(f"{what}: a series is {{ y = \"h\", unit = \"mm\" }}")
+                raise TemplateError(f'{what}: a series is {{ y = "h", unit = "mm" }}')
             if "table" in s:
-                series.append(SeriesSpec(
-                    y=_column("0", None, None, what), name=str(s.get("name", s.get("y", ""))),
-                    line=str(s.get("line", "solid")), axis=str(s.get("axis", "primary")),
-                    marker=bool(s.get("marker", False)), table=str(s["table"]),
-                    x_column=str(s.get("x", "")), y_column=str(s.get("y", ""))))
+                series.append(
+                    SeriesSpec(
+                        y=_column("0", None, None, what),
+                        name=str(s.get("name", s.get("y", ""))),
+                        line=str(s.get("line", "solid")),
+                        axis=str(s.get("axis", "primary")),
+                        marker=bool(s.get("marker", False)),
+                        table=str(s["table"]),
+                        x_column=str(s.get("x", "")),
+                        y_column=str(s.get("y", "")),
+                    )
+                )
                 continue
             y = _column(str(s["y"]), s.get("unit"), None, what, str(s.get("name", s["y"])))
             srange = parse_range(s["range"], what=what) if "range" in s else None
             sx = _column(str(s["x"]), s.get("x_unit"), None, what) if "x" in s else None
-            series.append(SeriesSpec(y, str(s.get("name", s["y"])), str(s.get("line", "solid")),
-                                     str(s.get("axis", "primary")), bool(s.get("marker", False)),
-                                     sx, srange))
+            series.append(
+                SeriesSpec(
+                    y,
+                    str(s.get("name", s["y"])),
+                    str(s.get("line", "solid")),
+                    str(s.get("axis", "primary")),
+                    bool(s.get("marker", False)),
+                    sx,
+                    srange,
+                )
+            )
         if not series:
             raise TemplateError(f"{what} has no series")
         for s in series:
@@ -643,28 +718,49 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
                 raise TemplateError(f"{what}: line must be solid, dash, dot or none")
             if s.axis not in ("primary", "secondary"):
                 raise TemplateError(f"{what}: axis must be primary or secondary")
-        return ChartSpec(name, str(raw.get("title", name)), rng, x,
-                         x_title or str(raw.get("x_title", "")), str(raw.get("y_title", "")),
-                         str(raw.get("y2_title", "")), series, bool(raw.get("log_x", False)),
-                         bool(raw.get("log_y", False)), bool(raw.get("equal_axes", False)), line)
+        return ChartSpec(
+            name,
+            str(raw.get("title", name)),
+            rng,
+            x,
+            x_title or str(raw.get("x_title", "")),
+            str(raw.get("y_title", "")),
+            str(raw.get("y2_title", "")),
+            series,
+            bool(raw.get("log_x", False)),
+            bool(raw.get("log_y", False)),
+            bool(raw.get("equal_axes", False)),
+            line,
+        )
     except WorkbookError as err:
         raise err.located(line=line, definition=what) from None
 
 
 def _printed_spec(raw: dict, path: Path, text: str) -> PrintedSpec:
     if "file" not in raw:
-        raise TemplateError("[[printed]] needs file = \"...csv\"")
-    misprints = [Misprint(str(m["name"]), float(m["at"]), str(m.get("note", "")),
-                          float(m["corrected"]) if "corrected" in m else None)
-                 for m in raw.get("misprints", [])]
+        raise TemplateError('[[printed]] needs file = "...csv"')
+    misprints = [
+        Misprint(
+            str(m["name"]),
+            float(m["at"]),
+            str(m.get("note", "")),
+            float(m["corrected"]) if "corrected" in m else None,
+        )
+        for m in raw.get("misprints", [])
+    ]
     role = str(raw.get("role", "check"))
     if role not in ("check", "information"):
         raise TemplateError("[[printed]] role is 'check' or 'information'")
-    return PrintedSpec(path.parent / str(raw["file"]), str(raw.get("title", raw["file"])),
-                       str(raw.get("argument", "")),
-                       float(raw["tolerance"]) if "tolerance" in raw else None,
-                       float(raw["rel_tolerance"]) if "rel_tolerance" in raw else None,
-                       role, misprints, str(raw.get("note", "")))
+    return PrintedSpec(
+        path.parent / str(raw["file"]),
+        str(raw.get("title", raw["file"])),
+        str(raw.get("argument", "")),
+        float(raw["tolerance"]) if "tolerance" in raw else None,
+        float(raw["rel_tolerance"]) if "rel_tolerance" in raw else None,
+        role,
+        misprints,
+        str(raw.get("note", "")),
+    )
 
 
 _RELATION = re.compile(
@@ -679,12 +775,21 @@ def _relation_spec(raw: dict, text: str) -> RelationSpec:
     line = find_line(text, "relation") if False else _value_line(text, rel)
     m = _RELATION.match(rel)
     if not m:
-        raise TemplateError(f"cannot read relation {rel!r} (write 'v1 = omega * d(h1)/d(phi)')",
-                            line=line)
+        raise TemplateError(
+            f"cannot read relation {rel!r} (write 'v1 = omega * d(h1)/d(phi)')", line=line
+        )
     factor = m.group(2).strip().rstrip("*").strip() or "1"
     rng = parse_range(raw["range"], what=rel) if "range" in raw else None
-    return RelationSpec(rel, m.group(1), ex.parse(factor, what=rel), m.group(3), m.group(4),
-                        str(raw.get("unit", "rad")), rng, line)
+    return RelationSpec(
+        rel,
+        m.group(1),
+        ex.parse(factor, what=rel),
+        m.group(3),
+        m.group(4),
+        str(raw.get("unit", "rad")),
+        rng,
+        line,
+    )
 
 
 def _value_line(text: str, value: str) -> int | None:

@@ -182,7 +182,7 @@ class Typer:
 
     def _typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
         if d.name in self._stack:
-            cycle = " -> ".join(self._stack[self._stack.index(d.name):] + [d.name])
+            cycle = " -> ".join(self._stack[self._stack.index(d.name) :] + [d.name])
             raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=d.name)
         self._stack.append(d.name)
         try:
@@ -204,7 +204,9 @@ class Typer:
             if first_unit is None:
                 first_unit = v.unit
             else:
-                v = self._convert(v, first_unit, f"piece {b.text!r} (first piece is in {un.dims(first_unit)})")
+                v = self._convert(
+                    v, first_unit, f"piece {b.text!r} (first piece is in {un.dims(first_unit)})"
+                )
             c = None
             if b.condition is not None:
                 c = self._t(b.condition, scope)
@@ -213,7 +215,9 @@ class Typer:
             conds.append(c)
             values.append(v)
             texts.append(b.text)
-        return TPiecewise(first_unit, conditions=tuple(conds), values=tuple(values), texts=tuple(texts))
+        return TPiecewise(
+            first_unit, conditions=tuple(conds), values=tuple(values), texts=tuple(texts)
+        )
 
     def _convert(self, t: T, target: pint.Unit, where: str) -> T:
         if t.unit == target:
@@ -233,8 +237,10 @@ class Typer:
         if t.boolean:
             raise TemplateError(f"{where}: a comparison cannot be used as a number")
         if t.unit.dimensionality:
-            raise UnitError(f"{where} needs a dimensionless argument, got {un.dims(t.unit)} "
-                            f"({un.pretty(t.unit)})")
+            raise UnitError(
+                f"{where} needs a dimensionless argument, got {un.dims(t.unit)} "
+                f"({un.pretty(t.unit)})"
+            )
         return self._convert(t, self.dimensionless, where)
 
     def _number(self, t: T, where: str) -> T:
@@ -285,8 +291,10 @@ class Typer:
         if name in self.spec.definitions:
             d = self.spec.definitions[name]
             if d.is_function:
-                raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}: "
-                                    f"write {name}({', '.join(d.params)})")
+                raise TemplateError(
+                    f"'{name}' is a function of {', '.join(d.params)}: "
+                    f"write {name}({', '.join(d.params)})"
+                )
             return TRef(self.scalar(name).unit, name=name, kind="definition")
         if name == "pi":
             return TRef(self.dimensionless, name="pi", kind="builtin")
@@ -338,7 +346,8 @@ class Typer:
                 v = math.pow(left.value, right.value)
             except (OverflowError, ValueError):
                 raise TemplateError(
-                    f"{left.value:g}^{right.value:g} is not a finite number") from None
+                    f"{left.value:g}^{right.value:g} is not a finite number"
+                ) from None
             return TConst(self.dimensionless, value=v)
         return TBinary(self.dimensionless, op="^", left=left, right=right)
 
@@ -355,23 +364,28 @@ class Typer:
         texts = [isinstance(t, TText) for t in typed]
         if any(texts):
             if len(typed) != 2 or node.ops[0] not in ("==", "!=") or sum(texts) != 1:
-                raise TemplateError("text can only be compared with a choice input: law == \"stepped\"")
+                raise TemplateError(
+                    'text can only be compared with a choice input: law == "stepped"'
+                )
             other = typed[1] if texts[0] else typed[0]
             if not (isinstance(other, TRef) and other.kind == "choice"):
                 raise TemplateError("text can only be compared with a choice input")
             opts = self.spec.inputs[other.name].options
             text = (typed[0] if texts[0] else typed[1]).value
             if text not in opts:
-                raise TemplateError(f"{text!r} is not one of the options of '{other.name}': "
-                                    f"{', '.join(opts)}")
+                raise TemplateError(
+                    f"{text!r} is not one of the options of '{other.name}': {', '.join(opts)}"
+                )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
         first = typed[0]
         out = [first]
         for t in typed[1:]:
             self._number(t, "comparison")
             if t.unit.dimensionality != first.unit.dimensionality:
-                raise UnitError(f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
-                                f"with {un.dims(t.unit)} ({un.pretty(t.unit)})")
+                raise UnitError(
+                    f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
+                    f"with {un.dims(t.unit)} ({un.pretty(t.unit)})"
+                )
             out.append(self._convert(t, first.unit, "comparison"))
         return TCompare(self.dimensionless, ops=node.ops, operands=tuple(out), boolean=True)
 
@@ -385,8 +399,10 @@ class Typer:
             if not d.is_function:
                 raise TemplateError(f"'{name}' is not a function; write {name} without brackets")
             if len(args) != len(d.params):
-                raise TemplateError(f"{name}() takes {len(d.params)} argument(s) "
-                                    f"({', '.join(d.params)}), got {len(args)}")
+                raise TemplateError(
+                    f"{name}() takes {len(d.params)} argument(s) "
+                    f"({', '.join(d.params)}), got {len(args)}"
+                )
             f = self.function(name)
             conv = tuple(
                 self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
@@ -398,8 +414,10 @@ class Typer:
 
             blk = blocks.get(self.spec.blocks[name], "function")
             if len(args) != len(blk.args):
-                raise TemplateError(f"{name}() takes {len(blk.args)} argument(s) "
-                                    f"({', '.join(blk.args)}), got {len(args)}")
+                raise TemplateError(
+                    f"{name}() takes {len(blk.args)} argument(s) "
+                    f"({', '.join(blk.args)}), got {len(args)}"
+                )
             conv = tuple(
                 self._convert(a, un.unit(u), f"argument '{p}' of {name}()")
                 for a, (p, u) in zip(args, blk.args.items())
@@ -422,7 +440,7 @@ class Typer:
             x = self._convert(x, y.unit, "atan2(y, x): x and y")
             return TFunc(dl, func=name, args=(y, x))
         if name == "sqrt":
-            return TFunc(args[0].unit**0.5, func=name, args=(args[0],))
+            return TFunc(args[0].unit ** 0.5, func=name, args=(args[0],))
         if name in ("abs", "floor", "ceil"):
             return TFunc(args[0].unit, func=name, args=(args[0],))
         if name == "sign":
@@ -457,8 +475,11 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         d = spec.definitions.get(n)
         if d is None:
             continue
-        bodies = [d.body] if d.body is not None else [
-            x for b in d.branches for x in (b.value, b.condition) if x is not None]
+        bodies = (
+            [d.body]
+            if d.body is not None
+            else [x for b in d.branches for x in (b.value, b.condition) if x is not None]
+        )
         for body in bodies:
             todo.extend(m for m in ex.names(body) if m not in d.params)
     return out

@@ -11,7 +11,7 @@ import pint
 from .errors import InputError
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def registry() -> pint.UnitRegistry:
     """Return the shared registry (created on first use: it costs ~0.1 s)."""
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
@@ -86,8 +86,13 @@ def dims(u: pint.Unit) -> str:
 def is_angle(u: pint.Unit) -> bool:
     """True for units that pint treats as angles (radian, degree, turn...)."""
     ureg = registry()
-    return u.dimensionless and (u == ureg.radian or "radian" in str(u) or "degree" in str(u)
-                                or "revolution" in str(u) or "turn" in str(u))
+    return u.dimensionless and (
+        u == ureg.radian
+        or "radian" in str(u)
+        or "degree" in str(u)
+        or "revolution" in str(u)
+        or "turn" in str(u)
+    )
 
 
 def pretty(u: pint.Unit) -> str:

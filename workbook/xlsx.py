@@ -61,8 +61,13 @@ class WorkbookWriter:
         self.path = path
         self.command = command or f"workbook run {sheet.name}"
         self.wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
-        self.wb.set_properties({"title": sheet.spec.title, "comments": sheet.spec.source,
-                                "author": "workbook " + __version__})
+        self.wb.set_properties(
+            {
+                "title": sheet.spec.title,
+                "comments": sheet.spec.source,
+                "author": "workbook " + __version__,
+            }
+        )
         self.printer = ExcelPrinter(sheet.typer)
         self.fmt = self._formats()
         self.columns: dict[tuple, ColumnCells] = {}
@@ -77,8 +82,14 @@ class WorkbookWriter:
         return {
             "title": add({"bold": True, "font_size": 13}),
             "header": add({"bold": True, "bottom": 1, "text_wrap": True, "valign": "top"}),
-            "input": add({"bg_color": "#FFF2CC", "font_color": "#0000FF", "border": 1,
-                          "num_format": "General"}),
+            "input": add(
+                {
+                    "bg_color": "#FFF2CC",
+                    "font_color": "#0000FF",
+                    "border": 1,
+                    "num_format": "General",
+                }
+            ),
             "value": add({"num_format": "0.000###"}),
             "number": add({"num_format": "General"}),
             "note": add({"italic": True, "font_color": "#595959"}),
@@ -109,7 +120,9 @@ class WorkbookWriter:
             ws.write_string(row, 0, name)
             if spec.options:
                 ws.write_string(row, 1, value, self.fmt["input"])
-                ws.data_validation(row, 1, row, 1, {"validate": "list", "source": list(spec.options)})
+                ws.data_validation(
+                    row, 1, row, 1, {"validate": "list", "source": list(spec.options)}
+                )
                 unit_text = ""
             else:
                 ws.write_number(row, 1, float(value.magnitude), self.fmt["input"])
@@ -122,20 +135,29 @@ class WorkbookWriter:
             xname = excel_name(name)
             self.wb.define_name(xname, f"=Inputs!$B${row + 1}")
             if xname != name:
-                ws.write_comment(row, 0, f"Defined name {xname} (Excel reads '{name}' as a cell "
-                                 "reference or function)")
+                ws.write_comment(
+                    row,
+                    0,
+                    f"Defined name {xname} (Excel reads '{name}' as a cell reference or function)",
+                )
             row += 1
-        ws.write_string(row + 1, 0, "Yellow cells are inputs: change them and the workbook "
-                        "recalculates.", self.fmt["note"])
+        ws.write_string(
+            row + 1,
+            0,
+            "Yellow cells are inputs: change them and the workbook recalculates.",
+            self.fmt["note"],
+        )
 
     def write_definitions(self, needed: set[str]) -> None:
-        defs = [d for n, d in self.sheet.spec.definitions.items()
-                if not d.is_function and n in needed]
+        defs = [
+            d for n, d in self.sheet.spec.definitions.items() if not d.is_function and n in needed
+        ]
         if not defs:
             return
         ws = self.ws("Definitions")
-        ws.write_row(0, 0, ["Name", "Value", "Unit", "Formula (worksheet)", "Note"],
-                     self.fmt["header"])
+        ws.write_row(
+            0, 0, ["Name", "Value", "Unit", "Formula (worksheet)", "Note"], self.fmt["header"]
+        )
         ws.set_column(0, 0, 12)
         ws.set_column(1, 1, 16)
         ws.set_column(3, 3, 50)
@@ -169,8 +191,10 @@ class WorkbookWriter:
         ws = self.ws(spec.sheet)
         start = self.rows[spec.sheet]
         if start + n + 3 > MAX_ROWS:
-            raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds "
-                             f"{MAX_ROWS:,}. Write it as CSV instead (workbook run --csv)")
+            raise LimitError(
+                f"table {spec.name} has {n:,} rows; an Excel sheet holds "
+                f"{MAX_ROWS:,}. Write it as CSV instead (workbook run --csv)"
+            )
         ws.write_string(start, 0, spec.title, self.fmt["title"])
         heads = [header(c.title, c.unit) for c in data.columns]
         ws.write_row(start + 1, 0, heads, self.fmt["header"])
@@ -182,9 +206,11 @@ class WorkbookWriter:
         for j, col in enumerate(data.columns[1:], start=1):
             self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n)
             self.columns[(spec.range.text, spec.sheet, col.text, str(col.unit))] = ColumnCells(
-                spec.sheet, j, first, first + n - 1, col.title)
+                spec.sheet, j, first, first + n - 1, col.title
+            )
         self.columns[(spec.range.text, spec.sheet, data.var, "var")] = ColumnCells(
-            spec.sheet, 0, first, first + n - 1, data.var)
+            spec.sheet, 0, first, first + n - 1, data.var
+        )
         ws.set_column(0, len(data.columns) - 1, 13)
         self.rows[spec.sheet] = first + n + 2
 
@@ -216,15 +242,20 @@ class WorkbookWriter:
             raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}")
         ws.write_string(start, 0, spec.title, self.fmt["title"])
         ws.write_row(start + 1, 0, [str(c) for c in df.columns], self.fmt["header"])
-        ws.write_comment(start + 1, 0, f"Values computed by the solver block {spec.block}; "
-                         "not live formulas (rerun workbook to update).")
+        ws.write_comment(
+            start + 1,
+            0,
+            f"Values computed by the solver block {spec.block}; "
+            "not live formulas (rerun workbook to update).",
+        )
         first = start + 2
         for j, name in enumerate(df.columns):
             col = df[name].tolist()
             for i, v in enumerate(col):
                 self._write_value(ws, first + i, j, v)
             self.block_columns[(spec.name, str(name))] = ColumnCells(
-                spec.sheet, j, first, first + n - 1, str(name))
+                spec.sheet, j, first, first + n - 1, str(name)
+            )
         ws.set_column(0, max(0, len(df.columns) - 1), 14)
         self.rows[spec.sheet] = first + n + 2
 
@@ -246,16 +277,23 @@ class WorkbookWriter:
     def chart_series_cells(self, chart, s) -> tuple[ColumnCells, ColumnCells]:
         if s.table is not None:
             try:
-                return (self.block_columns[(s.table, s.x_column)],
-                        self.block_columns[(s.table, s.y_column)])
+                return (
+                    self.block_columns[(s.table, s.x_column)],
+                    self.block_columns[(s.table, s.y_column)],
+                )
             except KeyError:
-                raise WorkbookError(f"chart {chart.name}: table '{s.table}' has no column "
-                                    f"'{s.x_column}' or '{s.y_column}'") from None
+                raise WorkbookError(
+                    f"chart {chart.name}: table '{s.table}' has no column "
+                    f"'{s.x_column}' or '{s.y_column}'"
+                ) from None
         rng = s.range or chart.range
         target = "Chart data"
         for key, cells in self.columns.items():
-            if key[0] == rng.text and key[2] == s.y.text and (
-                    s.y.unit is None or key[3] == str(s.y.unit)):
+            if (
+                key[0] == rng.text
+                and key[2] == s.y.text
+                and (s.y.unit is None or key[3] == str(s.y.unit))
+            ):
                 xcells = self.columns[(rng.text, key[1], rng.var, "var")]
                 return xcells, cells
         # not in any table: write a chart data block
@@ -268,17 +306,28 @@ class WorkbookWriter:
             self.write_range_table(spec)
         finally:
             self.sheet.spec.tables.remove(spec)
-        return (self.columns[(rng.text, target, rng.var, "var")],
-                self.columns[(rng.text, target, s.y.text, str(
-                    self.sheet._typed_column(s.y, rng.var, chart.name).unit))])
+        return (
+            self.columns[(rng.text, target, rng.var, "var")],
+            self.columns[
+                (
+                    rng.text,
+                    target,
+                    s.y.text,
+                    str(self.sheet._typed_column(s.y, rng.var, chart.name).unit),
+                )
+            ],
+        )
 
     def write_charts(self) -> None:
         if not self.sheet.spec.charts:
             return
         # Resolve (and if needed write) every series' data before the Charts sheet exists,
         # so the data sheets come before it in the workbook.
-        cells = {(chart.name, i): self.chart_series_cells(chart, s)
-                 for chart in self.sheet.spec.charts for i, s in enumerate(chart.series)}
+        cells = {
+            (chart.name, i): self.chart_series_cells(chart, s)
+            for chart in self.sheet.spec.charts
+            for i, s in enumerate(chart.series)
+        }
         ws = self.ws("Charts")
         row = 0
         for chart in self.sheet.spec.charts:
@@ -292,18 +341,26 @@ class WorkbookWriter:
                     line["dash_type"] = "round_dot"
                 elif s.line == "none":
                     line = {"none": True}
-                opts = {"name": s.name, "categories": _range_ref(xcells),
-                        "values": _range_ref(ycells), "line": line,
-                        "marker": {"type": "circle", "size": 4} if s.marker else {"type": "none"}}
+                opts = {
+                    "name": s.name,
+                    "categories": _range_ref(xcells),
+                    "values": _range_ref(ycells),
+                    "line": line,
+                    "marker": {"type": "circle", "size": 4} if s.marker else {"type": "none"},
+                }
                 if s.axis == "secondary":
                     opts["y2_axis"] = True
                 c.add_series(opts)
             c.set_title({"name": chart.title})
-            xaxis = {"name": chart.x_title or (chart.x.title if chart.x else ""),
-                     "label_position": "low",
-                     "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}}}
-            yaxis = {"name": chart.y_title,
-                     "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}}}
+            xaxis = {
+                "name": chart.x_title or (chart.x.title if chart.x else ""),
+                "label_position": "low",
+                "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}},
+            }
+            yaxis = {
+                "name": chart.y_title,
+                "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}},
+            }
             if chart.log_x:
                 xaxis["log_base"] = 10
             if chart.log_y:
@@ -328,8 +385,11 @@ class WorkbookWriter:
         values = []
         for s in chart.series:
             if s.table is not None:
-                df = self.sheet.block_table_cached(s.table) if hasattr(
-                    self.sheet, "block_table_cached") else None
+                df = (
+                    self.sheet.block_table_cached(s.table)
+                    if hasattr(self.sheet, "block_table_cached")
+                    else None
+                )
                 if df is not None:
                     values += [df[s.x_column].to_numpy(), df[s.y_column].to_numpy()]
             else:
@@ -348,8 +408,19 @@ class WorkbookWriter:
     # -- checks and about ------------------------------------------------------------------
     def write_checks(self, report) -> None:
         ws = self.ws("Checks")
-        heads = ["Source", "Name", "At", "Unit", "Printed", "Computed", "Abs error",
-                 "Rel error", "Tolerance", "Verdict", "Note"]
+        heads = [
+            "Source",
+            "Name",
+            "At",
+            "Unit",
+            "Printed",
+            "Computed",
+            "Abs error",
+            "Rel error",
+            "Tolerance",
+            "Verdict",
+            "Note",
+        ]
         ws.write_row(0, 0, heads, self.fmt["header"])
         ws.set_column(0, 0, 34)
         ws.set_column(4, 8, 12)
@@ -368,18 +439,33 @@ class WorkbookWriter:
                 live = self._write_checked_value(ws, row, r)
             E, F = f"E{row + 1}", f"F{row + 1}"
             if r.computed is not None:
-                ws.write_formula(row, 6, f"=ABS({F}-{E})", self.fmt["sci"], abs(r.computed - r.printed))
+                ws.write_formula(
+                    row, 6, f"=ABS({F}-{E})", self.fmt["sci"], abs(r.computed - r.printed)
+                )
                 if r.printed != 0:
-                    ws.write_formula(row, 7, f"=ABS({F}-{E})/ABS({E})", self.fmt["pct"],
-                                     abs(r.computed - r.printed) / abs(r.printed))
+                    ws.write_formula(
+                        row,
+                        7,
+                        f"=ABS({F}-{E})/ABS({E})",
+                        self.fmt["pct"],
+                        abs(r.computed - r.printed) / abs(r.printed),
+                    )
                 self.formula_cells += 1 + (r.printed != 0)
-            tol_text = (f"{r.tolerance:g}" if r.tolerance is not None else
-                        f"{100 * r.rel_tolerance:g}%" if r.rel_tolerance is not None else "")
+            tol_text = (
+                f"{r.tolerance:g}"
+                if r.tolerance is not None
+                else f"{100 * r.rel_tolerance:g}%"
+                if r.rel_tolerance is not None
+                else ""
+            )
             ws.write_string(row, 8, tol_text)
-            fmt = self.fmt["pass"] if r.verdict in ("pass", "misprint", "info") else self.fmt["fail"]
+            fmt = (
+                self.fmt["pass"] if r.verdict in ("pass", "misprint", "info") else self.fmt["fail"]
+            )
             if live and r.role == "check" and r.verdict in ("pass", "FAIL") and r.tolerance:
-                ws.write_formula(row, 9, f'=IF(G{row + 1}<={r.tolerance!r},"pass","FAIL")', fmt,
-                                 r.verdict)
+                ws.write_formula(
+                    row, 9, f'=IF(G{row + 1}<={r.tolerance!r},"pass","FAIL")', fmt, r.verdict
+                )
                 self.formula_cells += 1
             else:
                 ws.write_string(row, 9, r.verdict, fmt)
@@ -388,8 +474,12 @@ class WorkbookWriter:
         if report.findings:
             row += 1
             ws.write_string(row, 0, "Findings", self.fmt["title"])
-            ws.write_row(row + 1, 0, ["Topic", "What", "", "Unit", "Value", "", "", "", "",
-                                      "Verdict", "Note"], self.fmt["header"])
+            ws.write_row(
+                row + 1,
+                0,
+                ["Topic", "What", "", "Unit", "Value", "", "", "", "", "Verdict", "Note"],
+                self.fmt["header"],
+            )
             row += 2
             for f in report.findings:
                 ws.write_string(row, 0, f.topic)
@@ -403,8 +493,12 @@ class WorkbookWriter:
                 row += 1
         if report.unused_inputs:
             row += 1
-            ws.write_string(row, 0, "Inputs that no output uses: " + ", ".join(report.unused_inputs),
-                            self.fmt["note"])
+            ws.write_string(
+                row,
+                0,
+                "Inputs that no output uses: " + ", ".join(report.unused_inputs),
+                self.fmt["note"],
+            )
         ws.freeze_panes(1, 0)
 
     def _write_checked_value(self, ws, row, r) -> bool:
@@ -443,7 +537,10 @@ class WorkbookWriter:
             ("Regenerate with", self.command),
             ("Live formulas", f"{self.formula_cells} cells recalculate when an input changes"),
             ("Values, not formulas", ", ".join(sorted(set(self.not_live))) or "none"),
-            ("Units", "Every column header names its unit; input cells are in the unit beside them."),
+            (
+                "Units",
+                "Every column header names its unit; input cells are in the unit beside them.",
+            ),
             ("Macros", "none"),
         ]
         rows += [(str(k), str(v)) for k, v in spec.meta.get("about", {}).items()]
@@ -483,8 +580,9 @@ def needed_names(sheet) -> set[str]:
     return out
 
 
-def write_workbook(sheet, path: Path, *, force: bool = False, command: str | None = None,
-                   report=None) -> Path:
+def write_workbook(
+    sheet, path: Path, *, force: bool = False, command: str | None = None, report=None
+) -> Path:
     """Write ``sheet`` to ``path`` atomically (the old file survives any failure)."""
     path = Path(path)
     check_target(path, force=force)

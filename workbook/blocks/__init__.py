@@ -22,12 +22,13 @@ Three kinds:
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 from ..errors import TemplateError
 
-_REGISTRY: dict[str, "Block"] = {}
+_REGISTRY: dict[str, Block] = {}
 
 
 @dataclass
@@ -93,7 +94,9 @@ def get(ref: str, kind: str | None = None) -> Block:
         importlib.import_module(f"{__name__}.{module}")
     except ModuleNotFoundError as exc:
         if exc.name == f"{__name__}.{module}":
-            raise TemplateError(f"no block module '{module}' (looked for workbook/blocks/{module}.py)") from None
+            raise TemplateError(
+                f"no block module '{module}' (looked for workbook/blocks/{module}.py)"
+            ) from None
         raise
     blk = _REGISTRY.get(ref)
     if blk is None:

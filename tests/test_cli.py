@@ -1,0 +1,66 @@
+"""The command line as a user runs it (in a subprocess: exit codes and messages)."""
+
+import subprocess
+import sys
+
+import openpyxl
+
+
+def run(*args, cwd=None):
+    return subprocess.run(
+        [sys.executable, "-m", "workbook.cli", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=300,
+    )
+
+
+def test_list_names_first():
+    out = run("list")
+    assert out.returncode == 0
+    first = out.stdout.splitlines()[0].split("\t")
+    assert first[0] and first[1]
+    assert any(line.startswith("concave-cam\t") for line in out.stdout.splitlines())
+
+
+def test_run_writes_default_path(tmp_path):
+    out = run("run", "concave-cam", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    path = tmp_path / "reports" / "concave-cam.xlsx"
+    assert path.exists()
+    assert "wrote reports/concave-cam.xlsx" in out.stdout
+    assert "72 of 72 printed values reproduced" in out.stdout
+    wb = openpyxl.load_workbook(path)
+    assert wb.sheetnames[:2] == ["Inputs", "Definitions"]
+    assert {"Listing", "Charts", "Checks", "About"} <= set(wb.sheetnames)
+
+
+def test_run_with_set_and_out(tmp_path):
+    target = tmp_path / "r3.xlsx"
+    out = run("run", "concave-cam", "--set", "R3=40 mm", "--out", str(target))
+    assert out.returncode == 0, out.stderr
+    ws = openpyxl.load_workbook(target)["Inputs"]
+    row = next(r for r in ws.iter_rows(values_only=True) if r[0] == "R3")
+    assert row[1] == 40 and row[2] == "mm"
+    about = openpyxl.load_workbook(target)["About"]
+    texts = [c.value for row in about.iter_rows() for c in row if c.value]
+    assert any('--set R3="40 mm"' in str(t) for t in texts)
+
+
+def test_check_exit_codes(tmp_path):
+    ok = run("check", "concave-cam")
+    assert ok.returncode == 0
+    assert "misprint" in ok.stdout and "all printed values reproduced" in ok.stdout
+    bad = run("check", "concave-cam", "--set", "R3=51 mm")
+    assert bad.returncode == 1
+    assert "NOT reproduced" in bad.stdout
+
+
+def test_bad_input_exit_2_without_traceback():
+    out = run("run", "concave-cam", "--set", "R3=40 kg")
+    assert out.returncode == 2
+    assert "Traceback" not in out.stderr
+    assert "R3" in out.stderr and "[mass]" in out.stderr and "[length]" in out.stderr
+    out = run("check", "no-such-template")
+    assert out.returncode == 2 and "no template named" in out.stderr
