@@ -2,16 +2,19 @@
 
 import subprocess
 import sys
+import tempfile
 
 import openpyxl
 
 
 def run(*args, cwd=None):
+    """Run the installed command line from a folder outside the source tree."""
+    code = "import sys; from workbook.cli import main; sys.exit(main())"
     return subprocess.run(
-        [sys.executable, "-m", "workbook.cli", *args],
+        [sys.executable, "-c", code, *args],
         capture_output=True,
         text=True,
-        cwd=cwd,
+        cwd=cwd or tempfile.gettempdir(),
         timeout=300,
     )
 

@@ -17,14 +17,22 @@ __all__ = ["load", "list_templates", "template_path", "Sheet", "WorkbookError", 
 
 def list_templates() -> dict[str, Path]:
     """Installed templates: name -> path."""
-    from importlib import resources
-
-    root = resources.files("workbook.templates")
     out = {}
-    for entry in root.iterdir():
+    for entry in data_dir("templates").iterdir():
         if entry.name.endswith(".toml"):
             out[entry.name[: -len(".toml")]] = Path(str(entry))
     return dict(sorted(out.items()))
+
+
+def data_dir(folder: str) -> Path:
+    """The installed data folder ('templates' or 'units'), or the source tree's."""
+    from importlib import resources
+
+    package = {"templates": "workbook.templates", "units": "workbook.unitdefs"}[folder]
+    try:
+        return Path(str(resources.files(package)))
+    except ModuleNotFoundError:  # running from a source checkout without installing
+        return Path(__file__).resolve().parent.parent / folder
 
 
 def template_path(name_or_path: str | Path) -> Path:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import functools
 import math
-from importlib import resources
 
 import pint
 
@@ -15,10 +14,10 @@ from .errors import InputError
 def registry() -> pint.UnitRegistry:
     """Return the shared registry (created on first use: it costs ~0.1 s)."""
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
-    for entry in sorted(resources.files("workbook.unitdefs").iterdir(), key=lambda p: p.name):
-        if entry.name.endswith(".txt"):
-            with resources.as_file(entry) as path:
-                ureg.load_definitions(str(path))
+    from . import data_dir
+
+    for path in sorted(data_dir("units").glob("*.txt")):
+        ureg.load_definitions(str(path))
     pint.set_application_registry(ureg)
     return ureg
 

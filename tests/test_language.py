@@ -1,0 +1,58 @@
+"""Every example in docs/language.md is loaded and its `# expect:` lines are checked."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+import workbook
+from workbook.sheet import Sheet
+from workbook.template import load_spec
+
+DOC = Path(__file__).parent.parent / "docs" / "language.md"
+BLOCKS = re.findall(r"```toml\n(.*?)```", DOC.read_text(encoding="utf-8"), flags=re.S)
+RUNNABLE = [b for b in BLOCKS if "# expect:" in b]
+
+
+def test_the_reference_has_runnable_examples():
+    assert len(RUNNABLE) >= 10
+
+
+@pytest.mark.parametrize("text", RUNNABLE, ids=[f"example{i}" for i in range(len(RUNNABLE))])
+def test_example(tmp_path, text):
+    path = tmp_path / "example.toml"
+    path.write_text(text, encoding="utf-8")
+    expects = re.findall(r"# expect: (.*)", text)
+    errors = [e[len("error: "):] for e in expects if e.startswith("error: ")]
+    sheet = None
+    try:
+        sheet = Sheet(load_spec(path))
+    except workbook.WorkbookError as err:
+        assert errors, f"unexpected error {err}"
+        assert errors[0] in str(err)
+        assert str(path) in str(err)
+        return
+    for line in expects:
+        if line.startswith("error: "):
+            call = line[len("error: "):]
+            name, _, args = call.partition("(")
+            with pytest.raises(workbook.WorkbookError):
+                sheet.evaluate(name, *[float(a) for a in args.rstrip(")").split(",") if a])
+            continue
+        if line.startswith("table "):
+            _, name, _, _, n = line.split()
+            assert len(sheet.table(name)) == int(n)
+            continue
+        if line.startswith("chart "):
+            _, name, _, _, n = line.split()
+            assert len(next(c for c in sheet.spec.charts if c.name == name).series) == int(n)
+            sheet.write_xlsx(tmp_path / "chart.xlsx")
+            continue
+        lhs, _, rhs = line.partition(" = ")
+        value, _, unit = rhs.partition(" ")
+        name, _, args = lhs.partition("(")
+        args = [float(a) for a in args.rstrip(")").split(",") if a]
+        q = sheet.evaluate(name, *args)
+        got = q.to(unit).magnitude if unit else q.to("").magnitude
+        digits = len(value.split(".")[1]) if "." in value else 0
+        assert got == pytest.approx(float(value), abs=0.6 * 10**-digits), line
