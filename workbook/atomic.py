@@ -31,6 +31,16 @@ def _is_xlsx(path: Path) -> bool:
         return False
 
 
+def _mode_for(path: Path) -> int:
+    """Keep an existing file's permissions; a new file gets the usual 0666 less the umask."""
+    try:
+        return path.stat().st_mode & 0o7777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
 @contextlib.contextmanager
 def replacing(path: Path):
     """Yield a temporary path beside ``path``; move it into place only if the block succeeds."""
@@ -39,6 +49,7 @@ def replacing(path: Path):
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        os.chmod(tmp_path, _mode_for(path))
         os.replace(tmp_path, path)
     except BaseException:  # includes KeyboardInterrupt: the old file stays as it was
         with contextlib.suppress(OSError):
