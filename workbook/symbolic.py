@@ -1,0 +1,284 @@
+"""SymPy view of a sheet: the typed tree printed as a SymPy expression.
+
+The converter walks the engine's typed tree (:mod:`workbook.typecheck`), so the
+unit logic is already resolved: every magnitude is in the unit the typed node
+carries and every conversion is an explicit factor (``TScale``). Calls of the
+sheet's own functions are inlined; inputs become exact rational numbers (their
+decimal value) unless a symbol is asked for; the built-in ``pi`` is SymPy's
+exact ``pi``.
+
+API (kept small on purpose; other scenes use it)::
+
+    from workbook import symbolic
+    expr = symbolic.to_sympy(sheet, "h1")                 # in the symbol phi
+    d1 = symbolic.derivative(sheet, "h1", "phi", 1)       # d h1 / d phi (phi in its binding unit)
+    f = symbolic.lambdify(sheet, d1, "phi")               # numpy function of phi
+
+A function argument is a magnitude in its binding unit: for ``plain = true``
+arguments (Mathcad's ``phi*deg``) that is the plain number of degrees, so the
+derivative is per degree; multiply by ``per_radian(sheet, "phi")`` for the
+derivative per radian.
+
+``sympy`` is imported lazily (inside functions) so that loading the engine
+does not pay for it.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+from . import typecheck as tc
+from . import units as un
+from .errors import WorkbookError
+
+
+class NotSymbolic(WorkbookError):
+    """The expression contains something SymPy cannot represent (a solver block)."""
+
+    kind = "not symbolic"
+
+
+def _sympy():
+    import sympy
+
+    return sympy
+
+
+def exact_number(value: float):
+    """A float as an exact SymPy number: a short fraction (times pi), else its decimal."""
+    sp = _sympy()
+    v = float(value)
+    if not math.isfinite(v):
+        raise NotSymbolic(f"{v} is not a finite number")
+    if v == 0.0:
+        return sp.Integer(0)
+    if v.is_integer() and abs(v) < 2**53:
+        return sp.Integer(int(v))
+    for base, sym in ((1.0, sp.Integer(1)), (math.pi, sp.pi), (1 / math.pi, 1 / sp.pi)):
+        q = v / base
+        frac = Fraction(q).limit_denominator(10**6)
+        if frac.denominator < 10**6 and abs(float(frac) - q) <= 4e-16 * abs(q):
+            return sp.Rational(frac.numerator, frac.denominator) * sym
+    return sp.Rational(repr(v))
+
+
+class SympyConverter:
+    """Converts typed nodes of one sheet to SymPy; one ``_print_<Node>`` method per node kind."""
+
+    def __init__(self, sheet, symbols: dict | None = None, *, keep=(), true_pi: bool = False):
+        self.sheet = sheet
+        self.symbols = dict(symbols or {})
+        self.keep = set(keep)
+        self.true_pi = true_pi
+        self._scalars: dict[str, object] = {}
+        self._bodies: dict[str, tuple] = {}
+
+    # -- entry points -------------------------------------------------------------------
+    def convert(self, t: tc.T, env: dict | None = None):
+        method = getattr(self, "_print_" + type(t).__name__, None)
+        if method is None:  # pragma: no cover
+            raise NotSymbolic(f"no SymPy form for {type(t).__name__}")
+        return method(t, env or {})
+
+    def function(self, name: str):
+        """(parameter symbols, body expression) of a sheet function."""
+        if name not in self._bodies:
+            sp = _sympy()
+            f = self.sheet.typer.function(name)
+            syms = tuple(self.symbols.get(p, sp.Symbol(p, real=True)) for p in f.params)
+            body = self.convert(f.body, dict(zip(f.params, syms)))
+            self._bodies[name] = (syms, body)
+        return self._bodies[name]
+
+    # -- nodes --------------------------------------------------------------------------
+    def _print_TConst(self, t, env):
+        return exact_number(t.value)
+
+    def _print_TText(self, t, env):
+        return t.value
+
+    def _print_TParam(self, t, env):
+        if t.name in env:
+            return env[t.name]
+        if t.name in self.symbols:
+            return self.symbols[t.name]
+        return _sympy().Symbol(t.name, real=True)
+
+    def _print_TRef(self, t, env):
+        sp = _sympy()
+        name, kind = t.name, t.kind
+        if name in self.symbols:
+            return self.symbols[name]
+        if name in self.keep:
+            return sp.Symbol(name, real=True)
+        if kind == "builtin":
+            return sp.pi
+        if kind == "choice":
+            return self.sheet.values[name]
+        if kind == "input":
+            if self.true_pi and name == "pi":
+                return sp.pi
+            return exact_number(self.sheet.values[name].magnitude)
+        if name not in self._scalars:
+            self._scalars[name] = self.convert(self.sheet.typer.scalar(name), {})
+        return self._scalars[name]
+
+    def _print_TScale(self, t, env):
+        child = self.convert(t.child, env)
+        return child if t.factor == 1.0 else exact_number(t.factor) * child
+
+    def _print_TUnary(self, t, env):
+        sp = _sympy()
+        child = self.convert(t.child, env)
+        return sp.Not(child) if t.op == "not" else -child
+
+    def _print_TBinary(self, t, env):
+        sp = _sympy()
+        a, b = self.convert(t.left, env), self.convert(t.right, env)
+        if t.op == "+":
+            return a + b
+        if t.op == "-":
+            return a - b
+        if t.op == "*":
+            return a * b
+        if t.op == "/":
+            return a / b
+        return sp.Pow(a, b)
+
+    def _print_TCompare(self, t, env):
+        sp = _sympy()
+        vals = [self.convert(o, env) for o in t.operands]
+        if any(isinstance(v, str) for v in vals):
+            a, b = vals
+            same = a == b
+            return sp.true if (same if t.ops[0] == "==" else not same) else sp.false
+        rel = {"<": sp.Lt, "<=": sp.Le, ">": sp.Gt, ">=": sp.Ge, "==": sp.Eq, "!=": sp.Ne}
+        parts = [rel[op](x, y) for op, x, y in zip(t.ops, vals, vals[1:])]
+        return parts[0] if len(parts) == 1 else sp.And(*parts)
+
+    def _print_TLogic(self, t, env):
+        sp = _sympy()
+        vals = [self.convert(v, env) for v in t.values]
+        return sp.And(*vals) if t.op == "and" else sp.Or(*vals)
+
+    def _print_TFunc(self, t, env):
+        sp = _sympy()
+        args = [self.convert(a, env) for a in t.args]
+        simple = {
+            "sin": sp.sin,
+            "cos": sp.cos,
+            "tan": sp.tan,
+            "asin": sp.asin,
+            "acos": sp.acos,
+            "atan": sp.atan,
+            "sinh": sp.sinh,
+            "cosh": sp.cosh,
+            "tanh": sp.tanh,
+            "sqrt": sp.sqrt,
+            "exp": sp.exp,
+            "ln": sp.log,
+            "abs": sp.Abs,
+            "sign": sp.sign,
+            "floor": sp.floor,
+            "ceil": sp.ceiling,
+        }
+        if t.func in simple:
+            return simple[t.func](args[0])
+        if t.func == "log10":
+            return sp.log(args[0], 10)
+        if t.func == "atan2":
+            return sp.atan2(args[0], args[1])
+        if t.func == "min":
+            return sp.Min(*args)
+        if t.func == "max":
+            return sp.Max(*args)
+        raise NotSymbolic(f"no SymPy form for {t.func}()")  # pragma: no cover
+
+    def _print_TCall(self, t, env):
+        syms, body = self.function(t.name)
+        args = [self.convert(a, env) for a in t.args]
+        return body.xreplace(dict(zip(syms, args)))
+
+    def _print_TBlock(self, t, env):
+        raise NotSymbolic(
+            f"{t.name}() is a solver block ({t.ref}): it has no formula to differentiate"
+        )
+
+    def _print_TPiecewise(self, t, env):
+        sp = _sympy()
+        pieces = []
+        for cond, val in zip(t.conditions, t.values):
+            c = sp.true if cond is None else self.convert(cond, env)
+            pieces.append((self.convert(val, env), c))
+        if pieces[-1][1] is not sp.true:
+            pieces.append((sp.nan, True))
+        return sp.Piecewise(*pieces)
+
+
+def to_sympy(sheet, name_or_typed, symbols: dict | None = None, *, keep=(), true_pi=False):
+    """SymPy expression of a definition (by name) or of a typed node.
+
+    ``symbols`` maps parameter, input or definition names to SymPy symbols or expressions
+    (parameters default to real symbols named like the parameter); names in ``keep`` stay
+    symbols (for printing); ``true_pi=True`` replaces a sheet input named ``pi`` (such as
+    the concave-cam sheet's 3.142) by the exact pi.
+    """
+    conv = SympyConverter(sheet, symbols, keep=keep, true_pi=true_pi)
+    try:
+        if isinstance(name_or_typed, str):
+            d = sheet.spec.definitions.get(name_or_typed)
+            if d is None:
+                if name_or_typed in sheet.spec.inputs:
+                    return conv.convert(
+                        tc.TRef(sheet.typer.unit_of(name_or_typed), name=name_or_typed), {}
+                    )
+                raise NotSymbolic(f"'{name_or_typed}' is not defined in {sheet.name}")
+            if d.is_function:
+                return conv.function(name_or_typed)[1]
+            return conv.convert(sheet.typer.scalar(name_or_typed), {})
+        return conv.convert(name_or_typed, {})
+    except WorkbookError as err:
+        raise err.located(file=sheet.file) from None
+
+
+def symbol(name: str):
+    """The real SymPy symbol the converter uses for a parameter."""
+    return _sympy().Symbol(name, real=True)
+
+
+def derivative(sheet, name: str, var: str | None = None, order: int = 1, **options):
+    """d^order(name)/d(var)^order, with var in its binding unit (degrees for plain deg)."""
+    sp = _sympy()
+    d = sheet.spec.definitions.get(name)
+    if d is None or not d.is_function:
+        raise NotSymbolic(f"'{name}' is not a function of the sheet")
+    var = var or d.params[0]
+    if var not in d.params:
+        raise NotSymbolic(f"{name}() has no argument '{var}' (arguments: {', '.join(d.params)})")
+    expr = to_sympy(sheet, name, **options)
+    sym = (options.get("symbols") or {}).get(var, symbol(var))
+    return sp.diff(expr, sym, order)
+
+
+def per_radian(sheet, var: str, unit: str = "rad") -> float:
+    """Binding-unit magnitudes of ``var`` per one ``unit`` (57.29... for a degree argument)."""
+    arg = sheet.spec.arguments[var]
+    return un.factor(un.unit(unit), arg.unit)
+
+
+def lambdify(sheet, expr, *params: str, modules="numpy"):
+    """A fast function of the given parameters (names of symbols in ``expr``)."""
+    sp = _sympy()
+    return sp.lambdify([symbol(p) for p in params], expr, modules=modules)
+
+
+def text(sheet, t: tc.T, keep=None) -> str:
+    """Readable text of a typed sub-expression (inputs and scalar definitions kept as names)."""
+    sp = _sympy()
+    if keep is None:
+        keep = set(sheet.spec.inputs) | {
+            n for n, d in sheet.spec.definitions.items() if not d.is_function
+        }
+    expr = SympyConverter(sheet, keep=keep).convert(t, {})
+    return sp.sstr(expr).replace("**", "^")
