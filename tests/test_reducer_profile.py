@@ -1,0 +1,392 @@
+"""reducer-profile: tooth profile of a planetary roller reducer's cam (SCENES.md section 3).
+
+References that this file does not take from the engine:
+* the SCENES.md example coordinates (computed independently in double precision);
+* an mpmath implementation of formulas (1)-(5) written here from SCENES.md, with derivatives
+  by mpmath.diff at 30 digits (the normal of (5));
+* the closed-form radius of curvature at a tooth valley of R(t) = e1 cos(Zt) + sqrt(r2^2 -
+  e1^2 sin^2(Zt)): rho = (r2 - e1)^2 / (Z^2 (e1 - e1^2/r2) - (r2 - e1)).
+"""
+
+import math
+import zipfile
+
+import mpmath as mp
+import numpy as np
+import pytest
+
+import workbook
+from workbook.blocks import reducer
+from workbook.errors import InputError, TemplateError
+
+
+@pytest.fixture(scope="module")
+def sheet():
+    return workbook.load("reducer-profile")
+
+
+# -- an independent implementation of (1)-(5) ---------------------------------------------
+
+
+def ref_curve(k, n, e1, r2, sense):
+    """(x_t(phi), y_t(phi)) of roller k with the corrected rotation, phi in radians (mpmath)."""
+    Z = n - 1 if sense == "same" else n + 1
+    ratio = -mp.mpf(1) / Z if sense == "same" else mp.mpf(1) / Z
+    theta = 2 * mp.pi * k / n
+
+    def rho(phi):
+        return e1 * mp.cos(theta - phi) + mp.sqrt(r2**2 - e1**2 * mp.sin(theta - phi) ** 2)
+
+    def xt(phi):
+        a = ratio * phi
+        return rho(phi) * mp.cos(theta) * mp.cos(a) + rho(phi) * mp.sin(theta) * mp.sin(a)
+
+    def yt(phi):
+        a = ratio * phi
+        return -rho(phi) * mp.cos(theta) * mp.sin(a) + rho(phi) * mp.sin(theta) * mp.cos(a)
+
+    return xt, yt
+
+
+def ref_practical(k, phi_deg, n, e1, r2, rp, sense):
+    """(x_t, y_t, x_k, y_k) by (5) with derivatives from mpmath.diff."""
+    with mp.workdps(30):
+        xt, yt = ref_curve(k, n, mp.mpf(e1), mp.mpf(r2), sense)
+        phi = mp.radians(mp.mpf(phi_deg))
+        dx, dy = mp.diff(xt, phi), mp.diff(yt, phi)
+        length = mp.sqrt(dx**2 + dy**2)
+        rps = rp if sense == "same" else -rp
+        x, y = xt(phi), yt(phi)
+        return [float(v) for v in (x, y, x + rps * dy / length, y - rps * dx / length)]
+
+
+# -- the SCENES.md example ------------------------------------------------------------------
+
+SCENES = [  # phi, rho, a, x_t, y_t, x_k, y_k (n = 12, Z = 11, e1 = 2, r2 = 40, rp = 4, k = 0)
+    (0, 42, 0.0, 42, 0, 46, 0),
+    (90, 39.95, -8.182, 39.5433, 5.6855, 42.7369, 8.0940),
+    (180, 38, None, 36.4607, 10.7058, 40.2987, 11.8328),
+]
+
+
+@pytest.mark.parametrize("row", SCENES, ids=[f"phi={r[0]}" for r in SCENES])
+def test_scenes_example_coordinates(sheet, row):
+    phi, rho, a, xt, yt, xk, yk = row
+    assert sheet.evaluate("rho", 0, phi).to("mm").magnitude == pytest.approx(rho, abs=5e-3)
+    if a is not None:
+        assert sheet.evaluate("a", phi).to("deg").magnitude == pytest.approx(a, abs=5e-4)
+    assert sheet.evaluate("x_t", 0, phi).to("mm").magnitude == pytest.approx(xt, abs=1e-4)
+    assert sheet.evaluate("y_t", 0, phi).to("mm").magnitude == pytest.approx(yt, abs=1e-4)
+    table = sheet.table("rollers")
+    r = table[(table["k"] == 0) & (table["phi [deg]"] == phi)].iloc[0]
+    assert r["x_t [mm]"] == pytest.approx(xt, abs=1e-4)
+    assert r["y_t [mm]"] == pytest.approx(yt, abs=1e-4)
+    assert r["x_k [mm]"] == pytest.approx(xk, abs=1e-4)
+    assert r["y_k [mm]"] == pytest.approx(yk, abs=1e-4)
+
+
+def test_inputs_and_derived_scalars(sheet):
+    assert sheet.evaluate("Z").magnitude == 11
+    assert sheet.with_inputs(sense="opposite").evaluate("Z").magnitude == 13
+    assert sheet.evaluate("rp_packing").to("mm").magnitude == pytest.approx(
+        38 * math.sin(math.pi / 12), rel=1e-14
+    )
+
+
+# -- the practical profile against mpmath, at every table point --------------------------------
+
+
+@pytest.mark.parametrize("n,sense", [(12, "same"), (12, "opposite"), (7, "same"), (7, "opposite")])
+def test_practical_profile_matches_mpmath(sheet, n, sense):
+    s = sheet.with_inputs(n=n, sense=sense, dphi="10 deg")
+    table = s.table("rollers")
+    rows = table.iloc[:: max(1, len(table) // 60)]
+    for _, r in rows.iterrows():
+        ref = ref_practical(int(r["k"]), r["phi [deg]"], n, 2, 40, 4, sense)
+        got = [r["x_t [mm]"], r["y_t [mm]"], r["x_k [mm]"], r["y_k [mm]"]]
+        assert got == pytest.approx(ref, abs=1e-10), (int(r["k"]), r["phi [deg]"])
+
+
+@pytest.mark.parametrize("sense", ["same", "opposite"])
+def test_offset_lies_at_distance_rp_at_every_point(sheet, sense):
+    s = sheet.with_inputs(sense=sense)
+    t = s.table("rollers")
+    dx, dy = t["x_k [mm]"] - t["x_t [mm]"], t["y_k [mm]"] - t["y_t [mm]"]
+    assert np.max(np.abs(np.hypot(dx, dy) - 4.0)) < 1e-12
+    # and it is the distance to the whole theoretical curve, not only to its own point:
+    # nearest point on a dense independent sampling of the closed form R(psi), refined
+    p = s.table("profile")
+    Z = s.evaluate("Z").magnitude
+    psi = np.linspace(0, 2 * np.pi, 400_001)
+    R = 2 * np.cos(Z * psi) + np.sqrt(1600 - 4 * np.sin(Z * psi) ** 2)
+    cx, cy = R * np.cos(psi), R * np.sin(psi)
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(np.column_stack([cx, cy])).query(p[["x_k [mm]", "y_k [mm]"]].to_numpy())
+    # chord sampling overestimates the distance by at most (spacing)^2/(8 rho) ~ 1e-9 mm
+    assert np.all(d >= 4.0 - 1e-12) and np.all(d - 4.0 < 1e-7)
+    # the engine's own nearest-point check (Newton refined) reports rp to rounding
+    f = {x.what: x for x in s.check().findings}
+    gap = next(v for k, v in f.items() if k.startswith("distance of the practical"))
+    assert gap.verdict == "ok" and gap.value < 1e-12
+
+
+def test_normal_includes_the_cam_rotation(sheet):
+    """Without da/dphi the tangent would vanish at theta_k - phi = 0; with it, it does not."""
+    m = reducer.model(sheet)
+    _, _, dx, dy, _, _ = m.derivs(0, np.array([0.0, 180.0]))
+    assert np.all(np.hypot(dx, dy) > 1e-3)
+
+
+# -- closure: all n traces coincide ----------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "n,sense,Z", [(12, "same", 11), (12, "opposite", 13), (7, "same", 6), (7, "opposite", 8)]
+)
+def test_closure_holds(sheet, n, sense, Z):
+    s = sheet.with_inputs(n=n, sense=sense)
+    m = reducer.model(s)
+    assert m.Z == Z and m.turns == Z
+    c = reducer.closure(m)
+    assert c["points"] == (n - 1) * 181
+    assert c["max"] < 1e-9
+    assert reducer.closed_form_deviation(m) < 1e-9
+    f = [x for x in s.check().findings if x.topic == "closure"]
+    assert f[0].verdict == "ok" and f[0].value < 1e-9
+
+
+@pytest.mark.parametrize(
+    "changes",
+    [{"transform": "printed"}, {"ratio": "printed"}, {"transform": "printed", "ratio": "printed"}],
+)
+def test_printed_variants_do_not_close(sheet, changes):
+    s = sheet.with_inputs(**changes)
+    c = reducer.closure(reducer.model(s))
+    assert c["max"] > 1.0  # millimetres apart
+    f = [x for x in s.check().findings if x.topic == "closure"]
+    assert f[0].verdict == "fail" and "do not coincide" in f[0].note
+
+
+def test_printed_transform_is_not_a_rotation(sheet):
+    s = sheet.with_inputs(transform="printed")
+    # a rotation keeps the distance from the axis; the printed (4) does not
+    # (roller 1: x and y both nonzero; |r|^2 = rho^2 (1 + 2 sin 2theta sin 2a))
+    r_t = np.hypot(s.evaluate("x_t", 1, 90).magnitude, s.evaluate("y_t", 1, 90).magnitude)
+    assert abs(r_t - s.evaluate("rho", 1, 90).magnitude) > 0.1
+    default = {x.what: x for x in sheet.check().findings}
+    shown = [x for x in default.values() if x.what.startswith("as printed")]
+    assert len(shown) == 3 and all(x.value > 1 for x in shown)
+
+
+# -- undercut -------------------------------------------------------------------------------
+
+
+def valley_radius(n, e1, r2, sense):
+    Z = n - 1 if sense == "same" else n + 1
+    return (r2 - e1) ** 2 / (Z**2 * (e1 - e1**2 / r2) - (r2 - e1))
+
+
+@pytest.mark.parametrize("n,sense", [(12, "same"), (12, "opposite"), (7, "opposite")])
+def test_smallest_concave_radius(sheet, n, sense):
+    s = sheet.with_inputs(n=n, sense=sense)
+    uc = reducer.undercut(reducer.model(s))
+    assert uc.concave
+    assert uc.rho_min == pytest.approx(valley_radius(n, 2, 40, sense), rel=1e-9)
+
+
+def test_example_limit_is_7_525(sheet):
+    uc = reducer.undercut(reducer.model(sheet))
+    assert uc.rho_min == pytest.approx(7.525, abs=5e-4)
+    assert uc.phi_at == pytest.approx(180, abs=1e-6)  # at the valley, roller 0
+    assert uc.packing == pytest.approx(9.8351, abs=1e-4)
+
+
+def test_rp_7_5_regular(sheet):
+    s = sheet.with_inputs(rp="7.5 mm")
+    f = [x for x in s.check().findings if x.topic == "undercut"]
+    assert not any(x.verdict == "fail" for x in f)
+    assert any(x.verdict == "ok" and "regular" in x.what for x in f)
+    assert s.table("profile")["regular"].all()
+    assert s.table("undercut").empty
+
+
+def test_rp_7_6_undercut(sheet):
+    s = sheet.with_inputs(rp="7.6 mm")
+    report = s.check()
+    assert not report.ok
+    f = [x for x in report.findings if x.topic == "undercut"]
+    verdict = next(x for x in f if x.what.startswith("INVALID PROFILE"))
+    assert verdict.verdict == "fail" and "7.52475" in verdict.what
+    m = reducer.model(s)
+    uc = reducer.undercut(m)
+    assert len(uc.cusps) == 22 and len(uc.loops) == 11
+    # each cusp: the practical curve stops (its tangent vanishes) - an independent check
+    for c in uc.cusps[:4]:
+
+        def xk(phi, sign):
+            return ref_practical(0, float(phi), 12, 2, 40, 7.6, "same")[sign]
+
+        h = 1e-4
+        vx = (xk(c["phi"] + h, 2) - xk(c["phi"] - h, 2)) / (2 * h)
+        vy = (xk(c["phi"] + h, 3) - xk(c["phi"] - h, 3)) / (2 * h)
+        speed_far = abs(xk(c["phi"] + 20, 2) - xk(c["phi"] + 20 - 2 * h, 2)) / (2 * h)
+        assert math.hypot(vx, vy) < 1e-4 * max(speed_far, 1e-3)
+    # each loop: two different eccentric angles give the same point
+    for lp in uc.loops[:3]:
+        p1 = ref_practical(0, lp["phi1"], 12, 2, 40, 7.6, "same")[2:]
+        p2 = ref_practical(0, lp["phi2"], 12, 2, 40, 7.6, "same")[2:]
+        assert abs(lp["phi2"] - lp["phi1"]) > 1
+        assert p1 == pytest.approx(p2, abs=1e-9)
+        assert p1 == pytest.approx([lp["x"], lp["y"]], abs=1e-9)
+    # the first loop sits on the valley's symmetry line, polar angle 180/Z deg
+    assert uc.loops[0]["psi"] == pytest.approx(180 / 11, abs=1e-9)
+    # the profile is still tabulated, marked invalid where the offset folds back
+    prof = s.table("profile")
+    assert (prof["regular"] == 0).sum() > 0
+    assert "undercut" in prof.attrs["invalid"]
+    ut = s.table("undercut")
+    assert list(ut["kind"]).count("cusp") == 22
+
+
+def test_packing_limit_verdict(sheet):
+    s = sheet.with_inputs(e1="0.3 mm", rp="10.3 mm")  # convex; packing limit 10.275 mm
+    f = [x for x in s.check().findings if x.topic == "undercut"]
+    bad = next(x for x in f if x.verdict == "fail")
+    assert "packing limit" in bad.what and "overlap" in bad.what
+
+
+@pytest.mark.parametrize("factor,concave", [(0.98, False), (1.02, True)])
+def test_concave_parts_exist_when_z2_e1_exceeds_r2(sheet, factor, concave):
+    e1 = factor * 40 / 121
+    s = sheet.with_inputs(e1=f"{e1} mm")
+    uc = reducer.undercut(reducer.model(s))
+    assert uc.concave is concave
+    if not concave:
+        assert math.isinf(uc.rho_min)
+        assert s.with_inputs(rp="9 mm").check().ok
+
+
+# -- degenerate inputs ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("sense", ["same", "opposite"])
+def test_e1_zero_gives_circles(sheet, sense):
+    s = sheet.with_inputs(e1="0 mm", sense=sense)
+    t = s.table("rollers")
+    assert np.allclose(np.hypot(t["x_t [mm]"], t["y_t [mm]"]), 40, atol=1e-12, rtol=0)
+    assert np.allclose(np.hypot(t["x_k [mm]"], t["y_k [mm]"]), 44, atol=1e-12, rtol=0)
+    report = s.check()
+    assert report.ok
+    assert any("circle" in x.what for x in report.findings)
+
+
+@pytest.mark.parametrize("e1", ["45 mm", "40 mm"])
+def test_e1_not_below_r2_is_refused_clearly(sheet, e1):
+    s = sheet.with_inputs(e1=e1)
+    f = s.check().findings
+    assert len(f) == 1 and f[0].verdict == "fail"
+    assert "not smaller than r2" in f[0].what and "cannot be assembled" in f[0].what
+    with pytest.raises(InputError, match="not smaller than r2"):
+        s.table("profile")
+
+
+def test_fractional_roller_count_is_refused(sheet):
+    f = sheet.with_inputs(n=12.5).check().findings
+    assert f[0].verdict == "fail" and "whole number" in f[0].what
+
+
+# -- the symbolic converter -------------------------------------------------------------------
+
+
+def test_sympy_form_is_the_templates_own(sheet):
+    import sympy as sp
+
+    m = reducer.model(sheet)
+    assert m.exprs["x_t"].free_symbols == {sp.Symbol("k", real=True), sp.Symbol("phi", real=True)}
+    f = {x.what: x for x in sheet.check().findings}
+    same = next(x for k, x in f.items() if k.startswith("sympy form"))
+    assert same.verdict == "ok" and same.value < 1e-12
+
+
+def test_converter_piecewise_in_the_parameter_and_refusals(tmp_path):
+    import sympy as sp
+
+    path = tmp_path / "pw.toml"
+    path.write_text(
+        '[inputs]\nc = "2 mm"\n[arguments]\nphi = { unit = "deg" }\n'
+        '[definitions]\n"f(phi)" = { pieces = ["c*sin(phi) if phi < 90", "c otherwise"], '
+        'unit = "mm" }\n',
+        encoding="utf-8",
+    )
+    s = workbook.load(path)
+    phi = sp.Symbol("phi", real=True)
+    e = reducer.to_sympy(s, s.typer.function("f").body, {"phi": phi})
+    assert isinstance(e, sp.Piecewise)
+    d = sp.lambdify(phi, sp.diff(e, phi))
+    assert d(30.0) == pytest.approx(2 * math.cos(math.radians(30)) * math.pi / 180, rel=1e-14)
+    with pytest.raises(TemplateError, match="x_t"):
+        reducer.model(s)
+
+
+# -- workbook, chart and CAD export ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("sense,lobes", [("same", 11), ("opposite", 13)])
+def test_profile_has_z_lobes(sheet, sense, lobes):
+    p = sheet.with_inputs(sense=sense).table("profile")
+    r = np.hypot(p["x_t [mm]"], p["y_t [mm]"]).to_numpy()[:-1]  # closed: drop the repeat
+    peaks = (r > np.roll(r, 1)) & (r > np.roll(r, -1))
+    assert peaks.sum() == lobes
+    assert p["phi [deg]"].iloc[-1] == 360 * lobes
+
+
+def test_workbook_chart_has_equal_axes(sheet, tmp_path):
+    spec = next(c for c in sheet.spec.charts if c.name == "tooth_profile")
+    assert spec.equal_axes
+    path = sheet.write_xlsx(tmp_path / "rp.xlsx")
+    with zipfile.ZipFile(path) as z:
+        xml = z.read("xl/charts/chart1.xml").decode()
+    import re
+
+    mins = [float(v) for v in re.findall(r'<c:min val="([^"]+)"/>', xml)]
+    maxs = [float(v) for v in re.findall(r'<c:max val="([^"]+)"/>', xml)]
+    assert len(mins) == len(maxs) == 2 and mins[0] == mins[1] and maxs[0] == maxs[1]
+    assert maxs[0] >= 46 and mins[0] <= -46  # the practical profile fits
+    assert 'c:w val="0.76' in xml and 'c:h val="0.76' in xml  # square plot area
+
+
+def test_invalid_profile_is_still_written(sheet, tmp_path):
+    import openpyxl
+
+    path = sheet.with_inputs(rp="7.6 mm").write_xlsx(tmp_path / "bad.xlsx")
+    wb = openpyxl.load_workbook(path)
+    text = " ".join(str(c.value) for row in wb["Checks"].iter_rows() for c in row if c.value)
+    assert "INVALID PROFILE" in text and "cusp" in text and "loop" in text
+    assert wb["Profile"].max_row > 1900
+
+
+def test_export_profile_csv(sheet, tmp_path):
+    path = reducer.export_profile_csv(sheet, tmp_path / "cam.csv")
+    lines = path.read_text().splitlines()
+    assert lines[0] == "x_mm,y_mm,z_mm"
+    pts = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    assert len(pts) == 11 * 180  # 2-degree steps over 11 turns, closing point left out
+    r = np.hypot(pts[:, 0], pts[:, 1])
+    assert r.max() == pytest.approx(46, abs=1e-9)  # tooth tip: r2 + e1 + rp
+    assert np.all(pts[:, 2] == 0)
+    with pytest.raises(InputError, match="invalid"):
+        reducer.export_profile_csv(sheet.with_inputs(rp="7.6 mm"), tmp_path / "bad.csv")
+    ok = reducer.export_profile_csv(
+        sheet.with_inputs(rp="7.6 mm"), tmp_path / "bad.csv", allow_invalid=True
+    )
+    assert ok.exists()
+
+
+def test_check_is_quick(sheet):
+    import time
+
+    s = sheet.with_inputs(rp="4.5 mm")  # a new Sheet: nothing cached
+    t = time.perf_counter()
+    s.check()
+    assert time.perf_counter() - t < 5

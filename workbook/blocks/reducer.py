@@ -1,0 +1,904 @@
+"""Planetary roller reducer: tooth profile of the cam (template ``reducer-profile``).
+
+Kireev, Kovalev, Ershov (2003), formulas (1)-(5). The template defines the theoretical
+profile ``x_t(k, phi)``, ``y_t(k, phi)`` of roller k; this module
+
+* turns those definitions (the engine's typed trees) into sympy expressions with a small
+  whitelisted converter and differentiates them symbolically in phi: the normal of (5) and
+  the curvature of the theoretical profile come from these exact derivatives (no hand-written
+  derivative formulas, no finite differences);
+* tabulates the theoretical and practical profile of every roller (block tables);
+* checks closure (the traces of all n rollers must coincide) by the distance of every
+  point of rollers 1..n-1 from the trace of roller 0 (nearest point on the curve, refined by
+  Newton's method on the exact derivatives);
+* checks undercut: the smallest radius of curvature of the concave parts of the theoretical
+  profile, the packing limit, and where the practical profile gets cusps and loops.
+
+Names the blocks read from the template: inputs n, e1, r2, rp, dphi; definitions Z, i_a,
+rp_s, x_t(k, phi), y_t(k, phi), rho(k, phi), a(phi), R_closed(psi).
+
+sympy and scipy are imported inside functions (the engine imports this module only when a
+template asks for it).
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import typecheck as tc
+from .. import units as un
+from ..errors import InputError, TemplateError
+from . import Finding, findings_block, table_block
+
+#: The closure check passes when the traces agree to this distance (mm).
+CLOSURE_TOL_MM = 1e-9
+#: Step of the dense sampling used to find nearest points and curvature extremes (deg of phi).
+_SAMPLE_DEG = 0.25
+
+# ----------------------------------------------------------------------------------------
+# typed tree -> sympy (whitelisted; nothing is ever sympified from text)
+# ----------------------------------------------------------------------------------------
+
+_FUNCS_1 = {
+    "sin": "sin",
+    "cos": "cos",
+    "tan": "tan",
+    "asin": "asin",
+    "acos": "acos",
+    "atan": "atan",
+    "sinh": "sinh",
+    "cosh": "cosh",
+    "tanh": "tanh",
+    "sqrt": "sqrt",
+    "exp": "exp",
+    "ln": "log",
+    "abs": "Abs",
+    "sign": "sign",
+    "floor": "floor",
+    "ceil": "ceiling",
+}
+
+
+class _Choice(str):
+    """The value of a choice input inside the converter (only compared with text)."""
+
+
+def to_sympy(sheet, t: tc.T, env: dict):
+    """Convert a typed tree of ``sheet`` into a sympy expression.
+
+    ``env`` maps function parameters to sympy expressions (symbols at the top). Inputs and
+    scalar definitions become their numbers (magnitudes in the unit the typed tree expects);
+    conditions on choice inputs are decided here, conditions on parameters become
+    ``Piecewise``. Solver blocks cannot be differentiated and are refused.
+    """
+    import sympy as sp
+
+    def conv(node, env):
+        if isinstance(node, tc.TConst):
+            v = float(node.value)
+            return sp.Integer(int(v)) if v.is_integer() and abs(v) < 2**53 else sp.Float(v)
+        if isinstance(node, tc.TText):
+            return _Choice(node.value)
+        if isinstance(node, tc.TParam):
+            return env[node.name]
+        if isinstance(node, tc.TRef):
+            if node.kind == "builtin":
+                return sp.Float(math.pi)
+            if node.kind == "choice":
+                return _Choice(sheet.values[node.name])
+            q = sheet.evaluate(node.name)
+            return sp.Float(float(q.to(node.unit).magnitude))
+        if isinstance(node, tc.TScale):
+            child = conv(node.child, env)
+            return child if node.factor == 1.0 else child * sp.Float(node.factor)
+        if isinstance(node, tc.TUnary):
+            child = conv(node.child, env)
+            return sp.Not(child) if node.op == "not" else -child
+        if isinstance(node, tc.TBinary):
+            left, right = conv(node.left, env), conv(node.right, env)
+            if node.op == "+":
+                return left + right
+            if node.op == "-":
+                return left - right
+            if node.op == "*":
+                return left * right
+            if node.op == "/":
+                return left / right
+            return sp.Pow(left, right)
+        if isinstance(node, tc.TCompare):
+            vals = [conv(o, env) for o in node.operands]
+            parts = []
+            for op, x, y in zip(node.ops, vals[:-1], vals[1:]):
+                if isinstance(x, _Choice) or isinstance(y, _Choice):
+                    same = str(x) == str(y)
+                    parts.append(sp.true if (same if op == "==" else not same) else sp.false)
+                    continue
+                rel = {"<": sp.Lt, "<=": sp.Le, ">": sp.Gt, ">=": sp.Ge, "==": sp.Eq, "!=": sp.Ne}[
+                    op
+                ]
+                parts.append(rel(x, y))
+            return sp.And(*parts)
+        if isinstance(node, tc.TLogic):
+            vals = [conv(v, env) for v in node.values]
+            return sp.And(*vals) if node.op == "and" else sp.Or(*vals)
+        if isinstance(node, tc.TFunc):
+            args = [conv(a, env) for a in node.args]
+            if node.func in _FUNCS_1:
+                return getattr(sp, _FUNCS_1[node.func])(args[0])
+            if node.func == "log10":
+                return sp.log(args[0], 10)
+            if node.func == "atan2":
+                return sp.atan2(args[0], args[1])
+            if node.func == "min":
+                return sp.Min(*args)
+            if node.func == "max":
+                return sp.Max(*args)
+            raise TemplateError(f"function {node.func}() cannot be differentiated symbolically")
+        if isinstance(node, tc.TCall):
+            f = sheet.typer.function(node.name)
+            inner = {p: conv(a, env) for p, a in zip(f.params, node.args)}
+            return conv(f.body, inner)
+        if isinstance(node, tc.TPiecewise):
+            pieces = []
+            for cond, value in zip(node.conditions, node.values):
+                c = sp.true if cond is None else conv(cond, env)
+                if c is sp.false:
+                    continue
+                pieces.append((conv(value, env), c))
+                if c is sp.true:
+                    break
+            if not pieces:
+                raise InputError("no piece of a piecewise definition applies")
+            if len(pieces) == 1 and pieces[0][1] is sp.true:
+                return pieces[0][0]
+            return sp.Piecewise(*pieces)
+        if isinstance(node, tc.TBlock):
+            raise TemplateError(
+                f"the solver block {node.name}() cannot be differentiated symbolically; "
+                "write x_t and y_t with worksheet formulas only"
+            )
+        raise TemplateError(f"cannot convert {type(node).__name__} to sympy")  # pragma: no cover
+
+    return conv(t, env)
+
+
+# ----------------------------------------------------------------------------------------
+# the model of one sheet (built once per Sheet object)
+# ----------------------------------------------------------------------------------------
+
+
+@dataclass
+class Undercut:
+    concave: bool  # the theoretical profile has concave parts (seen from the roller side)
+    rho_min: float  # smallest radius of curvature of the concave parts, mm (inf if none)
+    phi_at: float  # eccentric angle of roller 0 where it occurs, deg
+    point: tuple[float, float]  # (x_t, y_t) there, mm
+    packing: float  # (r2 - e1) sin(pi/n), mm
+    cusps: list = field(default_factory=list)  # dicts: tooth, phi, psi, x, y
+    loops: list = field(default_factory=list)  # dicts: tooth, phi1, phi2, psi, x, y
+    bad_intervals: int = 0
+
+    def regular(self, rp: float) -> bool:
+        return rp < self.rho_min and rp < self.packing
+
+
+@dataclass
+class Model:
+    sheet: object
+    n: int
+    Z: float
+    i_a: float
+    turns: int  # eccentric turns after which roller 0 has traced the whole closed profile
+    e1: float
+    r2: float
+    rp: float
+    rp_s: float
+    dphi: float
+    phi_unit: object
+    exprs: dict
+    _f: object
+    _cache: dict = field(default_factory=dict)
+
+    @property
+    def sign(self) -> float:
+        return 1.0 if self.rp_s >= 0 else -1.0
+
+    def deg(self, phi_deg):
+        """Eccentric angle in degrees -> magnitude in the template's unit of phi."""
+        return np.asarray(phi_deg, dtype=float) * un.factor(un.unit("deg"), self.phi_unit)
+
+    def derivs(self, k, phi_deg):
+        """x_t, y_t and their first and second derivatives per degree of phi (arrays)."""
+        k = np.asarray(k, dtype=float)
+        phi = self.deg(phi_deg)
+        shape = np.broadcast(k, phi).shape
+        out = self._f(k, phi)
+        scale = un.factor(un.unit("deg"), self.phi_unit)
+        vals = [np.broadcast_to(np.asarray(v, dtype=float), shape) for v in out]
+        x, y, dx, dy, ddx, ddy = vals
+        return x, y, dx * scale, dy * scale, ddx * scale**2, ddy * scale**2
+
+    def normal(self, dx, dy):
+        """Unit normal of (5) on the offset side: sign(rp_s) * (y', -x') / |t'|."""
+        length = np.hypot(dx, dy)
+        if np.any(length == 0):
+            raise InputError(
+                "the theoretical profile has a point where its tangent vanishes; "
+                "the normal of (5) is undefined there"
+            )
+        return self.sign * dy / length, -self.sign * dx / length
+
+    def practical(self, k, phi_deg, xt=None, yt=None):
+        x, y, dx, dy, _, _ = self.derivs(k, phi_deg)
+        xt = x if xt is None else xt
+        yt = y if yt is None else yt
+        nx, ny = self.normal(dx, dy)
+        return xt + self.rp * nx, yt + self.rp * ny
+
+    def kappa_n(self, k, phi_deg):
+        """Curvature of the theoretical profile toward the offset side, 1/mm.
+
+        Positive on the concave parts (the centre of curvature lies on the roller side):
+        the offset by rp is regular while rp * kappa_n < 1.
+        """
+        _, _, dx, dy, ddx, ddy = self.derivs(k, phi_deg)
+        kappa_left = (dx * ddy - dy * ddx) / np.hypot(dx, dy) ** 3
+        return -self.sign * kappa_left
+
+    def offset_point_and_tangent(self, phi_deg, k=0):
+        """Practical-profile point and its derivative per degree (exact, from x'', y'')."""
+        x, y, dx, dy, ddx, ddy = self.derivs(k, phi_deg)
+        L = np.hypot(dx, dy)
+        dL = (dx * ddx + dy * ddy) / L
+        nx, ny = self.sign * dy / L, -self.sign * dx / L
+        dnx = self.sign * (ddy / L - dy * dL / L**2)
+        dny = -self.sign * (ddx / L - dx * dL / L**2)
+        return x + self.rp * nx, y + self.rp * ny, dx + self.rp * dnx, dy + self.rp * dny
+
+    @property
+    def period(self) -> float:
+        return 360.0 * self.turns
+
+
+_MODELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _mag(sheet, name: str, unit: str) -> float:
+    return float(sheet.evaluate(name).to(unit).magnitude)
+
+
+def model(sheet) -> Model:
+    """The symbolic model of ``sheet`` (built once, cached per Sheet object)."""
+    m = _MODELS.get(sheet)
+    if m is None:
+        m = _build(sheet)
+        _MODELS[sheet] = m
+    return m
+
+
+def validate(sheet) -> None:
+    """Refuse inputs for which the mechanism does not exist, with a message saying why."""
+    n = _mag(sheet, "n", "")
+    if abs(n - round(n)) > 1e-9:
+        raise InputError(f"n = {n:g}: the number of rollers must be a whole number", definition="n")
+    e1, r2 = _mag(sheet, "e1", "mm"), _mag(sheet, "r2", "mm")
+    if e1 >= r2:
+        raise InputError(
+            f"e1 = {e1:g} mm is not smaller than r2 = {r2:g} mm: the eccentric would carry the "
+            "roller-centre circle onto or across the cam axis, r2^2 - e1^2*sin^2 in (1) turns "
+            "negative and the rollers have no position (the mechanism cannot be assembled); "
+            "choose e1 < r2",
+            definition="e1",
+        )
+
+
+def _build(sheet) -> Model:
+    import sympy as sp
+
+    spec = sheet.spec
+    for name in ("x_t", "y_t"):
+        d = spec.definitions.get(name)
+        if d is None or d.params != ("k", "phi"):
+            raise TemplateError(f"the reducer blocks need a definition {name}(k, phi)")
+    missing = [x for x in ("n", "e1", "r2", "rp", "dphi") if x not in spec.inputs]
+    missing += [x for x in ("Z", "i_a", "rp_s", "rp_packing") if x not in spec.definitions]
+    if missing:
+        raise TemplateError("the reducer blocks need " + ", ".join(missing))
+    validate(sheet)
+    n = int(round(_mag(sheet, "n", "")))
+    i_a = _mag(sheet, "i_a", "")
+    if i_a == 0:
+        raise InputError("the cam does not turn (a/phi = 0): no profile is traced")
+    turns = int(round(1 / abs(i_a)))
+    if abs(turns * abs(i_a) - 1) > 1e-9:
+        raise InputError(f"a/phi = {i_a:g} is not 1/(whole number): the trace never closes")
+    k, phi = sp.symbols("k phi", real=True)
+    exprs = {}
+    for name in ("x_t", "y_t"):
+        f = sheet.typer.function(name)
+        expr = to_sympy(sheet, f.body, {"k": k, "phi": phi})
+        exprs[name] = expr * sp.Float(un.factor(f.unit, un.unit("mm")))
+    X, Y = exprs["x_t"], exprs["y_t"]
+    dX, dY = sp.diff(X, phi), sp.diff(Y, phi)
+    ddX, ddY = sp.diff(dX, phi), sp.diff(dY, phi)
+    exprs.update({"dx_t": dX, "dy_t": dY, "ddx_t": ddX, "ddy_t": ddY})
+    func = sp.lambdify((k, phi), [X, Y, dX, dY, ddX, ddY], modules="numpy", cse=True)
+    rp = _mag(sheet, "rp", "mm")
+    return Model(
+        sheet=sheet,
+        n=n,
+        Z=_mag(sheet, "Z", ""),
+        i_a=i_a,
+        turns=turns,
+        e1=_mag(sheet, "e1", "mm"),
+        r2=_mag(sheet, "r2", "mm"),
+        rp=rp,
+        rp_s=_mag(sheet, "rp_s", "mm"),
+        dphi=_mag(sheet, "dphi", "deg"),
+        phi_unit=spec.arguments["phi"].unit,
+        exprs=exprs,
+        _f=func,
+    )
+
+
+def _grid(last_deg: float, step_deg: float) -> np.ndarray:
+    from ..template import range_values
+
+    return range_values(0.0, step_deg, last_deg, what="reducer grid")
+
+
+def _engine(sheet, name: str, unit: str, *args) -> np.ndarray:
+    return np.asarray(sheet.evaluate(name, *args).to(unit).magnitude, dtype=float)
+
+
+# ----------------------------------------------------------------------------------------
+# nearest points, closure, undercut
+# ----------------------------------------------------------------------------------------
+
+
+def distance_to_trace(m: Model, px, py, k_ref: int = 0):
+    """Distance of points (px, py) from the closed theoretical trace of roller ``k_ref``.
+
+    Nearest sample on a dense grid (k-d tree), then Newton's method on
+    g(s) = (C(s) - P) . C'(s) with the exact first and second derivatives.
+    Returns (distance, parameter s in deg).
+    """
+    from scipy.spatial import cKDTree
+
+    key = ("trace", k_ref)
+    if key not in m._cache:
+        s = np.arange(0.0, m.period, _SAMPLE_DEG)
+        x, y, *_ = m.derivs(k_ref, s)
+        m._cache[key] = (s, cKDTree(np.column_stack([x, y])))
+    s_grid, tree = m._cache[key]
+    px, py = np.asarray(px, dtype=float).ravel(), np.asarray(py, dtype=float).ravel()
+    d0, idx = tree.query(np.column_stack([px, py]))
+    s = s_grid[idx].copy()
+    for _ in range(12):
+        x, y, dx, dy, ddx, ddy = m.derivs(k_ref, s)
+        g = (x - px) * dx + (y - py) * dy
+        dg = dx * dx + dy * dy + (x - px) * ddx + (y - py) * ddy
+        step = np.where(dg > 0, -g / np.where(dg > 0, dg, 1.0), 0.0)
+        step = np.clip(step, -_SAMPLE_DEG, _SAMPLE_DEG)
+        s = s + step
+        if np.all(np.abs(step) < 1e-13 * max(1.0, m.period)):
+            break
+    x, y, *_ = m.derivs(k_ref, s)
+    d = np.hypot(x - px, y - py)
+    return np.minimum(d, d0), s
+
+
+def closure(m: Model) -> dict:
+    """Largest distance of the traces of rollers 1..n-1 (one eccentric turn) from roller 0's."""
+    phi = _grid(360.0, m.dphi)
+    K = np.repeat(np.arange(1, m.n), phi.size)
+    PHI = np.tile(phi, m.n - 1)
+    x, y, *_ = m.derivs(K, PHI)
+    d, _ = distance_to_trace(m, x, y, 0)
+    i = int(np.argmax(d))
+    return {"max": float(d[i]), "k": int(K[i]), "phi": float(PHI[i]), "points": int(d.size)}
+
+
+def closed_form_deviation(m: Model) -> float:
+    """Largest |radius - R_closed(psi)| over all rollers and one turn (psi: polar angle)."""
+    sheet = m.sheet
+    phi = _grid(360.0, m.dphi)
+    K = np.repeat(np.arange(m.n), phi.size)
+    PHI = np.tile(phi, m.n)
+    x, y, *_ = m.derivs(K, PHI)
+    psi = np.degrees(np.arctan2(y, x))
+    R = _engine(sheet, "R_closed", "mm", psi)
+    return float(np.max(np.abs(np.hypot(x, y) - R)))
+
+
+def undercut(m: Model) -> Undercut:
+    """Smallest concave radius of curvature, cusps and loops of the practical profile."""
+    if "undercut" in m._cache:
+        return m._cache["undercut"]
+    from scipy.optimize import brentq, minimize_scalar
+
+    packing = _mag(m.sheet, "rp_packing", "mm")
+    L = m.period
+    s = np.arange(0.0, L, _SAMPLE_DEG)
+    kap = m.kappa_n(0, s)
+    # the first tooth where the curvature is largest (all teeth are alike when the traces close)
+    i = int(np.argmax(kap >= kap.max() - 1e-9 * abs(kap.max())))
+    if kap[i] > 0:
+        res = minimize_scalar(
+            lambda t: -float(m.kappa_n(0, t)),
+            bounds=(s[i] - _SAMPLE_DEG, s[i] + _SAMPLE_DEG),
+            method="bounded",
+            options={"xatol": 1e-10},
+        )
+        phi_at = float(res.x) % L
+        kmax = max(float(m.kappa_n(0, phi_at)), float(kap[i]))
+        x, y, *_ = m.derivs(0, phi_at)
+        out = Undercut(True, 1.0 / kmax, phi_at, (float(x), float(y)), packing)
+    else:
+        out = Undercut(False, math.inf, math.nan, (math.nan, math.nan), packing)
+    rp = abs(m.rp_s)
+    g = 1.0 - rp * kap
+    if out.concave and np.any(g <= 0):
+        start = int(np.argmax(g))  # begin the scan where the offset is surely regular
+        ss = np.concatenate([s[start:], s[:start] + L, [s[start] + L]])
+        gg = np.concatenate([g[start:], g[:start], [g[start]]])
+
+        def gfun(t):
+            return 1.0 - rp * float(m.kappa_n(0, t))
+
+        crossings = np.nonzero(np.sign(gg[:-1]) != np.sign(gg[1:]))[0]
+        roots = [brentq(gfun, ss[j], ss[j + 1], xtol=1e-12) for j in crossings]
+        pairs = [(roots[j], roots[j + 1]) for j in range(0, len(roots) - 1, 2)]
+        out.bad_intervals = len(pairs)
+        for tooth, (c1, c2) in enumerate(pairs, start=1):
+            for c in (c1, c2):
+                xk, yk = m.practical(0, c)
+                out.cusps.append(
+                    {
+                        "tooth": tooth,
+                        "phi": c % L,
+                        "psi": math.degrees(math.atan2(float(yk), float(xk))),
+                        "x": float(xk),
+                        "y": float(yk),
+                    }
+                )
+            loop = _loop_crossing(m, c1, c2, L)
+            if loop is not None:
+                loop["tooth"] = tooth
+                out.loops.append(loop)
+    m._cache["undercut"] = out
+    return out
+
+
+def _loop_crossing(m: Model, c1: float, c2: float, L: float):
+    """Self-intersection of the practical profile around the cusp pair (c1, c2)."""
+    half = min(180.0, L / 2)
+    mid = 0.5 * (c1 + c2)
+    left = np.linspace(mid - half, c1, 721)
+    right = np.linspace(c2, mid + half, 721)
+    ax, ay, *_ = m.offset_point_and_tangent(left)
+    bx, by, *_ = m.offset_point_and_tangent(right)
+    p, r = (
+        np.column_stack([ax[:-1], ay[:-1]]),
+        np.column_stack([ax[1:] - ax[:-1], ay[1:] - ay[:-1]]),
+    )
+    q, u = (
+        np.column_stack([bx[:-1], by[:-1]]),
+        np.column_stack([bx[1:] - bx[:-1], by[1:] - by[:-1]]),
+    )
+    # segments p + t r and q + w u: solve for t, w in [0, 1]
+    P, R = p[:, None, :], r[:, None, :]
+    Q, U = q[None, :, :], u[None, :, :]
+    cross = R[..., 0] * U[..., 1] - R[..., 1] * U[..., 0]
+    qp = Q - P
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (qp[..., 0] * U[..., 1] - qp[..., 1] * U[..., 0]) / cross
+        w = (qp[..., 0] * R[..., 1] - qp[..., 1] * R[..., 0]) / cross
+    hit = (cross != 0) & (t >= 0) & (t <= 1) & (w >= 0) & (w <= 1)
+    if not hit.any():
+        return None
+    ii, jj = np.nonzero(hit)
+    best = int(np.argmin(right[jj] - left[ii]))  # the innermost crossing
+    i, j = int(ii[best]), int(jj[best])
+    s1 = left[i] + t[i, j] * (left[i + 1] - left[i])
+    s2 = right[j] + w[i, j] * (right[j + 1] - right[j])
+    for _ in range(30):  # Newton on P(s1) - P(s2) = 0
+        x1, y1, dx1, dy1 = (float(v) for v in m.offset_point_and_tangent(s1))
+        x2, y2, dx2, dy2 = (float(v) for v in m.offset_point_and_tangent(s2))
+        F = np.array([x1 - x2, y1 - y2])
+        J = np.array([[dx1, -dx2], [dy1, -dy2]])
+        try:
+            step = np.linalg.solve(J, -F)
+        except np.linalg.LinAlgError:
+            break
+        s1, s2 = s1 + step[0], s2 + step[1]
+        if np.max(np.abs(step)) < 1e-12:
+            break
+    x, y, *_ = m.offset_point_and_tangent(s1)
+    return {
+        "phi1": s1 % L,
+        "phi2": s2 % L,
+        "psi": math.degrees(math.atan2(float(y), float(x))),
+        "x": float(x),
+        "y": float(y),
+    }
+
+
+# ----------------------------------------------------------------------------------------
+# blocks
+# ----------------------------------------------------------------------------------------
+
+
+@table_block
+def roller_table(sheet):
+    """Every roller over one turn of the eccentric: rho, theoretical and practical profile."""
+    import pandas as pd
+
+    m = model(sheet)
+    phi = _grid(360.0, m.dphi)
+    K = np.repeat(np.arange(m.n), phi.size)
+    PHI = np.tile(phi, m.n)
+    xt = _engine(sheet, "x_t", "mm", K, PHI)
+    yt = _engine(sheet, "y_t", "mm", K, PHI)
+    xk, yk = m.practical(K, PHI, xt, yt)
+    return pd.DataFrame(
+        {
+            "k": K,
+            "phi [deg]": PHI,
+            "a [deg]": _engine(sheet, "a", "deg", PHI),
+            "rho [mm]": _engine(sheet, "rho", "mm", K, PHI),
+            "x_t [mm]": xt,
+            "y_t [mm]": yt,
+            "x_k [mm]": xk,
+            "y_k [mm]": yk,
+        }
+    )
+
+
+@table_block
+def profile_table(sheet):
+    """The closed cam profile: roller 0 over the eccentric turns that close its trace."""
+    import pandas as pd
+
+    m = model(sheet)
+    phi = _grid(m.period, m.dphi)
+    xt = _engine(sheet, "x_t", "mm", 0, phi)
+    yt = _engine(sheet, "y_t", "mm", 0, phi)
+    xk, yk = m.practical(0, phi, xt, yt)
+    kap = m.kappa_n(0, phi)
+    regular = (1.0 - abs(m.rp_s) * kap > 0).astype(int)
+    df = pd.DataFrame(
+        {
+            "phi [deg]": phi,
+            "psi [deg]": np.degrees(np.arctan2(yt, xt)),
+            "x_t [mm]": xt,
+            "y_t [mm]": yt,
+            "x_k [mm]": xk,
+            "y_k [mm]": yk,
+            "kappa_n [1/mm]": kap,
+            "regular": regular,
+        }
+    )
+    uc = undercut(m)
+    if not uc.regular(abs(m.rp_s)):
+        df.attrs["invalid"] = _verdict_text(m, uc)
+    return df
+
+
+@table_block
+def undercut_table(sheet):
+    """Cusps and loop crossings of the practical profile (no rows when it is regular)."""
+    import pandas as pd
+
+    m = model(sheet)
+    uc = undercut(m)
+    rows = []
+    for c in uc.cusps:
+        rows.append(
+            {
+                "tooth": c["tooth"],
+                "kind": "cusp",
+                "phi [deg]": c["phi"],
+                "phi2 [deg]": math.nan,
+                "psi [deg]": c["psi"],
+                "x_k [mm]": c["x"],
+                "y_k [mm]": c["y"],
+            }
+        )
+    for c in uc.loops:
+        rows.append(
+            {
+                "tooth": c["tooth"],
+                "kind": "loop crossing",
+                "phi [deg]": c["phi1"],
+                "phi2 [deg]": c["phi2"],
+                "psi [deg]": c["psi"],
+                "x_k [mm]": c["x"],
+                "y_k [mm]": c["y"],
+            }
+        )
+    cols = ["tooth", "kind", "phi [deg]", "phi2 [deg]", "psi [deg]", "x_k [mm]", "y_k [mm]"]
+    df = pd.DataFrame(rows, columns=cols)
+    return df.sort_values(["tooth", "phi [deg]"], kind="stable").reset_index(drop=True)
+
+
+def _verdict_text(m: Model, uc: Undercut) -> str:
+    rp = abs(m.rp_s)
+    parts = []
+    if rp >= uc.rho_min:
+        parts.append(
+            f"rp = {rp:g} mm exceeds the smallest radius of curvature of the concave "
+            f"parts of the theoretical profile, {uc.rho_min:.6g} mm: the practical "
+            f"profile is undercut (cusps and a loop on each of its "
+            f"{uc.bad_intervals} teeth)"
+        )
+    if rp >= uc.packing:
+        parts.append(
+            f"rp = {rp:g} mm reaches the packing limit (r2 - e1)*sin(pi/n) = "
+            f"{uc.packing:.6g} mm: neighbouring rollers overlap"
+        )
+    return "; ".join(parts)
+
+
+@findings_block
+def findings(sheet) -> list[Finding]:
+    """Closure of the n roller traces, the printed variants, and the undercut verdict."""
+    out: list[Finding] = []
+    try:
+        m = model(sheet)
+    except InputError as err:
+        return [Finding("inputs", err.message, None, "", "fail")]
+    variant = (sheet.values.get("transform"), sheet.values.get("ratio"))
+    corrected = variant == ("rotation", "lobes")
+    out.append(
+        Finding(
+            "profile",
+            f"Z = {m.Z:g} lobes; the cam turns by a = {m.i_a:+.6g}*phi; transform "
+            f"(4): {variant[0]}; ratio: {variant[1]}",
+            m.Z,
+            "",
+            "info",
+            "" if corrected else "a printed variant, kept to show what the paper's formulas give",
+        )
+    )
+    if m.e1 == 0:
+        out.append(
+            Finding(
+                "profile",
+                "e1 = 0: the theoretical profile is the circle of radius r2 (no teeth)",
+                m.r2,
+                "mm",
+                "info",
+            )
+        )
+
+    # the symbolic model must reproduce the worksheet formulas it was built from
+    phi = _grid(360.0, max(m.dphi, 5.0))
+    worst = 0.0
+    for k in sorted({0, m.n // 2, m.n - 1}):
+        x, y, *_ = m.derivs(k, phi)
+        worst = max(
+            worst,
+            float(np.max(np.abs(x - _engine(sheet, "x_t", "mm", k, phi)))),
+            float(np.max(np.abs(y - _engine(sheet, "y_t", "mm", k, phi)))),
+        )
+    out.append(
+        Finding(
+            "profile",
+            "sympy form of x_t, y_t (used for the normal) against the "
+            "worksheet formulas: largest difference",
+            worst,
+            "mm",
+            "ok" if worst < 1e-9 else "fail",
+        )
+    )
+
+    c = closure(m)
+    ok = c["max"] <= CLOSURE_TOL_MM
+    out.append(
+        Finding(
+            "closure",
+            f"largest distance of the traces of rollers 1..{m.n - 1} from the trace of "
+            f"roller 0 ({c['points']} points, one eccentric turn)",
+            c["max"],
+            "mm",
+            "ok" if ok else "fail",
+            f"tolerance {CLOSURE_TOL_MM:g} mm"
+            if ok
+            else f"the traces do not coincide (worst: roller {c['k']} at phi = {c['phi']:g} deg): "
+            "the n rollers would cut n different cams",
+        )
+    )
+    if corrected:
+        dev = closed_form_deviation(m)
+        out.append(
+            Finding(
+                "closure",
+                "largest deviation from the closed form "
+                "R(psi) = e1*cos(Z*psi) + sqrt(r2^2 - e1^2*sin(Z*psi)^2)",
+                dev,
+                "mm",
+                "ok" if dev < 1e-9 else "warning",
+            )
+        )
+        for label, changes in (
+            ("the printed transform (4)", {"transform": "printed"}),
+            ("the printed ratio a = phi/n", {"ratio": "printed"}),
+            ("the printed (4) and ratio together", {"transform": "printed", "ratio": "printed"}),
+        ):
+            try:
+                other = closure(model(sheet.with_inputs(**changes)))["max"]
+            except InputError as err:
+                out.append(
+                    Finding("closure", f"as printed, with {label}", None, "", "info", err.message)
+                )
+                continue
+            out.append(
+                Finding(
+                    "closure",
+                    f"as printed, with {label}: largest distance between the roller traces",
+                    other,
+                    "mm",
+                    "info",
+                    "they do not coincide" if other > CLOSURE_TOL_MM else "",
+                )
+            )
+
+    uc = undercut(m)
+    rp = abs(m.rp_s)
+    if uc.concave:
+        out.append(
+            Finding(
+                "undercut",
+                f"smallest radius of curvature of the concave parts of the theoretical "
+                f"profile (roller 0 at phi = {uc.phi_at:.6g} deg, x_t = {uc.point[0]:.6g} mm, "
+                f"y_t = {uc.point[1]:.6g} mm)",
+                uc.rho_min,
+                "mm",
+                "info",
+                "rp must stay below it",
+            )
+        )
+    else:
+        out.append(
+            Finding(
+                "undercut",
+                "the theoretical profile has no concave part (Z^2*e1/r2 = "
+                f"{m.Z**2 * m.e1 / m.r2:.6g} <= 1): no undercut whatever rp",
+                None,
+                "",
+                "info",
+            )
+        )
+    out.append(
+        Finding(
+            "undercut",
+            "packing limit (r2 - e1)*sin(pi/n)",
+            uc.packing,
+            "mm",
+            "info",
+            "neighbouring rollers touch when rp reaches it",
+        )
+    )
+    if uc.regular(rp):
+        margin = min(uc.rho_min, uc.packing) - rp
+        out.append(
+            Finding(
+                "undercut",
+                f"rp = {rp:g} mm is below both limits: the practical "
+                "profile is regular (no cusps, no loops)",
+                margin,
+                "mm",
+                "ok",
+                "margin to the nearer limit",
+            )
+        )
+    else:
+        out.append(
+            Finding(
+                "undercut",
+                "INVALID PROFILE: " + _verdict_text(m, uc),
+                rp,
+                "mm",
+                "fail",
+                "the profile tables and the chart still show it",
+            )
+        )
+        for cusp in uc.cusps[:2]:
+            out.append(
+                Finding(
+                    "undercut",
+                    f"tooth {cusp['tooth']}: cusp of the practical profile at phi = "
+                    f"{cusp['phi']:.6g} deg (polar angle {cusp['psi']:.6g} deg), "
+                    f"x_k = {cusp['x']:.6g} mm, y_k = {cusp['y']:.6g} mm",
+                    cusp["phi"],
+                    "deg",
+                    "fail",
+                )
+            )
+        for loop in uc.loops[:1]:
+            out.append(
+                Finding(
+                    "undercut",
+                    f"tooth {loop['tooth']}: the practical profile crosses itself "
+                    f"(loop) at x_k = {loop['x']:.6g} mm, y_k = {loop['y']:.6g} mm, polar angle "
+                    f"{loop['psi']:.6g} deg (phi = {loop['phi1']:.6g} and {loop['phi2']:.6g} deg)",
+                    loop["psi"],
+                    "deg",
+                    "fail",
+                )
+            )
+        if uc.cusps:
+            out.append(
+                Finding(
+                    "undercut",
+                    f"{len(uc.cusps)} cusps and {len(uc.loops)} loops in "
+                    "all: see the table 'undercut'",
+                    len(uc.cusps),
+                    "",
+                    "fail",
+                )
+            )
+
+    # the practical profile must keep the distance rp from the theoretical one
+    prof = _grid(m.period, m.dphi)
+    xk, yk = m.practical(0, prof)
+    d, _ = distance_to_trace(m, xk, yk, 0)
+    gap = float(np.max(np.abs(d - rp)))
+    ok = gap < 1e-9 * max(1.0, rp)
+    out.append(
+        Finding(
+            "undercut",
+            "distance of the practical profile from the theoretical profile: largest "
+            "departure from rp",
+            gap,
+            "mm",
+            "ok" if ok else ("fail" if not uc.regular(rp) else "warning"),
+            ""
+            if ok
+            else f"the practical profile comes as close as {float(np.min(d)):.6g} mm to "
+            "the theoretical one: the roller would cut into the neighbouring flank",
+        )
+    )
+    return out
+
+
+# ----------------------------------------------------------------------------------------
+# CAD export (the command-line option is wired by the lead)
+# ----------------------------------------------------------------------------------------
+
+
+def export_profile_csv(sheet, path, *, allow_invalid: bool = False, header: bool = True):
+    """Write the closed practical profile as CSV points ``x,y,z`` in mm for CAD; returns the path.
+
+    One point per step dphi of the eccentric over the turns that close the profile; the
+    closing point (equal to the first) is left out. An undercut profile is refused unless
+    ``allow_invalid`` (its loops would make a wrong CAD curve).
+    """
+    from pathlib import Path
+
+    from ..atomic import check_target, replacing
+
+    m = model(sheet)
+    uc = undercut(m)
+    if not uc.regular(abs(m.rp_s)) and not allow_invalid:
+        raise InputError(
+            "the practical profile is invalid: "
+            + _verdict_text(m, uc)
+            + "; reduce rp (or export anyway with allow_invalid=True)"
+        )
+    phi = _grid(m.period, m.dphi)[:-1]
+    xt = _engine(sheet, "x_t", "mm", 0, phi)
+    yt = _engine(sheet, "y_t", "mm", 0, phi)
+    xk, yk = m.practical(0, phi, xt, yt)
+    path = Path(path)
+    check_target(path, kind="csv")
+    lines = ["x_mm,y_mm,z_mm"] if header else []
+    lines += [f"{x:.10f},{y:.10f},0" for x, y in zip(xk, yk)]
+    with replacing(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="ascii")
+    return path
