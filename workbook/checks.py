@@ -150,6 +150,10 @@ def run_checks(sheet) -> Report:
         for row in read_printed(spec):
             report.rows.append(_check_row(sheet, spec, row))
     report.findings = collect_findings(sheet)
+    if sheet.spec.relations or sheet.spec.meta.get("hand_checks"):
+        from .analysis import findings as hand_checks  # relations, joins, domains, pi
+
+        report.findings += hand_checks(sheet)
     report.unused_inputs = sheet.unused_inputs()
     return report
 
