@@ -1,0 +1,406 @@
+"""advance-coupling: steady curves and stiff dynamics of the centrifugal injection-advance coupling.
+
+References are not taken from the code under test where that is possible: the steady roots
+from mpmath.findroot on the equilibrium written out here from SCENES.md section 4, the printed
+example values of SCENES.md, eigenfrequencies from scipy.linalg.eigh on (K, M), the exact
+solution (matrix exponential) checked against solve_ivp at rtol 1e-12, and the rigid-tooth
+limit from a 2-DOF ODE written out here and integrated with solve_ivp at rtol 1e-12.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+import workbook
+from workbook.blocks import coupling as cp
+from workbook.blocks import solvers as sv
+from workbook.errors import WorkbookError
+
+# SCENES.md section 4 example dimensions (SI)
+EX = dict(O1O=0.042, OC=0.036, OC1=0.052, lam=0.001, OB=0.015, O1B=0.040, tg=1 / 3, MD0=1.2,
+          m=0.7, c1=3000.0, phi20=0.5236)
+
+
+@pytest.fixture(scope="module")
+def sheet():
+    return workbook.load("advance-coupling")
+
+
+def F_ref(phi, w, d):
+    """The equilibrium of SCENES.md, written out independently (mpmath numbers)."""
+    import mpmath as mp
+
+    G = d["MD0"] * d["OB"] / d["O1B"] * d["tg"]
+    return (2 * d["m"] * w**2 * (d["O1O"] - d["OC"] * mp.cos(phi)) * d["OC"] * mp.sin(phi)
+            - 8 * d["c1"] * (d["lam"] + d["OC1"] * (mp.cos(d["phi20"]) - mp.cos(phi)))
+            * d["OC1"] * mp.sin(phi) - G)
+
+
+def root_ref(w, **changes):
+    """Stable root by mpmath: scan from phi20 for the first + to - change, then findroot."""
+    import mpmath as mp
+
+    mp.mp.dps = 30
+    d = {**EX, **changes}
+    if F_ref(mp.mpf(d["phi20"]), w, d) <= 0:
+        return 0.0
+    xs = np.linspace(d["phi20"], math.pi - 1e-6, 4001)
+    prev = F_ref(mp.mpf(xs[0]), w, d)
+    for a, b in zip(xs[:-1], xs[1:]):
+        cur = F_ref(mp.mpf(b), w, d)
+        if prev > 0 >= cur:
+            x = mp.findroot(lambda x: F_ref(x, w, d), (mp.mpf(a), mp.mpf(b)), solver="anderson")
+            return float(x) - d["phi20"]
+        prev = cur
+    raise AssertionError("no root")
+
+
+# -- steady state ------------------------------------------------------------------------------
+def test_steady_values_match_scenes(sheet):
+    got = sheet.evaluate("phi2", omega1=[50, 80, 110]).to("rad").magnitude
+    assert got[0] == 0.0  # on the stop at 50 rad/s
+    assert abs(got[1] - 0.070) <= 1e-3
+    assert abs(got[2] - 0.204) <= 1e-3
+
+
+@pytest.mark.parametrize("w", [55.0, 80.0, 95.0, 110.0])
+def test_root_against_mpmath(sheet, w):
+    got = float(sheet.evaluate("phi2", omega1=w).to("rad").magnitude)
+    assert got == pytest.approx(root_ref(w), abs=1e-11)
+
+
+@pytest.mark.parametrize("name,values,expected", [
+    ("c1", ["1500 N/m", "3000 N/m", "4000 N/m", "6000 N/m"], [0.730, 0.204, 0.131, 0.067]),
+    ("m", ["0.65 kg", "0.7 kg", "0.75 kg", "0.8 kg"], [0.181, 0.204, 0.228, 0.253]),
+])
+def test_families_at_110_match_scenes(sheet, name, values, expected):
+    for v, e in zip(values, expected):
+        got = float(sheet.with_inputs(**{name: v}).evaluate("phi2", omega1=110).magnitude)
+        assert abs(got - e) <= 1e-3, (name, v, got, e)
+
+
+def test_root_is_on_the_stable_branch():
+    p = cp.Params()
+    for w in (60.0, 80.0, 110.0):
+        phi = p.phi20 + cp.steady(w, p).phi2
+        h = 1e-6
+        slope = (cp.weight_force(phi + h, w, p) - cp.weight_force(phi - h, w, p)) / (2 * h)
+        assert slope < 0  # a restoring generalized force
+        assert cp.weight_stiffness(phi, w, p) == pytest.approx(-slope, rel=1e-6)
+
+
+SPEEDS = [60.0, 70.0, 80.0, 90.0, 100.0, 110.0]
+
+
+@pytest.mark.parametrize("w", SPEEDS)
+def test_trend_phi2_falls_as_c1_rises(sheet, w):
+    vals = [float(sheet.with_inputs(c1=f"{c} N/m").evaluate("phi2", omega1=w).magnitude)
+            for c in (1500, 3000, 4000, 6000)]
+    nonzero = [v for v in vals if v > 0]
+    assert len(nonzero) >= 2
+    assert all(a > b for a, b in zip(nonzero, nonzero[1:]))
+    assert all(a >= b for a, b in zip(vals, vals[1:]))
+
+
+@pytest.mark.parametrize("w", SPEEDS)
+def test_trend_phi2_rises_with_m(sheet, w):
+    vals = [float(sheet.with_inputs(m=f"{m} kg").evaluate("phi2", omega1=w).magnitude)
+            for m in (0.65, 0.7, 0.75, 0.8)]
+    assert all(b > a for a, b in zip(vals, vals[1:]))
+
+
+@pytest.mark.parametrize("w", SPEEDS)
+def test_trend_phi2_rises_with_phi20(sheet, w):
+    vals = [float(sheet.with_inputs(phi20=f"{a} rad").evaluate("phi2", omega1=w).magnitude)
+            for a in (0.4363, 0.5235, 0.6108, 0.6981)]
+    assert all(b > a for a, b in zip(vals, vals[1:]))
+
+
+def test_trend_findings_hold(sheet):
+    p, ws = cp.Params.from_sheet(sheet), cp.speeds(sheet)
+    for key in cp.FAMILIES:
+        holds, fails, _ = cp.trend_holds(p, key, ws)
+        assert not fails and len(holds) >= 10, key
+    found = {f.what: f for f in cp.findings(sheet)}
+    for text in cp.TREND_TEXT.values():
+        assert found[text].verdict == "ok"
+    assert found["phi2 at omega1 = 80 rad/s (SCENES.md: 0.070)"].verdict == "ok"
+
+
+def test_lift_off_speed_is_where_F_changes_sign(sheet):
+    import mpmath as mp
+
+    wl = float(sheet.evaluate("omega_lift").to("rad/s").magnitude)
+    mp.mp.dps = 30
+    ref = mp.findroot(lambda w: F_ref(mp.mpf(EX["phi20"]), w, EX), 50)
+    assert wl == pytest.approx(float(ref), rel=1e-12)
+    assert float(sheet.evaluate("phi2", omega1=wl - 0.01).magnitude) == 0.0
+    assert float(sheet.evaluate("phi2", omega1=wl + 0.5).magnitude) > 0.0
+
+
+def test_linear_forms(sheet):
+    d = EX
+    w = 90.0
+    s, c = math.sin(d["phi20"]), math.cos(d["phi20"])
+    A = d["O1O"] - d["OC"] * c
+    G = d["MD0"] * d["OB"] / d["O1B"] * d["tg"]
+    N = 2 * d["m"] * w**2 * A * d["OC"] * s - 8 * d["c1"] * d["lam"] * d["OC1"] * s - G
+    D = 8 * d["c1"] * (d["lam"] * d["OC1"] * c + d["OC1"]**2 * s**2) - 2 * d["m"] * w**2 * A * d["OC"] * c
+    assert float(sheet.evaluate("phi2_lin", omega1=w).magnitude) == pytest.approx(N / D, rel=1e-12)
+    # the consistent Newton step is -F(phi20)/F'(phi20): check against a numerical derivative
+    import mpmath as mp
+
+    dF = mp.diff(lambda x: F_ref(x, w, d), mp.mpf(d["phi20"]))
+    newton = -float(F_ref(mp.mpf(d["phi20"]), w, d)) / float(dF)
+    assert float(sheet.evaluate("phi2_newton", omega1=w).magnitude) == pytest.approx(newton, rel=1e-9)
+    # where the printed form departs by more than 5 % (base case): near lift-off and at 110
+    dev = sheet.evaluate("dev_lin", omega1=[60, 90, 110]).to("percent").magnitude
+    assert abs(dev[0]) > 5 and abs(dev[1]) < 5 and abs(dev[2]) > 5
+
+
+def test_soft_spring_denominator_is_reported_not_divided(sheet):
+    soft = sheet.with_inputs(c1="800 N/m")
+    assert float(soft.evaluate("D_lin", omega1=110).magnitude) < 0
+    with pytest.raises(WorkbookError, match="no piece applies"):
+        soft.evaluate("phi2_lin", omega1=110)
+    p = cp.replace(cp.Params(), c1=800.0)
+    lin = cp.linear_phi2(110.0, p)
+    assert math.isnan(lin.value) and lin.denominator < 0
+    # the root is still there
+    assert cp.steady(110.0, p).phi2 > 0
+    assert cp.soft_spring_limit(cp.Params(), 110.0) == pytest.approx(990.95, abs=0.05)
+    # Newton form: c1 = 1500 N/m passes through zero inside 50..110 rad/s
+    deps = dict((v, z) for v, _, _, z in cp.departures(cp.Params(), "c1", np.arange(50, 111, 5.0), "newton"))
+    assert deps[1500.0] == [100.0, 105.0, 110.0]
+
+
+def test_printed_and_corrected_forms_visible(sheet):
+    d = sheet.spec.definitions
+    assert "drops the square" in d["a11"].note
+    assert float(sheet.evaluate("b22_printed").magnitude) == -float(sheet.evaluate("b22").magnitude)
+    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236))**2 + 2 * 1.5e-4
+    assert float(sheet.evaluate("a11").to("kg*m^2").magnitude) == pytest.approx(a11, rel=1e-12)
+
+
+# -- dynamics -----------------------------------------------------------------------------------
+def _undamped_freqs(c2):
+    """Nonzero eigenfrequencies of (K, M) written out here from SCENES.md (scipy.linalg.eigh)."""
+    from scipy.linalg import eigh
+
+    p = cp.Params()
+    st = root_ref(80.0)
+    phi = p.phi20 + st
+    h = 1e-6
+    d = EX
+    kw = -(float(F_ref(phi + h, 80.0, d)) - float(F_ref(phi - h, 80.0, d))) / (2 * h)
+    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236))**2 + 3e-4
+    M = np.diag([a11, 2 * 0.7 * 0.036**2 + 3e-4, 0.01])
+    v = np.array([0.040, 0.015 / 3, -0.040])
+    K = 2 * c2 * np.outer(v, v) + np.diag([0, kw, 0])
+    lam = eigh(K, M, eigvals_only=True)
+    return np.sqrt(np.sort(lam[lam > 1e-6 * lam.max()]))
+
+
+@pytest.mark.parametrize("c2,tooth", [(1e6, 707.0), (1e8, 7070.0)])
+def test_eigenvalues(c2, tooth):
+    lam = cp.eigen(cp.Params(), c2)
+    assert len(lam) == 4  # rigid rotation mode excluded
+    ref = _undamped_freqs(c2)
+    got = np.sort(np.abs(lam.imag))[::2]
+    np.testing.assert_allclose(got, ref, rtol=2e-3)  # light damping shifts them a little
+    assert abs(lam[-1].imag) == pytest.approx(tooth, rel=0.01)  # SCENES.md: ~707, ~7070
+    assert np.all(lam.real < 0)
+    assert np.all(cp.eigen(cp.Params(), c2, damping="as printed").real > 0)  # printed sign
+
+
+def test_stiffness_grows_with_c2():
+    idx = [cp.stiffness(cp.Params(), c2)["index"] for c2 in (1e6, 1e8, 1e10)]
+    assert idx[1] / idx[0] == pytest.approx(10, rel=0.01)
+    assert idx[2] / idx[1] == pytest.approx(10, rel=0.01)
+    assert cp.auto_method(cp.Params(), 1e6) == "LSODA"
+    assert cp.auto_method(cp.Params(), 1e10) == "Radau"
+
+
+def test_exact_solution_matches_tight_solve_ivp():
+    from scipy.integrate import solve_ivp
+
+    cs = cp.case(cp.Params(), 1e8, 0.1)
+    pr = cs.problem
+    sol = solve_ivp(pr.fun, (0, pr.t_end), pr.y0, method="DOP853", rtol=1e-12, atol=1e-15,
+                    t_eval=pr.t_eval)
+    err = np.max(np.abs(pr.model.outputs(sol.y) - cs.exact))
+    assert err < 1e-10
+
+
+def _rigid_reference(t_end, n_out=401):
+    """The rigid-tooth limit written out here: q = (phi1, phi2), phi3 = phi1 + k*phi2."""
+    from scipy.integrate import solve_ivp
+
+    d = EX
+    w = 80.0
+    st = root_ref(w)
+    phi = d["phi20"] + st
+    h = 1e-6
+    kw = -(float(F_ref(phi + h, w, d)) - float(F_ref(phi - h, w, d))) / (2 * h)
+    k = d["OB"] * d["tg"] / d["O1B"]
+    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236))**2 + 3e-4
+    a22 = 2 * 0.7 * 0.036**2 + 3e-4
+    J3 = 0.01
+    M = np.array([[a11 + J3, J3 * k], [J3 * k, a22 + J3 * k * k]])
+    b22 = 20 * 0.036**2 * math.sin(0.5236)**2
+    Minv = np.linalg.inv(M)
+    Om = 4 * w
+
+    def f(t, y):
+        x, v = y[:2], y[2:]
+        pump = 2.0 * math.sin(Om * t)
+        force = np.array([-pump, -kw * (x[1] - st) - k * pump]) - np.array([0.0, b22 * v[1]])
+        return np.concatenate([v, Minv @ force])
+
+    ts = np.linspace(0, t_end, n_out)
+    sol = solve_ivp(f, (0, t_end), [0.0, st, 0.0, 0.0], method="DOP853", rtol=1e-12,
+                    atol=1e-15, t_eval=ts)
+    return np.vstack([sol.y[1], k * sol.y[1]])
+
+
+def test_rigid_limit_and_default_solver_at_c2_1e10():
+    p = cp.Params()
+    ref = _rigid_reference(p.t_end)
+    cs = cp.case(p, 1e10)
+    np.testing.assert_allclose(cs.rigid, ref, atol=1e-11)  # our rigid model = written-out one
+    # the model difference falls like 1/c2: the study's prediction for c2 = 1e10
+    d8, d9 = cp.case(p, 1e8).delta, cp.case(p, 1e9).delta
+    predicted = d9 / 10
+    assert cs.delta == pytest.approx(predicted, rel=0.2)
+    assert d8 / d9 == pytest.approx(10, rel=0.2)
+    tol = 2 * predicted
+    method = cp.auto_method(p, 1e10)
+    run = cs.problem.run(method, 1e-5)
+    assert run.ok
+    dev = np.max(np.abs(cs.problem.model.outputs(run.y) - ref))
+    assert dev <= tol, (method, dev, tol)
+
+
+@pytest.mark.slow
+def test_default_solver_within_2x_of_fastest():
+    """One study at c2 = 1e10 N/m; the default and the fastest run that reaches the rigid
+    limit are then timed again side by side (best of 3)."""
+    p = cp.replace(cp.Params(), t_end=0.1)
+    df = cp.study(p, (1e10,), (1e-3, 1e-4, 1e-5, 1e-6, 1e-7), max_time=2.0, label=None)
+    cs = cp.case(p, 1e10)
+    tol = 2 * cs.delta
+    ok = df[(df["stopped"] == "finished") & (df["deviation from rigid [rad]"] <= tol)]
+    assert not ok.empty
+    best = ok.loc[ok["run time [s]"].idxmin()]
+    method = cp.auto_method(p, 1e10)
+    default_rows = ok[(ok["method"] == method) & (ok["rtol"] == 1e-5)]
+    assert not default_rows.empty  # the default reaches the rigid limit
+    t_best = min(cs.problem.run(best["method"], best["rtol"]).elapsed for _ in range(3))
+    t_def = min(cs.problem.run(method, 1e-5).elapsed for _ in range(3))
+    assert t_def <= 2 * t_best, (best["method"], best["rtol"], t_best, t_def)
+
+
+def test_errors_fall_with_rtol_at_moderate_c2():
+    p = cp.replace(cp.Params(), t_end=0.1)
+    df = cp.study(p, (1e6,), (1e-3, 1e-6, 1e-9), max_time=5.0, label=None)
+    for m in sv.METHODS:
+        e = df[df["method"] == m].sort_values("rtol", ascending=False)["error [rad]"].to_numpy()
+        assert e[-1] < e[0] / 100, (m, e)
+
+
+# -- extreme cases ------------------------------------------------------------------------------
+def test_explicit_method_on_a_very_stiff_tooth_is_bounded():
+    t = time.perf_counter()
+    run, need = cp.stall_run(cp.Params(), "RK45", c2=1e14, max_time=0.3, max_steps=10**7)
+    assert time.perf_counter() - t < 3.0
+    assert not run.ok and run.stop_reason == "time budget"
+    assert run.fraction < 0.5 and need > 1e5
+    run, _ = cp.stall_run(cp.Params(), "DOP853", c2=1e14, max_time=30, max_steps=500)
+    assert run.stop_reason == "step cap" and run.nsteps == 500
+    assert "step cap" in run.summary()
+
+
+def test_weights_on_the_stop_dynamics():
+    p = cp.replace(cp.Params(), omega_dyn=50.0)
+    assert cp.steady(50.0, p).on_stop
+    mdl = cp.model(p)
+    assert mdl.n == 2  # phi2 held on the stop
+    cs = cp.case(p, 1e8, 0.05)
+    run = cs.problem.run("Radau", 1e-6)
+    assert run.ok
+    assert np.all(cs.problem.model.outputs(run.y)[0] == 0.0)
+
+
+def test_run_ode_progress_goes_to_stderr(capsys):
+    pr = cp.case(cp.Params(), 1e8, 0.05).problem
+    sv.run_ode(pr.fun, (0, pr.t_end), pr.y0, method="RK45", rtol=1e-6, label="probe",
+               progress_every=0.0, t_eval=pr.t_eval)
+    err = capsys.readouterr().err
+    assert "[probe] t = " in err and "finished" in err
+
+
+def test_ctrl_c_leaves_no_partial_state(monkeypatch):
+    p = cp.replace(cp.Params(), t_end=0.013)
+    calls = {"n": 0}
+    real = cp.Problem.run
+
+    def interrupted(self, *a, **k):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(cp.Problem, "run", interrupted)
+    before = set(cp._CACHE)
+    with pytest.raises(KeyboardInterrupt):
+        cp.study(p, (1e6,), (1e-3, 1e-4), label=None)
+    assert not any(k[0] == "study" for k in set(cp._CACHE) - before)
+
+
+def test_ctrl_c_during_write_keeps_old_file(tmp_path, monkeypatch):
+    sheet = workbook.load("advance-coupling")
+    out = tmp_path / "ac.xlsx"
+    out.write_bytes(b"old")
+
+    def boom(sheet):
+        raise KeyboardInterrupt
+
+    from workbook import blocks
+
+    monkeypatch.setattr(blocks.get("coupling.histories", "table"), "func", boom)
+    with pytest.raises(KeyboardInterrupt):
+        sheet.write_xlsx(out, force=True)
+    assert out.read_bytes() == b"old"
+    assert [f.name for f in tmp_path.iterdir()] == ["ac.xlsx"]
+
+
+# -- solver helpers -----------------------------------------------------------------------------
+def test_stable_root_helper():
+    r = sv.stable_root(lambda x: np.cos(x), 0.0, 3.0)
+    assert r.converged and r.x == pytest.approx(math.pi / 2, abs=1e-14)
+    r = sv.stable_root(lambda x: x - 1.0, 0.0, 3.0)  # only a + direction change: no stable root
+    assert not r.converged and r.reason == "no sign change"
+
+
+def test_bench_quick_is_fast(sheet):
+    t = time.perf_counter()
+    df = cp.bench(sheet, quick=True)
+    assert time.perf_counter() - t < 5.0
+    assert set(df["method"]) == set(sv.METHODS)
+    assert {"error [rad]", "run time [s]", "stopped"} <= set(df.columns)
+
+
+@pytest.mark.slow
+def test_workbook_writes(tmp_path, sheet):
+    import openpyxl
+
+    out = sheet.write_xlsx(tmp_path / "ac.xlsx")
+    wb = openpyxl.load_workbook(out)
+    for name in ("Families", "Dynamics", "Stiffness", "Solvers", "Checks"):
+        assert name in wb.sheetnames
+    text = " ".join(str(c) for row in wb["Checks"].iter_rows(values_only=True) for c in row if c)
+    assert "phi2 falls as c1 rises" in text and "time / fastest" in text

@@ -1,0 +1,266 @@
+"""Solver helpers for blocks: bracketed root finding and a bounded ODE runner.
+
+Any block module may use these; nothing here is registered as a block itself.
+scipy is imported inside the functions, so importing this module is cheap.
+
+Root finding::
+
+    r = stable_root(f, a, b)          # first + to - sign change of f on [a, b], refined by brentq
+    r.x, r.converged, r.reason
+
+ODE runs, in the style of ``scipy.integrate.solve_ivp`` (one result object, methods swappable)
+but bounded: a wall-clock budget and a step cap end a run that would otherwise take hours
+(an explicit method on a very stiff system), and the result says why it stopped::
+
+    run = run_ode(fun, (0, T), y0, method="Radau", rtol=1e-6, atol=1e-9, jac=J,
+                  t_eval=ts, max_time=10, max_steps=200_000, label="tooth c2=1e10")
+    run.ok, run.stop_reason, run.elapsed, run.nfev, run.y
+
+Ctrl-C is not caught: a KeyboardInterrupt leaves the runner at once and nothing half-made is
+kept (results are only returned complete). Long runs print a progress line to stderr every
+``progress_every`` seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+IMPLICIT = ("Radau", "BDF", "LSODA")  # methods that use a Jacobian
+
+
+# -- roots -----------------------------------------------------------------------------------
+@dataclass
+class RootResult:
+    """A root of a scalar function, or the reason there is none."""
+
+    x: float
+    converged: bool
+    reason: str  # "root" | "no sign change" | "not converged"
+    iterations: int = 0
+    bracket: tuple[float, float] | None = None
+
+
+def sign_changes(f: Callable[[np.ndarray], np.ndarray], a: float, b: float, n: int = 512):
+    """Brackets [x_k, x_k+1] of a uniform grid of n intervals where f changes sign.
+
+    ``f`` must accept a numpy array. Returns a list of (lo, hi, direction) with direction
+    -1 for a + to - change (a stable equilibrium of a generalized force) and +1 otherwise.
+    """
+    xs = np.linspace(a, b, n + 1)
+    fs = np.asarray(f(xs), dtype=float)
+    out = []
+    for k in range(n):
+        f0, f1 = fs[k], fs[k + 1]
+        if not (math.isfinite(f0) and math.isfinite(f1)):
+            continue
+        if f0 == 0.0:
+            out.append((xs[k], xs[k], -1 if f1 < 0 else 1))
+        elif f0 * f1 < 0:
+            out.append((xs[k], xs[k + 1], -1 if f1 < f0 else 1))
+    return out
+
+
+def stable_root(f: Callable, a: float, b: float, *, n: int = 512, xtol: float = 1e-14,
+                rtol: float = 4 * np.finfo(float).eps, maxiter: int = 200) -> RootResult:
+    """The first root of f on [a, b] where f goes from + to - (a stable equilibrium when f is
+    a generalized force), refined by brentq inside its grid bracket."""
+    from scipy.optimize import brentq
+
+    for lo, hi, direction in sign_changes(f, a, b, n):
+        if direction > 0:
+            continue
+        if lo == hi:
+            return RootResult(lo, True, "root", 0, (lo, hi))
+        g = lambda x: float(np.asarray(f(np.asarray([x])))[0])
+        x, info = brentq(g, lo, hi, xtol=xtol, rtol=rtol, maxiter=maxiter, full_output=True,
+                         disp=False)
+        return RootResult(float(x), bool(info.converged), "root" if info.converged
+                          else "not converged", int(info.iterations), (lo, hi))
+    return RootResult(math.nan, False, "no sign change")
+
+
+# -- ODE runs ---------------------------------------------------------------------------------
+@dataclass
+class OdeRun:
+    """One ODE run: the solution at t_eval (or at the steps), cost, and why it stopped."""
+
+    method: str
+    rtol: float
+    atol: float
+    t: np.ndarray
+    y: np.ndarray  # shape (n, len(t))
+    stop_reason: str  # "finished" | "time budget" | "step cap" | "failed: <message>"
+    elapsed: float  # wall-clock seconds (time.perf_counter)
+    nfev: int
+    njev: int
+    nlu: int
+    nsteps: int
+    t_reached: float
+    t_final: float
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return self.stop_reason == "finished"
+
+    @property
+    def fraction(self) -> float:
+        """Fraction of the time span covered."""
+        span = self.t_final - self.t[0] if len(self.t) else 1.0
+        return 1.0 if span == 0 else min(1.0, max(0.0, (self.t_reached - self.t[0]) / span))
+
+    def summary(self) -> str:
+        head = f"{self.method} rtol={self.rtol:.0e}: {self.stop_reason}"
+        return (f"{head} at t = {self.t_reached:.6g} of {self.t_final:.6g} "
+                f"({100 * self.fraction:.1f} %), {self.nsteps} steps, {self.nfev} f-evals, "
+                f"{self.elapsed:.3g} s")
+
+
+def _progress(label: str, solver, t0: float, t1: float, nsteps: int, start: float) -> None:
+    frac = (solver.t - t0) / (t1 - t0) if t1 != t0 else 1.0
+    print(f"[{label}] t = {solver.t:.4g} of {t1:.4g} ({100 * frac:.1f} %), {nsteps} steps, "
+          f"{time.perf_counter() - start:.1f} s", file=sys.stderr, flush=True)
+
+
+def run_ode(fun: Callable, t_span: Sequence[float], y0, *, method: str = "RK45",
+            rtol: float = 1e-6, atol: float | np.ndarray = 1e-9, jac=None, t_eval=None,
+            max_time: float = 30.0, max_steps: int = 1_000_000, first_step=None,
+            max_step: float = np.inf, label: str | None = None,
+            progress_every: float = 2.0) -> OdeRun:
+    """Integrate y' = fun(t, y) over t_span with scipy's solver ``method``, bounded in time.
+
+    Like ``solve_ivp`` (t_eval values are interpolated from each step's dense output) but the
+    run stops, with ``stop_reason`` saying why, after ``max_time`` wall-clock seconds or
+    ``max_steps`` steps. ``jac`` is passed to the implicit methods only.
+    """
+    from scipy import integrate
+
+    classes = {"RK45": integrate.RK45, "DOP853": integrate.DOP853, "Radau": integrate.Radau,
+               "BDF": integrate.BDF, "LSODA": integrate.LSODA, "RK23": integrate.RK23}
+    if method not in classes:
+        raise ValueError(f"unknown ODE method {method!r} (known: {', '.join(classes)})")
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    y0 = np.asarray(y0, dtype=float)
+    options = dict(rtol=rtol, atol=atol, max_step=max_step)
+    if first_step is not None:
+        options["first_step"] = first_step
+    if jac is not None and method in IMPLICIT:
+        options["jac"] = jac
+    start = time.perf_counter()
+    solver = classes[method](fun, t0, y0, t1, **options)
+    if t_eval is None:
+        ts, ys = [t0], [y0.copy()]
+    else:
+        t_eval = np.asarray(t_eval, dtype=float)
+        ts, ys = [], []
+        if t_eval.size and t_eval[0] == t0:
+            ts.append(t_eval[:1])
+            ys.append(y0[:, None].copy())
+            t_eval_i = 1
+        else:
+            t_eval_i = 0
+    nsteps = 0
+    reason = None
+    last_report = start
+    notes: list[str] = []
+    while reason is None:
+        message = solver.step()
+        nsteps += 1
+        if solver.status == "failed":
+            reason = f"failed: {message}"
+            break
+        if t_eval is None:
+            ts.append(solver.t)
+            ys.append(solver.y.copy())
+        else:
+            hi = np.searchsorted(t_eval, solver.t, side="right")
+            if hi > t_eval_i:
+                sol = solver.dense_output()
+                chunk = t_eval[t_eval_i:hi]
+                ts.append(chunk)
+                ys.append(np.asarray(sol(chunk)).reshape(len(y0), -1))
+                t_eval_i = hi
+        if solver.status == "finished":
+            reason = "finished"
+            break
+        now = time.perf_counter()
+        if now - start > max_time:
+            reason = "time budget"
+            notes.append(f"stopped after the wall-clock budget of {max_time:g} s")
+        elif nsteps >= max_steps:
+            reason = "step cap"
+            notes.append(f"stopped after the step cap of {max_steps} steps")
+        elif label and now - last_report >= progress_every:
+            _progress(label, solver, t0, t1, nsteps, start)
+            last_report = now
+    elapsed = time.perf_counter() - start
+    if t_eval is None:
+        t_out = np.asarray(ts, dtype=float)
+        y_out = np.asarray(ys, dtype=float).T.reshape(len(y0), -1)
+    else:
+        t_out = np.concatenate(ts) if ts else np.empty(0)
+        y_out = np.hstack(ys) if ys else np.empty((len(y0), 0))
+    run = OdeRun(method, float(rtol), float(np.max(atol)), t_out, y_out, reason, elapsed,
+                 int(solver.nfev), int(getattr(solver, "njev", 0)), int(getattr(solver, "nlu", 0)),
+                 nsteps, float(solver.t), t1, notes)
+    if label and (elapsed > progress_every or not run.ok):
+        print(f"[{label}] {run.summary()}", file=sys.stderr, flush=True)
+    return run
+
+
+@dataclass
+class StudyRow:
+    """One cell of a work-precision study."""
+
+    case: str
+    method: str
+    rtol: float
+    error: float
+    elapsed: float
+    nfev: int
+    nsteps: int
+    stop_reason: str
+    extra: dict = field(default_factory=dict)
+
+
+def work_precision(run_case: Callable[[str, float], OdeRun], error_of: Callable[[OdeRun], float],
+                   methods: Sequence[str], rtols: Sequence[float], *, case: str = "",
+                   label: str | None = None, skip_after_stall: bool = True,
+                   extra_of: Callable[[OdeRun], dict] | None = None) -> list[StudyRow]:
+    """Run every method at every rtol (tight last); errors from ``error_of(run)``.
+
+    When a method stops early (budget or step cap) at some rtol, its tighter rtols are not
+    run (they would stall too) and are recorded with stop_reason "skipped (stalled at ...)".
+    """
+    rows: list[StudyRow] = []
+    for method in methods:
+        stalled = None
+        for rtol in sorted(rtols, reverse=True):
+            if stalled is not None and skip_after_stall:
+                rows.append(StudyRow(case, method, rtol, math.nan, math.nan, 0, 0,
+                                     f"skipped (stopped at rtol {stalled:.0e})"))
+                continue
+            run = run_case(method, rtol)
+            err = error_of(run) if run.ok else math.nan
+            rows.append(StudyRow(case, method, rtol, err, run.elapsed, run.nfev, run.nsteps,
+                                 run.stop_reason, extra_of(run) if extra_of else {}))
+            if not run.ok:
+                stalled = rtol
+            if label:
+                print(f"[{label}] {case} {method} rtol={rtol:.0e}: error {err:.2e}, "
+                      f"{run.elapsed:.3f} s, {run.stop_reason}", file=sys.stderr, flush=True)
+    return rows
+
+
+def fastest_within(rows: Sequence[StudyRow], target: float) -> StudyRow | None:
+    """The quickest finished row whose error is at most ``target``."""
+    ok = [r for r in rows if r.stop_reason == "finished" and math.isfinite(r.error)
+          and r.error <= target]
+    return min(ok, key=lambda r: r.elapsed) if ok else None
