@@ -114,8 +114,7 @@ def _relation_values(sheet, child, terms, var, x, unit_child):
             f"({un.pretty(combined)}), {child} is {un.dims(unit_child)} ({un.pretty(unit_child)})"
         )
     conv = un.factor(combined, unit_child)
-    expr = symbolic.derivative(sheet, parent, var, order)
-    fn = symbolic.lambdify(sheet, expr, var)
+    fn = _derivative_fn(sheet, parent, var, order)
     scale = symbolic.per_radian(sheet, var, var_unit) ** order
     with np.errstate(all="ignore"):
         deriv = np.asarray(fn(x), dtype=complex) * (scale * fval * conv)
@@ -127,6 +126,41 @@ def _relation_values(sheet, child, terms, var, x, unit_child):
         )
     childv = sheet.evaluate(child, **{var: x}).to(unit_child).magnitude
     return np.broadcast_to(childv, x.shape), deriv.real
+
+
+_DERIVATIVES: dict = {}
+
+
+def _derivative_fn(sheet, parent: str, var: str, order: int):
+    """numpy function of var: d^order(parent)/d(var)^order, cached per sheet and inputs.
+
+    A sheet input named pi stays a symbol, so the sheet as written and the sheet with the
+    true pi share one symbolic derivative.
+    """
+    import sympy as sp
+
+    from . import symbolic
+
+    own_pi = "pi" in sheet.spec.inputs and not sheet.spec.inputs["pi"].options
+    inputs = tuple(sorted((k, str(v)) for k, v in sheet.values.items() if k != "pi"))
+    key = (str(sheet.spec.path), sheet.spec.text, inputs, parent, var)
+    pi = sp.Symbol("pi_sheet")
+    exprs = _DERIVATIVES.setdefault(key, {})
+    if 0 not in exprs:
+        if len(_DERIVATIVES) > 64:
+            _DERIVATIVES.clear()
+            exprs = _DERIVATIVES.setdefault(key, {})
+        exprs[0] = (symbolic.to_sympy(sheet, parent, {"pi": pi} if own_pi else None), None)
+    x = symbolic.symbol(var)
+    for n in range(1, order + 1):
+        if n not in exprs:
+            exprs[n] = (sp.diff(exprs[n - 1][0], x), None)
+    expr, fn = exprs[order]
+    if fn is None:
+        fn = sp.lambdify([x, pi], expr, modules="numpy")
+        exprs[order] = (expr, fn)
+    pval = float(sheet.values["pi"].magnitude) if own_pi else math.pi
+    return lambda v: fn(v, pval)
 
 
 def _measure(sheet, res: RelationResult, child, terms, x, var):
@@ -384,15 +418,6 @@ def _analyse_piecewise(sheet, name, res: PiecewiseResult, var_unit: str):
                 points.add(b)
     per = symbolic.per_radian(sheet, var, var_unit)
     unit = sheet.typer.function(name).unit
-    cache: dict = {}
-
-    def _diff(exprs, k, order, x):
-        if (k, order) not in cache:
-            cache[(k, order)] = (
-                exprs[k] if order == 0 else sp.diff(_diff(exprs, k, order - 1, x), x)
-            )
-        return cache[(k, order)]
-
     res.joins = []
     for p in sorted(points, key=float):
         eps = sp.Rational(1, 10**9)
@@ -408,8 +433,7 @@ def _analyse_piecewise(sheet, name, res: PiecewiseResult, var_unit: str):
             continue
         jumps, scale = [], []
         for order in range(3):
-            a = _diff(exprs, left, order, x).evalf(30, subs={x: p})
-            b = _diff(exprs, right, order, x).evalf(30, subs={x: p})
+            a, b = (_piece_derivative(sheet, body, exprs, k, order, x, p) for k in (left, right))
             f = per**order
             jumps.append(float(b - a) * f)
             scale.append(max(abs(float(a)), abs(float(b))) * f)
@@ -419,6 +443,21 @@ def _analyse_piecewise(sheet, name, res: PiecewiseResult, var_unit: str):
         res.joins.append(
             Join(name, float(p), names[left], names[right], tuple(jumps), units, tuple(scale))
         )
+
+
+def _piece_derivative(sheet, body, exprs, k, order, x, p) -> float:
+    """d^order of piece k at p: via the cached derivative when the piece is f(var)."""
+    import sympy as sp
+
+    val = body.values[k]
+    if (
+        isinstance(val, tc.TCall)
+        and len(val.args) == 1
+        and isinstance(val.args[0], tc.TParam)
+        and val.args[0].name == str(x)
+    ):
+        return float(_derivative_fn(sheet, val.name, str(x), order)(float(p)))
+    return float(sp.diff(exprs[k], x, order).evalf(30, subs={x: p}))
 
 
 def _as_set(cond, x):
@@ -594,6 +633,35 @@ def typed_text(t: tc.T, parent: int = 0) -> str:
     return "..."
 
 
+def _squares(t: tc.T):
+    """Bases of a product of squares (k^2*sin(x)^2 -> [k, sin(x)]), else None."""
+    if isinstance(t, tc.TScale) and t.factor == 1.0:
+        return _squares(t.child)
+    if isinstance(t, tc.TBinary) and t.op == "^" and isinstance(t.right, tc.TConst):
+        return [t.left] if t.right.value == 2 else None
+    if isinstance(t, tc.TBinary) and t.op == "*":
+        a, b = _squares(t.left), _squares(t.right)
+        return a + b if a is not None and b is not None else None
+    return None
+
+
+def meaning(kind: str, node: tc.T) -> str:
+    """What leaving the domain means in the sheet's terms: 1 - X^2 < 0 is |X| > 1."""
+    if not (kind.startswith("sqrt") or kind.startswith("power")):
+        return ""
+    t = node.child if isinstance(node, tc.TScale) and node.factor == 1.0 else node
+    if (
+        isinstance(t, tc.TBinary)
+        and t.op == "-"
+        and isinstance(t.left, tc.TConst)
+        and t.left.value == 1
+    ):
+        bases = _squares(t.right)
+        if bases:
+            return " (|" + "*".join(typed_text(b, 6) for b in bases) + "| > 1)"
+    return ""
+
+
 def _runs(x: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
     """Contiguous runs of True in mask, as (first x, last x)."""
     out, start = [], None
@@ -641,7 +709,7 @@ def explain_domain(evaluator, typed: tc.TypedFunction, env: dict, units: dict | 
         )
         if len(runs) > 4:
             where += f" and {len(runs) - 4} more interval(s)"
-        parts.append(f"{kind}: {text} for {where} {unit}".rstrip())
+        parts.append(f"{kind}: {text}{meaning(kind, node)} for {where} {unit}".rstrip())
     return "; ".join(parts)
 
 
@@ -702,7 +770,7 @@ def domain_margins(sheet) -> list[Finding]:
                             first,
                             unit,
                             "ok",
-                            f"{kind} beyond that angle",
+                            f"{kind}{meaning(kind, node_)} beyond that angle",
                         )
                     )
     return out
