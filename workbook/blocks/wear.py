@@ -1,0 +1,1066 @@
+"""Solver blocks of the cam-wear sheets (Ivashko, Buikus, Osuchukwu 2006).
+
+Valve (templates/cam-wear-valve.toml):
+
+* ``time_section_3`` / ``time_section_eff``: the valve's time-section, the integral of the
+  flow area over cam angle, for the unworn cam (w_b = w_n = 0) or a worn one. The lift law,
+  wear model and flow area are the template's; they are repeated here in numpy because a
+  function block receives numbers, not the sheet (tests/test_cam_wear.py checks that both
+  agree). The integral is split where the integrand has a kink (the worn lift reaching zero,
+  the validity limit of (3), the port cap) and each piece is integrated by 64-point
+  Gauss-Legendre on 8 sub-intervals, which is exact to rounding for these smooth pieces.
+* ``quadrature_unworn`` / ``quadrature_worn`` (tables) and ``bench``: trapezoid, Simpson and
+  Gauss-Legendre at increasing point counts, error against the converged value and run time.
+  They integrate the template's own functions (the compiled sheet), not the copies above.
+* ``measured_lift`` (table): a worn lift given as measured points (CSV with units in the
+  header); velocity and acceleration by a Savitzky-Golay filter whose noise gain is reported.
+* ``valve_findings``: validity of (3), port cap, (1) and (2) against (3), wear deeper than the
+  lift, the measured-lift time-section and noise gains.
+
+Pump (cam-wear-pump.toml): ``worn_lift_inverse`` (the unworn lift at which the worn cam
+reaches a given lift: a root of the wear model) and ``pump_findings``.
+
+Brake (cam-wear-brake.toml): ``shoe_integrals`` (the pressure integrals behind A and B by
+scipy.integrate.quad, as a table against the closed forms) and ``brake_findings``.
+
+scipy is imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import weakref
+from pathlib import Path
+
+import numpy as np
+
+from . import Finding, bench_block, block, findings_block, table_block
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _cached(sheet, key, make):
+    store = _CACHE.setdefault(sheet, {})
+    if key not in store:
+        store[key] = make()
+    return store[key]
+
+
+# ---------------------------------------------------------------------------------------------
+# Valve: the template's formulas in numpy (kept equal to the template by the tests)
+# ---------------------------------------------------------------------------------------------
+def _f3(h, d, alpha):
+    """Flow area (3): pi*(d*h*cos(a) + h^2*cos(a)^2*sin(a))."""
+    return math.pi * (d * h * math.cos(alpha) + h**2 * math.cos(alpha) ** 2 * math.sin(alpha))
+
+
+def _f_eff(h, d, d1, alpha, d_stem):
+    """(3) up to its validity limit, the second regime above it, capped at the port area."""
+    w = (d1 - d) / 2
+    h_lim = (d1 - d) / math.sin(2 * alpha)
+    second = math.pi * (d + d1) / 2 * np.sqrt((h - w * math.tan(alpha)) ** 2 + w**2)
+    area = np.where(h <= h_lim, _f3(h, d, alpha), second)
+    return np.minimum(area, math.pi / 4 * (d**2 - d_stem**2))
+
+
+def _h0(phi, H, Phi):
+    phi = np.asarray(phi, dtype=float)
+    inside = (phi >= 0) & (phi <= Phi)
+    return np.where(inside, H * (1 - np.cos(2 * np.pi * phi / Phi)) / 2, 0.0)
+
+
+def _worn(h0, H, p, w_b, w_n):
+    """Worn lift before clipping at zero: h0 - w(h0), w = w_b + (w_n - w_b)*(h0/H)^p."""
+    return h0 - (w_b + (w_n - w_b) * (h0 / H) ** p)
+
+
+def _hw(phi, H, Phi, p, w_b, w_n):
+    return np.maximum(0.0, _worn(_h0(phi, H, Phi), H, p, w_b, w_n))
+
+
+def _kinks(lift, Phi, levels, n=2048):
+    """Angles in (0, Phi) where lift(phi) crosses one of the levels (brentq in grid brackets)."""
+    from scipy.optimize import brentq
+
+    xs = np.linspace(0.0, Phi, n + 1)
+    out = []
+    for level in levels:
+        g = lift(xs) - level
+        for k in range(n):
+            if g[k] == 0.0 and 0 < xs[k] < Phi:
+                out.append(xs[k])
+            elif g[k] * g[k + 1] < 0:
+                out.append(
+                    brentq(
+                        lambda x, level=level: float(lift(x)) - level,
+                        xs[k],
+                        xs[k + 1],
+                        xtol=1e-13,
+                        rtol=1e-15,
+                    )
+                )
+    return sorted(set(out))
+
+
+def _gl_pieces(func, points, nodes=64, sub=8):
+    """Composite Gauss-Legendre over the pieces between successive points."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    total = 0.0
+    for a, b in zip(points[:-1], points[1:]):
+        edges = np.linspace(a, b, sub + 1)
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            mid, half = (lo + hi) / 2, (hi - lo) / 2
+            total += half * float(np.dot(w, func(mid + half * x)))
+    return total
+
+
+def _time_section(area, H, Phi, p, w_b, w_n, levels):
+    lift = (
+        (lambda phi: _h0(phi, H, Phi))
+        if (w_b == 0 and w_n == 0)
+        else (lambda phi: _hw(phi, H, Phi, p, w_b, w_n))
+    )
+    raw = (
+        (lambda phi: _h0(phi, H, Phi))
+        if (w_b == 0 and w_n == 0)
+        else (lambda phi: _worn(_h0(phi, H, Phi), H, p, w_b, w_n))
+    )
+    if float(np.max(raw(np.linspace(0, Phi, 4097)))) <= 0:
+        return 0.0  # the wear is deeper than the lift: the valve never opens
+    cuts = _kinks(raw, Phi, [0.0]) + _kinks(lift, Phi, [lv for lv in levels if lv > 0])
+    points = sorted({0.0, float(Phi), *cuts})
+    return _gl_pieces(lambda phi: area(lift(phi)), points)
+
+
+@block(
+    args={"d": "mm", "alpha": "rad", "H": "mm", "Phi": "deg", "p": "", "w_b": "mm", "w_n": "mm"},
+    returns="mm^2*deg",
+    vectorized=False,
+)
+def time_section_3(d, alpha, H, Phi, p, w_b, w_n):
+    """Time-section in angular units, integral of (3) f(h(phi)) dphi over the whole lift."""
+    return _time_section(lambda h: _f3(h, d, alpha), H, Phi, p, w_b, w_n, [])
+
+
+@block(
+    args={
+        "d": "mm",
+        "d1": "mm",
+        "alpha": "rad",
+        "d_stem": "mm",
+        "H": "mm",
+        "Phi": "deg",
+        "p": "",
+        "w_b": "mm",
+        "w_n": "mm",
+    },
+    returns="mm^2*deg",
+    vectorized=False,
+)
+def time_section_eff(d, d1, alpha, d_stem, H, Phi, p, w_b, w_n):
+    """Time-section with (3) up to its validity limit, the second regime above, the port cap."""
+    h_lim = (d1 - d) / math.sin(2 * alpha)
+    w = (d1 - d) / 2
+    r = (math.pi / 4 * (d**2 - d_stem**2)) / (math.pi * (d + d1) / 2)
+    h_port = w * math.tan(alpha) + math.sqrt(max(r**2 - w**2, 0.0))
+    return _time_section(
+        lambda h: _f_eff(h, d, d1, alpha, d_stem), H, Phi, p, w_b, w_n, [h_lim, h_port]
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Valve: quadrature against run time
+# ---------------------------------------------------------------------------------------------
+_POINTS = (5, 9, 17, 33, 65, 129, 257, 513, 1025)
+_POINTS_QUICK = (5, 9, 17, 33, 65, 129)
+_METHODS = ("trapezoid", "Simpson", "Gauss-Legendre", "Gauss-Legendre split")
+
+
+def _valve_numbers(sheet) -> dict:
+    v = sheet.values
+    q = lambda name, unit: float(v[name].to(unit).magnitude)  # noqa: E731
+    return dict(
+        d=q("d", "mm"),
+        d1=q("d1", "mm"),
+        alpha=q("alpha", "rad"),
+        d_stem=q("d_stem", "mm"),
+        H=q("H", "mm"),
+        Phi=q("Phi", "deg"),
+        p=q("p", ""),
+        cases={
+            "unworn": (0.0, 0.0),
+            "worn 1": (q("w_b1", "mm"), q("w_n1", "mm")),
+            "worn 2": (q("w_b2", "mm"), q("w_n2", "mm")),
+        },
+    )
+
+
+def _integrand(sheet, name):
+    """The template's function name(phi) compiled: plain degrees in, mm^2 out."""
+    fn = sheet.evaluator.function(name)
+    return lambda phi: np.asarray(fn({"phi": phi}), dtype=float)
+
+
+@__import__("functools").lru_cache(maxsize=None)
+def _legendre(n: int):
+    """Gauss-Legendre nodes and weights on [-1, 1] (tabulated once, as a rule's table is)."""
+    return np.polynomial.legendre.leggauss(n)
+
+
+def _rule(method: str, n: int, a: float, b: float):
+    if method == "trapezoid":
+        x = np.linspace(a, b, n)
+        w = np.full(n, (b - a) / (n - 1))
+        w[0] = w[-1] = w[0] / 2
+    elif method == "Simpson":
+        x = np.linspace(a, b, n)
+        hstep = (b - a) / (n - 1)
+        w = np.full(n, 2.0)
+        w[1::2] = 4.0
+        w[0] = w[-1] = 1.0
+        w *= hstep / 3
+    else:
+        t, w = _legendre(n)
+        x = (a + b) / 2 + (b - a) / 2 * t
+        w = w * (b - a) / 2
+    return x, w
+
+
+def _study(sheet, case: str, quick: bool):
+    """Rows (method, points, value, error, time) for one wear case."""
+    num = _valve_numbers(sheet)
+    w_b, w_n = num["cases"][case]
+    name = {"unworn": "fA0", "worn 1": "fA1", "worn 2": "fA2"}[case]
+    f = _integrand(sheet, name)
+    Phi = num["Phi"]
+    ref = time_section_3(num["d"], num["alpha"], num["H"], Phi, num["p"], w_b, w_n)
+    budget = 0.002 if quick else 0.02  # seconds of repeated runs per point, at least 3 runs
+    rows = []
+    for method in _METHODS:
+        for n in _POINTS_QUICK if quick else _POINTS:
+            if method == "Gauss-Legendre split":
+                if case == "unworn":
+                    continue
+                raw = lambda phi: _worn(_h0(phi, num["H"], Phi), num["H"], num["p"], w_b, w_n)  # noqa: E731
+
+                def run(n=n, raw=raw):
+                    cuts = _kinks(raw, Phi, [0.0], n=64) or [0.0, Phi]
+                    a, b = cuts[0], cuts[-1]
+                    x, w = _rule("Gauss-Legendre", n, a, b)
+                    return float(np.dot(w, f(x)))
+            else:
+                x, w = _rule(method, n, 0.0, Phi)
+
+                def run(x=x, w=w):
+                    return float(np.dot(w, f(x)))
+
+            best, spent, runs = math.inf, 0.0, 0
+            while runs < 3 or (spent < budget and runs < 200):
+                t0 = time.perf_counter()
+                value = run()
+                took = time.perf_counter() - t0
+                best, spent, runs = min(best, took), spent + took, runs + 1
+            rows.append((method, n, value, abs(value - ref), best))
+    return ref, rows
+
+
+def _study_cached(sheet, case, quick=False):
+    return _cached(sheet, ("study", case, quick), lambda: _study(sheet, case, quick))
+
+
+def _wide(sheet, case):
+    import pandas as pd
+
+    ref, rows = _study_cached(sheet, case)
+    floor = 1e-16 * abs(ref)
+    out = {"points": list(_POINTS)}
+    for method in _METHODS:
+        mine = {n: (val, err, t) for m, n, val, err, t in rows if m == method}
+        if not mine:
+            continue
+        out[f"{method} value [mm^2*deg]"] = [mine[n][0] for n in _POINTS]
+        out[f"{method} error [mm^2*deg]"] = [max(mine[n][1], floor) for n in _POINTS]
+        out[f"{method} time [ms]"] = [1e3 * mine[n][2] for n in _POINTS]
+    return pd.DataFrame(out)
+
+
+@table_block
+def quadrature_unworn(sheet):
+    """Time-section of the unworn cam by trapezoid, Simpson, Gauss-Legendre: error and time."""
+    return _wide(sheet, "unworn")
+
+
+@table_block
+def quadrature_worn(sheet):
+    """Time-section of the heavily worn cam (a kink where the worn lift reaches zero)."""
+    return _wide(sheet, "worn 2")
+
+
+@bench_block
+def bench(sheet, quick=False):
+    """Time-section by trapezoid, Simpson and Gauss-Legendre: error against run time."""
+    import pandas as pd
+
+    frames = []
+    for case in ("unworn", "worn 2"):
+        ref, rows = _study(sheet, case, quick)
+        frames.append(
+            pd.DataFrame(
+                [
+                    (case, m, n, v, e, e / abs(ref) if ref else math.nan, 1e3 * t)
+                    for m, n, v, e, t in rows
+                ],
+                columns=[
+                    "case",
+                    "method",
+                    "points",
+                    "value [mm^2*deg]",
+                    "error [mm^2*deg]",
+                    "relative error",
+                    "time [ms]",
+                ],
+            )
+        )
+    return pd.concat(frames, ignore_index=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# Valve: measured lift
+# ---------------------------------------------------------------------------------------------
+SG_WINDOW = 15  # points (30 deg at a 2 deg spacing); cubic Savitzky-Golay
+SG_ORDER = 3
+
+
+def read_measured_lift(path: Path):
+    """Read ``phi [deg],h [mm]`` (any angle and length units; '#' lines are comments).
+
+    Returns (phi in deg, h in mm) as numpy arrays, checked: finite, increasing, evenly spaced.
+    """
+    import csv
+
+    from .. import units as un
+    from ..errors import InputError, TemplateError
+
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise TemplateError(f"cannot read measured lift {path}: {exc.strerror}") from None
+    rows, header = [], None
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        cells = next(csv.reader([line]))
+        if header is None:
+            header = cells
+            continue
+        if len(cells) != 2:
+            raise InputError(f"{path}:{number}: expected two values (angle, lift)")
+        try:
+            rows.append((float(cells[0]), float(cells[1])))
+        except ValueError:
+            raise InputError(f"{path}:{number}: not a number in {line!r}") from None
+    if header is None or len(header) != 2:
+        raise InputError(f"{path}: the first line must be a header like 'phi [deg],h [mm]'")
+    units = []
+    for cell, want in zip(header, ("deg", "mm")):
+        inside = cell[cell.find("[") + 1 : cell.rfind("]")] if "[" in cell else ""
+        if not inside:
+            raise InputError(f"{path}: header {cell!r} names no unit (write e.g. 'h [mm]')")
+        try:
+            units.append(un.factor(un.unit(inside), un.unit(want)))
+        except Exception:
+            raise InputError(
+                f"{path}: header {cell!r}: {inside!r} is not convertible to {want}"
+            ) from None
+    if len(rows) < 2 * SG_WINDOW:
+        raise InputError(f"{path}: {len(rows)} points; at least {2 * SG_WINDOW} are needed")
+    data = np.array(rows)
+    phi, h = data[:, 0] * units[0], data[:, 1] * units[1]
+    if not np.all(np.isfinite(data)):
+        raise InputError(f"{path}: not every value is a finite number")
+    step = np.diff(phi)
+    if np.any(step <= 0) or np.ptp(step) > 1e-6 * step.mean():
+        raise InputError(f"{path}: the angles must increase in equal steps")
+    return phi, h
+
+
+def _measured_path(sheet) -> Path:
+    from ..errors import TemplateError
+
+    name = Path(
+        str(sheet.spec.meta.get("measured_lift", f"{sheet.spec.path.stem}.measured-lift.csv"))
+    )
+    if name.is_absolute() or ".." in name.parts:  # a worksheet reads only files beside it
+        raise TemplateError(
+            f"[sheet] measured_lift {str(name)!r} must be a file name beside the template"
+        )
+    return sheet.spec.path.parent / name
+
+
+def _measured(sheet):
+    def make():
+        from scipy.signal import savgol_coeffs, savgol_filter
+
+        phi, h = read_measured_lift(_measured_path(sheet))
+        dphi = float(phi[1] - phi[0])
+        omega = float(sheet.values["n"].to("deg/s").magnitude)
+        hs = savgol_filter(h, SG_WINDOW, SG_ORDER, mode="interp")
+        d1 = savgol_filter(h, SG_WINDOW, SG_ORDER, deriv=1, delta=dphi, mode="interp")
+        d2 = savgol_filter(h, SG_WINDOW, SG_ORDER, deriv=2, delta=dphi, mode="interp")
+        g0 = math.sqrt(float(np.sum(savgol_coeffs(SG_WINDOW, SG_ORDER) ** 2)))
+        g1 = math.sqrt(float(np.sum(savgol_coeffs(SG_WINDOW, SG_ORDER, deriv=1, delta=dphi) ** 2)))
+        g2 = math.sqrt(float(np.sum(savgol_coeffs(SG_WINDOW, SG_ORDER, deriv=2, delta=dphi) ** 2)))
+        # central differences (numpy.gradient, twice) for comparison
+        c1 = 1 / (math.sqrt(2) * dphi)
+        c2 = math.sqrt(6) / (4 * dphi**2)
+        # residual of a linear smoother: E|(I - S)e|^2 = sigma^2*(1 - c0) per point, c0 = g0^2
+        mid = np.abs(phi - phi.mean()) < np.ptp(phi) / 3
+        sigma = float(np.sqrt(np.mean((h - hs)[mid] ** 2) / (1 - g0**2)))
+        truth = {k: sheet.evaluate(k, phi=phi) for k in ("h_w2", "v_w2", "a_w2")}
+        return dict(
+            phi=phi,
+            h=h,
+            hs=hs,
+            v=d1 * omega * 1e-3,
+            a=d2 * omega**2 * 1e-3,
+            vc=np.gradient(h, dphi) * omega * 1e-3,
+            ac=np.gradient(np.gradient(h, dphi), dphi) * omega**2 * 1e-3,
+            gain=(g0, g1, g2),
+            central=(c1, c2),
+            sigma=sigma,
+            dphi=dphi,
+            omega=omega,
+            h_true=truth["h_w2"].to("mm").magnitude,
+            v_true=truth["v_w2"].to("m/s").magnitude,
+            a_true=truth["a_w2"].to("m/s^2").magnitude,
+        )
+
+    return _cached(sheet, "measured", make)
+
+
+@table_block
+def measured_lift(sheet):
+    """Measured worn lift: Savitzky-Golay velocity and acceleration against the wear formula."""
+    import pandas as pd
+
+    m = _measured(sheet)
+    return pd.DataFrame(
+        {
+            "phi [deg]": m["phi"],
+            "h measured [mm]": m["h"],
+            "h smoothed [mm]": m["hs"],
+            "h formula [mm]": m["h_true"],
+            "v Savitzky-Golay [m/s]": m["v"],
+            "v central differences [m/s]": m["vc"],
+            "v formula [m/s]": m["v_true"],
+            "a Savitzky-Golay [m/s^2]": m["a"],
+            "a central differences [m/s^2]": m["ac"],
+            "a formula [m/s^2]": m["a_true"],
+        }
+    )
+
+
+def measured_time_section(sheet) -> float:
+    """Time-section (mm^2*deg) of the measured lift: trapezoid of (3) at the measured points."""
+    m = _measured(sheet)
+    num = _valve_numbers(sheet)
+    area = _f3(np.maximum(m["h"], 0.0), num["d"], num["alpha"])
+    return float(np.sum((area[1:] + area[:-1]) / 2 * np.diff(m["phi"])))
+
+
+# ---------------------------------------------------------------------------------------------
+# Valve: findings
+# ---------------------------------------------------------------------------------------------
+@findings_block
+def valve_findings(sheet):
+    """Validity of (3), port cap, (1)/(2) against (3), wear against lift, measured lift."""
+    out = []
+    mm = lambda name: float(sheet.evaluate(name).to("mm").magnitude)  # noqa: E731
+    num = _valve_numbers(sheet)
+    H, Phi = num["H"], num["Phi"]
+    h_lim, h_port = mm("h_lim"), mm("h_port")
+    topic = "validity of (3)"
+    if H > h_lim:
+        phi_lim = Phi / (2 * math.pi) * math.acos(1 - 2 * h_lim / H)
+        out.append(
+            Finding(
+                topic,
+                "the lift passes the validity limit of (3), (d1 - d)/sin(2a),",
+                h_lim,
+                "mm",
+                "warning",
+                f"H = {H:g} mm; (3) holds for phi < {phi_lim:.1f} deg and after "
+                f"{Phi - phi_lim:.1f} deg. The paper's time-sections use (3) over the "
+                "whole lift; TS_eff uses the second regime above the limit",
+            )
+        )
+        ts3, tse = (float(sheet.evaluate(k).to("mm^2*deg").magnitude) for k in ("TS0", "TS0_eff"))
+        out.append(
+            Finding(
+                topic,
+                "(3) beyond its limit, against the second regime, changes the unworn "
+                "time-section by",
+                100 * (ts3 / tse - 1),
+                "%",
+                "info",
+                f"{ts3:.0f} against {tse:.0f} mm^2*deg with the second regime",
+            )
+        )
+    else:
+        out.append(
+            Finding(topic, "the whole lift is within the validity limit of (3)", h_lim, "mm", "ok")
+        )
+    if H >= h_port:
+        out.append(
+            Finding(
+                "port cap",
+                "the flow area reaches the port area at the lift",
+                h_port,
+                "mm",
+                "info",
+                "above it the port, not the seat, limits the flow",
+            )
+        )
+    else:
+        out.append(
+            Finding(
+                "port cap",
+                "the port area would cap the flow above the lift",
+                h_port,
+                "mm",
+                "ok",
+                f"not reached: H = {H:g} mm",
+            )
+        )
+    for h in (1.0, 5.0, H):
+        f1, f2, f3 = (
+            float(sheet.evaluate(k, h=h).to("mm^2").magnitude) for k in ("f1", "f2", "f3")
+        )
+        out.append(
+            Finding(
+                "(1) and (2) against (3)",
+                f"at h = {h:g} mm, (1) with the fixed d1 differs from (3) by",
+                100 * (f1 / f3 - 1),
+                "%",
+                "info",
+                f"(2) as printed by {100 * (f2 / f3 - 1):+.2f} %; (1) equals (3) "
+                f"only with d1 = d + 2h sin(a)cos(a) = "
+                f"{float(sheet.evaluate('d1_eq', h=h).to('mm').magnitude):.3f} mm",
+            )
+        )
+    for label, (w_b, w_n) in num["cases"].items():
+        if label == "unworn":
+            continue
+        raw = lambda phi, w_b=w_b, w_n=w_n: _worn(_h0(phi, H, Phi), H, num["p"], w_b, w_n)  # noqa: E731
+        grid = raw(np.linspace(0.0, Phi, 4097))
+        top, nose = float(grid.max()), _worn(H, H, num["p"], w_b, w_n)
+        if top <= 0:
+            out.append(
+                Finding(
+                    "wear against lift",
+                    f"{label}: the wear is deeper than the lift "
+                    "everywhere: the worn cam never opens the valve",
+                    top,
+                    "mm",
+                    "fail",
+                    "its time-section is zero",
+                )
+            )
+            continue
+        cuts = _kinks(raw, Phi, [0.0])
+        opened = float(np.mean(grid > 0) * Phi)
+        if nose <= 0:
+            out.append(
+                Finding(
+                    "wear against lift",
+                    f"{label}: the wear at the nose ({w_n:g} mm) "
+                    f"is deeper than the lift ({H:g} mm): the worn lift dips to zero "
+                    "at the nose and the valve opens twice",
+                    top,
+                    "mm",
+                    "warning",
+                    f"greatest worn lift; open for about {opened:.1f} deg in all",
+                )
+            )
+            continue
+        span = (cuts[-1] - cuts[0]) if len(cuts) >= 2 else Phi
+        out.append(
+            Finding(
+                "wear against lift",
+                f"{label}: the valve opens for",
+                span,
+                "deg",
+                "info",
+                f"unworn {Phi:g} deg; greatest worn lift {top:.3f} mm",
+            )
+        )
+    for k in ("dTS1", "dTS2"):
+        out.append(
+            Finding(
+                "time-section",
+                f"change of the time-section by wear ({k})",
+                float(sheet.evaluate(k).to("percent").magnitude),
+                "%",
+                "info",
+            )
+        )
+    try:
+        m = _measured(sheet)
+    except Exception as exc:  # a missing or bad table is reported, not fatal to the checks
+        out.append(
+            Finding(
+                "measured lift", "the measured lift could not be read", None, "", "fail", str(exc)
+            )
+        )
+        return out
+    ts_m = measured_time_section(sheet)
+    ts_f = float(sheet.evaluate("TS2").to("mm^2*deg").magnitude)
+    out.append(
+        Finding(
+            "measured lift",
+            "time-section of the measured lift (trapezoid)",
+            ts_m,
+            "mm^2*deg",
+            "info",
+            (
+                f"{100 * (ts_m / ts_f - 1):+.2f} % against the wear formula (worn 2)"
+                if ts_f
+                else "the wear formula (worn 2) gives zero"
+            ),
+        )
+    )
+    g0, g1, g2 = m["gain"]
+    c1, c2 = m["central"]
+    out.append(
+        Finding(
+            "measured lift",
+            "noise estimated from the residual of the smoothing",
+            1e3 * m["sigma"],
+            "um",
+            "info",
+        )
+    )
+    out.append(
+        Finding(
+            "measured lift",
+            "noise gain of the velocity (Savitzky-Golay, "
+            f"{SG_WINDOW} points, cubic; sigma_v = gain*sigma_h*omega)",
+            g1,
+            "1/deg",
+            "info",
+            f"central differences: {c1:.4f} 1/deg, {c1 / g1:.1f} times more noise",
+        )
+    )
+    out.append(
+        Finding(
+            "measured lift",
+            "noise gain of the acceleration (sigma_a = gain*sigma_h*omega^2)",
+            g2,
+            "1/deg^2",
+            "info",
+            f"central differences twice: {c2:.4f} 1/deg^2, {c2 / g2:.0f} times more",
+        )
+    )
+    away = np.abs(m["phi"] - Phi / 2) < Phi / 3
+    err_v = float(np.sqrt(np.mean((m["v"] - m["v_true"])[away] ** 2)))
+    err_vc = float(np.sqrt(np.mean((m["vc"] - m["v_true"])[away] ** 2)))
+    err_a = float(np.sqrt(np.mean((m["a"] - m["a_true"])[away] ** 2)))
+    err_ac = float(np.sqrt(np.mean((m["ac"] - m["a_true"])[away] ** 2)))
+    out.append(
+        Finding(
+            "measured lift",
+            "rms velocity error against the formula (middle two thirds)",
+            err_v,
+            "m/s",
+            "info",
+            f"central differences {err_vc:.3g} m/s",
+        )
+    )
+    out.append(
+        Finding(
+            "measured lift",
+            "rms acceleration error against the formula",
+            err_a,
+            "m/s^2",
+            "info",
+            f"central differences {err_ac:.3g} m/s^2; peak "
+            f"|a| {float(np.max(np.abs(m['a_true']))):.3g} m/s^2",
+        )
+    )
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Pump
+# ---------------------------------------------------------------------------------------------
+@block(
+    args={"h": "mm", "w_b": "mm", "w_n": "mm", "H": "mm", "p": ""}, returns="mm", vectorized=False
+)
+def worn_lift_inverse(h, w_b, w_n, H, p):
+    """Unworn lift h0 at which the worn lift h0 - w(h0) first reaches h (H if it never does)."""
+    from scipy.optimize import brentq
+
+    g = lambda x: _worn(x, H, p, w_b, w_n) - h  # noqa: E731
+    xs = np.linspace(0.0, H, 1025)
+    gs = g(xs)
+    for k in range(len(xs) - 1):
+        if gs[k] == 0.0:
+            return float(xs[k])
+        if gs[k] < 0 < gs[k + 1]:
+            return float(brentq(g, xs[k], xs[k + 1], xtol=1e-14, rtol=1e-15))
+    return float(H) if gs[-1] >= 0 else float(H)
+
+
+@findings_block
+def pump_findings(sheet):
+    """Active stroke within the acceleration section; (4)-(6) as printed; delivery with wear."""
+    ev = lambda name, unit: float(sheet.evaluate(name).to(unit).magnitude)  # noqa: E731
+    out = []
+    h_1, h_gn, h_gk = ev("h_1", "mm"), ev("h_gn", "mm"), ev("h_gk", "mm")
+    if h_gn <= 0:
+        out.append(
+            Finding(
+                "delivery",
+                "the port closes before the rise starts (dh > h_1)",
+                h_gn,
+                "mm",
+                "fail",
+                "choose dh smaller than the lift at the end of acceleration",
+            )
+        )
+    if h_gk <= h_1:
+        out.append(
+            Finding(
+                "delivery",
+                "the active stroke lies inside the acceleration section, "
+                "as (4)-(6) assume: end of delivery at the lift",
+                h_gk,
+                "mm",
+                "ok",
+                f"acceleration ends at {h_1:.4g} mm",
+            )
+        )
+    else:
+        out.append(
+            Finding(
+                "delivery",
+                "the active stroke runs into the deceleration section: "
+                "(4)-(6) do not hold; the angles here come from the cam itself",
+                h_gk,
+                "mm",
+                "warning",
+                f"acceleration ends at {h_1:.4g} mm",
+            )
+        )
+    d4 = ev("phi_gk_4_printed", "deg") - ev("phi_gk", "deg")
+    out.append(
+        Finding(
+            "(4)-(6) as printed",
+            "(4) as printed puts the end of delivery late by",
+            d4,
+            "deg",
+            "info",
+            "0.5*phi_na is counted twice; with the mean speed c_na the printed form is right",
+        )
+    )
+    out.append(
+        Finding(
+            "(4)-(6) as printed",
+            "(6) as printed gives, in the m/s it claims",
+            ev("c_na_6_printed", "mm/s"),
+            "m/s",
+            "info",
+            f"1000 times too large: it is mm/s; with units {ev('c_na_6', 'm/s'):.4f} m/s",
+        )
+    )
+    out.append(
+        Finding(
+            "(4)-(6) as printed",
+            "(5): both printed forms agree, difference",
+            ev("h_gk_5a", "mm") - ev("h_gk_5b", "mm"),
+            "mm",
+            "ok",
+        )
+    )
+    out.append(
+        Finding(
+            "(4)-(6) as printed",
+            "(7) is garbled and dimensionally wrong (it adds "
+            "deg^2 to (m/s)^2): not evaluated; the speeds come from the cam",
+            None,
+            "",
+            "info",
+        )
+    )
+    H_pw = ev("H_pw", "mm")
+    if H_pw <= h_gk:
+        out.append(
+            Finding(
+                "wear",
+                "the worn cam no longer reaches the geometric end of "
+                "delivery: the delivery is cut short",
+                H_pw,
+                "mm",
+                "fail",
+                f"worn stroke {H_pw:.3f} mm, end of delivery at {h_gk:.3f} mm",
+            )
+        )
+        return out
+    out.append(
+        Finding(
+            "wear",
+            "the geometric start of delivery comes later by",
+            ev("dphi_gn", "deg"),
+            "deg",
+            "info",
+            "cam shaft degrees: the injection timing retards",
+        )
+    )
+    out.append(
+        Finding(
+            "wear",
+            "active stroke duration, unworn -> worn",
+            ev("phi_na_w", "deg"),
+            "deg",
+            "info",
+            f"unworn {ev('phi_na', 'deg'):.3f} deg; mean speed "
+            f"{ev('c_na', 'm/s'):.3f} -> {ev('c_na_w', 'm/s'):.3f} m/s",
+        )
+    )
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Brake
+# ---------------------------------------------------------------------------------------------
+def shoe_factors_by_quadrature(r, s, alpha0, alpha1, psi, mu=1.0):
+    """A and B from the forces on a pivoted shoe, integrated by scipy.integrate.quad.
+
+    Drum centre at the origin, pivot Q = (s, 0); a lining point P = r*(cos a, sin a) carries
+    the pressure p = sin(a + psi) (p_max*b = 1), the normal force p*r*da along -n (n radial)
+    and the friction force mu*p*r*da along t = (-sin a, cos a). The moments about Q are cross
+    products (P - Q) x force; A and B are those moments over r times the friction-torque
+    integral, as in F*h = (A -/+ mu*B)*M/mu. Angles in radians, lengths in any one unit.
+    Returns dict(A, B, D, M_N, M_F, torque) (per unit p_max*b).
+    """
+    from scipy.integrate import quad
+
+    def cross(ax, ay, bx, by):
+        return ax * by - ay * bx
+
+    def arm(a, fx, fy):
+        return cross(r * math.cos(a) - s, r * math.sin(a), fx, fy)
+
+    p = lambda a: math.sin(a + psi)  # noqa: E731
+    opts = dict(epsabs=0.0, epsrel=1e-13, limit=200)
+    # normal force on the shoe from the drum points inward (-n): its moment about Q
+    m_n = quad(lambda a: arm(a, -math.cos(a), -math.sin(a)) * p(a) * r, alpha0, alpha1, **opts)[0]
+    m_f = quad(lambda a: arm(a, -math.sin(a), math.cos(a)) * p(a) * r, alpha0, alpha1, **opts)[0]
+    torque = quad(lambda a: p(a) * r * r, alpha0, alpha1, **opts)[0]  # friction torque / mu
+    d = quad(p, alpha0, alpha1, **opts)[0]
+    return dict(A=m_n / torque, B=m_f / torque, D=d, M_N=m_n, M_F=m_f, torque=torque)
+
+
+def _brake_numbers(sheet):
+    v = sheet.values
+    q = lambda name, unit: float(v[name].to(unit).magnitude)  # noqa: E731
+    return dict(
+        r=q("r", "mm"),
+        s=q("s", "mm"),
+        alpha0=q("alpha0", "rad"),
+        alpha1=q("alpha1", "rad"),
+        phi1=q("phi1", "rad"),
+        phi2=q("phi2", "rad"),
+        mu=q("mu", ""),
+    )
+
+
+@table_block
+def shoe_integrals(sheet):
+    """A and B of both shoes by quad of the shoe forces, against the template's closed forms."""
+    import pandas as pd
+
+    b = _brake_numbers(sheet)
+    rows = []
+    for shoe, psi, a_name, b_name in ((1, b["phi1"], "A1", "B1"), (2, -b["phi2"], "A2", "B2")):
+        qd = shoe_factors_by_quadrature(b["r"], b["s"], b["alpha0"], b["alpha1"], psi)
+        a_c = float(sheet.evaluate(a_name).to("").magnitude)
+        b_c = float(sheet.evaluate(b_name).to("").magnitude)
+        a_p = float(sheet.evaluate("A_10", psi=math.degrees(psi)).to("").magnitude)
+        b_p = float(sheet.evaluate("B_11", psi=math.degrees(psi)).to("").magnitude)
+        rows.append(
+            (
+                shoe,
+                math.degrees(psi),
+                qd["A"],
+                a_c,
+                abs(qd["A"] - a_c),
+                a_p,
+                qd["B"],
+                b_c,
+                abs(qd["B"] - b_c),
+                b_p,
+            )
+        )
+    return pd.DataFrame(
+        rows,
+        columns=[
+            "shoe",
+            "psi [deg]",
+            "A by quad",
+            "A closed form",
+            "A difference",
+            "A (10) printed",
+            "B by quad",
+            "B closed form",
+            "B difference",
+            "B (11) printed",
+        ],
+    )
+
+
+@findings_block
+def brake_findings(sheet):
+    """A, B against quadrature; printed (10), (11); self-locking; (8) and (12); wear; units."""
+    out = []
+    b = _brake_numbers(sheet)
+    df = shoe_integrals(sheet)
+    worst = float(max(df["A difference"].max(), df["B difference"].max()))
+    out.append(
+        Finding(
+            "shoe factors",
+            "A and B closed forms against quad of the shoe forces: largest difference",
+            worst,
+            "",
+            "ok" if worst < 1e-9 else "fail",
+        )
+    )
+    for _, row in df.iterrows():
+        out.append(
+            Finding(
+                "shoe factors",
+                f"shoe {int(row['shoe'])}: (10) as printed against A",
+                100 * (row["A (10) printed"] / row["A closed form"] - 1),
+                "%",
+                "info",
+                f"(11) as printed against B: "
+                f"{100 * (row['B (11) printed'] / row['B closed form'] - 1):+.1f} %",
+            )
+        )
+    ev = lambda name, unit="": float(sheet.evaluate(name).to(unit).magnitude)  # noqa: E731
+    lock = ev("lock1")
+    if lock >= 1:
+        out.append(
+            Finding(
+                "self-locking",
+                "mu*B/A of the leading shoe is 1 or more: the "
+                "leading shoe self-locks (its cam force (8) is not positive and "
+                "its torque has no bound)",
+                lock,
+                "",
+                "fail",
+                f"mu = {b['mu']:g}; it locks from mu = {ev('A1') / ev('B1'):.3f}",
+            )
+        )
+    else:
+        out.append(
+            Finding(
+                "self-locking",
+                "mu*B/A of the leading shoe (self-locks at 1)",
+                lock,
+                "",
+                "ok",
+                f"it would lock from mu = {ev('A1') / ev('B1'):.3f}",
+            )
+        )
+    for name, psi in (("shoe 1", b["phi1"]), ("shoe 2", -b["phi2"])):
+        lo = min(b["alpha0"] + psi, b["alpha1"] + psi)
+        hi = max(b["alpha0"] + psi, b["alpha1"] + psi)
+        if lo < -1e-12 or hi > math.pi + 1e-12:
+            out.append(
+                Finding(
+                    "pressure",
+                    f"{name}: sin(alpha + psi) is negative on part of "
+                    "the lining: the lining would lift off there, the A and B of "
+                    "this model do not hold",
+                    math.degrees(psi),
+                    "deg",
+                    "warning",
+                )
+            )
+    x_max, x_0, x_lost = ev("x_max", "mm"), ev("x_0", "mm"), ev("x_lost", "mm")
+    out.append(
+        Finding(
+            "wear",
+            "pushrod travel lost to the cam wear, l_k*w/(d_k/2)",
+            x_lost,
+            "mm",
+            "info",
+            f"free travel {x_0:.2f} mm unworn, {x_0 + x_lost:.2f} mm worn; "
+            "the torque curve moves right by this much, its slope is unchanged",
+        )
+    )
+    if x_0 + x_lost >= x_max:
+        out.append(
+            Finding(
+                "wear",
+                "the worn cam reaches the tip of its profile before the "
+                "shoes touch the drum: no braking",
+                x_0 + x_lost,
+                "mm",
+                "fail",
+                f"travel to the tip {x_max:.1f} mm",
+            )
+        )
+    else:
+        out.append(
+            Finding(
+                "wear",
+                "travel left for braking after the clearance, worn cam",
+                x_max - x_0 - x_lost,
+                "mm",
+                "info",
+                f"unworn {x_max - x_0:.1f} mm (to the tip of the profile)",
+            )
+        )
+    g0 = ev("gamma0", "rad")
+    out.append(
+        Finding(
+            "units",
+            "roll angle gamma0 of (9), in radians",
+            g0,
+            "rad",
+            "ok",
+            f"= {math.degrees(g0):.2f} deg; give it with its unit ('0.5 rad' or "
+            "'28.6 deg'): a bare number is read as radians",
+        )
+    )
+    xs = np.array([x_0 + 10.0])
+    f8 = float(sheet.evaluate("F1_8", x=xs).to("kN").magnitude[0])
+    f1 = float(sheet.evaluate("F1", x=xs).to("kN").magnitude[0])
+    out.append(
+        Finding(
+            "(8)",
+            "with the radius r_s as the arm, (8) as printed differs from the "
+            "corrected force (10 mm after contact) by",
+            100 * (f8 / f1 - 1),
+            "%",
+            "info",
+            "the involute's normal is tangent to the base circle: the arm "
+            "is d_k/2 whatever the contact radius",
+        )
+    )
+    xs = np.array([x_0 + 10.0])
+    m, m12 = (float(sheet.evaluate(k, x=xs).to("kN*m").magnitude[0]) for k in ("M", "M_12"))
+    out.append(
+        Finding(
+            "(12)",
+            "(12) with the mean A against the sum of the shoe torques",
+            100 * (m12 / m - 1),
+            "%",
+            "info",
+            "exact when both shoes have the same A and B",
+        )
+    )
+    return out
