@@ -105,6 +105,8 @@ class ExcelPrinter:
     def __init__(self, typer: tc.Typer, names: dict[str, str] | None = None):
         self.typer = typer
         self.names = names or {}
+        # (table, column) -> absolute cell range, filled by the writer for max_over()/min_over()
+        self.ranges: dict[tuple[str, str], str] = {}
 
     def formula(self, t: tc.T, subst: dict[str, str]) -> str:
         text = "=" + self.print(t, subst)
@@ -184,6 +186,15 @@ class ExcelPrinter:
 
     def _print_TBlock(self, t, s):
         raise NotLive(f"{t.name}() is a solver block ({t.ref}); its values are written as numbers")
+
+    def _print_TAggregate(self, t, s):
+        ref = self.ranges.get((t.table, t.column))
+        if ref is None:
+            raise NotLive(
+                f"{t.func}_over({t.table}, {t.column}) needs the cell range of that column, "
+                "which this writer does not register"
+            )
+        return f"{t.func.upper()}({ref})", ATOM
 
     def _print_TPiecewise(self, t, s):
         tail = "NA()"

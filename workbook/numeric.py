@@ -55,8 +55,10 @@ class Evaluator:
         typer: tc.Typer,
         scalar_value: Callable[[str, str], object],
         describe_args: Callable[[str, tuple, dict], str],
+        column_values: Callable[[str, str], object] | None = None,
     ):
         self.typer = typer
+        self.column_values = column_values  # (table, column) -> values, for max_over()
         self.scalar_value = scalar_value  # (name, kind) -> magnitude in the ref's unit
         self.describe_args = describe_args
         self._functions: dict[str, Fn] = {}
@@ -68,7 +70,6 @@ class Evaluator:
             self._functions[name] = _checked(
                 name, f.params, self.compile(f.body), self.describe_args
             )
-            self._functions[name].explain = lambda env, f=f: _explain(self, f, env)
         return self._functions[name]
 
     def compile(self, t: tc.T) -> Fn:
@@ -161,6 +162,11 @@ class Evaluator:
             return lambda env: f({p: a(env) for p, a in zip(params, args)})
         if isinstance(t, tc.TBlock):
             return self._block(t)
+        if isinstance(t, tc.TAggregate):
+            get, red = self.column_values, (np.max if t.func == "max" else np.min)
+            if get is None:
+                raise InputError(f"{t.func}_over({t.table}, {t.column}) needs a sheet's tables")
+            return lambda env: float(red(get(t.table, t.column)))
         if isinstance(t, tc.TPiecewise):
             return _piecewise(
                 t, [None if k is None else c(k) for k in t.conditions], [c(v) for v in t.values]
@@ -249,34 +255,12 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
                     for p in params
                 }
                 raise DomainError(
-                    f"{name} is not a finite number {describe(name, params, sub)}"
-                    + _explain_of(run, env),
-                    definition=name,
+                    f"{name} is not a finite number {describe(name, params, sub)}", definition=name
                 )
         elif isinstance(out, float) and not np.isfinite(out):
             raise DomainError(
-                f"{name} is not a finite number {describe(name, params, env)}"
-                + _explain_of(run, env),
-                definition=name,
+                f"{name} is not a finite number {describe(name, params, env)}", definition=name
             )
         return out
 
     return run
-
-
-def _explain_of(run, env) -> str:
-    explain = getattr(run, "explain", None)
-    return explain(env) if explain is not None else ""
-
-
-def _explain(evaluator: Evaluator, f: tc.TypedFunction, env) -> str:
-    """Which sub-expression left its domain, and for which arguments (workbook.analysis)."""
-    try:
-        from . import units as un
-        from .analysis import explain_domain
-
-        args = evaluator.typer.spec.arguments
-        text = explain_domain(evaluator, f, env, {p: un.pretty(args[p].unit) for p in f.params})
-    except Exception:  # noqa: BLE001 - the explanation must never hide the error itself
-        return ""
-    return f": {text}" if text else ""

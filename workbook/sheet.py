@@ -51,7 +51,9 @@ class Sheet:
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
         self.typer = typer or tc.Typer(spec, input_units)
         self._memo: dict[str, object] = {}
-        self.evaluator = Evaluator(self.typer, self._scalar_value, self._describe)
+        self.evaluator = Evaluator(
+            self.typer, self._scalar_value, self._describe, self._column_values
+        )
         if typer is None:
             self.check_units()
 
@@ -188,6 +190,17 @@ class Sheet:
                     )
             self._memo[name] = value
         return self._memo[name]
+
+    def _column_values(self, table: str, column: str) -> np.ndarray:
+        """Values of one column of a range table (for max_over/min_over), memoised."""
+        key = ("column", table, column)
+        if key not in self._memo:
+            spec = next(t for t in self.spec.tables if t.name == table)
+            col = next(c for c in spec.columns if c.text == column)
+            what = f"table {table}"
+            values = self.range_values(spec.range, what)
+            self._memo[key] = self.column(col, spec.range.var, values, what).values
+        return self._memo[key]
 
     def _describe(self, fname: str, params, env) -> str:
         parts = []

@@ -101,6 +101,15 @@ class TBlock(T):
 
 
 @dataclass(eq=False)
+class TAggregate(T):
+    """max_over(table, column) / min_over(...): one number from a range table's column."""
+
+    func: str = "max"
+    table: str = ""
+    column: str = ""
+
+
+@dataclass(eq=False)
 class TPiecewise(T):
     conditions: tuple = ()  # None for 'otherwise'
     values: tuple = ()
@@ -391,6 +400,8 @@ class Typer:
 
     def _call(self, node: ex.Call, scope) -> T:
         name = node.func
+        if name in AGGREGATES and name not in self.spec.definitions:
+            return self._aggregate(node)
         args = [self._t(a, scope) for a in node.args]
         for a in args:
             self._number(a, f"argument of {name}()")
@@ -451,9 +462,50 @@ class Typer:
             return TFunc(first.unit, func=name, args=(first, *rest))
         raise TemplateError(f"unknown function '{name}'")  # pragma: no cover
 
+    def _aggregate(self, node: ex.Call) -> T:
+        """``max_over(table, column)``: the largest value of a column of a range table."""
+        name = node.func
+        if len(node.args) != 2 or not all(isinstance(a, ex.Name) for a in node.args):
+            raise TemplateError(f"write {name}(table, column), e.g. {name}(design, S0_req)")
+        tname, cname = node.args[0].id, node.args[1].id
+        table = next((t for t in self.spec.tables if t.name == tname), None)
+        if table is None or table.range is None:
+            raise TemplateError(f"{name}(): '{tname}' is not a range table of this sheet")
+        col = next((c for c in table.columns if c.text == cname), None)
+        if col is None:
+            raise TemplateError(
+                f"{name}(): table '{tname}' has no column '{cname}' (columns: "
+                f"{', '.join(c.text for c in table.columns)})"
+            )
+        unit = column_type(self, col, table.range.var, f"{name}({tname}, {cname})").unit
+        return TAggregate(unit, func=AGGREGATES[name], table=tname, column=cname)
+
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
         return self._convert(a, unit, where)
+
+
+AGGREGATES = {"max_over": "max", "min_over": "min"}
+
+
+def column_node(spec: SheetSpec, col, var: str) -> ex.Node:
+    """A bare one-argument function name as a column means that function of the range variable."""
+    node = col.node
+    if isinstance(node, ex.Name):
+        d = spec.definitions.get(node.id)
+        if d is not None and d.is_function and len(d.params) == 1:
+            return ex.Call(node.id, (ex.Name(var),))
+    return node
+
+
+def column_type(typer: Typer, col, var: str, what: str) -> T:
+    """Typed tree of a table column (in its declared unit, if any)."""
+    arg = typer.spec.arguments.get(var)
+    scope = {var: arg.binding_unit if arg else typer.dimensionless}
+    t = typer.expression(column_node(typer.spec, col, var), scope, what)
+    if col.unit is not None:
+        t = typer._convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
+    return t
 
 
 def _with_unit(t: T, unit: pint.Unit) -> T:

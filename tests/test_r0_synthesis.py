@@ -1,0 +1,401 @@
+"""r0-synthesis: minimum cam radius for a pressure-angle limit (the VBA loop and the exact answer).
+
+References used here, none of them the solver under test: the numbers of SCENES.md section 2,
+brute force over dense grids refined by scipy's bounded minimiser, mpmath at 40 digits, and a
+central-difference derivative of the rise laws.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import zipfile
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+import workbook
+from workbook.blocks import r0 as R
+from workbook.errors import DomainError, InputError, LimitError, WorkbookError
+
+SCENE = dict(
+    H=16.0, phi_rise=math.radians(100), alpha_max=28.0, e=6.0, delta_sigma=1.0, law="stepped"
+)
+
+
+@pytest.fixture(scope="module")
+def sheet():
+    return workbook.load("r0-synthesis")
+
+
+def mm(q) -> float:
+    return float(q.to("mm").magnitude)
+
+
+# -- independent references ---------------------------------------------------------------------
+def law_arrays(law, x):
+    """The four rise laws written out again (unit stroke), independent of the engine's."""
+    x = np.asarray(x, dtype=float)
+    if law == "stepped":
+        return np.where(x <= 0.5, 2 * x * x, 1 - 2 * (1 - x) ** 2)
+    if law == "harmonic":
+        return 0.5 - 0.5 * np.cos(np.pi * x)
+    if law == "cycloidal":
+        return x - np.sin(2 * np.pi * x) / (2 * np.pi)
+    return 10 * x**3 - 15 * x**4 + 6 * x**5
+
+
+def law_slope(law, x, h=1e-6):
+    """ds/dx by a central difference (the formulas extend smoothly past 0 and 1)."""
+    x = np.asarray(x, dtype=float)
+    return (law_arrays(law, x + h) - law_arrays(law, x - h)) / (2 * h)
+
+
+def brute_r0(H, phi_rise, alpha_max, e, delta_sigma, law, n=200_001):
+    """Dense grid, then scipy's bounded minimiser around the five best points."""
+    t = math.tan(math.radians(alpha_max))
+    from workbook.blocks.r0 import shape  # only for the closed-form slope of the law
+
+    def g(x):
+        s, ds = shape(law, x)
+        return np.abs(H * ds / phi_rise + delta_sigma * e) / t - H * s
+
+    xs = np.linspace(0.0, 1.0, n)
+    vals = g(xs)
+    best = float(vals.max())
+    for i in np.argsort(vals)[-5:]:
+        lo, hi = xs[max(i - 1, 0)], xs[min(i + 1, n - 1)]
+        res = minimize_scalar(
+            lambda x: -float(g(x)), bounds=(lo, hi), method="bounded", options={"xatol": 1e-15}
+        )
+        best = max(best, -float(res.fun))
+    return math.hypot(max(best, 0.0), e)
+
+
+def law_slope_exact(law, x):
+    """ds/dx written out by hand (checked against law_slope in test_rise_laws)."""
+    x = np.asarray(x, dtype=float)
+    if law == "stepped":
+        return np.where(x <= 0.5, 4 * x, 4 * (1 - x))
+    if law == "harmonic":
+        return 0.5 * np.pi * np.sin(np.pi * x)
+    if law == "cycloidal":
+        return 1 - np.cos(2 * np.pi * x)
+    return 30 * x**2 - 60 * x**3 + 30 * x**4
+
+
+def max_abs_alpha_dense(H, phi_rise, e, delta_sigma, law, r0, n=400_001):
+    x = np.linspace(0.0, 1.0, n)
+    S = H * law_arrays(law, x)
+    Sp = H * law_slope_exact(law, x) / phi_rise
+    S0 = math.sqrt(r0 * r0 - e * e)
+    a = np.degrees(np.abs(np.arctan((Sp + delta_sigma * e) / (S0 + S))))
+    return float(a.max())
+
+
+# -- the numbers of the scene ---------------------------------------------------------------------
+def test_direct_r0_is_scene_value(sheet):
+    r0 = mm(sheet.evaluate("r0"))
+    assert r0 == pytest.approx(38.2405, abs=1e-4)
+    # and exact to floating point against a 40-digit evaluation
+    ref = float(R.reference_r0(**SCENE))
+    assert r0 == pytest.approx(ref, rel=1e-14)
+
+
+@pytest.mark.parametrize("dr, expected", [("1 mm", 39.0), ("0.1 mm", 38.3), ("0.01 mm", 38.25)])
+def test_loop_gives_listed_values(sheet, dr, expected):
+    s = sheet.with_inputs(dr=dr)
+    assert mm(s.evaluate("r0_loop")) == pytest.approx(expected, abs=1e-9)
+    # the closed form of the loop (live in Excel) agrees
+    assert mm(s.evaluate("r0_step")) == pytest.approx(expected, abs=1e-9)
+
+
+def test_loop_steps_from_e_without_drift():
+    r, k = R.loop(**SCENE, dr=0.1, n=101)
+    assert k == 323 and r == 6.0 + 323 * 0.1
+    drifted = 6.0
+    for _ in range(323):
+        drifted += 0.1  # what r0 += dr does
+    assert drifted != r  # the accumulated sum has drifted; e + k*dr has not
+
+
+def test_largest_pressure_angle_at_r0_is_alpha_max(sheet):
+    r0 = mm(sheet.evaluate("r0"))
+    alpha = sheet.evaluate("alpha", x=np.linspace(0, 1, 100_001)).to("deg").magnitude
+    assert np.abs(alpha).max() == pytest.approx(28.0, abs=1e-9)
+    assert float(sheet.evaluate("alpha", x=0.5).to("deg").magnitude) == pytest.approx(
+        28.0, abs=1e-9
+    )
+    # over the continuous angle (independent dense evaluation with a finite-difference S')
+    worst = max_abs_alpha_dense(16.0, math.radians(100), 6.0, 1.0, "stepped", r0)
+    assert worst == pytest.approx(28.0, abs=1e-9)
+    assert R.max_abs_alpha(16.0, math.radians(100), 6.0, 1.0, "stepped", r0) == pytest.approx(
+        28.0, abs=1e-9
+    )
+
+
+def test_evaluable_with_inputs(sheet):
+    s = sheet.with_inputs(H="20 mm", alpha_max="30 deg", e="5 mm", dr="0.1 mm")
+    r0 = mm(s.evaluate("r0"))
+    assert r0 == pytest.approx(
+        brute_r0(20.0, math.radians(100), 30.0, 5.0, 1.0, "stepped"), rel=1e-12
+    )
+    loop = mm(s.evaluate("r0_loop"))
+    assert r0 <= loop <= r0 + 0.1 + 1e-12
+
+
+# -- the direct solution against brute force, for all laws ----------------------------------------
+CASES = [
+    (law, ds, am, phr, e)
+    for law in R.LAWS
+    for ds in (1.0, -1.0)
+    for am in (12.0, 28.0, 45.0, 70.0)
+    for phr in (45.0, 100.0, 200.0)
+    for e in (0.0, 6.0, 40.0)
+]
+
+
+@pytest.mark.parametrize("law, ds, am, phr, e", CASES)
+def test_direct_matches_refined_brute_force(law, ds, am, phr, e):
+    p = dict(H=16.0, phi_rise=math.radians(phr), alpha_max=am, e=e, delta_sigma=ds, law=law)
+    try:
+        _, _, r0 = R.solve(**p)
+    except InputError:  # alpha_max does not bound r0: brute force must agree
+        assert brute_r0(**p, n=20_001) <= e * (1 + 1e-12) + 1e-12
+        return
+    assert r0 == pytest.approx(brute_r0(**p), rel=1e-11, abs=1e-11)
+
+
+@pytest.mark.parametrize("law", R.LAWS)
+def test_direct_matches_mpmath(law):
+    p = dict(SCENE, law=law)
+    assert R.solve(**p)[2] == pytest.approx(float(R.reference_r0(**p)), rel=1e-13)
+
+
+@pytest.mark.parametrize("law", R.LAWS)
+def test_rise_laws(sheet, law):
+    s = sheet.with_inputs(law=law)
+    x = np.linspace(0, 1, 2001)
+    S = s.evaluate("S", x=x).to("mm").magnitude
+    Sp = s.evaluate("Sp", x=x).to("mm/rad").magnitude
+    assert S[0] == pytest.approx(0, abs=1e-12) and S[-1] == pytest.approx(16.0, rel=1e-12)
+    assert np.allclose(S, 16.0 * law_arrays(law, x), rtol=0, atol=1e-12)
+    phi_rise = math.radians(100)
+    # central differences with h = 1e-6 (error 2h at the stepped law's kink, ~1e-10 elsewhere)
+    assert np.allclose(Sp, 16.0 * law_slope(law, x) / phi_rise, rtol=0, atol=5e-5)
+    assert np.allclose(law_slope_exact(law, x), law_slope(law, x), rtol=0, atol=5e-6)
+    assert np.allclose(Sp, 16.0 * law_slope_exact(law, x) / phi_rise, rtol=0, atol=1e-12)
+    assert Sp[0] == pytest.approx(0, abs=1e-12) and Sp[-1] == pytest.approx(0, abs=1e-12)
+    # and the workbook r0 for this law is the direct answer
+    assert mm(s.evaluate("r0")) == pytest.approx(R.solve(**dict(SCENE, law=law))[2], rel=1e-14)
+
+
+def test_grid_maximum_aggregate(sheet):
+    table = sheet.table("design")
+    assert len(table) == 101
+    assert mm(sheet.evaluate("S0_grid")) == table["S0 required [mm]"].max()
+    # the stepped law's grid with 101 angles contains the critical angle phi_rise/2
+    assert mm(sheet.evaluate("r0_grid")) == pytest.approx(mm(sheet.evaluate("r0")), rel=1e-15)
+
+
+# -- extreme inputs: clear errors, not tracebacks or nonsense -------------------------------------
+def test_negative_stroke(sheet):
+    with pytest.raises(InputError, match="H = -20 mm must be positive"):
+        sheet.with_inputs(H="-20 mm")
+
+
+@pytest.mark.parametrize("angle", ["0 deg", "90 deg"])
+def test_alpha_max_at_the_ends(sheet, angle):
+    s = sheet.with_inputs(alpha_max=angle)
+    for name in ("r0", "r0_loop"):
+        with pytest.raises(InputError, match="strictly between 0 and 90 deg"):
+            s.evaluate(name)
+
+
+def test_alpha_max_near_90(sheet):
+    s = sheet.with_inputs(alpha_max="89.9 deg")
+    r0 = mm(s.evaluate("r0"))
+    assert 6.0 < r0 < 6.001  # the limit hardly constrains r0 any more
+    with pytest.raises(InputError, match="first candidate r0 = e \\+ dr"):
+        s.evaluate("r0_loop")
+    # e = 0: alpha -> 90 deg at the start of the rise as S0 -> 0, so r0 stays positive, tiny
+    s0 = sheet.with_inputs(alpha_max="89.9 deg", e="0 mm")
+    r0 = mm(s0.evaluate("r0"))
+    assert 0 < r0 < 1e-3
+    assert r0 == pytest.approx(
+        brute_r0(16.0, math.radians(100), 89.9, 0.0, 1.0, "stepped"), rel=1e-9
+    )
+
+
+def test_alpha_max_near_0(sheet):
+    s = sheet.with_inputs(alpha_max="0.5 deg")
+    r0 = mm(s.evaluate("r0"))
+    assert r0 == pytest.approx(
+        brute_r0(16.0, math.radians(100), 0.5, 6.0, 1.0, "stepped"), rel=1e-12
+    )
+    assert r0 > 2000  # metres of cam
+    with pytest.raises(LimitError, match="steps"):
+        s.evaluate("r0_loop")
+
+
+def test_dr_larger_than_the_answer(sheet):
+    with pytest.raises(InputError, match="set by dr, not by alpha_max"):
+        sheet.with_inputs(dr="50 mm").evaluate("r0_loop")
+
+
+def test_grid_missing_the_kink(sheet):
+    s = sheet.with_inputs(n_grid=100)
+    with pytest.raises(InputError, match="misses phi_rise/2"):
+        s.evaluate("r0_loop")
+    # what the loop would have accepted exceeds alpha_max between grid points
+    r_bad, _ = R.loop(**SCENE, dr=0.001, n=100, allow_kink_miss=True)
+    assert r_bad < mm(sheet.evaluate("r0"))
+    assert max_abs_alpha_dense(16.0, math.radians(100), 6.0, 1.0, "stepped", r_bad) > 28.0
+    # the direct answer does not depend on the grid
+    assert mm(s.evaluate("r0")) == pytest.approx(mm(sheet.evaluate("r0")), rel=1e-15)
+
+
+def test_e_not_below_r(sheet):
+    with pytest.raises(DomainError, match="alpha_r is not a finite number"):
+        sheet.evaluate("alpha_r", x=0, r="5 mm")  # e = 6 mm > r: sqrt(r^2 - e^2) of a negative
+    with pytest.raises(InputError, match="must exceed e"):
+        R.alpha_deg("stepped", 0.0, 16.0, 1.0, 6.0, 1.0, 6.0)
+
+
+def test_bad_delta_sigma(sheet):
+    with pytest.raises(InputError, match="delta_sigma = 0.5"):
+        sheet.with_inputs(delta_sigma=0.5).evaluate("r0")
+
+
+def test_absolute_not_signed_pressure_angle():
+    """A signed check accepts designs where the follower is pushed hard the other way."""
+    p = dict(SCENE, delta_sigma=-1.0, e=30.0)
+    r_abs, _ = R.loop(**p, dr=0.01, n=101)
+    x = R.grid(101)
+    s, ds = R.shape("stepped", x)
+    num = 16.0 * ds / p["phi_rise"] - 30.0
+    k = 1
+    while True:  # the same loop with a signed comparison
+        r = 30.0 + k * 0.01
+        a = np.degrees(np.arctan(num / (math.sqrt(r * r - 900.0) + 16.0 * s)))
+        if a.max() <= 28.0:
+            break
+        k += 1
+    assert np.degrees(np.arctan(-30.0 / math.sqrt(r * r - 900.0))) < -60.0  # alpha(0)
+    assert r < r_abs
+    a_abs = R.alpha_deg("stepped", x, 16.0, p["phi_rise"], 30.0, -1.0, r_abs)
+    assert np.abs(a_abs).max() <= 28.0
+
+
+# -- error against run time ------------------------------------------------------------------------
+def test_bench_direct_faster_and_more_accurate(sheet):
+    df = R.bench(sheet, quick=True)
+    row = df[(df["dr [mm]"] == 0.001) & (df["angles"] == 101)].iloc[0]
+    ratio = row["loop time [s]"] / row["direct time [s]"]
+    direct_err = abs(row["r0 direct [mm]"] - float(R.reference_r0(**SCENE)))
+    print(
+        f"\ndr = 0.001 mm, 101 angles: loop {row['loop time [s]']:.4g} s, error "
+        f"{row['loop error [mm]']:.3g} mm; direct {row['direct time [s]']:.3g} s, error "
+        f"{direct_err:.2g} mm; loop/direct time = {ratio:.0f}"
+    )
+    assert ratio >= 100
+    assert direct_err < abs(row["loop error [mm]"])
+    assert set(df["dr [mm]"]) == {1.0, 0.1, 0.01, 0.001}
+    # the loop's error is below dr and does not depend on the grid (it contains phi_rise/2)
+    assert (df["loop error [mm]"] >= 0).all() and (df["loop error [mm]"] < df["dr [mm]"]).all()
+
+
+def test_bench_is_declared(sheet):
+    assert sheet.spec.meta["bench"] == "r0.bench"
+
+
+def test_findings_all_pass(sheet):
+    report = sheet.check()
+    verdicts = {f.what: f.verdict for f in report.findings}
+    assert report.ok, verdicts
+    assert not any(v in ("fail", "warning") for v in verdicts.values()), verdicts
+    fig4 = [f for f in report.findings if f.topic == "Fig. 4"]
+    assert all(abs(f.value) > 1 for f in fig4)  # alpha at phi_rise/2 and phi_rise does change
+
+
+# -- the workbook ---------------------------------------------------------------------------
+def _definitions(path):
+    import openpyxl
+
+    wb = openpyxl.load_workbook(path)
+    ws = wb["Definitions"]
+    return {row[0].value: row[1].coordinate for row in ws.iter_rows(min_row=2)}
+
+
+def test_workbook_has_no_macro_and_live_r0(tmp_path, sheet):
+    import openpyxl
+
+    path = sheet.write_xlsx(tmp_path / "r0.xlsx")
+    with zipfile.ZipFile(path) as z:
+        names = z.namelist()
+    assert not any("vba" in n.lower() for n in names)
+    wb = openpyxl.load_workbook(path)
+    ws = wb["Definitions"]
+    cells = {row[0].value: row[1].value for row in ws.iter_rows(min_row=2)}
+    assert str(cells["r0"]).startswith("=")  # a live formula
+    assert str(cells["S0_crit"]).startswith("=")
+    design = wb["Design"]
+    assert str(design["E3"].value).startswith("=")  # required S0 at each angle
+    assert {"Charts", "Error vs time", "Design", "Result"} <= set(wb.sheetnames)
+
+
+def _recalc():
+    pytest.importorskip("openpyxl")
+    try:
+        from recalc import cell_values, formula_values, recalculate, soffice
+    except ImportError:
+        pytest.skip("tests/recalc.py is not there")
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    return cell_values, formula_values, recalculate
+
+
+def test_libreoffice_recalculates_to_engine_values(tmp_path, sheet):
+    cell_values, formula_values, recalculate = _recalc()
+    path = sheet.write_xlsx(tmp_path / "r0.xlsx")
+    cached = formula_values(path)
+    new = cell_values(recalculate(path, tmp_path / "lo"))
+    bad = [
+        (k, v, new.get(k))
+        for k, (f, v) in cached.items()
+        if isinstance(v, (int, float))
+        and not isinstance(v, bool)
+        and not (
+            isinstance(new.get(k), (int, float)) and abs(new[k] - v) <= 1e-9 * max(1.0, abs(v))
+        )
+    ]
+    assert len(cached) > 1000 and not bad, bad[:5]
+
+
+@pytest.mark.parametrize("alpha_max, H", [(35.0, 16.0), (22.0, 20.0)])
+def test_changing_alpha_max_in_excel_moves_r0(tmp_path, sheet, alpha_max, H):
+    import openpyxl
+
+    cell_values, _, recalculate = _recalc()
+    path = sheet.write_xlsx(tmp_path / "r0.xlsx")
+    edited = tmp_path / "edited.xlsx"
+    shutil.copy(path, edited)
+    wb = openpyxl.load_workbook(edited)
+    for row in wb["Inputs"].iter_rows():
+        if row[0].value == "alpha_max":
+            row[1].value = alpha_max
+        if row[0].value == "H":
+            row[1].value = H
+    wb.save(edited)
+    cell = _definitions(path)["r0"]
+    got = cell_values(recalculate(edited, tmp_path / "lo"))[("Definitions", cell)]
+    expected = mm(sheet.with_inputs(alpha_max=f"{alpha_max} deg", H=f"{H} mm").evaluate("r0"))
+    assert got == pytest.approx(expected, rel=1e-12)
+    assert abs(got - 38.2405) > 1  # it moved
+
+
+def test_errors_are_engine_errors(sheet):
+    for change in (dict(H="-1 mm"), dict(alpha_max="0 deg"), dict(dr="100 mm"), dict(n_grid=10)):
+        with pytest.raises(WorkbookError):
+            sheet.with_inputs(**change).evaluate("r0_loop")
