@@ -572,7 +572,12 @@ def check_input_value(spec: InputSpec, q: pint.Quantity) -> None:
         except pint.DimensionalityError:
             raise InputError(f"{spec.name}: bound {bound:~} has other units than {q:~}") from None
         if not np.all(ok(mag, b)):
-            raise InputError(f"{spec.name} = {q:~} must be {word} {bound:~}", definition=spec.name)
+            hint = ""  # a bare number for a radian input: say so if it fits read as degrees
+            if str(q.units) == "radian" and np.ndim(mag) == 0 and ok(np.radians(mag), b):
+                hint = f" (a bare number is read as radians; for degrees write '{mag:g} deg')"
+            raise InputError(
+                f"{spec.name} = {q:~} must be {word} {bound:~}{hint}", definition=spec.name
+            )
 
 
 def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
