@@ -70,6 +70,7 @@ class Evaluator:
             self._functions[name] = _checked(
                 name, f.params, self.compile(f.body), self.describe_args
             )
+            self._functions[name].explain = lambda env, f=f: _explain(self, f, env)
         return self._functions[name]
 
     def compile(self, t: tc.T) -> Fn:
@@ -255,12 +256,34 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
                     for p in params
                 }
                 raise DomainError(
-                    f"{name} is not a finite number {describe(name, params, sub)}", definition=name
+                    f"{name} is not a finite number {describe(name, params, sub)}"
+                    + _explain_of(run, env),
+                    definition=name,
                 )
         elif isinstance(out, float) and not np.isfinite(out):
             raise DomainError(
-                f"{name} is not a finite number {describe(name, params, env)}", definition=name
+                f"{name} is not a finite number {describe(name, params, env)}"
+                + _explain_of(run, env),
+                definition=name,
             )
         return out
 
     return run
+
+
+def _explain_of(run, env) -> str:
+    explain = getattr(run, "explain", None)
+    return explain(env) if explain is not None else ""
+
+
+def _explain(evaluator: Evaluator, f: tc.TypedFunction, env) -> str:
+    """Which sub-expression left its domain, and for which arguments (workbook.analysis)."""
+    try:
+        from . import units as un
+        from .analysis import explain_domain
+
+        args = evaluator.typer.spec.arguments
+        text = explain_domain(evaluator, f, env, {p: un.pretty(args[p].unit) for p in f.params})
+    except Exception:  # noqa: BLE001 - the explanation must never hide the error itself
+        return ""
+    return f": {text}" if text else ""
