@@ -149,14 +149,16 @@ def test_linear_forms(sheet):
     A = d["O1O"] - d["OC"] * c
     G = d["MD0"] * d["OB"] / d["O1B"] * d["tg"]
     N = 2 * d["m"] * w**2 * A * d["OC"] * s - 8 * d["c1"] * d["lam"] * d["OC1"] * s - G
-    D = 8 * d["c1"] * (d["lam"] * d["OC1"] * c + d["OC1"]**2 * s**2) - 2 * d["m"] * w**2 * A * d["OC"] * c
+    D = (8 * d["c1"] * (d["lam"] * d["OC1"] * c + d["OC1"]**2 * s**2)
+         - 2 * d["m"] * w**2 * A * d["OC"] * c)
     assert float(sheet.evaluate("phi2_lin", omega1=w).magnitude) == pytest.approx(N / D, rel=1e-12)
     # the consistent Newton step is -F(phi20)/F'(phi20): check against a numerical derivative
     import mpmath as mp
 
     dF = mp.diff(lambda x: F_ref(x, w, d), mp.mpf(d["phi20"]))
     newton = -float(F_ref(mp.mpf(d["phi20"]), w, d)) / float(dF)
-    assert float(sheet.evaluate("phi2_newton", omega1=w).magnitude) == pytest.approx(newton, rel=1e-9)
+    got = float(sheet.evaluate("phi2_newton", omega1=w).magnitude)
+    assert got == pytest.approx(newton, rel=1e-9)
     # where the printed form departs by more than 5 % (base case): near lift-off and at 110
     dev = sheet.evaluate("dev_lin", omega1=[60, 90, 110]).to("percent").magnitude
     assert abs(dev[0]) > 5 and abs(dev[1]) < 5 and abs(dev[2]) > 5
@@ -174,7 +176,8 @@ def test_soft_spring_denominator_is_reported_not_divided(sheet):
     assert cp.steady(110.0, p).phi2 > 0
     assert cp.soft_spring_limit(cp.Params(), 110.0) == pytest.approx(990.95, abs=0.05)
     # Newton form: c1 = 1500 N/m passes through zero inside 50..110 rad/s
-    deps = dict((v, z) for v, _, _, z in cp.departures(cp.Params(), "c1", np.arange(50, 111, 5.0), "newton"))
+    ws = np.arange(50, 111, 5.0)
+    deps = {v: z for v, _, _, z in cp.departures(cp.Params(), "c1", ws, "newton")}
     assert deps[1500.0] == [100.0, 105.0, 110.0]
 
 
@@ -394,13 +397,36 @@ def test_bench_quick_is_fast(sheet):
     assert {"error [rad]", "run time [s]", "stopped"} <= set(df.columns)
 
 
+@pytest.fixture(scope="module")
+def written(tmp_path_factory, sheet):
+    return sheet.write_xlsx(tmp_path_factory.mktemp("ac") / "ac.xlsx")
+
+
 @pytest.mark.slow
-def test_workbook_writes(tmp_path, sheet):
+def test_workbook_writes(written):
     import openpyxl
 
-    out = sheet.write_xlsx(tmp_path / "ac.xlsx")
-    wb = openpyxl.load_workbook(out)
+    wb = openpyxl.load_workbook(written)
     for name in ("Families", "Dynamics", "Stiffness", "Solvers", "Checks"):
         assert name in wb.sheetnames
     text = " ".join(str(c) for row in wb["Checks"].iter_rows(values_only=True) for c in row if c)
     assert "phi2 falls as c1 rises" in text and "time / fastest" in text
+
+
+@pytest.mark.slow
+def test_live_formulas_recalculate_in_libreoffice(tmp_path, written):
+    """The closed forms, matrix entries and mode estimates are live: LibreOffice gets the
+    engine's numbers."""
+    recalc = pytest.importorskip("recalc")
+    if recalc.soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    cached = recalc.formula_values(written)
+    new = recalc.cell_values(recalc.recalculate(written, tmp_path / "lo"))
+    assert len(cached) > 50
+    bad = []
+    for key, (formula, value) in cached.items():
+        got = new.get(key)
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            if not isinstance(got, (int, float)) or abs(got - value) > 1e-9 * max(1.0, abs(value)):
+                bad.append((key, formula[:60], value, got))
+    assert not bad, bad[:5]

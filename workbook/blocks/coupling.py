@@ -16,13 +16,12 @@ from __future__ import annotations
 
 import math
 import sys
-import time
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
 from . import Finding, bench_block, block, findings_block, table_block
-from .solvers import METHODS, OdeRun, fastest_within, run_ode, stable_root, work_precision
+from .solvers import METHODS, OdeRun, run_ode, stable_root, work_precision
 
 # ---------------------------------------------------------------------------------------------
 # parameters
@@ -63,7 +62,7 @@ class Params:
     t_end: float = 0.2
 
     @classmethod
-    def from_sheet(cls, sheet) -> "Params":
+    def from_sheet(cls, sheet) -> Params:
         """Read the template inputs of the same names (any that exist) in SI units."""
         values = {}
         for f in fields(cls):
@@ -188,7 +187,8 @@ FAMILIES = {
     "m": ("weight mass m", "kg", (0.65, 0.7, 0.75, 0.8)),
     "phi20": ("initial angle phi20", "rad", (0.4363, 0.5235, 0.6108, 0.6981)),
 }
-TRENDS = {"c1": -1, "m": +1, "phi20": +1}  # the printed trends: phi2 falls with c1, rises with m, phi20
+# the printed trends: phi2 falls as c1 rises, rises with m and with phi20
+TRENDS = {"c1": -1, "m": +1, "phi20": +1}
 TREND_TEXT = {"c1": "phi2 falls as c1 rises", "m": "phi2 rises with m",
               "phi20": "phi2 rises with phi20"}
 
@@ -236,7 +236,7 @@ def _family_table(sheet, key: str):
 
 @table_block
 def family_c1(sheet):
-    """Fig. 3a: phi2(omega1) for c1 = 1500, 3000, 4000, 6000 N/m (nonlinear root, printed linear form)."""
+    """Fig. 3a: phi2(omega1) for c1 = 1500, 3000, 4000, 6000 N/m (root, printed closed form)."""
     return _family_table(sheet, "c1")
 
 
@@ -474,6 +474,8 @@ def _cached(key, compute):
     """Results are stored only when complete (a Ctrl-C leaves no half-filled entry)."""
     if key not in _CACHE:
         value = compute()
+        if len(_CACHE) > 512:  # many input variations (sweeps): start afresh
+            _CACHE.clear()
         _CACHE[key] = value
     return _CACHE[key]
 
@@ -754,7 +756,7 @@ def departures(p: Params, key: str, ws, form: str = "printed", limit: float = 0.
         rel[mask] = np.abs(lin[mask] - root[mask]) / root[mask]
         bad = mask & ((rel > limit) | np.isnan(lin))
         where = [float(w) for w in ws[bad]]
-        zero = [float(w) for w, l in zip(ws, lin) if np.isnan(l)]
+        zero = [float(w) for w, v in zip(ws, lin) if np.isnan(v)]
         out.append((value, where, float(np.nanmax(rel)) if mask.any() else 0.0, zero))
     return out
 
@@ -852,7 +854,8 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
     ok = sub[(sub["stopped"] == "finished") & (sub["deviation from rigid [rad]"] <= tol)]
     default = auto_method(p, CHOICE_C2) if method == "auto" else method
     out = [F("solver choice", f"rigid-model difference at c2 = {CHOICE_C2:.0e} N/m", delta, "rad",
-             "info", f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g} rad")]
+             "info", f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g}"
+             " rad")]
     if ok.empty:
         out.append(F("solver choice", "no run of the study reaches the rigid limit", None, "",
                      "warning"))
@@ -892,5 +895,5 @@ def bench(sheet, quick: bool = False):
         q = replace(p, t_end=0.02)
         df = study(q, (CHOICE_C2,), (1e-3, 1e-5), t_end=0.02, max_time=0.3, label=None)
     else:
-        df = study(p, FULL_C2, FULL_RTOLS, max_time=5.0)
+        df = study(p, FULL_C2, FULL_RTOLS, max_time=10.0)
     return df
