@@ -256,6 +256,7 @@ def test_grid_missing_the_kink(sheet):
     assert mm(s.evaluate("r0")) == pytest.approx(mm(sheet.evaluate("r0")), rel=1e-15)
 
 
+@pytest.mark.filterwarnings("ignore:invalid value encountered in sqrt:RuntimeWarning")
 def test_e_not_below_r(sheet):
     with pytest.raises(DomainError, match="alpha_r is not a finite number"):
         sheet.evaluate("alpha_r", x=0, r="5 mm")  # e = 6 mm > r: sqrt(r^2 - e^2) of a negative
