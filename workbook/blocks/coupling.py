@@ -874,6 +874,20 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
     out.append(F("solver choice", f"default {default} rtol {rtol:.0e}: time / fastest", ratio, "",
                  "ok" if ratio <= 2 and dev <= tol else "warning",
                  f"{t_def:.3g} s, deviation from the rigid limit {dev:.3g} rad (<= {tol:.3g})"))
+    for c2 in sorted(df["c2 [N/m]"].unique()):
+        rows = df[(df["c2 [N/m]"] == c2) & (df["stopped"] == "finished")
+                  & (df["error [rad]"] <= 1e-6)]
+        auto = auto_method(p, c2) if method == "auto" else method
+        mine = df[(df["c2 [N/m]"] == c2) & (df["method"] == auto) & (df["rtol"] == rtol)]
+        if rows.empty:
+            continue
+        fast = rows.loc[rows["run time [s]"].idxmin()]
+        note = f"fastest with error <= 1e-6 rad: {fast['method']} rtol {fast['rtol']:.0e}"
+        if not mine.empty:
+            note += (f"; {auto} rtol {rtol:.0e}: error {mine['error [rad]'].iloc[0]:.2g} rad, "
+                     f"{mine['run time [s]'].iloc[0]:.3g} s")
+        out.append(F("solver choice", f"c2 = {c2:.0e} N/m: auto takes {auto}",
+                     float(fast["run time [s]"]), "s", "info", note))
     out.append(F("solver choice", "why", None, "", "info",
                  "the tooth mode is almost undamped and, for c2 >= 1e9 N/m, far faster than the "
                  "weights: explicit methods (RK45, DOP853) must follow it with about "
