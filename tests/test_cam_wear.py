@@ -386,3 +386,11 @@ def test_workbook_recalculates_in_libreoffice(name, tmp_path):
         elif value != got:
             bad.append((key, formula[:80], value, got))
     assert not bad, f"{len(bad)} of {len(cached)} formula cells differ, e.g. {bad[:5]}"
+
+
+def test_pump_port_closing_before_the_rise_is_reported(pump):
+    bad = pump.with_inputs(dh="4 mm")  # more than the 3.086 mm lift at the end of acceleration
+    f = [x for x in bad.check().findings if x.topic == "delivery"]
+    assert (
+        len(f) == 1 and f[0].verdict == "fail" and f[0].value == pytest.approx(3.0864 - 4, abs=1e-4)
+    )

@@ -729,6 +729,7 @@ def pump_findings(sheet):
                 "choose dh smaller than the lift at the end of acceleration",
             )
         )
+        return out  # the delivery angles and speeds do not exist
     if h_gk <= h_1:
         out.append(
             Finding(
