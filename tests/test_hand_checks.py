@@ -1,0 +1,431 @@
+"""Issue 3: the hand calculation of the concave cam checked by the engine.
+
+References are computed here independently (closed forms, plane geometry with numpy,
+mpmath at 50 digits), not taken from the engine.
+"""
+
+import math
+import time
+
+import mpmath
+import numpy as np
+import pytest
+
+import workbook
+from workbook import analysis
+from workbook.blocks import concave as cc
+from workbook.errors import DomainError
+
+R1, R2, R3, RP, A, OMEGA = 20.0, 10.0, 50.0, 10.0, 20.0, 104.6  # mm, 1/s
+D, C = R1 + R3, R3 - RP
+K = D / C
+
+
+@pytest.fixture(scope="module")
+def geometry():
+    return workbook.load("concave-cam-geometry")
+
+
+@pytest.fixture(scope="module")
+def relations(concave):
+    return {r.text: r for r in analysis.relation_results(concave)}
+
+
+# -- 1. derivative relations -----------------------------------------------------------------------
+def test_every_velocity_and_acceleration_has_a_relation(concave):
+    declared = {(r.child, r.parent) for r in concave.spec.relations}
+    assert declared == {
+        ("v1", "h1"),
+        ("v2", "h2"),
+        ("v3", "h3"),
+        ("j1", "v1"),
+        ("j2", "v2"),
+        ("j3", "v3"),
+    }
+
+
+def test_relations_that_hold(relations):
+    for text in ("v1 = omega * d(h1)/d(phi)", "v3 = omega * d(h3)/d(phi)"):
+        r = relations[text]
+        assert r.holds and r.rel < 1e-9, (text, r.rel)
+        # with the sheet's pi = 3.142 the sheet's degree is 3.142/pi of a true one
+        assert r.pi_rel == pytest.approx(3.142 / math.pi - 1, rel=1e-3)
+    # j2 is the second derivative of h2 (it is v2 that carries the factor psi = 1.5)
+    second = [r for r in relations.values() if r.second and r.child == "j2"][0]
+    assert second.holds and second.rel < 1e-9
+
+
+def test_v2_carries_psi(relations):
+    r = relations["v2 = omega * d(h2)/d(phi)"]
+    assert not r.holds
+    # v2 = 3 a omega sin(Theta - phi), omega dh2/dphi = 2 a omega sin(Theta - phi): largest at 22
+    assert r.at == pytest.approx(22)
+    assert r.max_abs == pytest.approx(A * 1e-3 * OMEGA * math.sin(math.radians(30)), rel=1e-3)
+    assert r.rel == pytest.approx(1 / 3, rel=1e-9)
+
+
+def test_j2_against_v2(relations):
+    r = relations["j2 = omega * d(v2)/d(phi)"]
+    assert not r.holds and r.at == pytest.approx(52)
+    assert r.max_abs == pytest.approx(A * 1e-3 * OMEGA**2, rel=1e-9)  # a omega^2 at the top
+    assert r.rel == pytest.approx(0.5, rel=1e-9)
+
+
+@pytest.mark.parametrize("child,at", [("j1", 22.0), ("j3", 82.0)])
+def test_formula_9_has_a_sign_error(relations, child, at):
+    """omega d(v1)/dphi = omega^2 (R1+R3) ((k cos 2x + k^3 sin^4 x)/(1-k^2 sin^2 x)^1.5 - cos x):
+    the paper prints -k^3 sin^4 x; the discrepancy is 2 k^3 sin^4 x/(...)^1.5 omega^2 (R1+R3)."""
+    text = f"{child} = omega * d({'v1' if child == 'j1' else 'v3'})/d(phi)"
+    r = relations[text]
+    assert not r.holds and r.at == pytest.approx(at)
+    x = math.radians(22)  # the relations are measured with the true pi
+    s = math.sin(x)
+    expected = 2 * K**3 * s**4 / (1 - K**2 * s**2) ** 1.5 * OMEGA**2 * D * 1e-3
+    assert r.max_abs == pytest.approx(expected, rel=1e-9)
+    assert 0.27 < r.rel < 0.29
+
+
+def test_check_lists_every_relation(concave):
+    report = concave.check()
+    assert report.ok
+    lines = [f for f in report.findings if f.topic == "relations"]
+    for r in concave.spec.relations:
+        hit = [f for f in lines if f.what.startswith(r.text)]
+        assert hit and hit[0].value is not None
+    bad = {f.what.split(":")[0] for f in lines if f.verdict == "warning"}
+    assert {b for b in bad if "d2" not in b} == {
+        "v2 = omega * d(h2)/d(phi)",
+        "j1 = omega * d(v1)/d(phi)",
+        "j2 = omega * d(v2)/d(phi)",
+        "j3 = omega * d(v3)/d(phi)",
+    }
+    text = report.text()
+    assert "largest discrepancy at phi = 22 deg" in text
+    assert "largest discrepancy at phi = 52 deg" in text
+
+
+def _with(tmp_path, extra: str):
+    src = workbook.load("concave-cam").spec.path
+    text = src.read_text(encoding="utf-8") + extra
+    path = tmp_path / "concave-cam.toml"
+    path.write_text(text, encoding="utf-8")
+    for csv in src.parent.glob("concave-cam.*.csv"):
+        (tmp_path / csv.name).write_text(csv.read_text(encoding="utf-8"), encoding="utf-8")
+    return workbook.load(str(path))
+
+
+@pytest.mark.parametrize(
+    "relation,message",
+    [
+        ('relation = "v1 = omega * d(nothing)/d(phi)"', "not a function"),
+        ('relation = "v1 = R1 * d(h1)/d(phi)"', "units do not work out"),
+    ],
+)
+def test_a_relation_that_cannot_be_evaluated_fails_the_check(tmp_path, relation, message):
+    sheet = _with(tmp_path, f"\n[[relations]]\n{relation}\n")
+    report = sheet.check()
+    assert not report.ok
+    failed = [f for f in report.findings if f.verdict == "fail"]
+    assert len(failed) == 1 and message in failed[0].note
+    assert not report.failed  # the printed values are still reproduced
+
+
+# -- 2. joins --------------------------------------------------------------------------------
+def test_joins_of_h_v_j(concave):
+    res = {r.function: r for r in analysis.join_results(concave)}
+    assert set(res) == {"h", "v", "j"}
+    for name in ("h", "v", "j"):
+        r = res[name]
+        assert not r.error and not r.gaps
+        assert r.domain == (0.0, 104.0)
+        assert [(o[0][0], o[1][0], o[2]) for o in r.overlaps] == [(name, name, "{22}")]
+        assert [j.at for j in r.joins] == [22.0, 82.0]
+    h22 = res["h"].joins[0]
+    ev = concave.evaluate
+    assert h22.jumps[0] == pytest.approx(
+        (ev("h2", phi=22) - ev("h1", phi=22)).to("mm").magnitude, rel=1e-9
+    )
+    # first-derivative jump against central differences of each side's own formula
+    step = 1e-4
+    per_rad = 180 / 3.142  # the sheet's own degree
+    d2 = (ev("h2", phi=22 + step) - ev("h2", phi=22 - step)).to("mm").magnitude / (2 * step)
+    d1 = (ev("h1", phi=22 + step) - ev("h1", phi=22 - step)).to("mm").magnitude / (2 * step)
+    assert h22.jumps[1] == pytest.approx((d2 - d1) * per_rad * 3.142 / math.pi, rel=1e-6)
+    v22 = res["v"].joins[0]
+    assert v22.jumps[0] == pytest.approx(3.138369 - 3.151546, abs=1e-5)
+    j22 = res["j"].joins[0]
+    assert j22.jumps[0] == pytest.approx(-378.998 - 1341.423, abs=1e-2)
+
+
+def test_gaps_and_overlaps_are_found(tmp_path):
+    text = (
+        '[arguments]\nx = { unit = "" }\n[definitions]\n'
+        '"f(x)" = ["1 if 0 <= x <= 1", "2 if 2 <= x <= 3", "3 if 2.5 <= x <= 4"]\n'
+        "[sheet]\nhand_checks = true\n"
+    )
+    path = tmp_path / "gaps.toml"
+    path.write_text(text, encoding="utf-8")
+    sheet = workbook.load(str(path))
+    (r,) = analysis.join_results(sheet)
+    assert r.gaps == ["Interval.open(1, 2)"]
+    assert r.overlaps == [("2", "3", "Interval(5/2, 3)")]
+    # the first true piece wins: "2" holds up to 3, where "3" takes over (a jump of 1)
+    assert [(j.at, j.jumps[0]) for j in r.joins] == [(3.0, 1.0)]
+    found = [f for f in sheet.check().findings if f.topic == "joins"]
+    assert any("no piece applies" in f.what and f.verdict == "warning" for f in found)
+    assert any("overlap" in f.what and f.verdict == "warning" for f in found)
+
+
+# -- 3. geometry --------------------------------------------------------------------------------
+def _centres():
+    cos_t = (A**2 + D**2 - (R2 + R3) ** 2) / (2 * A * D)
+    theta = math.acos(cos_t)
+    o2 = np.array([A * math.cos(theta), A * math.sin(theta)])
+    o3 = np.array([D, 0.0])
+    return theta, o2, o3
+
+
+def test_theta_and_transition_from_the_geometry(geometry):
+    theta, o2, o3 = _centres()
+    # O3 is at R1 + R3 from O1 and at R3 + R2 from O2
+    assert np.linalg.norm(o3) == pytest.approx(R1 + R3)
+    assert np.linalg.norm(o3 - o2) == pytest.approx(R3 + R2)
+    b = o3 + (o2 - o3) * C / (R3 + R2)  # roller centre on O3-O2
+    t = geometry.evaluate("theta_geom")
+    p = geometry.evaluate("phiB_geom")
+    assert t.check("[]") and str(t.units) == "degree"
+    assert t.to("rad").magnitude == pytest.approx(theta, rel=1e-14)
+    assert p.to("rad").magnitude == pytest.approx(math.atan2(b[1], b[0]), rel=1e-14)
+    assert t.magnitude == pytest.approx(52.6168016, abs=1e-6)
+    assert p.magnitude == pytest.approx(18.6289580, abs=1e-6)
+
+
+def _lift_reference(phi_deg):
+    """Roller-centre lift from plane geometry: intersect the follower ray with the pitch circles."""
+    theta, o2, o3 = _centres()
+    _, _, _ = theta, o2, o3
+    b = o3 + (o2 - o3) * C / (R3 + R2)
+    phib = math.atan2(b[1], b[0])
+    x = math.radians(phi_deg)
+    if x > 2 * theta - phib:
+        x = 2 * theta - x  # the mirrored flank
+    u = np.array([math.cos(x), math.sin(x)])
+    if x <= phib:  # |r u - O3| = R3 - Rp, the root nearer O1
+        centre, radius, root = o3, C, min
+    else:  # |r u - O2| = R2 + Rp, the root farther out
+        centre, radius, root = o2, R2 + RP, max
+    r = root(np.roots([1.0, -2 * u @ centre, centre @ centre - radius**2]).real)
+    return r - (R1 + RP)
+
+
+def test_exact_lift_against_plane_geometry(geometry):
+    phis = [0.0, 5.0, 18.0, 18.6, 19.0, 30.0, 52.0, 52.6, 70.0, 86.0, 87.0, 100.0, 105.0]
+    got = geometry.evaluate("h_exact", phi=phis).to("mm").magnitude
+    ref = [_lift_reference(p) for p in phis]
+    assert np.allclose(got, ref, rtol=0, atol=1e-11)
+    assert max(got) <= 10.0 + 1e-12
+
+
+def test_exact_lift_is_c1_at_the_transition(geometry):
+    pb = geometry.evaluate("phiBG").magnitude
+
+    def h(x):
+        return geometry.evaluate("h_exact", phi=x).to("mm").magnitude
+
+    for e in (1e-2, 1e-4, 1e-6):
+        # value: the change across the transition shrinks with the step (slope ~0.39 mm/deg)
+        assert abs(h(pb + e) - h(pb - e)) < 1.0 * e
+        # slope from the left and from the right agree to O(e)
+        left = (h(pb) - h(pb - e)) / e
+        right = (h(pb + e) - h(pb)) / e
+        assert abs(right - left) < 2.0 * e * max(abs(left), 1.0) + 1e-8
+    assert geometry.evaluate("hf", phi=pb).magnitude == pytest.approx(
+        geometry.evaluate("hn", phi=pb).magnitude, abs=1e-12
+    )
+    assert geometry.evaluate("vf", phi=pb).magnitude == pytest.approx(
+        geometry.evaluate("vn", phi=pb).magnitude, abs=1e-12
+    )
+    # the acceleration does jump: concave flank to convex nose
+    assert (
+        abs(geometry.evaluate("jf", phi=pb).magnitude - geometry.evaluate("jn", phi=pb).magnitude)
+        > 1000
+    )
+
+
+def test_paper_against_exact(geometry):
+    g = cc.geometry_numbers(geometry)
+    theta, o2, o3 = _centres()
+    b = o3 + (o2 - o3) * C / (R3 + R2)
+    psi = theta - math.atan2(b[1], b[0])
+    v_peak = 2 * A * 1e-3 * OMEGA * math.sin(psi)  # lambda = 1 on the nose
+    assert g["v_exact_peak"] == pytest.approx(v_peak, rel=1e-12)
+    assert g["v_exact_grid_max"] <= v_peak + 1e-12
+    assert g["v_paper_peak"] == pytest.approx(3.151546, abs=1e-6)
+    assert g["v_paper_peak"] / g["v_exact_peak"] - 1 == pytest.approx(0.3474, abs=1e-3)
+    assert g["h_err"] == pytest.approx(-0.4746, abs=1e-3) and g["h_err_at"] == pytest.approx(85.66)
+    report = geometry.check()
+    assert report.ok
+    text = report.text()
+    assert "peak velocity of the paper" in text and "largest lift error" in text
+    rel = [f for f in report.findings if f.topic == "relations"]
+    assert rel and all(f.verdict == "ok" for f in rel), [f.what for f in rel if f.verdict != "ok"]
+
+
+# -- 4. domains and extreme inputs -----------------------------------------------------------------
+def test_domain_error_names_function_and_interval(concave):
+    with pytest.raises(DomainError) as err:
+        concave.evaluate("h1", phi=[0, 10, 40, 50, 150])
+    msg = str(err.value)
+    assert "h1" in msg and "sqrt of a negative number" in msg
+    assert "|k*sin(phi * deg)| > 1" in msg and "phi from 40 to 50 deg" in msg
+    with pytest.raises(DomainError, match=r"power 1.5 of a negative number"):
+        concave.evaluate("j1", phi=40)
+    with pytest.raises(DomainError, match=r"phi from 5 to 22 deg"):
+        concave.with_inputs(R3="10.5 mm").table("flank_AB")
+
+
+def test_flank_domain_limit(concave):
+    f = [x for x in concave.check().findings if x.topic == "domains" and x.what.startswith("h1")]
+    # k sin(phi) = 1 at asin(1/k), in the sheet's degrees
+    assert f[0].value == pytest.approx(math.degrees(math.asin(1 / K)) * math.pi / 3.142, abs=2e-3)
+
+
+def test_sweep_reports_invalid_cases(concave):
+    rows = {r["case"]: r for r in cc.sweep_rows(concave)}
+    assert len(rows) == len(cc.SWEEP)
+    valid = {c for c, r in rows.items() if r["status"] == "computed"}
+    assert valid == {"as printed", "very large R3", "omega x 10", "omega x 10, very large R3"}
+    for case, r in rows.items():
+        if case not in valid:
+            assert r["reason"] and r["h max [mm]"] is None
+    assert "|k*sin(phi * deg)| > 1" in rows["R3 close to Rp"]["reason"]
+    assert "k is not a finite number" in rows["R3 = Rp"]["reason"]
+    assert "lambda = a/(R2 + Rp) = 1.5" in rows["lambda = 1.5 on the nose"]["reason"]
+    assert "theta_geom" in rows["nose inside the base circle"]["reason"]
+    base, fast = rows["as printed"], rows["omega x 10"]
+    assert fast["v max [m/s]"] / base["v max [m/s]"] == pytest.approx(10, rel=1e-12)
+    assert fast["j max [m/s^2]"] / base["j max [m/s^2]"] == pytest.approx(100, rel=1e-12)
+    df = cc.sweep(concave)
+    numbers = [v for v in df.to_numpy().ravel() if isinstance(v, float)]
+    assert all(math.isfinite(v) for v in numbers)  # never a silent NaN
+
+
+# -- 5. numerical stability ------------------------------------------------------------------------
+def _reference_lift(phi_deg):
+    mpmath.mp.dps = 50
+    x = mpmath.mpf(phi_deg) * mpmath.mpf("3.142") / 180  # the sheet's own degree
+    k = mpmath.mpf(D) / C
+    return D * (mpmath.cos(x) - mpmath.sqrt(1 - k**2 * mpmath.sin(x) ** 2) / k) - (R1 + RP)
+
+
+def test_stability_of_the_lift(concave):
+    rows = {r["phi [deg]"]: r for r in cc._stability(concave)}
+    for phi, r in rows.items():
+        ref = float(_reference_lift(repr(phi)))
+        assert r["reference h1 (50 digits) [mm]"] == pytest.approx(ref, rel=1e-15)
+        assert r["stable form rel error"] < 1e-15
+    assert rows[1e-6]["formula (1) rel error"] > 0.1  # catastrophic cancellation
+    assert 1e-8 < rows[1e-3]["formula (1) rel error"] < 1e-5
+    assert rows[1.0]["formula (1) rel error"] < 1e-10
+    f = [x for x in concave.check().findings if x.topic == "stability"]
+    assert len(f) == 6
+
+
+# -- 6. error against run time ---------------------------------------------------------------------
+def test_derivative_bench(concave):
+    t0 = time.perf_counter()
+    df = cc.bench(workbook.load("concave-cam"), quick=True)
+    assert time.perf_counter() - t0 < 5.0
+    assert set(df["method"]) == set(cc.METHODS)
+    rows, _ = cc._derivative_bench(concave, quick=True)
+    by = {r["step [deg]"]: r for r in rows}
+    # truncation orders: central h^2, five-point h^4
+    assert by[1.0]["central v error"] / by[0.1]["central v error"] == pytest.approx(100, rel=0.05)
+    assert by[1.0]["five-point v error"] / by[0.1]["five-point v error"] == pytest.approx(
+        1e4, rel=0.05
+    )
+    # round-off: the central second difference gets worse below 0.01 deg
+    assert by[1e-4]["central j error"] > 100 * by[1e-2]["central j error"]
+    # complex step has no subtractive cancellation in v
+    assert by[1e-4]["complex-step v error"] < 1e-10
+    assert by[1e-4]["complex-step j error"] < 1e-9
+    for r in rows:
+        assert r["symbolic v error"] < 1e-14 and r["symbolic j error"] < 1e-14
+        assert all(r[f"{m} time [us]"] > 0 for m in cc.METHODS)
+
+
+def test_exact_velocity_of_the_bench_is_v1(concave):
+    v, j, _, _ = cc._exact_derivatives(concave, [3.0, 18.0])
+    assert v == pytest.approx(
+        concave.evaluate("v1", phi=[3.0, 18.0]).to("m/s").magnitude, rel=1e-12
+    )
+
+
+def test_bench_command(capsys):
+    from workbook.cli import main
+
+    assert main(["bench", "concave-cam", "--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "complex-step" in out and "symbolic" in out and "time [us]" in out
+
+
+# -- 7. where it shows -----------------------------------------------------------------------------
+def test_check_command(capsys):
+    from workbook.cli import main
+
+    assert main(["check", "concave-cam"]) == 0
+    out = capsys.readouterr().out
+    for topic in ("[relations]", "[joins]", "[domains]", "[pi rounding]", "[stability]"):
+        assert topic in out
+    assert "the sheet's pi = 3.142" in out
+
+
+def test_workbook_holds_the_findings_and_tables(tmp_path, concave):
+    import openpyxl
+
+    path = concave.write_xlsx(tmp_path / "cc.xlsx")
+    wb = openpyxl.load_workbook(path)
+    assert {"Hand checks", "Derivatives"} <= set(wb.sheetnames)
+    checks = [r for r in wb["Checks"].iter_rows(values_only=True)]
+    topics = {r[0] for r in checks}
+    assert {
+        "relations",
+        "joins",
+        "stability",
+        "extreme inputs",
+        "derivatives",
+        "pi rounding",
+    } <= topics
+    rel = [r for r in checks if r[0] == "relations" and str(r[1]).startswith("j1 = omega * d(v1)")]
+    assert rel and rel[0][4] == pytest.approx(375.42, abs=0.01)
+    assert len(wb["Charts"]._charts) == 5
+
+
+def test_geometry_workbook_recalculates_in_libreoffice(tmp_path, geometry):
+    from recalc import cell_values, formula_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    path = geometry.write_xlsx(tmp_path / "geo.xlsx")
+    cached = formula_values(path)
+    new = cell_values(recalculate(path, tmp_path / "lo"))
+    assert len(cached) > 600
+    bad = [
+        (k, v, new.get(k))
+        for k, (f, v) in cached.items()
+        if isinstance(v, float) and abs(new.get(k, math.inf) - v) > 1e-9 * max(1.0, abs(v))
+    ]
+    assert not bad, bad[:5]
+    assert new[("Definitions", _definition_cell(path, "theta_geom"))] == pytest.approx(
+        52.6168016, abs=1e-6
+    )
+
+
+def _definition_cell(path, name):
+    import openpyxl
+
+    ws = openpyxl.load_workbook(path)["Definitions"]
+    for row in ws.iter_rows():
+        if row[0].value == name:
+            return row[1].coordinate
+    raise KeyError(name)
