@@ -13,7 +13,7 @@ import pint
 from . import expr as ex
 from . import typecheck as tc
 from . import units as un
-from .errors import DomainError, InputError, TemplateError, WorkbookError
+from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .numeric import Evaluator
 from .template import ColumnSpec, RangeSpec, SheetSpec, check_input_value, range_values
 
@@ -73,6 +73,13 @@ class Sheet:
                 self.typer.function(name) if d.is_function else self.typer.scalar(name)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
+            except RecursionError:
+                raise LimitError(
+                    "definitions and expressions nested too deeply for the engine",
+                    file=self.file,
+                    line=d.line,
+                    definition=d.name,
+                ) from None
         for t in self.spec.tables:
             if t.range is not None:
                 for col in t.columns:
@@ -97,7 +104,10 @@ class Sheet:
                 raise InputError(
                     f"'{name}' is not an input of {self.name} (inputs: {known})", file=self.file
                 )
-            values[name] = coerce_input(spec, raw, file=self.file)
+            try:
+                values[name] = coerce_input(spec, raw, file=self.file)
+            except WorkbookError as err:  # point at the input's declaration (unit, bounds)
+                raise err.located(file=self.file, line=spec.line, definition=name) from None
         return Sheet(self.spec, values, self.typer)
 
     # -- evaluation -------------------------------------------------------------------
@@ -223,6 +233,12 @@ class Sheet:
     # -- tables ---------------------------------------------------------------------------
     def range_values(self, rng: RangeSpec, what: str = "range") -> np.ndarray:
         """The values of a range (numbers in the argument's declared unit)."""
+        try:
+            return self._range_values(rng, what)
+        except WorkbookError as err:
+            raise self._locate(err, what) from None
+
+    def _range_values(self, rng: RangeSpec, what: str) -> np.ndarray:
         spec = self.spec.arguments.get(rng.var)
         nums = []
         for node in (rng.first, rng.second, rng.last):
@@ -268,7 +284,16 @@ class Sheet:
                 )
             return t
         except WorkbookError as err:
-            raise err.located(file=self.file, definition=what) from None
+            raise self._locate(err, what) from None
+
+    def _locate(self, err: WorkbookError, what: str) -> WorkbookError:
+        """Give an error from a table or chart the line of the definition that failed, or else
+        the line of the table or chart (``what`` is 'table NAME' or 'chart NAME')."""
+        d = self.spec.definitions.get(err.definition or "")
+        kind, _, name = what.partition(" ")
+        items = {"table": self.spec.tables, "chart": self.spec.charts}.get(kind, [])
+        line = d.line if d is not None else next((i.line for i in items if i.name == name), None)
+        return err.located(file=self.file, line=line, definition=what)
 
     def column(self, col: ColumnSpec, var: str, values: np.ndarray, what: str) -> Column:
         t = self._typed_column(col, var, what)
@@ -276,7 +301,7 @@ class Sheet:
         try:
             out = fn({var: values})
         except WorkbookError as err:
-            raise err.located(file=self.file, definition=what) from None
+            raise self._locate(err, what) from None
         out = np.broadcast_to(np.asarray(out, dtype=float), values.shape).copy()
         bad = ~np.isfinite(out)
         if bad.any():
@@ -322,6 +347,17 @@ class Sheet:
 
         return blocks.get(ref, "table").func(self)
 
+    def block_table_cached(self, name: str):
+        """The DataFrame of the block table named ``name``, computed once per Sheet
+        (the xlsx writer's equal-axes charts read block-table series through it)."""
+        key = ("block table", name)
+        if key not in self._memo:
+            spec = next((t for t in self.spec.tables if t.name == name and t.block), None)
+            if spec is None:
+                raise InputError(f"no block table '{name}' in {self.name}")
+            self._memo[key] = self.block_table(spec.block)
+        return self._memo[key]
+
     def write_xlsx(self, path, **options) -> Path:
         """Write the workbook (atomically); returns the path written."""
         from .xlsx import write_workbook
@@ -340,6 +376,9 @@ class Sheet:
         roots: list[ex.Node] = []
         for t in self.spec.tables:
             roots += [c.node for c in t.columns]
+            roots += [ex.Name(u) for u in t.uses]
+        for f in self.spec.findings:
+            roots += [ex.Name(str(u)) for u in f.get("uses", ())]
         for c in self.spec.charts:
             roots += [s.y.node for s in c.series if s.table is None]
         for p in self.spec.printed:

@@ -24,6 +24,7 @@ from . import units as un
 from .errors import InputError, LimitError, TemplateError, WorkbookError
 
 MAX_RANGE_POINTS = 2_000_000
+MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
 
 SECTIONS = {
     "sheet",
@@ -36,6 +37,7 @@ SECTIONS = {
     "printed",
     "relations",
     "findings",
+    "sweep",
 }
 
 
@@ -125,6 +127,7 @@ class TableSpec:
     sheet: str = "Listing"
     block: str | None = None
     line: int | None = None
+    uses: tuple[str, ...] = ()  # inputs a block table reads (for the unused-input report)
 
 
 @dataclass
@@ -266,11 +269,13 @@ def range_values(first: float, second: float | None, last: float, *, what: str =
             f"{what}: range step {step:g} goes away from the last value {last:g} "
             f"(first {first:g}); reverse the step's sign"
         )
-    count = math.floor((last - first) / step * (1 + 1e-12) + 1e-9) + 1
-    if count > MAX_RANGE_POINTS:
+    span = (last - first) / step * (1 + 1e-12) + 1e-9
+    if not span < MAX_RANGE_POINTS:  # also refuses an infinite span (1e308 / 1e-300)
         raise LimitError(
-            f"{what}: range has {count:,} points (limit {MAX_RANGE_POINTS:,}); use a larger step"
+            f"{what}: range has {span + 1:,.0f} points (limit {MAX_RANGE_POINTS:,}); "
+            "use a larger step"
         )
+    count = math.floor(span) + 1
     values = first + step * np.arange(count, dtype=float)  # first + k*step: no drift
     if abs(values[-1] - last) > 1e-9 * max(1.0, abs(step)):
         values = np.append(values, last)
@@ -328,6 +333,11 @@ def load_spec(path: Path, name: str | None = None) -> SheetSpec:
     """Read and validate a template file."""
     file = str(path)
     try:
+        if path.stat().st_size > MAX_TEMPLATE_BYTES:
+            raise LimitError(
+                f"template is {path.stat().st_size:,} bytes (limit {MAX_TEMPLATE_BYTES:,})",
+                file=file,
+            )
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise TemplateError(f"cannot read template: {exc.strerror}", file=file) from None
@@ -341,6 +351,8 @@ def load_spec(path: Path, name: str | None = None) -> SheetSpec:
             m = re.search(r"line (\d+)", str(exc))
             line = int(m.group(1)) if m else None
         raise TemplateError(f"TOML syntax: {exc}", file=file, line=line) from None
+    except RecursionError:  # tomllib recurses into nested arrays and inline tables
+        raise LimitError("TOML arrays or tables nested too deeply", file=file) from None
     try:
         return _build(path, name or path.stem, text, data)
     except WorkbookError as err:
@@ -363,6 +375,11 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             line=find_line(text, key) or _section_line(text, key),
         )
     sheet = _table(data, "sheet")
+    if "name" in sheet and not re.match(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$", str(sheet["name"])):
+        raise TemplateError(  # the name becomes reports/NAME.xlsx: no folders, no '..'
+            f"[sheet] name {str(sheet['name'])[:80]!r} must be letters, digits, '-', '_', '.'",
+            line=find_line(text, "name", "sheet"),
+        )
     seen: dict[str, str] = {}
 
     def claim(key: str, section: str, line):
@@ -558,7 +575,7 @@ def check_input_value(spec: InputSpec, q: pint.Quantity) -> None:
 
     mag = np.asarray(q.magnitude, dtype=float)
     if not np.all(np.isfinite(mag)):
-        raise InputError(f"{spec.name} = {q} is not a finite number", definition=spec.name)
+        raise InputError(f"{spec.name} = {q:~} is not a finite number", definition=spec.name)
     if spec.positive and np.any(mag <= 0):
         raise InputError(f"{spec.name} = {q:~} must be positive", definition=spec.name)
     for bound, ok, word in (
@@ -656,6 +673,7 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
             str(raw.get("sheet", "Listing")),
             raw.get("block"),
             line,
+            tuple(str(u) for u in raw.get("uses", ())),
         )
     except WorkbookError as err:
         raise err.located(line=line, definition=f"table {name}") from None
@@ -753,6 +771,12 @@ def _printed_spec(raw: dict, path: Path, text: str) -> PrintedSpec:
         )
         for m in raw.get("misprints", [])
     ]
+    rel = Path(str(raw["file"]))
+    if rel.is_absolute() or ".." in rel.parts:
+        raise TemplateError(  # a worksheet reads only files in its own folder
+            f"[[printed]] file {str(raw['file'])!r} must be a file name beside the template",
+            line=_value_line(text, str(raw["file"])),
+        )
     role = str(raw.get("role", "check"))
     if role not in ("check", "information"):
         raise TemplateError("[[printed]] role is 'check' or 'information'")

@@ -15,7 +15,7 @@ import pint
 
 from . import expr as ex
 from . import units as un
-from .errors import TemplateError, UnitError, WorkbookError
+from .errors import LimitError, TemplateError, UnitError, WorkbookError
 from .template import Definition, SheetSpec
 
 
@@ -128,6 +128,9 @@ class TypedFunction:
         return self.body.unit
 
 
+#: Longest chain of definitions typed inside one another (a -> b -> c ...).
+MAX_CHAIN = 100
+
 _ANGLE_IN = {"sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "ln", "log10"}
 _INVERSE = {"asin", "acos", "atan"}
 
@@ -193,6 +196,13 @@ class Typer:
         if d.name in self._stack:
             cycle = " -> ".join(self._stack[self._stack.index(d.name) :] + [d.name])
             raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=d.name)
+        if len(self._stack) >= MAX_CHAIN:
+            raise LimitError(
+                f"definitions refer to each other more than {MAX_CHAIN} deep "
+                f"({' -> '.join(self._stack[:3])} -> ... -> {d.name})",
+                line=d.line,
+                definition=d.name,
+            )
         self._stack.append(d.name)
         try:
             if d.branches is None:
@@ -231,6 +241,8 @@ class Typer:
     def _convert(self, t: T, target: pint.Unit, where: str) -> T:
         if t.unit == target:
             return t
+        if _is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
+            return TConst(target, value=0.0)
         if t.unit.dimensionality != target.dimensionality:
             raise UnitError(
                 f"{where}: {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}) cannot be converted "
@@ -320,7 +332,9 @@ class Typer:
         if isinstance(left, TText) or isinstance(right, TText):
             raise TemplateError("text can only be compared with a choice input (==)")
         if op in "+-":
-            if right.unit.dimensionality != left.unit.dimensionality:
+            if _is_zero(left) and not _is_zero(right):
+                left = TConst(right.unit, value=0.0)
+            if right.unit.dimensionality != left.unit.dimensionality and not _is_zero(right):
                 self._mismatch(op, left, right)
             right = self._convert(right, left.unit, "sum")
             if isinstance(left, TConst) and isinstance(right, TConst):
@@ -363,8 +377,8 @@ class Typer:
     def _mismatch(self, op, left, right):
         verb = "add" if op == "+" else "subtract"
         raise UnitError(
-            f"cannot {verb} {un.dims(right.unit)} ({un.pretty(right.unit)}) "
-            f"{'to' if op == '+' else 'from'} {un.dims(left.unit)} ({un.pretty(left.unit)})"
+            f"cannot {verb} {un.dims(right.unit)} ({un.pretty(right.unit) or '1'}) "
+            f"{'to' if op == '+' else 'from'} {un.dims(left.unit)} ({un.pretty(left.unit) or '1'})"
         )
 
     def _compare(self, node: ex.Compare, scope) -> T:
@@ -386,11 +400,11 @@ class Typer:
                     f"{text!r} is not one of the options of '{other.name}': {', '.join(opts)}"
                 )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
-        first = typed[0]
-        out = [first]
-        for t in typed[1:]:
+        first = next((t for t in typed if not _is_zero(t)), typed[0])
+        out = []
+        for t in typed:
             self._number(t, "comparison")
-            if t.unit.dimensionality != first.unit.dimensionality:
+            if t.unit.dimensionality != first.unit.dimensionality and not _is_zero(t):
                 raise UnitError(
                     f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
                     f"with {un.dims(t.unit)} ({un.pretty(t.unit)})"
@@ -435,6 +449,13 @@ class Typer:
             )
             return TBlock(un.unit(blk.returns), name=name, ref=blk.ref, args=conv)
         if name not in ex.FUNCTIONS:
+            if name == "log":
+                raise TemplateError(
+                    "log() is not accepted (Mathcad's log is base 10, numpy's is natural): "
+                    "write ln() or log10()"
+                )
+            if name in self.spec.inputs or name in scope:
+                raise TemplateError(f"'{name}' is a value, not a function; write {name}")
             raise TemplateError(f"unknown function '{name}'")
         want = ex.FUNCTIONS[name]
         if want is not None and len(args) != want:
@@ -506,6 +527,12 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     if col.unit is not None:
         t = typer._convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
+
+
+def _is_zero(t: T) -> bool:
+    """A dimensionless literal zero, which agrees with any unit."""
+    return isinstance(t, TConst) and t.value == 0.0 and not t.unit.dimensionality and (
+        t.unit == un.registry().dimensionless)
 
 
 def _with_unit(t: T, unit: pint.Unit) -> T:
