@@ -316,6 +316,9 @@ def test_findings_all_pass(sheet):
     verdicts = {f.what: f.verdict for f in report.findings}
     assert report.ok, verdicts
     assert not any(v in ("fail", "warning") for v in verdicts.values()), verdicts
+    listed = [f for f in report.findings if f.topic == "listed example"]
+    assert [f.verdict for f in listed] == ["ok"] * 4
+    assert [f.value for f in listed[1:]] == pytest.approx([39.0, 38.3, 38.25], abs=1e-9)
     fig4 = [f for f in report.findings if f.topic == "Fig. 4"]
     assert all(abs(f.value) > 1 for f in fig4)  # alpha at phi_rise/2 and phi_rise does change
 
