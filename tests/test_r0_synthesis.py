@@ -403,3 +403,48 @@ def test_errors_are_engine_errors(sheet):
     for change in (dict(H="-1 mm"), dict(alpha_max="0 deg"), dict(dr="100 mm"), dict(n_grid=10)):
         with pytest.raises(WorkbookError):
             sheet.with_inputs(**change).evaluate("r0_loop")
+
+
+# -- the engine's table aggregate used by this sheet ---------------------------------------------
+AGG = """
+[inputs]
+a = "2 mm"
+[arguments]
+x = { unit = "" }
+[definitions]
+"f(x)" = { expr = "a*(x - 0.3)^2", unit = "mm" }
+top = "%s"
+[[tables]]
+name = "t"
+range = "x := 0, 0.1 .. 1"
+columns = { f = "mm" }
+"""
+
+
+def test_max_over_and_min_over(tmp_path):
+    from conftest import write_template
+
+    s = workbook.load(write_template(tmp_path, AGG % "max_over(t, f) - min_over(t, f)"))
+    x = np.linspace(0, 1, 11)
+    vals = 2 * (x - 0.3) ** 2
+    assert mm(s.evaluate("top")) == pytest.approx(vals.max() - vals.min(), rel=1e-15)
+    assert mm(s.with_inputs(a="4 mm").evaluate("top")) == pytest.approx(
+        2 * (vals.max() - vals.min()), rel=1e-15
+    )
+
+
+@pytest.mark.parametrize(
+    "expr, message",
+    [
+        ("max_over(u, f)", "'u' is not a range table"),
+        ("max_over(t, g)", "table 't' has no column 'g'"),
+        ("max_over(t)", "write max_over\\(table, column\\)"),
+    ],
+)
+def test_max_over_errors(tmp_path, expr, message):
+    from conftest import write_template
+
+    from workbook.errors import TemplateError
+
+    with pytest.raises(TemplateError, match=message):
+        workbook.load(write_template(tmp_path, AGG % expr))
