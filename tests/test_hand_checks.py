@@ -305,6 +305,17 @@ def test_sweep_reports_invalid_cases(concave):
     base, fast = rows["as printed"], rows["omega x 10"]
     assert fast["v max [m/s]"] / base["v max [m/s]"] == pytest.approx(10, rel=1e-12)
     assert fast["j max [m/s^2]"] / base["j max [m/s^2]"] == pytest.approx(100, rel=1e-12)
+    # the sweep's geometry is the geometry template's
+    g = workbook.load("concave-cam-geometry")
+    for case in ("as printed", "very large R3", "lambda = 1.5 on the nose"):
+        changes = dict(c for c in cc.SWEEP if c[0] == case)[case]
+        gs = g.with_inputs(**changes)
+        assert rows[case]["theta_geom [deg]"] == pytest.approx(
+            gs.evaluate("theta_geom").to("deg").magnitude, rel=1e-13
+        )
+        assert rows[case]["phiB_geom [deg]"] == pytest.approx(
+            gs.evaluate("phiB_geom").to("deg").magnitude, rel=1e-13
+        )
     df = cc.sweep(concave)
     numbers = [v for v in df.to_numpy().ravel() if isinstance(v, float)]
     assert all(math.isfinite(v) for v in numbers)  # never a silent NaN

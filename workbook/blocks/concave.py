@@ -287,18 +287,23 @@ SWEEP = (
 )
 
 
-def _geometry_sheet(changes: dict):
-    base = _cached_geometry()
-    keep = {k: v for k, v in changes.items() if k in base.spec.inputs}
-    return base.with_inputs(**keep) if keep else base
+def geometry_angles(R1: float, R2: float, R3: float, Rp: float, a: float) -> tuple[float, float]:
+    """theta_geom and phiB_geom in degrees (the formulas of concave-cam-geometry.toml).
 
-
-def _cached_geometry():
-    import workbook
-
-    if "geometry sheet" not in _CACHE:
-        _CACHE["geometry sheet"] = workbook.load("concave-cam-geometry")
-    return _CACHE["geometry sheet"]
+    Raises ValueError with the reason when the geometry does not exist.
+    """
+    d = R1 + R3
+    cos_t = (a * a + d * d - (R2 + R3) ** 2) / (2 * a * d)
+    if not -1.0 <= cos_t <= 1.0:
+        raise ValueError(
+            f"theta_geom: acos of a value beyond 1 ({cos_t:.4g}): the circles R1 + R3 about O1 "
+            "and R3 + R2 about O2 do not meet, there is no flank centre O3"
+        )
+    theta = math.acos(cos_t)
+    t = (R3 - Rp) / (R3 + R2)
+    bx = d + t * (a * math.cos(theta) - d)
+    by = t * a * math.sin(theta)
+    return math.degrees(theta), math.degrees(math.atan2(by, bx))
 
 
 def _sweep_case(sheet, label: str, changes: dict) -> dict:
@@ -322,12 +327,9 @@ def _sweep_case(sheet, label: str, changes: dict) -> dict:
         row.update(status="invalid", reason=err.message)
         return row
     try:
-        g = _geometry_sheet(changes)
-        row["theta_geom [deg]"] = float(g.evaluate("theta_geom").to("deg").magnitude)
-        row["phiB_geom [deg]"] = float(g.evaluate("phiB_geom").to("deg").magnitude)
-    except WorkbookError as err:
-        reasons.append(f"geometry: {err.message}")
-    except Exception as err:  # noqa: BLE001 - reported
+        theta, phib = geometry_angles(*(_mag(s, n, "mm") for n in ("R1", "R2", "R3", "Rp", "a")))
+        row["theta_geom [deg]"], row["phiB_geom [deg]"] = theta, phib
+    except ValueError as err:
         reasons.append(f"geometry: {err}")
     lam = _mag(s, "a", "mm") / (_mag(s, "R2", "mm") + _mag(s, "Rp", "mm"))
     if abs(lam - 1) > 1e-12:
