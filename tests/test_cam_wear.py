@@ -396,3 +396,16 @@ def test_pump_port_closing_before_the_rise_is_reported(pump):
     assert (
         len(f) == 1 and f[0].verdict == "fail" and f[0].value == pytest.approx(3.0864 - 4, abs=1e-4)
     )
+
+
+def test_valve_velocity_and_acceleration_are_derivatives_of_the_lift(valve):
+    phi = np.linspace(1, 239, 477)
+    phi = phi[np.abs(phi - 7.655) > 0.3]  # not across the kinks of the worn lift
+    phi = phi[np.abs(phi - 232.345) > 0.3]
+    eps, omega = 1e-3, 6 * 3000.0  # deg, deg/s
+    for h, v, a in (("h0", "v0", "a0"), ("h_w2", "v_w2", "a_w2")):
+        hh = lambda x, h=h: mag(valve.evaluate(h, phi=x), "m")  # noqa: E731
+        dv = (hh(phi + eps) - hh(phi - eps)) / (2 * eps) * omega
+        da = (hh(phi + eps) - 2 * hh(phi) + hh(phi - eps)) / eps**2 * omega**2
+        assert mag(valve.evaluate(v, phi=phi), "m/s") == pytest.approx(dv, abs=1e-6)
+        assert mag(valve.evaluate(a, phi=phi), "m/s^2") == pytest.approx(da, abs=1e-2)
