@@ -409,3 +409,32 @@ def test_valve_velocity_and_acceleration_are_derivatives_of_the_lift(valve):
         da = (hh(phi + eps) - 2 * hh(phi) + hh(phi - eps)) / eps**2 * omega**2
         assert mag(valve.evaluate(v, phi=phi), "m/s") == pytest.approx(dv, abs=1e-6)
         assert mag(valve.evaluate(a, phi=phi), "m/s^2") == pytest.approx(da, abs=1e-2)
+
+
+def test_brake_workbook_follows_edited_inputs_in_libreoffice(tmp_path):
+    import shutil
+
+    import openpyxl
+    from recalc import cell_values, formula_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    brake = workbook.load("cam-wear-brake")
+    path = brake.write_xlsx(tmp_path / "brake.xlsx")
+    edited = tmp_path / "edited.xlsx"
+    shutil.copy(path, edited)
+    wb = openpyxl.load_workbook(edited)
+    rows = {r[0].value: r for r in wb["Inputs"].iter_rows()}
+    rows["w_k"][1].value = 1.0  # mm: twice the wear
+    rows["mu"][1].value = 0.4
+    wb.save(edited)
+    values = cell_values(recalculate(edited, tmp_path / "lo"))
+    expected = brake.with_inputs(w_k="1.0 mm", mu="0.4")
+    reference = formula_values(expected.write_xlsx(tmp_path / "expected.xlsx"))
+    live = [(k, v) for k, (f, v) in reference.items() if k[0] in ("Listing", "Results")]
+    assert len(live) > 450
+    for key, value in live:
+        assert values[key] == pytest.approx(value, rel=1e-9, abs=1e-12), key
+    # and they did change: the worn torque starts 10 mm later than the unworn
+    m_w = expected.evaluate("M_w", x=np.array([15.0, 17.0]))
+    assert mag(m_w, "N*m")[0] == 0 and mag(m_w, "N*m")[1] > 0
