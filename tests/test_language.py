@@ -43,6 +43,19 @@ def test_example(tmp_path, text):
             _, name, _, _, n = line.split()
             assert len(sheet.table(name)) == int(n)
             continue
+        if line.startswith("sweep "):  # sweep NAME at INPUT=VALUE = NUMBER UNIT
+            from workbook.sweep import sweep
+
+            lhs, _, rhs = line[len("sweep "):].partition(" = ")
+            out, _, setting = lhs.partition(" at ")
+            name, _, value = setting.partition("=")
+            result = sweep(sheet, {name: value + ".." + value + ":1"}, {out: None})
+            number, _, unit = rhs.partition(" ")
+            assert result.output_units[out] == unit, line
+            digits = len(number.split(".")[1]) if "." in number else 0
+            got = result.table.iloc[0][f"{out} [{unit}]" if unit else out]
+            assert got == pytest.approx(float(number), abs=0.6 * 10**-digits), line
+            continue
         if line.startswith("chart "):
             _, name, _, _, n = line.split()
             assert len(next(c for c in sheet.spec.charts if c.name == name).series) == int(n)

@@ -38,6 +38,11 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="output .xlsx (default reports/NAME.xlsx)")
     run.add_argument("--force", action="store_true", help="overwrite a file that is not an xlsx")
     run.add_argument(
+        "--inputs",
+        metavar="XLSX",
+        help="read the inputs back from the Inputs sheet of an edited workbook",
+    )
+    run.add_argument(
         "--csv",
         metavar="TABLE",
         action="append",
@@ -49,6 +54,37 @@ def _parser() -> argparse.ArgumentParser:
     bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
     sheet_args(bench)
     bench.add_argument("--quick", action="store_true", help="a small, fast version")
+    sw = sub.add_parser("sweep", help="chosen outputs over a grid of inputs: a table and a chart")
+    sheet_args(sw)
+    sw.add_argument(
+        "--vary",
+        action="append",
+        default=[],
+        metavar="NAME=FIRST..LAST:COUNT",
+        help="an input and its values, e.g. --vary R3=40mm..60mm:21 or R3=40mm,50mm (repeatable)",
+    )
+    sw.add_argument(
+        "--output",
+        action="append",
+        default=[],
+        metavar="NAME=EXPR",
+        help='an output, e.g. "v_peak=max of v(phi) over phi := 0 .. 104" (default: the '
+        "template's [sweep] outputs)",
+    )
+    sw.add_argument("--out", help="output .xlsx or .csv (default reports/NAME.sweep.xlsx)")
+    sw.add_argument("--force", action="store_true", help="overwrite a file of another kind")
+    sw.add_argument(
+        "--mode",
+        default="auto",
+        choices=["auto", "vector", "serial", "processes"],
+        help="how cases run locally (auto: vector for formulas, processes for solvers)",
+    )
+    sw.add_argument("--workers", type=int, help="processes of the local pool (default: CPUs)")
+    sw.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (tcp://...)")
+    new = sub.add_parser("new", help="write a commented starter worksheet that runs as it is")
+    new.add_argument("name", help="name of the new worksheet (writes NAME.toml)")
+    new.add_argument("--out", help="file to write (default ./NAME.toml)")
+    new.add_argument("--force", action="store_true", help="overwrite an existing file")
     return p
 
 
@@ -68,6 +104,11 @@ def load_sheet(args):
     import workbook
 
     sheet = workbook.load(args.name)
+    if getattr(args, "inputs", None):
+        from .roundtrip import changed_inputs
+
+        changed = changed_inputs(sheet, args.inputs)  # checked like --set; --set wins
+        args.set = [f"{k}={v}" for k, v in changed.items()] + list(args.set)
     sets = parse_sets(args.set)
     if sets:
         sheet = sheet.with_inputs(**sets)
@@ -159,7 +200,11 @@ def main(argv: list[str] | None = None) -> int:
     if not args.command:
         _parser().print_help()
         return EXIT_INPUT
-    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}[
+    from .scaffold import cmd_new
+    from .sweep import cmd_sweep
+
+    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}
+    handler = {**handler, "sweep": cmd_sweep, "new": cmd_new}[
         args.command
     ]
     from .errors import WorkbookError
