@@ -150,8 +150,11 @@ def _derivative_fn(sheet, parent: str, var: str, order: int):
         if len(_DERIVATIVES) > 64:
             _DERIVATIVES.clear()
             exprs = _DERIVATIVES.setdefault(key, {})
-        exprs[0] = (symbolic.to_sympy(sheet, parent, {"pi": pi} if own_pi else None), None)
-    x = symbolic.symbol(var)
+        syms = {var: symbolic.symbol(var, real=False)}
+        if own_pi:
+            syms["pi"] = pi
+        exprs[0] = (symbolic.to_sympy(sheet, parent, syms), None)
+    x = symbolic.symbol(var, real=False)
     for n in range(1, order + 1):
         if n not in exprs:
             exprs[n] = (sp.diff(exprs[n - 1][0], x), None)
@@ -387,7 +390,7 @@ def _analyse_piecewise(sheet, name, res: PiecewiseResult, var_unit: str):
     var = res.var
     arg = sheet.spec.arguments[var]
     res.var_unit = un.pretty(arg.unit)
-    x = symbolic.symbol(var)
+    x = symbolic.symbol(var, real=False)  # no assumptions: much faster to differentiate
     conv = symbolic.SympyConverter(sheet)
     env = {var: x}
     names = _piece_names(body)

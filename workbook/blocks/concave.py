@@ -76,8 +76,14 @@ def lift_reference(sheet, phi_deg: float, digits: int = 50) -> float:
 
     from .. import symbolic
 
-    expr = _cached(sheet, "h1 sympy", lambda: symbolic.to_sympy(sheet, "h1"))
-    return float(expr.evalf(digits, subs={symbolic.symbol("phi"): sp.Rational(repr(phi_deg))}))
+    expr = _cached(
+        sheet,
+        "h1 sympy",
+        lambda: symbolic.to_sympy(sheet, "h1", {"phi": symbolic.symbol("phi", real=False)}),
+    )
+    return float(
+        expr.evalf(digits, subs={symbolic.symbol("phi", real=False): sp.Rational(repr(phi_deg))})
+    )
 
 
 def _stability(sheet):
@@ -425,8 +431,12 @@ def _exact_derivatives(sheet, points):
 
     from .. import symbolic
 
-    expr = _cached(sheet, "h1 sympy", lambda: symbolic.to_sympy(sheet, "h1"))
-    phi = symbolic.symbol("phi")
+    expr = _cached(
+        sheet,
+        "h1 sympy",
+        lambda: symbolic.to_sympy(sheet, "h1", {"phi": symbolic.symbol("phi", real=False)}),
+    )
+    phi = symbolic.symbol("phi", real=False)
     d1 = sp.diff(expr, phi)
     d2 = sp.diff(d1, phi)
     own_pi = "pi" in sheet.spec.inputs
@@ -456,7 +466,7 @@ def _derivative_bench(sheet, quick: bool):
     om = _mag(sheet, "omega", "1/s")
     kv, kj = om / deg / 1000, om**2 / deg**2 / 1000  # per degree -> per radian, mm -> m
     t0 = time.perf_counter()
-    phi = symbolic.symbol("phi")
+    phi = symbolic.symbol("phi", real=False)
     fv = sp.lambdify([phi], d1, "numpy")
     fj = sp.lambdify([phi], d2, "numpy")
     setup = time.perf_counter() - t0
