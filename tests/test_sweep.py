@@ -44,7 +44,11 @@ def paper_v2(phi_deg, a=20.0, omega=104.6, Theta=52.0, pi=3.142):
 
 
 def test_peak_velocity_over_R3_matches_the_paper_and_its_formula(concave):
-    res = sw.sweep(concave, {"R3": R3_GRID}, {"v_peak": V_PEAK, "phi_at": "argmax of v(phi) over phi := 0, 0.5 .. 104"})
+    res = sw.sweep(
+        concave,
+        {"R3": R3_GRID},
+        {"v_peak": V_PEAK, "phi_at": "argmax of v(phi) over phi := 0, 0.5 .. 104"},
+    )
     t = res.table
     assert res.mode == "vector" and res.failed == 0 and len(t) == 21
     assert list(t.columns) == ["R3 [mm]", "v_peak [m/s]", "phi_at [deg]", "error"]
@@ -61,7 +65,12 @@ def test_peak_velocity_over_R3_matches_the_paper_and_its_formula(concave):
 
 
 def test_vector_serial_and_processes_give_identical_tables(concave):
-    outs = {"v_peak": V_PEAK, "h22": "h(22)", "k": "k", "j_min": "min of j(phi) over phi := 0 .. 104"}
+    outs = {
+        "v_peak": V_PEAK,
+        "h22": "h(22)",
+        "k": "k",
+        "j_min": "min of j(phi) over phi := 0 .. 104",
+    }
     tables = {
         mode: sw.sweep(concave, {"R3": R3_GRID}, outs, mode=mode, workers=2).table
         for mode in ("vector", "serial", "processes")
@@ -94,7 +103,9 @@ def test_two_inputs_make_a_grid_and_one_series_per_value(tmp_path, concave):
     assert len(t) == 10 and t["R2 [mm]"].tolist() == [8.0] * 5 + [10.0] * 5
     direct = concave.with_inputs(R2="8 mm", R3="45 mm")
     phi = np.arange(0, 104.01, 0.5)
-    assert t["v_peak [m/s]"][1] == pytest.approx(direct.evaluate("v", phi=phi).to("m/s").magnitude.max(), rel=1e-12)
+    assert t["v_peak [m/s]"][1] == pytest.approx(
+        direct.evaluate("v", phi=phi).to("m/s").magnitude.max(), rel=1e-12
+    )
     out = sw.write(res, tmp_path / "grid.xlsx")
     chart = zipfile.ZipFile(out).read("xl/charts/chart1.xml").decode()
     assert chart.count("<c:ser>") == 2 and "R2 = 8" in chart
@@ -114,14 +125,26 @@ t = { unit = "s" }
 [definitions]
 "x(t)" = { expr = "R*cos(omega*t)", unit = "mm" }
 
+[sweep.outputs]
+x_max = "max of x(t) over t := 0, 0.001 .. 0.0628"
+t_min = "argmin of x(t) over t := 0, 0.001 .. 0.0628"
+x_mean = { expr = "mean of x(t) over t := 0, 0.001 .. 0.0628", unit = "cm" }
+twoR = "2*R"
+
 [sweep]
-outputs = { x_max = "max of x(t) over t := 0, 0.001 .. 0.0628", t_min = "argmin of x(t) over t := 0, 0.001 .. 0.0628", x_mean = { expr = "mean of x(t) over t := 0, 0.001 .. 0.0628", unit = "cm" }, twoR = "2*R" }
 units = { twoR = "cm" }
 """,
     )
     res = sw.sweep(workbook.load(path), {"R": "10mm,20mm"})
     t = res.table
-    assert list(t.columns) == ["R [mm]", "x_max [mm]", "t_min [s]", "x_mean [cm]", "twoR [cm]", "error"]
+    assert list(t.columns) == [
+        "R [mm]",
+        "x_max [mm]",
+        "t_min [s]",
+        "x_mean [cm]",
+        "twoR [cm]",
+        "error",
+    ]
     assert t["x_max [mm]"].tolist() == [10.0, 20.0]
     assert t["t_min [s]"][0] == pytest.approx(0.031, abs=1e-12)  # pi/omega = 0.0314 on a 1 ms grid
     tt = np.linspace(0, 0.062, 63)
@@ -143,7 +166,19 @@ units = { twoR = "cm" }
 def test_bad_outputs_are_one_error_and_write_nothing(tmp_path, capsys, output, message):
     out = tmp_path / "s.xlsx"
     out.write_bytes(b"old")
-    code = main(["sweep", "concave-cam", "--vary", "R3=40mm..60mm:3", "--output", output, "--out", str(out), "--force"])
+    code = main(
+        [
+            "sweep",
+            "concave-cam",
+            "--vary",
+            "R3=40mm..60mm:3",
+            "--output",
+            output,
+            "--out",
+            str(out),
+            "--force",
+        ]
+    )
     assert code == 2
     assert message in capsys.readouterr().err
     assert out.read_bytes() == b"old"
@@ -155,14 +190,36 @@ def test_bad_vary_is_refused(capsys):
         ("R9=40mm..60mm:3", "not an input"),
         ("R3=40mm..60mm", "cannot read"),
     ]:
-        code = main(["sweep", "concave-cam", "--vary", vary, "--output", "h22=h(22)", "--out", "/tmp/never.csv"])
+        code = main(
+            [
+                "sweep",
+                "concave-cam",
+                "--vary",
+                vary,
+                "--output",
+                "h22=h(22)",
+                "--out",
+                "/tmp/never.csv",
+            ]
+        )
         assert code == 2
         assert message in capsys.readouterr().err, vary
 
 
 def test_command_line_writes_a_table_and_a_chart(tmp_path, capsys):
     out = tmp_path / "r3.xlsx"
-    code = main(["sweep", "concave-cam", "--vary", f"R3={R3_GRID}", "--output", f"v_peak={V_PEAK}", "--out", str(out)])
+    code = main(
+        [
+            "sweep",
+            "concave-cam",
+            "--vary",
+            f"R3={R3_GRID}",
+            "--output",
+            f"v_peak={V_PEAK}",
+            "--out",
+            str(out),
+        ]
+    )
     assert code == 0
     assert "21 cases, 1 outputs, vector" in capsys.readouterr().out
     import openpyxl
@@ -190,7 +247,16 @@ def coupling_reference(c1, w=80.0):
     from scipy.optimize import brentq
 
     m, phi20, lam, O1O, OC, OC1, OB, O1B, tg, M = (
-        0.7, 0.5236, 1e-3, 0.042, 0.036, 0.052, 0.015, 0.040, 1 / 3, 1.2,
+        0.7,
+        0.5236,
+        1e-3,
+        0.042,
+        0.036,
+        0.052,
+        0.015,
+        0.040,
+        1 / 3,
+        1.2,
     )
     G = M * OB / O1B * tg
 

@@ -118,7 +118,9 @@ def _formulas(path: Path) -> dict[int, str]:
         ws = wb["Inputs"]
         return {
             r: str(v)
-            for r, (v,) in enumerate(ws.iter_rows(min_row=2, min_col=2, max_col=2, values_only=True), 2)
+            for r, (v,) in enumerate(
+                ws.iter_rows(min_row=2, min_col=2, max_col=2, values_only=True), 2
+            )
             if isinstance(v, str) and v.startswith("=")
         }
     finally:

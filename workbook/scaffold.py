@@ -6,7 +6,7 @@ from pathlib import Path
 
 from .errors import InputError
 
-STARTER = '''\
+STARTER = """\
 # {name}: a starter worksheet. Run it with
 #     workbook run {file}
 # and open reports/{name}.xlsx. Every line below is an example of the language;
@@ -22,7 +22,7 @@ description = "A projectile thrown at speed v0 and angle alpha from height y0."
 # yellow cells; `workbook run {file} --set v0="25 m/s"` overrides one.
 [inputs]
 v0 = {{ value = "20 m/s", note = "launch speed", positive = true }}
-alpha = {{ value = "40 deg", note = "launch angle above the horizontal", min = "0 deg", max = "90 deg" }}
+alpha = {{ value = "40 deg", note = "launch angle", min = "0 deg", max = "90 deg" }}
 y0 = {{ value = "1.5 m", note = "launch height", min = "0 m" }}
 g = {{ value = "9.81 m/s^2", note = "gravity", positive = true }}
 # A choice input: one of listed words, compared with == in conditions.
@@ -39,7 +39,7 @@ x = {{ unit = "m", note = "horizontal distance" }}
 vx = {{ expr = "v0*cos(alpha)", unit = "m/s", note = "horizontal speed" }}
 vy0 = {{ expr = "v0*sin(alpha)", unit = "m/s", note = "initial vertical speed" }}
 # ^ is the power operator; sqrt, sin, cos, ln, exp, min, max ... are built in.
-t_flight = {{ expr = "(vy0 + sqrt(vy0^2 + 2*g*y0))/g", unit = "s", note = "time to reach the ground" }}
+t_flight = {{ expr = "(vy0 + sqrt(vy0^2 + 2*g*y0))/g", unit = "s", note = "time of flight" }}
 range_flat = {{ expr = "vx*t_flight", unit = "m" }}
 # A piecewise value: the first true condition wins; "otherwise" closes the list.
 reach = ["min(range_flat, wall) if ground == \\"wall\\"", "range_flat otherwise"]
@@ -72,7 +72,7 @@ series = [{{ y = "height", unit = "m", name = "height, m" }}]
 [sweep]
 outputs = {{ reach = "reach", top = "max of y(t) over t := 0, 0.01 .. t_flight" }}
 units = {{ top = "m" }}
-'''
+"""
 
 
 def starter(name: str, file: str) -> str:

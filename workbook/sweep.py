@@ -554,7 +554,7 @@ def sweep(
 ) -> SweepResult:
     """Evaluate ``outputs`` of ``sheet`` for every combination of the ``vary`` values.
 
-    ``vary``: list of :class:`Vary`, or ``{"R3": ["40 mm", "45 mm"]}`` / ``{"R3": "40mm..60mm:21"}``.
+    ``vary``: list of :class:`Vary`, ``{"R3": ["40 mm", "45 mm"]}`` or ``{"R3": "40mm..60mm:21"}``.
     ``outputs``: list of :class:`Output`, ``{"v_peak": "max of v(phi) over phi := 0 .. 104"}``,
     or None for the template's ``[sweep]`` outputs.
     """
@@ -695,10 +695,9 @@ def _run(tasks: list[tuple], mode: str, scheduler, workers: int | None, timeout:
         return
     if mode == "processes":
         import multiprocessing as mp
+        import threading
         from concurrent.futures import ProcessPoolExecutor, as_completed
         from concurrent.futures.process import BrokenProcessPool
-
-        import threading
 
         # fork (the workers inherit the loaded sheet) when this process has no other
         # threads to copy in a half-held state (a notebook or a Dask client has some)
@@ -899,7 +898,9 @@ def cmd_sweep(args) -> int:
     print(f"wrote {out}: {result.summary()}")
     for i, err in enumerate(result.table["error"]):
         if err is not None:
-            case = ", ".join(f"{h} = {result.table.iloc[i][h]}" for h in result.table.columns[: len(varies)])
+            case = ", ".join(
+                f"{h} = {result.table.iloc[i][h]}" for h in result.table.columns[: len(varies)]
+            )
             print(f"  case {i + 1} ({case}) failed: {err}", file=sys.stderr)
     return 0
 

@@ -1,0 +1,71 @@
+"""A Sheet in Jupyter: HTML of inputs, definitions, functions and tables (DataFrames)."""
+
+import pytest
+from conftest import write_template
+
+import workbook
+from workbook import notebook
+
+
+def test_the_html_shows_inputs_definitions_and_tables(concave):
+    text = concave._repr_html_()
+    assert text == notebook.sheet_html(concave)
+    assert (
+        "<h4>Inputs</h4>" in text
+        and "<td>R3</td>" in text
+        and "radius of the concave flank" in text
+    )
+    assert "<h4>Definitions</h4>" in text and "<td>k</td>" in text and "<td>1.75</td>" in text
+    assert "h1(phi)" in text  # the functions, with their formulas
+    assert "Table flank_AB" in text and "<th>h1 [mm]</th>" in text and "<th>v1 [m/s]</th>" in text
+    assert "Fig. 4. Lift and velocity of the follower" in text
+    # the 105-row chart-data table is shortened
+    assert "105 rows" in text and "..." in text
+
+
+def test_tables_are_dataframes_with_units_in_the_headers(concave):
+    frames = notebook.tables(concave)
+    assert list(frames) == ["flank_AB", "nose_BB", "flank_BA", "curves"]
+    df = frames["flank_AB"]
+    assert list(df.columns) == ["phi [deg]", "h1 [mm]", "v1 [m/s]", "j1 [m/s^2]"]
+    assert df["v1 [m/s]"].iloc[-1] == pytest.approx(3.152, abs=5e-4)  # the printed v1(22)
+    inputs = notebook.inputs_frame(concave.with_inputs(R3="45 mm"))
+    assert inputs.set_index("name").loc["R3", "value"] == 45.0
+    assert inputs.set_index("name").loc["phi_n", "unit"] == "deg"
+
+
+def test_ipython_displays_it():
+    formatters = pytest.importorskip("IPython.core.formatters")
+    sheet = workbook.load("concave-cam")
+    html = formatters.HTMLFormatter()(sheet)
+    assert html and "<h4>Inputs</h4>" in html
+
+
+def test_an_error_is_shown_not_raised(tmp_path):
+    path = write_template(
+        tmp_path,
+        """
+[sheet]
+title = "a <b>bold</b> title"
+
+[inputs]
+x = { value = "-1", note = "choice <and> text" }
+law = { value = "a", options = ["a", "b"] }
+
+[arguments]
+t = { unit = "" }
+
+[definitions]
+r = "sqrt(x)"
+"f(t)" = "sqrt(t)"
+
+[[tables]]
+name = "bad"
+range = "t := -2 .. 2"
+columns = { f = "" }
+""",
+    )
+    text = workbook.load(path)._repr_html_()
+    assert "a &lt;b&gt;bold&lt;/b&gt; title" in text and "choice &lt;and&gt; text" in text
+    assert "Table bad" in text and "error:" in text and "not a finite number" in text
+    assert "one of: a, b" in text
