@@ -148,13 +148,15 @@ def cmd_run(args) -> int:
     if not args.out:
         out.parent.mkdir(parents=True, exist_ok=True)
     report = sheet.check()
+    frames = {table: sheet.table(table) for table in args.csv}  # all computed before writing
     sheet.write_xlsx(out, force=args.force, command=_command_line(args), report=report)
-    for table in args.csv:
-        from .atomic import replacing
+    for table, frame in frames.items():
+        from .atomic import check_target, replacing
 
         path = out.with_name(f"{out.stem}.{table}.csv")
+        check_target(path, kind="csv", force=args.force)
         with replacing(path) as tmp:
-            sheet.table(table).to_csv(tmp, index=False)
+            frame.to_csv(tmp, index=False)
         print(f"wrote {path}")
     n_checked = sum(r.role == "check" for r in report.rows)
     n_ok = sum(r.role == "check" and r.verdict in ("pass", "misprint") for r in report.rows)
@@ -209,12 +211,25 @@ def main(argv: list[str] | None = None) -> int:
     ]
     from .errors import WorkbookError
 
+    if not args.debug:  # the engine reports non-finite results itself, with the arguments
+        import warnings
+
+        warnings.simplefilter("ignore", RuntimeWarning)
     try:
         return handler(args)
     except WorkbookError as err:
         if args.debug:
             raise
         print(f"workbook: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except (RecursionError, MemoryError) as exc:  # a last resort behind the documented limits
+        if args.debug:
+            raise
+        what = "nested too deeply" if isinstance(exc, RecursionError) else "too large for memory"
+        print(
+            f"workbook: limit exceeded: the worksheet is {what} (see docs/errors.md)",
+            file=sys.stderr,
+        )
         return EXIT_INPUT
     except KeyboardInterrupt:
         print("workbook: interrupted; no output file was changed", file=sys.stderr)

@@ -8,6 +8,7 @@ is turned into the engine's own nodes; nothing is ever evaluated by Python.
 from __future__ import annotations
 
 import ast
+import math
 import re
 from dataclasses import dataclass
 
@@ -124,10 +125,15 @@ def parse(text: str, *, what: str = "expression") -> Node:
         tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
         col = f" at column {exc.offset}" if exc.offset else ""
-        raise TemplateError(f"{what}: cannot parse {text!r}{col}: {exc.msg}") from None
+        raise TemplateError(f"{what}: cannot parse {_short(text)!r}{col}: {exc.msg}") from None
     except (RecursionError, MemoryError):
-        raise LimitError(f"{what}: expression nested too deeply") from None
-    return _convert(tree.body, text, what, 0)
+        raise LimitError(f"{what}: expression nested too deeply (limit {MAX_DEPTH})") from None
+    return _convert(tree.body, _short(text), what, 0)
+
+
+def _short(text: str, limit: int = 80) -> str:
+    """The expression as quoted in messages: long texts are cut."""
+    return text if len(text) <= limit else text[: limit - 20] + " ... " + text[-15:]
 
 
 def _paren_depth(source: str) -> int:
@@ -150,7 +156,13 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
             raise TemplateError(f"{what}: {node.value!r} is not allowed in {text!r}")
         if isinstance(node.value, str):
             return Text(node.value)
-        return Number(float(node.value))
+        try:
+            value = float(node.value)
+        except OverflowError:
+            value = math.inf
+        if not math.isfinite(value):
+            raise TemplateError(f"{what}: a number in {text!r} is too large (limit about 1.8e308)")
+        return Number(value)
     if isinstance(node, ast.Name):
         if not is_identifier(node.id):
             raise TemplateError(f"{what}: name {node.id!r} is not allowed in {text!r}")

@@ -44,7 +44,8 @@ _CMP = {
     "==": operator.eq,
     "!=": operator.ne,
 }
-_ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}
+# np.true_divide: x/0 of plain floats gives inf/nan (a DomainError later), not ZeroDivisionError
+_ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": np.true_divide}
 
 
 class Evaluator:

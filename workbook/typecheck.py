@@ -131,6 +131,9 @@ class TypedFunction:
 #: Longest chain of definitions typed inside one another (a -> b -> c ...).
 MAX_CHAIN = 100
 
+#: Longest chain of definitions typed inside one another (a -> b -> c ...).
+MAX_CHAIN = 100
+
 _ANGLE_IN = {"sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "ln", "log10"}
 _INVERSE = {"asin", "acos", "atan"}
 
@@ -203,10 +206,17 @@ class Typer:
                 line=d.line,
                 definition=d.name,
             )
+        if len(self._stack) >= MAX_CHAIN:
+            raise LimitError(
+                f"definitions refer to each other more than {MAX_CHAIN} deep "
+                f"({' -> '.join(self._stack[:3])} -> ... -> {d.name})",
+                line=d.line,
+                definition=d.name,
+            )
         self._stack.append(d.name)
         try:
             if d.branches is None:
-                return self._t(d.body, scope)
+                return self._not_text(self._t(d.body, scope), f"'{d.name}'")
             return self._piecewise(d, scope)
         except WorkbookError as err:
             raise err.located(file=str(self.spec.path), line=d.line, definition=d.name) from None
@@ -220,6 +230,7 @@ class Typer:
             v = self._t(b.value, scope)
             if v.boolean:
                 raise TemplateError(f"piece {b.text!r} has a condition as its value")
+            self._not_text(v, f"piece {b.text!r}")
             if first_unit is None:
                 first_unit = v.unit
             else:
@@ -267,6 +278,18 @@ class Typer:
     def _number(self, t: T, where: str) -> T:
         if t.boolean:
             raise TemplateError(f"{where}: a comparison cannot be used as a number")
+        return self._not_text(t, where)
+
+    def _not_text(self, t: T, where: str) -> T:
+        """Refuse text and choice inputs where a number is needed (found by the fuzz test)."""
+        if isinstance(t, TText):
+            raise TemplateError(f"{where}: text can only be compared with a choice input (==)")
+        if isinstance(t, TRef) and t.kind == "choice":
+            opts = ", ".join(self.spec.inputs[t.name].options)
+            raise TemplateError(
+                f"{where}: '{t.name}' is a choice ({opts}), not a number; "
+                f'compare it: {t.name} == "..."'
+            )
         return t
 
     def _t(self, node: ex.Node, scope: dict[str, pint.Unit]) -> T:
@@ -416,7 +439,8 @@ class Typer:
         name = node.func
         if name in AGGREGATES and name not in self.spec.definitions:
             return self._aggregate(node)
-        args = [self._t(a, scope) for a in node.args]
+        known = name in self.spec.definitions or name in self.spec.blocks or name in ex.FUNCTIONS
+        args = [self._t(a, scope) for a in node.args] if known else []  # unknown: say so first
         for a in args:
             self._number(a, f"argument of {name}()")
         if name in self.spec.definitions:

@@ -1,0 +1,274 @@
+"""Hostile worksheets: each is refused at load or stopped by a documented limit, with a message.
+
+Every case runs the real command line in a fresh interpreter with an address-space limit
+(RLIMIT_AS), a CPU-time limit and a wall-clock timeout. An audit hook (PEP 578) installed
+before the command runs records every file opened for writing, every file read outside the
+Python installation, the package and the case's folder, every import of a module that could
+reach the system, and every process start; none may happen.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+
+import pytest
+
+from workbook import expr, template, typecheck
+
+MEMORY = 1536 * 2**20  # bytes of address space for one run
+CPU_SECONDS = 60
+WALL_SECONDS = 120  # generous: CI machines are shared; a refused case takes about 1 s of CPU
+
+GUARD = r"""
+import json, os, sys
+import numpy, pint, workbook, workbook.cli, workbook.sheet, workbook.template, workbook.units
+import workbook.typecheck, workbook.numeric, workbook.checks, workbook.blocks
+workbook.units.registry()
+roots = tuple(os.path.realpath(p) for p in {sys.prefix, sys.base_prefix, sys.exec_prefix,
+              os.path.dirname(os.path.dirname(workbook.__file__)), os.getcwd()})
+SYSTEM = {"subprocess", "socket", "ctypes", "pickle", "shutil", "multiprocessing", "pty",
+          "webbrowser", "http", "urllib", "ftplib", "smtplib", "telnetlib", "code", "pdb"}
+SPAWN = ("os.system", "os.exec", "os.posix_spawn", "os.spawn", "os.fork", "subprocess.Popen",
+         "os.remove", "os.rename", "os.rmdir", "os.unlink", "shutil.", "socket.")
+events = []
+def hook(event, args):
+    if event == "open":
+        path, mode, flags = args
+        if isinstance(path, int) or path is None:
+            return
+        path = os.fsdecode(path)
+        writing = (isinstance(mode, str) and any(c in mode for c in "wax+")) or (
+            isinstance(flags, int) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT))
+        real = os.path.realpath(path)
+        if writing or not real.startswith(roots):
+            events.append(f"open {path} {mode!r}")
+    elif event == "import" and args[0].split(".")[0] in SYSTEM:
+        events.append(f"import {args[0]}")
+    elif event.startswith(SPAWN):
+        events.append(event)
+sys.addaudithook(hook)
+from workbook.cli import main
+code = main(sys.argv[1:])
+print("AUDIT " + json.dumps(events))
+sys.exit(code)
+"""
+
+
+def _limits():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY, MEMORY))
+    resource.setrlimit(resource.RLIMIT_CPU, (CPU_SECONDS, CPU_SECONDS))
+
+
+def guarded(tmp_path, text: str | bytes, *args: str):
+    path = tmp_path / "hostile.toml"
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text, encoding="utf-8")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    start = time.monotonic()
+    out = subprocess.run(
+        [sys.executable, "-c", GUARD, *(args or ("run", path.name))],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=WALL_SECONDS,
+        preexec_fn=_limits,
+        env=env,
+    )
+    out.elapsed = time.monotonic() - start
+    audit = [line for line in out.stdout.splitlines() if line.startswith("AUDIT ")]
+    out.events = json.loads(audit[-1][6:]) if audit else None
+    return out
+
+
+HEAD = '[inputs]\nR1 = "20 mm"\n\n[arguments]\nx = { unit = "" }\n\n[definitions]\n'
+TABLE = '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { s = "" }\n'
+
+
+def define(expression: str) -> str:
+    """A sheet whose definition s is ``expression``, shown in a table so that it is computed."""
+    return HEAD + "s = " + json.dumps(expression) + "\n" + TABLE
+
+
+DEEP = 5000
+HOSTILE = {
+    # expressions that try to reach Python
+    "attribute": (define("R1.__class__"), "Attribute is not allowed"),
+    "attribute_chain": (
+        define("x.__class__.__bases__[0].__subclasses__()"),
+        "only plain function calls",
+    ),
+    "import_call": (define("__import__('os').system('touch pwned')"), "only plain function calls"),
+    "import_statement": (define("import os"), "cannot parse"),
+    "dunder_name": (define("__builtins__"), "name '__builtins__' is not allowed"),
+    "dunder_function": (define("__import__('os')"), "only plain function calls"),
+    "eval_call": (define("eval('1')"), "unknown function 'eval'"),
+    "open_call": (define("open('/etc/passwd')"), "unknown function 'open'"),
+    "lambda": (define("lambda: 1"), "Lambda is not allowed"),
+    "lambda_call": (define("(lambda: 1)()"), "only plain function calls"),
+    "list_comprehension": (define("[x for x in range(10**9)]"), "ListComp is not allowed"),
+    "generator": (define("max(x for x in range(10**9))"), "GeneratorExp is not allowed"),
+    "set_comprehension": (define("{x for x in R1}"), "SetComp is not allowed"),
+    "subscript": (define("R1[0]"), "Subscript is not allowed"),
+    "slice": (define("R1[::-1]"), "Subscript is not allowed"),
+    "walrus": (define("(y := 1)"), "NamedExpr is not allowed"),
+    "conditional": (define("1 if R1 > 0 else 2"), "IfExp is not allowed"),
+    "keyword_argument": (define("max(a=1)"), "keyword arguments are not allowed"),
+    "starred": (define("max(*R1)"), "starred arguments are not allowed"),
+    "string_repeat": (define("'a' * 10**9"), "text can only be compared"),
+    "string_format": (define("'%s' % R1"), "operator Mod not allowed"),
+    "fstring": (define("f'{R1.__class__}'"), "JoinedStr is not allowed"),
+    "bytes": (define("b'abc'"), "is not allowed"),
+    "tuple": (define("(1, 2)"), "Tuple is not allowed"),
+    "dict": (define("{'a': 1}"), "Dict is not allowed"),
+    "bit_shift": (define("1 << 100000"), "operator LShift not allowed"),
+    "matmul": (define("R1 @ R1"), "operator MatMult not allowed"),
+    # numbers and sizes
+    "power_tower": (define("10**10**10"), "is not a finite number"),
+    "power_tower_caret": (define("10^10^10"), "is not a finite number"),
+    "power_of_length": (define("R1^(10^10)"), "out of range"),
+    "huge_literal": (define("9" * 4000), "too large"),
+    "too_long": (define("+".join(["x"] * 15000)), f"limit {expr.MAX_TEXT}"),
+    "parentheses_deep": (define("(" * DEEP + "1" + ")" * DEEP), f"limit {expr.MAX_DEPTH}"),
+    "unary_deep": (define("-" * DEEP + "1"), "nested"),
+    "not_deep": (
+        HEAD + '"f(x)" = ["1 if ' + "not " * 2000 + 'x > 0", "2 otherwise"]\n' + TABLE,
+        "nested",
+    ),
+    "sum_deep": (define("+".join(["1"] * 3000)), "nested too deeply"),
+    "sum_201_terms": (define("+".join(["1"] * 202)), f"nested more than {expr.MAX_DEPTH} deep"),
+    "call_deep": (define("abs(" * DEEP + "1" + ")" * DEEP), f"limit {expr.MAX_DEPTH}"),
+    "toml_arrays_deep": ("a = " + "[" * 100_000 + "]" * 100_000 + "\n", "nested too deeply"),
+    "toml_tables_deep": ("a = " + "{b = " * 100_000 + "1" + "}" * 100_000 + "\n", "nested"),
+    "template_too_big": (
+        HEAD + "".join(f'd{i} = "{i} + R1 * 0"\n' for i in range(200_000)),
+        f"limit {template.MAX_TEMPLATE_BYTES:,}",
+    ),
+    "definition_chain": (
+        HEAD
+        + "".join(f'"f{i}(x)" = "f{i + 1}(x) + 1"\n' for i in range(3000))
+        + '"f3000(x)" = "x"\n'
+        + '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { f0 = "" }\n',
+        f"more than {typecheck.MAX_CHAIN} deep",
+    ),
+    "range_1e10_points": (
+        HEAD + 's = "1"\n\n[[tables]]\nname = "t"\nrange = "x := 0, 1 .. 1e10"\n'
+        'columns = { "2*x" = "" }\n',
+        f"range has 10,000,000,001 points (limit {template.MAX_RANGE_POINTS:,})",
+    ),
+    "range_infinite_points": (
+        HEAD + 's = "1"\n\n[[tables]]\nname = "t"\nrange = "x := 0, 1e-300 .. 1e300"\n'
+        'columns = { "2*x" = "" }\n',
+        f"points (limit {template.MAX_RANGE_POINTS:,})",
+    ),
+    "chart_range_1e10": (
+        HEAD + '"y(x)" = "x"\n\n[[charts]]\nname = "c"\nrange = "x := 0 .. 1e10"\n'
+        'series = [{ y = "y" }]\n',
+        "points (limit",
+    ),
+    # files and modules outside the worksheet
+    "printed_absolute": (
+        HEAD + 's = "1"\n\n[[printed]]\nfile = "/etc/passwd"\n',
+        "must be a file name beside the template",
+    ),
+    "printed_parent": (
+        HEAD + 's = "1"\n\n[[printed]]\nfile = "../../../../etc/passwd"\n',
+        "must be a file name beside the template",
+    ),
+    "sheet_name_escapes": (
+        '[sheet]\nname = "../../escaped"\n' + define("R1"),
+        "must be letters, digits",
+    ),
+    "block_os_system": (
+        '[blocks]\nrun = "os.system"\n\n' + define("run(1)"),
+        "no block module 'os'",
+    ),
+    "block_builtins": (
+        '[blocks]\nrun = "builtins.eval"\n\n' + define("run(1)"),
+        "no block module 'builtins'",
+    ),
+    "block_helper_not_registered": (
+        '[blocks]\nrun = "solvers.run_ode"\n\n' + define("run(1)"),
+        "has no registered block 'run_ode'",
+    ),
+    "block_dotted": (
+        '[blocks]\nrun = "os.path.join"\n\n' + define("run(1)"),
+        "a block is named as 'module.function'",
+    ),
+    "table_block_os": (
+        HEAD + 's = "1"\n\n[[tables]]\nname = "b"\nblock = "os.system"\n',
+        "no block module 'os'",
+    ),
+    "findings_block_os": (
+        HEAD + 's = "1"\n\n[[findings]]\nblock = "subprocess.run"\n',
+        "subprocess.run could not run",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HOSTILE))
+def test_hostile_worksheet_is_refused(tmp_path, name):
+    text, expected = HOSTILE[name]
+    if name == "findings_block_os":  # a findings block that cannot be found is reported
+        out = guarded(tmp_path, text, "check", "hostile.toml")
+        assert out.returncode in (0, 1), out.stderr
+        assert expected in out.stdout and "Traceback" not in out.stderr, out.stdout + out.stderr
+    else:
+        out = guarded(tmp_path, text)
+        assert out.returncode == 2, (out.returncode, out.stderr[-2000:])
+        assert expected in out.stderr, out.stderr[-2000:]
+        assert out.stderr.startswith("workbook: ") and "Traceback" not in out.stderr, out.stderr
+        assert len(out.stderr.strip().splitlines()) == 1
+        assert len(out.stderr) < 600, out.stderr  # one readable paragraph, even for huge input
+        written = [p.name for p in tmp_path.rglob("*") if p.is_file()]
+        assert written == ["hostile.toml"], written  # not even an empty or partial workbook
+    # Nothing written, read, imported or started. Ranges and block tables are evaluated while
+    # the workbook is written: there the temporary file beside the target is made and removed.
+    temporary = [e for e in out.events if e.endswith(".partial None") and str(tmp_path) in e]
+    rest = [e for e in out.events if e not in temporary and not (temporary and e == "os.remove")]
+    assert rest == [], out.events
+
+
+def test_guard_sees_a_write(tmp_path):
+    """The audit hook works: an ordinary run writes its workbook, and the hook reports it."""
+    out = guarded(tmp_path, define("2*R1/R1 + 1"))
+    assert out.returncode == 0, out.stderr
+    assert any("hostile.xlsx" in e for e in out.events), out.events
+
+
+def test_limits_are_documented():
+    doc = (os.path.dirname(__file__) + "/../docs/language.md").replace("/", os.sep)
+    text = open(doc, encoding="utf-8").read()
+    limits = text[text.index("## Limits") :]
+    for value in (
+        expr.MAX_TEXT,
+        expr.MAX_DEPTH,
+        template.MAX_RANGE_POINTS,
+        template.MAX_TEMPLATE_BYTES,
+        typecheck.MAX_CHAIN,
+    ):
+        assert f"{value:,}" in limits or str(value) in limits, value
+
+
+def test_solver_step_cap_stops_a_billion_steps():
+    """A solver asked for 10^9 steps on a stiff problem with an explicit method stops at its
+    documented budget (wall clock, then the step cap) with a reason, not after hours."""
+    import numpy as np
+
+    from workbook.blocks.solvers import run_ode
+
+    def stiff(t, y):  # y' = -1e6 (y - cos t): RK45 needs ~1e6 steps per unit of time
+        return -1e6 * (y - np.cos(t))
+
+    start = time.monotonic()
+    run = run_ode(stiff, (0.0, 1e4), [0.0], method="RK45", max_steps=10**9, max_time=2.0)
+    assert time.monotonic() - start < 30
+    assert run.stop_reason == "time budget" and "wall-clock budget of 2 s" in run.notes[0]
+    capped = run_ode(stiff, (0.0, 1e4), [0.0], method="RK45", max_steps=2000, max_time=60)
+    assert capped.stop_reason == "step cap" and capped.nsteps == 2000
