@@ -105,10 +105,7 @@ class Sheet:
                     f"'{name}' is not an input of {self.name} (inputs: {known})", file=self.file
                 )
             try:
-                try:
                 values[name] = coerce_input(spec, raw, file=self.file)
-            except WorkbookError as err:  # point at the input's declaration (unit, bounds)
-                raise err.located(file=self.file, line=spec.line, definition=name) from None
             except WorkbookError as err:  # point at the input's declaration (unit, bounds)
                 raise err.located(file=self.file, line=spec.line, definition=name) from None
         return Sheet(self.spec, values, self.typer)

@@ -131,9 +131,6 @@ class TypedFunction:
 #: Longest chain of definitions typed inside one another (a -> b -> c ...).
 MAX_CHAIN = 100
 
-#: Longest chain of definitions typed inside one another (a -> b -> c ...).
-MAX_CHAIN = 100
-
 _ANGLE_IN = {"sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "ln", "log10"}
 _INVERSE = {"asin", "acos", "atan"}
 
@@ -199,13 +196,6 @@ class Typer:
         if d.name in self._stack:
             cycle = " -> ".join(self._stack[self._stack.index(d.name) :] + [d.name])
             raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=d.name)
-        if len(self._stack) >= MAX_CHAIN:
-            raise LimitError(
-                f"definitions refer to each other more than {MAX_CHAIN} deep "
-                f"({' -> '.join(self._stack[:3])} -> ... -> {d.name})",
-                line=d.line,
-                definition=d.name,
-            )
         if len(self._stack) >= MAX_CHAIN:
             raise LimitError(
                 f"definitions refer to each other more than {MAX_CHAIN} deep "
