@@ -272,6 +272,7 @@ def test_paper_against_exact(geometry):
 
 
 # -- 4. domains and extreme inputs -----------------------------------------------------------------
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # numpy's own note on the sqrt
 def test_domain_error_names_function_and_interval(concave):
     with pytest.raises(DomainError) as err:
         concave.evaluate("h1", phi=[0, 10, 40, 50, 150])
