@@ -92,9 +92,49 @@ def test_a_failed_case_is_recorded_and_the_others_go_on(concave):
     assert good["v_peak [m/s]"].to_numpy() == pytest.approx(
         np.maximum(paper_v1(22.0, good["R3 [mm]"].to_numpy()), paper_v2(22.5)), rel=1e-12
     )
+    assert res.mode == "vector"  # the failing cases were split off and done one by one
+    serial = sw.sweep(concave, {"R3": "5mm..60mm:12"}, {"v_peak": V_PEAK}, mode="serial")
+    pd.testing.assert_frame_equal(t, serial.table, check_exact=True)
     # an input bound (positive = true) fails the case, not the sweep
     res = sw.sweep(concave, {"R3": "-5mm,50mm"}, {"v_peak": V_PEAK})
     assert "must be positive" in res.table["error"][0] and res.table["error"][1] is None
+
+
+def test_vector_blocks_split_around_failing_cases(concave, monkeypatch):
+    grid = {"R3": "5mm..60mm:23", "R1": "15mm..25mm:5"}
+    outs = {"v": V_PEAK, "k": "k"}
+    serial = sw.sweep(concave, grid, outs, mode="serial").table
+    assert 0 < serial["error"].notna().sum() < len(serial)
+    for points in (1_000_000, 2000, 209):  # one block; several; one case per block
+        monkeypatch.setattr(sw, "VECTOR_POINTS", points)
+        res = sw.sweep(concave, grid, outs)
+        assert res.mode == "vector"
+        pd.testing.assert_frame_equal(res.table, serial, check_exact=True)
+
+
+def test_a_table_aggregate_is_not_vectorised(tmp_path):
+    path = write_template(
+        tmp_path,
+        """
+[inputs]
+R = "10 mm"
+
+[arguments]
+phi = { unit = "deg" }
+
+[definitions]
+"y(phi)" = "R*sin(phi)"
+
+[[tables]]
+name = "t"
+range = "phi := 0, 10 .. 90"
+columns = { y = "mm" }
+""",
+    )
+    sheet = workbook.load(path)
+    res = sw.sweep(sheet, {"R": "10mm,20mm"}, {"top": "max_over(t, y)"})
+    assert res.mode == "serial"
+    assert res.table["top [mm]"].tolist() == pytest.approx([10.0, 20.0], rel=1e-15)
 
 
 def test_two_inputs_make_a_grid_and_one_series_per_value(tmp_path, concave):

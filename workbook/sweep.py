@@ -50,6 +50,7 @@ REDUCTIONS = ("max", "min", "mean", "argmax", "argmin")
 _REDUCE = re.compile(r"^\s*(max|min|mean|argmax|argmin)\s+of\s+(.+?)\s+over\s+(.+?)\s*$", re.S)
 _VARY = re.compile(r"^\s*(.+?)\s*\.\.\s*(.+?)\s*:\s*(\d+)\s*$")
 MAX_CASES = 1_000_000
+VECTOR_POINTS = 1_000_000  # vector mode: points (cases x range) evaluated per block
 QUICK_SECONDS = 2.0  # auto mode: solver cases that would all run within this stay in-process
 
 
@@ -432,6 +433,9 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
         blocks = sorted(deps & set(sheet.spec.blocks))
         if blocks:
             why.append(f"{out.name} needs the solver block(s) {', '.join(blocks)}")
+        aggregates = sorted(deps & {"max_over", "min_over"} - set(sheet.spec.definitions))
+        if aggregates:
+            why.append(f"{out.name} uses the table aggregate {', '.join(aggregates)}()")
         if out.range is not None:
             for node in (out.range.first, out.range.second, out.range.last):
                 if node is not None and tc.dependencies(sheet.spec, node) & swept:
@@ -440,8 +444,12 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
     return why
 
 
-def _vector_cases(sheet, outputs: list[Output], varies: list[Vary], cases: list[dict]):
-    """All cases at once; returns (values per case, errors per case) or raises."""
+def _vector_cases(sheet, outputs: list[Output], varies: list[Vary], cases: list[dict], one=None):
+    """All cases at once, in blocks; returns (values per case, errors per case).
+
+    A block in which some case leaves a formula's domain is done again case by case with
+    ``one(i) -> (values, error)``, so that the failing case gets its own error.
+    """
     from .sheet import coerce_input
 
     n = len(cases)
@@ -457,33 +465,60 @@ def _vector_cases(sheet, outputs: list[Output], varies: list[Vary], cases: list[
             except WorkbookError as err:
                 errors[i] = err.message
                 mags[name][i] = float(sheet.values[name].magnitude)  # a placeholder
-    ok = np.array([e is None for e in errors])
+    ok = np.flatnonzero([e is None for e in errors])
     ev = _CaseEvaluator(sheet, swept)
-    m = int(ok.sum())
+    typed = [(out, _type_output(sheet, out)) for out in outputs]
+    fns = [ev.compile(t.t) for _, t in typed]
+    grids = [
+        None if out.range is None else sheet.range_values(out.range, f"sweep output {out.name}")
+        for out in outputs
+    ]
+    points = max([1] + [len(g) for g in grids if g is not None])
+    chunk = max(1, VECTOR_POINTS // points)  # cases per block: bounded memory
+    results: list[dict | None] = [None] * n
+    bad = (WorkbookError, FloatingPointError, ValueError, ZeroDivisionError)
+
+    def solve(idx):
+        try:
+            cols = _vector_block(mags, idx, typed, fns, grids)
+        except bad:
+            if one is None:
+                raise
+            if len(idx) == 1:  # the failing case, evaluated alone for its own error
+                results[idx[0]], errors[idx[0]] = one(idx[0])
+                return
+            half = len(idx) // 2  # halve the block until the failing cases are alone
+            solve(idx[:half])
+            solve(idx[half:])
+            return
+        for j, i in enumerate(idx):
+            results[i] = {name: float(cols[name][j]) for name in cols}
+
+    for lo in range(0, len(ok), chunk):
+        solve(ok[lo : lo + chunk])
+    return results, errors
+
+
+def _vector_block(mags, idx, typed, fns, grids) -> dict:
+    """The outputs of the cases ``idx`` at once (raises if any value is not finite)."""
+    m = len(idx)
     cols = {}
-    for out in outputs:
-        typed = _type_output(sheet, out)
-        fn = ev.compile(typed.t)
-        env = {"\x00" + k: v[ok] for k, v in mags.items()}
-        if out.range is None:
+    for (out, t), fn, g in zip(typed, fns, grids):
+        env = {"\x00" + k: v[idx] for k, v in mags.items()}
+        if g is None:
             vals = np.broadcast_to(np.asarray(fn(env), dtype=float), (m,)).copy()
         else:
-            g = sheet.range_values(out.range, f"sweep output {out.name}")
             env = {k: np.repeat(v, len(g)) for k, v in env.items()}
             env[out.range.var] = np.tile(g, m)
             flat = np.broadcast_to(np.asarray(fn(env), dtype=float), (m * len(g),))
-            vals = _reduce(out.reduction, flat.reshape(m, len(g)), g, axis=1)
             if not np.all(np.isfinite(flat)):
                 raise InputError("not finite")
-        vals = vals * typed.factor
+            vals = _reduce(out.reduction, flat.reshape(m, len(g)), g, axis=1)
+        vals = vals * t.factor
         if not np.all(np.isfinite(vals)):
             raise InputError("not finite")
         cols[out.name] = vals
-    results: list[dict | None] = [None] * n
-    idx = np.flatnonzero(ok)
-    for j, i in enumerate(idx):
-        results[i] = {name: float(cols[name][j]) for name in cols}
-    return results, errors
+    return cols
 
 
 # -- the sweep -------------------------------------------------------------------------------
@@ -533,7 +568,9 @@ class Progress:
             msg = f"sweep: {self.done}/{self.total} cases"
             if self.failed:
                 msg += f" ({self.failed} failed)"
-            msg += f", {now - self.start:.1f} s, about {left:.0f} s left"
+            msg += f", {now - self.start:.1f} s"
+            if self.done < self.total:
+                msg += f", about {left:.0f} s left"
             end = "\n" if self.done == self.total else ""
             if getattr(self.stream, "isatty", lambda: False)():
                 print("\r" + msg, end=end, file=self.stream, flush=True)
@@ -588,14 +625,17 @@ def sweep(
     errors: list[str | None] = [None] * n
     seconds = [0.0] * n
     if chosen == "vector":
-        try:
-            with np.errstate(all="ignore"):
-                results, errors = _vector_cases(sheet, outs, varies, cases)
-            if progress:
-                for e in errors:
-                    progress(e is None)
-        except (WorkbookError, FloatingPointError, ValueError):
-            chosen = "serial"  # some case left a domain: go case by case to name it
+        tasks = _tasks(sheet, outs, cases)
+
+        def one(i):
+            _, values, error, _ = run_case(tasks[i])
+            return values, error
+
+        with np.errstate(all="ignore"):
+            results, errors = _vector_cases(sheet, outs, varies, cases, one)
+        if progress:
+            for e in errors:
+                progress(e is None)
     if chosen != "vector":
         tasks = _tasks(sheet, outs, cases)
         done = []
@@ -707,18 +747,18 @@ def _run(tasks: list[tuple], mode: str, scheduler, workers: int | None, timeout:
         else:
             method = "forkserver" if "forkserver" in methods else "spawn"
         n = max(1, min(workers or os.cpu_count() or 1, len(tasks)))
-        with ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context(method)) as pool:
-            futures = {pool.submit(run_case, t): t[0] for t in tasks}
-            try:
-                for fut in as_completed(futures):
-                    try:
-                        yield fut.result()
-                    except BrokenProcessPool as err:  # a worker died (crash, out of memory)
-                        yield futures[fut], None, f"worker process died: {err}", 0.0
-            except BaseException:
-                for fut in futures:
-                    fut.cancel()
-                raise
+        pool = ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context(method))
+        futures = {pool.submit(run_case, t): t[0] for t in tasks}
+        try:
+            for fut in as_completed(futures):
+                try:
+                    yield fut.result()
+                except BrokenProcessPool as err:  # a worker died (crash, out of memory)
+                    yield futures[fut], None, f"worker process died: {err}", 0.0
+        except BaseException:  # Ctrl-C or an error: do not wait for the queued cases
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
         return
     if mode == "dask":
         yield from _run_dask(tasks, scheduler, timeout)
