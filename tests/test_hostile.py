@@ -272,3 +272,17 @@ def test_solver_step_cap_stops_a_billion_steps():
     assert run.stop_reason == "time budget" and "wall-clock budget of 2 s" in run.notes[0]
     capped = run_ode(stiff, (0.0, 1e4), [0.0], method="RK45", max_steps=2000, max_time=60)
     assert capped.stop_reason == "step cap" and capped.nsteps == 2000
+
+
+def test_solver_loop_asked_for_billions_of_steps(tmp_path):
+    """The r0-synthesis VBA loop (workbook/blocks/r0.py) with dr = 1e-9 mm would need ~3e10
+    steps: it is refused before it starts, by its step cap, under the same guard."""
+    pytest.importorskip("workbook.blocks.r0")
+    out = guarded(tmp_path, "", "run", "r0-synthesis", "--set", "dr=1e-9 mm", "--out", "r0.xlsx")
+    assert out.returncode == 2, out.stderr
+    assert "limit exceeded" in out.stderr and "steps of dr = 1e-09 mm" in out.stderr
+    assert "r0-synthesis.toml:" in out.stderr and "in 'r0_loop'" in out.stderr
+    assert "Traceback" not in out.stderr and out.elapsed < WALL_SECONDS
+    assert not (tmp_path / "r0.xlsx").exists()
+    temporary = [e for e in out.events if e.endswith(".partial None") and str(tmp_path) in e]
+    assert [e for e in out.events if e not in temporary and e != "os.remove"] == [], out.events
