@@ -157,6 +157,13 @@ HOSTILE = {
         + '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { f0 = "" }\n',
         f"more than {typecheck.MAX_CHAIN} deep",
     ),
+    "definition_chain_in_order": (  # typed one by one, but inlined into one Excel formula
+        HEAD
+        + '"f0(x)" = "x"\n'
+        + "".join(f'"f{i}(x)" = "f{i - 1}(x) + 1"\n' for i in range(1, 400))
+        + '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { f399 = "" }\n',
+        "limit exceeded: the worksheet is nested too deeply",
+    ),
     "range_1e10_points": (
         HEAD + 's = "1"\n\n[[tables]]\nname = "t"\nrange = "x := 0, 1 .. 1e10"\n'
         'columns = { "2*x" = "" }\n',
