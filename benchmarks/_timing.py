@@ -21,13 +21,14 @@ class Result:
     target: float
     unit: str = "x"  # "x" for a ratio
     detail: str = ""  # the medians behind the ratio
+    info: bool = False  # shown for information: not one of the targets
 
     @property
     def ok(self) -> bool:
-        return self.value <= self.target
+        return self.info or self.value <= self.target
 
     def line(self) -> str:
-        verdict = "ok" if self.ok else "MISSED"
+        verdict = "information" if self.info else "ok" if self.ok else "MISSED"
         return (
             f"{self.name}: {self.value:.2f}{self.unit} (target <= {self.target:g}{self.unit}) "
             f"{verdict}   [{self.detail}]"

@@ -48,14 +48,50 @@ STAGE_NAMES = (
 def stages(template: str = "concave-cam") -> str:
     """Where one cold `workbook run` spends its time (one fresh process, informational)."""
     with tempfile.TemporaryDirectory() as tmp:
-        out = subprocess.run(
-            [sys.executable, "-c", STAGES, template, str(Path(tmp) / "s.xlsx")],
-            check=True,
-            capture_output=True,
-            text=True,
-        ).stdout.split()
+        out = (
+            subprocess.run(
+                [sys.executable, "-c", STAGES, template, str(Path(tmp) / "s.xlsx")],
+                check=True,
+                capture_output=True,
+                text=True,
+            )
+            .stdout.splitlines()[-1]
+            .split()
+        )  # the last line: blocks may print progress
     parts = [f"{name} {ms(float(x))}" for name, x in zip(STAGE_NAMES, out)]
     return "; ".join(parts) + f"; heavy modules imported: {out[-1]}"
+
+
+def core_template(folder: Path, template: str = "concave-cam") -> Path:
+    """A copy of the template with only the Mathcad sheet: inputs, definitions, range tables,
+    their charts and printed values; without [[relations]], [[findings]] and block tables
+    (and the charts drawn from them), which other issues added for the hand checks."""
+    import shutil
+
+    import workbook
+
+    src = workbook.template_path(template)
+    blocks, current = [], []
+    for line in src.read_text(encoding="utf-8").splitlines(keepends=True):
+        if line.startswith("["):
+            blocks.append(current)
+            current = []
+        current.append(line)
+    blocks.append(current)
+    kept = []
+    for block in blocks:
+        head = block[0].strip() if block else ""
+        text = "".join(block)
+        if head in ("[[relations]]", "[[findings]]"):
+            continue
+        if head in ("[[tables]]", "[[charts]]") and ("block =" in text or "table =" in text):
+            continue
+        kept.append(text)
+    out = folder / f"{template}-core.toml"
+    out.write_text("".join(kept), encoding="utf-8")
+    for csv in src.parent.glob(f"{template}.*.csv"):
+        shutil.copy(csv, folder / csv.name)
+    return out
 
 
 def engine_command(out: Path, template: str = "concave-cam") -> list[str]:
@@ -80,8 +116,23 @@ def measure(reps: int = 7, template: str = "concave-cam") -> tuple[list[float], 
     return te, tb
 
 
-def run(reps: int = 7, template: str = "concave-cam") -> list[Result]:
+def run(reps: int = 7, template: str = "concave-cam", core: bool = True) -> list[Result]:
     te, tb = measure(reps, template)
+    extra = []
+    if core:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = core_template(Path(tmp), template)
+            tc, tb2 = measure(reps, str(path))
+        extra.append(
+            Result(
+                f"  (information) the same for the Mathcad sheet alone ({template} without "
+                "relations, findings and block tables)",
+                median(tc) / median(tb2),
+                TARGET,
+                detail=f"run {ms(median(tc))}, bare imports {ms(median(tb2))}, medians of {reps}",
+                info=True,
+            )
+        )
     return [
         Result(
             f"cold start: workbook run {template} / python -c 'import numpy, pint, xlsxwriter'",
@@ -89,7 +140,7 @@ def run(reps: int = 7, template: str = "concave-cam") -> list[Result]:
             TARGET,
             detail=f"run {ms(median(te))}, bare imports {ms(median(tb))}, medians of {reps}",
         )
-    ]
+    ] + extra
 
 
 def main(argv=None) -> int:

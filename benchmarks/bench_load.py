@@ -37,9 +37,11 @@ print(time.perf_counter() - t0, ",".join(loaded) or "-", ",".join(failed) or "-"
 
 def load_all_seconds() -> tuple[float, list[str], list[str]]:
     """Seconds, templates loaded, templates that failed to load (a template error)."""
-    out = subprocess.run(
-        [sys.executable, "-c", LOAD_ALL], check=True, capture_output=True, text=True
-    ).stdout.split()
+    out = (
+        subprocess.run([sys.executable, "-c", LOAD_ALL], check=True, capture_output=True, text=True)
+        .stdout.splitlines()[-1]
+        .split()
+    )
     names = [[n for n in part.split(",") if n != "-"] for part in out[1:3]]
     return float(out[0]), names[0], names[1]
 

@@ -48,11 +48,11 @@ def test_plain_numpy_matches_the_sheet():
 
 
 def test_write_bench_tiny():
-    _check(bench_write.run(n=30, reps=1), 1)
+    _check(bench_write.run(n=30, reps=1), 2)
 
 
 def test_coldstart_bench_tiny():
-    _check(bench_coldstart.run(reps=1), 1)
+    _check(bench_coldstart.run(reps=1), 2)  # the ratio, and the Mathcad sheet alone
 
 
 def test_load_bench_tiny():
@@ -67,7 +67,7 @@ def test_run_quick():
         timeout=300,
     )
     assert out.returncode == 0, out.stderr
-    assert out.stdout.count("target <=") == 3
+    assert out.stdout.count("target <=") == 4
     assert "cores" in out.stdout.splitlines()[0]
 
 
