@@ -3,8 +3,8 @@
 Kireev, Kovalev, Ershov (2003), formulas (1)-(5). The template defines the theoretical
 profile ``x_t(k, phi)``, ``y_t(k, phi)`` of roller k; this module
 
-* turns those definitions (the engine's typed trees) into sympy expressions with a small
-  whitelisted converter and differentiates them symbolically in phi: the normal of (5) and
+* turns those definitions (the engine's typed trees) into sympy expressions with
+  :mod:`workbook.symbolic` and differentiates them symbolically in phi: the normal of (5) and
   the curvature of the theoretical profile come from these exact derivatives (no hand-written
   derivative formulas, no finite differences);
 * tabulates the theoretical and practical profile of every roller (block tables);
@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import typecheck as tc
+from .. import symbolic
 from .. import units as un
 from ..errors import InputError, TemplateError
 from . import Finding, findings_block, table_block
@@ -38,133 +38,6 @@ from . import Finding, findings_block, table_block
 CLOSURE_TOL_MM = 1e-9
 #: Step of the dense sampling used to find nearest points and curvature extremes (deg of phi).
 _SAMPLE_DEG = 0.25
-
-# ----------------------------------------------------------------------------------------
-# typed tree -> sympy (whitelisted; nothing is ever sympified from text)
-# ----------------------------------------------------------------------------------------
-
-_FUNCS_1 = {
-    "sin": "sin",
-    "cos": "cos",
-    "tan": "tan",
-    "asin": "asin",
-    "acos": "acos",
-    "atan": "atan",
-    "sinh": "sinh",
-    "cosh": "cosh",
-    "tanh": "tanh",
-    "sqrt": "sqrt",
-    "exp": "exp",
-    "ln": "log",
-    "abs": "Abs",
-    "sign": "sign",
-    "floor": "floor",
-    "ceil": "ceiling",
-}
-
-
-class _Choice(str):
-    """The value of a choice input inside the converter (only compared with text)."""
-
-
-def to_sympy(sheet, t: tc.T, env: dict):
-    """Convert a typed tree of ``sheet`` into a sympy expression.
-
-    ``env`` maps function parameters to sympy expressions (symbols at the top). Inputs and
-    scalar definitions become their numbers (magnitudes in the unit the typed tree expects);
-    conditions on choice inputs are decided here, conditions on parameters become
-    ``Piecewise``. Solver blocks cannot be differentiated and are refused.
-    """
-    import sympy as sp
-
-    def conv(node, env):
-        if isinstance(node, tc.TConst):
-            v = float(node.value)
-            return sp.Integer(int(v)) if v.is_integer() and abs(v) < 2**53 else sp.Float(v)
-        if isinstance(node, tc.TText):
-            return _Choice(node.value)
-        if isinstance(node, tc.TParam):
-            return env[node.name]
-        if isinstance(node, tc.TRef):
-            if node.kind == "builtin":
-                return sp.Float(math.pi)
-            if node.kind == "choice":
-                return _Choice(sheet.values[node.name])
-            q = sheet.evaluate(node.name)
-            return sp.Float(float(q.to(node.unit).magnitude))
-        if isinstance(node, tc.TScale):
-            child = conv(node.child, env)
-            return child if node.factor == 1.0 else child * sp.Float(node.factor)
-        if isinstance(node, tc.TUnary):
-            child = conv(node.child, env)
-            return sp.Not(child) if node.op == "not" else -child
-        if isinstance(node, tc.TBinary):
-            left, right = conv(node.left, env), conv(node.right, env)
-            if node.op == "+":
-                return left + right
-            if node.op == "-":
-                return left - right
-            if node.op == "*":
-                return left * right
-            if node.op == "/":
-                return left / right
-            return sp.Pow(left, right)
-        if isinstance(node, tc.TCompare):
-            vals = [conv(o, env) for o in node.operands]
-            parts = []
-            for op, x, y in zip(node.ops, vals[:-1], vals[1:]):
-                if isinstance(x, _Choice) or isinstance(y, _Choice):
-                    same = str(x) == str(y)
-                    parts.append(sp.true if (same if op == "==" else not same) else sp.false)
-                    continue
-                rel = {"<": sp.Lt, "<=": sp.Le, ">": sp.Gt, ">=": sp.Ge, "==": sp.Eq, "!=": sp.Ne}[
-                    op
-                ]
-                parts.append(rel(x, y))
-            return sp.And(*parts)
-        if isinstance(node, tc.TLogic):
-            vals = [conv(v, env) for v in node.values]
-            return sp.And(*vals) if node.op == "and" else sp.Or(*vals)
-        if isinstance(node, tc.TFunc):
-            args = [conv(a, env) for a in node.args]
-            if node.func in _FUNCS_1:
-                return getattr(sp, _FUNCS_1[node.func])(args[0])
-            if node.func == "log10":
-                return sp.log(args[0], 10)
-            if node.func == "atan2":
-                return sp.atan2(args[0], args[1])
-            if node.func == "min":
-                return sp.Min(*args)
-            if node.func == "max":
-                return sp.Max(*args)
-            raise TemplateError(f"function {node.func}() cannot be differentiated symbolically")
-        if isinstance(node, tc.TCall):
-            f = sheet.typer.function(node.name)
-            inner = {p: conv(a, env) for p, a in zip(f.params, node.args)}
-            return conv(f.body, inner)
-        if isinstance(node, tc.TPiecewise):
-            pieces = []
-            for cond, value in zip(node.conditions, node.values):
-                c = sp.true if cond is None else conv(cond, env)
-                if c is sp.false:
-                    continue
-                pieces.append((conv(value, env), c))
-                if c is sp.true:
-                    break
-            if not pieces:
-                raise InputError("no piece of a piecewise definition applies")
-            if len(pieces) == 1 and pieces[0][1] is sp.true:
-                return pieces[0][0]
-            return sp.Piecewise(*pieces)
-        if isinstance(node, tc.TBlock):
-            raise TemplateError(
-                f"the solver block {node.name}() cannot be differentiated symbolically; "
-                "write x_t and y_t with worksheet formulas only"
-            )
-        raise TemplateError(f"cannot convert {type(node).__name__} to sympy")  # pragma: no cover
-
-    return conv(t, env)
-
 
 # ----------------------------------------------------------------------------------------
 # the model of one sheet (built once per Sheet object)
@@ -316,12 +189,12 @@ def _build(sheet) -> Model:
     turns = int(round(1 / abs(i_a)))
     if abs(turns * abs(i_a) - 1) > 1e-9:
         raise InputError(f"a/phi = {i_a:g} is not 1/(whole number): the trace never closes")
-    k, phi = sp.symbols("k phi", real=True)
+    k, phi = symbolic.symbol("k"), symbolic.symbol("phi")
     exprs = {}
     for name in ("x_t", "y_t"):
-        f = sheet.typer.function(name)
-        expr = to_sympy(sheet, f.body, {"k": k, "phi": phi})
-        exprs[name] = expr * sp.Float(un.factor(f.unit, un.unit("mm")))
+        expr = symbolic.to_sympy(sheet, name, {"k": k, "phi": phi})
+        to_mm = un.factor(sheet.typer.function(name).unit, un.unit("mm"))
+        exprs[name] = expr if to_mm == 1.0 else expr * symbolic.exact_number(to_mm)
     X, Y = exprs["x_t"], exprs["y_t"]
     dX, dY = sp.diff(X, phi), sp.diff(Y, phi)
     ddX, ddY = sp.diff(dX, phi), sp.diff(dY, phi)
@@ -443,7 +316,8 @@ def undercut(m: Model) -> Undercut:
     rp = abs(m.rp_s)
     g = 1.0 - rp * kap
     if out.concave and np.any(g <= 0):
-        start = int(np.argmax(g))  # begin the scan where the offset is surely regular
+        # begin the scan at phi = 0, or where the offset is surely regular: teeth count from there
+        start = 0 if g[0] > 0 else int(np.argmax(g))
         ss = np.concatenate([s[start:], s[:start] + L, [s[start] + L]])
         gg = np.concatenate([g[start:], g[:start], [g[start]]])
 
@@ -623,7 +497,10 @@ def undercut_table(sheet):
         )
     cols = ["tooth", "kind", "phi [deg]", "phi2 [deg]", "psi [deg]", "x_k [mm]", "y_k [mm]"]
     df = pd.DataFrame(rows, columns=cols)
-    return df.sort_values(["tooth", "phi [deg]"], kind="stable").reset_index(drop=True)
+    df = df.sort_values(["tooth", "phi [deg]"], kind="stable").reset_index(drop=True)
+    # a cusp has one angle: leave the second cell empty (None), not "nan"
+    df["phi2 [deg]"] = df["phi2 [deg]"].astype(object).where(df["phi2 [deg]"].notna(), None)
+    return df
 
 
 def _verdict_text(m: Model, uc: Undercut) -> str:
