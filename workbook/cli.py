@@ -202,13 +202,14 @@ def main(argv: list[str] | None = None) -> int:
     if not args.command:
         _parser().print_help()
         return EXIT_INPUT
-    from .scaffold import cmd_new
-    from .sweep import cmd_sweep
-
-    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}
-    handler = {**handler, "sweep": cmd_sweep, "new": cmd_new}[
+    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}.get(
         args.command
-    ]
+    )
+    if handler is None:  # imported only when used: sweep pulls in sympy
+        if args.command == "sweep":
+            from .sweep import cmd_sweep as handler
+        else:
+            from .scaffold import cmd_new as handler
     from .errors import WorkbookError
 
     if not args.debug:  # the engine reports non-finite results itself, with the arguments
