@@ -67,3 +67,35 @@ def test_bad_input_exit_2_without_traceback():
     assert "R3" in out.stderr and "[mass]" in out.stderr and "[length]" in out.stderr
     out = run("check", "no-such-template")
     assert out.returncode == 2 and "no template named" in out.stderr
+
+
+def test_export_profile_csv_for_cad(tmp_path):
+    out = run(
+        "run",
+        "reducer-profile",
+        "--out",
+        str(tmp_path / "r.xlsx"),
+        "--export",
+        str(tmp_path / "profile.csv"),
+    )
+    assert out.returncode == 0, out.stderr
+    lines = (tmp_path / "profile.csv").read_text().splitlines()
+    assert lines[0] == "x_mm,y_mm,z_mm"
+    x, y, z = map(float, lines[1].split(","))
+    assert (x, y, z) == (46.0, 0.0, 0.0)  # SCENES.md: x_k = 46, y_k = 0 at phi = 0
+    undercut = run(
+        "run",
+        "reducer-profile",
+        "--set",
+        "rp=7.6 mm",
+        "--out",
+        str(tmp_path / "u.xlsx"),
+        "--export",
+        str(tmp_path / "u.csv"),
+    )
+    assert undercut.returncode == 2 and "undercut" in undercut.stderr
+    assert not (tmp_path / "u.csv").exists()
+    none = run(
+        "run", "concave-cam", "--out", str(tmp_path / "c.xlsx"), "--export", str(tmp_path / "c.csv")
+    )
+    assert none.returncode == 2 and "has no export" in none.stderr

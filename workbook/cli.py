@@ -43,6 +43,12 @@ def _parser() -> argparse.ArgumentParser:
         help="read the inputs back from the Inputs sheet of an edited workbook",
     )
     run.add_argument(
+        "--export",
+        metavar="PATH",
+        help="also write the sheet's export file (reducer-profile: the practical profile "
+        "as CSV points x,y,z in mm for CAD)",
+    )
+    run.add_argument(
         "--csv",
         metavar="TABLE",
         action="append",
@@ -148,6 +154,15 @@ def cmd_run(args) -> int:
     if not args.out:
         out.parent.mkdir(parents=True, exist_ok=True)
     report = sheet.check()
+    exporter = None
+    if args.export:
+        from . import blocks
+        from .errors import InputError
+
+        ref = sheet.spec.meta.get("export")
+        if not ref:
+            raise InputError(f'{sheet.name} has no export ([sheet] export = "module.func")')
+        exporter = blocks.get(ref, "export").func
     frames = {table: sheet.table(table) for table in args.csv}  # all computed before writing
     sheet.write_xlsx(out, force=args.force, command=_command_line(args), report=report)
     for table, frame in frames.items():
@@ -158,6 +173,8 @@ def cmd_run(args) -> int:
         with replacing(path) as tmp:
             frame.to_csv(tmp, index=False)
         print(f"wrote {path}")
+    if exporter is not None:
+        print(f"wrote {exporter(sheet, Path(args.export))}")
     n_checked = sum(r.role == "check" for r in report.rows)
     n_ok = sum(r.role == "check" and r.verdict in ("pass", "misprint") for r in report.rows)
     summary = f"{len(sheet.spec.tables)} tables, {len(sheet.spec.charts)} charts"

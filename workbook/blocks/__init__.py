@@ -83,6 +83,7 @@ def _simple(kind: str):
 table_block = _simple("table")
 findings_block = _simple("findings")
 bench_block = _simple("bench")
+export_block = _simple("export")  # func(sheet, path) writes a file for other programs (CAD)
 
 
 def get(ref: str, kind: str | None = None) -> Block:

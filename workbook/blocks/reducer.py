@@ -32,7 +32,7 @@ import numpy as np
 from .. import symbolic
 from .. import units as un
 from ..errors import InputError, TemplateError
-from . import Finding, findings_block, table_block
+from . import Finding, export_block, findings_block, table_block
 
 #: The closure check passes when the traces agree to this distance (mm).
 CLOSURE_TOL_MM = 1e-9
@@ -749,6 +749,7 @@ def findings(sheet) -> list[Finding]:
 # ----------------------------------------------------------------------------------------
 
 
+@export_block
 def export_profile_csv(sheet, path, *, allow_invalid: bool = False, header: bool = True):
     """Write the closed practical profile as CSV points ``x,y,z`` in mm for CAD; returns the path.
 
