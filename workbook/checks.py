@@ -119,20 +119,32 @@ class Report:
         return "\n".join(lines)
 
 
-def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
-    """Read a printed-values CSV: name, argument value, value, unit ('#' lines are comments)."""
+def read_commented_csv(path, what: str):
+    """Read a CSV whose '#' lines and blank lines are comments.
+
+    Returns (header cells or None, [(line number, cells, line text), ...]).
+    """
     try:
-        text = Path(spec.file).read_text(encoding="utf-8")
+        text = Path(path).read_text(encoding="utf-8")
     except OSError as exc:
-        raise TemplateError(f"cannot read printed values {spec.file}: {exc.strerror}") from None
-    rows, header = [], None
+        raise TemplateError(f"cannot read {what} {path}: {exc.strerror}") from None
+    header, rows = None, []
     for number, line in enumerate(text.splitlines(), start=1):
         if not line.strip() or line.lstrip().startswith("#"):
             continue
         cells = next(csv.reader([line]))
         if header is None:
             header = cells
-            continue
+        else:
+            rows.append((number, cells, line))
+    return header, rows
+
+
+def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
+    """Read a printed-values CSV: name, argument value, value, unit ('#' lines are comments)."""
+    header, lines = read_commented_csv(spec.file, "printed values")
+    rows = []
+    for number, cells, line in lines:
         if len(cells) != 4:
             raise TemplateError(f"{spec.file}:{number}: expected name, argument, value, unit")
         try:

@@ -337,23 +337,13 @@ def read_measured_lift(path: Path):
 
     Returns (phi in deg, h in mm) as numpy arrays, checked: finite, increasing, evenly spaced.
     """
-    import csv
-
     from .. import units as un
-    from ..errors import InputError, TemplateError
+    from ..checks import read_commented_csv
+    from ..errors import InputError
 
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise TemplateError(f"cannot read measured lift {path}: {exc.strerror}") from None
-    rows, header = [], None
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip() or line.lstrip().startswith("#"):
-            continue
-        cells = next(csv.reader([line]))
-        if header is None:
-            header = cells
-            continue
+    header, lines = read_commented_csv(path, "measured lift")
+    rows = []
+    for number, cells, line in lines:
         if len(cells) != 2:
             raise InputError(f"{path}:{number}: expected two values (angle, lift)")
         try:
