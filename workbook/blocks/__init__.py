@@ -57,6 +57,11 @@ class Finding:
     note: str = ""
 
 
+def input_magnitude(sheet, name: str, unit: str) -> float:
+    """The sheet's input ``name`` as a plain number in ``unit``."""
+    return float(sheet.values[name].to(unit).magnitude)
+
+
 def _ref(func: Callable) -> str:
     module = func.__module__.rsplit(".", 1)[-1]
     return f"{module}.{func.__name__}"

@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from . import Finding, bench_block, findings_block, table_block
+from . import Finding, bench_block, findings_block, input_magnitude, table_block
 
 STABILITY_ANGLES = (1e-6, 1e-3, 1.0)  # deg
 BENCH_POINTS = (3.0, 8.0, 13.0, 18.0)  # deg, inside the flank 0 .. 22
@@ -44,8 +44,7 @@ def _cached(sheet, what: str, compute):
     return _CACHE[key]
 
 
-def _mag(sheet, name: str, unit: str) -> float:
-    return float(sheet.values[name].to(unit).magnitude)
+_mag = input_magnitude
 
 
 def _deg(sheet) -> float:

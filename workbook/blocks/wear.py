@@ -28,6 +28,7 @@ scipy is imported inside the functions.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 import weakref
@@ -35,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import Finding, bench_block, block, findings_block, table_block
+from . import Finding, bench_block, block, findings_block, input_magnitude, table_block
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -178,8 +179,7 @@ _METHODS = ("trapezoid", "Simpson", "Gauss-Legendre", "Gauss-Legendre split")
 
 
 def _valve_numbers(sheet) -> dict:
-    v = sheet.values
-    q = lambda name, unit: float(v[name].to(unit).magnitude)  # noqa: E731
+    q = functools.partial(input_magnitude, sheet)
     return dict(
         d=q("d", "mm"),
         d1=q("d1", "mm"),
@@ -854,8 +854,7 @@ def shoe_factors_by_quadrature(r, s, alpha0, alpha1, psi, mu=1.0):
 
 
 def _brake_numbers(sheet):
-    v = sheet.values
-    q = lambda name, unit: float(v[name].to(unit).magnitude)  # noqa: E731
+    q = functools.partial(input_magnitude, sheet)
     return dict(
         r=q("r", "mm"),
         s=q("s", "mm"),
