@@ -21,8 +21,19 @@ from workbook.blocks import solvers as sv
 from workbook.errors import WorkbookError
 
 # SCENES.md section 4 example dimensions (SI)
-EX = dict(O1O=0.042, OC=0.036, OC1=0.052, lam=0.001, OB=0.015, O1B=0.040, tg=1 / 3, MD0=1.2,
-          m=0.7, c1=3000.0, phi20=0.5236)
+EX = dict(
+    O1O=0.042,
+    OC=0.036,
+    OC1=0.052,
+    lam=0.001,
+    OB=0.015,
+    O1B=0.040,
+    tg=1 / 3,
+    MD0=1.2,
+    m=0.7,
+    c1=3000.0,
+    phi20=0.5236,
+)
 
 
 @pytest.fixture(scope="module")
@@ -35,9 +46,15 @@ def F_ref(phi, w, d):
     import mpmath as mp
 
     G = d["MD0"] * d["OB"] / d["O1B"] * d["tg"]
-    return (2 * d["m"] * w**2 * (d["O1O"] - d["OC"] * mp.cos(phi)) * d["OC"] * mp.sin(phi)
-            - 8 * d["c1"] * (d["lam"] + d["OC1"] * (mp.cos(d["phi20"]) - mp.cos(phi)))
-            * d["OC1"] * mp.sin(phi) - G)
+    return (
+        2 * d["m"] * w**2 * (d["O1O"] - d["OC"] * mp.cos(phi)) * d["OC"] * mp.sin(phi)
+        - 8
+        * d["c1"]
+        * (d["lam"] + d["OC1"] * (mp.cos(d["phi20"]) - mp.cos(phi)))
+        * d["OC1"]
+        * mp.sin(phi)
+        - G
+    )
 
 
 def root_ref(w, **changes):
@@ -73,10 +90,13 @@ def test_root_against_mpmath(sheet, w):
     assert got == pytest.approx(root_ref(w), abs=1e-11)
 
 
-@pytest.mark.parametrize("name,values,expected", [
-    ("c1", ["1500 N/m", "3000 N/m", "4000 N/m", "6000 N/m"], [0.730, 0.204, 0.131, 0.067]),
-    ("m", ["0.65 kg", "0.7 kg", "0.75 kg", "0.8 kg"], [0.181, 0.204, 0.228, 0.253]),
-])
+@pytest.mark.parametrize(
+    "name,values,expected",
+    [
+        ("c1", ["1500 N/m", "3000 N/m", "4000 N/m", "6000 N/m"], [0.730, 0.204, 0.131, 0.067]),
+        ("m", ["0.65 kg", "0.7 kg", "0.75 kg", "0.8 kg"], [0.181, 0.204, 0.228, 0.253]),
+    ],
+)
 def test_families_at_110_match_scenes(sheet, name, values, expected):
     for v, e in zip(values, expected):
         got = float(sheet.with_inputs(**{name: v}).evaluate("phi2", omega1=110).magnitude)
@@ -98,8 +118,10 @@ SPEEDS = [60.0, 70.0, 80.0, 90.0, 100.0, 110.0]
 
 @pytest.mark.parametrize("w", SPEEDS)
 def test_trend_phi2_falls_as_c1_rises(sheet, w):
-    vals = [float(sheet.with_inputs(c1=f"{c} N/m").evaluate("phi2", omega1=w).magnitude)
-            for c in (1500, 3000, 4000, 6000)]
+    vals = [
+        float(sheet.with_inputs(c1=f"{c} N/m").evaluate("phi2", omega1=w).magnitude)
+        for c in (1500, 3000, 4000, 6000)
+    ]
     nonzero = [v for v in vals if v > 0]
     assert len(nonzero) >= 2
     assert all(a > b for a, b in zip(nonzero, nonzero[1:]))
@@ -108,15 +130,19 @@ def test_trend_phi2_falls_as_c1_rises(sheet, w):
 
 @pytest.mark.parametrize("w", SPEEDS)
 def test_trend_phi2_rises_with_m(sheet, w):
-    vals = [float(sheet.with_inputs(m=f"{m} kg").evaluate("phi2", omega1=w).magnitude)
-            for m in (0.65, 0.7, 0.75, 0.8)]
+    vals = [
+        float(sheet.with_inputs(m=f"{m} kg").evaluate("phi2", omega1=w).magnitude)
+        for m in (0.65, 0.7, 0.75, 0.8)
+    ]
     assert all(b > a for a, b in zip(vals, vals[1:]))
 
 
 @pytest.mark.parametrize("w", SPEEDS)
 def test_trend_phi2_rises_with_phi20(sheet, w):
-    vals = [float(sheet.with_inputs(phi20=f"{a} rad").evaluate("phi2", omega1=w).magnitude)
-            for a in (0.4363, 0.5235, 0.6108, 0.6981)]
+    vals = [
+        float(sheet.with_inputs(phi20=f"{a} rad").evaluate("phi2", omega1=w).magnitude)
+        for a in (0.4363, 0.5235, 0.6108, 0.6981)
+    ]
     assert all(b > a for a, b in zip(vals, vals[1:]))
 
 
@@ -149,8 +175,10 @@ def test_linear_forms(sheet):
     A = d["O1O"] - d["OC"] * c
     G = d["MD0"] * d["OB"] / d["O1B"] * d["tg"]
     N = 2 * d["m"] * w**2 * A * d["OC"] * s - 8 * d["c1"] * d["lam"] * d["OC1"] * s - G
-    D = (8 * d["c1"] * (d["lam"] * d["OC1"] * c + d["OC1"]**2 * s**2)
-         - 2 * d["m"] * w**2 * A * d["OC"] * c)
+    D = (
+        8 * d["c1"] * (d["lam"] * d["OC1"] * c + d["OC1"] ** 2 * s**2)
+        - 2 * d["m"] * w**2 * A * d["OC"] * c
+    )
     assert float(sheet.evaluate("phi2_lin", omega1=w).magnitude) == pytest.approx(N / D, rel=1e-12)
     # the consistent Newton step is -F(phi20)/F'(phi20): check against a numerical derivative
     import mpmath as mp
@@ -185,7 +213,7 @@ def test_printed_and_corrected_forms_visible(sheet):
     d = sheet.spec.definitions
     assert "drops the square" in d["a11"].note
     assert float(sheet.evaluate("b22_printed").magnitude) == -float(sheet.evaluate("b22").magnitude)
-    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236))**2 + 2 * 1.5e-4
+    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236)) ** 2 + 2 * 1.5e-4
     assert float(sheet.evaluate("a11").to("kg*m^2").magnitude) == pytest.approx(a11, rel=1e-12)
 
 
@@ -200,7 +228,7 @@ def _undamped_freqs(c2):
     h = 1e-6
     d = EX
     kw = -(float(F_ref(phi + h, 80.0, d)) - float(F_ref(phi - h, 80.0, d))) / (2 * h)
-    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236))**2 + 3e-4
+    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236)) ** 2 + 3e-4
     M = np.diag([a11, 2 * 0.7 * 0.036**2 + 3e-4, 0.01])
     v = np.array([0.040, 0.015 / 3, -0.040])
     K = 2 * c2 * np.outer(v, v) + np.diag([0, kw, 0])
@@ -233,8 +261,9 @@ def test_exact_solution_matches_tight_solve_ivp():
 
     cs = cp.case(cp.Params(), 1e8, 0.1)
     pr = cs.problem
-    sol = solve_ivp(pr.fun, (0, pr.t_end), pr.y0, method="DOP853", rtol=1e-12, atol=1e-15,
-                    t_eval=pr.t_eval)
+    sol = solve_ivp(
+        pr.fun, (0, pr.t_end), pr.y0, method="DOP853", rtol=1e-12, atol=1e-15, t_eval=pr.t_eval
+    )
     err = np.max(np.abs(pr.model.outputs(sol.y) - cs.exact))
     assert err < 1e-10
 
@@ -250,11 +279,11 @@ def _rigid_reference(t_end, n_out=401):
     h = 1e-6
     kw = -(float(F_ref(phi + h, w, d)) - float(F_ref(phi - h, w, d))) / (2 * h)
     k = d["OB"] * d["tg"] / d["O1B"]
-    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236))**2 + 3e-4
+    a11 = 0.02 + 2 * 0.7 * (0.042 - 0.036 * math.cos(0.5236)) ** 2 + 3e-4
     a22 = 2 * 0.7 * 0.036**2 + 3e-4
     J3 = 0.01
     M = np.array([[a11 + J3, J3 * k], [J3 * k, a22 + J3 * k * k]])
-    b22 = 20 * 0.036**2 * math.sin(0.5236)**2
+    b22 = 20 * 0.036**2 * math.sin(0.5236) ** 2
     Minv = np.linalg.inv(M)
     Om = 4 * w
 
@@ -265,8 +294,9 @@ def _rigid_reference(t_end, n_out=401):
         return np.concatenate([v, Minv @ force])
 
     ts = np.linspace(0, t_end, n_out)
-    sol = solve_ivp(f, (0, t_end), [0.0, st, 0.0, 0.0], method="DOP853", rtol=1e-12,
-                    atol=1e-15, t_eval=ts)
+    sol = solve_ivp(
+        f, (0, t_end), [0.0, st, 0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-15, t_eval=ts
+    )
     return np.vstack([sol.y[1], k * sol.y[1]])
 
 
@@ -340,8 +370,16 @@ def test_weights_on_the_stop_dynamics():
 
 def test_run_ode_progress_goes_to_stderr(capsys):
     pr = cp.case(cp.Params(), 1e8, 0.05).problem
-    sv.run_ode(pr.fun, (0, pr.t_end), pr.y0, method="RK45", rtol=1e-6, label="probe",
-               progress_every=0.0, t_eval=pr.t_eval)
+    sv.run_ode(
+        pr.fun,
+        (0, pr.t_end),
+        pr.y0,
+        method="RK45",
+        rtol=1e-6,
+        label="probe",
+        progress_every=0.0,
+        t_eval=pr.t_eval,
+    )
     err = capsys.readouterr().err
     assert "[probe] t = " in err and "finished" in err
 

@@ -23,7 +23,7 @@ def test_example(tmp_path, text):
     path = tmp_path / "example.toml"
     path.write_text(text, encoding="utf-8")
     expects = re.findall(r"# expect: (.*)", text)
-    errors = [e[len("error: "):] for e in expects if e.startswith("error: ")]
+    errors = [e[len("error: ") :] for e in expects if e.startswith("error: ")]
     sheet = None
     try:
         sheet = Sheet(load_spec(path))
@@ -34,7 +34,7 @@ def test_example(tmp_path, text):
         return
     for line in expects:
         if line.startswith("error: "):
-            call = line[len("error: "):]
+            call = line[len("error: ") :]
             name, _, args = call.partition("(")
             with pytest.raises(workbook.WorkbookError):
                 sheet.evaluate(name, *[float(a) for a in args.rstrip(")").split(",") if a])
@@ -46,7 +46,7 @@ def test_example(tmp_path, text):
         if line.startswith("sweep "):  # sweep NAME at INPUT=VALUE = NUMBER UNIT
             from workbook.sweep import sweep
 
-            lhs, _, rhs = line[len("sweep "):].partition(" = ")
+            lhs, _, rhs = line[len("sweep ") :].partition(" = ")
             out, _, setting = lhs.partition(" at ")
             name, _, value = setting.partition("=")
             result = sweep(sheet, {name: value + ".." + value + ":1"}, {out: None})

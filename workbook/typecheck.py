@@ -545,8 +545,12 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
 
 def _is_zero(t: T) -> bool:
     """A dimensionless literal zero, which agrees with any unit."""
-    return isinstance(t, TConst) and t.value == 0.0 and not t.unit.dimensionality and (
-        t.unit == un.registry().dimensionless)
+    return (
+        isinstance(t, TConst)
+        and t.value == 0.0
+        and not t.unit.dimensionality
+        and (t.unit == un.registry().dimensionless)
+    )
 
 
 def _with_unit(t: T, unit: pint.Unit) -> T:

@@ -27,10 +27,28 @@ from .solvers import METHODS, OdeRun, run_ode, stable_root, work_precision
 # parameters
 # ---------------------------------------------------------------------------------------------
 _SI = {
-    "m": "kg", "c1": "N/m", "phi20": "rad", "lam_st": "m", "O1O": "m", "OC": "m", "OC1": "m",
-    "OB": "m", "O1B": "m", "tan_gamma": "", "M_D0": "N*m", "J1": "kg*m^2", "J3": "kg*m^2",
-    "Jx": "kg*m^2", "Jy": "kg*m^2", "Jxy": "kg*m^2", "beta": "N*s/m", "c2": "N/m",
-    "omega_dyn": "rad/s", "pump_amp": "N*m", "pump_order": "", "t_end": "s",
+    "m": "kg",
+    "c1": "N/m",
+    "phi20": "rad",
+    "lam_st": "m",
+    "O1O": "m",
+    "OC": "m",
+    "OC1": "m",
+    "OB": "m",
+    "O1B": "m",
+    "tan_gamma": "",
+    "M_D0": "N*m",
+    "J1": "kg*m^2",
+    "J3": "kg*m^2",
+    "Jx": "kg*m^2",
+    "Jy": "kg*m^2",
+    "Jxy": "kg*m^2",
+    "beta": "N*s/m",
+    "c2": "N/m",
+    "omega_dyn": "rad/s",
+    "pump_amp": "N*m",
+    "pump_order": "",
+    "t_end": "s",
 }
 
 
@@ -69,8 +87,9 @@ class Params:
             q = sheet.values.get(f.name)
             if q is None or isinstance(q, str):
                 continue
-            values[f.name] = float(q.to(_SI[f.name]).magnitude) if _SI[f.name] else float(
-                q.to("").magnitude)
+            values[f.name] = (
+                float(q.to(_SI[f.name]).magnitude) if _SI[f.name] else float(q.to("").magnitude)
+            )
         return cls(**values)
 
     @property
@@ -166,16 +185,38 @@ def linear_phi2(w: float, p: Params, form: str = "printed") -> Linear:
     return Linear(value, N, D)
 
 
-_STEADY_ARGS = {"omega1": "rad/s", "m": "kg", "c1": "N/m", "phi20": "rad", "lam_st": "m",
-                "O1O": "m", "OC": "m", "OC1": "m", "OB": "m", "O1B": "m", "tan_gamma": "",
-                "M_D0": "N*m"}
+_STEADY_ARGS = {
+    "omega1": "rad/s",
+    "m": "kg",
+    "c1": "N/m",
+    "phi20": "rad",
+    "lam_st": "m",
+    "O1O": "m",
+    "OC": "m",
+    "OC1": "m",
+    "OB": "m",
+    "O1B": "m",
+    "tan_gamma": "",
+    "M_D0": "N*m",
+}
 
 
 @block(args=_STEADY_ARGS, returns="rad", vectorized=False)
 def phi2_root(omega1, m, c1, phi20, lam_st, O1O, OC, OC1, OB, O1B, tan_gamma, M_D0):
     """Steady weight angle: stable root of the nonlinear equilibrium (0 on the stop)."""
-    p = Params(m=m, c1=c1, phi20=phi20, lam_st=lam_st, O1O=O1O, OC=OC, OC1=OC1, OB=OB, O1B=O1B,
-               tan_gamma=tan_gamma, M_D0=M_D0)
+    p = Params(
+        m=m,
+        c1=c1,
+        phi20=phi20,
+        lam_st=lam_st,
+        O1O=O1O,
+        OC=OC,
+        OC1=OC1,
+        OB=OB,
+        O1B=O1B,
+        tan_gamma=tan_gamma,
+        M_D0=M_D0,
+    )
     return steady(float(omega1), p).phi2
 
 
@@ -189,8 +230,11 @@ FAMILIES = {
 }
 # the printed trends: phi2 falls as c1 rises, rises with m and with phi20
 TRENDS = {"c1": -1, "m": +1, "phi20": +1}
-TREND_TEXT = {"c1": "phi2 falls as c1 rises", "m": "phi2 rises with m",
-              "phi20": "phi2 rises with phi20"}
+TREND_TEXT = {
+    "c1": "phi2 falls as c1 rises",
+    "m": "phi2 rises with m",
+    "phi20": "phi2 rises with phi20",
+}
 
 
 def speeds(sheet) -> np.ndarray:
@@ -304,8 +348,14 @@ def tooth_vector(p: Params) -> np.ndarray:
     return np.array([p.O1B, p.OB * p.tan_gamma, -p.O1B])
 
 
-def model(p: Params, w: float | None = None, c2: float | None = None, *, rigid: bool = False,
-          damping: str = "corrected") -> LinearModel:
+def model(
+    p: Params,
+    w: float | None = None,
+    c2: float | None = None,
+    *,
+    rigid: bool = False,
+    damping: str = "corrected",
+) -> LinearModel:
     """The coupling about its steady state at speed w, driven by the pump torque
     pump_amp*sin(pump_order*w*t) on the driven half (M_N0 = M_D0: balanced mean torques).
 
@@ -342,8 +392,17 @@ def model(p: Params, w: float | None = None, c2: float | None = None, *, rigid: 
         else:
             C, x0 = C[:, [0, 2]], x0[[0, 2]]
     Omega = p.pump_order * w
-    return LinearModel(C.T @ M3 @ C, C.T @ Phi3 @ C, C.T @ K3 @ C, C.T @ f0, C.T @ fp, Omega, C,
-                       x0, "rigid tooth" if rigid else "3 DOF")
+    return LinearModel(
+        C.T @ M3 @ C,
+        C.T @ Phi3 @ C,
+        C.T @ K3 @ C,
+        C.T @ f0,
+        C.T @ fp,
+        Omega,
+        C,
+        x0,
+        "rigid tooth" if rigid else "3 DOF",
+    )
 
 
 def eigen(p: Params, c2: float, w: float | None = None, damping: str = "corrected"):
@@ -381,9 +440,15 @@ def stiffness(p: Params, c2: float, w: float | None = None) -> dict:
     lam = eigen(p, c2, w)
     big, small = float(np.max(np.abs(lam))), float(np.min(np.abs(lam)))
     tooth = lam[np.argmax(np.abs(lam))]
-    return {"lam": lam, "ratio": big / small, "index": big * p.t_end,
-            "tooth_freq": abs(tooth.imag), "tooth_damping": -tooth.real / abs(tooth),
-            "weight_freq": abs(lam[0].imag), "weight_damping": -lam[0].real / abs(lam[0])}
+    return {
+        "lam": lam,
+        "ratio": big / small,
+        "index": big * p.t_end,
+        "tooth_freq": abs(tooth.imag),
+        "tooth_damping": -tooth.real / abs(tooth),
+        "weight_freq": abs(lam[0].imag),
+        "weight_damping": -lam[0].real / abs(lam[0]),
+    }
 
 
 class Problem:
@@ -406,11 +471,28 @@ class Problem:
         scale = np.concatenate([np.full(n, 1.0), np.full(n, max(self.Omega, 1.0))])
         return rtol * 1e-3 * scale
 
-    def run(self, method: str, rtol: float, *, max_time: float = 20.0,
-            max_steps: int = 2_000_000, label: str | None = None) -> OdeRun:
-        return run_ode(self.fun, (0.0, self.t_end), self.y0, method=method, rtol=rtol,
-                       atol=self.atol(rtol), jac=self.jac, t_eval=self.t_eval,
-                       max_time=max_time, max_steps=max_steps, label=label)
+    def run(
+        self,
+        method: str,
+        rtol: float,
+        *,
+        max_time: float = 20.0,
+        max_steps: int = 2_000_000,
+        label: str | None = None,
+    ) -> OdeRun:
+        return run_ode(
+            self.fun,
+            (0.0, self.t_end),
+            self.y0,
+            method=method,
+            rtol=rtol,
+            atol=self.atol(rtol),
+            jac=self.jac,
+            t_eval=self.t_eval,
+            max_time=max_time,
+            max_steps=max_steps,
+            label=label,
+        )
 
     def exact(self, t=None) -> np.ndarray:
         """Exact solution at t (default t_eval) from the matrix exponential of the system
@@ -530,8 +612,16 @@ def _dev(cs: Case, run: OdeRun, against: np.ndarray) -> float:
     return float(np.max(np.abs(cs.problem.model.outputs(run.y) - against)))
 
 
-def study(p: Params, c2s, rtols, methods=METHODS, *, t_end=None, max_time=5.0,
-          label: str | None = "advance-coupling study"):
+def study(
+    p: Params,
+    c2s,
+    rtols,
+    methods=METHODS,
+    *,
+    t_end=None,
+    max_time=5.0,
+    label: str | None = "advance-coupling study",
+):
     """Work-precision rows: every method x rtol at every c2; error against the exact solution
     and deviation from the exact rigid-tooth limit."""
     import pandas as pd
@@ -539,30 +629,47 @@ def study(p: Params, c2s, rtols, methods=METHODS, *, t_end=None, max_time=5.0,
     def build():
         rows = []
         if label:
-            print(f"[{label}] {len(c2s) * len(rtols) * len(methods)} runs: {len(methods)} methods"
-                  f" x {len(rtols)} rtols x c2 = {', '.join(f'{c:.0e}' for c in c2s)} N/m "
-                  f"(each run at most {max_time:g} s)", file=sys.stderr, flush=True)
+            print(
+                f"[{label}] {len(c2s) * len(rtols) * len(methods)} runs: {len(methods)} methods"
+                f" x {len(rtols)} rtols x c2 = {', '.join(f'{c:.0e}' for c in c2s)} N/m "
+                f"(each run at most {max_time:g} s)",
+                file=sys.stderr,
+                flush=True,
+            )
         for c2 in c2s:
             cs = case(p, c2, t_end)
             runs = {}
 
             def run_case(method, rtol, cs=cs, runs=runs):
-                run = cs.problem.run(method, rtol, max_time=max_time, max_steps=2_000_000,
-                                     label=label)
+                run = cs.problem.run(
+                    method, rtol, max_time=max_time, max_steps=2_000_000, label=label
+                )
                 runs[(method, rtol)] = run
                 return run
 
-            for r in work_precision(run_case, lambda run, cs=cs: _dev(cs, run, cs.exact),
-                                    methods, rtols, case=f"{c2:.0e}", label=None):
+            for r in work_precision(
+                run_case,
+                lambda run, cs=cs: _dev(cs, run, cs.exact),
+                methods,
+                rtols,
+                case=f"{c2:.0e}",
+                label=None,
+            ):
                 run = runs.get((r.method, r.rtol))
-                rows.append({
-                    "c2 [N/m]": c2, "method": r.method, "rtol": r.rtol,
-                    "error [rad]": r.error,
-                    "deviation from rigid [rad]": _dev(cs, run, cs.rigid) if run else math.nan,
-                    "rigid-model difference [rad]": cs.delta,
-                    "run time [s]": r.elapsed, "f-evals": r.nfev, "steps": r.nsteps,
-                    "stopped": r.stop_reason,
-                })
+                rows.append(
+                    {
+                        "c2 [N/m]": c2,
+                        "method": r.method,
+                        "rtol": r.rtol,
+                        "error [rad]": r.error,
+                        "deviation from rigid [rad]": _dev(cs, run, cs.rigid) if run else math.nan,
+                        "rigid-model difference [rad]": cs.delta,
+                        "run time [s]": r.elapsed,
+                        "f-evals": r.nfev,
+                        "steps": r.nsteps,
+                        "stopped": r.stop_reason,
+                    }
+                )
             if label:
                 print(f"[{label}] c2 = {c2:.0e} N/m done", file=sys.stderr, flush=True)
         return pd.DataFrame(rows)
@@ -628,17 +735,21 @@ def stiffness_table(sheet):
         s = stiffness(p, c2)
         cs = case(p, c2)
         lam = s["lam"]
-        rows.append({
-            "c2 [N/m]": c2,
-            "weight mode Re [1/s]": float(lam[0].real), "weight mode Im [rad/s]": abs(lam[0].imag),
-            "tooth mode Re [1/s]": float(lam[-1].real), "tooth mode Im [rad/s]": abs(lam[-1].imag),
-            "tooth damping ratio": s["tooth_damping"],
-            "stiffness ratio |lam|max/|lam|min": s["ratio"],
-            "stiffness index |lam|max*t_end": s["index"],
-            "rigid-model difference [rad]": cs.delta,
-            "difference*c2 [N rad/m]": cs.delta * c2,
-            "auto method": auto_method(p, c2),
-        })
+        rows.append(
+            {
+                "c2 [N/m]": c2,
+                "weight mode Re [1/s]": float(lam[0].real),
+                "weight mode Im [rad/s]": abs(lam[0].imag),
+                "tooth mode Re [1/s]": float(lam[-1].real),
+                "tooth mode Im [rad/s]": abs(lam[-1].imag),
+                "tooth damping ratio": s["tooth_damping"],
+                "stiffness ratio |lam|max/|lam|min": s["ratio"],
+                "stiffness index |lam|max*t_end": s["index"],
+                "rigid-model difference [rad]": cs.delta,
+                "difference*c2 [N rad/m]": cs.delta * c2,
+                "auto method": auto_method(p, c2),
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -654,33 +765,44 @@ def histories(sheet):
 
     p = Params.from_sheet(sheet)
     method, rtol = chosen_method(sheet, p), rtol_of(sheet)
-    cs, run = _cached(("history", p, method, rtol),
-                      lambda: default_run(p, method, rtol, budget_of(sheet)))
+    cs, run = _cached(
+        ("history", p, method, rtol), lambda: default_run(p, method, rtol, budget_of(sheet))
+    )
     t = cs.problem.t_eval
     out = cs.problem.model.outputs(run.y) if run.ok else np.full((2, len(t)), math.nan)
     if not run.ok:  # a partial run: keep what was reached
         k = run.y.shape[1]
         out[:, :k] = cs.problem.model.outputs(run.y)
-    return _blank(pd.DataFrame({
-        "t [s]": t,
-        "phi2 [rad]": out[0],
-        "advance psi [deg]": np.degrees(out[1]),
-        "phi2 rigid tooth [rad]": cs.rigid[0],
-        "advance psi rigid tooth [deg]": np.degrees(cs.rigid[1]),
-        "phi2 - rigid [rad]": out[0] - cs.rigid[0],
-    }))
+    return _blank(
+        pd.DataFrame(
+            {
+                "t [s]": t,
+                "phi2 [rad]": out[0],
+                "advance psi [deg]": np.degrees(out[1]),
+                "phi2 rigid tooth [rad]": cs.rigid[0],
+                "advance psi rigid tooth [deg]": np.degrees(cs.rigid[1]),
+                "phi2 - rigid [rad]": out[0] - cs.rigid[0],
+            }
+        )
+    )
 
 
 # ---------------------------------------------------------------------------------------------
 # extreme cases
 # ---------------------------------------------------------------------------------------------
-def stall_run(p: Params, method: str = "RK45", c2: float = STALL_C2, max_time: float = 0.5,
-              max_steps: int = 20_000) -> tuple[OdeRun, float]:
+def stall_run(
+    p: Params,
+    method: str = "RK45",
+    c2: float = STALL_C2,
+    max_time: float = 0.5,
+    max_steps: int = 20_000,
+) -> tuple[OdeRun, float]:
     """An explicit method on a very stiff tooth: bounded by a budget and a step cap.
     Returns the run and the steps it would need at its stability limit (about index/3)."""
     cs = case(p, c2)
-    run = cs.problem.run(method, 1e-5, max_time=max_time, max_steps=max_steps,
-                         label="advance-coupling stall")
+    run = cs.problem.run(
+        method, 1e-5, max_time=max_time, max_steps=max_steps, label="advance-coupling stall"
+    )
     need = stiffness(p, c2)["index"] / 3.3
     return run, need
 
@@ -768,29 +890,63 @@ def findings(sheet):
     p, ws = Params.from_sheet(sheet), speeds(sheet)
     out: list[Finding] = []
     base = Params()
-    same = all(math.isclose(getattr(p, k), getattr(base, k), rel_tol=1e-9)
-               for k in _STEADY_ARGS if k != "omega1")
+    same = all(
+        math.isclose(getattr(p, k), getattr(base, k), rel_tol=1e-9)
+        for k in _STEADY_ARGS
+        if k != "omega1"
+    )
     for w, ref in SCENE_VALUES:
         val = steady(w, p).phi2
         if same:
             ok = abs(val - ref) <= 1e-3
-            out.append(F("steady state", f"phi2 at omega1 = {w:g} rad/s (SCENES.md: {ref:.3f})",
-                         val, "rad", "ok" if ok else "fail"))
+            out.append(
+                F(
+                    "steady state",
+                    f"phi2 at omega1 = {w:g} rad/s (SCENES.md: {ref:.3f})",
+                    val,
+                    "rad",
+                    "ok" if ok else "fail",
+                )
+            )
         else:
-            out.append(F("steady state", f"phi2 at omega1 = {w:g} rad/s", val, "rad", "info",
-                         "inputs differ from the SCENES.md example"))
+            out.append(
+                F(
+                    "steady state",
+                    f"phi2 at omega1 = {w:g} rad/s",
+                    val,
+                    "rad",
+                    "info",
+                    "inputs differ from the SCENES.md example",
+                )
+            )
     wl = lift_off_speed(p)
     stop = [float(w) for w in ws if steady(w, p).on_stop]
-    out.append(F("steady state", "lift-off speed (weights leave the stop)", wl, "rad/s", "info",
-                 f"on the stop at {_speeds_text(stop, ws)}: phi2 = 0 there, not a root"))
+    out.append(
+        F(
+            "steady state",
+            "lift-off speed (weights leave the stop)",
+            wl,
+            "rad/s",
+            "info",
+            f"on the stop at {_speeds_text(stop, ws)}: phi2 = 0 there, not a root",
+        )
+    )
     for key in FAMILIES:
         holds, fails, vacuous = trend_holds(p, key, ws)
         verdict = "ok" if holds and not fails else ("warning" if holds else "fail")
         note = f"holds at {_speeds_text(holds, ws)}; fails at {_speeds_text(fails, ws)}"
         if vacuous:
             note += f"; all weights on the stop at {_speeds_text(vacuous, ws)}"
-        out.append(F("printed trends (Fig. 3)", TREND_TEXT[key], float(len(holds)), "speeds",
-                     verdict, note))
+        out.append(
+            F(
+                "printed trends (Fig. 3)",
+                TREND_TEXT[key],
+                float(len(holds)),
+                "speeds",
+                verdict,
+                note,
+            )
+        )
     for form, title in (("printed", "printed linear form"), ("newton", "Newton-step linear form")):
         for key in FAMILIES:
             for value, where, worst, zero in departures(p, key, ws, form):
@@ -801,45 +957,101 @@ def findings(sheet):
                 else:
                     note, verdict = (f"more than 5 % at {_speeds_text(where, ws)}", "warning")
                 if zero:
-                    note += (f"; denominator <= 0 at {_speeds_text(zero, ws)}: reported, "
-                             "not divided by")
-                out.append(F(f"linear form vs nonlinear root ({form})", what,
-                             100 * worst, "%", verdict, note))
+                    note += (
+                        f"; denominator <= 0 at {_speeds_text(zero, ws)}: reported, not divided by"
+                    )
+                out.append(
+                    F(
+                        f"linear form vs nonlinear root ({form})",
+                        what,
+                        100 * worst,
+                        "%",
+                        verdict,
+                        note,
+                    )
+                )
     wmax = float(ws[-1])
     for form in ("printed", "newton"):
         c1z = soft_spring_limit(p, wmax, form)
-        out.append(F("extreme cases", f"{form} linear form: denominator passes through zero at "
-                     f"{wmax:g} rad/s for springs softer than", c1z, "N/m", "info",
-                     f"with c1 = {p.c1:g} N/m it is zero at "
-                     f"{denominator_zero_speed(p, form):.4g} rad/s"))
+        out.append(
+            F(
+                "extreme cases",
+                f"{form} linear form: denominator passes through zero at "
+                f"{wmax:g} rad/s for springs softer than",
+                c1z,
+                "N/m",
+                "info",
+                f"with c1 = {p.c1:g} N/m it is zero at {denominator_zero_speed(p, form):.4g} rad/s",
+            )
+        )
     # dynamics
     lam = eigen(p, p.c2)
-    out.append(F("dynamics", f"weight mode at c2 = {p.c2:.0e} N/m: Im lambda", abs(lam[0].imag),
-                 "rad/s", "info", f"Re lambda = {lam[0].real:.4g} 1/s"))
-    out.append(F("dynamics", "tooth mode: Im lambda", abs(lam[-1].imag), "rad/s", "info",
-                 f"Re lambda = {lam[-1].real:.3g} 1/s (almost undamped)"))
+    out.append(
+        F(
+            "dynamics",
+            f"weight mode at c2 = {p.c2:.0e} N/m: Im lambda",
+            abs(lam[0].imag),
+            "rad/s",
+            "info",
+            f"Re lambda = {lam[0].real:.4g} 1/s",
+        )
+    )
+    out.append(
+        F(
+            "dynamics",
+            "tooth mode: Im lambda",
+            abs(lam[-1].imag),
+            "rad/s",
+            "info",
+            f"Re lambda = {lam[-1].real:.3g} 1/s (almost undamped)",
+        )
+    )
     lam_p = eigen(p, p.c2, damping="as printed")
-    out.append(F("dynamics", "with the printed damping sign (-beta OC^2 sin^2 phi20) the weight "
-                 "mode grows: Re lambda", float(lam_p[0].real), "1/s", "warning",
-                 "negative damping; the corrected sign is used"))
+    out.append(
+        F(
+            "dynamics",
+            "with the printed damping sign (-beta OC^2 sin^2 phi20) the weight "
+            "mode grows: Re lambda",
+            float(lam_p[0].real),
+            "1/s",
+            "warning",
+            "negative damping; the corrected sign is used",
+        )
+    )
     method, rtol = chosen_method(sheet, p), rtol_of(sheet)
-    cs, run = _cached(("history", p, method, rtol),
-                      lambda: default_run(p, method, rtol, budget_of(sheet)))
+    cs, run = _cached(
+        ("history", p, method, rtol), lambda: default_run(p, method, rtol, budget_of(sheet))
+    )
     note = run.summary()
     if run.ok:
         dev = _dev(cs, run, cs.exact)
         note += f"; error against the exact solution {dev:.3g} rad"
-    out.append(F("dynamics", f"time histories: {method} rtol {rtol:.0e} at c2 = {p.c2:.0e} N/m"
-                 f" ({'auto' if method_of(sheet) == 'auto' else 'chosen'})", run.elapsed, "s",
-                 "ok" if run.ok else "warning", note))
+    out.append(
+        F(
+            "dynamics",
+            f"time histories: {method} rtol {rtol:.0e} at c2 = {p.c2:.0e} N/m"
+            f" ({'auto' if method_of(sheet) == 'auto' else 'chosen'})",
+            run.elapsed,
+            "s",
+            "ok" if run.ok else "warning",
+            note,
+        )
+    )
     # solver choice at the stiff case
     ps, df = _study_for_sheet(sheet)
     out += choice_findings(ps, df, method_of(sheet), rtol_of(sheet))
     run, need = stall_run(p)
-    out.append(F("extreme cases", f"RK45 at c2 = {STALL_C2:.0e} N/m stopped ({run.stop_reason})",
-                 run.fraction * 100, "% of the run", "ok" if not run.ok else "info",
-                 f"{run.nsteps} steps in {run.elapsed:.2f} s reached t = {run.t_reached:.3g} s; "
-                 f"the stability limit needs about {need:.3g} steps"))
+    out.append(
+        F(
+            "extreme cases",
+            f"RK45 at c2 = {STALL_C2:.0e} N/m stopped ({run.stop_reason})",
+            run.fraction * 100,
+            "% of the run",
+            "ok" if not run.ok else "info",
+            f"{run.nsteps} steps in {run.elapsed:.2f} s reached t = {run.t_reached:.3g} s; "
+            f"the stability limit needs about {need:.3g} steps",
+        )
+    )
     return out
 
 
@@ -853,12 +1065,20 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
     tol = 2 * delta
     ok = sub[(sub["stopped"] == "finished") & (sub["deviation from rigid [rad]"] <= tol)]
     default = auto_method(p, CHOICE_C2) if method == "auto" else method
-    out = [F("solver choice", f"rigid-model difference at c2 = {CHOICE_C2:.0e} N/m", delta, "rad",
-             "info", f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g}"
-             " rad")]
+    out = [
+        F(
+            "solver choice",
+            f"rigid-model difference at c2 = {CHOICE_C2:.0e} N/m",
+            delta,
+            "rad",
+            "info",
+            f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g} rad",
+        )
+    ]
     if ok.empty:
-        out.append(F("solver choice", "no run of the study reaches the rigid limit", None, "",
-                     "warning"))
+        out.append(
+            F("solver choice", "no run of the study reaches the rigid limit", None, "", "warning")
+        )
         return out
     best = ok.loc[ok["run time [s]"].idxmin()]
     # time the best and the default again side by side (best of 3)
@@ -868,15 +1088,30 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
     t_def = min(r.elapsed for r in runs)
     dev = _dev(cs, runs[0], cs.rigid)
     ratio = t_def / t_best
-    out.append(F("solver choice", f"fastest run reaching the rigid limit: {best['method']} "
-                 f"rtol {best['rtol']:.0e}", t_best, "s", "info",
-                 f"deviation {best['deviation from rigid [rad]']:.3g} rad"))
-    out.append(F("solver choice", f"default {default} rtol {rtol:.0e}: time / fastest", ratio, "",
-                 "ok" if ratio <= 2 and dev <= tol else "warning",
-                 f"{t_def:.3g} s, deviation from the rigid limit {dev:.3g} rad (<= {tol:.3g})"))
+    out.append(
+        F(
+            "solver choice",
+            f"fastest run reaching the rigid limit: {best['method']} rtol {best['rtol']:.0e}",
+            t_best,
+            "s",
+            "info",
+            f"deviation {best['deviation from rigid [rad]']:.3g} rad",
+        )
+    )
+    out.append(
+        F(
+            "solver choice",
+            f"default {default} rtol {rtol:.0e}: time / fastest",
+            ratio,
+            "",
+            "ok" if ratio <= 2 and dev <= tol else "warning",
+            f"{t_def:.3g} s, deviation from the rigid limit {dev:.3g} rad (<= {tol:.3g})",
+        )
+    )
     for c2 in sorted(df["c2 [N/m]"].unique()):
-        rows = df[(df["c2 [N/m]"] == c2) & (df["stopped"] == "finished")
-                  & (df["error [rad]"] <= 1e-6)]
+        rows = df[
+            (df["c2 [N/m]"] == c2) & (df["stopped"] == "finished") & (df["error [rad]"] <= 1e-6)
+        ]
         auto = auto_method(p, c2) if method == "auto" else method
         mine = df[(df["c2 [N/m]"] == c2) & (df["method"] == auto) & (df["rtol"] == rtol)]
         if rows.empty:
@@ -884,17 +1119,35 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
         fast = rows.loc[rows["run time [s]"].idxmin()]
         note = f"fastest with error <= 1e-6 rad: {fast['method']} rtol {fast['rtol']:.0e}"
         if not mine.empty:
-            note += (f"; {auto} rtol {rtol:.0e}: error {mine['error [rad]'].iloc[0]:.2g} rad, "
-                     f"{mine['run time [s]'].iloc[0]:.3g} s")
-        out.append(F("solver choice", f"c2 = {c2:.0e} N/m: auto takes {auto}",
-                     float(fast["run time [s]"]), "s", "info", note))
-    out.append(F("solver choice", "why", None, "", "info",
-                 "the tooth mode is almost undamped and, for c2 >= 1e9 N/m, far faster than the "
-                 "weights: explicit methods (RK45, DOP853) must follow it with about "
-                 "|lambda|*t_end/3 steps, LSODA falls back to small steps, BDF of high order is "
-                 "not stable near the imaginary axis; Radau (L-stable) steps over it. So 'auto' "
-                 f"takes Radau when |lambda_max|*t_end > {AUTO_INDEX:g}, LSODA (cheapest in the "
-                 "study at small c2) otherwise"))
+            note += (
+                f"; {auto} rtol {rtol:.0e}: error {mine['error [rad]'].iloc[0]:.2g} rad, "
+                f"{mine['run time [s]'].iloc[0]:.3g} s"
+            )
+        out.append(
+            F(
+                "solver choice",
+                f"c2 = {c2:.0e} N/m: auto takes {auto}",
+                float(fast["run time [s]"]),
+                "s",
+                "info",
+                note,
+            )
+        )
+    out.append(
+        F(
+            "solver choice",
+            "why",
+            None,
+            "",
+            "info",
+            "the tooth mode is almost undamped and, for c2 >= 1e9 N/m, far faster than the "
+            "weights: explicit methods (RK45, DOP853) must follow it with about "
+            "|lambda|*t_end/3 steps, LSODA falls back to small steps, BDF of high order is "
+            "not stable near the imaginary axis; Radau (L-stable) steps over it. So 'auto' "
+            f"takes Radau when |lambda_max|*t_end > {AUTO_INDEX:g}, LSODA (cheapest in the "
+            "study at small c2) otherwise",
+        )
+    )
     return out
 
 

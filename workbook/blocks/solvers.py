@@ -67,8 +67,16 @@ def sign_changes(f: Callable[[np.ndarray], np.ndarray], a: float, b: float, n: i
     return out
 
 
-def stable_root(f: Callable, a: float, b: float, *, n: int = 512, xtol: float = 1e-14,
-                rtol: float = 4 * np.finfo(float).eps, maxiter: int = 200) -> RootResult:
+def stable_root(
+    f: Callable,
+    a: float,
+    b: float,
+    *,
+    n: int = 512,
+    xtol: float = 1e-14,
+    rtol: float = 4 * np.finfo(float).eps,
+    maxiter: int = 200,
+) -> RootResult:
     """The first root of f on [a, b] where f goes from + to - (a stable equilibrium when f is
     a generalized force), refined by brentq inside its grid bracket."""
     from scipy.optimize import brentq
@@ -79,10 +87,16 @@ def stable_root(f: Callable, a: float, b: float, *, n: int = 512, xtol: float = 
         if lo == hi:
             return RootResult(lo, True, "root", 0, (lo, hi))
         g = lambda x: float(np.asarray(f(np.asarray([x])))[0])
-        x, info = brentq(g, lo, hi, xtol=xtol, rtol=rtol, maxiter=maxiter, full_output=True,
-                         disp=False)
-        return RootResult(float(x), bool(info.converged), "root" if info.converged
-                          else "not converged", int(info.iterations), (lo, hi))
+        x, info = brentq(
+            g, lo, hi, xtol=xtol, rtol=rtol, maxiter=maxiter, full_output=True, disp=False
+        )
+        return RootResult(
+            float(x),
+            bool(info.converged),
+            "root" if info.converged else "not converged",
+            int(info.iterations),
+            (lo, hi),
+        )
     return RootResult(math.nan, False, "no sign change")
 
 
@@ -118,22 +132,40 @@ class OdeRun:
 
     def summary(self) -> str:
         head = f"{self.method} rtol={self.rtol:.0e}: {self.stop_reason}"
-        return (f"{head} at t = {self.t_reached:.6g} of {self.t_final:.6g} "
-                f"({100 * self.fraction:.1f} %), {self.nsteps} steps, {self.nfev} f-evals, "
-                f"{self.elapsed:.3g} s")
+        return (
+            f"{head} at t = {self.t_reached:.6g} of {self.t_final:.6g} "
+            f"({100 * self.fraction:.1f} %), {self.nsteps} steps, {self.nfev} f-evals, "
+            f"{self.elapsed:.3g} s"
+        )
 
 
 def _progress(label: str, solver, t0: float, t1: float, nsteps: int, start: float) -> None:
     frac = (solver.t - t0) / (t1 - t0) if t1 != t0 else 1.0
-    print(f"[{label}] t = {solver.t:.4g} of {t1:.4g} ({100 * frac:.1f} %), {nsteps} steps, "
-          f"{time.perf_counter() - start:.1f} s", file=sys.stderr, flush=True)
+    print(
+        f"[{label}] t = {solver.t:.4g} of {t1:.4g} ({100 * frac:.1f} %), {nsteps} steps, "
+        f"{time.perf_counter() - start:.1f} s",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
-def run_ode(fun: Callable, t_span: Sequence[float], y0, *, method: str = "RK45",
-            rtol: float = 1e-6, atol: float | np.ndarray = 1e-9, jac=None, t_eval=None,
-            max_time: float = 30.0, max_steps: int = 1_000_000, first_step=None,
-            max_step: float = np.inf, label: str | None = None,
-            progress_every: float = 2.0) -> OdeRun:
+def run_ode(
+    fun: Callable,
+    t_span: Sequence[float],
+    y0,
+    *,
+    method: str = "RK45",
+    rtol: float = 1e-6,
+    atol: float | np.ndarray = 1e-9,
+    jac=None,
+    t_eval=None,
+    max_time: float = 30.0,
+    max_steps: int = 1_000_000,
+    first_step=None,
+    max_step: float = np.inf,
+    label: str | None = None,
+    progress_every: float = 2.0,
+) -> OdeRun:
     """Integrate y' = fun(t, y) over t_span with scipy's solver ``method``, bounded in time.
 
     Like ``solve_ivp`` (t_eval values are interpolated from each step's dense output) but the
@@ -142,8 +174,14 @@ def run_ode(fun: Callable, t_span: Sequence[float], y0, *, method: str = "RK45",
     """
     from scipy import integrate
 
-    classes = {"RK45": integrate.RK45, "DOP853": integrate.DOP853, "Radau": integrate.Radau,
-               "BDF": integrate.BDF, "LSODA": integrate.LSODA, "RK23": integrate.RK23}
+    classes = {
+        "RK45": integrate.RK45,
+        "DOP853": integrate.DOP853,
+        "Radau": integrate.Radau,
+        "BDF": integrate.BDF,
+        "LSODA": integrate.LSODA,
+        "RK23": integrate.RK23,
+    }
     if method not in classes:
         raise ValueError(f"unknown ODE method {method!r} (known: {', '.join(classes)})")
     t0, t1 = float(t_span[0]), float(t_span[1])
@@ -207,9 +245,22 @@ def run_ode(fun: Callable, t_span: Sequence[float], y0, *, method: str = "RK45",
     else:
         t_out = np.concatenate(ts) if ts else np.empty(0)
         y_out = np.hstack(ys) if ys else np.empty((len(y0), 0))
-    run = OdeRun(method, float(rtol), float(np.max(atol)), t_out, y_out, reason, elapsed,
-                 int(solver.nfev), int(getattr(solver, "njev", 0)), int(getattr(solver, "nlu", 0)),
-                 nsteps, float(solver.t), t1, notes)
+    run = OdeRun(
+        method,
+        float(rtol),
+        float(np.max(atol)),
+        t_out,
+        y_out,
+        reason,
+        elapsed,
+        int(solver.nfev),
+        int(getattr(solver, "njev", 0)),
+        int(getattr(solver, "nlu", 0)),
+        nsteps,
+        float(solver.t),
+        t1,
+        notes,
+    )
     if label and (elapsed > progress_every or not run.ok):
         print(f"[{label}] {run.summary()}", file=sys.stderr, flush=True)
     return run
@@ -230,10 +281,17 @@ class StudyRow:
     extra: dict = field(default_factory=dict)
 
 
-def work_precision(run_case: Callable[[str, float], OdeRun], error_of: Callable[[OdeRun], float],
-                   methods: Sequence[str], rtols: Sequence[float], *, case: str = "",
-                   label: str | None = None, skip_after_stall: bool = True,
-                   extra_of: Callable[[OdeRun], dict] | None = None) -> list[StudyRow]:
+def work_precision(
+    run_case: Callable[[str, float], OdeRun],
+    error_of: Callable[[OdeRun], float],
+    methods: Sequence[str],
+    rtols: Sequence[float],
+    *,
+    case: str = "",
+    label: str | None = None,
+    skip_after_stall: bool = True,
+    extra_of: Callable[[OdeRun], dict] | None = None,
+) -> list[StudyRow]:
     """Run every method at every rtol (tight last); errors from ``error_of(run)``.
 
     When a method stops early (budget or step cap) at some rtol, its tighter rtols are not
@@ -244,23 +302,51 @@ def work_precision(run_case: Callable[[str, float], OdeRun], error_of: Callable[
         stalled = None
         for rtol in sorted(rtols, reverse=True):
             if stalled is not None and skip_after_stall:
-                rows.append(StudyRow(case, method, rtol, math.nan, math.nan, 0, 0,
-                                     f"skipped (stopped at rtol {stalled:.0e})"))
+                rows.append(
+                    StudyRow(
+                        case,
+                        method,
+                        rtol,
+                        math.nan,
+                        math.nan,
+                        0,
+                        0,
+                        f"skipped (stopped at rtol {stalled:.0e})",
+                    )
+                )
                 continue
             run = run_case(method, rtol)
             err = error_of(run) if run.ok else math.nan
-            rows.append(StudyRow(case, method, rtol, err, run.elapsed, run.nfev, run.nsteps,
-                                 run.stop_reason, extra_of(run) if extra_of else {}))
+            rows.append(
+                StudyRow(
+                    case,
+                    method,
+                    rtol,
+                    err,
+                    run.elapsed,
+                    run.nfev,
+                    run.nsteps,
+                    run.stop_reason,
+                    extra_of(run) if extra_of else {},
+                )
+            )
             if not run.ok:
                 stalled = rtol
             if label:
-                print(f"[{label}] {case} {method} rtol={rtol:.0e}: error {err:.2e}, "
-                      f"{run.elapsed:.3f} s, {run.stop_reason}", file=sys.stderr, flush=True)
+                print(
+                    f"[{label}] {case} {method} rtol={rtol:.0e}: error {err:.2e}, "
+                    f"{run.elapsed:.3f} s, {run.stop_reason}",
+                    file=sys.stderr,
+                    flush=True,
+                )
     return rows
 
 
 def fastest_within(rows: Sequence[StudyRow], target: float) -> StudyRow | None:
     """The quickest finished row whose error is at most ``target``."""
-    ok = [r for r in rows if r.stop_reason == "finished" and math.isfinite(r.error)
-          and r.error <= target]
+    ok = [
+        r
+        for r in rows
+        if r.stop_reason == "finished" and math.isfinite(r.error) and r.error <= target
+    ]
     return min(ok, key=lambda r: r.elapsed) if ok else None
