@@ -1,6 +1,8 @@
 """Ratio 2: cold start. `workbook run concave-cam` in a fresh process (imports, load, unit
 check, compute, checks, write the xlsx with its charts) against a fresh
 `python -c "import numpy, pint, xlsxwriter"`. Both run alternately as subprocesses; medians.
+The optional part hand-checks (sympy, scipy, mpmath) is left out by `workbook run` unless asked
+for; the information line measures `workbook run concave-cam --part all` the same way.
 """
 
 from __future__ import annotations
@@ -23,17 +25,18 @@ import sys, time
 t = [time.perf_counter()]
 import numpy, pint, xlsxwriter
 t.append(time.perf_counter())
+bare = set(sys.modules)
 import workbook, workbook.cli, workbook.sheet, workbook.xlsx
 from workbook import units
 units.registry()
 t.append(time.perf_counter())
-sheet = workbook.load(sys.argv[1])
+sheet = workbook.load(sys.argv[1], parts=sys.argv[3:] or None)
 t.append(time.perf_counter())
 report = sheet.check()
 t.append(time.perf_counter())
 sheet.write_xlsx(sys.argv[2], report=report, force=True)
 t.append(time.perf_counter())
-heavy = [m for m in ("sympy", "scipy", "pandas", "matplotlib") if m in sys.modules]
+heavy = [m for m in ("sympy", "scipy", "pandas", "mpmath") if m in set(sys.modules) - bare]
 print(*[b - a for a, b in zip(t, t[1:])], ",".join(heavy) or "-")
 """
 STAGE_NAMES = (
@@ -45,12 +48,12 @@ STAGE_NAMES = (
 )
 
 
-def stages(template: str = "concave-cam") -> str:
+def stages(template: str = "concave-cam", parts: tuple[str, ...] = ()) -> str:
     """Where one cold `workbook run` spends its time (one fresh process, informational)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = (
             subprocess.run(
-                [sys.executable, "-c", STAGES, template, str(Path(tmp) / "s.xlsx")],
+                [sys.executable, "-c", STAGES, template, str(Path(tmp) / "s.xlsx"), *parts],
                 check=True,
                 capture_output=True,
                 text=True,
@@ -58,50 +61,23 @@ def stages(template: str = "concave-cam") -> str:
             .stdout.splitlines()[-1]
             .split()
         )  # the last line: blocks may print progress
-    parts = [f"{name} {ms(float(x))}" for name, x in zip(STAGE_NAMES, out)]
-    return "; ".join(parts) + f"; heavy modules imported: {out[-1]}"
+    parts_done = [f"{name} {ms(float(x))}" for name, x in zip(STAGE_NAMES, out)]
+    return "; ".join(parts_done) + f"; imported beyond the bare imports: {out[-1]}"
 
 
-def core_template(folder: Path, template: str = "concave-cam") -> Path:
-    """A copy of the template with only the Mathcad sheet: inputs, definitions, range tables,
-    their charts and printed values; without [[relations]], [[findings]] and block tables
-    (and the charts drawn from them), which other issues added for the hand checks."""
-    import shutil
-
-    import workbook
-
-    src = workbook.template_path(template)
-    blocks, current = [], []
-    for line in src.read_text(encoding="utf-8").splitlines(keepends=True):
-        if line.startswith("["):
-            blocks.append(current)
-            current = []
-        current.append(line)
-    blocks.append(current)
-    kept = []
-    for block in blocks:
-        head = block[0].strip() if block else ""
-        text = "".join(block)
-        if head in ("[[relations]]", "[[findings]]"):
-            continue
-        if head in ("[[tables]]", "[[charts]]") and ("block =" in text or "table =" in text):
-            continue
-        kept.append(text)
-    out = folder / f"{template}-core.toml"
-    out.write_text("".join(kept), encoding="utf-8")
-    for csv in src.parent.glob(f"{template}.*.csv"):
-        shutil.copy(csv, folder / csv.name)
-    return out
+def engine_command(out: Path, template: str = "concave-cam", *parts: str) -> list[str]:
+    command = workbook_command() + ["run", template, "--out", str(out)]
+    for part in parts:
+        command += ["--part", part]
+    return command
 
 
-def engine_command(out: Path, template: str = "concave-cam") -> list[str]:
-    return workbook_command() + ["run", template, "--out", str(out)]
-
-
-def measure(reps: int = 7, template: str = "concave-cam") -> tuple[list[float], list[float]]:
+def measure(
+    reps: int = 7, template: str = "concave-cam", parts: tuple[str, ...] = ()
+) -> tuple[list[float], list[float]]:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "cold.xlsx"
-        cmd = engine_command(out, template)
+        cmd = engine_command(out, template, *parts)
         run_seconds(cmd)  # warm the OS file cache and .pyc files on both sides
         run_seconds(BARE)
         te, tb = [], []
@@ -116,31 +92,29 @@ def measure(reps: int = 7, template: str = "concave-cam") -> tuple[list[float], 
     return te, tb
 
 
-def run(reps: int = 7, template: str = "concave-cam", core: bool = True) -> list[Result]:
+def run(reps: int = 7, template: str = "concave-cam", whole: bool = True) -> list[Result]:
     te, tb = measure(reps, template)
-    extra = []
-    if core:
-        with tempfile.TemporaryDirectory() as tmp:
-            path = core_template(Path(tmp), template)
-            tc, tb2 = measure(reps, str(path))
-        extra.append(
-            Result(
-                f"  (information) the same for the Mathcad sheet alone ({template} without "
-                "relations, findings and block tables)",
-                median(tc) / median(tb2),
-                TARGET,
-                detail=f"run {ms(median(tc))}, bare imports {ms(median(tb2))}, medians of {reps}",
-                info=True,
-            )
-        )
-    return [
+    results = [
         Result(
             f"cold start: workbook run {template} / python -c 'import numpy, pint, xlsxwriter'",
             median(te) / median(tb),
             TARGET,
             detail=f"run {ms(median(te))}, bare imports {ms(median(tb))}, medians of {reps}",
         )
-    ] + extra
+    ]
+    if whole:
+        tw, tb2 = measure(reps, template, ("all",))
+        results.append(
+            Result(
+                f"  (information) the same with every optional part: workbook run {template} "
+                "--part all",
+                median(tw) / median(tb2),
+                TARGET,
+                detail=f"run {ms(median(tw))}, bare imports {ms(median(tb2))}, medians of {reps}",
+                info=True,
+            )
+        )
+    return results
 
 
 def main(argv=None) -> int:
@@ -151,6 +125,7 @@ def main(argv=None) -> int:
     for r in results:
         print(r.line())
     print("  one cold run, in stages:", stages())
+    print("  the same with --part all:", stages(parts=("all",)))
     return 0 if all(r.ok for r in results) else 1
 
 

@@ -22,6 +22,12 @@ K = D / C
 
 
 @pytest.fixture(scope="module")
+def concave():
+    """The concave cam with its optional part hand-checks (left out by a plain load)."""
+    return workbook.load("concave-cam", parts="hand-checks")
+
+
+@pytest.fixture(scope="module")
 def geometry():
     return workbook.load("concave-cam-geometry")
 

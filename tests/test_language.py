@@ -43,6 +43,12 @@ def test_example(tmp_path, text):
             _, name, _, _, n = line.split()
             assert len(sheet.table(name)) == int(n)
             continue
+        if line.startswith("tables "):  # tables [with PART] = NAME, NAME
+            lhs, _, rhs = line.partition(" = ")
+            part = lhs.partition(" with ")[2] or None
+            chosen = sheet.with_parts(part) if part else sheet
+            assert [t.name for t in chosen.spec.tables] == rhs.split(", "), line
+            continue
         if line.startswith("sweep "):  # sweep NAME at INPUT=VALUE = NUMBER UNIT
             from workbook.sweep import sweep
 

@@ -51,13 +51,16 @@ def template_path(name_or_path: str | Path) -> Path:
     return found[text]
 
 
-def load(name_or_path: str | Path):
-    """Load a template by name or path and check its units; returns a :class:`Sheet`."""
+def load(name_or_path: str | Path, parts=None):
+    """Load a template by name or path and check its units; returns a :class:`Sheet`.
+
+    ``parts`` chooses the template's optional parts to compute and write: None (only what is
+    in no part), a part name, several names, or ``"all"``."""
     from .sheet import Sheet
     from .template import load_spec
 
     path = template_path(name_or_path)
-    return Sheet(load_spec(path))
+    return Sheet(load_spec(path), parts=parts)
 
 
 def __getattr__(name):

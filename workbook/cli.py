@@ -33,8 +33,19 @@ def _parser() -> argparse.ArgumentParser:
             help='override an input, e.g. --set R3="40 mm" (repeatable)',
         )
 
+    def part_args(sp, default: str):
+        sp.add_argument(
+            "--part",
+            action="append",
+            default=[],
+            metavar="PART",
+            help=f"an optional part of the worksheet, e.g. hand-checks, or 'all' (repeatable; "
+            f"default: {default})",
+        )
+
     run = sub.add_parser("run", help="compute a worksheet and write its Excel workbook")
     sheet_args(run)
+    part_args(run, "none: what is in no part")
     run.add_argument("--out", help="output .xlsx (default reports/NAME.xlsx)")
     run.add_argument("--force", action="store_true", help="overwrite a file that is not an xlsx")
     run.add_argument(
@@ -57,6 +68,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
     sheet_args(chk)
+    part_args(chk, "all")
     bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
     sheet_args(bench)
     bench.add_argument("--quick", action="store_true", help="a small, fast version")
@@ -106,10 +118,10 @@ def parse_sets(items: list[str]) -> dict[str, str]:
     return out
 
 
-def load_sheet(args):
+def load_sheet(args, parts=None):
     import workbook
 
-    sheet = workbook.load(args.name)
+    sheet = workbook.load(args.name, parts=parts)
     if getattr(args, "inputs", None):
         from .roundtrip import changed_inputs
 
@@ -123,6 +135,7 @@ def load_sheet(args):
 
 def _command_line(args) -> str:
     parts = ["workbook", "run", args.name]
+    parts += [f"--part {p}" for p in args.part]
     for item in args.set:
         name, _, value = item.partition("=")
         parts.append(f'--set {name}="{value}"' if " " in value else f"--set {item}")
@@ -149,7 +162,7 @@ def cmd_list(args) -> int:
 
 
 def cmd_run(args) -> int:
-    sheet = load_sheet(args)
+    sheet = load_sheet(args, args.part or None)
     out = Path(args.out) if args.out else Path("reports") / f"{sheet.name}.xlsx"
     if not args.out:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -181,11 +194,14 @@ def cmd_run(args) -> int:
     if n_checked:
         summary += f", {n_ok} of {n_checked} printed values reproduced"
     print(f"wrote {out}: {summary}")
+    for name in sheet.left_out:
+        part = sheet.full_spec.parts[name]
+        print(f"left out part {name} ({part.title}): add it with --part {name}")
     return EXIT_OK
 
 
 def cmd_check(args) -> int:
-    sheet = load_sheet(args)
+    sheet = load_sheet(args, args.part or "all")
     report = sheet.check()
     print(report.text())
     return EXIT_OK if report.ok else EXIT_CHECK

@@ -15,7 +15,15 @@ from . import typecheck as tc
 from . import units as un
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .numeric import Evaluator
-from .template import ColumnSpec, RangeSpec, SheetSpec, check_input_value, range_values
+from .template import (
+    ColumnSpec,
+    RangeSpec,
+    SheetSpec,
+    check_input_value,
+    range_values,
+    resolve_parts,
+    select_parts,
+)
 
 
 @dataclass
@@ -42,9 +50,15 @@ class Sheet:
     """A worksheet: inputs, definitions, tables. Evaluation follows only what is asked."""
 
     def __init__(
-        self, spec: SheetSpec, values: dict[str, Any] | None = None, typer: tc.Typer | None = None
+        self,
+        spec: SheetSpec,
+        values: dict[str, Any] | None = None,
+        typer: tc.Typer | None = None,
+        parts=None,
     ):
-        self.spec = spec
+        self.full_spec = spec
+        self.parts = resolve_parts(spec, parts)
+        self.spec = select_parts(spec, self.parts)  # the sections this sheet computes and writes
         self.values = (
             dict(values) if values is not None else {n: i.value for n, i in spec.inputs.items()}
         )
@@ -80,11 +94,11 @@ class Sheet:
                     line=d.line,
                     definition=d.name,
                 ) from None
-        for t in self.spec.tables:
+        for t in self.full_spec.tables:  # every part is checked, chosen or not
             if t.range is not None:
                 for col in t.columns:
                     self._typed_column(col, t.range.var, f"table {t.name}")
-        for c in self.spec.charts:
+        for c in self.full_spec.charts:
             for s in c.series:
                 if s.table is None:
                     rng = s.range or c.range
@@ -108,7 +122,17 @@ class Sheet:
                 values[name] = coerce_input(spec, raw, file=self.file)
             except WorkbookError as err:  # point at the input's declaration (unit, bounds)
                 raise err.located(file=self.file, line=spec.line, definition=name) from None
-        return Sheet(self.spec, values, self.typer)
+        return Sheet(self.full_spec, values, self.typer, self.parts)
+
+    def with_parts(self, *names: str) -> Sheet:
+        """The same sheet computing and writing the optional parts ``names`` (``"all"``: every
+        part; none: only what is not in a part). See ``[parts]`` in docs/language.md."""
+        return Sheet(self.full_spec, self.values, self.typer, names)
+
+    @property
+    def left_out(self) -> list[str]:
+        """Optional parts this sheet does not compute or write."""
+        return [p for p in self.full_spec.parts if p not in self.parts]
 
     # -- evaluation -------------------------------------------------------------------
     def evaluate(self, name: str, *args, **kwargs) -> pint.Quantity | str:
@@ -371,23 +395,24 @@ class Sheet:
         return run_checks(self)
 
     def unused_inputs(self) -> list[str]:
-        """Inputs that no table, chart, printed value or definition in use needs."""
+        """Inputs that no table, chart, printed value or definition in use needs (in any part)."""
+        spec = self.full_spec
         used: set[str] = set()
         roots: list[ex.Node] = []
-        for t in self.spec.tables:
+        for t in spec.tables:
             roots += [c.node for c in t.columns]
             roots += [ex.Name(u) for u in t.uses]
-        for f in self.spec.findings:
+        for f in spec.findings:
             roots += [ex.Name(str(u)) for u in f.get("uses", ())]
-        for c in self.spec.charts:
+        for c in spec.charts:
             roots += [s.y.node for s in c.series if s.table is None]
-        for p in self.spec.printed:
+        for p in spec.printed:
             roots += [ex.Name(n) for n in _printed_names(p)]
-        for r in self.spec.relations:
+        for r in spec.relations:
             roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
         for node in roots:
-            used |= tc.dependencies(self.spec, node)
-        return [n for n in self.spec.inputs if n not in used]
+            used |= tc.dependencies(spec, node)
+        return [n for n in spec.inputs if n not in used]
 
     def _repr_html_(self) -> str:
         from .notebook import sheet_html

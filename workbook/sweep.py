@@ -337,7 +337,7 @@ def _prime(sheet) -> tuple[str, str]:
     text = sheet.spec.text
     key = (path, hashlib.sha256(text.encode("utf-8")).hexdigest())
     if key not in _SHEETS:
-        _SHEETS[key] = Sheet(sheet.spec, None, sheet.typer)
+        _SHEETS[key] = Sheet(sheet.full_spec, None, sheet.typer, sheet.parts)
     return path, text
 
 

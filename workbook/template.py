@@ -13,7 +13,7 @@ try:
     import tomllib
 except ImportError:  # Python 3.10
     import tomli as tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -38,7 +38,10 @@ SECTIONS = {
     "relations",
     "findings",
     "sweep",
+    "parts",
 }
+ALL_PARTS = "all"
+_PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
 
 
 @dataclass
@@ -102,6 +105,16 @@ class Definition:
 
 
 @dataclass
+class PartSpec:
+    """An optional part of a worksheet (hand checks, studies): left out unless asked for."""
+
+    name: str
+    title: str
+    note: str = ""
+    line: int | None = None
+
+
+@dataclass
 class RangeSpec:
     var: str
     first: ex.Node
@@ -128,6 +141,7 @@ class TableSpec:
     block: str | None = None
     line: int | None = None
     uses: tuple[str, ...] = ()  # inputs a block table reads (for the unused-input report)
+    part: str | None = None
 
 
 @dataclass
@@ -158,6 +172,7 @@ class ChartSpec:
     log_y: bool = False
     equal_axes: bool = False
     line: int | None = None
+    part: str | None = None
 
 
 @dataclass
@@ -178,6 +193,7 @@ class PrintedSpec:
     role: str = "check"  # check | information
     misprints: list[Misprint] = field(default_factory=list)
     note: str = ""
+    part: str | None = None
 
 
 @dataclass
@@ -192,6 +208,7 @@ class RelationSpec:
     var_unit: str
     range: RangeSpec | None
     line: int | None = None
+    part: str | None = None
 
 
 @dataclass
@@ -212,6 +229,7 @@ class SheetSpec:
     findings: list[dict]
     meta: dict[str, Any]
     text: str
+    parts: dict[str, PartSpec] = field(default_factory=dict)
 
     def line_of(self, key: str, section: str | None = None) -> int | None:
         return find_line(self.text, key, section)
@@ -494,6 +512,13 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         if t.name in names_seen:
             raise TemplateError(f"two tables are named '{t.name}'", line=t.line)
         names_seen.add(t.name)
+    parts = _parts(_table(data, "parts"), text)
+    _assign_parts(data, parts, text, tables, charts, printed, relations)
+    if isinstance(sheet.get("hand_checks"), str) and sheet["hand_checks"] not in parts:
+        raise TemplateError(
+            f"[sheet] hand_checks names no part declared in [parts]: {sheet['hand_checks']!r}",
+            line=find_line(text, "hand_checks", "sheet"),
+        )
 
     return SheetSpec(
         name=str(sheet.get("name", name)),
@@ -512,7 +537,101 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         findings=findings,
         meta=sheet,
         text=text,
+        parts=parts,
     )
+
+
+def _parts(raw: dict, text: str) -> dict[str, PartSpec]:
+    parts = {}
+    for key, value in raw.items():
+        line = find_line(text, key, "parts")
+        if not _PART_NAME.match(key) or key == ALL_PARTS:
+            raise TemplateError(
+                f"part name {key!r}: lowercase letters, digits and '-' (and not 'all')", line=line
+            )
+        if isinstance(value, str):
+            value = {"title": value}
+        if not isinstance(value, dict):
+            raise TemplateError(
+                'a part is declared as { title = "...", note = "..." }', line=line, definition=key
+            )
+        parts[key] = PartSpec(key, str(value.get("title", key)), str(value.get("note", "")), line)
+    return parts
+
+
+def _assign_parts(data: dict, parts: dict[str, PartSpec], text: str, *specs: list) -> None:
+    """Set ``part`` on every table, chart, printed file and relation that names one; a section
+    may name only a declared part, and a chart may not draw a table that is left out more often
+    than the chart itself."""
+    sections = ("tables", "charts", "printed", "relations")
+    for section, items in zip(sections, specs):
+        for item, raw in zip(items, _list(data, section)):
+            item.part = _part_of(raw, parts, section, text, getattr(item, "line", None))
+    for raw in _list(data, "findings"):
+        _part_of(raw, parts, "findings", text, None)
+    tables, charts = specs[0], specs[1]
+    table_part = {t.name: t.part for t in tables}
+    for c in charts:
+        for s in c.series:
+            if s.table in table_part and table_part[s.table] not in (None, c.part):
+                raise TemplateError(
+                    f"chart {c.name} draws table {s.table} of part {table_part[s.table]!r}: "
+                    f'give the chart part = "{table_part[s.table]}" too',
+                    line=c.line,
+                    definition=f"chart {c.name}",
+                )
+
+
+def _part_of(raw: dict, parts: dict[str, PartSpec], section: str, text: str, line) -> str | None:
+    part = raw.get("part")
+    if part is None:
+        return None
+    if not isinstance(part, str) or part not in parts:
+        known = ", ".join(parts) or "none declared"
+        raise TemplateError(
+            f"[[{section}]] part = {part!r} is not declared in [parts] (parts: {known})",
+            line=line or _value_line(text, f"part = {part!r}".replace("'", '"')),
+        )
+    return part
+
+
+def select_parts(spec: SheetSpec, chosen: frozenset[str]) -> SheetSpec:
+    """The spec with only the sections of no part or of a chosen part."""
+    if set(spec.parts) <= chosen:
+        return spec
+
+    def keep(part) -> bool:
+        return part is None or part in chosen
+
+    meta = dict(spec.meta)
+    if isinstance(meta.get("hand_checks"), str) and meta["hand_checks"] not in chosen:
+        meta["hand_checks"] = False
+    return replace(
+        spec,
+        tables=[t for t in spec.tables if keep(t.part)],
+        charts=[c for c in spec.charts if keep(c.part)],
+        printed=[p for p in spec.printed if keep(p.part)],
+        relations=[r for r in spec.relations if keep(r.part)],
+        findings=[f for f in spec.findings if keep(f.get("part"))],
+        meta=meta,
+    )
+
+
+def resolve_parts(spec: SheetSpec, parts) -> frozenset[str]:
+    """``None`` (the default: no optional part), ``"all"``, a part name, or several names."""
+    if parts is None:
+        return frozenset()
+    names = [parts] if isinstance(parts, str) else list(parts)
+    if ALL_PARTS in names:
+        return frozenset(spec.parts)
+    unknown = [n for n in names if n not in spec.parts]
+    if unknown:
+        known = ", ".join(spec.parts) or "it has none"
+        raise InputError(
+            f"{spec.name} has no part {unknown[0]!r} (parts: {known}; or 'all')",
+            file=str(spec.path),
+        )
+    return frozenset(names)
 
 
 def _section_line(text: str, key: str) -> int | None:

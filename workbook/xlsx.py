@@ -96,7 +96,9 @@ class WorkbookWriter:
 
         self.sheet = sheet
         self.path = path
-        self.command = command or f"workbook run {sheet.name}"
+        self.command = command or " ".join(
+            ["workbook", "run", sheet.name] + [f"--part {p}" for p in sorted(sheet.parts)]
+        )
         self.wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
         self.wb.set_properties(
             {
@@ -579,6 +581,13 @@ class WorkbookWriter:
             ),
             ("Macros", "none"),
         ]
+        for name, part in self.sheet.full_spec.parts.items():
+            state = (
+                "included"
+                if name in self.sheet.parts
+                else f"left out (not computed); add it with --part {name}"
+            )
+            rows.append((f"Part {name}", f"{part.title}: {state}"))
         rows += [(str(k), str(v)) for k, v in spec.meta.get("about", {}).items()]
         ws.write_string(0, 0, spec.title, self.fmt["title"])
         for i, (k, v) in enumerate(rows, start=2):
