@@ -29,7 +29,7 @@ def concave():
 
 @pytest.fixture(scope="module")
 def geometry():
-    return workbook.load("concave-cam-geometry")
+    return workbook.load("concave-cam-geometry", parts="all")
 
 
 @pytest.fixture(scope="module")
