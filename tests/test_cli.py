@@ -5,6 +5,7 @@ import sys
 import tempfile
 
 import openpyxl
+import pytest
 
 
 def run(*args, cwd=None):
@@ -99,3 +100,29 @@ def test_export_profile_csv_for_cad(tmp_path):
         "run", "concave-cam", "--out", str(tmp_path / "c.xlsx"), "--export", str(tmp_path / "c.csv")
     )
     assert none.returncode == 2 and "has no export" in none.stderr
+
+
+def test_a_bug_in_a_block_is_exit_3_in_one_line(tmp_path, monkeypatch, capsys):
+    """An exception that is not a WorkbookError (a bug, not a user mistake): one line, exit 3,
+    the previous output untouched; --debug shows the traceback."""
+    from workbook import blocks
+    from workbook.cli import main
+
+    out = tmp_path / "cc.xlsx"
+    assert main(["run", "concave-cam", "--out", str(out)]) == 0
+    before = out.read_bytes()
+    blocks.get("concave.stability_findings")  # registers the module's blocks
+
+    def broken(sheet):
+        return 1 / 0
+
+    monkeypatch.setattr(blocks._REGISTRY["concave.stability_findings"], "func", broken)
+    capsys.readouterr()
+    args = ["run", "concave-cam", "--part", "hand-checks", "--out", str(out)]
+    assert main(args) == 3
+    err = capsys.readouterr().err
+    assert err.startswith("workbook: internal error (ZeroDivisionError: division by zero)")
+    assert len(err.strip().splitlines()) == 1
+    assert out.read_bytes() == before
+    with pytest.raises(ZeroDivisionError):
+        main(["--debug", *args])

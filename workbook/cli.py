@@ -1,7 +1,8 @@
 """Command line: ``workbook list | run | check | bench``.
 
 Exit status: 0 success, 1 printed values not reproduced (check), 2 bad input
-(template, units, values, paths). No traceback for user mistakes unless --debug.
+(template, units, values, paths), 3 internal error (a bug), 130 interrupted. No traceback
+unless --debug.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
+EXIT_OK, EXIT_CHECK, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 3
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -268,6 +269,16 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("workbook: interrupted; no output file was changed", file=sys.stderr)
         return 130
+    except Exception as exc:  # a bug of the engine or of a solver block, not of the worksheet
+        if args.debug:
+            raise
+        print(
+            f"workbook: internal error ({type(exc).__name__}: {exc}); this is a bug in workbook, "
+            "not in your worksheet; no output file was changed. Rerun with --debug for the "
+            "traceback and report it.",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":
