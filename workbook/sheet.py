@@ -337,14 +337,26 @@ class Sheet:
             )
         return Column(col.title, t.unit, out, t, col.text)
 
+    def table_spec(self, name: str):
+        """The declaration of table ``name``; an error names a part that would add it."""
+        spec = next((t for t in self.spec.tables if t.name == name), None)
+        if spec is not None:
+            return spec
+        hidden = next((t for t in self.full_spec.tables if t.name == name), None)
+        if hidden is not None:
+            raise InputError(
+                f"table '{name}' is in the optional part {hidden.part} of {self.name}: add it "
+                f"with --part {hidden.part} (Python: sheet.with_parts({hidden.part!r}))",
+                file=self.file,
+            )
+        raise InputError(
+            f"no table '{name}' in {self.name} (tables: "
+            f"{', '.join(t.name for t in self.spec.tables)})"
+        )
+
     def table_data(self, name: str) -> TableData:
         """Evaluate one template table (only what it needs)."""
-        spec = next((t for t in self.spec.tables if t.name == name), None)
-        if spec is None:
-            raise InputError(
-                f"no table '{name}' in {self.name} (tables: "
-                f"{', '.join(t.name for t in self.spec.tables)})"
-            )
+        spec = self.table_spec(name)
         if spec.range is None:
             raise InputError(f"table '{name}' is computed by a block; use sheet.block_table()")
         what = f"table {name}"
@@ -360,8 +372,8 @@ class Sheet:
         """A table as a pandas DataFrame, the unit in every column header: ``"h1 [mm]"``."""
         import pandas as pd
 
-        spec = next((t for t in self.spec.tables if t.name == name), None)
-        if spec is not None and spec.block:
+        spec = self.table_spec(name)
+        if spec.block:
             return self.block_table(spec.block)
         data = self.table_data(name)
         return pd.DataFrame({header(c.title, c.unit): c.values for c in data.columns})
