@@ -38,7 +38,8 @@ EX = dict(
 
 @pytest.fixture(scope="module")
 def sheet():
-    return workbook.load("advance-coupling")
+    """With the optional part studies (left out by a plain load)."""
+    return workbook.load("advance-coupling", parts="all")
 
 
 def F_ref(phi, w, d):

@@ -26,7 +26,8 @@ SCENE = dict(
 
 @pytest.fixture(scope="module")
 def sheet():
-    return workbook.load("r0-synthesis")
+    """With the optional part studies (left out by a plain load)."""
+    return workbook.load("r0-synthesis", parts="all")
 
 
 def mm(q) -> float:

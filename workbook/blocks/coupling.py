@@ -1037,9 +1037,17 @@ def findings(sheet):
             note,
         )
     )
-    # solver choice at the stiff case
+    return out
+
+
+@findings_block
+def study_findings(sheet):
+    """Solver choice from the work-precision study, and the explicit solver's stall (the
+    optional part studies: 45 solver runs and a stalled RK45, a few seconds)."""
+    F = Finding
+    p = Params.from_sheet(sheet)
     ps, df = _study_for_sheet(sheet)
-    out += choice_findings(ps, df, method_of(sheet), rtol_of(sheet))
+    out = choice_findings(ps, df, method_of(sheet), rtol_of(sheet))
     run, need = stall_run(p)
     out.append(
         F(
