@@ -84,6 +84,18 @@ def test_unknown_part_is_an_input_error(tmp_path, capsys):
     assert not (tmp_path / "x.xlsx").exists()
 
 
+def test_a_table_of_a_left_out_part_names_the_part(tmp_path, capsys):
+    with pytest.raises(InputError, match="in the optional part hand-checks of concave-cam"):
+        workbook.load("concave-cam").table("stability")
+    out = tmp_path / "cc.xlsx"
+    assert main(["run", "concave-cam", "--csv", "stability", "--out", str(out)]) == 2
+    assert "add it with --part hand-checks" in capsys.readouterr().err
+    assert not out.exists()
+    args = ["run", "concave-cam", "--part", "hand-checks", "--csv", "stability", "--out", str(out)]
+    assert main(args) == 0
+    assert (tmp_path / "cc.stability.csv").read_text().startswith("phi [deg],")
+
+
 BASE = """
 [inputs]
 R = "10 mm"
@@ -137,3 +149,33 @@ def test_an_input_used_only_by_a_part_is_not_unused(tmp_path):
     )
     sheet = workbook.load(write_template(tmp_path, text))
     assert sheet.spec.tables == [] and sheet.unused_inputs() == []
+
+
+SCENE_PARTS = {
+    "concave-cam": {"hand-checks"},
+    "concave-cam-geometry": {"hand-checks"},
+    "r0-synthesis": {"studies"},
+    "advance-coupling": {"studies"},
+}
+
+
+@pytest.mark.parametrize("name", sorted(SCENE_PARTS))
+def test_scene_parts_are_left_out_by_default(name):
+    plain = workbook.load(name)
+    whole = plain.with_parts("all")
+    assert set(plain.full_spec.parts) == SCENE_PARTS[name] == set(plain.left_out)
+    assert whole.left_out == []
+    for section in ("tables", "charts", "printed", "relations"):
+        in_part = [x for x in getattr(whole.spec, section) if x.part]
+        assert all(x.part is None for x in getattr(plain.spec, section))
+        assert len(getattr(plain.spec, section)) + len(in_part) == len(getattr(whole.spec, section))
+    assert all("part" not in f for f in plain.spec.findings)
+
+
+def test_coupling_without_its_studies(tmp_path):
+    out = tmp_path / "ac.xlsx"
+    assert main(["run", "advance-coupling", "--out", str(out)]) == 0
+    wb = openpyxl.load_workbook(out)
+    assert "Solvers" not in wb.sheetnames and {"Families", "Dynamics"} <= set(wb.sheetnames)
+    topics = {r[0] for r in wb["Checks"].iter_rows(values_only=True)}
+    assert "solver choice" not in topics and "dynamics" in topics
