@@ -53,3 +53,27 @@ def test_changed_input_follows_with_inputs(tmp_path, concave):
         assert values[key] == pytest.approx(value, rel=1e-9, abs=1e-12), key
     # and they did change
     assert values[("Definitions", "B3")] == pytest.approx(2.0)  # k = (20 + 40)/(40 - 10)
+
+
+def test_live_verdicts_use_the_absolute_or_the_relative_tolerance(tmp_path):
+    """The Checks sheet's pass/FAIL formulas apply the engine's test (checks.within): LibreOffice
+    recalculates the same verdicts, including one that passes only by the relative bound."""
+    import workbook
+
+    (tmp_path / "p.csv").write_text("name,argument,value,unit\ny,,20.5,mm\nz,,32,mm\n")
+    (tmp_path / "d.csv").write_text("name,argument,value,unit\ny,,20.0,mm\nz,,30.06,mm\n")
+    (tmp_path / "t.toml").write_text(
+        '[inputs]\nR = "10 mm"\n\n[definitions]\ny = "2*R"\nz = "3*R"\n\n'
+        '[[printed]]\nfile = "p.csv"\ntolerance = 0.1\nrel_tolerance = 0.03\n\n'
+        '[[printed]]\nfile = "d.csv"\n'
+    )
+    sheet = workbook.load(tmp_path / "t.toml")
+    report = sheet.check()
+    assert [r.verdict for r in report.rows] == ["pass", "FAIL", "pass", "FAIL"]
+    path = sheet.write_xlsx(tmp_path / "t.xlsx", report=report)
+    recalculated = recalculate(path, tmp_path / "lo")
+    assert_same(path, recalculated)
+    verdicts = [cell_values(recalculated)[("Checks", f"J{row}")] for row in range(2, 6)]
+    assert verdicts == ["pass", "FAIL", "pass", "FAIL"]
+    formula = formula_values(path)[("Checks", "J2")][0]
+    assert formula.startswith("=IF(OR(G2<=0.1000000001") and "G2<=0.03*ABS(E2)" in formula

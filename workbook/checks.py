@@ -237,16 +237,21 @@ def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
     return CheckRow(**base, computed=computed, verdict="pass" if ok else "FAIL")
 
 
-def within(computed: float, printed: float, tol: float | None, rel: float | None) -> bool:
-    """True if computed agrees with printed within the absolute or the relative tolerance."""
+def tolerances(printed: float, tol: float | None, rel: float | None):
+    """The (absolute, relative) bounds a check uses: without either, half a unit of the last
+    printed digit; the absolute bound is widened by 1e-9 relative against binary rounding."""
     if tol is None and rel is None:
         tol = 0.5 * 10 ** -_decimals(printed)
-    ok = False
-    if tol is not None:
-        ok = abs(computed - printed) <= tol * (1 + 1e-9)
-    if rel is not None and not ok:
-        ok = abs(computed - printed) <= rel * abs(printed)
-    return ok
+    return (None if tol is None else tol * (1 + 1e-9)), rel
+
+
+def within(computed: float, printed: float, tol: float | None, rel: float | None) -> bool:
+    """True if computed agrees with printed within the absolute or the relative tolerance."""
+    bound, rel = tolerances(printed, tol, rel)
+    error = abs(computed - printed)
+    if bound is not None and error <= bound:
+        return True
+    return rel is not None and error <= rel * abs(printed)
 
 
 def _decimals(value: float) -> int:

@@ -19,6 +19,7 @@ from . import expr as ex
 from . import typecheck as tc
 from . import units as un
 from .atomic import check_target, replacing
+from .checks import tolerances
 from .errors import LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive, excel_name
 from .sheet import header
@@ -489,21 +490,26 @@ class WorkbookWriter:
                         abs(r.computed - r.printed) / abs(r.printed),
                     )
                 self.formula_cells += 1 + (r.printed != 0)
-            tol_text = (
-                f"{r.tolerance:g}"
-                if r.tolerance is not None
-                else f"{100 * r.rel_tolerance:g}%"
-                if r.rel_tolerance is not None
-                else ""
-            )
+            bound, rel = tolerances(r.printed, r.tolerance, r.rel_tolerance)
+            shown = []
+            if bound is not None:
+                shown.append(f"{r.tolerance if r.tolerance is not None else bound:g}")
+            if rel is not None:
+                shown.append(f"{100 * rel:g}%")
+            tol_text = " or ".join(shown)
             ws.write_string(row, 8, tol_text)
             fmt = (
                 self.fmt["pass"] if r.verdict in ("pass", "misprint", "info") else self.fmt["fail"]
             )
-            if live and r.role == "check" and r.verdict in ("pass", "FAIL") and r.tolerance:
-                ws.write_formula(
-                    row, 9, f'=IF(G{row + 1}<={r.tolerance!r},"pass","FAIL")', fmt, r.verdict
-                )
+            if live and r.role == "check" and r.verdict in ("pass", "FAIL"):
+                # the engine's own test (checks.within): within the absolute OR the relative bound
+                tests = []
+                if bound is not None:
+                    tests.append(f"G{row + 1}<={bound!r}")
+                if rel is not None:
+                    tests.append(f"G{row + 1}<={rel!r}*ABS({E})")
+                test = tests[0] if len(tests) == 1 else f"OR({','.join(tests)})"
+                ws.write_formula(row, 9, f'=IF({test},"pass","FAIL")', fmt, r.verdict)
                 self.formula_cells += 1
             else:
                 ws.write_string(row, 9, r.verdict, fmt)
