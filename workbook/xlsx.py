@@ -326,36 +326,36 @@ class WorkbookWriter:
                     f"'{s.x_column}' or '{s.y_column}'"
                 ) from None
         rng = s.range or chart.range
-        target = "Chart data"
-        for key, cells in self.columns.items():
-            if (
-                key[0] == rng.text
-                and key[2] == s.y.text
-                and (s.y.unit is None or key[3] == str(s.y.unit))
-            ):
-                xcells = self.columns[(rng.text, key[1], rng.var, "var")]
-                return xcells, cells
+        x = _x_column(chart, s, rng)
+        wanted = [s.y] if x is None else [x, s.y]
+        keys = [(rng.text, c.text, self._unit_key(c, rng, chart)) for c in wanted]
+        # a table already written over the same range with these columns (same sheet, same rows)
+        for sheet_name in dict.fromkeys(k[1] for k in self.columns):
+            found = [self.columns.get((k[0], sheet_name, k[1], k[2])) for k in keys]
+            if all(found):
+                xcells = (
+                    found[0]
+                    if x is not None
+                    else self.columns[(rng.text, sheet_name, rng.var, "var")]
+                )
+                return xcells, found[-1]
         # not in any table: write a chart data block
         from .template import TableSpec
 
+        target = "Chart data"
         name = f"{chart.name}_{len(self.columns)}"
-        spec = TableSpec(name, f"Data of {chart.title}: {s.name}", rng, [s.y], target)
+        spec = TableSpec(name, f"Data of {chart.title}: {s.name}", rng, wanted, target)
         self.sheet.spec.tables.append(spec)
         try:
             self.write_range_table(spec)
         finally:
             self.sheet.spec.tables.remove(spec)
-        return (
-            self.columns[(rng.text, target, rng.var, "var")],
-            self.columns[
-                (
-                    rng.text,
-                    target,
-                    s.y.text,
-                    str(self.sheet._typed_column(s.y, rng.var, chart.name).unit),
-                )
-            ],
-        )
+        found = [self.columns[(k[0], target, k[1], k[2])] for k in keys]
+        xcells = found[0] if x is not None else self.columns[(rng.text, target, rng.var, "var")]
+        return xcells, found[-1]
+
+    def _unit_key(self, col, rng, chart) -> str:
+        return str(self.sheet._typed_column(col, rng.var, f"chart {chart.name}").unit)
 
     def write_charts(self) -> None:
         if not self.sheet.spec.charts:
@@ -599,6 +599,14 @@ class WorkbookWriter:
         for i, (k, v) in enumerate(rows, start=2):
             ws.write_string(i, 0, k, self.fmt["header"])
             ws.write_string(i, 1, v, self.fmt["wrap"])
+
+
+def _x_column(chart, s, rng):
+    """The series' x expression, or None when x is the range variable itself."""
+    x = s.x or chart.x
+    if x is None or (isinstance(x.node, ex.Name) and x.node.id == rng.var and x.unit is None):
+        return None
+    return x
 
 
 def _nice(x: float, floor: bool) -> float:
