@@ -77,3 +77,25 @@ def test_live_verdicts_use_the_absolute_or_the_relative_tolerance(tmp_path):
     assert verdicts == ["pass", "FAIL", "pass", "FAIL"]
     formula = formula_values(path)[("Checks", "J2")][0]
     assert formula.startswith("=IF(OR(G2<=0.1000000001") and "G2<=0.03*ABS(E2)" in formula
+
+
+def test_max_over_is_a_live_max_of_the_table_column(tmp_path):
+    import workbook
+
+    (tmp_path / "t.toml").write_text(
+        '[inputs]\nR = "10 mm"\n\n[arguments]\nphi = { unit = "deg" }\n\n[definitions]\n'
+        '"y(phi)" = "R*sin(phi)"\ny_top = "max_over(t, y)"\n\n'
+        '[[tables]]\nname = "t"\nrange = "phi := 0, 10 .. 90"\ncolumns = { y = "mm" }\n\n'
+        '[[tables]]\nname = "top"\nrange = "k := 1 .. 1"\n'
+        'columns = [{ expr = "y_top", unit = "mm" }]\n'
+    )
+    path = workbook.load(tmp_path / "t.toml").write_xlsx(tmp_path / "t.xlsx")
+    formulas = formula_values(path)
+    assert formulas[("Definitions", "B2")][0] == "=MAX('Listing'!$B$3:$B$12)"
+    edited = tmp_path / "edited.xlsx"
+    wb = openpyxl.load_workbook(path)
+    wb["Inputs"]["B2"].value = 25
+    wb.save(edited)
+    values = cell_values(recalculate(edited, tmp_path / "lo"))
+    assert values[("Definitions", "B2")] == 25
+    assert values[("Listing", "B17")] == 25  # the table that shows it

@@ -393,11 +393,15 @@ def test_changing_alpha_max_in_excel_moves_r0(tmp_path, sheet, alpha_max, H):
         if row[0].value == "H":
             row[1].value = H
     wb.save(edited)
-    cell = _definitions(path)["r0"]
-    got = cell_values(recalculate(edited, tmp_path / "lo"))[("Definitions", cell)]
-    expected = mm(sheet.with_inputs(alpha_max=f"{alpha_max} deg", H=f"{H} mm").evaluate("r0"))
-    assert got == pytest.approx(expected, rel=1e-12)
+    values = cell_values(recalculate(edited, tmp_path / "lo"))
+    changed = sheet.with_inputs(alpha_max=f"{alpha_max} deg", H=f"{H} mm")
+    got = values[("Definitions", _definitions(path)["r0"])]
+    assert got == pytest.approx(mm(changed.evaluate("r0")), rel=1e-12)
     assert abs(got - 38.2405) > 1  # it moved
+    # the grid's answer is MAX over the Design table's live column: it follows too
+    for name in ("S0_grid", "r0_grid", "r0_step"):
+        got = values[("Definitions", _definitions(path)[name])]
+        assert got == pytest.approx(mm(changed.evaluate(name)), rel=1e-12), name
 
 
 def test_errors_are_engine_errors(sheet):

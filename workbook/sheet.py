@@ -229,7 +229,7 @@ class Sheet:
         """Values of one column of a range table (for max_over/min_over), memoised."""
         key = ("column", table, column)
         if key not in self._memo:
-            spec = next(t for t in self.spec.tables if t.name == table)
+            spec = next(t for t in self.full_spec.tables if t.name == table)  # any part
             col = next(c for c in spec.columns if c.text == column)
             what = f"table {table}"
             values = self.range_values(spec.range, what)

@@ -91,6 +91,12 @@ def _range_ref(c: ColumnCells) -> list:
     return [c.sheet, c.first_row, c.col, c.last_row, c.col]
 
 
+def _cells_text(c: ColumnCells) -> str:
+    """``'Design'!$E$3:$E$103``: the absolute range of a column, for a formula."""
+    col = _col_letter(c.col)
+    return f"'{c.sheet}'!${col}${c.first_row + 1}:${col}${c.last_row + 1}"
+
+
 class WorkbookWriter:
     def __init__(self, sheet, path: Path, command: str | None = None):
         import xlsxwriter
@@ -116,6 +122,7 @@ class WorkbookWriter:
         self.rows: dict[str, int] = {}
         self.not_live: list[str] = []
         self.formula_cells = 0
+        self.planned: dict[tuple[str, str], ColumnCells] = {}
 
     def _formats(self):
         add = self.wb.add_format
@@ -226,6 +233,28 @@ class WorkbookWriter:
         return True
 
     # -- range tables -------------------------------------------------------------------
+    def plan_range_tables(self) -> None:
+        """Register where each range table's columns will be written, so that a definition
+        aggregating a column (``max_over(design, S0_req)``) is printed as a live
+        ``MAX('Design'!$E$3:$E$103)`` on the Definitions sheet, written before the tables.
+        A block table's length is known only once computed, so range tables after one on the
+        same sheet are not planned (their aggregates stay values, with a comment)."""
+        rows: dict[str, int | None] = {}
+        for t in self.sheet.spec.tables:
+            if t.sheet in ("Inputs", "Definitions"):
+                continue
+            start = rows.get(t.sheet, 0)
+            if t.block or start is None:
+                rows[t.sheet] = None
+                continue
+            n = len(self.sheet.range_values(t.range, f"table {t.name}"))
+            first = start + 2
+            for j, col in enumerate(t.columns, start=1):
+                cells = ColumnCells(t.sheet, j, first, first + n - 1, col.title)
+                self.planned[(t.name, col.text)] = cells
+                self.printer.ranges[(t.name, col.text)] = _cells_text(cells)
+            rows[t.sheet] = first + n + 2
+
     def write_range_table(self, spec) -> None:
         data = self.sheet.table_data(spec.name)
         n = len(data.columns[0].values)
@@ -246,9 +275,11 @@ class WorkbookWriter:
         var_ref = f"$A${ROW_TOKEN}"
         for j, col in enumerate(data.columns[1:], start=1):
             self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n)
-            self.columns[(spec.range.text, spec.sheet, col.text, str(col.unit))] = ColumnCells(
-                spec.sheet, j, first, first + n - 1, col.title
-            )
+            cells = ColumnCells(spec.sheet, j, first, first + n - 1, col.title)
+            planned = self.planned.get((spec.name, col.text))
+            if planned is not None and planned != cells:  # a MAX(...) already points there
+                raise RuntimeError(f"table {spec.name} written at {cells}, planned at {planned}")
+            self.columns[(spec.range.text, spec.sheet, col.text, str(col.unit))] = cells
         self.columns[(spec.range.text, spec.sheet, data.var, "var")] = ColumnCells(
             spec.sheet, 0, first, first + n - 1, data.var
         )
@@ -651,6 +682,7 @@ def write_workbook(
     with replacing(path) as tmp:
         w = WorkbookWriter(sheet, tmp, command)
         needed = needed_names(sheet)
+        w.plan_range_tables()
         w.write_inputs(needed)
         w.write_definitions(needed)
         for t in sheet.spec.tables:
