@@ -402,6 +402,13 @@ def test_changing_alpha_max_in_excel_moves_r0(tmp_path, sheet, alpha_max, H):
     for name in ("S0_grid", "r0_grid", "r0_step"):
         got = values[("Definitions", _definitions(path)[name])]
         assert got == pytest.approx(mm(changed.evaluate(name)), rel=1e-12), name
+    # Fig. 4's range of radii (r4_lo .. r4_hi, from r0) is live too: its first and last rows
+    from recalc import formula_values
+
+    cells = {f: key for key, (f, _) in formula_values(path).items() if key[0] == "Chart data"}
+    for bound in ("r4_lo", "r4_hi"):
+        got = values[cells[f"=({bound})"]]
+        assert got == pytest.approx(mm(changed.evaluate(bound)), rel=1e-12), bound
 
 
 def test_errors_are_engine_errors(sheet):

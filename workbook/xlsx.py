@@ -269,9 +269,7 @@ class WorkbookWriter:
         heads = [header(c.title, c.unit) for c in data.columns]
         ws.write_row(start + 1, 0, heads, self.fmt["header"])
         first = start + 2
-        var_col = data.columns[0].values
-        for i in range(n):
-            ws.write_number(first + i, 0, float(var_col[i]), self.fmt["number"])
+        self._write_range_column(ws, spec, first, data.columns[0].values)
         var_ref = f"$A${ROW_TOKEN}"
         for j, col in enumerate(data.columns[1:], start=1):
             self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n)
@@ -285,6 +283,57 @@ class WorkbookWriter:
         )
         ws.set_column(0, len(data.columns) - 1, 13)
         self.rows[spec.sheet] = first + n + 2
+
+    def _write_range_column(self, ws, spec, first: int, values: np.ndarray) -> None:
+        """The range variable's column: numbers for constant bounds; for bounds that depend on
+        inputs, formulas ``=FIRST+i*(SECOND-FIRST)`` and ``=LAST`` (the engine's values), so
+        the table follows an edited input as long as the number of rows stays the same."""
+        fmt, n = self.fmt["number"], len(values)
+        bounds = self._live_bounds(spec.range) if n > 1 else None
+        if bounds is None:
+            for i in range(n):
+                ws.write_number(first + i, 0, float(values[i]), fmt)
+            return
+        lo, second, hi = bounds
+        if second is not None:
+            step = f"(({second})-({lo}))"
+        else:
+            step = "1" if values[-1] >= values[0] else "(-1)"
+        ws.write_formula(first, 0, f"=({lo})", fmt, float(values[0]))
+        for i in range(1, n - 1):
+            ws.write_formula(first + i, 0, f"=({lo})+{i}*{step}", fmt, float(values[i]))
+        ws.write_formula(first + n - 1, 0, f"=({hi})", fmt, float(values[-1]))
+        self.formula_cells += n
+        ws.write_comment(
+            first - 1,
+            0,
+            f"Live range {spec.range.text}: its bounds follow the inputs, but the number of "
+            f"rows ({n}) was fixed when the workbook was written; if an edit changes it, "
+            "regenerate (workbook run --inputs edited.xlsx).",
+        )
+
+    def _live_bounds(self, rng) -> tuple[str, str | None, str] | None:
+        """Excel texts of a range's bounds in the variable's unit, or None when the bounds are
+        constants (written as numbers) or cannot be live formulas."""
+        nodes = (rng.first, rng.second, rng.last)
+        names = set().union(*(tc.dependencies(self.sheet.spec, x) for x in nodes if x))
+        if not names & (set(self.sheet.spec.inputs) | set(self.sheet.spec.definitions)):
+            return None
+        arg = self.sheet.spec.arguments.get(rng.var)
+        dimensionless = un.registry().dimensionless
+        texts = []
+        for node in nodes:
+            if node is None:
+                texts.append(None)
+                continue
+            t = self.sheet.typer.expression(node, {}, f"range {rng.text}")
+            if arg is not None and (t.unit.dimensionality or t.unit != dimensionless):
+                t = self.sheet.typer._convert(t, arg.unit, f"range {rng.text}")
+            try:
+                texts.append(self.printer.formula(t, {})[1:])
+            except NotLive:
+                return None
+        return texts[0], texts[1], texts[2]
 
     def _write_column(self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n):
         fmt = self.fmt["value"]
@@ -661,6 +710,10 @@ def needed_names(sheet) -> set[str]:
             if s.table is None:
                 rng = s.range or c.range
                 roots.append(sheet.column_node(s.y, rng.var))
+                roots += [n for n in (rng.first, rng.second, rng.last) if n is not None]
+                x = _x_column(c, s, rng)
+                if x is not None:
+                    roots.append(sheet.column_node(x, rng.var))
     for p in sheet.spec.printed:
         from .checks import read_printed
 
