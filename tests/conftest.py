@@ -15,6 +15,29 @@ def concave():
     return workbook.load("concave-cam")
 
 
+# The smallest sheet with an input, an argument and a function: tests add tables and charts.
+SINE = """
+[inputs]
+R = "10 mm"
+
+[arguments]
+phi = { unit = "deg" }
+
+[definitions]
+"y(phi)" = "R*sin(phi)"
+"""
+
+SINE_TABLE = (
+    SINE
+    + """
+[[tables]]
+name = "t"
+range = "phi := 0, 10 .. 90"
+columns = { y = "mm" }
+"""
+)
+
+
 def write_template(tmp_path: Path, text: str, name: str = "t.toml") -> Path:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")

@@ -16,21 +16,15 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import SINE
 
 from workbook import xlsx
 from workbook.cli import main
 
-TEMPLATE = """
-[inputs]
-R = "10 mm"
-
-[arguments]
-phi = { unit = "deg" }
-
-[definitions]
-"y(phi)" = "R*sin(phi)"
-area = "R^2"
-
+TEMPLATE = (
+    SINE
+    + 'area = "R^2"\n'
+    + """
 [[tables]]
 name = "t"
 range = "phi := 0, 10 .. 90"
@@ -42,6 +36,7 @@ title = "y"
 range = "phi := 0 .. 90"
 series = [{ y = "y", unit = "mm", name = "y" }]
 """
+)
 
 
 def digest(path: Path) -> str:

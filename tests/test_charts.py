@@ -6,20 +6,13 @@ import zipfile
 import numpy as np
 import openpyxl
 import pytest
-from conftest import write_template
+from conftest import SINE, write_template
 
 import workbook
 
-CIRCLE = """
-[inputs]
-R = "10 mm"
-
-[arguments]
-phi = { unit = "deg" }
-
-[definitions]
-"y(phi)" = "R*sin(phi)"
-
+CIRCLE = (
+    SINE
+    + """
 [[tables]]
 name = "t"
 range = "phi := 0, 30 .. 360"
@@ -39,6 +32,7 @@ range = "phi := 0, 30 .. 360"
 x = { expr = "2*phi", title = "twice the angle, deg" }
 series = [{ y = "y", unit = "mm", name = "y" }]
 """
+)
 
 
 def series_refs(path) -> list[tuple[str, str]]:

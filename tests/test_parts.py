@@ -123,22 +123,25 @@ def test_bad_part_name(tmp_path):
         workbook.load(write_template(tmp_path, text))
 
 
-def test_chart_of_a_part_table_must_be_in_the_part(tmp_path):
-    text = BASE + (
-        '\n[parts]\nstudy = "a study"\n\n[[tables]]\nname = "b"\npart = "study"\n'
-        'block = "concave.stability"\n\n[[charts]]\nname = "c"\n'
-        'series = [{ table = "b", x = "phi [deg]", y = "as printed" }]\n'
-    )
-    with pytest.raises(TemplateError, match='give the chart part = "study" too'):
-        workbook.load(write_template(tmp_path, text))
-
-
-def test_units_of_a_left_out_part_are_still_checked(tmp_path):
-    text = BASE + (
-        '\n[parts]\nstudy = "a study"\n\n[[tables]]\nname = "t"\npart = "study"\n'
-        'range = "phi := 0 .. 9"\ncolumns = { "y(phi) + 1" = "mm" }\n'
-    )
-    with pytest.raises(workbook.WorkbookError, match="unit"):
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (  # a chart drawing a block table of a part must be in the part
+            '[[tables]]\nname = "b"\npart = "study"\nblock = "concave.stability"\n\n'
+            '[[charts]]\nname = "c"\n'
+            'series = [{ table = "b", x = "phi [deg]", y = "as printed" }]\n',
+            'give the chart part = "study" too',
+        ),
+        (  # units are checked in every part, chosen or not
+            '[[tables]]\nname = "t"\npart = "study"\nrange = "phi := 0 .. 9"\n'
+            'columns = { "y(phi) + 1" = "mm" }\n',
+            "unit",
+        ),
+    ],
+)
+def test_a_part_is_checked_at_load_even_when_left_out(tmp_path, extra, message):
+    text = BASE + '\n[parts]\nstudy = "a study"\n\n' + extra
+    with pytest.raises(workbook.WorkbookError, match=message):
         workbook.load(write_template(tmp_path, text))
 
 

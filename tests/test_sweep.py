@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import write_template
+from conftest import SINE_TABLE, write_template
 
 import workbook
 from workbook import sweep as sw
@@ -113,24 +113,7 @@ def test_vector_blocks_split_around_failing_cases(concave, monkeypatch):
 
 
 def test_a_table_aggregate_is_not_vectorised(tmp_path):
-    path = write_template(
-        tmp_path,
-        """
-[inputs]
-R = "10 mm"
-
-[arguments]
-phi = { unit = "deg" }
-
-[definitions]
-"y(phi)" = "R*sin(phi)"
-
-[[tables]]
-name = "t"
-range = "phi := 0, 10 .. 90"
-columns = { y = "mm" }
-""",
-    )
+    path = write_template(tmp_path, SINE_TABLE)
     sheet = workbook.load(path)
     res = sw.sweep(sheet, {"R": "10mm,20mm"}, {"top": "max_over(t, y)"})
     assert res.mode == "serial"
