@@ -41,7 +41,8 @@ def quad_ts(wb=0.0, wn=0.0):
 
 @pytest.fixture(scope="module")
 def valve():
-    return workbook.load("cam-wear-valve")
+    """With the optional part studies (left out by a plain load)."""
+    return workbook.load("cam-wear-valve", parts="all")
 
 
 @pytest.fixture(scope="module")

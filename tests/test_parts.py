@@ -159,6 +159,7 @@ SCENE_PARTS = {
     "concave-cam-geometry": {"hand-checks"},
     "r0-synthesis": {"studies"},
     "advance-coupling": {"studies"},
+    "cam-wear-valve": {"studies"},
 }
 
 
