@@ -262,28 +262,31 @@ class Sheet:
         except WorkbookError as err:
             raise self._locate(err, what) from None
 
-    def _range_values(self, rng: RangeSpec, what: str) -> np.ndarray:
+    def range_bounds(self, rng: RangeSpec, what: str = "range") -> list[tc.T | None]:
+        """The typed first, second (or None) and last value of a range, in the range
+        variable's declared unit (a plain number is taken as already in it)."""
         spec = self.spec.arguments.get(rng.var)
-        nums = []
+        dimensionless = un.registry().dimensionless
+        out: list[tc.T | None] = []
         for node in (rng.first, rng.second, rng.last):
             if node is None:
-                nums.append(None)
+                out.append(None)
                 continue
             t = self.typer.expression(node, {}, what)
-            v = float(self.evaluator.compile(t)({}))
-            if t.unit.dimensionality:
-                if spec is None:
-                    raise TemplateError(
-                        f"{what}: range bound has units but '{rng.var}' has no declared unit"
-                    )
-                v *= un.factor(t.unit, spec.unit)
-            elif (
-                spec is not None
-                and spec.unit != t.unit
-                and not (t.unit == un.registry().dimensionless)
-            ):
-                v *= un.factor(t.unit, spec.unit)
-            nums.append(v)
+            if t.unit.dimensionality and spec is None:
+                raise TemplateError(
+                    f"{what}: range bound has units but '{rng.var}' has no declared unit"
+                )
+            if spec is not None and (t.unit.dimensionality or t.unit != dimensionless):
+                t = self.typer._convert(t, spec.unit, what)
+            out.append(t)
+        return out
+
+    def _range_values(self, rng: RangeSpec, what: str) -> np.ndarray:
+        nums = [
+            None if t is None else float(self.evaluator.compile(t)({}))
+            for t in self.range_bounds(rng, what)
+        ]
         return range_values(nums[0], nums[1], nums[2], what=what)
 
     def _scope(self, var: str) -> dict:

@@ -319,20 +319,13 @@ class WorkbookWriter:
         names = set().union(*(tc.dependencies(self.sheet.spec, x) for x in nodes if x))
         if not names & (set(self.sheet.spec.inputs) | set(self.sheet.spec.definitions)):
             return None
-        arg = self.sheet.spec.arguments.get(rng.var)
-        dimensionless = un.registry().dimensionless
-        texts = []
-        for node in nodes:
-            if node is None:
-                texts.append(None)
-                continue
-            t = self.sheet.typer.expression(node, {}, f"range {rng.text}")
-            if arg is not None and (t.unit.dimensionality or t.unit != dimensionless):
-                t = self.sheet.typer._convert(t, arg.unit, f"range {rng.text}")
-            try:
-                texts.append(self.printer.formula(t, {})[1:])
-            except NotLive:
-                return None
+        try:
+            texts = [
+                None if t is None else self.printer.formula(t, {})[1:]
+                for t in self.sheet.range_bounds(rng, f"range {rng.text}")
+            ]
+        except NotLive:
+            return None
         return texts[0], texts[1], texts[2]
 
     def _write_column(self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n):
