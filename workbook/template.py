@@ -514,11 +514,6 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         names_seen.add(t.name)
     parts = _parts(_table(data, "parts"), text)
     _assign_parts(data, parts, text, tables, charts, printed, relations)
-    if isinstance(sheet.get("hand_checks"), str) and sheet["hand_checks"] not in parts:
-        raise TemplateError(
-            f"[sheet] hand_checks names no part declared in [parts]: {sheet['hand_checks']!r}",
-            line=find_line(text, "hand_checks", "sheet"),
-        )
 
     return SheetSpec(
         name=str(sheet.get("name", name)),
@@ -560,9 +555,9 @@ def _parts(raw: dict, text: str) -> dict[str, PartSpec]:
 
 
 def _assign_parts(data: dict, parts: dict[str, PartSpec], text: str, *specs: list) -> None:
-    """Set ``part`` on every table, chart, printed file and relation that names one; a section
-    may name only a declared part, and a chart may not draw a table that is left out more often
-    than the chart itself."""
+    """Set ``part`` on every table, chart, printed file and relation that names one. A section
+    may name only a declared part, and a chart that draws a block table of a part must be in
+    that part (else it would draw a table that was not written)."""
     sections = ("tables", "charts", "printed", "relations")
     for section, items in zip(sections, specs):
         for item, raw in zip(items, _list(data, section)):
@@ -603,9 +598,6 @@ def select_parts(spec: SheetSpec, chosen: frozenset[str]) -> SheetSpec:
     def keep(part) -> bool:
         return part is None or part in chosen
 
-    meta = dict(spec.meta)
-    if isinstance(meta.get("hand_checks"), str) and meta["hand_checks"] not in chosen:
-        meta["hand_checks"] = False
     return replace(
         spec,
         tables=[t for t in spec.tables if keep(t.part)],
@@ -613,7 +605,6 @@ def select_parts(spec: SheetSpec, chosen: frozenset[str]) -> SheetSpec:
         printed=[p for p in spec.printed if keep(p.part)],
         relations=[r for r in spec.relations if keep(r.part)],
         findings=[f for f in spec.findings if keep(f.get("part"))],
-        meta=meta,
     )
 
 
