@@ -274,7 +274,7 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(
             f"workbook: internal error ({type(exc).__name__}: {exc}); this is a bug in workbook, "
-            "not in your worksheet; no output file was changed. Rerun with --debug for the "
+            "not in your worksheet; no file was left half-written. Rerun with --debug for the "
             "traceback and report it.",
             file=sys.stderr,
         )
