@@ -26,7 +26,7 @@ from .solvers import METHODS, OdeRun, run_ode, stable_root, work_precision
 # ---------------------------------------------------------------------------------------------
 # parameters
 # ---------------------------------------------------------------------------------------------
-_SI = {
+_STEADY_SI = {  # the data of the steady equilibrium, in the SI units the blocks take
     "m": "kg",
     "c1": "N/m",
     "phi20": "rad",
@@ -38,6 +38,9 @@ _SI = {
     "O1B": "m",
     "tan_gamma": "",
     "M_D0": "N*m",
+}
+_SI = {
+    **_STEADY_SI,
     "J1": "kg*m^2",
     "J3": "kg*m^2",
     "Jx": "kg*m^2",
@@ -185,20 +188,7 @@ def linear_phi2(w: float, p: Params, form: str = "printed") -> Linear:
     return Linear(value, N, D)
 
 
-_STEADY_ARGS = {
-    "omega1": "rad/s",
-    "m": "kg",
-    "c1": "N/m",
-    "phi20": "rad",
-    "lam_st": "m",
-    "O1O": "m",
-    "OC": "m",
-    "OC1": "m",
-    "OB": "m",
-    "O1B": "m",
-    "tan_gamma": "",
-    "M_D0": "N*m",
-}
+_STEADY_ARGS = {"omega1": "rad/s", **_STEADY_SI}
 
 
 @block(args=_STEADY_ARGS, returns="rad", vectorized=False)
