@@ -35,6 +35,13 @@ class Result:
         )
 
 
+def report(results: list[Result]) -> int:
+    """Print each result line; the exit status: 1 if a target is missed, else 0."""
+    for r in results:
+        print(r.line())
+    return 0 if all(r.ok for r in results) else 1
+
+
 def alternate(engine, plain, reps: int = 5, warmup: int = 1) -> tuple[list[float], list[float]]:
     """Time ``engine()`` and ``plain()`` alternately (engine first, then plain first, ...)."""
     for _ in range(warmup):

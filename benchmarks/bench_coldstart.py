@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _timing import Result, median, ms, run_seconds, workbook_command  # noqa: E402
+from _timing import Result, median, ms, report, run_seconds, workbook_command  # noqa: E402
 
 TARGET = 2.0
 BARE = [sys.executable, "-c", "import numpy, pint, xlsxwriter"]
@@ -122,11 +122,10 @@ def main(argv=None) -> int:
     ap.add_argument("--reps", type=int, default=7)
     args = ap.parse_args(argv)
     results = run(args.reps)
-    for r in results:
-        print(r.line())
+    status = report(results)
     print("  one cold run, in stages:", stages())
     print("  the same with --part all:", stages(parts=("all",)))
-    return 0 if all(r.ok for r in results) else 1
+    return status
 
 
 if __name__ == "__main__":

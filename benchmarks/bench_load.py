@@ -15,7 +15,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _timing import Result, median, ms, run_seconds  # noqa: E402
+from _timing import Result, median, ms, report, run_seconds  # noqa: E402
 from bench_coldstart import engine_command  # noqa: E402
 
 TARGET = 1.0
@@ -78,9 +78,7 @@ def main(argv=None) -> int:
     ap.add_argument("--reps", type=int, default=5)
     args = ap.parse_args(argv)
     results = run(args.reps)
-    for r in results:
-        print(r.line())
-    return 0 if all(r.ok for r in results) else 1
+    return report(results)
 
 
 if __name__ == "__main__":

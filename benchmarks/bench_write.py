@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _timing import Result, alternate, median, ms  # noqa: E402
+from _timing import Result, alternate, median, ms, report  # noqa: E402
 
 TARGET = 1.3
 
@@ -171,9 +171,7 @@ def main(argv=None) -> int:
     ap.add_argument("--reps", type=int, default=5)
     args = ap.parse_args(argv)
     results = run(args.rows, args.reps)
-    for r in results:
-        print(r.line())
-    return 0 if all(r.ok for r in results) else 1
+    return report(results)
 
 
 if __name__ == "__main__":
