@@ -106,7 +106,7 @@ def test_vector_blocks_split_around_failing_cases(concave, monkeypatch):
     serial = sw.sweep(concave, grid, outs, mode="serial").table
     assert 0 < serial["error"].notna().sum() < len(serial)
     for points in (1_000_000, 2000, 209):  # one block; several; one case per block
-        monkeypatch.setattr(sw, "VECTOR_POINTS", points)
+        monkeypatch.setattr(sw.vector, "VECTOR_POINTS", points)
         res = sw.sweep(concave, grid, outs)
         assert res.mode == "vector"
         pd.testing.assert_frame_equal(res.table, serial, check_exact=True)

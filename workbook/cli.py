@@ -226,6 +226,52 @@ def cmd_bench(args) -> int:
     return EXIT_OK
 
 
+def cmd_sweep(args) -> int:
+    """``workbook sweep NAME --vary R3=40mm..60mm:21 [--output NAME=EXPR] [--out FILE]``."""
+    import math
+
+    from .atomic import check_target
+    from .errors import InputError
+    from .sweep import Progress, parse_output_option, parse_vary, sweep, write
+
+    sheet = load_sheet(args)
+    if not args.vary:
+        raise InputError("give at least one --vary NAME=FIRST..LAST:COUNT, e.g. R3=40mm..60mm:21")
+    varies = [parse_vary(item, sheet) for item in args.vary]
+    outputs = [parse_output_option(o) for o in args.output] if args.output else None
+    out = Path(args.out) if args.out else Path("reports") / f"{sheet.name}.sweep.xlsx"
+    if not args.out:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    check_target(out, kind="csv" if out.suffix.lower() == ".csv" else "xlsx", force=args.force)
+    progress = Progress(math.prod(len(v.values) for v in varies))
+    result = sweep(
+        sheet,
+        varies,
+        outputs,
+        mode=args.mode,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        progress=progress,
+    )
+    write(result, out, force=args.force, command=_sweep_command_line(args))
+    print(f"wrote {out}: {result.summary()}")
+    for i, err in enumerate(result.table["error"]):
+        if err is not None:
+            case = ", ".join(
+                f"{h} = {result.table.iloc[i][h]}" for h in result.table.columns[: len(varies)]
+            )
+            print(f"  case {i + 1} ({case}) failed: {err}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _sweep_command_line(args) -> str:
+    parts = ["workbook", "sweep", args.name]
+    parts += [f'--set "{s}"' for s in args.set]
+    parts += [f"--vary {v}" for v in args.vary]
+    parts += [f'--output "{o}"' for o in args.output]
+    return " ".join(parts)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     if args.version:
@@ -236,14 +282,16 @@ def main(argv: list[str] | None = None) -> int:
     if not args.command:
         _parser().print_help()
         return EXIT_INPUT
-    handler = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "bench": cmd_bench}.get(
-        args.command
-    )
-    if handler is None:  # imported only when used: sweep pulls in sympy
-        if args.command == "sweep":
-            from .sweep import cmd_sweep as handler
-        else:
-            from .scaffold import cmd_new as handler
+    if args.command == "new":
+        from .scaffold import cmd_new as handler
+    else:
+        handler = {
+            "list": cmd_list,
+            "run": cmd_run,
+            "check": cmd_check,
+            "bench": cmd_bench,
+            "sweep": cmd_sweep,
+        }[args.command]
     from .errors import WorkbookError
 
     if not args.debug:  # the engine reports non-finite results itself, with the arguments

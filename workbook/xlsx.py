@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from . import __version__, style
 from . import expr as ex
 from . import typecheck as tc
 from . import units as un
@@ -115,7 +115,7 @@ class WorkbookWriter:
             }
         )
         self.printer = ExcelPrinter(sheet.typer)
-        self.fmt = self._formats()
+        self.fmt = style.add_formats(self.wb)
         self.columns: dict[tuple, ColumnCells] = {}
         self.block_columns: dict[tuple[str, str], ColumnCells] = {}
         self.sheets: dict[str, object] = {}
@@ -123,29 +123,6 @@ class WorkbookWriter:
         self.not_live: list[str] = []
         self.formula_cells = 0
         self.planned: dict[tuple[str, str], ColumnCells] = {}
-
-    def _formats(self):
-        add = self.wb.add_format
-        return {
-            "title": add({"bold": True, "font_size": 13}),
-            "header": add({"bold": True, "bottom": 1, "text_wrap": True, "valign": "top"}),
-            "input": add(
-                {
-                    "bg_color": "#FFF2CC",
-                    "font_color": "#0000FF",
-                    "border": 1,
-                    "num_format": "General",
-                }
-            ),
-            "value": add({"num_format": "0.000###"}),
-            "number": add({"num_format": "General"}),
-            "note": add({"italic": True, "font_color": "#595959"}),
-            "pct": add({"num_format": "0.000%"}),
-            "sci": add({"num_format": "0.00E+00"}),
-            "pass": add({"font_color": "#006100", "bg_color": "#C6EFCE"}),
-            "fail": add({"font_color": "#9C0006", "bg_color": "#FFC7CE"}),
-            "wrap": add({"text_wrap": True, "valign": "top"}),
-        }
 
     def ws(self, name: str):
         if name not in self.sheets:
@@ -443,7 +420,7 @@ class WorkbookWriter:
         ws = self.ws("Charts")
         row = 0
         for chart in self.sheet.spec.charts:
-            c = self.wb.add_chart({"type": "scatter", "subtype": "straight"})
+            c = style.scatter_chart(self.wb)
             for i, s in enumerate(chart.series):
                 xcells, ycells = cells[(chart.name, i)]
                 line = {"width": 2.0}
@@ -458,40 +435,32 @@ class WorkbookWriter:
                     "categories": _range_ref(xcells),
                     "values": _range_ref(ycells),
                     "line": line,
-                    "marker": {"type": "circle", "size": 4} if s.marker else {"type": "none"},
+                    "marker": style.MARKER if s.marker else style.NO_MARKER,
                 }
                 if s.axis == "secondary":
                     opts["y2_axis"] = True
                 c.add_series(opts)
             c.set_title({"name": chart.title})
-            xaxis = {
-                "name": chart.x_title or (chart.x.title if chart.x else ""),
-                "label_position": "low",
-                "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}},
-            }
-            yaxis = {
-                "name": chart.y_title,
-                "major_gridlines": {"visible": True, "line": {"color": "#D9D9D9"}},
-            }
+            xaxis = style.axis(
+                chart.x_title or (chart.x.title if chart.x else ""), label_position="low"
+            )
+            yaxis = style.axis(chart.y_title)
             if chart.log_x:
                 xaxis["log_base"] = 10
             if chart.log_y:
                 yaxis["log_base"] = 10
-            size = {"width": 760, "height": 430}
+            size = style.CHART_SIZE
             if chart.equal_axes:
                 lo, hi = self._common_span(chart)
                 for axis in (xaxis, yaxis):
                     axis.update({"min": lo, "max": hi})
-                size = {"width": 620, "height": 620}
+                size = style.SQUARE_CHART_SIZE
                 c.set_plotarea({"layout": {"x": 0.12, "y": 0.1, "width": 0.76, "height": 0.76}})
             c.set_x_axis(xaxis)
             c.set_y_axis(yaxis)
             if any(s.axis == "secondary" for s in chart.series):
                 c.set_y2_axis({"name": chart.y2_title})
-            c.set_legend({"position": "bottom"})
-            c.set_size(size)
-            ws.insert_chart(row, 0, c)
-            row += int(size["height"] / 20) + 2
+            row = style.place_chart(ws, row, c, size)
 
     def _common_span(self, chart) -> tuple[float, float]:
         values = []

@@ -1,0 +1,172 @@
+"""Running cases one by one: in this process, in a process pool, or on a Dask cluster.
+
+Only plain data crosses process boundaries (the template's path and text, the input
+overrides, the output texts); each process loads the Sheet once.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .. import units as un
+from ..errors import InputError, WorkbookError
+from .outputs import Output, evaluate_outputs
+
+_SHEETS: dict[tuple[str, str], object] = {}
+
+
+def _sheet_for(path: str, text: str):
+    """The template's Sheet (with its own defaults), loaded once per process.
+
+    The task carries the template's text too: a worker that cannot read the same file
+    (a remote Dask worker) loads a copy of it.
+    """
+    import hashlib
+
+    key = (path, hashlib.sha256(text.encode("utf-8")).hexdigest())
+    if key not in _SHEETS:
+        import workbook
+
+        p = Path(path)
+        try:
+            same = p.is_file() and p.read_text(encoding="utf-8") == text
+        except OSError:
+            same = False
+        if not same:
+            import tempfile
+
+            p = Path(tempfile.mkdtemp(prefix="workbook-sweep-")) / Path(path).name
+            p.write_text(text, encoding="utf-8")
+        _SHEETS[key] = workbook.load(p)
+    return _SHEETS[key]
+
+
+def _prime(sheet) -> tuple[str, str]:
+    """Put ``sheet``'s template into this process's cache (forked workers inherit it)."""
+    import hashlib
+
+    from ..sheet import Sheet
+
+    path = str(Path(sheet.spec.path).resolve())
+    text = sheet.spec.text
+    key = (path, hashlib.sha256(text.encode("utf-8")).hexdigest())
+    if key not in _SHEETS:
+        _SHEETS[key] = Sheet(sheet.full_spec, None, sheet.typer, sheet.parts)
+    return path, text
+
+
+def _overrides(values: dict) -> dict:
+    out = {}
+    for name, v in values.items():
+        if isinstance(v, tuple):
+            mag, unit = v
+            if isinstance(mag, str):  # a choice
+                out[name] = mag
+            else:
+                out[name] = un.registry().Quantity(float(mag), unit) if unit else float(mag)
+        else:
+            out[name] = v
+    return out
+
+
+def run_case(task: tuple) -> tuple[int, dict | None, str | None, float]:
+    """One case: ``(index, (template_path, template_text), base_values, case_values, outputs)``.
+
+    Only plain data crosses process boundaries; the Sheet is loaded (once per process)
+    from the template path. Returns (index, values or None, error or None, seconds).
+    """
+    index, (path, text), base, case, outputs = task
+    start = time.perf_counter()
+    try:
+        sheet = _sheet_for(path, text)
+        sheet = sheet.with_inputs(**_overrides({**base, **case}))
+        outs = [Output.parse(n, text, unit) for n, text, unit in outputs]
+        with np.errstate(all="ignore"):  # a domain error is reported as this case's error
+            values = evaluate_outputs(sheet, outs)
+        return index, values, None, time.perf_counter() - start
+    except WorkbookError as err:
+        return index, None, getattr(err, "message", str(err)), time.perf_counter() - start
+    except Exception as err:  # a solver may fail in its own way; record it, go on
+        return index, None, f"{type(err).__name__}: {err}", time.perf_counter() - start
+
+
+def base_values(sheet) -> dict:
+    out = {}
+    for name, v in sheet.values.items():
+        out[name] = v if isinstance(v, str) else (float(v.magnitude), str(v.units))
+    return out
+
+
+def make_tasks(sheet, outs: list[Output], cases: list[dict]) -> list[tuple]:
+    template = _prime(sheet)
+    base = base_values(sheet)
+    spec = tuple((o.name, o.text, o.unit_text) for o in outs)
+    return [(i, template, base, case, spec) for i, case in enumerate(cases)]
+
+
+def run_tasks(tasks: list[tuple], mode: str, scheduler, workers: int | None, timeout: float = 20.0):
+    if mode == "serial" or (mode == "processes" and len(tasks) == 1):
+        for task in tasks:
+            yield run_case(task)
+        return
+    if mode == "processes":
+        import multiprocessing as mp
+        import threading
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures.process import BrokenProcessPool
+
+        # fork (the workers inherit the loaded sheet) when this process has no other
+        # threads to copy in a half-held state (a notebook or a Dask client has some)
+        methods = mp.get_all_start_methods()
+        if "fork" in methods and threading.active_count() == 1:
+            method = "fork"
+        else:
+            method = "forkserver" if "forkserver" in methods else "spawn"
+        n = max(1, min(workers or os.cpu_count() or 1, len(tasks)))
+        pool = ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context(method))
+        futures = {pool.submit(run_case, t): t[0] for t in tasks}
+        try:
+            for fut in as_completed(futures):
+                try:
+                    yield fut.result()
+                except BrokenProcessPool as err:  # a worker died (crash, out of memory)
+                    yield futures[fut], None, f"worker process died: {err}", 0.0
+        except BaseException:  # Ctrl-C or an error: do not wait for the queued cases
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
+        return
+    if mode == "dask":
+        yield from _run_dask(tasks, scheduler, timeout)
+        return
+    raise InputError(f"unknown sweep mode {mode!r}")
+
+
+def _run_dask(tasks: list[tuple], scheduler, timeout: float = 20.0):
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError:
+        raise InputError(
+            "--scheduler needs dask.distributed: pip install 'workbook[dask]'"
+        ) from None
+    own = not isinstance(scheduler, Client)
+    try:
+        client = Client(scheduler, timeout=f"{timeout}s") if own else scheduler
+    except OSError as err:
+        raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
+    try:
+        futures = client.map(run_case, tasks, pure=False)
+        for fut in as_completed(futures):
+            if fut.status == "error":
+                exc = fut.exception()
+                index = futures.index(fut)
+                yield index, None, f"{type(exc).__name__}: {exc}", 0.0
+            else:
+                yield fut.result()
+    finally:
+        if own:
+            client.close()

@@ -1,0 +1,159 @@
+"""Every case at once: the swept inputs become arrays that travel with the range variable."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import expr as ex
+from .. import typecheck as tc
+from .. import units as un
+from ..errors import InputError, WorkbookError
+from ..numeric import Evaluator
+from .grid import Vary
+from .outputs import Output, reduce_values, type_output
+
+VECTOR_POINTS = 1_000_000  # points (cases x range) evaluated per block
+
+
+class CaseEvaluator(Evaluator):
+    """Evaluate with some inputs as arrays that travel through every call with the arguments.
+
+    The swept inputs are entries of the environment (keys ``"\\x00NAME"``), so piecewise
+    functions mask them together with the range variable, point by point.
+    """
+
+    def __init__(self, sheet, swept: set[str]):
+        super().__init__(sheet.typer, sheet._scalar_value, sheet._describe)
+        self.spec = sheet.spec
+        self.swept = swept
+        self.keys = tuple("\x00" + n for n in sorted(swept))
+        self._depends: dict[str, bool] = {}
+
+    def depends(self, name: str) -> bool:
+        if name not in self._depends:
+            deps = tc.dependencies(self.spec, ex.Name(name))
+            self._depends[name] = bool(deps & self.swept)
+        return self._depends[name]
+
+    def compile(self, t):
+        if isinstance(t, tc.TRef):
+            if t.kind == "input" and t.name in self.swept:
+                key = "\x00" + t.name
+                return lambda env: env[key]
+            if t.kind == "definition" and self.depends(t.name):
+                return self.compile(self.typer.scalar(t.name))
+            return super().compile(t)
+        if isinstance(t, tc.TCall):
+            f = self.function(t.name)
+            params = self.typer.function(t.name).params
+            args = [self.compile(a) for a in t.args]
+            keys = self.keys
+
+            def call(env):
+                inner = {p: a(env) for p, a in zip(params, args)}
+                for k in keys:
+                    inner[k] = env[k]
+                return f(inner)
+
+            return call
+        return super().compile(t)
+
+
+def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[str]:
+    """Why the outputs cannot be computed for all cases at once (empty: they can)."""
+    why = []
+    for v in varies:
+        if sheet.spec.inputs[v.name].options:
+            why.append(f"{v.name} is a choice")
+    swept = {v.name for v in varies}
+    for out in outputs:
+        deps = tc.dependencies(sheet.spec, out.node, (out.range.var,) if out.range else ())
+        blocks = sorted(deps & set(sheet.spec.blocks))
+        if blocks:
+            why.append(f"{out.name} needs the solver block(s) {', '.join(blocks)}")
+        aggregates = sorted(deps & {"max_over", "min_over"} - set(sheet.spec.definitions))
+        if aggregates:
+            why.append(f"{out.name} uses the table aggregate {', '.join(aggregates)}()")
+        if out.range is not None:
+            for node in (out.range.first, out.range.second, out.range.last):
+                if node is not None and tc.dependencies(sheet.spec, node) & swept:
+                    why.append(f"the range of {out.name} depends on a swept input")
+                    break
+    return why
+
+
+def vector_cases(sheet, outputs: list[Output], varies: list[Vary], cases: list[dict], one=None):
+    """All cases at once, in blocks; returns (values per case, errors per case).
+
+    A block in which some case leaves a formula's domain is done again case by case with
+    ``one(i) -> (values, error)``, so that the failing case gets its own error.
+    """
+    from ..sheet import coerce_input
+
+    n = len(cases)
+    swept = {v.name for v in varies}
+    errors: list[str | None] = [None] * n
+    mags = {name: np.empty(n) for name in swept}
+    for i, case in enumerate(cases):
+        for name, (mag, unit) in case.items():
+            spec = sheet.spec.inputs[name]
+            try:
+                q = coerce_input(spec, un.registry().Quantity(float(mag), unit))
+                mags[name][i] = float(q.magnitude)
+            except WorkbookError as err:
+                errors[i] = err.message
+                mags[name][i] = float(sheet.values[name].magnitude)  # a placeholder
+    ok = np.flatnonzero([e is None for e in errors])
+    ev = CaseEvaluator(sheet, swept)
+    typed = [(out, type_output(sheet, out)) for out in outputs]
+    fns = [ev.compile(t.t) for _, t in typed]
+    grids = [
+        None if out.range is None else sheet.range_values(out.range, f"sweep output {out.name}")
+        for out in outputs
+    ]
+    points = max([1] + [len(g) for g in grids if g is not None])
+    chunk = max(1, VECTOR_POINTS // points)  # cases per block: bounded memory
+    results: list[dict | None] = [None] * n
+    bad = (WorkbookError, FloatingPointError, ValueError, ZeroDivisionError)
+
+    def solve(idx):
+        try:
+            cols = vector_block(mags, idx, typed, fns, grids)
+        except bad:
+            if one is None:
+                raise
+            if len(idx) == 1:  # the failing case, evaluated alone for its own error
+                results[idx[0]], errors[idx[0]] = one(idx[0])
+                return
+            half = len(idx) // 2  # halve the block until the failing cases are alone
+            solve(idx[:half])
+            solve(idx[half:])
+            return
+        for j, i in enumerate(idx):
+            results[i] = {name: float(cols[name][j]) for name in cols}
+
+    for lo in range(0, len(ok), chunk):
+        solve(ok[lo : lo + chunk])
+    return results, errors
+
+
+def vector_block(mags, idx, typed, fns, grids) -> dict:
+    """The outputs of the cases ``idx`` at once (raises if any value is not finite)."""
+    m = len(idx)
+    cols = {}
+    for (out, t), fn, g in zip(typed, fns, grids):
+        env = {"\x00" + k: v[idx] for k, v in mags.items()}
+        if g is None:
+            vals = np.broadcast_to(np.asarray(fn(env), dtype=float), (m,)).copy()
+        else:
+            env = {k: np.repeat(v, len(g)) for k, v in env.items()}
+            env[out.range.var] = np.tile(g, m)
+            flat = np.broadcast_to(np.asarray(fn(env), dtype=float), (m * len(g),))
+            if not np.all(np.isfinite(flat)):
+                raise InputError("not finite")
+            vals = reduce_values(out.reduction, flat.reshape(m, len(g)), g, axis=1)
+        vals = vals * t.factor
+        if not np.all(np.isfinite(vals)):
+            raise InputError("not finite")
+        cols[out.name] = vals
+    return cols
