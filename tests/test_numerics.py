@@ -1,0 +1,128 @@
+"""The numerical engine (workbook.numerics) against scipy's scalar routines and mpmath."""
+
+import mpmath
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from workbook.numerics import NumericsError, Tolerance
+from workbook.numerics.extrema import extremum
+from workbook.numerics.given import solve
+from workbook.numerics.interpolate import interpolate
+from workbook.numerics.quadrature import integrate
+from workbook.numerics.roots import root_in, root_near
+from workbook.numerics.series import reduce
+
+TIGHT = Tolerance(rtol=1e-13)
+
+
+def colebrook(f, re, rr):
+    return 1 / np.sqrt(f) + 2 * np.log10(rr / 3.7 + 2.51 / (re * np.sqrt(f)))
+
+
+def test_root_in_every_row_matches_brentq():
+    re = np.geomspace(4e3, 1e8, 50)
+    got = root_in(colebrook, 0.005, 0.1, (re, 1e-4), TIGHT)
+    want = [brentq(colebrook, 0.005, 0.1, args=(r, 1e-4), xtol=1e-15, rtol=1e-15) for r in re]
+    assert np.max(np.abs(got.value - want) / want) < 1e-12
+    assert np.all(got.error >= np.abs(got.value - want))  # the estimate is a bound
+    assert np.all(got.error < 1e-8 * got.value)
+
+
+def test_root_near_guess_matches_mpmath():
+    c = np.array([0.5, 1.0, 3.0])
+    got = root_near(lambda x, c: np.cos(x) - c * x, 1.0, (c,), TIGHT)
+    for x, ci in zip(got.value, c):
+        ref = mpmath.findroot(lambda t, ci=ci: mpmath.cos(t) - ci * t, 1.0, tol=1e-30)
+        assert x == pytest.approx(float(ref), rel=1e-13)
+
+
+def test_root_without_sign_change_lists_samples():
+    with pytest.raises(NumericsError, match=r"no sign change .* signs \+{17}"):
+        root_in(lambda x: x**2 + 1, -3, 3, var="x")
+
+
+def test_root_with_two_roots_is_refused():
+    with pytest.raises(NumericsError, match="more than one root"):
+        root_in(lambda x: x**2 - 1, -3, 3)
+
+
+def test_root_near_without_bracket():
+    with pytest.raises(NumericsError, match="no sign change found searching out"):
+        root_near(lambda x: x**2 + 1, 1.0)
+
+
+def test_integral_matches_quad_and_splits_at_kinks():
+    c = np.linspace(0.1, 0.9, 9)
+    got = integrate(lambda x, c: np.abs(x - c) * np.exp(x), 0.0, 2.0, (c,), TIGHT, breaks=(c,))
+    for v, e, ci in zip(got.value, got.error, c):
+        want = quad(
+            lambda x, ci=ci: abs(x - ci) * np.exp(x), 0, 2, points=[ci], epsabs=0, epsrel=1e-13
+        )
+        assert v == pytest.approx(want[0], rel=1e-12)
+        assert e < 1e-10
+
+
+def test_integral_reversed_bounds_and_mpmath():
+    got = integrate(lambda x: 1 / (1 + x**2), 1.0, 0.0, (), TIGHT)
+    assert float(got.value) == pytest.approx(-float(mpmath.pi / 4), rel=1e-14)
+
+
+def test_divergent_integral_is_an_error():
+    with pytest.raises(NumericsError, match="divergent"):
+        integrate(lambda x: 1 / x, 0.0, 1.0)
+
+
+def test_extremum_is_global_among_local_ones():
+    c = np.array([0.0, 0.1, -0.5])
+    got = extremum(lambda x, c: np.sin(x) + c * x, 0.0, 10.0, (c,), kind="max")
+    for v, w, ci in zip(got.value, got.where, c):
+        xs = np.linspace(0, 10, 200001)
+        ys = np.sin(xs) + ci * xs
+        assert v == pytest.approx(ys.max(), abs=1e-9)
+        assert w == pytest.approx(xs[ys.argmax()], abs=1e-4)
+    f = lambda x: mpmath.sin(x) + mpmath.mpf("0.1") * x  # noqa: E731
+    ref = mpmath.findroot(lambda x: mpmath.diff(f, x), 7.95)
+    assert got.where[1] == pytest.approx(float(ref), rel=1e-7)
+    assert got.value[1] == pytest.approx(float(f(ref)), rel=1e-14)
+
+
+def test_flat_argmax_is_an_error():
+    with pytest.raises(NumericsError, match="flat"):
+        extremum(lambda x: 0 * x + 2.0, 0.0, 1.0, need_where=True)
+
+
+def test_sum_and_product_match_python():
+    n = np.array([0, 1, 5, 10])
+    s = reduce(lambda i, n: 1 / (i + 1) ** 2, 0, n, (n,), kind="sum")
+    assert s.value == pytest.approx([sum(1 / (i + 1) ** 2 for i in range(k + 1)) for k in n])
+    p = reduce(lambda i: i, 1, n, kind="product")
+    assert p.value == pytest.approx([1, 1, 120, 3628800])
+
+
+def test_solve_circle_and_line():
+    R, th = 2.0, 0.3
+
+    def res(z):
+        x, y = z
+        return [(x**2 + y**2 - R**2) / R**2, (y - x * np.tan(th)) / R]
+
+    got = solve(res, [1, 0.5], [1, 0.5], names="xy", equations=["x^2+y^2==R^2", "y==x*tan"])
+    assert got.value == pytest.approx([R * np.cos(th), R * np.sin(th)], rel=1e-12)
+
+
+def test_solve_not_converging_shows_residuals():
+    with pytest.raises(NumericsError, match="residual"):
+        solve(lambda z: [z[0] ** 2 + 1], [1.0], [1.0], names="x", equations=["x^2 + 1 == 0"])
+
+
+def test_interpolation_linear_and_cubic():
+    xs = np.linspace(0, 3, 7)
+    ys = xs**3
+    assert interpolate(xs, ys, 1.2) == pytest.approx(np.interp(1.2, xs, ys))
+    assert interpolate(xs, ys, np.array([1.2, 2.9]), kind="cubic") == pytest.approx(
+        [1.2**3, 2.9**3], rel=1e-12
+    )
+    with pytest.raises(NumericsError, match="outside the data"):
+        interpolate(xs, ys, 3.5)

@@ -1,0 +1,104 @@
+"""What every primitive shares: tolerances, the result with its error, the error type."""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..errors import DomainError
+
+Fn = Callable[..., object]
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """Tolerances of the numerical built-ins (``[sheet] tolerance`` sets ``rtol``).
+
+    ``rtol`` is relative to the result, ``atol`` absolute (in the unit of the result, 0: none);
+    ``samples`` is the number of intervals a bracket is sampled at (sign changes, extrema).
+    """
+
+    rtol: float = 1e-10
+    atol: float = 0.0
+    samples: int = 16
+
+    def tighter(self, rtol: float = 1e-14) -> Tolerance:
+        """The same sampling at a tighter tolerance (the reference of ``workbook bench``)."""
+        return replace(self, rtol=rtol, atol=0.0)
+
+
+class NumericsError(DomainError):
+    """A numerical built-in cannot give a trustworthy value (no root, divergent integral...)."""
+
+    kind = "numerical error"
+
+
+@dataclass
+class Result:
+    """Values (one per row), their estimated absolute errors, and where an extremum is."""
+
+    value: np.ndarray
+    error: np.ndarray
+    where: np.ndarray | None = None  # argmax/argmin for extrema
+    where_error: np.ndarray | None = None
+    evaluations: int = 0  # largest number of function evaluations of a row
+    notes: dict = field(default_factory=dict)
+
+
+_current: contextvars.ContextVar[Tolerance | None] = contextvars.ContextVar(
+    "workbook_numerics_tolerance", default=None
+)
+
+
+def current(default: Tolerance) -> Tolerance:
+    """The tolerance in force: an override set by :func:`tolerance`, else ``default``."""
+    return _current.get() or default
+
+
+@contextlib.contextmanager
+def tolerance(tol: Tolerance) -> Iterator[None]:
+    """Evaluate with ``tol`` instead of the sheet's tolerance (``workbook bench``'s reference)."""
+    token = _current.set(tol)
+    try:
+        yield
+    finally:
+        _current.reset(token)
+
+
+def rows(*arrays) -> tuple[tuple[int, ...], list[np.ndarray]]:
+    """Broadcast bounds and arguments to one shape; return it and the arrays flattened."""
+    arrs = np.broadcast_arrays(*[np.asarray(a, dtype=float) for a in arrays])
+    shape = arrs[0].shape
+    return shape, [np.ascontiguousarray(a).reshape(-1) for a in arrs]
+
+
+def call(f: Fn, x: np.ndarray, args: list[np.ndarray]) -> np.ndarray:
+    """``f(x, *args)`` as a float array of x's shape (a constant f is broadcast)."""
+    out = np.asarray(f(x, *args), dtype=float)
+    return np.broadcast_to(out, np.shape(x)) if out.shape != np.shape(x) else out
+
+
+def num(v: float) -> str:
+    """A number as messages print it."""
+    return f"{float(v):.6g}"
+
+
+def row_text(label: Callable[[int], str] | None, i: int, n: int) -> str:
+    """' (for ROW)' naming row ``i`` of ``n`` in messages."""
+    if label is not None:
+        text = label(i)
+        return f" ({text})" if text else ""
+    return f" (row {i + 1} of {n})" if n > 1 else ""
+
+
+def _u(unit: str) -> str:
+    """' mm' after a number in messages, or nothing for a plain number."""
+    return f" {unit}" if unit else ""
+
+
+#: the tolerance of a sheet that sets none
+DEFAULT = Tolerance()

@@ -1,0 +1,105 @@
+"""The global maximum or minimum of a function on [a, b], and where it is, for every row."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
+
+#: the bracket is sampled at this many times ``Tolerance.samples`` intervals
+OVERSAMPLE = 4
+
+
+def extremum(
+    f: Fn,
+    a,
+    b,
+    args=(),
+    tol: Tolerance = DEFAULT,
+    *,
+    kind: str = "max",
+    need_where: bool = False,
+    var: str = "x",
+    unit: str = "",
+    label: Callable[[int], str] | None = None,
+) -> Result:
+    """The largest (``kind="max"``) or smallest value of ``f(x, *args)`` on [a, b] per row.
+
+    [a, b] is sampled at ``OVERSAMPLE * tol.samples`` intervals; every interior local extremum
+    of the samples is refined by ``find_minimum`` (all rows and all candidates in one call) and
+    compared with the end points, so the global extremum among all local ones is returned.
+    ``where`` is its position (argmax/argmin). With ``need_where``, a function that is flat on
+    [a, b] (all samples equal within the tolerance) is an error: it has no one argmax.
+    """
+    from scipy.optimize.elementwise import find_minimum
+
+    shape, (a, b, *args) = rows(a, b, *args)
+    n, k = a.size, OVERSAMPLE * max(int(tol.samples), 2)
+    if n == 0:
+        return Result(np.empty(shape), np.empty(shape), np.empty(shape), np.empty(shape))
+    sgn = -1.0 if kind == "max" else 1.0
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    xs = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, k + 1)
+    fs = sgn * call(f, xs, [g[:, None] for g in args])
+    bad = ~np.isfinite(fs)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise NumericsError(
+            f"{kind}imum(): the function is not a finite number at {var} = {num(xs[i, j])}"
+            f"{_u(unit)}{row_text(label, i, n)}, inside [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
+        )
+    spread = fs.max(axis=1) - fs.min(axis=1)
+    scale = np.abs(fs).max(axis=1)
+    flat = spread <= np.maximum(tol.rtol * scale, tol.atol)
+    if need_where and flat.any():
+        i = np.flatnonzero(flat)[0]
+        raise NumericsError(
+            f"arg{kind}(): the function is flat on [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
+            f"{row_text(label, i, n)} (all {k + 1} samples equal {num(sgn * fs[i, 0])} within "
+            f"the tolerance): it has no one arg{kind}"
+        )
+    # interior local minima of the samples (of sgn*f), each bracketed by its neighbours
+    mid = fs[:, 1:-1]
+    cand = (mid <= fs[:, :-2]) & (mid <= fs[:, 2:]) & ~((mid == fs[:, :-2]) & (mid == fs[:, 2:]))
+    ri, ci = np.nonzero(cand)
+    ci = ci + 1
+    best_v = np.where(fs[:, 0] <= fs[:, -1], fs[:, 0], fs[:, -1])
+    best_x = np.where(fs[:, 0] <= fs[:, -1], xs[:, 0], xs[:, -1])
+    best_ve = np.zeros(n)
+    best_xe = np.zeros(n)
+    evaluations = k + 1
+    if ri.size:
+        init = (xs[ri, ci - 1], xs[ri, ci], xs[ri, ci + 1])
+        fa = tuple(g[ri] for g in args)
+        # a minimum's place is known to about sqrt(eps) relative at best
+        tols = {"xatol": tol.atol, "xrtol": max(tol.rtol, np.finfo(float).eps ** 0.5)}
+        with np.errstate(all="ignore"):
+            res = find_minimum(
+                lambda x, *p: sgn * np.asarray(f(x, *p)), init, args=fa, tolerances=tols
+            )
+        ok = np.asarray(res.success) | (np.asarray(res.status) == -2)
+        vals = np.where(ok, res.f_x, fs[ri, ci])
+        where = np.where(ok, res.x, xs[ri, ci])
+        span = xs[ri, ci + 1] - xs[ri, ci - 1]
+        werr = np.where(ok, np.abs(res.bracket[1] - res.bracket[0]), span)
+        verr = np.where(ok, np.abs(np.maximum(res.f_bracket[0], res.f_bracket[2]) - res.f_x), 0.0)
+        evaluations += int(np.max(res.nfev))
+        # per row: the best candidate (the first one on ties, as numpy's argmax)
+        order = np.lexsort((where, vals, ri))
+        first = order[np.r_[True, ri[order][1:] != ri[order][:-1]]]
+        rows_c = ri[first]
+        better = vals[first] < best_v[rows_c]
+        take = rows_c[better]
+        best_v[take] = vals[first][better]
+        best_x[take] = where[first][better]
+        best_ve[take] = verr[first][better]
+        best_xe[take] = werr[first][better]
+    return Result(
+        (sgn * best_v).reshape(shape),
+        best_ve.reshape(shape),
+        best_x.reshape(shape),
+        best_xe.reshape(shape),
+        evaluations=evaluations,
+    )

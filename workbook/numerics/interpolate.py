@@ -1,0 +1,43 @@
+"""Interpolation in measured data (Mathcad's linterp, and interp over cspline)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._common import NumericsError, _u, num
+
+
+def check_data(xs: np.ndarray, ys: np.ndarray, what: str) -> None:
+    """Data points must be finite, as many x as y, at least 2, x strictly increasing."""
+    if xs.shape != ys.shape or xs.ndim != 1:
+        raise NumericsError(f"{what}: x and y need the same number of values")
+    if xs.size < 2:
+        raise NumericsError(f"{what}: at least 2 points are needed, got {xs.size}")
+    if not (np.isfinite(xs).all() and np.isfinite(ys).all()):
+        raise NumericsError(f"{what}: the data hold a value that is not a finite number")
+    step = np.flatnonzero(np.diff(xs) <= 0)
+    if step.size:
+        i = step[0]
+        raise NumericsError(
+            f"{what}: x must be strictly increasing; x[{i + 1}] = {num(xs[i])} is followed by "
+            f"{num(xs[i + 1])}"
+        )
+
+
+def interpolate(xs, ys, x, *, kind: str = "linear", what: str = "linterp()", unit: str = ""):
+    """y at x by linear interpolation (``linear``) or a not-a-knot cubic spline (``cubic``,
+    Mathcad's cspline with cubic ends). x outside the data is an error, not an extrapolation."""
+    x = np.asarray(x, dtype=float)
+    out = (x < xs[0]) | (x > xs[-1])
+    if out.any():
+        v = x[out].flat[0] if x.ndim else float(x)
+        raise NumericsError(
+            f"{what}: x = {num(v)}{_u(unit)} is outside the data "
+            f"[{num(xs[0])}, {num(xs[-1])}]{_u(unit)}"
+        )
+    if kind == "linear":
+        return np.interp(x, xs, ys)
+    from scipy.interpolate import CubicSpline
+
+    bc = "not-a-knot" if xs.size > 3 else "natural"
+    return CubicSpline(xs, ys, bc_type=bc)(x)
