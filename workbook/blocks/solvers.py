@@ -119,6 +119,7 @@ class OdeRun:
     t_reached: float
     t_final: float
     notes: list[str] = field(default_factory=list)
+    sol: object = None  # scipy OdeSolution over [t0, t_reached] when run with dense_output
 
     @property
     def ok(self) -> bool:
@@ -165,12 +166,17 @@ def run_ode(
     max_step: float = np.inf,
     label: str | None = None,
     progress_every: float = 2.0,
+    dense_output: bool = False,
+    blowup: float | None = None,
 ) -> OdeRun:
     """Integrate y' = fun(t, y) over t_span with scipy's solver ``method``, bounded in time.
 
     Like ``solve_ivp`` (t_eval values are interpolated from each step's dense output) but the
     run stops, with ``stop_reason`` saying why, after ``max_time`` wall-clock seconds or
-    ``max_steps`` steps. ``jac`` is passed to the implicit methods only.
+    ``max_steps`` steps. ``jac`` is passed to the implicit methods only. With
+    ``dense_output`` the run keeps every step's interpolant (``run.sol``, a scipy
+    OdeSolution); with ``blowup`` it stops ("blow-up") when a state leaves the finite numbers
+    or exceeds that magnitude.
     """
     from scipy import integrate
 
@@ -208,12 +214,24 @@ def run_ode(
     reason = None
     last_report = start
     notes: list[str] = []
+    pieces, knots = [], [t0]
     while reason is None:
         message = solver.step()
         nsteps += 1
         if solver.status == "failed":
             reason = f"failed: {message}"
             break
+        if blowup is not None and not np.all(np.abs(solver.y) <= blowup):
+            k = int(np.argmax(~(np.abs(solver.y) <= blowup)))
+            reason = "blow-up"
+            notes.append(
+                f"state {k} reached {solver.y[k]:.3g} at t = {solver.t:.6g} "
+                f"(beyond {blowup:.3g}: the solution blows up)"
+            )
+            break
+        if dense_output:
+            pieces.append(solver.dense_output())
+            knots.append(solver.t)
         if t_eval is None:
             ts.append(solver.t)
             ys.append(solver.y.copy())
@@ -261,6 +279,10 @@ def run_ode(
         t1,
         notes,
     )
+    if dense_output and pieces:
+        from scipy.integrate import OdeSolution
+
+        run.sol = OdeSolution(knots, pieces)
     if label and (elapsed > progress_every or not run.ok):
         print(f"[{label}] {run.summary()}", file=sys.stderr, flush=True)
     return run

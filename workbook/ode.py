@@ -1,0 +1,429 @@
+"""Ordinary differential equations of a worksheet: ``[[ode]]`` sections.
+
+A section declares states (unit, initial value, derivative expression), the time range and the
+method; the engine types the expressions like any definition, integrates once with
+``workbook.blocks.solvers.run_ode`` (a wall-clock budget and a step cap, dense output) and
+each state becomes a function of time, ``x(t)``, usable in tables and charts::
+
+    [[ode]]
+    name = "fall"
+    time = "t := 0 .. t_end"             # t is declared in [arguments] with its unit
+    method = "auto"                      # auto | RK45 | DOP853 | Radau | BDF | LSODA
+    rtol = 1e-8
+    atol = 1e-10
+    states = [
+      { name = "x", unit = "m", initial = "x0", derivative = "v" },
+      { name = "v", unit = "m/s", initial = "0 m/s", derivative = "-g - c/m*v" },
+    ]
+
+This module holds the numerical side on plain magnitudes (states in their declared units,
+time in its unit): reading a section, choosing a method, running it and the bench rows.
+scipy is imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import expr as ex
+from .errors import DomainError, LimitError, TemplateError
+
+METHODS = ("auto", "RK45", "DOP853", "Radau", "BDF", "LSODA")
+#: "auto" takes an implicit method when max(-Re lambda) * span of the Jacobian at the start
+#: exceeds this: an explicit method would then need more than about STIFF_INDEX/3.3 steps for
+#: stability alone, whatever the tolerance.
+STIFF_INDEX = 500.0
+#: A state whose magnitude exceeds this (in its declared unit) stops the run: it blows up.
+BLOWUP = 1e100
+MAX_TIME = 30.0  # wall-clock budget of one run, seconds
+MAX_STEPS = 1_000_000
+MAX_STATES = 1000
+
+
+@dataclass(frozen=True)
+class StateSpec:
+    name: str
+    unit: str
+    initial: ex.Node
+    derivative: ex.Node
+    initial_text: str
+    derivative_text: str
+
+
+@dataclass(frozen=True)
+class OdeSpec:
+    name: str
+    var: str
+    first: ex.Node
+    last: ex.Node
+    time_text: str
+    states: tuple[StateSpec, ...]
+    method: str = "auto"
+    rtol: float = 1e-6
+    atol: float = 1e-9
+    max_time: float = MAX_TIME
+    max_steps: int = MAX_STEPS
+    note: str = ""
+    line: int | None = None
+
+
+_KEYS = {"name", "time", "states", "method", "rtol", "atol", "max_time", "max_steps", "note"}
+_STATE_KEYS = {"name", "unit", "initial", "derivative", "note"}
+
+
+def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
+    """Read one ``[[ode]]`` table (raises TemplateError naming the key)."""
+    from .template import parse_range
+
+    if not isinstance(raw, dict):
+        raise TemplateError(f"{where}: an [[ode]] entry is a table", line=line)
+    extra = set(raw) - _KEYS
+    if extra:
+        raise TemplateError(
+            f"{where}: unknown key(s) {', '.join(sorted(extra))} "
+            f"(known: {', '.join(sorted(_KEYS))})",
+            line=line,
+        )
+    name = raw.get("name")
+    if not isinstance(name, str) or not ex.is_identifier(name):
+        raise TemplateError(f'{where}: name = "..." (a plain name) is required', line=line)
+    where = f"ode '{name}'"
+    if "time" not in raw:
+        raise TemplateError(f'{where}: time = "t := 0 .. t_end" is required', line=line)
+    rng = parse_range(raw["time"], what=f"{where}: time")
+    if rng.second is not None:
+        raise TemplateError(f"{where}: time is 'VAR := FIRST .. LAST' (no step)", line=line)
+    method = raw.get("method", "auto")
+    if method not in METHODS:
+        raise TemplateError(
+            f"{where}: method {method!r} is not one of {', '.join(METHODS)}", line=line
+        )
+    rtol, atol = _positive(raw, "rtol", 1e-6, where), _positive(raw, "atol", 1e-9, where)
+    if rtol < 1e-13:
+        raise TemplateError(f"{where}: rtol {rtol:g} is below what doubles resolve (1e-13)")
+    max_time = _positive(raw, "max_time", MAX_TIME, where)
+    max_steps = int(_positive(raw, "max_steps", MAX_STEPS, where))
+    states = raw.get("states")
+    if not isinstance(states, list) or not states:
+        raise TemplateError(
+            f'{where}: states = [{{ name = "x", unit = "m", initial = "...", '
+            'derivative = "..." }, ...] is required',
+            line=line,
+        )
+    if len(states) > MAX_STATES:
+        raise LimitError(f"{where}: {len(states)} states (limit {MAX_STATES})", line=line)
+    out, seen = [], set()
+    for k, s in enumerate(states):
+        sw = f"{where}, state {k + 1}"
+        if not isinstance(s, dict):
+            raise TemplateError(f"{sw}: a state is a table {{ name = ..., ... }}", line=line)
+        extra = set(s) - _STATE_KEYS
+        missing = {"name", "initial", "derivative"} - set(s)
+        if extra or missing:
+            raise TemplateError(
+                f"{sw}: keys are name, unit, initial, derivative (and note); "
+                + (f"unknown: {', '.join(sorted(extra))}" if extra else "")
+                + (f"missing: {', '.join(sorted(missing))}" if missing else ""),
+                line=line,
+            )
+        sname = s["name"]
+        if not isinstance(sname, str) or not ex.is_identifier(sname) or sname in seen:
+            raise TemplateError(f"{sw}: name {sname!r} is not a new plain name", line=line)
+        seen.add(sname)
+        unit = s.get("unit", "")
+        if not isinstance(unit, str):
+            raise TemplateError(f'{sw}: unit is text like "m/s"', line=line)
+        init, der = s["initial"], s["derivative"]
+        init = repr(init) if isinstance(init, (int, float)) and not isinstance(init, bool) else init
+        der = repr(der) if isinstance(der, (int, float)) and not isinstance(der, bool) else der
+        out.append(
+            StateSpec(
+                sname,
+                unit,
+                ex.parse(init, what=f"{sw}: initial"),
+                ex.parse(der, what=f"{sw}: derivative"),
+                init,
+                der,
+            )
+        )
+    if rng.var in seen:
+        raise TemplateError(f"{where}: the time variable '{rng.var}' is also a state", line=line)
+    return OdeSpec(
+        name,
+        rng.var,
+        rng.first,
+        rng.last,
+        rng.text,
+        tuple(out),
+        method,
+        rtol,
+        atol,
+        max_time,
+        max_steps,
+        str(raw.get("note", "")),
+        line,
+    )
+
+
+def _positive(raw: dict, key: str, default: float, where: str) -> float:
+    v = raw.get(key, default)
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not (v > 0 and math.isfinite(v)):
+        raise TemplateError(f"{where}: {key} must be a positive number, got {v!r}")
+    return float(v)
+
+
+# -- stiffness and the choice of method -------------------------------------------------------
+def jacobian(fun: Callable, t: float, y: np.ndarray) -> np.ndarray:
+    """Forward-difference Jacobian of fun(t, y) with respect to y."""
+    y = np.asarray(y, dtype=float)
+    f0 = np.asarray(fun(t, y), dtype=float)
+    jac = np.empty((len(f0), len(y)))
+    for k in range(len(y)):
+        h = math.sqrt(np.finfo(float).eps) * max(1.0, abs(y[k]))
+        yk = y.copy()
+        yk[k] += h
+        jac[:, k] = (np.asarray(fun(t, yk), dtype=float) - f0) / h
+    return jac
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The method "auto" chose, and why (said as a finding)."""
+
+    method: str
+    reason: str
+    eigenvalues: np.ndarray
+    index: float  # max(-Re lambda) * span
+
+
+def choose_method(
+    fun: Callable, t0: float, t1: float, y0, rtol: float, time_unit: str = ""
+) -> Choice:
+    """Explicit unless the Jacobian at the start says the run is stiff (see STIFF_INDEX)."""
+    jac = jacobian(fun, t0, y0)
+    if not np.all(np.isfinite(jac)):
+        return Choice(
+            "LSODA",
+            "the Jacobian at the start is not finite; LSODA switches "
+            "between explicit and implicit steps as it goes",
+            np.array([]),
+            math.nan,
+        )
+    lam = np.linalg.eigvals(jac)
+    span = abs(t1 - t0)
+    decay = float(np.max(-lam.real, initial=0.0))
+    index = decay * span
+    unit = f" 1/{time_unit}" if time_unit else ""
+    fastest = lam[np.argmax(-lam.real)] if lam.size else 0.0
+    where = (
+        f"the Jacobian at t = {t0:g} has its fastest decaying eigenvalue {_complex(fastest)}{unit}"
+    )
+    if index > STIFF_INDEX:
+        method = "Radau" if len(y0) <= 200 else "BDF"
+        reason = (
+            f"{where}; times the span {span:g} that is {index:.3g} > {STIFF_INDEX:g}: stiff "
+            f"(an explicit method would need about {index / 3.3:.3g} steps for stability alone)"
+        )
+        return Choice(method, reason, lam, index)
+    method = "DOP853" if rtol < 1e-6 else "RK45"
+    reason = (
+        f"{where}; times the span {span:g} that is {index:.3g} <= {STIFF_INDEX:g}: not stiff, "
+        f"an explicit method ({'8th order for rtol < 1e-6' if method == 'DOP853' else '5th order'})"
+    )
+    return Choice(method, reason, lam, index)
+
+
+def _complex(z) -> str:
+    z = complex(z)
+    if abs(z.imag) <= 1e-12 * max(1.0, abs(z.real)):
+        return f"{z.real:.4g}"
+    return f"{z.real:.4g} {'+' if z.imag >= 0 else '-'} {abs(z.imag):.4g}i"
+
+
+# -- a run ------------------------------------------------------------------------------------
+@dataclass
+class Solution:
+    """The states as functions of time over [t0, t1] (dense output), and how they were got."""
+
+    name: str
+    states: tuple[str, ...]
+    t0: float
+    t1: float
+    method: str
+    choice: Choice | None
+    run: object  # solvers.OdeRun
+    notes: list[str] = field(default_factory=list)
+
+    def __call__(self, k: int, t) -> np.ndarray | float:
+        """State k at time(s) t (magnitudes in the time unit); outside the span is an error."""
+        arr = np.asarray(t, dtype=float)
+        lo, hi = min(self.t0, self.t1), max(self.t0, self.t1)
+        tol = 1e-12 * max(1.0, abs(hi - lo))
+        bad = (arr < lo - tol) | (arr > hi + tol) | ~np.isfinite(arr)
+        if np.any(bad):
+            first = float(np.atleast_1d(arr)[np.atleast_1d(bad)][0])
+            raise DomainError(
+                f"{self.states[k]}({first:g}) is outside the time range of ode '{self.name}' "
+                f"[{self.t0:g}, {self.t1:g}]",
+                definition=self.states[k],
+            )
+        out = self.run.sol(np.clip(arr, lo, hi))[k]
+        return float(out) if arr.ndim == 0 else out
+
+    def finding(self) -> str:
+        r = self.run
+        head = f"ode '{self.name}': {self.method}"
+        if self.choice is not None:
+            head += f" (auto: {self.choice.reason})"
+        return (
+            f"{head}; rtol {r.rtol:g}, atol {r.atol:g}: {r.nsteps} steps, {r.nfev} evaluations, "
+            f"{r.elapsed:.3g} s"
+        )
+
+
+def solve(
+    fun: Callable,
+    t0: float,
+    t1: float,
+    y0,
+    *,
+    name: str,
+    states: tuple[str, ...],
+    method: str = "auto",
+    rtol: float = 1e-6,
+    atol: float = 1e-9,
+    max_time: float = MAX_TIME,
+    max_steps: int = MAX_STEPS,
+    time_unit: str = "",
+) -> Solution:
+    """Integrate y' = fun(t, y) from t0 to t1; a run that does not finish is a LimitError
+    (budget, step cap) or a DomainError (blow-up, solver failure) that says where and why."""
+    from .blocks.solvers import run_ode
+
+    y0 = np.asarray(y0, dtype=float)
+    if not np.all(np.isfinite(y0)):
+        raise DomainError(f"ode '{name}': an initial value is not a finite number")
+    if t1 == t0:
+        raise TemplateError(f"ode '{name}': the time range is empty ({t0:g} .. {t1:g})")
+    choice = None
+    if method == "auto":
+        choice = choose_method(fun, t0, t1, y0, rtol, time_unit)
+        method = choice.method
+    f0 = np.asarray(fun(t0, y0), dtype=float)
+    if f0.shape != y0.shape or not np.all(np.isfinite(f0)):
+        raise DomainError(f"ode '{name}': a derivative is not a finite number at the start")
+    run = run_ode(
+        fun,
+        (t0, t1),
+        y0,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        max_time=max_time,
+        max_steps=max_steps,
+        dense_output=True,
+        blowup=BLOWUP,
+    )
+    if not run.ok:
+        _refuse(run, name, states, time_unit)
+    return Solution(name, tuple(states), float(t0), float(t1), method, choice, run)
+
+
+def _refuse(run, name: str, states, time_unit: str) -> None:
+    at = f"t = {run.t_reached:.6g}{' ' + time_unit if time_unit else ''} of {run.t_final:g}"
+    if run.stop_reason in ("time budget", "step cap"):
+        budget = "its time budget" if run.stop_reason == "time budget" else "its step cap"
+        raise LimitError(
+            f"ode '{name}' ({run.method}) stopped at {at}: {run.notes[-1]}; "
+            f"{run.nsteps} steps. {budget.capitalize()} is max_time/max_steps in [[ode]]; "
+            'a stiff system wants method = "Radau" or "BDF" (or "auto")',
+            definition=name,
+        )
+    if run.stop_reason == "blow-up":
+        note = run.notes[-1]
+        for k, s in enumerate(states):
+            note = note.replace(f"state {k} ", f"state '{s}' ", 1)
+        raise DomainError(f"ode '{name}' stopped at {at}: {note}", definition=name)
+    big = ""
+    if run.y.size and np.max(np.abs(run.y[:, -1])) > 1e6:
+        big = " (the states grow without bound: the solution blows up)"
+    raise DomainError(
+        f"ode '{name}' ({run.method}) stopped at {at}: {run.stop_reason}{big}", definition=name
+    )
+
+
+# -- error against run time -------------------------------------------------------------------
+def bench_rows(
+    fun: Callable,
+    t0: float,
+    t1: float,
+    y0,
+    *,
+    name: str,
+    atol_ratio: float = 1e-3,
+    rtols=(1e-3, 1e-6, 1e-9),
+    methods=("RK45", "DOP853", "Radau", "BDF", "LSODA"),
+    max_time: float = 10.0,
+    points: int = 201,
+) -> list[dict]:
+    """Every method at every rtol against a tight reference (DOP853 or Radau at rtol 1e-12,
+    the one "auto" would take): the largest error over ``points`` times, relative to the
+    largest magnitude of each state, and the run time."""
+    from .blocks.solvers import run_ode, work_precision
+
+    y0 = np.asarray(y0, dtype=float)
+    ref_method = choose_method(fun, t0, t1, y0, 1e-12).method
+    ts = np.linspace(t0, t1, points)
+    ref = run_ode(
+        fun, (t0, t1), y0, method=ref_method, rtol=1e-12, atol=1e-14, t_eval=ts, max_time=60.0
+    )
+    if not ref.ok:
+        raise LimitError(f"ode '{name}': the reference run did not finish: {ref.summary()}")
+    scale = np.maximum(np.max(np.abs(ref.y), axis=1), 1e-300)[:, None]
+
+    def case(method: str, rtol: float):
+        return run_ode(
+            fun,
+            (t0, t1),
+            y0,
+            method=method,
+            rtol=rtol,
+            atol=rtol * atol_ratio * scale[:, 0],
+            t_eval=ts,
+            max_time=max_time,
+        )
+
+    def error(run) -> float:
+        return float(np.max(np.abs(run.y - ref.y) / scale))
+
+    rows = work_precision(case, error, methods, rtols, case=name)
+    out = [
+        {
+            "ode": name,
+            "method": r.method,
+            "rtol": r.rtol,
+            "error": r.error,
+            "seconds": r.elapsed,
+            "evaluations": r.nfev,
+            "steps": r.nsteps,
+            "stop": r.stop_reason,
+        }
+        for r in rows
+    ]
+    out.append(
+        {
+            "ode": name,
+            "method": f"reference {ref_method}",
+            "rtol": 1e-12,
+            "error": 0.0,
+            "seconds": ref.elapsed,
+            "evaluations": ref.nfev,
+            "steps": ref.nsteps,
+            "stop": ref.stop_reason,
+        }
+    )
+    return out

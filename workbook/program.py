@@ -1,0 +1,675 @@
+"""Programs: a function body written as a few statements, as Mathcad's program regions.
+
+One statement a line; a block is the lines indented under its header (as in Python).
+The text is split into statements here and every expression goes through
+:func:`workbook.expr.parse`, so nothing is ever evaluated by Python::
+
+    a := x^2                      # a local (Mathcad's a <- x^2; '←' is read too)
+    for i in 1 .. n               # Mathcad's range form: first[, second] .. last
+        a := a + i
+        break if a > 100          # any simple statement may end in 'if CONDITION'
+    while a > 1
+        a := a/2
+    if a > 10                     # block form: if / else if / otherwise (or else)
+        return a
+    else if a > 5
+        return 2*a
+    "small" if a < 0              # one-line form, as Mathcad's 'value if condition'
+    a otherwise
+
+The value of a program is the value of the ``return`` that ends it or, without one, of the
+last value line it executed (an expression line, or the value of a one-line ``if`` /
+``otherwise``). Assignments and loops are not values. A program that ends without a value is
+an error, never a silent 0; so is a loop that runs more than :data:`MAX_STEPS` statements.
+
+Typing (:func:`type_program`) and running (:func:`compile_program`) take the expression
+back end as callbacks, so the same statements serve every back end.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+import tokenize
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from . import expr as ex
+from .errors import LimitError, TemplateError
+
+#: Statements one call of a program may execute (a `while` that never ends stops here).
+MAX_STEPS = 1_000_000
+#: Longest program text and deepest block nesting.
+MAX_PROGRAM_TEXT = 100_000
+MAX_BLOCK_DEPTH = 50
+
+
+# -- statements (E is ex.Node after parsing, a typed node after typing) -----------------------
+@dataclass(frozen=True)
+class Stmt:
+    line: int  # line within the program text, from 1
+
+
+@dataclass(frozen=True)
+class Assign(Stmt):
+    name: str
+    value: Any
+
+
+@dataclass(frozen=True)
+class Value(Stmt):
+    value: Any
+
+
+@dataclass(frozen=True)
+class Return(Stmt):
+    value: Any
+
+
+@dataclass(frozen=True)
+class Break(Stmt):
+    pass
+
+
+@dataclass(frozen=True)
+class Continue(Stmt):
+    pass
+
+
+@dataclass(frozen=True)
+class If(Stmt):
+    branches: tuple[tuple[Any, tuple[Stmt, ...]], ...]  # (condition, block)
+    otherwise: tuple[Stmt, ...] | None
+
+
+@dataclass(frozen=True)
+class For(Stmt):
+    var: str
+    first: Any
+    second: Any  # None: step 1 (or -1)
+    last: Any
+    body: tuple[Stmt, ...]
+
+
+@dataclass(frozen=True)
+class While(Stmt):
+    condition: Any
+    body: tuple[Stmt, ...]
+
+
+@dataclass(frozen=True)
+class Program:
+    body: tuple[Stmt, ...]
+    text: str
+
+
+# -- parsing ----------------------------------------------------------------------------------
+@dataclass
+class _Line:
+    number: int
+    indent: int
+    text: str
+
+
+def parse(text: str, *, what: str = "program") -> Program:
+    """Parse program text into statements (raises TemplateError naming the line)."""
+    if not isinstance(text, str):
+        raise TemplateError(f"{what}: a program is text (a multi-line string)")
+    if len(text) > MAX_PROGRAM_TEXT:
+        raise LimitError(f"{what}: program is {len(text)} characters (limit {MAX_PROGRAM_TEXT})")
+    lines = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        body = _strip_comment(raw, what, number).rstrip()
+        if not body.strip():
+            continue
+        if "\t" in body[: len(body) - len(body.lstrip())]:
+            raise TemplateError(f"{what}, line {number}: indent with spaces, not tabs")
+        lines.append(_Line(number, len(body) - len(body.lstrip()), body.strip()))
+    if not lines:
+        raise TemplateError(f"{what}: empty program")
+    block, rest = _block(lines, 0, lines[0].indent, what, 0)
+    if rest != len(lines):  # pragma: no cover - _block consumes everything at top level
+        raise TemplateError(f"{what}, line {lines[rest].number}: unexpected indent")
+    _check_loops(block, False, what)
+    return Program(block, text)
+
+
+def _check_loops(block: tuple[Stmt, ...], inside: bool, what: str) -> None:
+    """'break' and 'continue' only inside a loop."""
+    for s in block:
+        if isinstance(s, (Break, Continue)) and not inside:
+            word = "break" if isinstance(s, Break) else "continue"
+            raise TemplateError(f"{what}, line {s.line}: '{word}' outside a loop")
+        if isinstance(s, If):
+            for _, b in s.branches:
+                _check_loops(b, inside, what)
+            if s.otherwise:
+                _check_loops(s.otherwise, inside, what)
+        elif isinstance(s, (For, While)):
+            _check_loops(s.body, True, what)
+
+
+def _strip_comment(raw: str, what: str, number: int) -> str:
+    """The line without a trailing ``# comment`` (a '#' inside a string stays)."""
+    if "#" not in raw:
+        return raw
+    quote = None
+    for i, ch in enumerate(raw):
+        if quote:
+            if ch == quote:
+                quote = None
+        elif ch in "\"'":
+            quote = ch
+        elif ch == "#":
+            return raw[:i]
+    return raw
+
+
+def _block(lines: list[_Line], i: int, indent: int, what: str, depth: int):
+    if depth > MAX_BLOCK_DEPTH:
+        raise LimitError(f"{what}: blocks nested more than {MAX_BLOCK_DEPTH} deep")
+    out: list[Stmt] = []
+    while i < len(lines):
+        ln = lines[i]
+        if ln.indent < indent:
+            break
+        if ln.indent > indent:
+            raise TemplateError(f"{what}, line {ln.number}: unexpected indent")
+        where = f"{what}, line {ln.number}"
+        head, tail = _keyword(ln.text)
+        i += 1
+        if head in ("if", "for", "while", "else", "otherwise", "else if"):
+            is_header = head != "otherwise" or not tail
+            if head == "otherwise" and tail:
+                raise TemplateError(f"{where}: write 'VALUE otherwise' or 'otherwise' alone")
+        else:
+            is_header = False
+        if is_header:
+            body, i = _body(lines, i, ln, what, depth)
+            cond_text = tail.removesuffix(":").strip()
+            if head == "if":
+                out.append(If(ln.number, ((_expr(cond_text, where), body),), None))
+            elif head in ("else if", "else", "otherwise"):
+                prev = out[-1] if out else None
+                if not isinstance(prev, If) or prev.otherwise is not None:
+                    raise TemplateError(f"{where}: '{head}' without an 'if' before it")
+                if head == "else if":
+                    branches = (*prev.branches, (_expr(cond_text, where), body))
+                    out[-1] = If(prev.line, branches, None)
+                else:
+                    if cond_text:
+                        raise TemplateError(f"{where}: '{head}' takes no condition")
+                    out[-1] = If(prev.line, prev.branches, body)
+            elif head == "for":
+                out.append(_for(cond_text, body, ln.number, where))
+            else:
+                out.append(While(ln.number, _expr(cond_text, where), body))
+            continue
+        if i < len(lines) and lines[i].indent > indent:
+            raise TemplateError(
+                f"{what}, line {lines[i].number}: unexpected indent (only if, else if, "
+                "otherwise, for and while take an indented block)"
+            )
+        stmt = _simple(ln, where, out)
+        if stmt is not None:
+            out.append(stmt)
+    return tuple(out), i
+
+
+def _body(lines, i, header: _Line, what, depth):
+    if i >= len(lines) or lines[i].indent <= header.indent:
+        raise TemplateError(
+            f"{what}, line {header.number}: '{header.text}' needs an indented block under it"
+        )
+    return _block(lines, i, lines[i].indent, what, depth + 1)
+
+
+_KEYWORDS = re.compile(r"^(else\s+if|if|for|while|else|otherwise)\b\s*(.*)$")
+
+
+def _keyword(text: str) -> tuple[str | None, str]:
+    m = _KEYWORDS.match(text)
+    if not m:
+        return None, text
+    return re.sub(r"\s+", " ", m.group(1)), m.group(2)
+
+
+_FOR = re.compile(r"^([A-Za-z][A-Za-z0-9_]*)\s+(?:in|∈)\s+(.+)$")
+
+
+def _for(text: str, body, number: int, where: str) -> For:
+    from .template import parse_range
+
+    m = _FOR.match(text)
+    if not m:
+        raise TemplateError(f"{where}: write 'for i in FIRST .. LAST' (or FIRST, SECOND .. LAST)")
+    rng = parse_range(f"{m.group(1)} := {m.group(2)}", what=where)
+    return For(number, rng.var, rng.first, rng.second, rng.last, body)
+
+
+def _simple(ln: _Line, where: str, out: list[Stmt]) -> Stmt | None:
+    """A one-line statement; ``VALUE otherwise`` joins the ``if`` before it (returns None)."""
+    text = ln.text.replace("←", ":=")
+    marks = _top_keywords(text, where)
+    ifs = [c for w, c in marks if w == "if"]
+    others = [c for w, c in marks if w in ("else", "otherwise")]
+    if others and not ifs:
+        col = others[0]
+        if text[col:].strip() != "otherwise":
+            raise TemplateError(f"{where}: write 'VALUE otherwise' (nothing after otherwise)")
+        prev = out[-1] if out else None
+        if not isinstance(prev, If) or prev.otherwise is not None:
+            raise TemplateError(f"{where}: 'otherwise' without an 'if' before it")
+        out[-1] = If(prev.line, prev.branches, (_plain(text[:col].strip(), ln.number, where),))
+        return None
+    if ifs and not others:
+        if len(ifs) > 1:
+            raise TemplateError(f"{where}: more than one 'if' on a line")
+        col = ifs[0]
+        cond = _expr(text[col + 2 :].strip(), where)
+        stmt = _plain(text[:col].strip(), ln.number, where)
+        return If(ln.number, ((cond, (stmt,)),), None)
+    return _plain(text, ln.number, where)  # an inline 'a if c otherwise b' is an expression
+
+
+def _plain(text: str, number: int, where: str) -> Stmt:
+    if not text:
+        raise TemplateError(f"{where}: a statement is missing before 'if'/'otherwise'")
+    word = text.split(None, 1)
+    if word[0] == "return":
+        if len(word) == 1:
+            raise TemplateError(f"{where}: 'return' needs a value")
+        return Return(number, _expr(word[1], where))
+    if text == "break":
+        return Break(number)
+    if text == "continue":
+        return Continue(number)
+    if word[0] in ("break", "continue"):
+        raise TemplateError(f"{where}: '{word[0]}' takes nothing after it (or 'if CONDITION')")
+    if ":=" in text:
+        name, _, value = text.partition(":=")
+        name = name.strip()
+        if not ex.is_identifier(name):
+            raise TemplateError(f"{where}: cannot assign to {name!r} (a local is a plain name)")
+        return Assign(number, name, _expr(value, where))
+    if re.match(r"^[A-Za-z][A-Za-z0-9_]*\s*=[^=]", text):
+        raise TemplateError(f"{where}: a local is given its value with ':=' (not '=')")
+    return Value(number, _expr(text, where))
+
+
+def _top_keywords(text: str, where: str) -> list[tuple[str, int]]:
+    """(word, column) of 'if', 'else', 'otherwise' outside brackets and strings."""
+    found, depth = [], 0
+    try:
+        for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+            if tok.type == tokenize.OP and tok.string in "([{":
+                depth += 1
+            elif tok.type == tokenize.OP and tok.string in ")]}":
+                depth -= 1
+            elif tok.type == tokenize.NAME and depth == 0:
+                if tok.string in ("if", "else", "otherwise"):
+                    found.append((tok.string, tok.start[1]))
+    except (tokenize.TokenError, SyntaxError, IndentationError) as err:
+        raise TemplateError(f"{where}: cannot read {text!r}: {err}") from None
+    return found
+
+
+def _expr(text: str, where: str) -> ex.Node:
+    if not text.strip():
+        raise TemplateError(f"{where}: an expression is missing")
+    return ex.parse(text, what=where)
+
+
+# -- helpers for the back ends ----------------------------------------------------------------
+def walk(block: tuple[Stmt, ...]):
+    """Every statement of a block, nested ones included, parents first."""
+    for s in block:
+        yield s
+        if isinstance(s, If):
+            for _, b in s.branches:
+                yield from walk(b)
+            if s.otherwise:
+                yield from walk(s.otherwise)
+        elif isinstance(s, (For, While)):
+            yield from walk(s.body)
+
+
+def expressions(block: tuple[Stmt, ...]):
+    """Every expression of a block (conditions, values, loop bounds)."""
+    for s in walk(block):
+        if isinstance(s, (Assign, Value, Return)):
+            yield s.value
+        elif isinstance(s, If):
+            for c, _ in s.branches:
+                yield c
+        elif isinstance(s, For):
+            yield from (e for e in (s.first, s.second, s.last) if e is not None)
+        elif isinstance(s, While):
+            yield s.condition
+
+
+def names(program: Program) -> set[str]:
+    """Names the program refers to that it does not define itself (locals, loop variables)."""
+    local = set()
+    for s in walk(program.body):
+        if isinstance(s, Assign):
+            local.add(s.name)
+        elif isinstance(s, For):
+            local.add(s.var)
+    found = set()
+    for e in expressions(program.body):
+        found |= ex.names(e)
+    return found - local
+
+
+def has_loops(program: Program) -> bool:
+    return any(isinstance(s, (For, While)) for s in walk(program.body))
+
+
+# -- typing -----------------------------------------------------------------------------------
+@dataclass
+class ExprTyping:
+    """What :func:`type_program` needs from the typer (all callbacks)."""
+
+    type_expr: Callable[[Any, dict], Any]  # (expression, scope name -> unit) -> typed node
+    convert: Callable[[Any, Any, str], Any]  # (typed, unit, where) -> typed in that unit
+    is_boolean: Callable[[Any], bool]
+    is_text: Callable[[Any], bool]
+    is_zero: Callable[[Any], bool]  # a bare literal 0 (fits any unit)
+    unit_of: Callable[[Any], Any]
+
+
+@dataclass(frozen=True)
+class TypedProgram:
+    body: tuple[Stmt, ...]  # expressions are typed nodes
+    unit: Any
+    text: bool  # the program's value is text ("OK")
+    loops: bool
+    source: str
+
+
+def type_program(
+    program: Program, scope: dict, typing: ExprTyping, *, reserved=frozenset()
+) -> TypedProgram:
+    """Type every expression; locals keep the unit of their first value (a bare 0 waits for
+    the next); every value the program can give must agree (numbers in one dimension, or text).
+    """
+    pending: dict[str, Any] = {}
+    for _ in range(4):
+        state = _TypeState(dict(scope), dict(pending), typing, reserved)
+        body = state.block(program.body)
+        if state.local_units == pending:
+            break
+        pending = dict(state.local_units)
+    if state.value_unit is None and not state.value_text:
+        raise TemplateError("the program gives no value (no return and no value line)")
+    unit = state.value_unit if not state.value_text else typing.unit_of(state.first_value)
+    return TypedProgram(body, unit, state.value_text, has_loops(program), program.text)
+
+
+class _TypeState:
+    def __init__(self, scope, hints, typing: ExprTyping, reserved):
+        self.scope = scope
+        self.hints = hints  # units learned for locals in an earlier pass
+        self.local_units: dict[str, Any] = {}
+        self.t = typing
+        self.reserved = reserved
+        self.value_unit = None
+        self.value_text = False
+        self.first_value = None
+
+    def where(self, s: Stmt) -> str:
+        return f"program line {s.line}"
+
+    def expr(self, e, s: Stmt):
+        from .errors import WorkbookError
+
+        try:
+            return self.t.type_expr(e, self.scope)
+        except WorkbookError as err:
+            err.message = f"{self.where(s)}: {err.message}"
+            raise
+
+    def cond(self, e, s: Stmt):
+        t = self.expr(e, s)
+        if not self.t.is_boolean(t):
+            raise TemplateError(f"{self.where(s)}: a condition must be a comparison")
+        return t
+
+    def number(self, e, s: Stmt, what: str):
+        t = self.expr(e, s)
+        if self.t.is_boolean(t) or self.t.is_text(t):
+            raise TemplateError(f"{self.where(s)}: {what} must be a number")
+        return t
+
+    def value(self, e, s: Stmt):
+        t = self.expr(e, s)
+        if self.t.is_boolean(t):
+            raise TemplateError(f"{self.where(s)}: the value is a comparison, not a number")
+        if self.t.is_text(t):
+            if self.first_value is not None and not self.value_text:
+                raise TemplateError(f"{self.where(s)}: text here, a number in another branch")
+            self.value_text, self.first_value = True, self.first_value or t
+            return t
+        if self.value_text:
+            raise TemplateError(f"{self.where(s)}: a number here, text in another branch")
+        if self.value_unit is None:
+            if self.t.is_zero(t) and self.first_value is None:
+                self.first_value = t
+                return t  # a bare 0: its unit comes from another value, if any
+            self.value_unit = self.t.unit_of(t)
+            self.first_value = t
+            return t
+        return self.t.convert(t, self.value_unit, f"{self.where(s)}: the program's value")
+
+    def assign(self, s: Assign):
+        if s.name in self.reserved:
+            raise TemplateError(
+                f"{self.where(s)}: '{s.name}' is a name of the sheet; give the local another name"
+            )
+        t = self.number(s.value, s, f"the value of '{s.name}'")
+        unit = self.local_units.get(s.name) or self.hints.get(s.name)
+        if unit is None:
+            if self.t.is_zero(t):
+                self.scope.setdefault(s.name, self.t.unit_of(t))
+                return Assign(s.line, s.name, t)
+            unit = self.t.unit_of(t)
+            self.local_units[s.name] = unit
+        else:
+            self.local_units[s.name] = unit
+        self.scope[s.name] = unit
+        return Assign(s.line, s.name, self.t.convert(t, unit, f"{self.where(s)}: '{s.name}'"))
+
+    def block(self, block):
+        out = []
+        for s in block:
+            out.append(self.stmt(s))
+        return tuple(out)
+
+    def stmt(self, s: Stmt) -> Stmt:
+        if isinstance(s, Assign):
+            return self.assign(s)
+        if isinstance(s, Value):
+            return Value(s.line, self.value(s.value, s))
+        if isinstance(s, Return):
+            return Return(s.line, self.value(s.value, s))
+        if isinstance(s, (Break, Continue)):
+            return s
+        if isinstance(s, If):
+            branches = tuple((self.cond(c, s), self.block(b)) for c, b in s.branches)
+            other = self.block(s.otherwise) if s.otherwise is not None else None
+            return If(s.line, branches, other)
+        if isinstance(s, For):
+            if s.var in self.reserved:
+                raise TemplateError(f"{self.where(s)}: loop variable '{s.var}' is a sheet name")
+            first = self.number(s.first, s, "a loop bound")
+            unit = self.t.unit_of(first)
+            conv = lambda e: self.t.convert(  # noqa: E731
+                self.number(e, s, "a loop bound"), unit, f"{self.where(s)}: loop bounds"
+            )
+            second = conv(s.second) if s.second is not None else None
+            last = conv(s.last)
+            self.scope[s.var] = unit
+            return For(s.line, s.var, first, second, last, self.block(s.body))
+        if isinstance(s, While):
+            return While(s.line, self.cond(s.condition, s), self.block(s.body))
+        raise TypeError(s)  # pragma: no cover
+
+
+# -- running ----------------------------------------------------------------------------------
+class _Break(Exception):
+    pass
+
+
+class _Continue(Exception):
+    pass
+
+
+class _Return(Exception):
+    def __init__(self, value):
+        self.value = value
+
+
+class NoValue(Exception):
+    """The program ended without a value (the numeric back end names the function)."""
+
+
+_NONE = object()
+
+
+def compile_program(
+    typed: TypedProgram, compile_expr: Callable[[Any], Callable], name: str
+) -> Callable[[dict], Any]:
+    """A closure env -> value for scalar arguments (the back end loops over arrays)."""
+    from .template import range_values
+
+    steps = [0]
+
+    def tick(s: Stmt):
+        steps[0] += 1
+        if steps[0] > MAX_STEPS:
+            raise LimitError(
+                f"the program of '{name}' ran {MAX_STEPS:,} statements without ending "
+                f"(line {s.line}: a loop that never ends?)",
+                definition=name,
+            )
+
+    def block(stmts):
+        compiled = [stmt(s) for s in stmts]
+
+        def run(env, last):
+            for c in compiled:
+                last = c(env, last)
+            return last
+
+        return run
+
+    def stmt(s: Stmt):
+        if isinstance(s, Assign):
+            f, n = compile_expr(s.value), s.name
+
+            def assign(env, last):
+                tick(s)
+                env[n] = f(env)
+                return last
+
+            return assign
+        if isinstance(s, Value):
+            f = compile_expr(s.value)
+
+            def value(env, last):
+                tick(s)
+                return f(env)
+
+            return value
+        if isinstance(s, Return):
+            f = compile_expr(s.value)
+
+            def ret(env, last):
+                tick(s)
+                raise _Return(f(env))
+
+            return ret
+        if isinstance(s, Break):
+
+            def brk(env, last):
+                raise _Break
+
+            return brk
+        if isinstance(s, Continue):
+
+            def cont(env, last):
+                raise _Continue
+
+            return cont
+        if isinstance(s, If):
+            branches = [(compile_expr(c), block(b)) for c, b in s.branches]
+            other = block(s.otherwise) if s.otherwise is not None else None
+
+            def if_(env, last):
+                tick(s)
+                for c, b in branches:
+                    if bool(c(env)):
+                        return b(env, last)
+                return other(env, last) if other is not None else last
+
+            return if_
+        if isinstance(s, For):
+            first, last_ = compile_expr(s.first), compile_expr(s.last)
+            second = compile_expr(s.second) if s.second is not None else None
+            body, var = block(s.body), s.var
+
+            def for_(env, last):
+                values = range_values(
+                    float(first(env)),
+                    float(second(env)) if second is not None else None,
+                    float(last_(env)),
+                    what=f"program of '{name}', line {s.line}",
+                )
+                for v in values:
+                    tick(s)
+                    env[var] = float(v)
+                    try:
+                        last = body(env, last)
+                    except _Break:
+                        break
+                    except _Continue:
+                        continue
+                return last
+
+            return for_
+        if isinstance(s, While):
+            cond, body = compile_expr(s.condition), block(s.body)
+
+            def while_(env, last):
+                while True:
+                    tick(s)
+                    if not bool(cond(env)):
+                        return last
+                    try:
+                        last = body(env, last)
+                    except _Break:
+                        return last
+                    except _Continue:
+                        continue
+
+            return while_
+        raise TypeError(s)  # pragma: no cover
+
+    main = block(typed.body)
+
+    def run(env: dict):
+        steps[0] = 0
+        local = dict(env)
+        try:
+            out = main(local, _NONE)
+        except _Return as r:
+            return r.value
+        except (_Break, _Continue):
+            raise TemplateError(f"'break'/'continue' outside a loop in '{name}'") from None
+        if out is _NONE:
+            raise NoValue(name)
+        return out
+
+    return run
