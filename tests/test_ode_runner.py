@@ -1,0 +1,89 @@
+"""The ODE runner of [[ode]] sections (workbook.ode) against closed forms and scipy."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from workbook import ode
+from workbook.errors import DomainError, LimitError
+
+
+def _stiff(t, y):
+    return np.array([-1000.0 * (y[0] - np.cos(t)), -y[1]])
+
+
+def test_auto_takes_an_implicit_method_for_a_stiff_system_and_says_why():
+    s = ode.solve(_stiff, 0.0, 5.0, [0.0, 1.0], name="st", states=("a", "b"), rtol=1e-8, atol=1e-10)
+    assert s.method == "Radau"
+    assert "stiff" in s.choice.reason and "-1000" in s.choice.reason
+    assert "Radau" in s.finding()
+    t = np.linspace(0, 5, 11)
+    # closed form of a' = -k (a - cos t), a(0) = 0
+    k = 1000.0
+    exact = (k * k * np.cos(t) + k * np.sin(t) - k * k * np.exp(-k * t)) / (k * k + 1)
+    assert np.max(np.abs(s(0, t) - exact)) < 1e-7
+    assert np.max(np.abs(s(1, t) - np.exp(-t))) < 1e-7
+
+
+def test_auto_takes_an_explicit_method_when_not_stiff():
+    f = lambda t, y: np.array([y[1], -y[0]])  # noqa: E731
+    s = ode.solve(f, 0.0, 10.0, [1.0, 0.0], name="osc", states=("x", "v"), rtol=1e-10, atol=1e-12)
+    assert s.method == "DOP853" and "not stiff" in s.choice.reason
+    t = np.linspace(0, 10, 7)
+    assert np.max(np.abs(s(0, t) - np.cos(t))) < 1e-8
+    coarse = ode.solve(f, 0.0, 10.0, [1.0, 0.0], name="osc", states=("x", "v"), rtol=1e-4)
+    assert coarse.method == "RK45"
+
+
+def test_the_dense_output_agrees_with_solve_ivp():
+    from scipy.integrate import solve_ivp
+
+    f = lambda t, y: np.array([y[1], (1 - y[0] ** 2) * y[1] - y[0]])  # noqa: E731 van der Pol
+    s = ode.solve(f, 0, 8, [2.0, 0.0], name="vdp", states=("x", "v"), method="DOP853", rtol=1e-11)
+    t = np.linspace(0, 8, 33)
+    ref = solve_ivp(f, (0, 8), [2.0, 0.0], method="LSODA", rtol=1e-12, atol=1e-12, t_eval=t)
+    assert np.max(np.abs(s(0, t) - ref.y[0])) < 1e-8
+
+
+@pytest.mark.parametrize("method", ["auto", "RK45", "Radau"])
+def test_a_solution_that_blows_up_is_stopped_and_said_so(method):
+    with pytest.raises(DomainError, match="blows up") as info:
+        ode.solve(lambda t, y: y**2, 0.0, 2.0, [1.0], name="bl", states=("y",), method=method)
+    assert "ode 'bl'" in str(info.value) and "t = 1" in str(info.value)
+
+
+def test_growth_beyond_the_threshold_names_the_state():
+    with pytest.raises(DomainError, match="state 'y' reached") as info:
+        ode.solve(lambda t, y: 1000.0 * y, 0.0, 1.0, [1.0], name="g", states=("y",), method="RK45")
+    assert "blows up" in str(info.value)
+
+
+def test_an_explicit_method_on_a_stiff_system_stops_at_its_budget():
+    f = lambda t, y: np.array([-1e7 * (y[0] - np.cos(t))])  # noqa: E731
+    start = time.perf_counter()
+    with pytest.raises(LimitError, match="time budget") as info:
+        ode.solve(f, 0, 100, [0.0], name="st", states=("y",), method="RK45", max_time=0.3)
+    assert time.perf_counter() - start < 5
+    assert "Radau" in str(info.value)  # says what to do
+    with pytest.raises(LimitError, match="step cap"):
+        ode.solve(f, 0, 100, [0.0], name="st", states=("y",), method="RK45", max_steps=50)
+
+
+def test_time_outside_the_range_is_an_error():
+    s = ode.solve(lambda t, y: -y, 0.0, 1.0, [1.0], name="d", states=("y",))
+    with pytest.raises(DomainError, match=r"y\(2\) is outside the time range"):
+        s(0, np.array([0.5, 2.0]))
+    assert s(0, 1.0) == pytest.approx(np.exp(-1.0), rel=1e-5)
+
+
+def test_bench_rows_cover_every_method_against_a_tight_reference():
+    f = lambda t, y: np.array([y[1], -y[0]])  # noqa: E731
+    rows = ode.bench_rows(f, 0.0, 6.0, [1.0, 0.0], name="osc", rtols=(1e-4, 1e-8))
+    methods = {r["method"] for r in rows}
+    assert {"RK45", "DOP853", "Radau", "BDF", "LSODA"} <= methods
+    dop = {r["rtol"]: r["error"] for r in rows if r["method"] == "DOP853"}
+    assert dop[1e-8] < dop[1e-4] and dop[1e-8] < 1e-6
+    assert rows[-1]["method"].startswith("reference")
