@@ -24,7 +24,7 @@ class Tolerance:
 
     rtol: float = 1e-10
     atol: float = 0.0
-    samples: int = 16
+    samples: int = 8
 
     def tighter(self, rtol: float = 1e-14) -> Tolerance:
         """The same sampling at a tighter tolerance (the reference of ``workbook bench``)."""
