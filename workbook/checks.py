@@ -63,6 +63,29 @@ class Report:
     def ok(self) -> bool:
         return not self.failed and not any(f.verdict == "fail" for f in self.findings)
 
+    def summary(self) -> dict:
+        """Counts of the checked printed values and the ones not reproduced (``check --json``):
+        failed (computed, outside the tolerance) and not computable (an error)."""
+        checked = [r for r in self.rows if r.role == "check"]
+        bad = [r for r in checked if r.verdict in ("FAIL", "error")]
+        return {
+            "printed": len(checked),
+            "reproduced": sum(r.verdict in ("pass", "misprint") for r in checked),
+            "failed": sum(r.verdict == "FAIL" for r in checked),
+            "not_computable": sum(r.verdict == "error" for r in checked),
+            "failures": [
+                {
+                    "name": r.name,
+                    "at": r.at,
+                    "printed": _json_number(r.printed),
+                    "ours": _json_number(r.computed),
+                    "unit": r.unit,
+                    **({"error": r.note} if r.verdict == "error" else {}),
+                }
+                for r in bad
+            ],
+        }
+
     def text(self) -> str:
         """The report as readable text (what ``workbook check`` prints)."""
         lines = [f"checks of {self.sheet}"]
@@ -117,6 +140,10 @@ class Report:
             )
         )
         return "\n".join(lines)
+
+
+def _json_number(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else value
 
 
 def read_commented_csv(path, what: str):

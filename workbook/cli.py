@@ -70,6 +70,13 @@ def _parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
     sheet_args(chk)
     part_args(chk, "all")
+    chk.add_argument(
+        "--json", action="store_true", help="print one JSON object (counts and failures)"
+    )
+    imp = sub.add_parser("import", help="translate a Mathcad 11-15 worksheet (.xmcd)")
+    imp.add_argument("file", help="the .xmcd file")
+    imp.add_argument("--out", default=".", help="folder to write NAME.toml into (default: .)")
+    imp.add_argument("--force", action="store_true", help="replace existing files")
     bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
     sheet_args(bench)
     bench.add_argument("--quick", action="store_true", help="a small, fast version")
@@ -204,8 +211,20 @@ def cmd_run(args) -> int:
 def cmd_check(args) -> int:
     sheet = load_sheet(args, args.part or "all")
     report = sheet.check()
-    print(report.text())
+    if args.json:
+        import json
+
+        print(json.dumps(report.summary(), ensure_ascii=False))
+    else:
+        print(report.text())
     return EXIT_OK if report.ok else EXIT_CHECK
+
+
+def cmd_import(args) -> int:
+    from .mathcad import import_file
+
+    print(import_file(args.file, args.out, force=args.force).line())
+    return EXIT_OK
 
 
 def cmd_bench(args) -> int:
@@ -291,6 +310,7 @@ def main(argv: list[str] | None = None) -> int:
             "check": cmd_check,
             "bench": cmd_bench,
             "sweep": cmd_sweep,
+            "import": cmd_import,
         }[args.command]
     from .errors import WorkbookError
 

@@ -1,0 +1,77 @@
+"""`workbook import` of Mathcad worksheets, checked against the results Mathcad stored."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from workbook.cli import main
+
+DATA = Path(__file__).parent / "data" / "mathcad"
+
+
+def _import(name: str, out: Path, capsys) -> tuple[Path, str]:
+    assert main(["import", str(DATA / name), "--out", str(out)]) == 0
+    line = capsys.readouterr().out
+    return out / (Path(name).stem + ".toml"), line
+
+
+def _check(path: Path, capsys) -> dict:
+    main(["check", str(path), "--json"])
+    return json.loads(capsys.readouterr().out)
+
+
+def test_wind_load_reproduces_every_stored_result(tmp_path, capsys):
+    toml, line = _import("wind-load.xmcd", tmp_path, capsys)
+    assert re.match(r"wrote .*wind-load.toml: \d+ definitions, 2 results", line)
+    text = toml.read_text(encoding="utf-8")
+    assert 'v_b = { value = "24 m / s"' in text  # subscript as _, Mathcad units as pint
+    assert "rho = " in text  # Greek letters spelled out
+    assert "# Vindlasten bliver beregnet" in text  # text regions as comments
+    result = _check(toml, capsys)
+    assert result["printed"] == 2
+    assert result["reproduced"] == 2, result["failures"]
+
+
+def test_timber_beam_never_a_wrong_number(tmp_path, capsys):
+    """Every stored result is reproduced or not computable; a not computable one belongs to
+    a region the worksheet lists as not translated."""
+    toml, _ = _import("timber-beam.xmcd", tmp_path, capsys)
+    result = _check(toml, capsys)
+    assert result["printed"] == 60
+    assert result["failed"] == 0, result["failures"]
+    assert result["reproduced"] + result["not_computable"] == 60
+    text = toml.read_text(encoding="utf-8")
+    untranslated = set(re.findall(r"^#   region (\S+):", text, re.M))
+    csv = (tmp_path / "timber-beam.mathcad.csv").read_text(encoding="utf-8")
+    for failure in result["failures"]:
+        assert failure["error"]
+        assert failure["name"] not in re.findall(r"^(\w+) = ", text, re.M)
+    assert untranslated
+    assert 'unit = "MPa"' in text  # a unit override becomes the display unit
+    assert csv.count("\n") > 60
+
+
+def test_overwrite_needs_force(tmp_path, capsys):
+    _import("wind-load.xmcd", tmp_path, capsys)
+    assert main(["import", str(DATA / "wind-load.xmcd"), "--out", str(tmp_path)]) == 2
+    assert "--force" in capsys.readouterr().err
+    args = ["import", str(DATA / "wind-load.xmcd"), "--out", str(tmp_path), "--force"]
+    assert main(args) == 0
+
+
+def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
+    toml, _ = _import("frame/example.xmcd", tmp_path, capsys)
+    text = toml.read_text(encoding="utf-8")
+    assert "AddTrainInTable" in text  # a function of the referenced iSET_module.xmcd
+
+
+@pytest.mark.parametrize("name", ["circle-area-and-plots.xmcd", "wind-load.xmcd"])
+def test_imported_worksheet_runs(name, tmp_path, capsys):
+    toml, _ = _import(name, tmp_path, capsys)
+    out = tmp_path / "out.xlsx"
+    assert main(["run", str(toml), "--out", str(out)]) == 0
+    assert out.exists()

@@ -1,0 +1,115 @@
+"""``workbook import``: a Mathcad 11-15 worksheet (.xmcd) as a worksheet of the language.
+
+:func:`import_file` reads the file safely (:mod:`.reader`), follows its reference regions,
+translates the regions in order (:mod:`.translate`) and writes ``NAME.toml`` with the
+printed values (Mathcad's stored results) beside it (:mod:`.writer`). A region the engine
+refuses when it loads the result is marked untranslated, with the engine's reason, and the
+translation is redone, so the written worksheet always loads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import InputError, WorkbookError
+from .reader import Region, Worksheet, read
+
+MAX_REFERENCE_DEPTH = 8
+
+
+@dataclass
+class ImportSummary:
+    path: Path
+    definitions: int
+    results: int
+    untranslated: int
+    files: list[Path]
+
+    def line(self) -> str:
+        return (
+            f"wrote {self.path}: {self.definitions} definitions, {self.results} results of "
+            f"Mathcad as printed values, {self.untranslated} regions not translated"
+        )
+
+
+def sheet_name(path: Path) -> str:
+    """The worksheet's name from the file name: letters, digits, '-', '_'."""
+    from .names import identifier
+
+    raw = path.stem
+    name = "".join(c if (c.isascii() and (c.isalnum() or c in "-_.")) else " " for c in raw)
+    if name.split() != raw.split() or not name.strip():
+        name = identifier(raw).replace("_", "-")
+    name = "-".join(name.split()).strip("-.") or "mathcad"
+    return name[:80]
+
+
+def regions_with_references(ws: Worksheet, depth: int = 0, seen=None) -> list[Region]:
+    """The regions in order, a reference region replaced by the referenced file's regions
+    (resolved relative to the file; it must stay inside the file's folder)."""
+    seen = set() if seen is None else seen
+    seen.add(ws.path.resolve())
+    out: list[Region] = []
+    for region in ws.regions:
+        if region.kind != "reference":
+            out.append(region)
+            continue
+        target = _reference_path(ws.path, region.href)
+        if target.resolve() in seen:
+            raise InputError(f"{ws.path}: region {region.id} references itself in a cycle")
+        if depth >= MAX_REFERENCE_DEPTH:
+            raise InputError(f"{ws.path}: references nested more than {MAX_REFERENCE_DEPTH} deep")
+        out += regions_with_references(read(target), depth + 1, seen)
+    return out
+
+
+def _reference_path(path: Path, href: str) -> Path:
+    folder = path.parent.resolve()
+    text = href.replace("\\", "/")
+    if text.startswith("file:///"):
+        text = text[len("file:///") :]
+    candidate = Path(text)
+    if candidate.is_absolute() or (len(text) > 1 and text[1] == ":"):
+        candidate = Path(text.rsplit("/", 1)[-1])  # an absolute path of the author's disk
+    target = (folder / candidate).resolve()
+    if folder not in target.parents and target != folder:
+        raise InputError(
+            f"{path}: a reference region points outside the worksheet's folder ({href!r})"
+        )
+    if not target.is_file():
+        raise InputError(
+            f"{path}: the referenced worksheet {href!r} is not found beside it ({target.name})"
+        )
+    return target
+
+
+def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = False):
+    """Translate ``src`` and write ``out_dir/NAME.toml`` and its printed values."""
+    from . import writer
+    from .translate import Translator
+
+    src = Path(src)
+    ws = read(src)
+    regions = regions_with_references(ws)
+    name = sheet_name(src)
+    out_dir = Path(out_dir)
+    forced: dict[str, str] = {}
+    for _ in range(len(regions) + 1):
+        tr = Translator(forced).run(ws, regions)
+        rendered = writer.render(tr, name, src)
+        problem = writer.engine_problem(rendered, out_dir)
+        if problem is None:
+            break
+        region, why = problem
+        if region in forced:  # the same region again: give up rather than loop
+            raise WorkbookError(f"{src}: region {region} cannot be translated: {why}")
+        forced[region] = why
+    files = writer.write(rendered, out_dir, force=force)
+    return ImportSummary(
+        files[0],
+        rendered.definitions,
+        sum(len(r.rows) for r in tr.results),
+        len({s.region for s in tr.skipped}),
+        files,
+    )

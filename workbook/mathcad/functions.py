@@ -1,0 +1,49 @@
+"""Mathcad's built-in functions, as data: each maps one to one onto a language built-in.
+
+``name: (language name, argument order)``; the order lists Mathcad's argument positions in
+the order the language takes them (Mathcad's ``atan2(x, y)`` is the language's
+``atan2(y, x)``). A Mathcad function whose language name is not (yet) a built-in of the
+language is reported as not translated, never dropped.
+"""
+
+from __future__ import annotations
+
+MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
+    "sin": ("sin", None), "cos": ("cos", None), "tan": ("tan", None),
+    "asin": ("asin", None), "acos": ("acos", None), "atan": ("atan", None),
+    "atan2": ("atan2", (1, 0)), "angle": ("atan2", (1, 0)),
+    "sinh": ("sinh", None), "cosh": ("cosh", None), "tanh": ("tanh", None),
+    "exp": ("exp", None), "ln": ("ln", None), "log": ("log10", None),
+    "sqrt": ("sqrt", None), "abs": ("abs", None), "sign": ("sign", None),
+    "floor": ("floor", None), "ceil": ("ceil", None), "min": ("min", None),
+    "max": ("max", None), "mod": ("mod", None), "round": ("round", None),
+    "trunc": ("trunc", None),
+    "sec": ("sec", None), "csc": ("csc", None), "cot": ("cot", None),
+    # numerical methods and arrays (built-ins of the language once they exist)
+    "root": ("root", None), "linterp": ("linterp", None), "interp": ("interp", None),
+    "Find": ("find", None), "Maximize": ("maximize", None), "Minimize": ("minimize", None),
+    "length": ("length", None), "rows": ("rows", None), "cols": ("cols", None),
+    "last": ("last", None), "transpose": ("transpose", None), "det": ("det", None),
+    "stack": ("stack", None), "augment": ("augment", None), "submatrix": ("submatrix", None),
+    "identity": ("identity", None), "mean": ("mean", None), "stdev": ("stdev", None),
+    "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
+}  # fmt: skip
+
+#: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
+OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpose": "transpose"}
+
+
+def language_functions() -> set[str]:
+    """The built-in function names of the language as it is (its registry)."""
+    from .. import expr as ex
+
+    names = set(ex.FUNCTIONS)
+    try:
+        from .. import builtins as reg  # the registry of built-ins, where it exists
+    except ImportError:
+        return names
+    for attr in ("REGISTRY", "BUILTINS", "FUNCTIONS"):
+        table = getattr(reg, attr, None)
+        if isinstance(table, dict):
+            names |= set(table)
+    return names

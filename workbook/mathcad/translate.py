@@ -1,0 +1,726 @@
+"""Translating a Mathcad worksheet (regions in reading order) into the worksheet language.
+
+Mathcad's math trees become the language's expression trees (:mod:`workbook.expr`), names
+go through :mod:`.names`, units through :mod:`.units`, built-in functions through
+:mod:`.functions`. Every result Mathcad stored becomes a printed value. What the language
+cannot express is kept as a list of untranslated regions (id, what, why); a definition
+that uses an untranslated one is untranslated too.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from .. import expr as ex
+from ..visitor import Visitor
+from . import names as nm
+from .functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS, language_functions
+from .reader import MNode, Region, Worksheet
+from .units import FORMULA_UNITS, result_unit
+
+
+class Untranslatable(Exception):
+    """A construct the language cannot express (yet): the message says what and why."""
+
+
+@dataclass(eq=False)
+class Sym:
+    """A name of the generated worksheet; its final identifier is chosen at the end."""
+
+    kind: str  # var | func | param | unit | helper
+    base: str  # preferred identifier
+    mathcad: str  # the name as Mathcad shows it
+    unit: str = ""  # params and range variables: their unit (pint text)
+    broken: str = ""  # why it is not translated
+    region: str = ""
+    is_range: bool = False
+    final: str = ""
+
+    def token(self) -> str:
+        return f"\x00{id(self)}"
+
+
+@dataclass
+class Item:
+    """One entry of the worksheet in Mathcad's order."""
+
+    kind: str  # note | input | definition | function | range
+    region: str = ""
+    sym: Sym | None = None
+    params: list[Sym] = field(default_factory=list)
+    body: ex.Node | None = None
+    pieces: list[tuple[ex.Node, ex.Node | None]] | None = None
+    value: str = ""  # input: quantity text; note: the text
+    unit: str = ""  # display unit (pint text)
+    range: tuple[ex.Node, ex.Node | None, ex.Node] | None = None
+    range_values: list[float] | None = None
+
+
+@dataclass
+class Result:
+    """A result Mathcad stored for one evaluation."""
+
+    region: str
+    sym: Sym | None  # what the worksheet evaluates (None: nothing could be)
+    name: str  # the Mathcad expression, for messages
+    unit: str
+    rows: list[tuple[float | None, float | str]]
+    argument: Sym | None = None
+
+
+@dataclass
+class Skipped:
+    region: str
+    what: str
+    why: str
+
+
+@dataclass
+class Translation:
+    items: list[Item] = field(default_factory=list)
+    results: list[Result] = field(default_factory=list)
+    skipped: list[Skipped] = field(default_factory=list)
+    syms: list[Sym] = field(default_factory=list)
+    title: str = ""
+
+
+_BINARY = {"plus": "+", "minus": "-", "mult": "*", "div": "/", "pow": "^"}
+_COMPARE = {
+    "equal": "==",
+    "lessThan": "<",
+    "greaterThan": ">",
+    "lessOrEqual": "<=",
+    "greaterOrEqual": ">=",
+    "notEqual": "!=",
+}
+_WHAT = {
+    "indexer": "an array index",
+    "matcol": "a matrix column",
+    "matrix": "a matrix",
+    "summation": "a summation",
+    "product": "a product (of a range)",
+    "derivative": "a derivative",
+    "integral": "an integral",
+    "program": "a program",
+    "Find": "a solve block (Given/Find)",
+    "Maximize": "a solve block (Maximize)",
+    "Minimize": "a solve block (Minimize)",
+    "lambda": "a lambda function",
+    "symEval": "a symbolic evaluation",
+    "vectorize": "a vectorised expression",
+    "range": "a range",
+    "str": "a text",
+}
+
+
+def _what(tag: str) -> str:
+    return _WHAT.get(tag, f"Mathcad's <{tag}>")
+
+
+def _key(node: MNode) -> tuple[str, str]:
+    return node.text.strip(), node.attrs.get("subscript", "")
+
+
+class ExprTranslator(Visitor):
+    """Mathcad math element -> expression tree, names resolved in a scope."""
+
+    def __init__(self, tr: Translator, local: dict[tuple[str, str], Sym] | None = None):
+        self.tr = tr
+        self.local = local or {}
+        self.ranges: list[Sym] = []  # range variables this expression uses
+
+    def visit(self, node: MNode, *args):  # dispatch on the Mathcad tag
+        method = getattr(self, "visit_" + node.tag, None)
+        if method is None:
+            raise Untranslatable(f"{_what(node.tag)} is not in the language yet")
+        return method(node, *args)
+
+    def visit_real(self, node: MNode) -> ex.Node:
+        try:
+            value = float(node.text.strip())
+        except ValueError:
+            raise Untranslatable(f"the number {node.text.strip()!r}") from None
+        return ex.Number(value)
+
+    def visit_parens(self, node: MNode) -> ex.Node:
+        return self.visit(node.children[0])
+
+    def visit_id(self, node: MNode) -> ex.Node:
+        key = _key(node)
+        sym = self.local.get(key) or self.tr.scope.get(key)
+        if sym is not None:
+            if sym.broken:
+                raise Untranslatable(f"uses {sym.mathcad}, which is not translated")
+            if sym.kind == "func":
+                raise Untranslatable(f"uses the function {sym.mathcad} as a value")
+            if sym.is_range and sym not in self.local.values():
+                self.ranges.append(sym)
+            return ex.Name(sym.token())
+        text, sub = key
+        if not sub and text == "π":
+            return ex.Name("pi")
+        if not sub and text == "e":
+            return ex.Call("exp", (ex.Number(1.0),))
+        if not sub and text in FORMULA_UNITS:
+            return ex.Name(self.tr.unit_sym(text).token())
+        raise Untranslatable(f"{nm.mathcad_text(text, sub)} is not defined before it is used")
+
+    def visit_str(self, node: MNode) -> ex.Node:
+        return ex.Text(node.text)
+
+    def visit_apply(self, node: MNode) -> ex.Node:
+        op, args = node.children[0], node.children[1:]
+        if len(args) == 1 and args[0].tag == "sequence":
+            args = args[0].children
+        tag = op.tag
+        if tag in _BINARY and len(args) == 2:
+            return ex.Binary(_BINARY[tag], self.visit(args[0]), self.visit(args[1]))
+        if tag in _COMPARE and len(args) == 2:
+            return ex.Compare((_COMPARE[tag],), (self.visit(args[0]), self.visit(args[1])))
+        if tag == "neg" and len(args) == 1:
+            return ex.Unary("-", self.visit(args[0]))
+        if tag in ("and", "or") and len(args) == 2:
+            return ex.Logic(tag, (self.visit(args[0]), self.visit(args[1])))
+        if tag == "not" and len(args) == 1:
+            return ex.Unary("not", self.visit(args[0]))
+        if tag == "nthRoot" and len(args) == 2:
+            n, x = self.visit(args[0]), self.visit(args[1])
+            return ex.Binary("^", x, ex.Binary("/", ex.Number(1.0), n))
+        if tag in OPERATOR_FUNCTIONS and len(args) == 1:
+            return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.visit(args[0])])
+        if tag == "id":
+            return self._call(op, args)
+        raise Untranslatable(f"{_what(tag)} is not in the language yet")
+
+    def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
+        return self._builtin("sqrt", "sqrt", [self.visit(node.children[0])])
+
+    def _builtin(self, name: str, mathcad: str, args: list[ex.Node]) -> ex.Node:
+        if name not in language_functions():
+            raise Untranslatable(f"Mathcad's {mathcad}() has no built-in in the language yet")
+        return ex.Call(name, tuple(args))
+
+    def _call(self, op: MNode, args: list[MNode]) -> ex.Node:
+        key = _key(op)
+        sym = self.local.get(key) or self.tr.scope.get(key)
+        if sym is not None:
+            if sym.broken:
+                raise Untranslatable(f"uses {sym.mathcad}, which is not translated")
+            if sym.kind != "func":
+                raise Untranslatable(
+                    f"{sym.mathcad}(...) multiplies or indexes a value (not a function call)"
+                )
+            return ex.Call(sym.token(), tuple(self.visit(a) for a in args))
+        text = key[0]
+        if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
+            args = args[0].children  # min of a literal vector: min of its elements
+        if text in MATHCAD_FUNCTIONS and not key[1]:
+            name, order = MATHCAD_FUNCTIONS[text]
+            if order is not None:
+                if len(args) != len(order):
+                    raise Untranslatable(f"{text}() with {len(args)} arguments")
+                args = [args[i] for i in order]
+            return self._builtin(name, text, [self.visit(a) for a in args])
+        raise Untranslatable(
+            f"{nm.mathcad_text(*key)}() is neither defined before nor a known built-in"
+        )
+
+
+class Translator:
+    """Regions in order -> a :class:`Translation`."""
+
+    def __init__(self, forced: dict[str, str] | None = None):
+        self.scope: dict[tuple[str, str], Sym] = {}
+        self.units: dict[str, Sym] = {}
+        self.out = Translation()
+        self.forced = forced or {}  # region id -> why (found when the engine loads it)
+        self.note: list[str] = []
+
+    # -- symbols --------------------------------------------------------------
+    def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
+        sym = Sym(kind, base, mathcad, region=region, **kw)
+        self.out.syms.append(sym)
+        return sym
+
+    def unit_sym(self, name: str) -> Sym:
+        if name not in self.units:
+            self.units[name] = self.new_sym("unit", nm.identifier(name), name)
+            self.units[name].unit = FORMULA_UNITS[name]
+        return self.units[name]
+
+    def define(self, key: tuple[str, str], kind: str, region: str) -> Sym:
+        sym = self.new_sym(kind, nm.identifier(*key), nm.mathcad_text(*key), region)
+        self.scope[key] = sym
+        return sym
+
+    # -- regions --------------------------------------------------------------
+    def run(self, ws: Worksheet, regions: list[Region]) -> Translation:
+        for region in regions:
+            if region.kind == "text":
+                if region.text:
+                    if not self.out.title:
+                        self.out.title = region.text.splitlines()[0][:120]
+                    self.out.items.append(Item("note", region.id, value=region.text))
+                continue
+            if region.kind != "math":
+                what = {"plot": "a plot", "picture": "a picture"}.get(region.kind, "a component")
+                if region.kind == "reference":
+                    continue  # followed by the caller
+                self.skip(region.id, what, "not translated: the language has no such region")
+                continue
+            if region.math is None:
+                continue
+            try:
+                self.math(region)
+            except Untranslatable as why:
+                self.skip(region.id, self.describe(region.math), str(why))
+        return self.out
+
+    def skip(self, region: str, what: str, why: str) -> None:
+        self.out.skipped.append(Skipped(region, what, why))
+
+    def describe(self, node: MNode) -> str:
+        if node.tag == "define":
+            lhs = node.children[0]
+            if lhs.tag == "id":
+                return f"{nm.mathcad_text(*_key(lhs))} := ..."
+            if lhs.tag == "function":
+                return f"{nm.mathcad_text(*_key(lhs.children[0]))}(...) := ..."
+            return f"{_what(lhs.tag)} := ..."
+        if node.tag == "eval":
+            return "an evaluation ( = )"
+        if node.tag == "id":
+            return f"the name {nm.mathcad_text(*_key(node))} alone"
+        return _what(node.tag)
+
+    def math(self, region: Region) -> None:
+        node = region.math
+        if node.tag in ("define", "globalDefine"):
+            self.definition(region, node)
+        elif node.tag == "eval":
+            self.evaluation(region, node, None)
+        elif node.tag == "id" and node.text.strip() == "Given":
+            raise Untranslatable("Given/Find solve blocks are not in the language yet")
+        else:
+            raise Untranslatable("shows nothing and defines nothing (no := and no =)")
+
+    def _forced(self, region: Region, sym: Sym | None) -> None:
+        why = self.forced.get(region.id)
+        if why is not None:
+            if sym is not None:
+                sym.broken = why
+            raise Untranslatable(why)
+
+    def definition(self, region: Region, node: MNode) -> None:
+        lhs, rhs = node.children[0], node.children[1]
+        evaluation = rhs if rhs.tag == "eval" else None
+        if evaluation is not None:
+            rhs = evaluation.children[0]
+        if lhs.tag == "function":
+            fname, bound = lhs.children[0], lhs.children[1]
+            self.function(region, fname, [c for c in bound.children if c.tag == "id"], rhs)
+            return
+        if lhs.tag != "id":
+            if evaluation is not None:
+                self.stored_but_broken(region, evaluation, f"{_what(lhs.tag)} := ...")
+            raise Untranslatable(f"a definition of {_what(lhs.tag)} is not in the language yet")
+        key = _key(lhs)
+        if rhs.tag == "range":
+            self.range_variable(region, key, rhs)
+            return
+        display = _override_unit(evaluation) if evaluation is not None else ""
+        try:
+            item = self.value_item(region, rhs, display)
+        except Untranslatable as why:
+            sym = self.define(key, "var", region.id)
+            sym.broken = str(why)
+            if evaluation is not None:
+                self.evaluation(region, evaluation, sym)
+            raise
+        sym = self.define(key, "var", region.id)
+        item.sym = sym
+        try:
+            self._forced(region, sym)
+        except Untranslatable:
+            if evaluation is not None:
+                self.evaluation(region, evaluation, sym)
+            raise
+        self.out.items.append(item)
+        if evaluation is not None:
+            self.evaluation(region, evaluation, sym)
+
+    def stored_but_broken(self, region: Region, evaluation: MNode, what: str) -> None:
+        sym = self.new_sym("helper", f"result_{region.id}", what, region.id)
+        sym.broken = "not translated"
+        self.evaluation(region, evaluation, sym)
+
+    def value_item(self, region: Region, rhs: MNode, display: str) -> Item:
+        """The item a scalar definition becomes: an input for a number (with units), a
+        piecewise definition for a program of ifs, or a definition."""
+        literal = _quantity_text(rhs)
+        if literal is not None:
+            return Item("input", region.id, value=literal, unit=display)
+        if rhs.tag == "program":
+            return Item("definition", region.id, pieces=self.pieces(rhs, {}), unit=display)
+        et = ExprTranslator(self)
+        body = et.visit(rhs)
+        if et.ranges:
+            raise Untranslatable(
+                f"uses the range variable {et.ranges[0].mathcad} outside a function "
+                "(a vector of values: arrays are not in the language yet)"
+            )
+        return Item("definition", region.id, body=body, unit=display)
+
+    def pieces(self, program: MNode, local) -> list[tuple[ex.Node, ex.Node | None]]:
+        """A Mathcad program made only of `value if condition` lines and `otherwise`."""
+        out = []
+        for line in program.children:
+            et = ExprTranslator(self, local)
+            if line.tag == "ifThen" and len(line.children) == 2:
+                cond, value = line.children
+                if value.tag in ("program", "localDefine"):
+                    raise Untranslatable("a program with local definitions or blocks")
+                out.append((et.visit(value), et.visit(cond)))
+            elif line.tag == "otherwise" and len(line.children) == 1:
+                out.append((et.visit(line.children[0]), None))
+            else:
+                raise Untranslatable(
+                    f"a program with {_what(line.tag)} lines (only 'if' and 'otherwise' "
+                    "lines translate: as a piecewise definition)"
+                )
+            if et.ranges:
+                raise Untranslatable("a program over a range variable")
+        if not out:
+            raise Untranslatable("an empty program")
+        return out
+
+    def range_variable(self, region: Region, key, rng: MNode) -> None:
+        sym = self.define(key, "var", region.id)
+        sym.is_range = True
+        try:
+            self._forced(region, sym)
+            first_node = rng.children[0]
+            et = ExprTranslator(self)
+            if first_node.tag == "sequence":
+                first, second = (et.visit(c) for c in first_node.children[:2])
+                second_src = first_node.children[1]
+                first_src = first_node.children[0]
+            else:
+                first, second, first_src, second_src = et.visit(first_node), None, first_node, None
+            last = et.visit(rng.children[1])
+            values = _range_values(self, first_src, second_src, rng.children[1])
+        except Untranslatable as why:
+            sym.broken = str(why)
+            raise
+        sym.unit = values[1]
+        self.out.items.append(
+            Item("range", region.id, sym=sym, range=(first, second, last), range_values=values[0])
+        )
+
+    def function(self, region: Region, fname: MNode, params: list[MNode], body: MNode) -> None:
+        key = _key(fname)
+        local: dict[tuple[str, str], Sym] = {}
+        psyms = []
+        for p in params:
+            pkey = _key(p)
+            outer = self.scope.get(pkey)
+            unit = outer.unit if outer is not None and outer.is_range else ""
+            ps = self.new_sym("param", nm.identifier(*pkey), nm.mathcad_text(*pkey), unit=unit)
+            local[pkey] = ps
+            psyms.append(ps)
+        try:
+            if body.tag == "program":
+                item = Item("function", region.id, params=psyms, pieces=self.pieces(body, local))
+            else:
+                et = ExprTranslator(self, local)
+                item = Item("function", region.id, params=psyms, body=et.visit(body))
+                if et.ranges:
+                    raise Untranslatable(
+                        f"uses the range variable {et.ranges[0].mathcad} inside a function"
+                    )
+        except Untranslatable as why:
+            sym = self.define(key, "func", region.id)
+            sym.broken = str(why)
+            raise
+        sym = self.define(key, "func", region.id)
+        item.sym = sym
+        self._forced(region, sym)
+        self.out.items.append(item)
+
+    # -- results --------------------------------------------------------------
+    def evaluation(self, region: Region, node: MNode, target: Sym | None) -> None:
+        """An `expr =` with its stored result: a printed value (or several)."""
+        result = node.find("result")
+        if result is None or not result.children:
+            return  # Mathcad stored nothing (not calculated, or an error)
+        expr = node.children[0]
+        mathcad = self.describe_expr(expr)
+        try:
+            unit, values = _stored(result.children[0])
+        except Untranslatable as why:
+            self.out.results.append(Result(region.id, None, mathcad, "", []))
+            self.skip(region.id, f"the result of {mathcad}", str(why))
+            return
+        if target is not None:  # a definition with its value shown: x := ... = value
+            rows = [(None, v) for v in values] if len(values) == 1 else None
+            if rows is None:
+                self.out.results.append(Result(region.id, None, mathcad, unit, []))
+                self.skip(region.id, f"the result of {mathcad}", "an array result")
+                return
+            self.out.results.append(Result(region.id, target, mathcad, unit, rows))
+            return
+        try:
+            self.forced_region(region)
+            self.standalone(region, expr, unit, values, mathcad)
+        except Untranslatable as why:
+            sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
+            sym.broken = str(why)
+            rows = [(None, v) for v in values]
+            self.out.results.append(Result(region.id, sym, mathcad, unit, rows[:1]))
+            raise
+
+    def forced_region(self, region: Region) -> None:
+        if region.id in self.forced:
+            raise Untranslatable(self.forced[region.id])
+
+    def standalone(self, region: Region, expr: MNode, unit: str, values, mathcad: str) -> None:
+        et = ExprTranslator(self)
+        body = et.visit(expr)
+        ranges = list(dict.fromkeys(et.ranges))
+        if not ranges:
+            if len(values) != 1:
+                raise Untranslatable("an array result")
+            sym = None
+            if isinstance(body, ex.Name) and body.id.startswith("\x00"):
+                sym = next(s for s in self.out.syms if s.token() == body.id)
+                if sym.kind == "unit":
+                    sym = None
+            if sym is None:
+                sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
+                self.out.items.append(Item("definition", region.id, sym=sym, body=body, unit=unit))
+            self.out.results.append(Result(region.id, sym, mathcad, unit, [(None, values[0])]))
+            return
+        if len(ranges) > 1:
+            raise Untranslatable("an evaluation over two range variables (a matrix)")
+        var = ranges[0]
+        item = next(i for i in self.out.items if i.sym is var)
+        at = item.range_values
+        if len(at) != len(values):
+            raise Untranslatable(
+                f"Mathcad lists {len(values)} values of the range {var.mathcad}, which has "
+                f"{len(at)}"
+            )
+        if (
+            isinstance(body, ex.Call)
+            and len(body.args) == 1
+            and body.args[0] == ex.Name(var.token())
+        ):
+            fsym = next(s for s in self.out.syms if s.token() == body.func)
+            fitem = next(i for i in self.out.items if i.sym is fsym)
+            if fitem.params[0].unit == var.unit:
+                self.out.results.append(
+                    Result(region.id, fsym, mathcad, unit, list(zip(at, values)), fitem.params[0])
+                )
+                return
+        param = self.new_sym("param", var.base, var.mathcad, unit=var.unit)
+        sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
+        body = _rename(body, {var.token(): param.token()})
+        self.out.items.append(Item("function", region.id, sym=sym, params=[param], body=body))
+        self.out.results.append(Result(region.id, sym, mathcad, unit, list(zip(at, values)), param))
+
+    def describe_expr(self, node: MNode) -> str:
+        if node.tag == "id":
+            return nm.mathcad_text(*_key(node))
+        if node.tag == "apply" and node.children[0].tag == "id":
+            return nm.mathcad_text(*_key(node.children[0])) + "(...)"
+        return "an expression"
+
+
+class _Renamer(Visitor):
+    def __init__(self, mapping: dict[str, str]):
+        self.mapping = mapping
+
+    def visit_Number(self, n):
+        return n
+
+    def visit_Text(self, n):
+        return n
+
+    def visit_Name(self, n):
+        return ex.Name(self.mapping.get(n.id, n.id))
+
+    def visit_Unary(self, n):
+        return ex.Unary(n.op, self.visit(n.operand))
+
+    def visit_Binary(self, n):
+        return ex.Binary(n.op, self.visit(n.left), self.visit(n.right))
+
+    def visit_Compare(self, n):
+        return ex.Compare(n.ops, tuple(self.visit(o) for o in n.operands))
+
+    def visit_Logic(self, n):
+        return ex.Logic(n.op, tuple(self.visit(v) for v in n.values))
+
+    def visit_Call(self, n):
+        return ex.Call(self.mapping.get(n.func, n.func), tuple(self.visit(a) for a in n.args))
+
+
+def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
+    """The tree with names (and called functions) replaced as mapped."""
+    return _Renamer(mapping).visit(node)
+
+
+# -- stored values, units, literals ----------------------------------------------
+def _unit_monomial(node: MNode) -> str:
+    parts = []
+    for ref in node.children:
+        if ref.tag != "unitReference":
+            continue
+        name = result_unit(ref.attrs.get("unit", ""))
+        num = int(ref.attrs.get("power-numerator", "1"))
+        den = int(ref.attrs.get("power-denominator", "1"))
+        power = num / den
+        if power == 1:
+            parts.append(name)
+        else:
+            p = int(power) if power.is_integer() else power
+            parts.append(f"{name} ** {p}" if p > 0 else f"{name} ** ({p})")
+    return " * ".join(parts)
+
+
+def _stored(node: MNode) -> tuple[str, list[float | str]]:
+    """(unit text, values) of a stored result: a number, a number with units, a column, a
+    text."""
+    if node.tag == "real":
+        return "", [float(node.text)]
+    if node.tag == "str":
+        return "", [node.text]
+    if node.tag == "unitedValue":
+        inner = node.children[0]
+        mono = node.find("unitMonomial")
+        unit, values = _stored(inner)
+        return (_unit_monomial(mono) if mono is not None else unit), values
+    if node.tag == "matrix":
+        values = []
+        unit = ""
+        for c in node.children:
+            if c.tag == "matrix":
+                raise Untranslatable("a nested array result (arrays are not in the language yet)")
+            u, v = _stored(c)
+            unit = unit or u
+            values += v
+        return unit, values
+    if node.tag == "complex":
+        raise Untranslatable("a complex result (complex numbers are not in the language)")
+    raise Untranslatable(f"a result of kind <{node.tag}>")
+
+
+def _override_unit(evaluation: MNode) -> str:
+    """The display unit of a result whose unit was chosen (Mathcad's unit placeholder)."""
+    if evaluation.find("unitOverride") is None:
+        return ""
+    result = evaluation.find("result")
+    if result is None or not result.children or result.children[0].tag != "unitedValue":
+        return ""
+    mono = result.children[0].find("unitMonomial")
+    return _unit_monomial(mono) if mono is not None else ""
+
+
+def _unit_text(node: MNode) -> str | None:
+    """pint text of a product of Mathcad units (m, kN/m^2), or None."""
+    if node.tag == "id" and not node.attrs.get("subscript") and node.text.strip() in FORMULA_UNITS:
+        return FORMULA_UNITS[node.text.strip()]
+    if node.tag == "parens":
+        inner = _unit_text(node.children[0])
+        return None if inner is None else f"({inner})"
+    if node.tag == "apply" and len(node.children) == 3:
+        op, a, b = node.children
+        if op.tag in ("mult", "div"):
+            ua, ub = _unit_text(a), _unit_text(b)
+            if ua is not None and ub is not None:
+                return f"{ua} {'*' if op.tag == 'mult' else '/'} {ub}"
+        if op.tag == "pow" and b.tag == "real":
+            ua = _unit_text(a)
+            if ua is not None:
+                return f"{ua} ** {b.text.strip()}"
+    return None
+
+
+def _quantity_text(node: MNode) -> str | None:
+    """`24 m/s` for Mathcad's 24*m/s (a number times units), `1.3` for a number, else None."""
+    if node.tag == "real":
+        return node.text.strip()
+    if node.tag == "apply" and node.children[0].tag == "neg" and len(node.children) == 2:
+        inner = _quantity_text(node.children[1])
+        return None if inner is None else "-" + inner
+    if (
+        node.tag == "apply"
+        and len(node.children) == 3
+        and node.children[0].tag
+        in (
+            "mult",
+            "div",
+        )
+    ):
+        op, a, b = node.children
+        if a.tag == "real":
+            unit = _unit_text(b)
+            if unit is not None:
+                if op.tag == "mult":
+                    return f"{a.text.strip()} {unit}"
+                return f"{a.text.strip()} / ({unit})"
+    return None
+
+
+def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNode):
+    """Mathcad's values of a range first, second .. last (up to last, not beyond), and the
+    range's unit; the bounds must be numbers known at import."""
+    a, unit = _constant(tr, first)
+    b = _constant(tr, second)[0] if second is not None else (a + 1 if a <= 0 or True else a)
+    c = _constant(tr, last)[0]
+    if second is None:
+        b = a + 1 if c >= a else a - 1
+    step = b - a
+    if step == 0:
+        raise Untranslatable("a range with step 0")
+    n = math.floor((c - a) / step * (1 + 1e-12) + 1e-9)
+    if n < 0:
+        raise Untranslatable("an empty range")
+    if n > 100_000:
+        raise Untranslatable("a range of more than 100,000 values")
+    return [a + k * step for k in range(n + 1)], unit
+
+
+def _constant(tr: Translator, node: MNode) -> tuple[float, str]:
+    """The value of a bound made of numbers, pi and inputs with known values."""
+    text = _quantity_text(node)
+    if text is not None and " " not in text:
+        return float(text), ""
+    et = ExprTranslator(tr)
+    tree = et.visit(node)
+    values = {}
+    for item in tr.out.items:
+        if item.kind == "input" and item.sym is not None:
+            try:
+                values[item.sym.token()] = float(item.value)
+            except ValueError:
+                continue
+    try:
+        return _fold(tree, values), ""
+    except (KeyError, TypeError, ValueError, ZeroDivisionError, OverflowError):
+        raise Untranslatable("a range whose bounds are not plain numbers known at import") from None
+
+
+def _fold(n: ex.Node, values: dict[str, float]) -> float:
+    if isinstance(n, ex.Number):
+        return n.value
+    if isinstance(n, ex.Name):
+        return math.pi if n.id == "pi" else values[n.id]
+    if isinstance(n, ex.Unary) and n.op in "+-":
+        v = _fold(n.operand, values)
+        return -v if n.op == "-" else v
+    if isinstance(n, ex.Binary):
+        a, b = _fold(n.left, values), _fold(n.right, values)
+        return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else 1 / 0, "^": a**b}[n.op]
+    raise TypeError(n)

@@ -1,0 +1,66 @@
+"""Mathcad's unit names, as data: the names written in formulas, and the names in results.
+
+In a formula a unit is a predefined variable (``m``, ``kN``, ``MPa``); a worksheet may
+redefine the name (``l := 12 m`` hides the litre). A stored result names its units in full
+(``<unitReference unit="kilonewton" power-numerator="-2"/>``). Both map to pint unit text.
+"""
+
+from __future__ import annotations
+
+#: Unit names in Mathcad 11-15 formulas -> pint.
+FORMULA_UNITS: dict[str, str] = {
+    # length
+    "m": "meter", "cm": "centimeter", "mm": "millimeter", "km": "kilometer",
+    "μm": "micrometer", "nm": "nanometer", "in": "inch", "ft": "foot", "yd": "yard",
+    "mi": "mile",
+    # mass
+    "kg": "kilogram", "g": "gram", "mg": "milligram", "tonne": "tonne", "ton": "ton",
+    "lb": "pound", "oz": "ounce",
+    # time
+    "s": "second", "ms": "millisecond", "min": "minute", "hr": "hour", "day": "day",
+    "yr": "year", "wk": "week",
+    # force
+    "N": "newton", "kN": "kilonewton", "MN": "meganewton", "dyne": "dyne", "kgf": "kilogram_force",
+    "lbf": "pound_force", "kip": "kip", "tonf": "ton_force",
+    # pressure, stress
+    "Pa": "pascal", "kPa": "kilopascal", "MPa": "megapascal", "GPa": "gigapascal",
+    "bar": "bar", "atm": "atmosphere", "psi": "psi", "ksi": "ksi", "mmHg": "mmHg",
+    "torr": "torr",
+    # energy, power
+    "J": "joule", "kJ": "kilojoule", "MJ": "megajoule", "W": "watt", "kW": "kilowatt",
+    "MW": "megawatt", "cal": "calorie", "kcal": "kilocalorie", "hp": "horsepower",
+    "BTU": "BTU", "kWh": "kilowatt_hour",
+    # angle
+    "deg": "degree", "rad": "radian", "rev": "revolution",
+    # volume
+    "L": "liter", "l": "liter", "mL": "milliliter", "ml": "milliliter", "gal": "gallon",
+    # electric
+    "A": "ampere", "mA": "milliampere", "kA": "kiloampere", "V": "volt", "mV": "millivolt",
+    "kV": "kilovolt", "Ω": "ohm", "ohm": "ohm", "kΩ": "kiloohm", "C": "coulomb",
+    "F": "farad", "μF": "microfarad", "H": "henry", "Wb": "weber", "T": "tesla",
+    "S": "siemens",
+    # frequency, speed
+    "Hz": "hertz", "kHz": "kilohertz", "MHz": "megahertz", "rpm": "revolutions_per_minute",
+    "mph": "mile_per_hour", "kph": "kilometer_per_hour", "knot": "knot",
+    # temperature (differences) and amount
+    "K": "kelvin", "R": "degree_Rankine", "mol": "mole", "cd": "candela",
+    # area
+    "ha": "hectare", "acre": "acre",
+}  # fmt: skip
+
+#: Unit names in stored results (``unitReference unit="..."``) that pint reads otherwise.
+RESULT_UNITS: dict[str, str] = {
+    "liter": "liter",
+    "degree": "degree",
+    "revolution": "revolution",
+    "hour": "hour",
+    "minute": "minute",
+    "tonne": "tonne",
+    "ohm": "ohm",
+    "kelvin": "kelvin",
+}
+
+
+def result_unit(name: str) -> str:
+    """pint text of a unit named in a stored result (full names pint mostly knows)."""
+    return RESULT_UNITS.get(name, name)

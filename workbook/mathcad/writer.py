@@ -1,0 +1,323 @@
+"""Writing a translation as a worksheet: ``NAME.toml`` and its printed-values CSV files."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .. import expr as ex
+from ..errors import InputError, WorkbookError
+from .functions import language_functions
+from .translate import Item, Sym, Translation, _rename
+
+#: Relative tolerance of the printed values: Mathcad stores full doubles.
+REL_TOLERANCE = 1e-9
+#: Absolute tolerance (in the printed unit), for results Mathcad stores as exactly 0.
+ABS_TOLERANCE = 1e-12
+
+
+@dataclass
+class Rendered:
+    name: str
+    toml: str
+    csv: dict[str, str] = field(default_factory=dict)
+    definitions: int = 0
+    region_of: dict[str, str] = field(default_factory=dict)  # identifier -> region id
+
+
+def pretty_unit(text: str) -> str:
+    """Unit text in pint's short form (``kN / m ** 2``); as it is if pint cannot read it."""
+    from .. import units as un
+
+    try:
+        return format(un.registry().Unit(text), "~")
+    except Exception:  # noqa: BLE001 - left as written, the engine reports it at load
+        return text
+
+
+def pretty_quantity(text: str) -> str:
+    number, _, unit = text.partition(" ")
+    return f"{number} {pretty_unit(unit)}" if unit and "/ (" not in text else text
+
+
+def _q(text: str) -> str:
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _assign(tr: Translation) -> None:
+    """Choose every symbol's identifier: unique, not a built-in, arguments apart from the
+    names of inputs and definitions (shared by arguments of the same unit)."""
+    reserved = set(language_functions()) | {"pi"}
+    taken: dict[str, Sym] = {}
+    lower: set[str] = set()
+
+    def claim(sym: Sym, share=None) -> None:
+        base = sym.base if sym.base not in reserved else sym.base + "_"
+        n, name = 1, base
+        while True:
+            other = taken.get(name)
+            if other is None and name.lower() not in lower:
+                break
+            if other is not None and share is not None and share(other):
+                break
+            n += 1
+            name = f"{base}_{n}"
+        sym.final = name
+        taken[name] = sym
+        lower.add(name.lower())
+
+    arguments = [s for s in tr.syms if s.kind == "param" or s.is_range]
+    for sym in tr.syms:
+        if sym.kind in ("var", "func", "helper") and not sym.is_range:
+            claim(sym)
+    for sym in arguments:
+        claim(sym, share=lambda o, s=sym: (o.kind == "param" or o.is_range) and o.unit == s.unit)
+    for sym in tr.syms:
+        if sym.kind == "unit":
+            claim(sym)
+
+
+def _text(node: ex.Node, mapping: dict[str, str]) -> str:
+    return ex.to_text(_rename(node, mapping))
+
+
+def _comment(text: str, width: int = 96) -> list[str]:
+    lines = []
+    for para in text.splitlines():
+        words, cur = para.split(), ""
+        for w in words:
+            if cur and len(cur) + len(w) + 1 > width:
+                lines.append("# " + cur)
+                cur = w
+            else:
+                cur = f"{cur} {w}".strip()
+        if cur:
+            lines.append("# " + cur)
+    return lines
+
+
+def render(tr: Translation, name: str, src: Path) -> Rendered:
+    """The worksheet text and its CSV files."""
+    _assign(tr)
+    mapping = {s.token(): s.final for s in tr.syms}
+    out = Rendered(name, "")
+    head = [
+        f"# Imported from {src.name} by `workbook import`: Mathcad's definitions in order, its",
+        "# text regions as comments, and every result Mathcad stored as a printed value",
+        "# (`workbook check` compares them with the engine).",
+    ]
+    if tr.skipped:
+        head.append("#")
+        head.append(
+            f"# Not translated ({len({s.region for s in tr.skipped})} regions; their results "
+            "count as not reproduced):"
+        )
+        for s in tr.skipped:
+            head.append(f"#   region {s.region}: {s.what}: {s.why}")
+    renamed = sorted(
+        {(s.mathcad, s.final) for s in tr.syms if s.mathcad != s.final and s.kind != "helper"}
+    )
+    if renamed:
+        head.append("#")
+        head.append("# Names (Mathcad -> worksheet):")
+        line = "#  "
+        for mathcad, final in renamed:
+            piece = f" {mathcad} -> {final};"
+            if len(line) + len(piece) > 96:
+                head.append(line)
+                line = "#  "
+            line += piece
+        head.append(line)
+    sheet = [
+        "[sheet]",
+        f"name = {_q(name)}",
+        f"title = {_q(tr.title or name)}",
+        f"source = {_q('Mathcad worksheet ' + src.name)}",
+    ]
+    inputs, definitions, arguments = ["[inputs]"], ["[definitions]"], ["[arguments]"]
+    notes: list[str] = []
+    units = [s for s in tr.syms if s.kind == "unit"]
+    for sym in units:
+        value = _q("1 " + pretty_unit(sym.unit))
+        inputs.append(f'{sym.final} = {{ value = {value}, note = "the unit {sym.mathcad}" }}')
+    seen_args: set[str] = set()
+    for sym in tr.syms:
+        if (sym.kind == "param" or sym.is_range) and not sym.broken:
+            if sym.final in seen_args:
+                continue
+            seen_args.add(sym.final)
+            arguments.append(f"{sym.final} = {{ unit = {_q(pretty_unit(sym.unit))} }}")
+    tables: list[str] = []
+    for item in tr.items:
+        if item.kind == "note":
+            notes += _comment(item.value)
+            continue
+        if item.sym is None or item.sym.broken:
+            continue
+        out.region_of[item.sym.final] = item.region
+        target = inputs if item.kind == "input" else definitions
+        if item.kind == "range":
+            target = arguments
+        if notes:
+            target += notes
+            notes = []
+        note = f"{item.sym.mathcad} (region {item.region})"
+        if item.kind == "input":
+            value = pretty_quantity(item.value)
+            extra = f", unit = {_q(pretty_unit(item.unit))}" if item.unit else ""
+            target.append(f"{item.sym.final} = {{ value = {_q(value)}{extra}, note = {_q(note)} }}")
+            out.definitions += 1
+        elif item.kind == "range":
+            target.append(
+                f"# {item.sym.final} := {_range_text(item, mapping)} (region {item.region})"
+            )
+        else:
+            key = item.sym.final
+            if item.params:
+                key = f"{key}({', '.join(p.final for p in item.params)})"
+                key = _q(key)
+            if item.pieces is not None:
+                pieces = [
+                    f"{_text(v, mapping)} if {_text(c, mapping)}"
+                    if c is not None
+                    else f"{_text(v, mapping)} otherwise"
+                    for v, c in item.pieces
+                ]
+                value = "[" + ", ".join(_q(p) for p in pieces) + "]"
+                field_ = "pieces"
+            else:
+                value = _q(_text(item.body, mapping))
+                field_ = "expr"
+            extra = f", unit = {_q(pretty_unit(item.unit))}" if item.unit else ""
+            target.append(f"{key} = {{ {field_} = {value}{extra}, note = {_q(note)} }}")
+            out.definitions += 1
+    if notes:
+        definitions += notes
+    # printed values: one CSV per argument (scalars: no argument)
+    groups: dict[str, list[str]] = {}
+    for res in tr.results:
+        arg = res.argument.final if res.argument is not None else ""
+        rows = groups.setdefault(arg, [])
+        sym_name = res.sym.final if res.sym is not None else f"result_{res.region}"
+        if not res.rows:
+            rows.append(f"# region {res.region}: {res.name}: the stored result cannot be read")
+            rows.append(f"{sym_name},,nan,")
+            continue
+        for at, value in res.rows:
+            at_text = "" if at is None else repr(float(at))
+            if isinstance(value, str):  # printed values are numbers: a text is not checked
+                rows.append(f"# region {res.region}: Mathcad shows the text {value!r}")
+                value = math.nan
+            val = repr(float(value))
+            rows.append(f"{sym_name},{at_text},{val},{pretty_unit(res.unit) if res.unit else ''}")
+    printed: list[str] = []
+    for arg, rows in groups.items():
+        fname = f"{name}.mathcad.csv" if not arg else f"{name}.mathcad.{arg}.csv"
+        out.csv[fname] = (
+            "# Mathcad's stored results (imported by `workbook import`)\nname,argument,value,unit\n"
+            + "\n".join(rows)
+            + "\n"
+        )
+        printed += [
+            "",
+            "[[printed]]",
+            f"file = {_q(fname)}",
+            f"title = {_q('Mathcad results' + (' over ' + arg if arg else ''))}",
+        ]
+        if arg:
+            printed.append(f"argument = {_q(arg)}")
+        printed.append(f"rel_tolerance = {REL_TOLERANCE}")
+        printed.append(f"tolerance = {ABS_TOLERANCE}")
+        table = _table_for(tr, arg, mapping)
+        if table:
+            tables += table
+    parts = head + [""] + sheet + [""]
+    for section in (inputs, arguments, definitions):
+        if len(section) > 1:
+            parts += section + [""]
+    out.toml = "\n".join(parts + tables + printed) + "\n"
+    return out
+
+
+def _range_text(item: Item, mapping) -> str:
+    first, second, last = item.range
+    head = _text(first, mapping)
+    if second is not None:
+        head += ", " + _text(second, mapping)
+    return f"{head} .. {_text(last, mapping)}"
+
+
+def _table_for(tr: Translation, arg: str, mapping) -> list[str]:
+    """A table over the range variable `arg` listing what Mathcad listed over it."""
+    ranges = [i for i in tr.items if i.kind == "range" and i.sym.final == arg and not i.sym.broken]
+    if not ranges:
+        return []
+    item = ranges[-1]
+    funcs = []
+    for res in tr.results:
+        if res.argument is not None and res.argument.final == arg and res.sym is not None:
+            if not res.sym.broken and res.sym.final not in funcs:
+                funcs.append(res.sym.final)
+    if not funcs:
+        return []
+    cols = ", ".join(f'{_q(f + "(" + arg + ")")} = ""' for f in funcs)
+    return [
+        "",
+        "[[tables]]",
+        f"name = {_q('table_' + arg)}",
+        f"range = {_q(arg + ' := ' + _range_text(item, mapping))}",
+        f"columns = {{ {cols} }}",
+    ]
+
+
+def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
+    """Load the rendered worksheet with the engine: None if it loads, else (region, why)."""
+    import workbook
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"{rendered.name}.toml"
+        path.write_text(rendered.toml, encoding="utf-8")
+        for fname, text in rendered.csv.items():
+            (Path(tmp) / fname).write_text(text, encoding="utf-8")
+        try:
+            workbook.load(str(path))
+        except WorkbookError as err:
+            region = _region_of(err, rendered)
+            if region is None:
+                raise WorkbookError(
+                    f"the translated worksheet does not load: {err.message}"
+                ) from None
+            return region, f"the engine refuses it: {err.message}"
+    return None
+
+
+def _region_of(err: WorkbookError, rendered: Rendered) -> str | None:
+    if err.definition and err.definition in rendered.region_of:
+        return rendered.region_of[err.definition]
+    if err.line:
+        lines = rendered.toml.splitlines()
+        if 0 < err.line <= len(lines):
+            m = re.search(r"\(region ([^)]+)\)", lines[err.line - 1])
+            if m:
+                return m.group(1)
+    return None
+
+
+def write(rendered: Rendered, out_dir: Path, *, force: bool) -> list[Path]:
+    """Write the worksheet and its CSV files; an existing file needs --force."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    targets = [out_dir / f"{rendered.name}.toml"] + [out_dir / f for f in rendered.csv]
+    if not force:
+        existing = [p for p in targets if p.exists()]
+        if existing:
+            raise InputError(f"{existing[0]} exists; use --force to replace it")
+    from ..atomic import replacing
+
+    for path, text in zip(targets, [rendered.toml, *rendered.csv.values()]):
+        with replacing(path) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+    return targets
