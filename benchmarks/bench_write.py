@@ -62,7 +62,7 @@ class Raw:
     def __init__(self, sheet):
         from workbook import units as un
         from workbook.excel import ExcelPrinter, excel_name
-        from workbook.sheet import header
+        from workbook.units import header
         from workbook.xlsx import ROW_TOKEN
 
         data = sheet.table_data("big")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .data import data_dir
 from .errors import WorkbookError
 
 __version__ = "0.1.0"
@@ -22,17 +23,6 @@ def list_templates() -> dict[str, Path]:
         if entry.name.endswith(".toml"):
             out[entry.name[: -len(".toml")]] = Path(str(entry))
     return dict(sorted(out.items()))
-
-
-def data_dir(folder: str) -> Path:
-    """The installed data folder ('templates' or 'units'), or the source tree's."""
-    from importlib import resources
-
-    package = {"templates": "workbook.templates", "units": "workbook.unitdefs"}[folder]
-    try:
-        return Path(str(resources.files(package)))
-    except ModuleNotFoundError:  # running from a source checkout without installing
-        return Path(__file__).resolve().parent.parent / folder
 
 
 def template_path(name_or_path: str | Path) -> Path:

@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import units as un
-from .blocks import Finding
 from .errors import TemplateError, WorkbookError
+from .findings import Finding
 from .template import PrintedSpec
 
 

@@ -1,9 +1,10 @@
 """A Sheet in Jupyter: inputs, definitions, functions and tables as HTML.
 
-``Sheet._repr_html_`` calls :func:`sheet_html`. Tables are pandas DataFrames with the unit in
-every header (``sheet.table(name)``). Displaying a sheet does not compute block tables (ODE
-histories, studies: they may take long); they are listed with the call that computes them.
-A value that fails is shown with its error instead of breaking the display.
+Jupyter calls the Sheet's ``_repr_html_``, which is :func:`sheet_html`. Tables are pandas
+DataFrames with the unit in every header (``sheet.table(name)``). Displaying a sheet does not
+compute block tables (ODE histories, studies: they may take long); they are listed with the
+call that computes them. A value that fails is shown with its error instead of breaking the
+display.
 """
 
 from __future__ import annotations

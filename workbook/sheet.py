@@ -66,7 +66,7 @@ class Sheet:
         self.typer = typer or tc.Typer(spec, input_units)
         self._memo: dict[str, object] = {}
         self.evaluator = Evaluator(
-            self.typer, self._scalar_value, self._describe, self._column_values
+            self.typer, self.scalar_value, self.describe_call, self._column_values
         )
         if typer is None:
             self.check_units()
@@ -97,7 +97,7 @@ class Sheet:
         for t in self.full_spec.tables:  # every part is checked, chosen or not
             if t.range is not None:
                 for col in t.columns:
-                    self._typed_column(col, t.range.var, f"table {t.name}")
+                    self.typed_column(col, t.range.var, f"table {t.name}")
         for c in self.full_spec.charts:
             for s in c.series:
                 if s.table is None:
@@ -106,7 +106,7 @@ class Sheet:
                         raise TemplateError(
                             f"chart {c.name}: a series needs a range", file=self.file, line=c.line
                         )
-                    self._typed_column(s.y, rng.var, f"chart {c.name}")
+                    self.typed_column(s.y, rng.var, f"chart {c.name}")
 
     def with_inputs(self, **changes) -> Sheet:
         """A new Sheet with some inputs replaced (``"40 mm"``, a pint Quantity, or a number)."""
@@ -154,7 +154,7 @@ class Sheet:
             if not d.is_function:
                 if args or kwargs:
                     raise InputError(f"'{name}' takes no arguments")
-                return Q(self._scalar_value(name, "definition"), self.typer.scalar(name).unit)
+                return Q(self.scalar_value(name, "definition"), self.typer.scalar(name).unit)
             f = self.typer.function(name)
             env = self._bind(name, d.params, args, kwargs)
             out = self.evaluator.function(name)(env)
@@ -200,7 +200,7 @@ class Sheet:
         mag = np.asarray(mag, dtype=float)
         return float(mag) if mag.ndim == 0 else mag
 
-    def _scalar_value(self, name: str, kind: str):
+    def scalar_value(self, name: str, kind: str):
         if kind == "input":
             return float(self.values[name].magnitude)
         if kind == "choice":
@@ -236,7 +236,7 @@ class Sheet:
             self._memo[key] = self.column(col, spec.range.var, values, what).values
         return self._memo[key]
 
-    def _describe(self, fname: str, params, env) -> str:
+    def describe_call(self, fname: str, params, env) -> str:
         parts = []
         for p in params:
             v = env.get(p)
@@ -302,7 +302,7 @@ class Sheet:
                 return ex.Call(node.id, (ex.Name(var),))
         return node
 
-    def _typed_column(self, col: ColumnSpec, var: str, what: str) -> tc.T:
+    def typed_column(self, col: ColumnSpec, var: str, what: str) -> tc.T:
         try:
             t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
             if col.unit is not None:
@@ -323,7 +323,7 @@ class Sheet:
         return err.located(file=self.file, line=line, definition=what)
 
     def column(self, col: ColumnSpec, var: str, values: np.ndarray, what: str) -> Column:
-        t = self._typed_column(col, var, what)
+        t = self.typed_column(col, var, what)
         fn = self.evaluator.compile(t)
         try:
             out = fn({var: values})
@@ -379,7 +379,7 @@ class Sheet:
         if spec.block:
             return self.block_table(spec.block)
         data = self.table_data(name)
-        return pd.DataFrame({header(c.title, c.unit): c.values for c in data.columns})
+        return pd.DataFrame({un.header(c.title, c.unit): c.values for c in data.columns})
 
     def block_table(self, ref: str):
         from . import blocks
@@ -442,11 +442,6 @@ def _printed_names(p) -> set[str]:
         return {row.name for row in read_printed(p)}
     except WorkbookError:
         return set()
-
-
-def header(title: str, unit: pint.Unit) -> str:
-    u = un.pretty(unit)
-    return f"{title} [{u}]" if u else title
 
 
 def coerce_input(spec, raw, *, file: str | None = None):

@@ -34,7 +34,7 @@ def registry() -> pint.UnitRegistry:
 
 
 def _new_registry(cache_folder) -> pint.UnitRegistry:
-    from . import data_dir
+    from .data import data_dir
 
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True, cache_folder=cache_folder)
     for path in sorted(data_dir("units").glob("*.txt")):
@@ -139,3 +139,9 @@ def pretty(u: pint.Unit) -> str:
 
 def close(a: float, b: float, rel: float = 1e-12) -> bool:
     return math.isclose(a, b, rel_tol=rel, abs_tol=0.0)
+
+
+def header(title: str, unit) -> str:
+    """A column header with its unit: ``"h1 [mm]"`` (the title alone when dimensionless)."""
+    u = pretty(unit)
+    return f"{title} [{u}]" if u else title

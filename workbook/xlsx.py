@@ -22,7 +22,6 @@ from .atomic import check_target, replacing
 from .checks import tolerances
 from .errors import LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive, excel_name
-from .sheet import header
 
 MAX_ROWS = 1_048_576
 ROW_TOKEN = "\x00"
@@ -189,7 +188,7 @@ class WorkbookWriter:
         ws.set_column(4, 4, 50)
         for row, d in enumerate(defs, start=1):
             t = self.sheet.typer.scalar(d.name)
-            value = self.sheet._scalar_value(d.name, "definition")
+            value = self.sheet.scalar_value(d.name, "definition")
             ws.write_string(row, 0, d.name)
             self._write_cell(ws, row, 1, t, {}, float(value), self.fmt["number"], d.name)
             ws.write_string(row, 2, un.pretty(t.unit))
@@ -243,7 +242,7 @@ class WorkbookWriter:
                 f"{MAX_ROWS:,}. Write it as CSV instead (workbook run --csv)"
             )
         ws.write_string(start, 0, spec.title, self.fmt["title"])
-        heads = [header(c.title, c.unit) for c in data.columns]
+        heads = [un.header(c.title, c.unit) for c in data.columns]
         ws.write_row(start + 1, 0, heads, self.fmt["header"])
         first = start + 2
         self._write_range_column(ws, spec, first, data.columns[0].values)
@@ -405,7 +404,7 @@ class WorkbookWriter:
         return xcells, found[-1]
 
     def _unit_key(self, col, rng, chart) -> str:
-        return str(self.sheet._typed_column(col, rng.var, f"chart {chart.name}").unit)
+        return str(self.sheet.typed_column(col, rng.var, f"chart {chart.name}").unit)
 
     def write_charts(self) -> None:
         if not self.sheet.spec.charts:

@@ -27,6 +27,19 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import TemplateError
+from ..findings import Finding
+
+__all__ = [
+    "Block",
+    "Finding",
+    "input_magnitude",
+    "block",
+    "table_block",
+    "findings_block",
+    "bench_block",
+    "export_block",
+    "get",
+]
 
 _REGISTRY: dict[str, Block] = {}
 
@@ -43,18 +56,6 @@ class Block:
     @property
     def doc(self) -> str:
         return (self.func.__doc__ or "").strip().splitlines()[0] if self.func.__doc__ else ""
-
-
-@dataclass
-class Finding:
-    """One line of a check report: a number the engine found, and what it means."""
-
-    topic: str
-    what: str
-    value: float | None = None
-    unit: str = ""
-    verdict: str = "info"  # "ok" | "info" | "warning" | "fail"
-    note: str = ""
 
 
 def input_magnitude(sheet, name: str, unit: str) -> float:

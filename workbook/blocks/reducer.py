@@ -74,7 +74,7 @@ class Model:
     phi_unit: object
     exprs: dict
     _f: object
-    _cache: dict = field(default_factory=dict)
+    memo: dict = field(default_factory=dict)  # derived data computed once (k-d trees)
 
     @property
     def sign(self) -> float:
@@ -243,11 +243,11 @@ def distance_to_trace(m: Model, px, py, k_ref: int = 0):
     from scipy.spatial import cKDTree
 
     key = ("trace", k_ref)
-    if key not in m._cache:
+    if key not in m.memo:
         s = np.arange(0.0, m.period, _SAMPLE_DEG)
         x, y, *_ = m.derivs(k_ref, s)
-        m._cache[key] = (s, cKDTree(np.column_stack([x, y])))
-    s_grid, tree = m._cache[key]
+        m.memo[key] = (s, cKDTree(np.column_stack([x, y])))
+    s_grid, tree = m.memo[key]
     px, py = np.asarray(px, dtype=float).ravel(), np.asarray(py, dtype=float).ravel()
     d0, idx = tree.query(np.column_stack([px, py]))
     s = s_grid[idx].copy()
@@ -290,8 +290,8 @@ def closed_form_deviation(m: Model) -> float:
 
 def undercut(m: Model) -> Undercut:
     """Smallest concave radius of curvature, cusps and loops of the practical profile."""
-    if "undercut" in m._cache:
-        return m._cache["undercut"]
+    if "undercut" in m.memo:
+        return m.memo["undercut"]
     from scipy.optimize import brentq, minimize_scalar
 
     packing = _mag(m.sheet, "rp_packing", "mm")
@@ -344,7 +344,7 @@ def undercut(m: Model) -> Undercut:
             if loop is not None:
                 loop["tooth"] = tooth
                 out.loops.append(loop)
-    m._cache["undercut"] = out
+    m.memo["undercut"] = out
     return out
 
 

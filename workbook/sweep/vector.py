@@ -23,7 +23,7 @@ class CaseEvaluator(Evaluator):
     """
 
     def __init__(self, sheet, swept: set[str]):
-        super().__init__(sheet.typer, sheet._scalar_value, sheet._describe)
+        super().__init__(sheet.typer, sheet.scalar_value, sheet.describe_call)
         self.spec = sheet.spec
         self.swept = swept
         self.keys = tuple("\x00" + n for n in sorted(swept))

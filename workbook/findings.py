@@ -1,0 +1,17 @@
+"""Findings: what a check found, one line of a check report."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass
+class Finding:
+    """One line of a check report: a number the engine found, and what it means."""
+
+    topic: str
+    what: str
+    value: float | None = None
+    unit: str = ""
+    verdict: str = "info"  # "ok" | "info" | "warning" | "fail"
+    note: str = ""
