@@ -83,6 +83,7 @@ class Translation:
     skipped: list[Skipped] = field(default_factory=list)
     syms: list[Sym] = field(default_factory=list)
     title: str = ""
+    ignored: list[str] = field(default_factory=list)  # regions that show and define nothing
 
 
 _BINARY = {"plus": "+", "minus": "-", "mult": "*", "div": "/", "pow": "^"}
@@ -118,6 +119,12 @@ def _what(tag: str) -> str:
     return _WHAT.get(tag, f"Mathcad's <{tag}>")
 
 
+def _uses(sym: Sym) -> str:
+    """Why a use of an untranslated name is untranslated: the name and the first reason."""
+    root = sym.broken.split(", which is not translated: ", 1)[-1]
+    return f"uses {sym.mathcad}, which is not translated: {root}"
+
+
 def _key(node: MNode) -> tuple[str, str]:
     return node.text.strip(), node.attrs.get("subscript", "")
 
@@ -151,7 +158,7 @@ class ExprTranslator(Visitor):
         sym = self.local.get(key) or self.tr.scope.get(key)
         if sym is not None:
             if sym.broken:
-                raise Untranslatable(f"uses {sym.mathcad}, which is not translated")
+                raise Untranslatable(_uses(sym))
             if sym.kind == "func":
                 raise Untranslatable(f"uses the function {sym.mathcad} as a value")
             if sym.is_range and sym not in self.local.values():
@@ -206,7 +213,7 @@ class ExprTranslator(Visitor):
         sym = self.local.get(key) or self.tr.scope.get(key)
         if sym is not None:
             if sym.broken:
-                raise Untranslatable(f"uses {sym.mathcad}, which is not translated")
+                raise Untranslatable(_uses(sym))
             if sym.kind != "func":
                 raise Untranslatable(
                     f"{sym.mathcad}(...) multiplies or indexes a value (not a function call)"
@@ -302,8 +309,10 @@ class Translator:
             self.evaluation(region, node, None)
         elif node.tag == "id" and node.text.strip() == "Given":
             raise Untranslatable("Given/Find solve blocks are not in the language yet")
-        else:
-            raise Untranslatable("shows nothing and defines nothing (no := and no =)")
+        elif node.tag == "apply" and node.children and node.children[0].tag in _COMPARE:
+            raise Untranslatable("a constraint of a solve block (Given ... Find)")
+        else:  # a name or an expression alone: Mathcad shows nothing, defines nothing
+            self.out.ignored.append(region.id)
 
     def _forced(self, region: Region, sym: Sym | None) -> None:
         why = self.forced.get(region.id)

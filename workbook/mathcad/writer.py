@@ -118,6 +118,12 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         )
         for s in tr.skipped:
             head.append(f"#   region {s.region}: {s.what}: {s.why}")
+    if tr.ignored:
+        head.append("#")
+        head += _comment(
+            "Regions that define and show nothing in Mathcad (a name or an expression without "
+            ":= or =), left out: " + ", ".join(tr.ignored)
+        )
     renamed = sorted(
         {(s.mathcad, s.final) for s in tr.syms if s.mathcad != s.final and s.kind != "helper"}
     )
@@ -207,6 +213,7 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             rows.append(f"# region {res.region}: {res.name}: the stored result cannot be read")
             rows.append(f"{sym_name},,nan,")
             continue
+        rows.append(f"# region {res.region}: {res.name}")
         for at, value in res.rows:
             at_text = "" if at is None else repr(float(at))
             if isinstance(value, str):  # printed values are numbers: a text is not checked

@@ -1,0 +1,29 @@
+"""Imported Mathcad worksheets: their workbooks recalculate in LibreOffice to the engine."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from recalc import recalculate, soffice
+from test_libreoffice import assert_same
+
+from workbook.cli import main
+
+DATA = Path(__file__).parent / "data" / "mathcad"
+pytestmark = [
+    pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed"),
+    pytest.mark.slow,
+]
+
+
+@pytest.mark.parametrize(
+    "name", ["wind-load.xmcd", "timber-beam.xmcd", "circle-area-and-plots.xmcd"]
+)
+def test_imported_workbook_recalculates_to_engine_values(name, tmp_path, capsys):
+    assert main(["import", str(DATA / name), "--out", str(tmp_path)]) == 0
+    toml = tmp_path / (Path(name).stem + ".toml")
+    xlsx = tmp_path / "out.xlsx"
+    assert main(["run", str(toml), "--out", str(xlsx)]) == 0
+    capsys.readouterr()
+    assert assert_same(xlsx, recalculate(xlsx, tmp_path / "lo")) > 0
