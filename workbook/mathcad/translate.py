@@ -95,6 +95,12 @@ _COMPARE = {
     "greaterOrEqual": ">=",
     "notEqual": "!=",
 }
+_BINDERS = {
+    "summation": "sum",
+    "product": "product",
+    "integral": "integral",
+    "derivative": "diff",
+}
 _WHAT = {
     "indexer": "an array index",
     "matcol": "a matrix column",
@@ -198,7 +204,48 @@ class ExprTranslator(Visitor):
             return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.visit(args[0])])
         if tag == "id":
             return self._call(op, args)
+        if tag in _BINDERS:
+            return self._binder(tag, args)
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
+
+    def _bound(self, var: MNode, body: MNode) -> tuple[ex.Node, ex.Node]:
+        """A variable bound by a sum, product, integral, derivative or root, and the body in
+        which it is bound."""
+        if var.tag != "id":
+            raise Untranslatable(f"a bound variable that is {_what(var.tag)}")
+        key = _key(var)
+        sym = self.tr.new_sym("bound", nm.identifier(*key), nm.mathcad_text(*key))
+        inner = ExprTranslator(self.tr, {**self.local, key: sym})
+        tree = inner.visit(body)
+        self.ranges += [r for r in inner.ranges if r is not sym]
+        return tree, ex.Name(sym.token())
+
+    def _binder(self, tag: str, args: list[MNode]) -> ex.Node:
+        name = _BINDERS[tag]
+        lam = next((a for a in args if a.tag == "lambda"), None)
+        bounds = next((a for a in args if a.tag == "bounds"), None)
+        if lam is None or len(lam.children) != 2:
+            raise Untranslatable(f"{_what(tag)} without a bound variable")
+        bvars = lam.children[0].children
+        if len(bvars) != 1:
+            raise Untranslatable(f"{_what(tag)} over {len(bvars)} variables")
+        body, var = self._bound(bvars[0], lam.children[1])
+        if tag == "derivative":
+            if bounds is not None:
+                raise Untranslatable("a derivative with bounds")
+            return self._builtin(name, tag, [body, var])
+        if bounds is None or len(bounds.children) != 2:
+            raise Untranslatable(f"{_what(tag)} over a range variable (no bounds)")
+        a, b = (self.visit(c) for c in bounds.children)
+        return self._builtin(name, tag, [body, var, a, b])
+
+    def _root(self, args: list[MNode]) -> ex.Node:
+        """Mathcad's root(f(x), x, a, b), or root(f(x), x) from the current value of x."""
+        if len(args) not in (2, 4):
+            raise Untranslatable(f"root() with {len(args)} arguments")
+        body, var = self._bound(args[1], args[0])
+        rest = [self.visit(a) for a in args[2:]] if len(args) == 4 else [self.visit(args[1])]
+        return self._builtin("root", "root", [body, var, *rest])
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.visit(node.children[0])])
@@ -220,6 +267,8 @@ class ExprTranslator(Visitor):
                 )
             return ex.Call(sym.token(), tuple(self.visit(a) for a in args))
         text = key[0]
+        if text == "root" and not key[1]:
+            return self._root(args)
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
             args = args[0].children  # min of a literal vector: min of its elements
         if text in MATHCAD_FUNCTIONS and not key[1]:
@@ -338,6 +387,7 @@ class Translator:
         if rhs.tag == "range":
             self.range_variable(region, key, rhs)
             return
+        rhs = _symbolic_result(rhs)
         display = _override_unit(evaluation) if evaluation is not None else ""
         try:
             item = self.value_item(region, rhs, display)
@@ -429,6 +479,7 @@ class Translator:
 
     def function(self, region: Region, fname: MNode, params: list[MNode], body: MNode) -> None:
         key = _key(fname)
+        body = _symbolic_result(body)
         local: dict[tuple[str, str], Sym] = {}
         psyms = []
         for p in params:
@@ -578,6 +629,16 @@ class _Renamer(Visitor):
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
     return _Renamer(mapping).visit(node)
+
+
+def _symbolic_result(node: MNode) -> MNode:
+    """A symbolic evaluation (→) stands for the expression Mathcad found: that one is used."""
+    if node.tag == "symEval":
+        res = node.find("symResult")
+        if res is not None and len(res.children) == 1:
+            return res.children[0]
+        raise Untranslatable("a symbolic evaluation without its result")
+    return node
 
 
 # -- stored values, units, literals ----------------------------------------------

@@ -57,22 +57,24 @@ def _assign(tr: Translation) -> None:
 
     def claim(sym: Sym, share=None) -> None:
         base = sym.base if sym.base not in reserved else sym.base + "_"
-        n, name = 1, base
+        # an argument named like a variable gets a trailing _ first (x and x_), then numbers
+        candidates = [base] + ([base + "_"] if share is not None else [])
+        n = 1
         while True:
+            name = candidates.pop(0) if candidates else f"{base}_{n}"
             other = taken.get(name)
             if other is None and name.lower() not in lower:
                 break
             if other is not None and share is not None and share(other):
                 break
             n += 1
-            name = f"{base}_{n}"
         sym.final = name
         taken[name] = sym
         lower.add(name.lower())
 
     arguments = [s for s in tr.syms if s.kind == "param" or s.is_range]
     for sym in tr.syms:
-        if sym.kind in ("var", "func", "helper") and not sym.is_range:
+        if sym.kind in ("var", "func", "helper", "bound") and not sym.is_range:
             claim(sym)
     for sym in arguments:
         claim(sym, share=lambda o, s=sym: (o.kind == "param" or o.is_range) and o.unit == s.unit)

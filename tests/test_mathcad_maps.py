@@ -1,0 +1,111 @@
+"""The importer's maps (names, units, functions) and its handling of Mathcad's order."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from workbook import units as un
+from workbook.cli import main
+from workbook.mathcad.functions import MATHCAD_FUNCTIONS
+from workbook.mathcad.names import identifier
+from workbook.mathcad.units import FORMULA_UNITS
+
+
+@pytest.mark.parametrize(
+    "text, sub, expected",
+    [
+        ("v", "b", "v_b"),
+        ("ρ", "", "rho"),
+        ("σ", "m.α.d", "sigma_m_alpha_d"),
+        ("f", "m.d.Ø", "f_m_d_Oe"),
+        ("z", "0.II", "z_0_II"),
+        ("in", "", "in_"),
+        ("Δ", "", "Delta"),
+        ("точка", "", "tochka"),
+    ],
+)
+def test_names(text, sub, expected):
+    assert identifier(text, sub) == expected
+
+
+@pytest.mark.parametrize("name", sorted(FORMULA_UNITS))
+def test_every_mathcad_unit_is_a_pint_unit(name):
+    un.registry().Unit(FORMULA_UNITS[name])
+
+
+def test_mathcad_units_agree_with_their_definitions():
+    q = un.registry().Quantity
+    assert q(1, FORMULA_UNITS["kgf"]).to("N").magnitude == pytest.approx(9.80665, rel=1e-12)
+    assert q(1, FORMULA_UNITS["L"]).to("m**3").magnitude == pytest.approx(1e-3, rel=1e-12)
+    assert q(1, FORMULA_UNITS["psi"]).to("Pa").magnitude == pytest.approx(6894.757, rel=1e-6)
+
+
+def test_function_map_is_one_to_one_onto_names():
+    targets = [t for t, _ in MATHCAD_FUNCTIONS.values()]
+    assert all(t.isidentifier() for t in targets)
+    assert MATHCAD_FUNCTIONS["log"][0] == "log10"  # Mathcad's log is base 10
+    assert MATHCAD_FUNCTIONS["atan2"] == ("atan2", (1, 0))  # Mathcad's atan2(x, y)
+
+
+ML = "http://schemas.mathsoft.com/math30"
+
+
+def _region(rid: int, body: str) -> str:
+    return (
+        f'<region region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}">'
+        f'<math><ml:define xmlns:ml="{ML}">{body}</ml:define></math></region>'
+    )
+
+
+def _eval(rid: int, body: str, result: str) -> str:
+    return (
+        f'<region region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}">'
+        f'<math><ml:eval xmlns:ml="{ML}">{body}<ml:result>{result}</ml:result></ml:eval>'
+        "</math></region>"
+    )
+
+
+def _real(v) -> str:
+    return f"<ml:real>{v}</ml:real>"
+
+
+def _id(name, sub=None) -> str:
+    s = f' subscript="{sub}"' if sub else ""
+    return f"<ml:id{s}>{name}</ml:id>"
+
+
+def _apply(op, *args) -> str:
+    return f"<ml:apply><ml:{op}/>{''.join(args)}</ml:apply>"
+
+
+def _worksheet(*regions: str) -> str:
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n<worksheet '
+        'xmlns="http://schemas.mathsoft.com/worksheet30" '
+        f'xmlns:ml="{ML}"><regions>{"".join(regions)}</regions></worksheet>'
+    )
+
+
+def test_redefinitions_read_the_definition_in_force(tmp_path, capsys):
+    """x := 2, y := x^2, x := 5, then y = and x*y = : Mathcad's order decides."""
+    src = tmp_path / "order.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("x") + _real(2)),
+            _region(2, _id("y") + _apply("pow", _id("x"), _real(2))),
+            _region(3, _id("x") + _real(5)),
+            _eval(4, _id("y"), _real(4)),
+            _eval(5, _apply("mult", _id("x"), _id("y")), _real(20)),
+            _eval(6, _id("q"), _real(1)),  # q is defined nowhere: listed, not computable
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "1 regions not translated" in capsys.readouterr().out
+    main(["check", str(tmp_path / "order.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"], result["not_computable"]) == (3, 2, 1)
+    text = (tmp_path / "order.toml").read_text(encoding="utf-8")
+    assert "region 6: an evaluation ( = ): q is not defined before it is used" in text
