@@ -109,3 +109,52 @@ def test_redefinitions_read_the_definition_in_force(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["not_computable"]) == (3, 2, 1)
     text = (tmp_path / "order.toml").read_text(encoding="utf-8")
     assert "region 6: an evaluation ( = ): q is not defined before it is used" in text
+
+
+def _function(rid: int, name: str, params: list[str], body: str) -> str:
+    bound = "".join(_id(p) for p in params)
+    return (
+        f'<region region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}"><math>'
+        f'<ml:define xmlns:ml="{ML}"><ml:function>{_id(name)}<ml:boundVars>{bound}'
+        f"</ml:boundVars></ml:function>{body}</ml:define></math></region>"
+    )
+
+
+def test_function_argument_takes_the_unit_it_is_called_with(tmp_path, capsys):
+    """M(x) := q*x*(L - x)/2 with q = 10 kN/m, L = 6 m; M(3 m) = 45 kN*m as Mathcad stored."""
+    stored = (
+        '<ml:unitedValue><ml:real>45</ml:real><u:unitMonomial xmlns:u="http://schemas.mathsoft.'
+        'com/units10"><u:unitReference unit="kilonewton"/><u:unitReference unit="meter"/>'
+        "</u:unitMonomial></ml:unitedValue>"
+    )
+    call = f"<ml:apply>{_id('M')}{_apply('mult', _real(3), _id('m'))}</ml:apply>"
+    src = tmp_path / "beam.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("q") + _apply("mult", _real(10), _apply("div", _id("kN"), _id("m")))),
+            _region(2, _id("L") + _apply("mult", _real(6), _id("m"))),
+            _function(
+                3,
+                "M",
+                ["x"],
+                _apply(
+                    "div",
+                    _apply(
+                        "mult",
+                        _apply("mult", _id("q"), _id("x")),
+                        _apply("minus", _id("L"), _id("x")),
+                    ),
+                    _real(2),
+                ),
+            ),
+            _eval(4, call, stored),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "beam.toml").read_text(encoding="utf-8")
+    assert 'x = { unit = "m" }' in text
+    assert 'm_unit = { value = "1 m"' in text  # m and M are one name in Excel
+    capsys.readouterr()
+    main(["check", str(tmp_path / "beam.toml"), "--json"])
+    assert json.loads(capsys.readouterr().out)["reproduced"] == 1

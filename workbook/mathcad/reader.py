@@ -140,6 +140,10 @@ def _ns(tag) -> str:
 
 
 def _node(el) -> MNode:
+    if _local(el.tag) == "provenance":  # an expression pasted from another worksheet
+        inner = [c for c in el if isinstance(c.tag, str) and _ns(c.tag) == ML]
+        if inner:
+            return _node(inner[-1])
     children = [_node(c) for c in el if isinstance(c.tag, str)]
     return MNode(
         _local(el.tag),

@@ -265,7 +265,9 @@ class ExprTranslator(Visitor):
                 raise Untranslatable(
                     f"{sym.mathcad}(...) multiplies or indexes a value (not a function call)"
                 )
-            return ex.Call(sym.token(), tuple(self.visit(a) for a in args))
+            call = ex.Call(sym.token(), tuple(self.visit(a) for a in args))
+            self.tr.calls.setdefault(sym, []).append(call.args)
+            return call
         text = key[0]
         if text == "root" and not key[1]:
             return self._root(args)
@@ -292,6 +294,7 @@ class Translator:
         self.out = Translation()
         self.forced = forced or {}  # region id -> why (found when the engine loads it)
         self.note: list[str] = []
+        self.calls: dict[Sym, list[tuple[ex.Node, ...]]] = {}  # call sites of each function
 
     # -- symbols --------------------------------------------------------------
     def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
@@ -331,7 +334,25 @@ class Translator:
                 self.math(region)
             except Untranslatable as why:
                 self.skip(region.id, self.describe(region.math), str(why))
+        self.argument_units()
         return self.out
+
+    def argument_units(self) -> None:
+        """Mathcad's functions are untyped: an argument takes the unit of the values the
+        worksheet calls the function with (the first call whose unit is known)."""
+        units = _Units(self)
+        for item in self.out.items:
+            if item.kind != "function" or item.sym is None or item.sym.kind == "helper":
+                continue
+            for k, param in enumerate(item.params):
+                if param.unit:
+                    continue
+                for args in self.calls.get(item.sym, []):
+                    if k < len(args):
+                        unit = units.of(args[k])
+                        if unit is not None:
+                            param.unit = unit
+                            break
 
     def skip(self, region: str, what: str, why: str) -> None:
         self.out.skipped.append(Skipped(region, what, why))
@@ -639,6 +660,86 @@ def _symbolic_result(node: MNode) -> MNode:
             return res.children[0]
         raise Untranslatable("a symbolic evaluation without its result")
     return node
+
+
+class _Units(Visitor):
+    """The unit of an expression at import (pint text), or None where it is not known
+    (parameters, calls of the worksheet's functions): a guess for argument units only; the
+    engine checks every unit when it loads the result."""
+
+    def __init__(self, tr: Translator):
+        self.tr = tr
+        self.items = {i.sym.token(): i for i in tr.out.items if i.sym is not None}
+        self.units = {s.token(): s.unit for s in tr.out.syms if s.kind == "unit"}
+        self.memo: dict[str, object] = {}
+
+    def of(self, node: ex.Node) -> str | None:
+        try:
+            u = self.visit(node)
+        except (_Unknown, Exception):  # noqa: BLE001 - unknown: the engine decides
+            return None
+        return None if u is None else str(u)
+
+    def _reg(self):
+        from .. import units as un
+
+        return un.registry()
+
+    def visit_Number(self, n):
+        return self._reg().dimensionless
+
+    def visit_Name(self, n):
+        if n.id == "pi":
+            return self._reg().dimensionless
+        if n.id in self.units:
+            return self._reg().Unit(self.units[n.id])
+        item = self.items.get(n.id)
+        if item is None:
+            raise _Unknown
+        if n.id not in self.memo:
+            self.memo[n.id] = None  # a cycle is unknown
+            self.memo[n.id] = self._item_unit(item)
+        if self.memo[n.id] is None:
+            raise _Unknown
+        return self.memo[n.id]
+
+    def _item_unit(self, item: Item):
+        if item.kind == "input":
+            return self._reg().Quantity(item.value).units
+        if item.kind == "definition" and item.body is not None:
+            return self.visit(item.body)
+        if item.kind == "range" and item.sym.unit is not None:
+            return self._reg().Unit(item.sym.unit)
+        return None
+
+    def visit_Unary(self, n):
+        return self.visit(n.operand)
+
+    def visit_Binary(self, n):
+        a = self.visit(n.left)
+        if n.op in "+-":
+            return a
+        b = self.visit(n.right)
+        if n.op == "*":
+            return a * b
+        if n.op == "/":
+            return a / b
+        if isinstance(n.right, ex.Number):
+            return a**n.right.value
+        raise _Unknown
+
+    def visit_Call(self, n):
+        if n.func in ("abs", "min", "max", "floor", "ceil"):
+            return self.visit(n.args[0])
+        if n.func == "sqrt":
+            return self.visit(n.args[0]) ** 0.5
+        if n.func in ("sin", "cos", "tan", "exp", "ln", "log10", "asin", "acos", "atan"):
+            return self._reg().dimensionless
+        raise _Unknown
+
+
+class _Unknown(Exception):
+    pass
 
 
 # -- stored values, units, literals ----------------------------------------------

@@ -59,6 +59,8 @@ def _assign(tr: Translation) -> None:
         base = sym.base if sym.base not in reserved else sym.base + "_"
         # an argument named like a variable gets a trailing _ first (x and x_), then numbers
         candidates = [base] + ([base + "_"] if share is not None else [])
+        if sym.kind == "unit":  # a unit whose name the worksheet uses: kN_unit
+            candidates.append(base + "_unit")
         n = 1
         while True:
             name = candidates.pop(0) if candidates else f"{base}_{n}"
