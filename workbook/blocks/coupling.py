@@ -1,32 +1,52 @@
 """Centrifugal injection-advance coupling (Braginets, Kabelkov, Meremkulov 2003).
 
-Steady weight angle phi2(omega1) from the nonlinear equilibrium of the lever weights (root
-finding on the stable branch, the weights resting on the stop below the lift-off speed), the
-paper's linearised closed form beside it, and the 3-DOF dynamics M q'' + Phi q' + H q = M0 + M(t)
-with the corrections listed in SCENES.md section 4, compared with its rigid-tooth limit and
-integrated by five scipy methods in a work-precision study.
+Every formula of the scene is the template's (templates/advance-coupling.toml): the steady
+weight angle phi2(omega1), the closed forms, the lift-off speed, the entries of M, Phi and H
+and the weights' stiffness k_w. This module reads them through the sheet
+(``sheet.evaluate``, ``sheet.with_inputs`` for the families and the c2 variants) and does
+what is the scene's own: the families and trends of Fig. 3, the 3-DOF dynamics
+M q'' + Phi q' + H q = M0 + M(t) against its rigid-tooth limit (eigenvalues, the exact solution
+by the matrix exponential), and a work-precision study of five scipy ODE methods.
 
-Conventions (SI inside): q = (phi1, phi2, phi3); phi2 is the weight lever angle measured from
-its initial angle phi20; the advance angle is psi = phi3 - phi1 (the driven half ahead of the
-driving half). The dynamics is written relative to the steady rotation omega1*t*(1, 0, 1),
-which is the rigid rotation mode of H (H (1, 0, 1) = 0), so the state stays bounded.
+q = (phi1, phi2, phi3); phi2 is the weight lever angle from phi20; the advance angle is
+psi = phi3 - phi1. The dynamics is written relative to the steady rotation omega1*t*(1, 0, 1),
+the rigid rotation mode of H, so the state stays bounded.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
 import numpy as np
 
+from .. import expr as ex
+from .. import typecheck as tc
 from . import Finding, bench_block, block, findings_block, table_block
 from .solvers import METHODS, OdeRun, run_ode, stable_root, work_precision
 
+
+def _v(sheet, name: str, unit: str, **args):
+    """A definition or input of the sheet as a number (or array) in ``unit``."""
+    out = sheet.evaluate(name, **args).to(unit).magnitude
+    return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
+
+
+def _key(sheet):
+    return (str(sheet.spec.path), tuple(sorted((k, str(v)) for k, v in sheet.values.items())))
+
+
+def with_input(sheet, name: str, value: float, unit: str):
+    """The sheet with one input replaced by ``value`` in ``unit``."""
+    return sheet.with_inputs(**{name: f"{float(value)!r} {unit}"})
+
+
 # ---------------------------------------------------------------------------------------------
-# parameters
+# steady state
 # ---------------------------------------------------------------------------------------------
-_STEADY_SI = {  # the data of the steady equilibrium, in the SI units the blocks take
+_STEADY_SI = {  # the data of the steady equilibrium, in the SI units the block takes
+    "omega1": "rad/s",
     "m": "kg",
     "c1": "N/m",
     "phi20": "rad",
@@ -39,175 +59,23 @@ _STEADY_SI = {  # the data of the steady equilibrium, in the SI units the blocks
     "tan_gamma": "",
     "M_D0": "N*m",
 }
-_SI = {
-    **_STEADY_SI,
-    "J1": "kg*m^2",
-    "J3": "kg*m^2",
-    "Jx": "kg*m^2",
-    "Jy": "kg*m^2",
-    "Jxy": "kg*m^2",
-    "beta": "N*s/m",
-    "c2": "N/m",
-    "omega_dyn": "rad/s",
-    "pump_amp": "N*m",
-    "pump_order": "",
-    "t_end": "s",
-}
 
 
-@dataclass(frozen=True)
-class Params:
-    """Coupling data in SI units (the SCENES.md example by default)."""
-
-    m: float = 0.7
-    c1: float = 3000.0
-    phi20: float = 0.5236
-    lam_st: float = 1.0e-3
-    O1O: float = 0.042
-    OC: float = 0.036
-    OC1: float = 0.052
-    OB: float = 0.015
-    O1B: float = 0.040
-    tan_gamma: float = 1.0 / 3.0
-    M_D0: float = 1.2
-    J1: float = 0.02
-    J3: float = 0.01
-    Jx: float = 1.5e-4
-    Jy: float = 1.5e-4
-    Jxy: float = 0.0
-    beta: float = 20.0
-    c2: float = 1.0e8
-    omega_dyn: float = 80.0
-    pump_amp: float = 2.0
-    pump_order: float = 4.0
-    t_end: float = 0.2
-
-    @classmethod
-    def from_sheet(cls, sheet) -> Params:
-        """Read the template inputs of the same names (any that exist) in SI units."""
-        values = {}
-        for f in fields(cls):
-            q = sheet.values.get(f.name)
-            if q is None or isinstance(q, str):
-                continue
-            values[f.name] = (
-                float(q.to(_SI[f.name]).magnitude) if _SI[f.name] else float(q.to("").magnitude)
-            )
-        return cls(**values)
-
-    @property
-    def G(self) -> float:
-        """Torque of the tooth reaction on the weights, M_D0*(OB/O1B)*tan(gamma) [N m]."""
-        return self.M_D0 * self.OB / self.O1B * self.tan_gamma
-
-    @property
-    def k_ratio(self) -> float:
-        """Rigid-tooth gear ratio: phi3 - phi1 = k*phi2, k = OB*tan(gamma)/O1B."""
-        return self.OB * self.tan_gamma / self.O1B
-
-
-def method_of(sheet) -> str:
-    value = sheet.values.get("method", "auto")
-    return value if isinstance(value, str) else "auto"
-
-
-# ---------------------------------------------------------------------------------------------
-# steady state
-# ---------------------------------------------------------------------------------------------
-def weight_force(phi, w, p: Params):
-    """Generalized force on the weights at absolute lever angle phi (centrifugal - spring),
-    without the tooth reaction G [N m]."""
-    phi = np.asarray(phi, dtype=float)
-    centrifugal = 2 * p.m * w**2 * (p.O1O - p.OC * np.cos(phi)) * p.OC * np.sin(phi)
-    spring = 8 * p.c1 * (p.lam_st + p.OC1 * (np.cos(p.phi20) - np.cos(phi))) * p.OC1 * np.sin(phi)
-    return centrifugal - spring
-
-
-def weight_stiffness(phi, w, p: Params) -> float:
-    """k_w = -dQ_w/dphi at the lever angle phi [N m/rad] (spring minus centrifugal softening)."""
-    s, c = math.sin(phi), math.cos(phi)
-    dcent = 2 * p.m * w**2 * p.OC * (p.OC * s * s + (p.O1O - p.OC * c) * c)
-    dspring = 8 * p.c1 * p.OC1 * (p.OC1 * s * s + (p.lam_st + p.OC1 * (math.cos(p.phi20) - c)) * c)
-    return dspring - dcent
-
-
-@dataclass
-class Steady:
-    phi2: float  # rad, from phi20
-    on_stop: bool
-    margin: float  # F(phi20) [N m]: > 0 the weights lift off the stop
-    iterations: int = 0
-    reason: str = ""
-
-
-def steady(w: float, p: Params) -> Steady:
-    """Stable equilibrium of the weights at shaft speed w (rad/s)."""
-    F = lambda phi: weight_force(phi, w, p) - p.G
-    margin = float(F(np.asarray([p.phi20]))[0])
-    if margin <= 0:
-        return Steady(0.0, True, margin, 0, "on the stop")
-    upper = math.pi - 1e-9 if p.G > 0 else math.pi - 1e-6
-    r = stable_root(F, p.phi20, upper, n=512)
-    if not r.converged:
-        return Steady(math.nan, False, margin, r.iterations, r.reason)
-    return Steady(r.x - p.phi20, False, margin, r.iterations, "root")
-
-
-def lift_off_speed(p: Params) -> float:
-    """Speed at which the weights leave the stop, F(phi20) = 0 [rad/s]."""
-    s, A = math.sin(p.phi20), p.O1O - p.OC * math.cos(p.phi20)
-    num = 8 * p.c1 * p.lam_st * p.OC1 * s + p.G
-    den = 2 * p.m * A * p.OC * s
-    return math.sqrt(num / den) if den > 0 and num >= 0 else math.nan
-
-
-@dataclass
-class Linear:
-    value: float  # NaN when the denominator is not positive
-    numerator: float
-    denominator: float
-
-
-def linear_phi2(w: float, p: Params, form: str = "printed") -> Linear:
-    """The paper's closed form phi2 = N/D (one linearisation step about phi20), clamped at the stop.
-
-    form "printed": the denominator as legible in the print,
-        8 c1 (lam_st OC1 cos phi20 + OC1^2 sin^2 phi20) - 2 m w^2 (O1O - OC cos phi20) OC cos phi20;
-    form "newton": the consistent first-order step -F(phi20)/F'(phi20), whose centrifugal part
-        also has the term 2 m w^2 OC^2 sin^2 phi20.
-    The numerator is F(phi20) (its last printed term 2 c2 O1B tan(gamma) OB Delta with the tooth
-    deflection Delta = M_D0/(2 c2 O1B^2) is G: c2 drops out).
-    """
-    s, c = math.sin(p.phi20), math.cos(p.phi20)
-    A = p.O1O - p.OC * c
-    N = 2 * p.m * w**2 * A * p.OC * s - 8 * p.c1 * p.lam_st * p.OC1 * s - p.G
-    D = 8 * p.c1 * (p.lam_st * p.OC1 * c + p.OC1**2 * s**2) - 2 * p.m * w**2 * A * p.OC * c
-    if form == "newton":
-        D -= 2 * p.m * w**2 * p.OC**2 * s**2
-    value = max(0.0, N / D) if D > 0 else math.nan
-    return Linear(value, N, D)
-
-
-_STEADY_ARGS = {"omega1": "rad/s", **_STEADY_SI}
-
-
-@block(args=_STEADY_ARGS, returns="rad", vectorized=False)
+@block(args=_STEADY_SI, returns="rad", vectorized=False)
 def phi2_root(omega1, m, c1, phi20, lam_st, O1O, OC, OC1, OB, O1B, tan_gamma, M_D0):
     """Steady weight angle: stable root of the nonlinear equilibrium (0 on the stop)."""
-    p = Params(
-        m=m,
-        c1=c1,
-        phi20=phi20,
-        lam_st=lam_st,
-        O1O=O1O,
-        OC=OC,
-        OC1=OC1,
-        OB=OB,
-        O1B=O1B,
-        tan_gamma=tan_gamma,
-        M_D0=M_D0,
-    )
-    return steady(float(omega1), p).phi2
+    G = M_D0 * OB / O1B * tan_gamma
+
+    def F(phi):
+        cent = 2 * m * omega1**2 * (O1O - OC * np.cos(phi)) * OC * np.sin(phi)
+        return (
+            cent - 8 * c1 * (lam_st + OC1 * (math.cos(phi20) - np.cos(phi))) * OC1 * np.sin(phi) - G
+        )
+
+    if float(F(np.asarray([phi20]))[0]) <= 0:
+        return 0.0  # on the stop
+    r = stable_root(F, phi20, math.pi - (1e-9 if G > 0 else 1e-6), n=512)
+    return r.x - phi20 if r.converged else math.nan
 
 
 # ---------------------------------------------------------------------------------------------
@@ -228,37 +96,47 @@ TREND_TEXT = {
 
 
 def speeds(sheet) -> np.ndarray:
-    lo = float(sheet.values["omega_min"].to("rad/s").magnitude)
-    hi = float(sheet.values["omega_max"].to("rad/s").magnitude)
-    step = float(sheet.values["omega_step"].to("rad/s").magnitude)
-    n = int(math.floor((hi - lo) / step * (1 + 1e-12) + 1e-9)) + 1
-    ws = lo + step * np.arange(n)
-    if abs(ws[-1] - hi) > 1e-9:
-        ws = np.append(ws, hi)
-    return ws
+    """The speeds of the template's steady table (rad/s)."""
+    spec = sheet.table_spec("steady")
+    return sheet.range_values(spec.range, "table steady")
 
 
-def family(p: Params, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
-    """For each value of the family parameter: nonlinear root and both linear forms."""
-    out = {}
-    for value in FAMILIES[key][2]:
-        q = replace(p, **{key: value})
-        st = [steady(w, q) for w in ws]
-        out[value] = {
-            "root": np.array([s.phi2 for s in st]),
-            "on_stop": np.array([s.on_stop for s in st]),
-            "printed": np.array([linear_phi2(w, q, "printed").value for w in ws]),
-            "D": np.array([linear_phi2(w, q, "printed").denominator for w in ws]),
-            "newton": np.array([linear_phi2(w, q, "newton").value for w in ws]),
-        }
-    return out
+def closed_form(sheet, ws, form: str = "printed") -> tuple[np.ndarray, np.ndarray]:
+    """(value, denominator) of the template's closed form (phi2_lin or phi2_newton): NaN where
+    its denominator is not positive (the template gives no value there)."""
+    suffix = "lin" if form == "printed" else "newton"
+    den = np.atleast_1d(_v(sheet, f"D_{suffix}", "N*m", omega1=ws))
+    value = np.full(den.shape, math.nan)
+    ok = den > 0
+    if ok.any():
+        value[ok] = _v(sheet, f"phi2_{suffix}", "rad", omega1=np.asarray(ws)[ok])
+    return value, den
+
+
+def family(sheet, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
+    """For each value of the family parameter: nonlinear root and both closed forms."""
+
+    def build():
+        out = {}
+        for value in FAMILIES[key][2]:
+            s = with_input(sheet, key, value, FAMILIES[key][1])
+            printed, den = closed_form(s, ws, "printed")
+            out[value] = {
+                "root": np.atleast_1d(_v(s, "phi2", "rad", omega1=ws)),
+                "printed": printed,
+                "D": den,
+                "newton": closed_form(s, ws, "newton")[0],
+            }
+        return out
+
+    return _cached(("family", _key(sheet), key, tuple(ws)), build)
 
 
 def _family_table(sheet, key: str):
     import pandas as pd
 
-    p, ws = Params.from_sheet(sheet), speeds(sheet)
-    fam = family(p, key, ws)
+    ws = speeds(sheet)
+    fam = family(sheet, key, ws)
     unit = FAMILIES[key][1]
     cols = {"omega1 [rad/s]": ws}
     for value, d in fam.items():
@@ -328,116 +206,99 @@ class LinearModel:
         return np.vstack([q[1], q[2] - q[0]])
 
 
-def mass_matrix(p: Params) -> np.ndarray:
-    a11 = p.J1 + 2 * p.m * (p.O1O - p.OC * math.cos(p.phi20)) ** 2 + 2 * p.Jy
-    a22 = 2 * p.m * p.OC**2 + 2 * p.Jx
-    return np.array([[a11, -2 * p.Jxy, 0.0], [-2 * p.Jxy, a22, 0.0], [0.0, 0.0, p.J3]])
+def _matrix(sheet, names, unit) -> np.ndarray:
+    """A symmetric 3x3 matrix from the template's entries (upper triangle, row by row)."""
+    vals = {n: _v(sheet, n, unit) for n in names if n}
+    out = np.zeros((3, 3))
+    for (i, j), n in zip(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), names):
+        if n:
+            out[i, j] = out[j, i] = vals[n]
+    return out
 
 
-def tooth_vector(p: Params) -> np.ndarray:
-    return np.array([p.O1B, p.OB * p.tan_gamma, -p.O1B])
+def model(sheet, *, rigid: bool = False, damping: str = "corrected") -> LinearModel:
+    """The coupling about its steady state at omega_dyn, driven by the pump torque
+    pump_amp*sin(pump_order*omega_dyn*t) on the driven half (M_N0 = M_D0: balanced torques).
 
-
-def model(
-    p: Params,
-    w: float | None = None,
-    c2: float | None = None,
-    *,
-    rigid: bool = False,
-    damping: str = "corrected",
-) -> LinearModel:
-    """The coupling about its steady state at speed w, driven by the pump torque
-    pump_amp*sin(pump_order*w*t) on the driven half (M_N0 = M_D0: balanced mean torques).
-
-    rigid=True gives the rigid-tooth limit (2 DOF, phi3 = phi1 + k*phi2). If the weights sit on
-    the stop, phi2 is held at 0 (one DOF fewer).
+    rigid=True gives the rigid-tooth limit (2 DOF, phi3 = phi1 + k_gear*phi2). If the weights
+    sit on the stop, phi2 is held at 0 (one DOF fewer).
     """
-    w = p.omega_dyn if w is None else w
-    c2 = p.c2 if c2 is None else c2
-    st = steady(w, p)
-    s20 = math.sin(p.phi20)
-    b22 = p.beta * p.OC**2 * s20**2 * (-1.0 if damping == "as printed" else 1.0)
-    M3 = mass_matrix(p)
+    w = _v(sheet, "omega_dyn", "rad/s")
+    phi2 = _v(sheet, "phi2", "rad", omega1=w)
+    on_stop = _v(sheet, "F0", "N*m", omega1=w) <= 0
+    M3 = _matrix(sheet, ("a11", "a12", "", "a22", "", "a33"), "kg*m^2")
+    b22 = _v(sheet, "b22_printed" if damping == "as printed" else "b22", "N*m*s")
     Phi3 = np.diag([0.0, b22, 0.0])
-    v = tooth_vector(p)
-    H3 = 2 * c2 * np.outer(v, v)
-    kw = weight_stiffness(p.phi20 + st.phi2, w, p)
-    K3 = H3 + np.diag([0.0, 0.0 if st.on_stop else kw, 0.0])
-    f0 = np.array([p.M_D0, p.G + kw * st.phi2, -p.M_D0])  # M0 = (M_D0, 0, -M_N0) + weights
-    fp = np.array([0.0, 0.0, -p.pump_amp])
-    k = p.k_ratio
+    H3 = _matrix(sheet, ("c11", "c12", "c13", "c22", "c23", "c33"), "N*m")
+    kw = _v(sheet, "k_w", "N*m")
+    K3 = H3 + np.diag([0.0, 0.0 if on_stop else kw, 0.0])
+    M_D0 = _v(sheet, "M_D0", "N*m")
+    f0 = np.array([M_D0, _v(sheet, "G", "N*m") + kw * phi2, -M_D0])  # M0 + the weights
+    fp = np.array([0.0, 0.0, -_v(sheet, "pump_amp", "N*m")])
+    k = _v(sheet, "k_gear", "")
     if rigid:
         C = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, k]])
-        x0 = np.array([0.0, st.phi2])
-        K3 = K3 - H3  # the tooth does no work on a rigid-tooth motion (v . C = 0)
+        x0 = np.array([0.0, phi2])
+        K3 = K3 - H3  # the tooth does no work on a rigid-tooth motion
     else:
         C = np.eye(3)
-        delta = p.M_D0 / (2 * c2 * p.O1B)  # v . q of the loaded tooth
-        x0 = np.array([0.0, st.phi2, (p.OB * p.tan_gamma * st.phi2 - delta) / p.O1B])
-    if st.on_stop:  # weights held on the stop: drop phi2 (and its constant force)
-        f0 = f0.copy()
+        x0 = np.array([0.0, phi2, k * phi2 - _v(sheet, "delta_tooth", "rad")])
+    if on_stop:  # weights held on the stop: drop phi2 (and its constant force)
         f0[1] = 0.0
-        if rigid:
-            C, x0 = np.array([[1.0], [0.0], [1.0]]), np.array([0.0])
-        else:
-            C, x0 = C[:, [0, 2]], x0[[0, 2]]
-    Omega = p.pump_order * w
+        keep = [0] if rigid else [0, 2]
+        C, x0 = (
+            (np.array([[1.0], [0.0], [1.0]]), np.array([0.0])) if rigid else (C[:, keep], x0[keep])
+        )
     return LinearModel(
         C.T @ M3 @ C,
         C.T @ Phi3 @ C,
         C.T @ K3 @ C,
         C.T @ f0,
         C.T @ fp,
-        Omega,
+        _v(sheet, "pump_order", "") * w,
         C,
         x0,
         "rigid tooth" if rigid else "3 DOF",
     )
 
 
-def eigen(p: Params, c2: float, w: float | None = None, damping: str = "corrected"):
+def eigen(sheet, damping: str = "corrected"):
     """Eigenvalues of the linear system without the rigid rotation mode, sorted by size.
 
     The rigid rotation r0 (K r0 = 0, Phi r0 = 0) is condensed out: in coordinates (r0, rest)
     its row says (M u)_r0 = 0 for every mode with lambda != 0, which leaves the Schur
     complement of M on the rest; no near-zero eigenvalue has to be told from round-off.
     """
-    mdl = model(p, w, c2, damping=damping)
+    mdl = model(sheet, damping=damping)
     n = mdl.n
-    _, sv, vt = np.linalg.svd(mdl.K)
-    r0 = vt[-1]
-    basis = np.linalg.svd(np.column_stack([r0, np.eye(n)]))[0]  # r0 first, then its complement
-    basis[:, 0] = r0
-    T = basis
+    r0 = np.linalg.svd(mdl.K)[2][-1]
+    T = np.linalg.svd(np.column_stack([r0, np.eye(n)]))[0]  # r0 first, then its complement
+    T[:, 0] = r0
     Mr, Pr, Kr = T.T @ mdl.M @ T, T.T @ mdl.Phi @ T, T.T @ mdl.K @ T
     Mred = Mr[1:, 1:] - np.outer(Mr[1:, 0], Mr[0, 1:]) / Mr[0, 0]
-    Pred, Kred = Pr[1:, 1:], Kr[1:, 1:]
     m = n - 1
     if m == 0:
         return np.empty(0, dtype=complex)
     Minv = np.linalg.inv(Mred)
     A = np.zeros((2 * m, 2 * m))
     A[:m, m:] = np.eye(m)
-    A[m:, :m] = -Minv @ Kred
-    A[m:, m:] = -Minv @ Pred
+    A[m:, :m] = -Minv @ Kr[1:, 1:]
+    A[m:, m:] = -Minv @ Pr[1:, 1:]
     lam = np.linalg.eigvals(A)
     return lam[np.argsort(np.abs(lam))]
 
 
-def stiffness(p: Params, c2: float, w: float | None = None) -> dict:
+def stiffness(sheet) -> dict:
     """Stiffness measures: ratio max|lambda|/min|lambda| and max|lambda| * t_end (the number of
     radians of the fastest mode over the run: about the steps an explicit method needs / 3)."""
-    lam = eigen(p, c2, w)
+    lam = eigen(sheet)
     big, small = float(np.max(np.abs(lam))), float(np.min(np.abs(lam)))
     tooth = lam[np.argmax(np.abs(lam))]
     return {
         "lam": lam,
         "ratio": big / small,
-        "index": big * p.t_end,
-        "tooth_freq": abs(tooth.imag),
+        "index": big * _v(sheet, "t_end", "s"),
         "tooth_damping": -tooth.real / abs(tooth),
-        "weight_freq": abs(lam[0].imag),
-        "weight_damping": -lam[0].real / abs(lam[0]),
     }
 
 
@@ -484,12 +345,12 @@ class Problem:
             label=label,
         )
 
-    def exact(self, t=None) -> np.ndarray:
-        """Exact solution at t (default t_eval) from the matrix exponential of the system
-        augmented with the forcing (z = (y, 1, sin, cos)): independent of any ODE method."""
+    def exact(self) -> np.ndarray:
+        """Exact solution at t_eval from the matrix exponential of the system augmented with
+        the forcing (z = (y, 1, sin, cos)): independent of any ODE method."""
         from scipy.linalg import expm
 
-        t = self.t_eval if t is None else np.asarray(t, dtype=float)
+        t = self.t_eval
         N = len(self.y0)
         Z = np.zeros((N + 3, N + 3))
         Z[:N, :N] = self.A
@@ -499,33 +360,15 @@ class Problem:
         Z[N + 2, N + 1] = -self.Omega
         z = np.concatenate([self.y0, [1.0, 0.0, 1.0]])
         out = np.empty((N, len(t)))
-        dts = np.diff(t)
-        uniform = len(dts) and np.allclose(dts, dts[0], rtol=1e-12, atol=0)
-        # uniform grid: one propagator, refined by substeps so that |lambda h| stays small
-        if uniform:
-            h = dts[0]
-            sub = max(1, int(math.ceil(np.max(np.abs(np.linalg.eigvals(self.A))) * h / 0.5)))
-            E = np.linalg.matrix_power(expm(Z * (h / sub)), sub)
-            out[:, 0] = (expm(Z * t[0]) @ z)[:N]
-            z = expm(Z * t[0]) @ z
-            for k in range(1, len(t)):
-                z = E @ z
-                out[:, k] = z[:N]
-            return out
-        for k, tk in enumerate(t):
-            out[:, k] = (expm(Z * tk) @ z)[:N]
+        out[:, 0] = z[:N]
+        # one propagator for the uniform grid, refined by substeps so that |lambda h| stays small
+        h = t[1] - t[0]
+        sub = max(1, int(math.ceil(np.max(np.abs(np.linalg.eigvals(self.A))) * h / 0.5)))
+        E = np.linalg.matrix_power(expm(Z * (h / sub)), sub)
+        for k in range(1, len(t)):
+            z = E @ z
+            out[:, k] = z[:N]
         return out
-
-
-def error_of(problem: Problem, reference_outputs: np.ndarray):
-    """Max-norm error of (phi2, psi) against reference outputs (rad)."""
-
-    def err(run: OdeRun) -> float:
-        if run.y.shape[1] != reference_outputs.shape[1]:
-            return math.nan
-        return float(np.max(np.abs(problem.model.outputs(run.y) - reference_outputs)))
-
-    return err
 
 
 # ---------------------------------------------------------------------------------------------
@@ -538,6 +381,7 @@ FULL_C2 = (1e6, 1e7, 1e8, 1e9, 1e10)
 FULL_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 CHOICE_C2 = 1e10  # the stiff case the default solver is judged on
 STALL_C2 = 1e14  # the extreme case where explicit methods stall
+STUDY_T = 0.1  # s: the workbook's shortened study runs over min(t_end, STUDY_T)
 
 _CACHE: dict = {}
 
@@ -552,30 +396,28 @@ def _cached(key, compute):
     return _CACHE[key]
 
 
-def auto_method(p: Params, c2: float | None = None) -> str:
+def at_c2(sheet, c2: float):
+    return with_input(sheet, "c2", c2, "N/m")
+
+
+def auto_method(sheet) -> str:
     """The default solver: Radau when the tooth mode makes the run stiff (stiffness index
     |lambda_max|*t_end above AUTO_INDEX), LSODA otherwise. See docs/advance-coupling.md."""
-    return "Radau" if stiffness(p, p.c2 if c2 is None else c2)["index"] > AUTO_INDEX else "LSODA"
+    return "Radau" if stiffness(sheet)["index"] > AUTO_INDEX else "LSODA"
 
 
-def chosen_method(sheet, p: Params, c2: float | None = None) -> str:
+def method_of(sheet) -> str:
+    return str(sheet.values["method"])
+
+
+def chosen_method(sheet) -> str:
     m = method_of(sheet)
-    return auto_method(p, c2) if m == "auto" else m
-
-
-def rtol_of(sheet) -> float:
-    q = sheet.values.get("rtol")
-    return 1e-5 if q is None else float(q.to("").magnitude)
-
-
-def budget_of(sheet) -> float:
-    q = sheet.values.get("max_time")
-    return 20.0 if q is None else float(q.to("s").magnitude)
+    return auto_method(sheet) if m == "auto" else m
 
 
 @dataclass
 class Case:
-    """One c2: the 3-DOF problem, its exact solution and the rigid-tooth limit."""
+    """One sheet (one c2): the 3-DOF problem, its exact solution and the rigid-tooth limit."""
 
     c2: float
     problem: Problem
@@ -584,16 +426,16 @@ class Case:
     delta: float  # max |3-DOF - rigid| (model difference)
 
 
-def case(p: Params, c2: float, t_end: float | None = None, n_out: int = 401) -> Case:
-    t_end = p.t_end if t_end is None else t_end
+def case(sheet, n_out: int = 401) -> Case:
+    t_end = _v(sheet, "t_end", "s")
 
     def build():
-        pr = Problem(model(p, c2=c2), t_end, n_out)
-        rg = Problem(model(p, c2=c2, rigid=True), t_end, n_out)
-        ex, rr = pr.model.outputs(pr.exact()), rg.model.outputs(rg.exact())
-        return Case(c2, pr, ex, rr, float(np.max(np.abs(ex - rr))))
+        pr = Problem(model(sheet), t_end, n_out)
+        rg = Problem(model(sheet, rigid=True), t_end, n_out)
+        ex_, rr = pr.model.outputs(pr.exact()), rg.model.outputs(rg.exact())
+        return Case(_v(sheet, "c2", "N/m"), pr, ex_, rr, float(np.max(np.abs(ex_ - rr))))
 
-    return _cached(("case", p, c2, t_end, n_out), build)
+    return _cached(("case", _key(sheet), n_out), build)
 
 
 def _dev(cs: Case, run: OdeRun, against: np.ndarray) -> float:
@@ -603,12 +445,11 @@ def _dev(cs: Case, run: OdeRun, against: np.ndarray) -> float:
 
 
 def study(
-    p: Params,
+    sheet,
     c2s,
     rtols,
     methods=METHODS,
     *,
-    t_end=None,
     max_time=5.0,
     label: str | None = "advance-coupling study",
 ):
@@ -627,23 +468,15 @@ def study(
                 flush=True,
             )
         for c2 in c2s:
-            cs = case(p, c2, t_end)
+            cs = case(at_c2(sheet, c2))
             runs = {}
 
             def run_case(method, rtol, cs=cs, runs=runs):
-                run = cs.problem.run(
-                    method, rtol, max_time=max_time, max_steps=2_000_000, label=label
-                )
-                runs[(method, rtol)] = run
-                return run
+                runs[(method, rtol)] = cs.problem.run(method, rtol, max_time=max_time, label=label)
+                return runs[(method, rtol)]
 
             for r in work_precision(
-                run_case,
-                lambda run, cs=cs: _dev(cs, run, cs.exact),
-                methods,
-                rtols,
-                case=f"{c2:.0e}",
-                label=None,
+                run_case, lambda run, cs=cs: _dev(cs, run, cs.exact), methods, rtols, label=None
             ):
                 run = runs.get((r.method, r.rtol))
                 rows.append(
@@ -664,7 +497,9 @@ def study(
                 print(f"[{label}] c2 = {c2:.0e} N/m done", file=sys.stderr, flush=True)
         return pd.DataFrame(rows)
 
-    return _cached(("study", p, tuple(c2s), tuple(rtols), tuple(methods), t_end, max_time), build)
+    return _cached(
+        ("study", _key(sheet), tuple(c2s), tuple(rtols), tuple(methods), max_time), build
+    )
 
 
 def _blank(df):
@@ -672,20 +507,15 @@ def _blank(df):
     return df.astype(object).where(df.notna(), None)
 
 
-STUDY_T = 0.1  # s: the workbook's shortened study runs over min(t_end, STUDY_T)
-
-
 def _study_for_sheet(sheet):
-    p = Params.from_sheet(sheet)
-    p = replace(p, t_end=min(p.t_end, STUDY_T))
-    return p, study(p, STUDY_C2, STUDY_RTOLS, max_time=min(1.5, budget_of(sheet)))
+    short = with_input(sheet, "t_end", min(_v(sheet, "t_end", "s"), STUDY_T), "s")
+    return short, study(short, STUDY_C2, STUDY_RTOLS, max_time=min(1.5, _v(sheet, "max_time", "s")))
 
 
 @table_block
 def work_precision_table(sheet):
     """Work-precision study (shortened for the workbook; the full one is `workbook bench`)."""
-    _, df = _study_for_sheet(sheet)
-    return _blank(df)
+    return _blank(_study_for_sheet(sheet)[1])
 
 
 def _wide(df, c2: float):
@@ -703,15 +533,13 @@ def _wide(df, c2: float):
 @table_block
 def wp_stiff(sheet):
     """Work-precision chart data at c2 = 1e10 N/m: run time and error per method."""
-    _, df = _study_for_sheet(sheet)
-    return _wide(df, CHOICE_C2)
+    return _wide(_study_for_sheet(sheet)[1], CHOICE_C2)
 
 
 @table_block
 def wp_moderate(sheet):
     """Work-precision chart data at c2 = 1e8 N/m."""
-    _, df = _study_for_sheet(sheet)
-    return _wide(df, 1e8)
+    return _wide(_study_for_sheet(sheet)[1], 1e8)
 
 
 @table_block
@@ -719,11 +547,10 @@ def stiffness_table(sheet):
     """Eigenvalues (rigid rotation excluded) and stiffness measures for c2 = 1e6 .. 1e10 N/m."""
     import pandas as pd
 
-    p = Params.from_sheet(sheet)
     rows = []
     for c2 in FULL_C2:
-        s = stiffness(p, c2)
-        cs = case(p, c2)
+        s2 = at_c2(sheet, c2)
+        s, cs = stiffness(s2), case(s2)
         lam = s["lam"]
         rows.append(
             {
@@ -737,15 +564,24 @@ def stiffness_table(sheet):
                 "stiffness index |lam|max*t_end": s["index"],
                 "rigid-model difference [rad]": cs.delta,
                 "difference*c2 [N rad/m]": cs.delta * c2,
-                "auto method": auto_method(p, c2),
+                "auto method": auto_method(s2),
             }
         )
     return pd.DataFrame(rows)
 
 
-def default_run(p: Params, method: str, rtol: float, max_time: float, c2: float | None = None):
-    cs = case(p, p.c2 if c2 is None else c2)
-    return cs, cs.problem.run(method, rtol, max_time=max_time, label="advance-coupling dynamics")
+def default_run(sheet):
+    """The sheet's own run (method, rtol, max_time): the case and the run, computed once."""
+    method, rtol = chosen_method(sheet), _v(sheet, "rtol", "")
+
+    def build():
+        cs = case(sheet)
+        run = cs.problem.run(
+            method, rtol, max_time=_v(sheet, "max_time", "s"), label="advance-coupling dynamics"
+        )
+        return cs, run
+
+    return _cached(("history", _key(sheet), method), build)
 
 
 @table_block
@@ -753,16 +589,11 @@ def histories(sheet):
     """Time histories of phi2 and the advance angle psi = phi3 - phi1 (3 DOF and rigid tooth)."""
     import pandas as pd
 
-    p = Params.from_sheet(sheet)
-    method, rtol = chosen_method(sheet, p), rtol_of(sheet)
-    cs, run = _cached(
-        ("history", p, method, rtol), lambda: default_run(p, method, rtol, budget_of(sheet))
-    )
+    cs, run = default_run(sheet)
     t = cs.problem.t_eval
-    out = cs.problem.model.outputs(run.y) if run.ok else np.full((2, len(t)), math.nan)
-    if not run.ok:  # a partial run: keep what was reached
-        k = run.y.shape[1]
-        out[:, :k] = cs.problem.model.outputs(run.y)
+    out = np.full((2, len(t)), math.nan)
+    k = run.y.shape[1] if not run.ok else len(t)  # a partial run: keep what was reached
+    out[:, :k] = cs.problem.model.outputs(run.y)[:, :k]
     return _blank(
         pd.DataFrame(
             {
@@ -781,37 +612,34 @@ def histories(sheet):
 # extreme cases
 # ---------------------------------------------------------------------------------------------
 def stall_run(
-    p: Params,
-    method: str = "RK45",
-    c2: float = STALL_C2,
-    max_time: float = 0.5,
-    max_steps: int = 20_000,
+    sheet, method: str = "RK45", c2: float = STALL_C2, max_time: float = 0.5, max_steps=20_000
 ) -> tuple[OdeRun, float]:
     """An explicit method on a very stiff tooth: bounded by a budget and a step cap.
     Returns the run and the steps it would need at its stability limit (about index/3)."""
-    cs = case(p, c2)
-    run = cs.problem.run(
+    s2 = at_c2(sheet, c2)
+    run = case(s2).problem.run(
         method, 1e-5, max_time=max_time, max_steps=max_steps, label="advance-coupling stall"
     )
-    need = stiffness(p, c2)["index"] / 3.3
-    return run, need
+    return run, stiffness(s2)["index"] / 3.3
 
 
-def soft_spring_limit(p: Params, w: float, form: str = "printed") -> float:
-    """Spring stiffness c1 below which the linear form's denominator is <= 0 at speed w."""
-    s, c = math.sin(p.phi20), math.cos(p.phi20)
-    A = p.O1O - p.OC * c
-    cent = 2 * p.m * w**2 * (A * p.OC * c + (p.OC**2 * s**2 if form == "newton" else 0.0))
-    return cent / (8 * (p.lam_st * p.OC1 * c + p.OC1**2 * s**2))
+def soft_spring_limit(sheet, w: float, form: str = "printed") -> float:
+    """Spring stiffness c1 below which the closed form's denominator is <= 0 at speed w
+    (the template's denominator is linear in c1: one secant step is exact)."""
+    name = "D_lin" if form == "printed" else "D_newton"
+    c1 = _v(sheet, "c1", "N/m")
+    d1 = _v(sheet, name, "N*m", omega1=w)
+    d2 = _v(with_input(sheet, "c1", 2 * c1, "N/m"), name, "N*m", omega1=w)
+    return c1 - d1 * c1 / (d2 - d1)
 
 
-def denominator_zero_speed(p: Params, form: str = "printed") -> float:
-    """Speed at which the linear form's denominator passes through zero [rad/s]."""
-    s, c = math.sin(p.phi20), math.cos(p.phi20)
-    A = p.O1O - p.OC * c
-    k = 8 * p.c1 * (p.lam_st * p.OC1 * c + p.OC1**2 * s**2)
-    cent = 2 * p.m * (A * p.OC * c + (p.OC**2 * s**2 if form == "newton" else 0.0))
-    return math.sqrt(k / cent) if cent > 0 else math.inf
+def denominator_zero_speed(sheet, form: str = "printed") -> float:
+    """Speed at which the closed form's denominator passes through zero [rad/s] (the
+    template's denominator is k - c*omega1^2: its values at 0 and 1 rad/s give k and c)."""
+    name = "D_lin" if form == "printed" else "D_newton"
+    k = _v(sheet, name, "N*m", omega1=0.0)
+    c = k - _v(sheet, name, "N*m", omega1=1.0)
+    return math.sqrt(k / c) if c > 0 else math.inf
 
 
 # ---------------------------------------------------------------------------------------------
@@ -820,32 +648,30 @@ def denominator_zero_speed(p: Params, form: str = "printed") -> float:
 SCENE_VALUES = ((50.0, 0.0), (80.0, 0.070), (110.0, 0.204))  # SCENES.md section 4, base case
 
 
-def trend_holds(p: Params, key: str, ws) -> tuple[list[float], list[float], list[float]]:
+def trend_holds(sheet, key: str, ws) -> tuple[list[float], list[float], list[float]]:
     """Speeds where the printed trend holds strictly, where it fails, where it is vacuous
     (every member of the family on the stop)."""
-    fam = family(p, key, ws)
+    fam = family(sheet, key, ws)
     vals = np.array([fam[v]["root"] for v in FAMILIES[key][2]])  # members x speeds
-    sign = TRENDS[key]
     holds, fails, vacuous = [], [], []
     for j, w in enumerate(ws):
         col = vals[:, j]
         if np.all(col == 0):
             vacuous.append(float(w))
             continue
-        d = np.diff(col) * sign
+        d = np.diff(col) * TRENDS[key]
         # on the stop two members may both be 0: the trend is then "not reversed"
         ok = np.all(d >= 0) and np.any(d > 0) and np.all((d > 0) | (col[1:] == 0) | (col[:-1] == 0))
         (holds if ok else fails).append(float(w))
     return holds, fails, vacuous
 
 
-def _speeds_text(xs, all_speeds=None) -> str:
+def _speeds_text(xs, all_speeds) -> str:
     """Speeds as runs of consecutive grid points: '55..65, 110 rad/s'."""
     if not xs:
         return "none"
+    index = {w: i for i, w in enumerate(sorted(all_speeds))}
     xs = sorted(xs)
-    grid = sorted(all_speeds) if all_speeds is not None else xs
-    index = {w: i for i, w in enumerate(grid)}
     runs, start, prev = [], xs[0], xs[0]
     for w in xs[1:]:
         if index.get(w, -9) != index.get(prev, -99) + 1:
@@ -856,46 +682,47 @@ def _speeds_text(xs, all_speeds=None) -> str:
     return ", ".join(f"{a:g}" if a == b else f"{a:g}..{b:g}" for a, b in runs) + " rad/s"
 
 
-def departures(p: Params, key: str, ws, form: str = "printed", limit: float = 0.05):
-    """Per family member: (value, first speed with |lin - root| > limit*root, max rel. departure,
+def departures(sheet, key: str, ws, form: str = "printed", limit: float = 0.05):
+    """Per family member: (value, speeds with |lin - root| > limit*root, max rel. departure,
     speeds where the denominator is <= 0)."""
     out = []
-    for value, d in family(p, key, ws).items():
+    for value, d in family(sheet, key, ws).items():
         root = d["root"]
         lin = d["printed"] if form == "printed" else d["newton"]
         mask = root > 0
         rel = np.full(len(ws), np.nan)
         rel[mask] = np.abs(lin[mask] - root[mask]) / root[mask]
         bad = mask & ((rel > limit) | np.isnan(lin))
-        where = [float(w) for w in ws[bad]]
         zero = [float(w) for w, v in zip(ws, lin) if np.isnan(v)]
-        out.append((value, where, float(np.nanmax(rel)) if mask.any() else 0.0, zero))
+        worst = float(np.nanmax(rel)) if mask.any() else 0.0
+        out.append((value, [float(w) for w in ws[bad]], worst, zero))
     return out
+
+
+def _is_example(sheet) -> bool:
+    """Are the inputs that phi2 depends on those of the template (the SCENES.md example)?"""
+    used = tc.dependencies(sheet.spec, ex.Name("phi2")) & set(sheet.spec.inputs)
+    return all(sheet.values[n] == sheet.spec.inputs[n].value for n in used)
 
 
 @findings_block
 def findings(sheet):
-    """Steady values, printed trends, linear-form departures, stiffness and solver choice."""
+    """Steady values, printed trends, closed-form departures, stiffness and the run."""
     F = Finding
-    p, ws = Params.from_sheet(sheet), speeds(sheet)
+    ws = speeds(sheet)
     out: list[Finding] = []
-    base = Params()
-    same = all(
-        math.isclose(getattr(p, k), getattr(base, k), rel_tol=1e-9)
-        for k in _STEADY_ARGS
-        if k != "omega1"
-    )
+    example = _is_example(sheet)
     for w, ref in SCENE_VALUES:
-        val = steady(w, p).phi2
-        if same:
-            ok = abs(val - ref) <= 1e-3
+        val = _v(sheet, "phi2", "rad", omega1=w)
+        if example:
+            ok = "ok" if abs(val - ref) <= 1e-3 else "fail"
             out.append(
                 F(
                     "steady state",
                     f"phi2 at omega1 = {w:g} rad/s (SCENES.md: {ref:.3f})",
                     val,
                     "rad",
-                    "ok" if ok else "fail",
+                    ok,
                 )
             )
         else:
@@ -909,20 +736,19 @@ def findings(sheet):
                     "inputs differ from the SCENES.md example",
                 )
             )
-    wl = lift_off_speed(p)
-    stop = [float(w) for w in ws if steady(w, p).on_stop]
+    stop = [float(w) for w, f0 in zip(ws, _v(sheet, "F0", "N*m", omega1=ws)) if f0 <= 0]
     out.append(
         F(
             "steady state",
             "lift-off speed (weights leave the stop)",
-            wl,
+            _v(sheet, "omega_lift", "rad/s"),
             "rad/s",
             "info",
             f"on the stop at {_speeds_text(stop, ws)}: phi2 = 0 there, not a root",
         )
     )
     for key in FAMILIES:
-        holds, fails, vacuous = trend_holds(p, key, ws)
+        holds, fails, vacuous = trend_holds(sheet, key, ws)
         verdict = "ok" if holds and not fails else ("warning" if holds else "fail")
         note = f"holds at {_speeds_text(holds, ws)}; fails at {_speeds_text(fails, ws)}"
         if vacuous:
@@ -939,13 +765,12 @@ def findings(sheet):
         )
     for form, title in (("printed", "printed linear form"), ("newton", "Newton-step linear form")):
         for key in FAMILIES:
-            for value, where, worst, zero in departures(p, key, ws, form):
+            for value, where, worst, zero in departures(sheet, key, ws, form):
                 unit = FAMILIES[key][1]
                 what = f"{title}, {key} = {value:g} {unit}: largest departure from the root"
-                if not where:
-                    note, verdict = "within 5 % at every speed off the stop", "ok"
-                else:
-                    note, verdict = (f"more than 5 % at {_speeds_text(where, ws)}", "warning")
+                note, verdict = "within 5 % at every speed off the stop", "ok"
+                if where:
+                    note, verdict = f"more than 5 % at {_speeds_text(where, ws)}", "warning"
                 if zero:
                     note += (
                         f"; denominator <= 0 at {_speeds_text(zero, ws)}: reported, not divided by"
@@ -960,26 +785,26 @@ def findings(sheet):
                         note,
                     )
                 )
-    wmax = float(ws[-1])
+    wmax, c1 = float(ws[-1]), _v(sheet, "c1", "N/m")
     for form in ("printed", "newton"):
-        c1z = soft_spring_limit(p, wmax, form)
         out.append(
             F(
                 "extreme cases",
-                f"{form} linear form: denominator passes through zero at "
-                f"{wmax:g} rad/s for springs softer than",
-                c1z,
+                f"{form} linear form: denominator passes through zero at {wmax:g} rad/s "
+                "for springs softer than",
+                soft_spring_limit(sheet, wmax, form),
                 "N/m",
                 "info",
-                f"with c1 = {p.c1:g} N/m it is zero at {denominator_zero_speed(p, form):.4g} rad/s",
+                f"with c1 = {c1:g} N/m it is zero at "
+                f"{denominator_zero_speed(sheet, form):.4g} rad/s",
             )
         )
-    # dynamics
-    lam = eigen(p, p.c2)
+    c2 = _v(sheet, "c2", "N/m")
+    lam = eigen(sheet)
     out.append(
         F(
             "dynamics",
-            f"weight mode at c2 = {p.c2:.0e} N/m: Im lambda",
+            f"weight mode at c2 = {c2:.0e} N/m: Im lambda",
             abs(lam[0].imag),
             "rad/s",
             "info",
@@ -996,31 +821,26 @@ def findings(sheet):
             f"Re lambda = {lam[-1].real:.3g} 1/s (almost undamped)",
         )
     )
-    lam_p = eigen(p, p.c2, damping="as printed")
     out.append(
         F(
             "dynamics",
-            "with the printed damping sign (-beta OC^2 sin^2 phi20) the weight "
-            "mode grows: Re lambda",
-            float(lam_p[0].real),
+            "with the printed damping sign (-beta OC^2 sin^2 phi20) the weight mode grows: "
+            "Re lambda",
+            float(eigen(sheet, damping="as printed")[0].real),
             "1/s",
             "warning",
             "negative damping; the corrected sign is used",
         )
     )
-    method, rtol = chosen_method(sheet, p), rtol_of(sheet)
-    cs, run = _cached(
-        ("history", p, method, rtol), lambda: default_run(p, method, rtol, budget_of(sheet))
-    )
+    cs, run = default_run(sheet)
     note = run.summary()
     if run.ok:
-        dev = _dev(cs, run, cs.exact)
-        note += f"; error against the exact solution {dev:.3g} rad"
+        note += f"; error against the exact solution {_dev(cs, run, cs.exact):.3g} rad"
+    how = "auto" if method_of(sheet) == "auto" else "chosen"
     out.append(
         F(
             "dynamics",
-            f"time histories: {method} rtol {rtol:.0e} at c2 = {p.c2:.0e} N/m"
-            f" ({'auto' if method_of(sheet) == 'auto' else 'chosen'})",
+            f"time histories: {run.method} rtol {run.rtol:.0e} at c2 = {c2:.0e} N/m ({how})",
             run.elapsed,
             "s",
             "ok" if run.ok else "warning",
@@ -1034,13 +854,11 @@ def findings(sheet):
 def study_findings(sheet):
     """Solver choice from the work-precision study, and the explicit solver's stall (the
     optional part studies: 45 solver runs and a stalled RK45, a few seconds)."""
-    F = Finding
-    p = Params.from_sheet(sheet)
-    ps, df = _study_for_sheet(sheet)
-    out = choice_findings(ps, df, method_of(sheet), rtol_of(sheet))
-    run, need = stall_run(p)
+    short, df = _study_for_sheet(sheet)
+    out = choice_findings(short, df)
+    run, need = stall_run(sheet)
     out.append(
-        F(
+        Finding(
             "extreme cases",
             f"RK45 at c2 = {STALL_C2:.0e} N/m stopped ({run.stop_reason})",
             run.fraction * 100,
@@ -1053,39 +871,37 @@ def study_findings(sheet):
     return out
 
 
-def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
+def choice_findings(sheet, df) -> list[Finding]:
     """Is the default solver within 2x of the fastest run that reaches the rigid limit?"""
     F = Finding
     sub = df[df["c2 [N/m]"] == CHOICE_C2]
     if sub.empty:
         return []
-    delta = float(sub["rigid-model difference [rad]"].iloc[0])
-    tol = 2 * delta
+    tol = 2 * float(sub["rigid-model difference [rad]"].iloc[0])
     ok = sub[(sub["stopped"] == "finished") & (sub["deviation from rigid [rad]"] <= tol)]
-    default = auto_method(p, CHOICE_C2) if method == "auto" else method
+    stiff = at_c2(sheet, CHOICE_C2)
+    default, rtol = chosen_method(stiff), _v(sheet, "rtol", "")
     out = [
         F(
             "solver choice",
             f"rigid-model difference at c2 = {CHOICE_C2:.0e} N/m",
-            delta,
+            tol / 2,
             "rad",
             "info",
             f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g} rad",
         )
     ]
     if ok.empty:
-        out.append(
+        return out + [
             F("solver choice", "no run of the study reaches the rigid limit", None, "", "warning")
-        )
-        return out
+        ]
     best = ok.loc[ok["run time [s]"].idxmin()]
     # time the best and the default again side by side (best of 3)
-    cs = case(p, CHOICE_C2)
+    cs = case(stiff)
     t_best = min(cs.problem.run(best["method"], best["rtol"]).elapsed for _ in range(3))
     runs = [cs.problem.run(default, rtol) for _ in range(3)]
     t_def = min(r.elapsed for r in runs)
-    dev = _dev(cs, runs[0], cs.rigid)
-    ratio = t_def / t_best
+    dev, ratio = _dev(cs, runs[0], cs.rigid), t_def / t_best
     out.append(
         F(
             "solver choice",
@@ -1107,13 +923,12 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
         )
     )
     for c2 in sorted(df["c2 [N/m]"].unique()):
-        rows = df[
-            (df["c2 [N/m]"] == c2) & (df["stopped"] == "finished") & (df["error [rad]"] <= 1e-6)
-        ]
-        auto = auto_method(p, c2) if method == "auto" else method
-        mine = df[(df["c2 [N/m]"] == c2) & (df["method"] == auto) & (df["rtol"] == rtol)]
+        at = df[df["c2 [N/m]"] == c2]
+        rows = at[(at["stopped"] == "finished") & (at["error [rad]"] <= 1e-6)]
         if rows.empty:
             continue
+        auto = chosen_method(at_c2(sheet, c2))
+        mine = at[(at["method"] == auto) & (at["rtol"] == rtol)]
         fast = rows.loc[rows["run time [s]"].idxmin()]
         note = f"fastest with error <= 1e-6 rad: {fast['method']} rtol {fast['rtol']:.0e}"
         if not mine.empty:
@@ -1149,16 +964,10 @@ def choice_findings(p: Params, df, method: str, rtol: float) -> list[Finding]:
     return out
 
 
-# ---------------------------------------------------------------------------------------------
-# bench
-# ---------------------------------------------------------------------------------------------
 @bench_block
 def bench(sheet, quick: bool = False):
     """Work-precision of RK45, DOP853, Radau, BDF, LSODA: error against run time (full study)."""
-    p = Params.from_sheet(sheet)
     if quick:
-        q = replace(p, t_end=0.02)
-        df = study(q, (CHOICE_C2,), (1e-3, 1e-5), t_end=0.02, max_time=0.3, label=None)
-    else:
-        df = study(p, FULL_C2, FULL_RTOLS, max_time=10.0)
-    return df
+        short = with_input(sheet, "t_end", 0.02, "s")
+        return study(short, (CHOICE_C2,), (1e-3, 1e-5), max_time=0.3, label=None)
+    return study(sheet, FULL_C2, FULL_RTOLS, max_time=10.0)
