@@ -161,6 +161,8 @@ class ExprTranslator(Visitor):
 
     def visit_id(self, node: MNode) -> ex.Node:
         key = _key(node)
+        if node.attrs.get("labels") == "UNIT" and not key[1] and key[0] in FORMULA_UNITS:
+            return ex.Name(self.tr.unit_sym(key[0]).token())  # labelled a unit in Mathcad
         sym = self.local.get(key) or self.tr.scope.get(key)
         if sym is not None:
             if sym.broken:
@@ -315,6 +317,9 @@ class Translator:
 
     # -- regions --------------------------------------------------------------
     def run(self, ws: Worksheet, regions: list[Region]) -> Translation:
+        # Mathcad evaluates global definitions (≡) first, top to bottom, then the others
+        first = [r for r in regions if r.math is not None and r.math.tag == "globalDefine"]
+        regions = first + [r for r in regions if r not in first]
         for region in regions:
             if region.kind == "text":
                 if region.text:
@@ -329,6 +334,9 @@ class Translator:
                 self.skip(region.id, what, "not translated: the language has no such region")
                 continue
             if region.math is None:
+                continue
+            if region.disabled:
+                self.skip(region.id, self.describe(region.math), "disabled in Mathcad")
                 continue
             try:
                 self.math(region)
@@ -443,6 +451,8 @@ class Translator:
             return Item("input", region.id, value=literal, unit=display)
         if rhs.tag == "program":
             return Item("definition", region.id, pieces=self.pieces(rhs, {}), unit=display)
+        if _is_if(rhs):
+            return Item("definition", region.id, pieces=self.if_pieces(rhs, {}), unit=display)
         et = ExprTranslator(self)
         body = et.visit(rhs)
         if et.ranges:
@@ -473,6 +483,22 @@ class Translator:
                 raise Untranslatable("a program over a range variable")
         if not out:
             raise Untranslatable("an empty program")
+        return out
+
+    def if_pieces(self, node: MNode, local) -> list[tuple[ex.Node, ex.Node | None]]:
+        """Mathcad's if(cond, a, b), with further ifs in b, as pieces."""
+        out = []
+        while _is_if(node):
+            cond, a, b = _if_args(node)
+            et = ExprTranslator(self, local)
+            out.append((et.visit(a), et.visit(cond)))
+            if et.ranges:
+                raise Untranslatable("an if() over a range variable")
+            node = b
+        et = ExprTranslator(self, local)
+        out.append((et.visit(node), None))
+        if et.ranges:
+            raise Untranslatable("an if() over a range variable")
         return out
 
     def range_variable(self, region: Region, key, rng: MNode) -> None:
@@ -513,6 +539,8 @@ class Translator:
         try:
             if body.tag == "program":
                 item = Item("function", region.id, params=psyms, pieces=self.pieces(body, local))
+            elif _is_if(body):
+                item = Item("function", region.id, params=psyms, pieces=self.if_pieces(body, local))
             else:
                 et = ExprTranslator(self, local)
                 item = Item("function", region.id, params=psyms, body=et.visit(body))
@@ -650,6 +678,25 @@ class _Renamer(Visitor):
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
     return _Renamer(mapping).visit(node)
+
+
+def _if_args(node: MNode) -> list[MNode]:
+    args = node.children[1:]
+    if len(args) == 1 and args[0].tag == "sequence":
+        args = args[0].children
+    return args
+
+
+def _is_if(node: MNode) -> bool:
+    """Mathcad's function if(cond, a, b)."""
+    return (
+        node.tag == "apply"
+        and bool(node.children)
+        and node.children[0].tag == "id"
+        and node.children[0].text.strip() == "if"
+        and not node.children[0].attrs.get("subscript")
+        and len(_if_args(node)) == 3
+    )
 
 
 def _symbolic_result(node: MNode) -> MNode:
@@ -846,12 +893,20 @@ def _quantity_text(node: MNode) -> str | None:
 
 def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNode):
     """Mathcad's values of a range first, second .. last (up to last, not beyond), and the
-    range's unit; the bounds must be numbers known at import."""
-    a, unit = _constant(tr, first)
-    b = _constant(tr, second)[0] if second is not None else (a + 1 if a <= 0 or True else a)
-    c = _constant(tr, last)[0]
-    if second is None:
-        b = a + 1 if c >= a else a - 1
+    range's unit; the bounds must be values known at import (numbers, inputs, definitions)."""
+    ev = _Values(tr)
+    try:
+        a, c = ev.quantity(first), ev.quantity(last)
+        b = ev.quantity(second) if second is not None else None
+        unit = c.units if a.magnitude == 0 and not a.dimensionless else a.units
+        if a.magnitude == 0 and a.dimensionless:
+            unit = c.units
+        a, c = (float(q.to(unit).magnitude) if q.magnitude != 0 else 0.0 for q in (a, c))
+        b = float(b.to(unit).magnitude) if b is not None else (a + 1 if c >= a else a - 1)
+    except Untranslatable:
+        raise
+    except Exception:  # noqa: BLE001 - pint's unit errors and numeric ones alike
+        raise Untranslatable("a range whose bounds are not values known at import") from None
     step = b - a
     if step == 0:
         raise Untranslatable("a range with step 0")
@@ -860,38 +915,70 @@ def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNod
         raise Untranslatable("an empty range")
     if n > 100_000:
         raise Untranslatable("a range of more than 100,000 values")
-    return [a + k * step for k in range(n + 1)], unit
+    return [a + k * step for k in range(n + 1)], ("" if unit == "" or not str(unit) else str(unit))
 
 
-def _constant(tr: Translator, node: MNode) -> tuple[float, str]:
-    """The value of a bound made of numbers, pi and inputs with known values."""
-    text = _quantity_text(node)
-    if text is not None and " " not in text:
-        return float(text), ""
-    et = ExprTranslator(tr)
-    tree = et.visit(node)
-    values = {}
-    for item in tr.out.items:
-        if item.kind == "input" and item.sym is not None:
-            try:
-                values[item.sym.token()] = float(item.value)
-            except ValueError:
-                continue
-    try:
-        return _fold(tree, values), ""
-    except (KeyError, TypeError, ValueError, ZeroDivisionError, OverflowError):
-        raise Untranslatable("a range whose bounds are not plain numbers known at import") from None
+class _Values(Visitor):
+    """The value (a pint quantity) of an expression of numbers, units, inputs and scalar
+    definitions, at import: used for the values of a range only."""
 
+    _FUNCS = {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp",
+              "ln", "log10", "sqrt", "abs", "floor", "ceil"}  # fmt: skip
 
-def _fold(n: ex.Node, values: dict[str, float]) -> float:
-    if isinstance(n, ex.Number):
-        return n.value
-    if isinstance(n, ex.Name):
-        return math.pi if n.id == "pi" else values[n.id]
-    if isinstance(n, ex.Unary) and n.op in "+-":
-        v = _fold(n.operand, values)
+    def __init__(self, tr: Translator):
+        from .. import units as un
+
+        self.ureg = un.registry()
+        self.items = {i.sym.token(): i for i in tr.out.items if i.sym is not None}
+        self.units = {s.token(): s.unit for s in tr.out.syms if s.kind == "unit"}
+        self.tr = tr
+        self.depth = 0
+
+    def quantity(self, node: MNode):
+        return self.visit(ExprTranslator(self.tr).visit(node))
+
+    def visit_Number(self, n):
+        return self.ureg.Quantity(n.value)
+
+    def visit_Name(self, n):
+        if n.id == "pi":
+            return self.ureg.Quantity(math.pi)
+        if n.id in self.units:
+            return self.ureg.Quantity(1.0, self.units[n.id])
+        item = self.items.get(n.id)
+        self.depth += 1
+        if item is None or self.depth > 200:
+            raise Untranslatable("a range whose bounds are not values known at import")
+        if item.kind == "input":
+            return self.ureg.Quantity(item.value)
+        if item.kind == "definition" and item.body is not None:
+            return self.visit(item.body)
+        raise Untranslatable("a range whose bounds are not values known at import")
+
+    def visit_Unary(self, n):
+        v = self.visit(n.operand)
         return -v if n.op == "-" else v
-    if isinstance(n, ex.Binary):
-        a, b = _fold(n.left, values), _fold(n.right, values)
-        return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else 1 / 0, "^": a**b}[n.op]
-    raise TypeError(n)
+
+    def visit_Binary(self, n):
+        a, b = self.visit(n.left), self.visit(n.right)
+        if n.op == "^":
+            return a ** float(b.to("").magnitude)
+        return {"+": a.__add__, "-": a.__sub__, "*": a.__mul__, "/": a.__truediv__}[n.op](b)
+
+    def visit_Call(self, n):
+        import numpy as np
+
+        if n.func in ("min", "max"):
+            vals = [self.visit(a) for a in n.args]
+            return (min if n.func == "min" else max)(vals)
+        if n.func not in self._FUNCS or len(n.args) != 1:
+            raise Untranslatable("a range whose bounds are not values known at import")
+        v = self.visit(n.args[0])
+        if n.func == "sqrt":
+            return v**0.5
+        if n.func == "abs":
+            return abs(v)
+        name = {"ln": "log", "asin": "arcsin", "acos": "arccos", "atan": "arctan"}.get(
+            n.func, n.func
+        )
+        return self.ureg.Quantity(float(getattr(np, name)(v.to("").magnitude)))

@@ -46,6 +46,8 @@ FORMULA_UNITS: dict[str, str] = {
     "K": "kelvin", "R": "degree_Rankine", "mol": "mole", "cd": "candela",
     # area
     "ha": "hectare", "acre": "acre",
+    # ratios and signs
+    "%": "percent", "°": "degree", "′": "arcminute", "″": "arcsecond",
 }  # fmt: skip
 
 #: Unit names in stored results (``unitReference unit="..."``) that pint reads otherwise.
