@@ -24,7 +24,11 @@ import numpy as np
 from . import typecheck as tc
 from . import units as un
 from .blocks import Finding
+from .builtins import REGISTRY
 from .errors import WorkbookError
+from .expr import PREC
+from .typed import children
+from .visitor import Visitor
 
 #: a relation "holds" when its largest discrepancy is below this fraction of max |child|
 HOLDS = 1e-9
@@ -562,7 +566,7 @@ def _pure(t: tc.T) -> bool:
     """True if the tree calls no solver block (cheap to evaluate on a grid)."""
     if isinstance(t, (tc.TBlock,)) or type(t).__name__ == "TAggregate":
         return False
-    return all(_pure(c) for c in _children(t))
+    return all(_pure(c) for c in children(t))
 
 
 def restricted(t: tc.T):
@@ -574,14 +578,8 @@ def restricted(t: tc.T):
 
 def _restricted(t: tc.T):
     if isinstance(t, tc.TFunc):
-        if t.func == "sqrt":
-            yield "sqrt of a negative number", t.args[0], lambda v: v < 0, "sqrt({})"
-        elif t.func in ("asin", "acos"):
-            shown = t.func + "({})"
-            yield f"{t.func} of a value beyond 1", t.args[0], lambda v: np.abs(v) > 1, shown
-        elif t.func in ("ln", "log10"):
-            shown = t.func + "({})"
-            yield f"{t.func} of a value that is not positive", t.args[0], lambda v: v <= 0, shown
+        for d in REGISTRY[t.func].domain:
+            yield d.kind, t.args[d.arg], d.bad, d.shown
     elif isinstance(t, tc.TBinary):
         if t.op == "/":
             yield "division by zero", t.right, lambda v: v == 0, "1/({})"
@@ -593,47 +591,76 @@ def _restricted(t: tc.T):
             elif n < 0:
                 shown = "({})^" + f"{n:g}"
                 yield "division by zero (negative power of 0)", t.left, lambda v: v == 0, shown
-    for child in _children(t):
+    for child in children(t):
         yield from _restricted(child)
 
 
-def _children(t: tc.T):
-    for attr in ("child", "left", "right"):
-        c = getattr(t, attr, None)
-        if isinstance(c, tc.T):
-            yield c
-    for attr in ("args", "operands", "values", "conditions"):
-        for c in getattr(t, attr, ()) or ():
-            if isinstance(c, tc.T):
-                yield c
+class TypedText(Visitor):
+    """The typed tree back as worksheet text (unit conversions are implicit).
 
+    ``visit(t)`` returns (text, precedence level of :data:`workbook.expr.PREC`).
+    """
 
-_OPS = {"+": 5, "-": 5, "*": 6, "/": 6, "^": 8}
+    def text(self, t: tc.T, parent: int = 0) -> str:
+        s, p = self.visit(t)
+        return f"({s})" if p < parent else s
+
+    def visit_TConst(self, t: tc.TConst) -> tuple[str, int]:
+        v = t.value
+        s = repr(int(v)) if float(v).is_integer() and abs(v) < 1e15 else f"{v:.6g}"
+        return s, PREC["atom"]
+
+    def visit_TParam(self, t) -> tuple[str, int]:
+        return t.name, PREC["atom"]
+
+    visit_TRef = visit_TParam
+
+    def visit_TText(self, t: tc.TText) -> tuple[str, int]:
+        return f'"{t.value}"', PREC["atom"]
+
+    def visit_TScale(self, t: tc.TScale) -> tuple[str, int]:
+        return self.visit(t.child)
+
+    def visit_TUnary(self, t: tc.TUnary) -> tuple[str, int]:
+        if t.op == "not":
+            return "not " + self.text(t.child, PREC["not"]), PREC["not"]
+        return "-" + self.text(t.child, PREC["neg"]), PREC["neg"]
+
+    def visit_TBinary(self, t: tc.TBinary) -> tuple[str, int]:
+        p = PREC[t.op]
+        if t.op == "^":
+            return f"{self.text(t.left, p + 1)}^{self.text(t.right, p)}", p
+        return f"{self.text(t.left, p)} {t.op} {self.text(t.right, p + 1)}", p
+
+    def visit_TCompare(self, t: tc.TCompare) -> tuple[str, int]:
+        p = PREC["cmp"]
+        parts = [self.text(t.operands[0], p + 1)]
+        for op, o in zip(t.ops, t.operands[1:]):
+            parts += [op, self.text(o, p + 1)]
+        return " ".join(parts), p
+
+    def visit_TLogic(self, t: tc.TLogic) -> tuple[str, int]:
+        p = PREC[t.op]
+        return f" {t.op} ".join(self.text(v, p + 1) for v in t.values), p
+
+    def visit_TFunc(self, t: tc.TFunc) -> tuple[str, int]:
+        return f"{t.func}({', '.join(self.text(a) for a in t.args)})", PREC["atom"]
+
+    def visit_TCall(self, t) -> tuple[str, int]:
+        return f"{t.name}({', '.join(self.text(a) for a in t.args)})", PREC["atom"]
+
+    visit_TBlock = visit_TCall
+
+    def visit_TAggregate(self, t: tc.TAggregate) -> tuple[str, int]:
+        return f"{t.func}_over({t.table}, {t.column})", PREC["atom"]
+
+    def visit_TPiecewise(self, t: tc.TPiecewise) -> tuple[str, int]:
+        return "; ".join(t.texts), PREC["or"] - 1
 
 
 def typed_text(t: tc.T, parent: int = 0) -> str:
     """The typed tree back as worksheet text (unit conversions are implicit)."""
-    if isinstance(t, tc.TConst):
-        v = t.value
-        return repr(int(v)) if float(v).is_integer() and abs(v) < 1e15 else f"{v:.6g}"
-    if isinstance(t, (tc.TParam, tc.TRef)):
-        return t.name
-    if isinstance(t, tc.TText):
-        return f'"{t.value}"'
-    if isinstance(t, tc.TScale):
-        return typed_text(t.child, parent)
-    if isinstance(t, tc.TUnary):
-        return ("not " if t.op == "not" else "-") + typed_text(t.child, 7)
-    if isinstance(t, tc.TBinary):
-        p = _OPS[t.op]
-        left = typed_text(t.left, p + (1 if t.op == "^" else 0))
-        right = typed_text(t.right, p + (0 if t.op == "^" else 1))
-        s = f"{left}{t.op}{right}" if t.op == "^" else f"{left} {t.op} {right}"
-        return f"({s})" if p < parent else s
-    if isinstance(t, (tc.TFunc, tc.TCall, tc.TBlock)):
-        name = t.func if isinstance(t, tc.TFunc) else t.name
-        return f"{name}({', '.join(typed_text(a) for a in t.args)})"
-    return "..."
+    return TypedText().text(t, parent)
 
 
 def _squares(t: tc.T):

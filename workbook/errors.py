@@ -79,3 +79,10 @@ class CheckFailed(WorkbookError):
     """Printed values are not reproduced."""
 
     kind = "check failed"
+
+
+class NotLive(Exception):
+    """An expression cannot be a live Excel formula (a solver block, or too long).
+
+    Not a user error: the writer then writes the value as a number, with a note.
+    """

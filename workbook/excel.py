@@ -10,6 +10,10 @@ from __future__ import annotations
 import re
 
 from . import typecheck as tc
+from .builtins import REGISTRY
+from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
+from .expr import PREC
+from .visitor import Visitor
 
 MAX_FORMULA = 8192  # Excel's limit on formula length
 
@@ -56,10 +60,6 @@ _RESERVED = {
 }
 
 
-class NotLive(Exception):
-    """The expression cannot be a live Excel formula (a solver block, or too long)."""
-
-
 def excel_name(name: str) -> str:
     """A defined name Excel and LibreOffice will not read as a cell reference or function."""
     if _CELL.match(name) or _R1C1.match(name) or name.lower() in _RESERVED or len(name) == 1:
@@ -75,32 +75,17 @@ def number(value: float) -> str:
     return repr(float(value)).replace("e", "E")
 
 
-_FUNCS = {
-    "sin": "SIN",
-    "cos": "COS",
-    "tan": "TAN",
-    "asin": "ASIN",
-    "acos": "ACOS",
-    "atan": "ATAN",
-    "sinh": "SINH",
-    "cosh": "COSH",
-    "tanh": "TANH",
-    "sqrt": "SQRT",
-    "exp": "EXP",
-    "ln": "LN",
-    "log10": "LOG10",
-    "abs": "ABS",
-    "sign": "SIGN",
-    "min": "MIN",
-    "max": "MAX",
-}
 _CMP = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "=", "!=": "<>"}
 
-ATOM, POW, MUL, ADD, CMP = 6, 4, 3, 2, 1
+# Excel's precedence levels are the worksheet's (one table); only negation differs (below).
+ATOM, POW, MUL, ADD, CMP = PREC["atom"], PREC["^"], PREC["*"], PREC["+"], PREC["cmp"]
 
 
-class ExcelPrinter:
-    """Prints typed trees of one sheet; ``subst`` maps parameters to cell references."""
+class ExcelPrinter(Visitor):
+    """Prints typed trees of one sheet; ``subst`` maps parameters to cell references.
+
+    ``visit(t, subst)`` returns (text, precedence level); one ``visit_<Node>`` per node kind.
+    """
 
     def __init__(self, typer: tc.Typer, names: dict[str, str] | None = None):
         self.typer = typer
@@ -115,43 +100,39 @@ class ExcelPrinter:
         return text
 
     def print(self, t: tc.T, subst: dict[str, str]) -> str:
-        return self._p(t, subst)[0]
+        return self.visit(t, subst)[0]
 
     def _wrap(self, t, subst, level: int) -> str:
-        text, own = self._p(t, subst)
+        text, own = self.visit(t, subst)
         return f"({text})" if own <= level else text
 
-    def _p(self, t: tc.T, s: dict[str, str]) -> tuple[str, int]:
-        method = getattr(self, "_print_" + type(t).__name__)
-        return method(t, s)
-
-    def _print_TConst(self, t, s):
+    def visit_TConst(self, t, s):
         text = number(t.value)
         return text, (ADD if text.startswith("-") else ATOM)
 
-    def _print_TText(self, t, s):
+    def visit_TText(self, t, s):
         return '"' + t.value.replace('"', '""') + '"', ATOM
 
-    def _print_TParam(self, t, s):
+    def visit_TParam(self, t, s):
         return s[t.name], ATOM
 
-    def _print_TRef(self, t, s):
+    def visit_TRef(self, t, s):
         if t.kind == "builtin":
             return "PI()", ATOM
         return self.names.get(t.name, excel_name(t.name)), ATOM
 
-    def _print_TScale(self, t, s):
+    def visit_TScale(self, t, s):
         if t.factor == 1.0:
-            return self._p(t.child, s)
+            return self.visit(t.child, s)
         return f"{self._wrap(t.child, s, MUL - 1)}*{number(t.factor)}", MUL
 
-    def _print_TUnary(self, t, s):
+    def visit_TUnary(self, t, s):
         if t.op == "not":
             return f"NOT({self.print(t.child, s)})", ATOM
         # Excel's negation binds tighter than ^: -x^2 is (-x)^2 there, so bracket all but atoms.
         return "-" + self._wrap(t.child, s, ATOM - 1), ADD
 
-    def _print_TBinary(self, t, s):
+    def visit_TBinary(self, t, s):
         if t.op == "^":
             return f"{self._wrap(t.left, s, POW)}^{self._wrap(t.right, s, POW)}", POW
         level = ADD if t.op in "+-" else MUL
@@ -159,35 +140,39 @@ class ExcelPrinter:
         right = self._wrap(t.right, s, level)  # a-(b-c), a/(b*c)
         return f"{left}{t.op}{right}", level
 
-    def _print_TCompare(self, t, s):
+    def visit_TCompare(self, t, s):
         parts = [self._wrap(o, s, CMP) for o in t.operands]
         pairs = [f"{a}{_CMP[op]}{b}" for a, op, b in zip(parts, t.ops, parts[1:])]
         if len(pairs) == 1:
             return pairs[0], CMP
         return f"AND({', '.join(pairs)})", ATOM
 
-    def _print_TLogic(self, t, s):
+    def visit_TLogic(self, t, s):
         return f"{t.op.upper()}({', '.join(self.print(v, s) for v in t.values)})", ATOM
 
-    def _print_TFunc(self, t, s):
-        args = [self.print(a, s) for a in t.args]
-        if t.func == "atan2":  # Excel's ATAN2 takes (x, y)
-            return f"ATAN2({args[1]}, {args[0]})", ATOM
-        if t.func == "floor":
-            return f"INT({args[0]})", ATOM
-        if t.func == "ceil":
-            return f"-INT(-({args[0]}))", ADD
-        return f"{_FUNCS[t.func]}({', '.join(args)})", ATOM
+    def visit_TFunc(self, t, s):
+        entry = REGISTRY[t.func]
+        if not entry.binds:
+            return entry.excel([self.print(a, s) for a in t.args])
+        expr_at, var_at = entry.binds
+        body, var = t.args[expr_at], t.args[var_at].name
+        rest = [a for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
+        consts = [a.value if isinstance(a, tc.TConst) else None for a in rest]
 
-    def _print_TCall(self, t, s):
+        def printed(value: str) -> str:
+            return self.print(body, {**s, var: value})
+
+        return entry.excel(printed, [self.print(a, s) for a in rest], consts)
+
+    def visit_TCall(self, t, s):
         f = self.typer.function(t.name)
         inner = {p: self._wrap(a, s, ATOM - 1) for p, a in zip(f.params, t.args)}
-        return self._p(f.body, inner)
+        return self.visit(f.body, inner)
 
-    def _print_TBlock(self, t, s):
+    def visit_TBlock(self, t, s):
         raise NotLive(f"{t.name}() is a solver block ({t.ref}); its values are written as numbers")
 
-    def _print_TAggregate(self, t, s):
+    def visit_TAggregate(self, t, s):
         ref = self.ranges.get((t.table, t.column))
         if ref is None:
             raise NotLive(
@@ -196,7 +181,7 @@ class ExcelPrinter:
             )
         return f"{t.func.upper()}({ref})", ATOM
 
-    def _print_TPiecewise(self, t, s):
+    def visit_TPiecewise(self, t, s):
         tail = "NA()"
         for cond, val in reversed(list(zip(t.conditions, t.values))):
             v = self.print(val, s)

@@ -13,6 +13,7 @@ import re
 from dataclasses import dataclass
 
 from .errors import LimitError, TemplateError
+from .visitor import Visitor
 
 MAX_TEXT = 20_000
 MAX_DEPTH = 200
@@ -72,30 +73,6 @@ class Call(Node):
     func: str
     args: tuple[Node, ...]
 
-
-#: Built-in functions: name -> number of arguments (None: one or more).
-FUNCTIONS: dict[str, int | None] = {
-    "sin": 1,
-    "cos": 1,
-    "tan": 1,
-    "asin": 1,
-    "acos": 1,
-    "atan": 1,
-    "atan2": 2,
-    "sinh": 1,
-    "cosh": 1,
-    "tanh": 1,
-    "sqrt": 1,
-    "exp": 1,
-    "ln": 1,
-    "log10": 1,
-    "abs": 1,
-    "min": None,
-    "max": None,
-    "sign": 1,
-    "floor": 1,
-    "ceil": 1,
-}
 
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "^"}
 _CMPOPS = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
@@ -207,23 +184,38 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
     raise TemplateError(f"{what}: {kind} is not allowed in worksheet expressions ({text!r})")
 
 
+class _Children(Visitor):
+    """The direct sub-trees of a node."""
+
+    def visit_Number(self, node: Number) -> tuple[Node, ...]:
+        return ()
+
+    visit_Text = visit_Name = visit_Number
+
+    def visit_Unary(self, node: Unary) -> tuple[Node, ...]:
+        return (node.operand,)
+
+    def visit_Binary(self, node: Binary) -> tuple[Node, ...]:
+        return (node.left, node.right)
+
+    def visit_Compare(self, node: Compare) -> tuple[Node, ...]:
+        return node.operands
+
+    def visit_Logic(self, node: Logic) -> tuple[Node, ...]:
+        return node.values
+
+    def visit_Call(self, node: Call) -> tuple[Node, ...]:
+        return node.args
+
+
+_CHILDREN = _Children()
+
+
 def walk(node: Node):
     """Yield every node of the tree, parents first."""
     yield node
-    if isinstance(node, Unary):
-        yield from walk(node.operand)
-    elif isinstance(node, Binary):
-        yield from walk(node.left)
-        yield from walk(node.right)
-    elif isinstance(node, Compare):
-        for o in node.operands:
-            yield from walk(o)
-    elif isinstance(node, Logic):
-        for v in node.values:
-            yield from walk(v)
-    elif isinstance(node, Call):
-        for a in node.args:
-            yield from walk(a)
+    for child in _CHILDREN.visit(node):
+        yield from walk(child)
 
 
 def names(node: Node) -> set[str]:
@@ -237,45 +229,70 @@ def names(node: Node) -> set[str]:
     return found
 
 
+#: Precedence of operators, shared by every printer of text (worksheet text, typed text,
+#: Excel): a sub-expression whose level is below its parent's is bracketed.
+PREC = {
+    "or": 1,
+    "and": 2,
+    "not": 3,
+    "cmp": 4,
+    "+": 5,
+    "-": 5,
+    "*": 6,
+    "/": 6,
+    "neg": 7,
+    "^": 8,
+    "atom": 9,
+}
+
+
+def number_text(v: float) -> str:
+    """A number as worksheet text: integers without a decimal point."""
+    return repr(int(v)) if float(v).is_integer() and abs(v) < 1e15 else repr(float(v))
+
+
+class TextPrinter(Visitor):
+    """Prints a tree as worksheet text; ``visit`` returns (text, precedence level)."""
+
+    def text(self, node: Node, parent: int = 0) -> str:
+        s, p = self.visit(node)
+        return f"({s})" if p < parent else s
+
+    def visit_Number(self, node: Number) -> tuple[str, int]:
+        return number_text(node.value), PREC["atom"]
+
+    def visit_Text(self, node: Text) -> tuple[str, int]:
+        return '"' + node.value.replace('"', "") + '"', PREC["atom"]
+
+    def visit_Name(self, node: Name) -> tuple[str, int]:
+        return node.id, PREC["atom"]
+
+    def visit_Call(self, node: Call) -> tuple[str, int]:
+        return f"{node.func}({', '.join(self.text(a) for a in node.args)})", PREC["atom"]
+
+    def visit_Unary(self, node: Unary) -> tuple[str, int]:
+        if node.op == "not":
+            return "not " + self.text(node.operand, PREC["not"]), PREC["not"]
+        return node.op + self.text(node.operand, PREC["neg"]), PREC["neg"]
+
+    def visit_Binary(self, node: Binary) -> tuple[str, int]:
+        p = PREC[node.op]
+        if node.op == "^":
+            return f"{self.text(node.left, p + 1)}^{self.text(node.right, p)}", p
+        return f"{self.text(node.left, p)} {node.op} {self.text(node.right, p + 1)}", p
+
+    def visit_Compare(self, node: Compare) -> tuple[str, int]:
+        p = PREC["cmp"]
+        parts = [self.text(node.operands[0], p + 1)]
+        for op, o in zip(node.ops, node.operands[1:]):
+            parts += [op, self.text(o, p + 1)]
+        return " ".join(parts), p
+
+    def visit_Logic(self, node: Logic) -> tuple[str, int]:
+        p = PREC[node.op]
+        return f" {node.op} ".join(self.text(v, p + 1) for v in node.values), p
+
+
 def to_text(node: Node) -> str:
     """Print a tree back as worksheet text (fully parenthesised where needed)."""
-    return _text(node, 0)
-
-
-_PREC = {"or": 1, "and": 2, "not": 3, "cmp": 4, "+": 5, "-": 5, "*": 6, "/": 6, "neg": 7, "^": 8}
-
-
-def _text(node: Node, parent: int) -> str:
-    if isinstance(node, Number):
-        v = node.value
-        s = repr(int(v)) if v.is_integer() and abs(v) < 1e15 else repr(v)
-        return s
-    if isinstance(node, Text):
-        return '"' + node.value.replace('"', "") + '"'
-    if isinstance(node, Name):
-        return node.id
-    if isinstance(node, Call):
-        return f"{node.func}({', '.join(_text(a, 0) for a in node.args)})"
-    if isinstance(node, Unary):
-        if node.op == "not":
-            s, p = "not " + _text(node.operand, _PREC["not"]), _PREC["not"]
-        else:
-            s, p = node.op + _text(node.operand, _PREC["neg"]), _PREC["neg"]
-    elif isinstance(node, Binary):
-        p = _PREC[node.op]
-        if node.op == "^":
-            s = f"{_text(node.left, p + 1)}^{_text(node.right, p)}"
-        else:
-            s = f"{_text(node.left, p)} {node.op} {_text(node.right, p + 1)}"
-    elif isinstance(node, Compare):
-        p = _PREC["cmp"]
-        parts = [_text(node.operands[0], p + 1)]
-        for op, o in zip(node.ops, node.operands[1:]):
-            parts += [op, _text(o, p + 1)]
-        s = " ".join(parts)
-    elif isinstance(node, Logic):
-        p = _PREC[node.op]
-        s = f" {node.op} ".join(_text(v, p + 1) for v in node.values)
-    else:  # pragma: no cover
-        raise TypeError(node)
-    return f"({s})" if p < parent else s
+    return TextPrinter().text(node)

@@ -12,30 +12,13 @@ from collections.abc import Callable
 import numpy as np
 
 from . import typecheck as tc
+from .builtins import REGISTRY
 from .errors import DomainError, InputError
+from .visitor import Visitor
 
 Env = dict[str, object]
 Fn = Callable[[Env], object]
 
-_MATH = {
-    "sin": np.sin,
-    "cos": np.cos,
-    "tan": np.tan,
-    "asin": np.arcsin,
-    "acos": np.arccos,
-    "atan": np.arctan,
-    "sinh": np.sinh,
-    "cosh": np.cosh,
-    "tanh": np.tanh,
-    "sqrt": np.sqrt,
-    "exp": np.exp,
-    "ln": np.log,
-    "log10": np.log10,
-    "abs": np.abs,
-    "sign": np.sign,
-    "floor": np.floor,
-    "ceil": np.ceil,
-}
 _CMP = {
     "<": operator.lt,
     "<=": operator.le,
@@ -48,8 +31,11 @@ _CMP = {
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": np.true_divide}
 
 
-class Evaluator:
-    """Compiles typed trees of one sheet; scalar values are memoised per sheet."""
+class Evaluator(Visitor):
+    """Compiles typed trees of one sheet; scalar values are memoised per sheet.
+
+    ``compile(t)`` returns a closure ``env -> magnitude``; one ``visit_<Node>`` per typed node.
+    """
 
     def __init__(
         self,
@@ -75,105 +61,132 @@ class Evaluator:
         return self._functions[name]
 
     def compile(self, t: tc.T) -> Fn:
-        c = self.compile
-        if isinstance(t, tc.TConst):
-            v = t.value
-            return lambda env: v
-        if isinstance(t, tc.TText):
-            v = t.value
-            return lambda env: v
-        if isinstance(t, tc.TParam):
-            n = t.name
-            return lambda env: env[n]
-        if isinstance(t, tc.TRef):
-            name, kind, get = t.name, t.kind, self.scalar_value
-            return lambda env: get(name, kind)
-        if isinstance(t, tc.TScale):
-            child, f = c(t.child), t.factor
-            if f == 1.0:
-                return child
-            return lambda env: child(env) * f
-        if isinstance(t, tc.TUnary):
-            child = c(t.child)
-            if t.op == "not":
-                return lambda env: np.logical_not(child(env))
-            return lambda env: -child(env)
-        if isinstance(t, tc.TBinary):
-            left, right = c(t.left), c(t.right)
-            if t.op == "^":
-                if isinstance(t.right, tc.TConst):
-                    n = t.right.value
-                    if n == 2.0:
-                        return lambda env: np.square(left(env))
-                    if n == 0.5:
-                        return lambda env: np.sqrt(left(env))
-                    return lambda env: np.power(left(env), n)
-                return lambda env: np.power(left(env), right(env))
-            op = _ARITH[t.op]
-            return lambda env: op(left(env), right(env))
-        if isinstance(t, tc.TCompare):
-            parts = [c(o) for o in t.operands]
-            ops = [_CMP[o] for o in t.ops]
-            if len(parts) == 2:
-                a, b, op = parts[0], parts[1], ops[0]
-                return lambda env: op(a(env), b(env))
+        """A closure computing ``t`` from an environment of parameter values."""
+        return self.visit(t)
 
-            def chain(env):
-                vals = [p(env) for p in parts]
-                out = ops[0](vals[0], vals[1])
-                for op, x, y in zip(ops[1:], vals[1:], vals[2:]):
-                    out = np.logical_and(out, op(x, y))
-                return out
+    def visit_TConst(self, t: tc.TConst) -> Fn:
+        v = t.value
+        return lambda env: v
 
-            return chain
-        if isinstance(t, tc.TLogic):
-            parts = [c(v) for v in t.values]
-            join = np.logical_and if t.op == "and" else np.logical_or
+    def visit_TText(self, t: tc.TText) -> Fn:
+        v = t.value
+        return lambda env: v
 
-            def logic(env):
-                out = parts[0](env)
-                for p in parts[1:]:
-                    out = join(out, p(env))
-                return out
+    def visit_TParam(self, t: tc.TParam) -> Fn:
+        n = t.name
+        return lambda env: env[n]
 
-            return logic
-        if isinstance(t, tc.TFunc):
-            args = [c(a) for a in t.args]
-            if t.func in _MATH:
-                f, a0 = _MATH[t.func], args[0]
-                return lambda env: f(a0(env))
-            if t.func == "atan2":
-                y, x = args
-                return lambda env: np.arctan2(y(env), x(env))
-            red = np.minimum if t.func == "min" else np.maximum
+    def visit_TRef(self, t: tc.TRef) -> Fn:
+        name, kind, get = t.name, t.kind, self.scalar_value
+        return lambda env: get(name, kind)
 
-            def minmax(env):
-                out = args[0](env)
-                for a in args[1:]:
-                    out = red(out, a(env))
-                return out
+    def visit_TScale(self, t: tc.TScale) -> Fn:
+        child, f = self.compile(t.child), t.factor
+        if f == 1.0:
+            return child
+        return lambda env: child(env) * f
 
-            return minmax
-        if isinstance(t, tc.TCall):
-            f = self.function(t.name)
-            params = self.typer.function(t.name).params
-            args = [c(a) for a in t.args]
-            if len(args) == 1:
-                p0, a0 = params[0], args[0]
-                return lambda env: f({p0: a0(env)})
-            return lambda env: f({p: a(env) for p, a in zip(params, args)})
-        if isinstance(t, tc.TBlock):
-            return self._block(t)
-        if isinstance(t, tc.TAggregate):
-            get, red = self.column_values, (np.max if t.func == "max" else np.min)
-            if get is None:
-                raise InputError(f"{t.func}_over({t.table}, {t.column}) needs a sheet's tables")
-            return lambda env: float(red(get(t.table, t.column)))
-        if isinstance(t, tc.TPiecewise):
-            return _piecewise(
-                t, [None if k is None else c(k) for k in t.conditions], [c(v) for v in t.values]
-            )
-        raise TypeError(t)  # pragma: no cover
+    def visit_TUnary(self, t: tc.TUnary) -> Fn:
+        child = self.compile(t.child)
+        if t.op == "not":
+            return lambda env: np.logical_not(child(env))
+        return lambda env: -child(env)
+
+    def visit_TBinary(self, t: tc.TBinary) -> Fn:
+        left, right = self.compile(t.left), self.compile(t.right)
+        if t.op == "^":
+            if isinstance(t.right, tc.TConst):
+                n = t.right.value
+                if n == 2.0:
+                    return lambda env: np.square(left(env))
+                if n == 0.5:
+                    return lambda env: np.sqrt(left(env))
+                return lambda env: np.power(left(env), n)
+            return lambda env: np.power(left(env), right(env))
+        op = _ARITH[t.op]
+        return lambda env: op(left(env), right(env))
+
+    def visit_TCompare(self, t: tc.TCompare) -> Fn:
+        parts = [self.compile(o) for o in t.operands]
+        ops = [_CMP[o] for o in t.ops]
+        if len(parts) == 2:
+            a, b, op = parts[0], parts[1], ops[0]
+            return lambda env: op(a(env), b(env))
+
+        def chain(env):
+            vals = [p(env) for p in parts]
+            out = ops[0](vals[0], vals[1])
+            for op, x, y in zip(ops[1:], vals[1:], vals[2:]):
+                out = np.logical_and(out, op(x, y))
+            return out
+
+        return chain
+
+    def visit_TLogic(self, t: tc.TLogic) -> Fn:
+        parts = [self.compile(v) for v in t.values]
+        join = np.logical_and if t.op == "and" else np.logical_or
+
+        def logic(env):
+            out = parts[0](env)
+            for p in parts[1:]:
+                out = join(out, p(env))
+            return out
+
+        return logic
+
+    def visit_TFunc(self, t: tc.TFunc) -> Fn:
+        entry = REGISTRY[t.func]
+        f = entry.numpy
+        if entry.binds:
+            return self._binding(t, entry)
+        args = [self.compile(a) for a in t.args]
+        if len(args) == 1:
+            a0 = args[0]
+            return lambda env: f(a0(env))
+        if len(args) == 2:
+            a0, a1 = args
+            return lambda env: f(a0(env), a1(env))
+        return lambda env: f(*[a(env) for a in args])
+
+    def _binding(self, t: tc.TFunc, entry) -> Fn:
+        """A built-in binding a variable: its hook gets EXPR as a function of the variable."""
+        expr_at, var_at = entry.binds
+        body, var = self.compile(t.args[expr_at]), t.args[var_at].name
+        rest = [self.compile(a) for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
+        hook = entry.numpy
+
+        def call(env):
+            def of(value):
+                return body({**env, var: value})
+
+            return hook(of, *[a(env) for a in rest])
+
+        return call
+
+    def visit_TCall(self, t: tc.TCall) -> Fn:
+        f = self.function(t.name)
+        params = self.typer.function(t.name).params
+        args = [self.compile(a) for a in t.args]
+        if len(args) == 1:
+            p0, a0 = params[0], args[0]
+            return lambda env: f({p0: a0(env)})
+        return lambda env: f({p: a(env) for p, a in zip(params, args)})
+
+    def visit_TBlock(self, t: tc.TBlock) -> Fn:
+        return self._block(t)
+
+    def visit_TAggregate(self, t: tc.TAggregate) -> Fn:
+        get, red = self.column_values, (np.max if t.func == "max" else np.min)
+        if get is None:
+            raise InputError(f"{t.func}_over({t.table}, {t.column}) needs a sheet's tables")
+        return lambda env: float(red(get(t.table, t.column)))
+
+    def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
+        return _piecewise(
+            t,
+            [None if k is None else self.compile(k) for k in t.conditions],
+            [self.compile(v) for v in t.values],
+        )
 
     def _block(self, t: tc.TBlock) -> Fn:
         from . import blocks

@@ -278,7 +278,7 @@ class Sheet:
                     f"{what}: range bound has units but '{rng.var}' has no declared unit"
                 )
             if spec is not None and (t.unit.dimensionality or t.unit != dimensionless):
-                t = self.typer._convert(t, spec.unit, what)
+                t = self.typer.convert(t, spec.unit, what)
             out.append(t)
         return out
 
@@ -306,7 +306,7 @@ class Sheet:
         try:
             t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
             if col.unit is not None:
-                t = self.typer._convert(
+                t = self.typer.convert(
                     t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}"
                 )
             return t

@@ -30,7 +30,9 @@ from fractions import Fraction
 
 from . import typecheck as tc
 from . import units as un
+from .builtins import REGISTRY
 from .errors import WorkbookError
+from .visitor import Visitor
 
 
 class NotSymbolic(WorkbookError):
@@ -63,8 +65,8 @@ def exact_number(value: float):
     return sp.Rational(repr(v))
 
 
-class SympyConverter:
-    """Converts typed nodes of one sheet to SymPy; one ``_print_<Node>`` method per node kind."""
+class SympyConverter(Visitor):
+    """Converts typed nodes of one sheet to SymPy; one ``visit_<Node>`` method per node kind."""
 
     def __init__(self, sheet, symbols: dict | None = None, *, keep=(), true_pi: bool = False):
         self.sheet = sheet
@@ -76,10 +78,8 @@ class SympyConverter:
 
     # -- entry points -------------------------------------------------------------------
     def convert(self, t: tc.T, env: dict | None = None):
-        method = getattr(self, "_print_" + type(t).__name__, None)
-        if method is None:  # pragma: no cover
-            raise NotSymbolic(f"no SymPy form for {type(t).__name__}")
-        return method(t, env or {})
+        """SymPy expression of ``t``; ``env`` maps parameters to SymPy expressions."""
+        return self.visit(t, env or {})
 
     def function(self, name: str):
         """(parameter symbols, body expression) of a sheet function."""
@@ -92,20 +92,20 @@ class SympyConverter:
         return self._bodies[name]
 
     # -- nodes --------------------------------------------------------------------------
-    def _print_TConst(self, t, env):
+    def visit_TConst(self, t, env):
         return exact_number(t.value)
 
-    def _print_TText(self, t, env):
+    def visit_TText(self, t, env):
         return t.value
 
-    def _print_TParam(self, t, env):
+    def visit_TParam(self, t, env):
         if t.name in env:
             return env[t.name]
         if t.name in self.symbols:
             return self.symbols[t.name]
         return _sympy().Symbol(t.name, real=True)
 
-    def _print_TRef(self, t, env):
+    def visit_TRef(self, t, env):
         sp = _sympy()
         name, kind = t.name, t.kind
         if name in self.symbols:
@@ -124,16 +124,16 @@ class SympyConverter:
             self._scalars[name] = self.convert(self.sheet.typer.scalar(name), {})
         return self._scalars[name]
 
-    def _print_TScale(self, t, env):
+    def visit_TScale(self, t, env):
         child = self.convert(t.child, env)
         return child if t.factor == 1.0 else exact_number(t.factor) * child
 
-    def _print_TUnary(self, t, env):
+    def visit_TUnary(self, t, env):
         sp = _sympy()
         child = self.convert(t.child, env)
         return sp.Not(child) if t.op == "not" else -child
 
-    def _print_TBinary(self, t, env):
+    def visit_TBinary(self, t, env):
         sp = _sympy()
         a, b = self.convert(t.left, env), self.convert(t.right, env)
         if t.op == "+":
@@ -146,7 +146,7 @@ class SympyConverter:
             return a / b
         return sp.Pow(a, b)
 
-    def _print_TCompare(self, t, env):
+    def visit_TCompare(self, t, env):
         sp = _sympy()
         vals = [self.convert(o, env) for o in t.operands]
         if any(isinstance(v, str) for v in vals):
@@ -157,55 +157,38 @@ class SympyConverter:
         parts = [rel[op](x, y) for op, x, y in zip(t.ops, vals, vals[1:])]
         return parts[0] if len(parts) == 1 else sp.And(*parts)
 
-    def _print_TLogic(self, t, env):
+    def visit_TLogic(self, t, env):
         sp = _sympy()
         vals = [self.convert(v, env) for v in t.values]
         return sp.And(*vals) if t.op == "and" else sp.Or(*vals)
 
-    def _print_TFunc(self, t, env):
+    def visit_TFunc(self, t, env):
         sp = _sympy()
-        args = [self.convert(a, env) for a in t.args]
-        simple = {
-            "sin": sp.sin,
-            "cos": sp.cos,
-            "tan": sp.tan,
-            "asin": sp.asin,
-            "acos": sp.acos,
-            "atan": sp.atan,
-            "sinh": sp.sinh,
-            "cosh": sp.cosh,
-            "tanh": sp.tanh,
-            "sqrt": sp.sqrt,
-            "exp": sp.exp,
-            "ln": sp.log,
-            "abs": sp.Abs,
-            "sign": sp.sign,
-            "floor": sp.floor,
-            "ceil": sp.ceiling,
-        }
-        if t.func in simple:
-            return simple[t.func](args[0])
-        if t.func == "log10":
-            return sp.log(args[0], 10)
-        if t.func == "atan2":
-            return sp.atan2(args[0], args[1])
-        if t.func == "min":
-            return sp.Min(*args)
-        if t.func == "max":
-            return sp.Max(*args)
-        raise NotSymbolic(f"no SymPy form for {t.func}()")  # pragma: no cover
+        entry = REGISTRY[t.func]
+        if not entry.binds:
+            return entry.sympy(sp, *[self.convert(a, env) for a in t.args])
+        expr_at, var_at = entry.binds
+        var = sp.Symbol(t.args[var_at].name, real=True)
+        body = self.convert(t.args[expr_at], {**env, t.args[var_at].name: var})
+        rest = [self.convert(a, env) for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
+        return entry.sympy(sp, body, var, *rest)
 
-    def _print_TCall(self, t, env):
+    def visit_TCall(self, t, env):
         syms, body = self.function(t.name)
         args = [self.convert(a, env) for a in t.args]
         return body.xreplace(dict(zip(syms, args)))
 
-    def _print_TBlock(self, t, env):
+    def visit_TBlock(self, t, env):
         raise NotSymbolic(
             f"{t.name}() is a solver block ({t.ref}): it has no formula to differentiate"
         )
 
-    def _print_TPiecewise(self, t, env):
+    def visit_TAggregate(self, t, env):
+        raise NotSymbolic(
+            f"{t.func}_over({t.table}, {t.column}) is a value of a table, not a formula"
+        )
+
+    def visit_TPiecewise(self, t, env):
         sp = _sympy()
         pieces = []
         for cond, val in zip(t.conditions, t.values):

@@ -21,6 +21,7 @@ import pint
 
 from . import expr as ex
 from . import units as un
+from .builtins import REGISTRY
 from .errors import InputError, LimitError, TemplateError, WorkbookError
 
 MAX_RANGE_POINTS = 2_000_000
@@ -405,7 +406,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             raise TemplateError(
                 f"'{key}' is not a valid name (letters, digits, _)", line=line, definition=key
             )
-        if key in ex.FUNCTIONS:
+        if key in REGISTRY:
             raise TemplateError(
                 f"'{key}' shadows the built-in function {key}(); choose another name",
                 line=line,

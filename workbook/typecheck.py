@@ -9,134 +9,44 @@ tree, so the unit logic lives only here.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import pint
 
 from . import expr as ex
 from . import units as un
+from .builtins import REGISTRY
 from .errors import LimitError, TemplateError, UnitError, WorkbookError
 from .template import Definition, SheetSpec
-
-
-@dataclass(eq=False)
-class T:
-    unit: pint.Unit
-    boolean: bool = field(default=False, kw_only=True)
-
-
-@dataclass(eq=False)
-class TConst(T):
-    value: float = 0.0
-
-
-@dataclass(eq=False)
-class TText(T):
-    value: str = ""
-
-
-@dataclass(eq=False)
-class TParam(T):
-    name: str = ""
-
-
-@dataclass(eq=False)
-class TRef(T):
-    """A scalar: an input, a scalar definition, or the built-in pi."""
-
-    name: str = ""
-    kind: str = "input"  # input | definition | builtin
-
-
-@dataclass(eq=False)
-class TScale(T):
-    child: T = None
-    factor: float = 1.0
-
-
-@dataclass(eq=False)
-class TUnary(T):
-    op: str = "-"
-    child: T = None
-
-
-@dataclass(eq=False)
-class TBinary(T):
-    op: str = "+"
-    left: T = None
-    right: T = None
-
-
-@dataclass(eq=False)
-class TCompare(T):
-    ops: tuple = ()
-    operands: tuple = ()
-
-
-@dataclass(eq=False)
-class TLogic(T):
-    op: str = "and"
-    values: tuple = ()
-
-
-@dataclass(eq=False)
-class TFunc(T):
-    func: str = ""
-    args: tuple = ()
-
-
-@dataclass(eq=False)
-class TCall(T):
-    """Call of a user function; args are already in the parameters' binding units."""
-
-    name: str = ""
-    args: tuple = ()
-
-
-@dataclass(eq=False)
-class TBlock(T):
-    name: str = ""
-    ref: str = ""
-    args: tuple = ()
-
-
-@dataclass(eq=False)
-class TAggregate(T):
-    """max_over(table, column) / min_over(...): one number from a range table's column."""
-
-    func: str = "max"
-    table: str = ""
-    column: str = ""
-
-
-@dataclass(eq=False)
-class TPiecewise(T):
-    conditions: tuple = ()  # None for 'otherwise'
-    values: tuple = ()
-    texts: tuple = ()
-
-
-@dataclass
-class TypedFunction:
-    name: str
-    params: tuple[str, ...]
-    param_units: tuple[pint.Unit, ...]
-    body: T
-
-    @property
-    def unit(self) -> pint.Unit:
-        return self.body.unit
-
+from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
+    T,
+    TAggregate,
+    TBinary,
+    TBlock,
+    TCall,
+    TCompare,
+    TConst,
+    TFunc,
+    TLogic,
+    TParam,
+    TPiecewise,
+    TRef,
+    TScale,
+    TText,
+    TUnary,
+    TypedFunction,
+)
+from .visitor import Visitor
 
 #: Longest chain of definitions typed inside one another (a -> b -> c ...).
 MAX_CHAIN = 100
 
-_ANGLE_IN = {"sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "ln", "log10"}
-_INVERSE = {"asin", "acos", "atan"}
 
+class Typer(Visitor):
+    """Types the definitions of one sheet (lazily, each once, with cycle detection).
 
-class Typer:
-    """Types the definitions of one sheet (lazily, each once, with cycle detection)."""
+    ``visit(node, scope)`` types an expression node (one ``visit_<Node>`` per kind of
+    :mod:`workbook.expr` node) in a scope of parameters (name -> binding unit).
+    """
 
     def __init__(self, spec: SheetSpec, input_units: dict[str, pint.Unit | None]):
         self.spec = spec
@@ -155,7 +65,7 @@ class Typer:
                 raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
             body = self._typed_body(d, {})
             if d.unit is not None:
-                body = self._convert(body, d.unit, f"the declared unit of '{name}'")
+                body = self.convert(body, d.unit, f"the declared unit of '{name}'")
             self.scalars[name] = body
         return self.scalars[name]
 
@@ -165,14 +75,14 @@ class Typer:
             scope = {p: self.spec.arguments[p].binding_unit for p in d.params}
             body = self._typed_body(d, scope)
             if d.unit is not None:
-                body = self._convert(body, d.unit, f"the declared unit of '{name}'")
+                body = self.convert(body, d.unit, f"the declared unit of '{name}'")
             self.functions[name] = TypedFunction(name, d.params, tuple(scope.values()), body)
         return self.functions[name]
 
     def expression(self, node: ex.Node, scope: dict[str, pint.Unit], what: str) -> T:
         """Type a free expression (a table column, a chart series) in a scope of parameters."""
         try:
-            return self._t(node, scope)
+            return self.visit(node, scope)
         except WorkbookError as err:
             raise err.located(definition=what) from None
 
@@ -206,7 +116,7 @@ class Typer:
         self._stack.append(d.name)
         try:
             if d.branches is None:
-                return self._not_text(self._t(d.body, scope), f"'{d.name}'")
+                return self._not_text(self.visit(d.body, scope), f"'{d.name}'")
             return self._piecewise(d, scope)
         except WorkbookError as err:
             raise err.located(file=str(self.spec.path), line=d.line, definition=d.name) from None
@@ -217,19 +127,19 @@ class Typer:
         conds, values, texts = [], [], []
         first_unit = None
         for b in d.branches:
-            v = self._t(b.value, scope)
+            v = self.visit(b.value, scope)
             if v.boolean:
                 raise TemplateError(f"piece {b.text!r} has a condition as its value")
             self._not_text(v, f"piece {b.text!r}")
             if first_unit is None:
                 first_unit = v.unit
             else:
-                v = self._convert(
+                v = self.convert(
                     v, first_unit, f"piece {b.text!r} (first piece is in {un.dims(first_unit)})"
                 )
             c = None
             if b.condition is not None:
-                c = self._t(b.condition, scope)
+                c = self.visit(b.condition, scope)
                 if not c.boolean:
                     raise TemplateError(f"the condition of piece {b.text!r} is not a comparison")
             conds.append(c)
@@ -239,7 +149,8 @@ class Typer:
             first_unit, conditions=tuple(conds), values=tuple(values), texts=tuple(texts)
         )
 
-    def _convert(self, t: T, target: pint.Unit, where: str) -> T:
+    def convert(self, t: T, target: pint.Unit, where: str) -> T:
+        """``t`` in the unit ``target`` (an explicit factor), or a UnitError naming ``where``."""
         if t.unit == target:
             return t
         if _is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
@@ -254,7 +165,7 @@ class Typer:
             return _with_unit(t, target)
         return TScale(target, child=t, factor=f)
 
-    def _plain(self, t: T, where: str) -> T:
+    def plain(self, t: T, where: str) -> T:
         """Convert to a plain number (radians for angles); refuse dimensioned values."""
         if t.boolean:
             raise TemplateError(f"{where}: a comparison cannot be used as a number")
@@ -263,7 +174,7 @@ class Typer:
                 f"{where} needs a dimensionless argument, got {un.dims(t.unit)} "
                 f"({un.pretty(t.unit)})"
             )
-        return self._convert(t, self.dimensionless, where)
+        return self.convert(t, self.dimensionless, where)
 
     def _number(self, t: T, where: str) -> T:
         if t.boolean:
@@ -282,37 +193,33 @@ class Typer:
             )
         return t
 
-    def _t(self, node: ex.Node, scope: dict[str, pint.Unit]) -> T:
-        if isinstance(node, ex.Number):
-            return TConst(self.dimensionless, value=node.value)
-        if isinstance(node, ex.Text):
-            return TText(self.dimensionless, value=node.value)
-        if isinstance(node, ex.Name):
-            return self._name(node.id, scope)
-        if isinstance(node, ex.Unary):
-            child = self._t(node.operand, scope)
-            if node.op == "not":
-                if not child.boolean:
-                    raise TemplateError("'not' needs a comparison")
-                return TUnary(child.unit, op="not", child=child, boolean=True)
-            self._number(child, f"'{node.op}'")
-            if node.op == "+":
-                return child
-            if isinstance(child, TConst):
-                return TConst(child.unit, value=-child.value)
-            return TUnary(child.unit, op="-", child=child)
-        if isinstance(node, ex.Binary):
-            return self._binary(node, scope)
-        if isinstance(node, ex.Compare):
-            return self._compare(node, scope)
-        if isinstance(node, ex.Logic):
-            vals = tuple(self._t(v, scope) for v in node.values)
-            if not all(v.boolean for v in vals):
-                raise TemplateError(f"'{node.op}' joins comparisons, not numbers")
-            return TLogic(self.dimensionless, op=node.op, values=vals, boolean=True)
-        if isinstance(node, ex.Call):
-            return self._call(node, scope)
-        raise TemplateError(f"unsupported expression {node!r}")  # pragma: no cover
+    def visit_Number(self, node: ex.Number, scope) -> T:
+        return TConst(self.dimensionless, value=node.value)
+
+    def visit_Text(self, node: ex.Text, scope) -> T:
+        return TText(self.dimensionless, value=node.value)
+
+    def visit_Name(self, node: ex.Name, scope) -> T:
+        return self._name(node.id, scope)
+
+    def visit_Unary(self, node: ex.Unary, scope) -> T:
+        child = self.visit(node.operand, scope)
+        if node.op == "not":
+            if not child.boolean:
+                raise TemplateError("'not' needs a comparison")
+            return TUnary(child.unit, op="not", child=child, boolean=True)
+        self._number(child, f"'{node.op}'")
+        if node.op == "+":
+            return child
+        if isinstance(child, TConst):
+            return TConst(child.unit, value=-child.value)
+        return TUnary(child.unit, op="-", child=child)
+
+    def visit_Logic(self, node: ex.Logic, scope) -> T:
+        vals = tuple(self.visit(v, scope) for v in node.values)
+        if not all(v.boolean for v in vals):
+            raise TemplateError(f"'{node.op}' joins comparisons, not numbers")
+        return TLogic(self.dimensionless, op=node.op, values=vals, boolean=True)
 
     def _name(self, name: str, scope) -> T:
         if name in scope:
@@ -334,13 +241,13 @@ class Typer:
             return TRef(self.dimensionless, name="pi", kind="builtin")
         if name in self.spec.arguments:
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
-        if name in ex.FUNCTIONS or name in self.spec.blocks:
+        if name in REGISTRY or name in self.spec.blocks:
             raise TemplateError(f"'{name}' is a function: call it as {name}(...)")
         raise TemplateError(f"unknown name '{name}'")
 
-    def _binary(self, node: ex.Binary, scope) -> T:
-        left = self._number(self._t(node.left, scope), f"'{node.op}'")
-        right = self._number(self._t(node.right, scope), f"'{node.op}'")
+    def visit_Binary(self, node: ex.Binary, scope) -> T:
+        left = self._number(self.visit(node.left, scope), f"'{node.op}'")
+        right = self._number(self.visit(node.right, scope), f"'{node.op}'")
         op = node.op
         if isinstance(left, TText) or isinstance(right, TText):
             raise TemplateError("text can only be compared with a choice input (==)")
@@ -349,7 +256,7 @@ class Typer:
                 left = TConst(right.unit, value=0.0)
             if right.unit.dimensionality != left.unit.dimensionality and not _is_zero(right):
                 self._mismatch(op, left, right)
-            right = self._convert(right, left.unit, "sum")
+            right = self.convert(right, left.unit, "sum")
             if isinstance(left, TConst) and isinstance(right, TConst):
                 v = left.value + right.value if op == "+" else left.value - right.value
                 return TConst(left.unit, value=v)
@@ -365,7 +272,7 @@ class Typer:
         # power
         if not right.unit.dimensionless or right.unit.dimensionality:
             raise UnitError(f"an exponent must be dimensionless, got {un.dims(right.unit)}")
-        right = self._convert(right, self.dimensionless, "exponent")
+        right = self.convert(right, self.dimensionless, "exponent")
         if left.unit.dimensionality:
             if not isinstance(right, TConst):
                 raise UnitError(
@@ -376,7 +283,7 @@ class Typer:
             if abs(n) > 1000:
                 raise UnitError(f"exponent {n:g} of a dimensioned value is out of range")
             return TBinary(left.unit**n, op="^", left=left, right=right)
-        left = self._convert(left, self.dimensionless, "base of a power")
+        left = self.convert(left, self.dimensionless, "base of a power")
         if isinstance(left, TConst) and isinstance(right, TConst):
             try:
                 v = math.pow(left.value, right.value)
@@ -394,9 +301,9 @@ class Typer:
             f"{'to' if op == '+' else 'from'} {un.dims(left.unit)} ({un.pretty(left.unit) or '1'})"
         )
 
-    def _compare(self, node: ex.Compare, scope) -> T:
+    def visit_Compare(self, node: ex.Compare, scope) -> T:
         ops = list(node.operands)
-        typed = [self._t(o, scope) for o in ops]
+        typed = [self.visit(o, scope) for o in ops]
         texts = [isinstance(t, TText) for t in typed]
         if any(texts):
             if len(typed) != 2 or node.ops[0] not in ("==", "!=") or sum(texts) != 1:
@@ -422,15 +329,19 @@ class Typer:
                     f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
                     f"with {un.dims(t.unit)} ({un.pretty(t.unit)})"
                 )
-            out.append(self._convert(t, first.unit, "comparison"))
+            out.append(self.convert(t, first.unit, "comparison"))
         return TCompare(self.dimensionless, ops=node.ops, operands=tuple(out), boolean=True)
 
-    def _call(self, node: ex.Call, scope) -> T:
+    def visit_Call(self, node: ex.Call, scope) -> T:
         name = node.func
         if name in AGGREGATES and name not in self.spec.definitions:
             return self._aggregate(node)
-        known = name in self.spec.definitions or name in self.spec.blocks or name in ex.FUNCTIONS
-        args = [self._t(a, scope) for a in node.args] if known else []  # unknown: say so first
+        entry = REGISTRY.get(name)
+        if entry is not None and entry.binds and name not in self.spec.definitions:
+            if name not in self.spec.blocks:
+                return self._binding_call(node, scope)
+        known = name in self.spec.definitions or name in self.spec.blocks or name in REGISTRY
+        args = [self.visit(a, scope) for a in node.args] if known else []  # unknown: say so first
         for a in args:
             self._number(a, f"argument of {name}()")
         if name in self.spec.definitions:
@@ -458,11 +369,11 @@ class Typer:
                     f"({', '.join(blk.args)}), got {len(args)}"
                 )
             conv = tuple(
-                self._convert(a, un.unit(u), f"argument '{p}' of {name}()")
+                self.convert(a, un.unit(u), f"argument '{p}' of {name}()")
                 for a, (p, u) in zip(args, blk.args.items())
             )
             return TBlock(un.unit(blk.returns), name=name, ref=blk.ref, args=conv)
-        if name not in ex.FUNCTIONS:
+        if name not in REGISTRY:
             if name == "log":
                 raise TemplateError(
                     "log() is not accepted (Mathcad's log is base 10, numpy's is natural): "
@@ -471,31 +382,38 @@ class Typer:
             if name in self.spec.inputs or name in scope:
                 raise TemplateError(f"'{name}' is a value, not a function; write {name}")
             raise TemplateError(f"unknown function '{name}'")
-        want = ex.FUNCTIONS[name]
-        if want is not None and len(args) != want:
-            raise TemplateError(f"{name}() takes {want} argument(s), got {len(args)}")
-        if want is None and not args:
-            raise TemplateError(f"{name}() needs at least one argument")
-        dl = self.dimensionless
-        if name in _ANGLE_IN:
-            return TFunc(dl, func=name, args=(self._plain(args[0], f"{name}()"),))
-        if name in _INVERSE:
-            return TFunc(dl, func=name, args=(self._plain(args[0], f"{name}()"),))
-        if name == "atan2":
-            y, x = args
-            x = self._convert(x, y.unit, "atan2(y, x): x and y")
-            return TFunc(dl, func=name, args=(y, x))
-        if name == "sqrt":
-            return TFunc(args[0].unit ** 0.5, func=name, args=(args[0],))
-        if name in ("abs", "floor", "ceil"):
-            return TFunc(args[0].unit, func=name, args=(args[0],))
-        if name == "sign":
-            return TFunc(dl, func=name, args=(args[0],))
-        if name in ("min", "max"):
-            first = args[0]
-            rest = [self._convert(a, first.unit, f"{name}() arguments") for a in args[1:]]
-            return TFunc(first.unit, func=name, args=(first, *rest))
-        raise TemplateError(f"unknown function '{name}'")  # pragma: no cover
+        entry = REGISTRY[name]
+        entry.check_arity(len(args))
+        return entry.unit_rule(self, name, tuple(args))
+
+    def _binding_call(self, node: ex.Call, scope) -> T:
+        """A built-in that binds a variable: EXPR is typed with the variable in scope."""
+        name, entry = node.func, REGISTRY[node.func]
+        entry.check_arity(len(node.args))
+        expr_at, var_at = entry.binds
+        var = node.args[var_at]
+        if not isinstance(var, ex.Name):
+            raise TemplateError(
+                f"{name}(): argument {var_at + 1} must be the name of the variable, "
+                f"got {ex.to_text(var)!r}"
+            )
+        if var.id in self.spec.inputs or var.id in self.spec.definitions:
+            raise TemplateError(
+                f"{name}(): the variable '{var.id}' is already an input or a definition; "
+                "choose another name"
+            )
+        arg = self.spec.arguments.get(var.id)
+        unit = arg.binding_unit if arg is not None else self.dimensionless
+        args: list[T] = []
+        for i, a in enumerate(node.args):
+            if i == var_at:
+                args.append(TParam(unit, name=var.id))
+            elif i == expr_at:
+                body = self.visit(a, {**scope, var.id: unit})
+                args.append(self._number(body, f"argument {i + 1} of {name}()"))
+            else:
+                args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
+        return entry.unit_rule(self, name, tuple(args))
 
     def _aggregate(self, node: ex.Call) -> T:
         """``max_over(table, column)``: the largest value of a column of a range table."""
@@ -517,7 +435,7 @@ class Typer:
 
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
-        return self._convert(a, unit, where)
+        return self.convert(a, unit, where)
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}
@@ -539,7 +457,7 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     scope = {var: arg.binding_unit if arg else typer.dimensionless}
     t = typer.expression(column_node(typer.spec, col, var), scope, what)
     if col.unit is not None:
-        t = typer._convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
+        t = typer.convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
 
 

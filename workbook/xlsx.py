@@ -19,6 +19,7 @@ from . import expr as ex
 from . import typecheck as tc
 from . import units as un
 from .atomic import check_target, replacing
+from .builtins import excel_functions
 from .checks import tolerances
 from .errors import LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive, excel_name
@@ -36,11 +37,9 @@ class ColumnCells:
     title: str
 
 
-# Functions of Excel 2007 that need no "_xlfn." prefix; the engine prints only these.
-_CLASSIC = frozenset(
-    "ABS ACOS AND ASIN ATAN ATAN2 COS COSH EXP IF INT LN LOG10 MAX MIN NA NOT OR PI POWER "
-    "SIGN SIN SINH SQRT SUM TAN TANH".split()
-)
+# Functions of Excel 2007 that need no "_xlfn." prefix that the printer writes for operators,
+# conditions and aggregates; the built-ins add theirs (workbook.builtins.excel_functions()).
+_CLASSIC = frozenset("AND IF INT MAX MIN NA NOT OR PI POWER SUM".split())
 _CALLED = re.compile(r"([A-Za-z_][A-Za-z0-9._]*)\(")
 
 
@@ -56,10 +55,11 @@ def _classic_formulas_as_they_are(ws) -> None:
     original = getattr(ws, "_prepare_formula", None)
     if original is None or getattr(ws, "use_future_functions", False):
         return
+    classic = _CLASSIC | excel_functions()
 
     def prepare(formula, expand_future_functions=False):
         if expand_future_functions or not all(
-            name.upper() in _CLASSIC for name in _CALLED.findall(formula)
+            name.upper() in classic for name in _CALLED.findall(formula)
         ):
             return original(formula, expand_future_functions)
         if formula.startswith("{"):
@@ -594,7 +594,7 @@ class WorkbookWriter:
             node = ex.Call(r.name, (ex.Number(float(r.at)),))
         try:
             t = self.sheet.typer.expression(node, {}, f"check {r.name}")
-            t = self.sheet.typer._convert(t, un.unit(r.unit), "check")
+            t = self.sheet.typer.convert(t, un.unit(r.unit), "check")
             self._write_cell_plain(ws, row, 5, t, r.computed)
             return True
         except NotLive:

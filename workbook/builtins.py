@@ -1,0 +1,334 @@
+"""The built-in functions: one :class:`Builtin` entry per function, read by every back end.
+
+An entry says everything the engine needs to know about one function:
+
+* ``arity``: exact number of arguments, ``(min, max)`` (``max`` None: no limit), or None
+  for one or more;
+* ``unit_rule(ctx, name, args) -> T``: the typed node (:mod:`workbook.typed`) of a call whose
+  arguments are already typed; ``ctx`` is the typer (:class:`UnitContext`), which offers
+  ``convert(t, unit, where)``, ``plain(t, where)`` and ``dimensionless``;
+* ``numpy(*values)``: the function on numpy arrays (magnitudes in the units the rule chose);
+* ``excel(args) -> (text, level)``: the Excel formula from the printed arguments, with the
+  precedence level of the result (:data:`workbook.expr.PREC`); it raises
+  :class:`workbook.errors.NotLive` when there is no live formula;
+* ``sympy(sp, *exprs)``: the SymPy expression (``sp`` is the sympy module, imported lazily);
+* ``domain``: the arguments' restricted domains (:class:`Domain`), explained by
+  :mod:`workbook.analysis` when a value is not finite;
+* ``excel_functions``: the classic (Excel 2007) functions the printed formula calls; the writer
+  skips xlsxwriter's "_xlfn." rewriting for formulas that call only classic functions, so a
+  built-in that prints a newer function must not list it;
+* ``doc``: one line for the documentation.
+
+Built-ins that bind a variable (``sum(EXPR, I, A, B)``, later ``root``, ``integral``...) set
+``binds=(expr_index, var_index)``. The typer then types the argument at ``expr_index`` in the
+scope extended with the variable named at ``var_index`` (its unit is the declared unit of that
+name in ``[arguments]``; dimensionless if it is not declared), and the typed node keeps the
+source order of the arguments (the variable as a ``TParam``). The hooks then receive:
+
+* ``numpy(fn, *values)``: ``fn(v)`` evaluates EXPR with the variable set to ``v`` (the rest of
+  the environment as in the call); ``values`` are the other arguments, evaluated;
+* ``excel(body, args, consts) -> (text, level)``: ``body(text)`` prints EXPR with the variable
+  replaced by the formula ``text``; ``args`` are the other arguments printed and ``consts``
+  their values when they are constants (else None);
+* ``sympy(sp, body, var, *exprs)``: ``body`` in the symbol ``var``.
+
+To add a built-in, write its rule and hooks and call :func:`register` at import of the module
+that defines it (a module of the package imported by :mod:`workbook`), e.g.::
+
+    register(Builtin("cbrt", 1, unit_rule=root_unit(3), numpy=np.cbrt,
+                     excel=excel_call("POWER", "{}, 1/3"), sympy=lambda sp, x: sp.cbrt(x),
+                     doc="cube root"))
+
+and document it in docs/language.md. Nothing else in the engine lists built-ins.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+import pint
+
+from . import typed as ty
+from .errors import InputError, LimitError, NotLive, TemplateError, UnitError
+from .expr import PREC
+
+Arity = int | tuple[int, int | None] | None
+
+
+class UnitContext(Protocol):
+    """What a unit rule may ask of the typer."""
+
+    dimensionless: pint.Unit
+
+    def convert(self, t: ty.T, target: pint.Unit, where: str) -> ty.T: ...
+
+    def plain(self, t: ty.T, where: str) -> ty.T: ...
+
+
+@dataclass(frozen=True)
+class Domain:
+    """A restricted domain of argument ``arg``: ``bad(values)`` marks values outside it."""
+
+    kind: str  # "sqrt of a negative number"
+    bad: Callable[[np.ndarray], np.ndarray]
+    shown: str  # "sqrt({})", filled with the argument's text
+    arg: int = 0
+
+
+@dataclass(frozen=True)
+class Builtin:
+    """One built-in function (see the module docstring for the meaning of each field)."""
+
+    name: str
+    arity: Arity
+    unit_rule: Callable[..., ty.T]
+    numpy: Callable[..., Any]
+    excel: Callable[..., tuple[str, int]]
+    sympy: Callable[..., Any]
+    domain: tuple[Domain, ...] = ()
+    doc: str = ""
+    binds: tuple[int, int] | None = None
+    excel_functions: tuple[str, ...] = ()
+
+    def check_arity(self, n: int) -> None:
+        """Raise a TemplateError if ``n`` arguments do not fit."""
+        a = self.arity
+        if a is None:
+            if n < 1:
+                raise TemplateError(f"{self.name}() needs at least one argument")
+            return
+        if isinstance(a, int):
+            if n != a:
+                raise TemplateError(f"{self.name}() takes {a} argument(s), got {n}")
+            return
+        lo, hi = a
+        if n < lo or (hi is not None and n > hi):
+            span = f"{lo} or more" if hi is None else f"{lo} to {hi}"
+            raise TemplateError(f"{self.name}() takes {span} arguments, got {n}")
+
+
+#: Every built-in function by name.
+REGISTRY: dict[str, Builtin] = {}
+
+
+def register(entry: Builtin) -> Builtin:
+    """Add a built-in; a name can be registered once."""
+    if entry.name in REGISTRY:
+        raise ValueError(f"built-in {entry.name}() is registered twice")
+    REGISTRY[entry.name] = entry
+    return entry
+
+
+# -- unit rules ------------------------------------------------------------------------------
+def plain_in(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    """A plain number in and out (angles in radians): sin, exp, asin..."""
+    return ty.TFunc(ctx.dimensionless, func=name, args=(ctx.plain(args[0], f"{name}()"),))
+
+
+def same_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    """The result in the unit of the first argument; the others converted to it."""
+    first = args[0]
+    rest = tuple(ctx.convert(a, first.unit, f"{name}() arguments") for a in args[1:])
+    return ty.TFunc(first.unit, func=name, args=(first, *rest))
+
+
+def _sqrt_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    return ty.TFunc(args[0].unit ** 0.5, func=name, args=(args[0],))
+
+
+def _sign_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    return ty.TFunc(ctx.dimensionless, func=name, args=(args[0],))
+
+
+def _atan2_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    y, x = args
+    x = ctx.convert(x, y.unit, "atan2(y, x): x and y")
+    return ty.TFunc(ctx.dimensionless, func=name, args=(y, x))
+
+
+# -- Excel -------------------------------------------------------------------------------------
+def excel_call(function: str) -> Callable[[list[str]], tuple[str, int]]:
+    """The Excel function ``function`` called with the arguments in order."""
+
+    def printed(args: list[str]) -> tuple[str, int]:
+        return f"{function}({', '.join(args)})", PREC["atom"]
+
+    return printed
+
+
+def _excel_atan2(args: list[str]) -> tuple[str, int]:
+    return f"ATAN2({args[1]}, {args[0]})", PREC["atom"]  # Excel's ATAN2 takes (x, y)
+
+
+def _excel_ceil(args: list[str]) -> tuple[str, int]:
+    return f"-INT(-({args[0]}))", PREC["+"]
+
+
+# -- the classic built-ins -----------------------------------------------------------------------
+def _minimum(*values):
+    return functools.reduce(np.minimum, values)
+
+
+def _maximum(*values):
+    return functools.reduce(np.maximum, values)
+
+
+_SQRT = Domain("sqrt of a negative number", lambda v: v < 0, "sqrt({})")
+
+
+def _inverse_domain(name: str) -> tuple[Domain, ...]:
+    return (Domain(f"{name} of a value beyond 1", lambda v: np.abs(v) > 1, name + "({})"),)
+
+
+def _log_domain(name: str) -> tuple[Domain, ...]:
+    return (Domain(f"{name} of a value that is not positive", lambda v: v <= 0, name + "({})"),)
+
+
+def _simple(name, numpy, excel, sympy, doc, rule=plain_in, domain=(), arity=1):
+    xl = excel if callable(excel) else excel_call(excel)
+    uses = (excel,) if isinstance(excel, str) else ()
+    register(Builtin(name, arity, rule, numpy, xl, sympy, domain, doc, excel_functions=uses))
+
+
+_simple("sin", np.sin, "SIN", lambda sp, x: sp.sin(x), "sine (argument in radians)")
+_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine")
+_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent")
+_simple(
+    "asin", np.arcsin, "ASIN", lambda sp, x: sp.asin(x), "arc sine", domain=_inverse_domain("asin")
+)
+_simple(
+    "acos",
+    np.arccos,
+    "ACOS",
+    lambda sp, x: sp.acos(x),
+    "arc cosine",
+    domain=_inverse_domain("acos"),
+)
+_simple("atan", np.arctan, "ATAN", lambda sp, x: sp.atan(x), "arc tangent")
+_simple(
+    "atan2",
+    np.arctan2,
+    _excel_atan2,
+    lambda sp, y, x: sp.atan2(y, x),
+    "angle of the point (x, y): atan2(y, x)",
+    rule=_atan2_unit,
+    arity=2,
+)
+_simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine")
+_simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine")
+_simple("tanh", np.tanh, "TANH", lambda sp, x: sp.tanh(x), "hyperbolic tangent")
+_simple("sqrt", np.sqrt, "SQRT", lambda sp, x: sp.sqrt(x), "square root", _sqrt_unit, (_SQRT,))
+_simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential")
+_simple("ln", np.log, "LN", lambda sp, x: sp.log(x), "natural logarithm", domain=_log_domain("ln"))
+_simple(
+    "log10",
+    np.log10,
+    "LOG10",
+    lambda sp, x: sp.log(x, 10),
+    "logarithm base 10",
+    domain=_log_domain("log10"),
+)
+_simple("abs", np.abs, "ABS", lambda sp, x: sp.Abs(x), "absolute value", same_unit)
+_simple("min", _minimum, "MIN", lambda sp, *a: sp.Min(*a), "smallest argument", same_unit, (), None)
+_simple("max", _maximum, "MAX", lambda sp, *a: sp.Max(*a), "largest argument", same_unit, (), None)
+_simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
+register(
+    Builtin(
+        "floor",
+        1,
+        same_unit,
+        np.floor,
+        lambda args: (f"INT({args[0]})", PREC["atom"]),
+        lambda sp, x: sp.floor(x),
+        doc="largest integer not above",
+        excel_functions=("INT",),
+    )
+)
+register(
+    Builtin(
+        "ceil",
+        1,
+        same_unit,
+        np.ceil,
+        _excel_ceil,
+        lambda sp, x: sp.ceiling(x),
+        doc="smallest integer not below",
+        excel_functions=("INT",),
+    )
+)
+
+
+# -- sum(EXPR, I, A, B): a built-in that binds a variable ------------------------------------
+#: Most terms of sum(); Excel gets the terms written out up to MAX_EXCEL_TERMS.
+MAX_TERMS = 1_000_000
+MAX_EXCEL_TERMS = 64
+
+
+def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    body, var, a, b = args
+    if var.unit.dimensionality or var.unit != ctx.dimensionless:
+        raise UnitError(f"sum(): the index {var.name} must be a plain number (integers A..B)")
+    a = ctx.plain(a, "sum(): the first index")
+    b = ctx.plain(b, "sum(): the last index")
+    return ty.TFunc(body.unit, func=name, args=(body, var, a, b))
+
+
+def _bound(value, which: str) -> int:
+    v = np.asarray(value, dtype=float)
+    if v.ndim and v.size > 1 and not np.all(v == v.flat[0]):
+        raise InputError(f"sum(): the {which} index must be one number, not vary")
+    x = float(v.flat[0]) if v.ndim else float(v)
+    if not math.isfinite(x) or x != math.floor(x):
+        raise InputError(f"sum(): the {which} index must be an integer, got {x:g}")
+    return int(x)
+
+
+def _sum_numpy(fn, a, b):
+    lo, hi = _bound(a, "first"), _bound(b, "last")
+    if hi - lo + 1 > MAX_TERMS:
+        raise LimitError(f"sum(): {hi - lo + 1} terms (limit {MAX_TERMS})")
+    out = 0.0
+    for i in range(lo, hi + 1):  # each term is a numpy evaluation over the sheet's arrays
+        out = out + fn(float(i))
+    return out
+
+
+def _sum_excel(body, args, consts) -> tuple[str, int]:
+    lo, hi = consts
+    if lo is None or hi is None:
+        raise NotLive("sum() with bounds that are not constants has no live formula")
+    lo, hi = _bound(lo, "first"), _bound(hi, "last")
+    if hi < lo:
+        return "0", PREC["atom"]
+    if hi - lo + 1 > MAX_EXCEL_TERMS:
+        raise NotLive(f"sum() of {hi - lo + 1} terms (written out up to {MAX_EXCEL_TERMS})")
+    terms = [body(str(i) if i >= 0 else f"({i})") for i in range(lo, hi + 1)]
+    return "(" + ")+(".join(terms) + ")", PREC["+"]
+
+
+def _sum_sympy(sp, body, var, a, b):
+    return sp.Sum(body, (var, a, b)).doit()
+
+
+register(
+    Builtin(
+        "sum",
+        4,
+        _sum_unit,
+        _sum_numpy,
+        _sum_excel,
+        _sum_sympy,
+        doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A)",
+        binds=(0, 1),
+    )
+)
+
+
+def excel_functions() -> frozenset[str]:
+    """Excel functions that the printed formulas of built-ins call."""
+    return frozenset(f for b in REGISTRY.values() for f in b.excel_functions)

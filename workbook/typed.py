@@ -1,0 +1,172 @@
+"""The typed tree: expression nodes with their units resolved (built by workbook.typecheck).
+
+Every node carries the pint unit its value is in; every unit conversion is an explicit
+:class:`TScale`. The nodes are frozen: back ends (:mod:`workbook.numeric`,
+:mod:`workbook.excel`, :mod:`workbook.symbolic`, :mod:`workbook.analysis`) read them and
+never change them; each back end is a :class:`workbook.visitor.Visitor` with one
+``visit_<Node>`` method per class below.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import pint
+
+from .visitor import Visitor
+
+
+@dataclass(frozen=True, eq=False)
+class T:
+    """Base of typed nodes: the unit the value is in; ``boolean`` for conditions."""
+
+    unit: pint.Unit
+    boolean: bool = field(default=False, kw_only=True)
+
+
+@dataclass(frozen=True, eq=False)
+class TConst(T):
+    value: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class TText(T):
+    value: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class TParam(T):
+    name: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class TRef(T):
+    """A scalar: an input, a scalar definition, or the built-in pi."""
+
+    name: str = ""
+    kind: str = "input"  # input | definition | builtin
+
+
+@dataclass(frozen=True, eq=False)
+class TScale(T):
+    child: T = None
+    factor: float = 1.0
+
+
+@dataclass(frozen=True, eq=False)
+class TUnary(T):
+    op: str = "-"
+    child: T = None
+
+
+@dataclass(frozen=True, eq=False)
+class TBinary(T):
+    op: str = "+"
+    left: T = None
+    right: T = None
+
+
+@dataclass(frozen=True, eq=False)
+class TCompare(T):
+    ops: tuple = ()
+    operands: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TLogic(T):
+    op: str = "and"
+    values: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TFunc(T):
+    """Call of a built-in function (an entry of :data:`workbook.builtins.REGISTRY`).
+
+    For a built-in that binds a variable, ``args`` keeps the source order: the typed
+    expression, a :class:`TParam` naming the bound variable, then the other arguments.
+    """
+
+    func: str = ""
+    args: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TCall(T):
+    """Call of a user function; args are already in the parameters' binding units."""
+
+    name: str = ""
+    args: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TBlock(T):
+    name: str = ""
+    ref: str = ""
+    args: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TAggregate(T):
+    """max_over(table, column) / min_over(...): one number from a range table's column."""
+
+    func: str = "max"
+    table: str = ""
+    column: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class TPiecewise(T):
+    conditions: tuple = ()  # None for 'otherwise'
+    values: tuple = ()
+    texts: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TypedFunction:
+    name: str
+    params: tuple[str, ...]
+    param_units: tuple[pint.Unit, ...]
+    body: T
+
+    @property
+    def unit(self) -> pint.Unit:
+        return self.body.unit
+
+
+class _Children(Visitor):
+    """The direct sub-trees of a typed node, in source order."""
+
+    def _none(self, t: T) -> tuple[T, ...]:
+        return ()
+
+    visit_TConst = visit_TText = visit_TParam = visit_TRef = visit_TAggregate = _none
+
+    def visit_TScale(self, t: TScale) -> tuple[T, ...]:
+        return (t.child,)
+
+    visit_TUnary = visit_TScale
+
+    def visit_TBinary(self, t: TBinary) -> tuple[T, ...]:
+        return (t.left, t.right)
+
+    def visit_TCompare(self, t: TCompare) -> tuple[T, ...]:
+        return tuple(t.operands)
+
+    def visit_TLogic(self, t: TLogic) -> tuple[T, ...]:
+        return tuple(t.values)
+
+    def visit_TFunc(self, t: TFunc) -> tuple[T, ...]:
+        return tuple(t.args)
+
+    visit_TCall = visit_TBlock = visit_TFunc
+
+    def visit_TPiecewise(self, t: TPiecewise) -> tuple[T, ...]:
+        return tuple(t.values) + tuple(c for c in t.conditions if c is not None)
+
+
+_CHILDREN = _Children()
+
+
+def children(t: T) -> tuple[T, ...]:
+    """The direct sub-trees of ``t`` (values, then conditions, for a piecewise node)."""
+    return _CHILDREN.visit(t)
