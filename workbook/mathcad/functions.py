@@ -34,16 +34,7 @@ OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpos
 
 
 def language_functions() -> set[str]:
-    """The built-in function names of the language as it is (its registry)."""
-    from .. import expr as ex
+    """The built-in function names of the language (its registry)."""
+    from ..builtins import REGISTRY
 
-    names = set(ex.FUNCTIONS)
-    try:
-        from .. import builtins as reg  # the registry of built-ins, where it exists
-    except ImportError:
-        return names
-    for attr in ("REGISTRY", "BUILTINS", "FUNCTIONS"):
-        table = getattr(reg, attr, None)
-        if isinstance(table, dict):
-            names |= set(table)
-    return names
+    return set(REGISTRY)
