@@ -190,8 +190,9 @@ class TOdd(ty.T):
 def test_an_unknown_node_is_refused_by_every_back_end(tmp_path, backend):
     sheet = _sheet(tmp_path)
     node = TOdd(sheet.typer.dimensionless)
+    evaluator = Evaluator(sheet.typer, sheet.scalar_value, sheet.describe_call)
     run = {
-        "numpy": lambda: Evaluator(sheet.typer, sheet.scalar_value, sheet.describe_call).compile(node),
+        "numpy": lambda: evaluator.compile(node),
         "excel": lambda: ExcelPrinter(sheet.typer).print(node, {}),
         "sympy": lambda: SympyConverter(sheet).convert(node),
         "text": lambda: typed_text(node),
