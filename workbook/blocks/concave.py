@@ -55,20 +55,6 @@ def _deg(sheet) -> float:
 
 
 # -- stability ----------------------------------------------------------------------------------
-def lift_stable(sheet, phi):
-    """Formula (1) in the stable form (mm), phi in the sheet's degrees.
-
-    h = d cos x - sqrt(c^2 - d^2 sin^2 x) - (R1 + Rp) with d = R1 + R3, c = R3 - Rp = d/k
-    and d - c = R1 + Rp, so h = d^2 sin^2 x/(c + sqrt(c^2 - d^2 sin^2 x)) - 2 d sin^2(x/2):
-    both terms are of order x^2 and do not cancel (they are in the ratio -1 : k).
-    """
-    d = _mag(sheet, "R1", "mm") + _mag(sheet, "R3", "mm")
-    c = _mag(sheet, "R3", "mm") - _mag(sheet, "Rp", "mm")
-    x = np.asarray(phi, dtype=float) * _deg(sheet)
-    s2 = np.sin(x) ** 2
-    return d * d * s2 / (c + np.sqrt(c * c - d * d * s2)) - 2 * d * np.sin(x / 2) ** 2
-
-
 def lift_reference(sheet, phi_deg: float, digits: int = 50) -> float:
     """The sheet's h1 at phi (exact decimal inputs), evaluated with ``digits`` digits."""
     import sympy as sp
@@ -90,7 +76,7 @@ def _stability(sheet):
     for phi in STABILITY_ANGLES:
         ref = lift_reference(sheet, phi)
         printed = float(sheet.evaluate("h1", phi=phi).to("mm").magnitude)
-        stable = float(lift_stable(sheet, phi))
+        stable = float(sheet.evaluate("h1_stable", phi=phi).to("mm").magnitude)
         rows.append(
             {
                 "phi [deg]": phi,
@@ -292,25 +278,6 @@ SWEEP = (
 )
 
 
-def geometry_angles(R1: float, R2: float, R3: float, Rp: float, a: float) -> tuple[float, float]:
-    """theta_geom and phiB_geom in degrees (the formulas of concave-cam-geometry.toml).
-
-    Raises ValueError with the reason when the geometry does not exist.
-    """
-    d = R1 + R3
-    cos_t = (a * a + d * d - (R2 + R3) ** 2) / (2 * a * d)
-    if not -1.0 <= cos_t <= 1.0:
-        raise ValueError(
-            f"theta_geom: acos of a value beyond 1 ({cos_t:.4g}): the circles R1 + R3 about O1 "
-            "and R3 + R2 about O2 do not meet, there is no flank centre O3"
-        )
-    theta = math.acos(cos_t)
-    t = (R3 - Rp) / (R3 + R2)
-    bx = d + t * (a * math.cos(theta) - d)
-    by = t * a * math.sin(theta)
-    return math.degrees(theta), math.degrees(math.atan2(by, bx))
-
-
 def _sweep_case(sheet, label: str, changes: dict) -> dict:
     from ..errors import WorkbookError
 
@@ -331,12 +298,16 @@ def _sweep_case(sheet, label: str, changes: dict) -> dict:
     except WorkbookError as err:
         row.update(status="invalid", reason=err.message)
         return row
+    geo = _geometry(sheet).with_inputs(**changes)
     try:
-        theta, phib = geometry_angles(*(_mag(s, n, "mm") for n in ("R1", "R2", "R3", "Rp", "a")))
-        row["theta_geom [deg]"], row["phiB_geom [deg]"] = theta, phib
-    except ValueError as err:
-        reasons.append(f"geometry: {err}")
-    lam = _mag(s, "a", "mm") / (_mag(s, "R2", "mm") + _mag(s, "Rp", "mm"))
+        row["theta_geom [deg]"] = float(geo.evaluate("theta_geom").to("deg").magnitude)
+        row["phiB_geom [deg]"] = float(geo.evaluate("phiB_geom").to("deg").magnitude)
+    except WorkbookError as err:
+        reasons.append(
+            f"geometry: {err.message} (the circles R1 + R3 about O1 and R3 + R2 about O2 do "
+            "not meet: there is no flank centre O3)"
+        )
+    lam = float(geo.evaluate("lam").magnitude)
     if abs(lam - 1) > 1e-12:
         reasons.append(
             f"lambda = a/(R2 + Rp) = {lam:g}: the sheet's nose formulas (5), (12), (13) "
@@ -355,6 +326,13 @@ def _sweep_case(sheet, label: str, changes: dict) -> dict:
         row.update(status="invalid", reason="; ".join(reasons))
         row.update({"h max [mm]": None, "v max [m/s]": None, "j max [m/s^2]": None})
     return row
+
+
+def _geometry(sheet):
+    """The geometry of the same cam (concave-cam-geometry.toml beside the template)."""
+    from .. import load
+
+    return load(sheet.spec.path.parent / "concave-cam-geometry.toml")
 
 
 def sweep_rows(sheet) -> list[dict]:
