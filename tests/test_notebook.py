@@ -1,4 +1,5 @@
-"""A Sheet in Jupyter: HTML of inputs, definitions, functions and tables (DataFrames)."""
+"""A Sheet in Jupyter: the report's rendering (inputs, formulas, tables, charts, checks),
+and the tables as DataFrames."""
 
 import pytest
 from conftest import write_template
@@ -10,17 +11,13 @@ from workbook import notebook
 def test_the_html_shows_inputs_definitions_and_tables(concave):
     text = concave._repr_html_()
     assert text == notebook.sheet_html(concave)
-    assert (
-        "<h4>Inputs</h4>" in text
-        and "<td>R3</td>" in text
-        and "radius of the concave flank" in text
-    )
-    assert "<h4>Definitions</h4>" in text and "<td>k</td>" in text and "<td>1.75</td>" in text
-    assert "h1(phi)" in text  # the functions, with their formulas
-    assert "Table flank_AB" in text and "<th>h1 [mm]</th>" in text and "<th>v1 [m/s]</th>" in text
-    assert "Fig. 4. Lift and velocity of the follower" in text
-    # the 105-row chart-data table is shortened
-    assert "105 rows" in text and "..." in text
+    assert "1. Inputs</h2>" in text and "<tr data-name='R3'>" in text
+    assert "radius of the concave flank" in text
+    assert "2. Calculation</h2>" in text and "id='def-k'" in text
+    assert "<mrow class='result' data-name='k'><mrow><mn>1.75</mn></mrow></mrow>" in text
+    assert "id='def-h1'" in text and "<mfrac>" in text  # the functions, as formulas
+    assert "Table flank_AB" in text and "105 rows" in text
+    assert "Fig. 4. Lift and velocity of the follower</figcaption>" in text and "<svg" in text
 
 
 def test_tables_are_dataframes_with_units_in_the_headers(concave):
@@ -38,7 +35,7 @@ def test_ipython_displays_it():
     formatters = pytest.importorskip("IPython.core.formatters")
     sheet = workbook.load("concave-cam")
     html = formatters.HTMLFormatter()(sheet)
-    assert html and "<h4>Inputs</h4>" in html
+    assert html and "1. Inputs</h2>" in html
 
 
 def test_an_error_is_shown_not_raised(tmp_path):
@@ -67,5 +64,5 @@ columns = { f = "" }
     )
     text = workbook.load(path)._repr_html_()
     assert "a &lt;b&gt;bold&lt;/b&gt; title" in text and "choice &lt;and&gt; text" in text
-    assert "Table bad" in text and "error:" in text and "not a finite number" in text
+    assert "Table bad" in text and "not computed" in text and "not a finite number" in text
     assert "one of: a, b" in text

@@ -1,4 +1,4 @@
-"""Command line: ``workbook list | run | check | bench``.
+"""Command line: ``workbook list | run | check | bench | sweep | new | report``.
 
 Exit status: 0 success, 1 printed values not reproduced (check), 2 bad input
 (template, units, values, paths), 3 internal error (a bug), 130 interrupted. No traceback
@@ -107,6 +107,21 @@ def _parser() -> argparse.ArgumentParser:
     )
     sw.add_argument("--workers", type=int, help="processes of the local pool (default: CPUs)")
     sw.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (tcp://...)")
+    rep = sub.add_parser(
+        "report", help="the calculation as a document: reports/NAME.html (and --pdf)"
+    )
+    sheet_args(rep)
+    part_args(rep, "none: what is in no part")
+    rep.add_argument("--out", help="output .html (default reports/NAME.html)")
+    rep.add_argument(
+        "--pdf", action="store_true", help="also print it to PDF beside the HTML (Chromium)"
+    )
+    rep.add_argument(
+        "--full-tables",
+        action="store_true",
+        help="every row of long tables (default: first and last rows above 1,000)",
+    )
+    rep.add_argument("--force", action="store_true", help="overwrite a file of another kind")
     new = sub.add_parser("new", help="write a commented starter worksheet that runs as it is")
     new.add_argument("name", help="name of the new worksheet (writes NAME.toml)")
     new.add_argument("--out", help="file to write (default ./NAME.toml)")
@@ -202,6 +217,31 @@ def cmd_run(args) -> int:
     if n_checked:
         summary += f", {n_ok} of {n_checked} printed values reproduced"
     print(f"wrote {out}: {summary}")
+    for name in sheet.left_out:
+        part = sheet.full_spec.parts[name]
+        print(f"left out part {name} ({part.title}): add it with --part {name}")
+    return EXIT_OK
+
+
+def cmd_report(args) -> int:
+    from .report import regenerate_command, write_report
+
+    sheet = load_sheet(args, args.part or None)
+    command = regenerate_command(sheet, parse_sets(args.set))
+    if args.full_tables:
+        command += " --full-tables"
+    if args.pdf:
+        command += " --pdf"
+    written = write_report(
+        sheet,
+        Path(args.out) if args.out else None,
+        pdf=args.pdf,
+        force=args.force,
+        command=command,
+        full_tables=args.full_tables,
+    )
+    for path in written:
+        print(f"wrote {path}")
     for name in sheet.left_out:
         part = sheet.full_spec.parts[name]
         print(f"left out part {name} ({part.title}): add it with --part {name}")
@@ -311,6 +351,7 @@ def main(argv: list[str] | None = None) -> int:
             "bench": cmd_bench,
             "sweep": cmd_sweep,
             "import": cmd_import,
+            "report": cmd_report,
         }[args.command]
     from .errors import WorkbookError
 

@@ -1,10 +1,9 @@
-"""A Sheet in Jupyter: inputs, definitions, functions and tables as HTML.
+"""A Sheet in Jupyter: the report's rendering, and its parts as DataFrames.
 
-Jupyter calls the Sheet's ``_repr_html_``, which is :func:`sheet_html`. Tables are pandas
-DataFrames with the unit in every header (``sheet.table(name)``). Displaying a sheet does not
-compute block tables (ODE histories, studies: they may take long); they are listed with the
-call that computes them. A value that fails is shown with its error instead of breaking the
-display.
+``Sheet._repr_html_`` calls :func:`sheet_html`, which shows what ``workbook report`` writes
+(:mod:`workbook.report`). Tables are pandas DataFrames with the unit in every header
+(``sheet.table(name)``, :func:`tables`). A value that fails is shown with its error instead of
+breaking the display.
 """
 
 from __future__ import annotations
@@ -13,8 +12,6 @@ import html
 
 from . import units as un
 from .errors import WorkbookError
-
-MAX_ROWS = 12  # longer tables show their first and last rows
 
 
 def inputs_frame(sheet):
@@ -78,67 +75,12 @@ def _choice_note(spec) -> str:
     return f"{spec.note} ({opts})" if spec.note else opts
 
 
-def _frame_html(df) -> str:
-    return df.to_html(
-        index=False,
-        max_rows=MAX_ROWS,
-        float_format=lambda x: f"{x:.6g}",
-        border=0,
-        classes="workbook-table",
-        na_rep="",
-    )
-
-
 def sheet_html(sheet) -> str:
-    """HTML of a Sheet for Jupyter: title, source, inputs, definitions, functions, tables."""
-    import numpy as np
+    """HTML of a Sheet for Jupyter: the same rendering as ``workbook report`` (formulas as
+    MathML, the values put in, tables, charts, checks), as a fragment with its own style."""
+    from .report import fragment
 
-    with np.errstate(all="ignore"):  # a value that leaves its domain is shown as an error
-        return _sheet_html(sheet)
-
-
-def _sheet_html(sheet) -> str:
-    esc = html.escape
-    parts = [f"<div class='workbook-sheet'><h3>{esc(sheet.spec.title or sheet.name)}</h3>"]
-    if sheet.spec.source:
-        parts.append(f"<p><i>{esc(sheet.spec.source)}</i></p>")
-    if sheet.spec.description:
-        parts.append(f"<p>{esc(sheet.spec.description)}</p>")
-    parts.append(f"<p><code>{esc(sheet.file)}</code></p>")
-    sections = [
-        ("Inputs", lambda: inputs_frame(sheet)),
-        ("Definitions", lambda: definitions_frame(sheet)),
-        ("Functions", lambda: functions_frame(sheet)),
-    ]
-    for title, make in sections:
-        try:
-            df = make()
-        except Exception as err:  # the display must not fail
-            parts.append(f"<h4>{title}</h4><p>error: {esc(str(err))}</p>")
-            continue
-        if len(df):
-            parts.append(f"<h4>{title}</h4>{_frame_html(df)}")
-    for t in sheet.spec.tables:
-        head = f"<h4>Table {esc(t.name)}: {esc(t.title)}</h4>"
-        if t.block:
-            parts.append(
-                f"{head}<p>computed by the solver block <code>{esc(t.block)}</code>: "
-                f"<code>sheet.table({t.name!r})</code></p>"
-            )
-            continue
-        try:
-            df = sheet.table(t.name)
-        except WorkbookError as err:
-            parts.append(f"{head}<p>error: {esc(err.message)}</p>")
-            continue
-        except Exception as err:
-            parts.append(f"{head}<p>error: {esc(type(err).__name__)}: {esc(str(err))}</p>")
-            continue
-        parts.append(f"{head}<p>{len(df)} rows</p>{_frame_html(df)}")
-    if sheet.spec.charts:
-        names = ", ".join(esc(c.title) for c in sheet.spec.charts)
-        parts.append(
-            f"<p>Charts (in the workbook: <code>sheet.write_xlsx(path)</code>): {names}</p>"
-        )
-    parts.append("</div>")
-    return "\n".join(parts)
+    try:
+        return fragment(sheet)
+    except Exception as err:  # the display must not fail
+        return f"<p>{html.escape(sheet.name)}: error: {html.escape(str(err))}</p>"

@@ -403,6 +403,13 @@ class Sheet:
 
         return write_workbook(self, Path(path), **options)
 
+    def report(self, path=None, pdf: bool = False, **options) -> Path:
+        """Write the calculation as a document: ``path`` (default ``reports/NAME.html``) and,
+        with ``pdf``, the PDF beside it (needs Chromium). Returns the HTML path."""
+        from .report import write_report
+
+        return write_report(self, path, pdf=pdf, **options)[0]
+
     def check(self):
         """Compare with the printed values; returns a :class:`workbook.checks.Report`."""
         from .checks import run_checks

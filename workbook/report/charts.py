@@ -1,0 +1,103 @@
+"""Charts of a report: the sheet's ``[[charts]]`` drawn by matplotlib as inline SVG.
+
+matplotlib is imported here only (reports draw charts; ``workbook run`` does not), with the
+Agg backend, so no display is needed. The data are the engine's: the same range values and
+columns the workbook writes, or the block table a series names.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+
+import numpy as np
+
+_STYLES = {"solid": "-", "dash": "--", "dot": ":", "none": "none"}
+WIDTH_IN, HEIGHT_IN = 6.6, 3.7  # fits the A4 text width
+
+
+def series_data(sheet, chart, s) -> tuple[np.ndarray, np.ndarray]:
+    """x and y of one series, as the engine computes them."""
+    if s.table is not None:
+        df = sheet.block_table_cached(s.table)
+        return (
+            np.asarray(df[s.x_column], dtype=float),
+            np.asarray(df[s.y_column], dtype=float),
+        )
+    rng = s.range or chart.range
+    what = f"chart {chart.name}"
+    x = sheet.range_values(rng, what)
+    y = sheet.column(s.y, rng.var, x, what).values
+    xcol = s.x or chart.x
+    if xcol is not None and not (xcol.unit is None and getattr(xcol.node, "id", None) == rng.var):
+        x = sheet.column(xcol, rng.var, x, what).values
+    return x, y
+
+
+def chart_svg(sheet, chart) -> str:
+    """The chart as an ``<svg>`` element (no XML header), text kept as text."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    data = [series_data(sheet, chart, s) for s in chart.series]
+    with matplotlib.rc_context(
+        {
+            "svg.fonttype": "none",
+            "svg.hashsalt": f"{sheet.name}-{chart.name}",
+            "font.size": 9,
+            "font.family": "DejaVu Sans",
+        }
+    ):
+        fig, ax = plt.subplots(figsize=(WIDTH_IN, HEIGHT_IN if not chart.equal_axes else WIDTH_IN))
+        try:
+            ax2 = ax.twinx() if any(s.axis == "secondary" for s in chart.series) else None
+            handles = []
+            for i, (s, (x, y)) in enumerate(zip(chart.series, data)):
+                target = ax2 if (s.axis == "secondary" and ax2 is not None) else ax
+                style = _STYLES.get(s.line, "-")
+                (h,) = target.plot(
+                    x,
+                    y,
+                    linestyle=style,
+                    marker="o" if s.marker or style == "none" else None,
+                    markersize=3.5,
+                    linewidth=1.6,
+                    color=f"C{i}",
+                    label=s.name,
+                )
+                handles.append(h)
+            ax.set_xlabel(chart.x_title or (chart.x.title if chart.x else ""))
+            ax.set_ylabel(chart.y_title)
+            if ax2 is not None:
+                ax2.set_ylabel(chart.y2_title)
+            for a in (ax, ax2):
+                if a is None:
+                    continue
+                if chart.log_x:
+                    a.set_xscale("log")
+                if chart.log_y:
+                    a.set_yscale("log")
+            if chart.equal_axes:
+                ax.set_aspect("equal", adjustable="datalim")
+            ax.grid(True, color="#d9d9d9", linewidth=0.6)
+            if len(handles) > 1 or ax2 is not None:
+                ax.legend(
+                    handles=handles,
+                    loc="upper center",
+                    bbox_to_anchor=(0.5, -0.16),
+                    ncol=min(len(handles), 3),
+                    frameon=False,
+                    fontsize=8,
+                )
+            fig.tight_layout()
+            buf = io.StringIO()
+            fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
+        finally:
+            plt.close(fig)
+    text = buf.getvalue()
+    text = text[text.index("<svg") :]
+    text = re.sub(r"<metadata>.*?</metadata>", "", text, flags=re.S)
+    # scale with the page: the viewBox keeps the drawing, CSS sets the size
+    return re.sub(r'<svg([^>]*?) width="[^"]*" height="[^"]*"', r"<svg\1", text, count=1)
