@@ -45,6 +45,12 @@ def to_text(el) -> str:
     """MathML back to worksheet text: ``<mfrac>`` as (a)/(b), R with subscript 3 as R3."""
     tag = _tag(el)
     kids = [k for k in el if _tag(k)]
+    if el.get("data-call"):  # a built-in written as its registry entry says: its arguments
+        args = {}
+        for a in el.xpath(".//*[@data-arg]"):
+            if a.xpath("ancestor::*[@data-call][1]")[0] is el:
+                args[int(a.get("data-arg"))] = to_text(a)
+        return f"{el.get('data-call')}({', '.join(args[i] for i in sorted(args))})"
     if tag == "mrow" and el.get("class") == "over":  # max_over(table, column)
         head, _apply, col = kids
         func, label = (k.text_content() for k in head)
@@ -57,8 +63,6 @@ def to_text(el) -> str:
         return el.text_content().replace("\u2212", "-")
     if tag == "mo":
         t = el.text_content()
-        if t in ("|", "\u230a", "\u230b", "\u2308", "\u2309"):
-            return {"\u230a": "floor(", "\u2308": "ceil(", "|": "|"}.get(t, ")")
         return _OPS.get(t, t)
     if tag == "mtext":
         t = el.text_content().replace("\u00a0", " ")
@@ -69,8 +73,6 @@ def to_text(el) -> str:
         return " "
     if tag == "mfrac":
         return f"(({to_text(kids[0])})/({to_text(kids[1])}))"
-    if tag == "msqrt":
-        return f"sqrt({''.join(to_text(k) for k in kids)})"
     if tag == "msup":
         base, exp = kids
         if _tag(base) == "mi" and base.text_content() in ("sin", "cos", "tan", "sinh", "cosh"):
@@ -78,8 +80,6 @@ def to_text(el) -> str:
         return f"({to_text(base)})^({to_text(exp)})"
     if tag == "msub":
         base, sub = kids
-        if base.text_content() == "log":
-            return "log10"
         parts = (
             [to_text(k) for k in sub if _tag(k) in ("mi", "mn")]
             if _tag(sub) == "mrow"
@@ -116,8 +116,6 @@ def formula_text(el) -> str:
             + f"^({m.group(2)})"
             + text[i + 1 :]
         )
-    text = re.sub(r"\|([^|]*)\|", r"abs(\1)", text)
-    text = text.replace("arcsin", "asin").replace("arccos", "acos").replace("arctan", "atan")
     return text
 
 

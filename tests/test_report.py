@@ -68,12 +68,30 @@ def _shown(text: str) -> str:
         "a*(b*c)",
         "0 <= phi <= 22 and not x > 1",
         "log10(x) + ln(y) + exp(-z) + atan2(y, x)",
+        "sum(R*sin(k*x)/k, k, 1, 3) + 2*sum(I^2 + 1, I, 1, n)",
+        "floor(x/2) - ceil(-x) + abs(a - b)*sqrt(c)",
     ],
 )
 def test_the_formula_shown_is_the_formula_written(text):
     """MathML read back as text parses to the same tree (same precedence, same names)."""
     back = _shown(text)
     assert ex.to_text(ex.parse(back)) == ex.to_text(ex.parse(text)), back
+
+
+def test_every_builtin_is_written_as_its_registry_entry_says():
+    from workbook.builtins import REGISTRY
+
+    for name, entry in REGISTRY.items():
+        a = entry.arity
+        n = a if isinstance(a, int) else (a[0] if isinstance(a, tuple) else 2)
+        args = ["x", "y", "z", "w"][:n]
+        if entry.binds is not None:
+            args[entry.binds[1]] = "I"
+        text = f"{name}({', '.join(args)})"
+        box = MathML().box(ex.parse(text))
+        if entry.mathml:
+            assert box.xml.startswith(f"<mrow data-call='{name}'>"), name
+        assert ex.to_text(ex.parse(_shown(text))) == ex.to_text(ex.parse(text)), name
 
 
 def test_fractions_roots_powers_and_braces():

@@ -17,7 +17,12 @@ An entry says everything the engine needs to know about one function:
 * ``excel_functions``: the classic (Excel 2007) functions the printed formula calls; the writer
   skips xlsxwriter's "_xlfn." rewriting for formulas that call only classic functions, so a
   built-in that prints a newer function must not list it;
-* ``doc``: one line for the documentation.
+* ``doc``: one line for the documentation;
+* ``mathml``: how a report writes a call (:mod:`workbook.report.mathml`): MathML in which
+  ``{0}``, ``{1}``... are the arguments, ``{0:group}`` the argument bracketed unless it is a
+  product or tighter, ``{args}`` all of them with commas; empty: the name and the arguments in
+  brackets, ``sin(x)``. ``mathml_powered``: a power of a call is written on the name, as
+  ``sin²(x)``.
 
 Built-ins that bind a variable (``sum(EXPR, I, A, B)``, later ``root``, ``integral``...) set
 ``binds=(expr_index, var_index)``. The typer then types the argument at ``expr_index`` in the
@@ -94,6 +99,8 @@ class Builtin:
     doc: str = ""
     binds: tuple[int, int] | None = None
     excel_functions: tuple[str, ...] = ()
+    mathml: str = ""
+    mathml_powered: bool = False
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""
@@ -189,17 +196,36 @@ def _log_domain(name: str) -> tuple[Domain, ...]:
     return (Domain(f"{name} of a value that is not positive", lambda v: v <= 0, name + "({})"),)
 
 
-def _simple(name, numpy, excel, sympy, doc, rule=plain_in, domain=(), arity=1):
+def _simple(name, numpy, excel, sympy, doc, rule=plain_in, domain=(), arity=1, **display):
     xl = excel if callable(excel) else excel_call(excel)
     uses = (excel,) if isinstance(excel, str) else ()
-    register(Builtin(name, arity, rule, numpy, xl, sympy, domain, doc, excel_functions=uses))
+    register(
+        Builtin(name, arity, rule, numpy, xl, sympy, domain, doc, excel_functions=uses, **display)
+    )
 
 
-_simple("sin", np.sin, "SIN", lambda sp, x: sp.sin(x), "sine (argument in radians)")
-_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine")
-_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent")
+def mathml_call(label: str) -> str:
+    """MathML of a call written with another name: ``arcsin(x)`` for asin."""
+    return f"<mi>{label}</mi><mo>\u2061</mo><mrow><mo>(</mo>{{args}}<mo>)</mo></mrow>"
+
+
+def mathml_fence(left: str, right: str) -> str:
+    """MathML of a one-argument call written between fences: ``|x|``."""
+    return f"<mrow><mo>{left}</mo>{{0}}<mo>{right}</mo></mrow>"
+
+
+_TRIG = {"mathml_powered": True}
+_simple("sin", np.sin, "SIN", lambda sp, x: sp.sin(x), "sine (argument in radians)", **_TRIG)
+_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG)
+_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG)
 _simple(
-    "asin", np.arcsin, "ASIN", lambda sp, x: sp.asin(x), "arc sine", domain=_inverse_domain("asin")
+    "asin",
+    np.arcsin,
+    "ASIN",
+    lambda sp, x: sp.asin(x),
+    "arc sine",
+    domain=_inverse_domain("asin"),
+    mathml=mathml_call("arcsin"),
 )
 _simple(
     "acos",
@@ -208,8 +234,11 @@ _simple(
     lambda sp, x: sp.acos(x),
     "arc cosine",
     domain=_inverse_domain("acos"),
+    mathml=mathml_call("arccos"),
 )
-_simple("atan", np.arctan, "ATAN", lambda sp, x: sp.atan(x), "arc tangent")
+_simple(
+    "atan", np.arctan, "ATAN", lambda sp, x: sp.atan(x), "arc tangent", mathml=mathml_call("arctan")
+)
 _simple(
     "atan2",
     np.arctan2,
@@ -219,10 +248,19 @@ _simple(
     rule=_atan2_unit,
     arity=2,
 )
-_simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine")
-_simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine")
-_simple("tanh", np.tanh, "TANH", lambda sp, x: sp.tanh(x), "hyperbolic tangent")
-_simple("sqrt", np.sqrt, "SQRT", lambda sp, x: sp.sqrt(x), "square root", _sqrt_unit, (_SQRT,))
+_simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine", **_TRIG)
+_simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine", **_TRIG)
+_simple("tanh", np.tanh, "TANH", lambda sp, x: sp.tanh(x), "hyperbolic tangent", **_TRIG)
+_simple(
+    "sqrt",
+    np.sqrt,
+    "SQRT",
+    lambda sp, x: sp.sqrt(x),
+    "square root",
+    _sqrt_unit,
+    (_SQRT,),
+    mathml="<msqrt>{0}</msqrt>",
+)
 _simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential")
 _simple("ln", np.log, "LN", lambda sp, x: sp.log(x), "natural logarithm", domain=_log_domain("ln"))
 _simple(
@@ -232,8 +270,17 @@ _simple(
     lambda sp, x: sp.log(x, 10),
     "logarithm base 10",
     domain=_log_domain("log10"),
+    mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
 )
-_simple("abs", np.abs, "ABS", lambda sp, x: sp.Abs(x), "absolute value", same_unit)
+_simple(
+    "abs",
+    np.abs,
+    "ABS",
+    lambda sp, x: sp.Abs(x),
+    "absolute value",
+    same_unit,
+    mathml=mathml_fence("|", "|"),
+)
 _simple("min", _minimum, "MIN", lambda sp, *a: sp.Min(*a), "smallest argument", same_unit, (), None)
 _simple("max", _maximum, "MAX", lambda sp, *a: sp.Max(*a), "largest argument", same_unit, (), None)
 _simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
@@ -247,6 +294,7 @@ register(
         lambda sp, x: sp.floor(x),
         doc="largest integer not above",
         excel_functions=("INT",),
+        mathml=mathml_fence("\u230a", "\u230b"),
     )
 )
 register(
@@ -259,6 +307,7 @@ register(
         lambda sp, x: sp.ceiling(x),
         doc="smallest integer not below",
         excel_functions=("INT",),
+        mathml=mathml_fence("\u2308", "\u2309"),
     )
 )
 
@@ -325,6 +374,7 @@ register(
         _sum_sympy,
         doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A)",
         binds=(0, 1),
+        mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
     )
 )
 

@@ -15,11 +15,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from html import escape
 
+from .. import builtins as bi
 from .. import expr as ex
 from ..visitor import Visitor
 
-PREC = ex._PREC  # the one precedence table of the language
-ATOM = 100  # a name, a number, a call, a parenthesised group
+PREC = ex.PREC  # the one precedence table of the language
+ATOM = PREC["atom"]  # a name, a number, a call, a parenthesised group
 FRAC = PREC["neg"] + 0.5  # a stacked fraction: needs brackets only as the base of a power
 PRECISION = 6  # significant digits of a computed value
 
@@ -68,8 +69,7 @@ _MINUS = "\u2212"
 _TIMES = "\u22c5"
 _APPLY = "<mo>\u2061</mo>"  # function application (no visible space)
 _NAME = re.compile(r"^([A-Za-z]+?)([0-9]*)(?:_([A-Za-z0-9_]+))?$")
-_POWERED = {"sin", "cos", "tan", "sinh", "cosh", "tanh"}  # sin(x)^2 is written sin²(x)
-_FUNC_LABEL = {"asin": "arcsin", "acos": "arccos", "atan": "arctan"}
+_TAG = re.compile(r"<[^>]*>|\{[^}]*\}")
 
 
 @dataclass(frozen=True)
@@ -223,6 +223,7 @@ class MathML(Visitor):
     def __init__(self, values: Callable[[str], Value | None] | None = None):
         self.values = values
         self.inline = 0  # inside an exponent: division as a slash, not stacked
+        self.bound: set[str] = set()  # variables bound by an enclosing sum(): never values
 
     def box(self, node: ex.Node) -> Box:
         return self.visit(node)
@@ -242,7 +243,7 @@ class MathML(Visitor):
         return text_box(f"\u201c{node.value}\u201d")
 
     def visit_Name(self, node: ex.Name) -> Box:
-        value = self.values(node.id) if self.values else None
+        value = self.values(node.id) if self.values and node.id not in self.bound else None
         if value is None:
             return name_box(node.id)
         if isinstance(value, str):
@@ -291,9 +292,10 @@ class MathML(Visitor):
             exp = self.box(exp_node)
         finally:
             self.inline -= 1
+        entry = bi.REGISTRY.get(base_node.func) if isinstance(base_node, ex.Call) else None
         if (
-            isinstance(base_node, ex.Call)
-            and base_node.func in _POWERED
+            entry is not None
+            and entry.mathml_powered
             and isinstance(exp_node, ex.Number)
             and exp_node.value > 0
             and len(base_node.args) == 1
@@ -321,9 +323,9 @@ class MathML(Visitor):
         return _join(*boxes, prec=p, numeric=False)
 
     def visit_Call(self, node: ex.Call) -> Box:
-        args = [self.box(a) for a in node.args]
         func = node.func
-        if func in ("max_over", "min_over") and len(node.args) == 2:
+        entry = bi.REGISTRY.get(func)
+        if entry is None and func in ("max_over", "min_over") and len(node.args) == 2:
             table, column = node.args
             # the largest value of a table's column: max with the table's name below
             label = f"<mtext>table {escape(_text(table))}</mtext>"
@@ -331,26 +333,33 @@ class MathML(Visitor):
             col = _parens(self.box(column))
             xml = f"<mrow class='over'>{head}{_APPLY}{col.xml}</mrow>"
             return Box(xml, 2.0 + col.width + 0.3 * len(_text(table)))
-        if func == "sqrt" and len(args) == 1:
-            return Box(f"<msqrt>{args[0].row()}</msqrt>", args[0].width + 1.0)
-        if func == "abs" and len(args) == 1:
-            return _parens(args[0], "|", "|")
-        if func in ("floor", "ceil") and len(args) == 1:
-            o, c = ("\u230a", "\u230b") if func == "floor" else ("\u2308", "\u2309")
-            return _parens(args[0], o, c)
-        if func == "log10":
-            head = Box("<msub><mi>log</mi><mn>10</mn></msub>", 2.2)
-        elif func in ex.FUNCTIONS:
-            head = _mi(_FUNC_LABEL.get(func, func))
-        else:
-            head = name_box(func)  # the sheet's own functions and solver blocks
-        inner: list[Box] = []
-        for i, a in enumerate(args):
-            if i:
-                inner.append(Box("<mo separator='true'>,</mo>", 0.5))
-            inner.append(a)
-        group = _parens(_join(*inner) if inner else Box("", 0.0))
+        bound = set()
+        if entry is not None and entry.binds is not None:
+            var = node.args[entry.binds[1]] if len(node.args) > entry.binds[1] else None
+            bound = {var.id} - self.bound if isinstance(var, ex.Name) else set()
+        self.bound |= bound
+        try:
+            args = [self.box(a) for a in node.args]
+        finally:
+            self.bound -= bound
+        if entry is not None and entry.mathml:
+            return self._registered(func, entry.mathml, args)
+        # the sheet's own functions and solver blocks are named like values (R3 as R₃)
+        head = _mi(func) if entry is not None else name_box(func)
+        group = _parens(_commas(args))
         return Box(head.xml + _APPLY + group.xml, head.width + group.width)
+
+    def _registered(self, func: str, template: str, args: list[Box]) -> Box:
+        """A built-in's call written as its registry entry says (``{0}``, ``{0:group}``,
+        ``{args}``); each argument is marked for the reader of the report's tests."""
+        marked = [
+            Box(f"<mrow data-arg='{i}'>{a.xml}</mrow>", a.width, a.prec) for i, a in enumerate(args)
+        ]
+        xml = template.format(*(_Arg(b) for b in marked), args=_Arg(_commas(marked)))
+        visible = len(_TAG.sub("", template))
+        width = sum(a.width for a in args) + 0.5 * visible + 0.7
+        trailing = template.rstrip().endswith("}")  # an operand at the end: binds like a product
+        return Box(f"<mrow data-call='{func}'>{xml}</mrow>", width, PREC["*"] if trailing else ATOM)
 
     # -- piecewise ---------------------------------------------------------------------------
     def pieces(self, branches) -> Box:
@@ -368,6 +377,27 @@ class MathML(Visitor):
             cond_widths.append(cond.width)
         xml = f"<mrow><mo stretchy='true'>{{</mo><mtable>{''.join(rows)}</mtable></mrow>"
         return Box(xml, max(widths, default=0) + max(cond_widths, default=0) + 2.0)
+
+
+class _Arg:
+    """An argument in a registry template: ``{0:group}`` brackets it below a product."""
+
+    def __init__(self, box: Box):
+        self.box = box
+
+    def __format__(self, spec: str) -> str:
+        if spec == "group" and self.box.prec < PREC["*"]:
+            return _parens(self.box).xml
+        return self.box.xml
+
+
+def _commas(boxes: list[Box]) -> Box:
+    inner: list[Box] = []
+    for i, b in enumerate(boxes):
+        if i:
+            inner.append(Box("<mo separator='true'>,</mo>", 0.5))
+        inner.append(b)
+    return _join(*inner) if inner else Box("", 0.0)
 
 
 def _text(node: ex.Node) -> str:
