@@ -196,6 +196,12 @@ def _valve_numbers(sheet) -> dict:
     )
 
 
+def _raw_lift(sheet, w_b: float, w_n: float):
+    """The template's worn lift before the cut at zero, h_raw(phi, w_b, w_n): degrees in, mm out."""
+    fn = sheet.evaluator.function("h_raw")
+    return lambda phi: np.asarray(fn({"phi": phi, "wb": w_b, "wn": w_n}), dtype=float)
+
+
 def _integrand(sheet, name):
     """The template's function name(phi) compiled: plain degrees in, mm^2 out."""
     fn = sheet.evaluator.function(name)
@@ -231,10 +237,10 @@ def _study(sheet, case: str, quick: bool):
     """Rows (method, points, value, error, time) for one wear case."""
     num = _valve_numbers(sheet)
     w_b, w_n = num["cases"][case]
-    name = {"unworn": "fA0", "worn 1": "fA1", "worn 2": "fA2"}[case]
-    f = _integrand(sheet, name)
+    f = _integrand(sheet, {"unworn": "fA0", "worn 1": "fA1", "worn 2": "fA2"}[case])
     Phi = num["Phi"]
-    ref = time_section_3(num["d"], num["alpha"], num["H"], Phi, num["p"], w_b, w_n)
+    ts = {"unworn": "TS0", "worn 1": "TS1", "worn 2": "TS2"}[case]
+    ref = float(sheet.evaluate(ts).to("mm^2*deg").magnitude)
     budget = 0.002 if quick else 0.02  # seconds of repeated runs per point, at least 3 runs
     rows = []
     for method in _METHODS:
@@ -242,12 +248,11 @@ def _study(sheet, case: str, quick: bool):
             if method == "Gauss-Legendre split":
                 if case == "unworn":
                     continue
-                raw = lambda phi: _worn(_h0(phi, num["H"], Phi), num["H"], num["p"], w_b, w_n)  # noqa: E731
+                raw = _raw_lift(sheet, w_b, w_n)
 
                 def run(n=n, raw=raw):
                     cuts = _kinks(raw, Phi, [0.0], n=64) or [0.0, Phi]
-                    a, b = cuts[0], cuts[-1]
-                    x, w = _rule("Gauss-Legendre", n, a, b)
+                    x, w = _rule("Gauss-Legendre", n, cuts[0], cuts[-1])
                     return float(np.dot(w, f(x)))
             else:
                 x, w = _rule(method, n, 0.0, Phi)
@@ -454,8 +459,7 @@ def measured_lift(sheet):
 def measured_time_section(sheet) -> float:
     """Time-section (mm^2*deg) of the measured lift: trapezoid of (3) at the measured points."""
     m = _measured(sheet)
-    num = _valve_numbers(sheet)
-    area = _f3(np.maximum(m["h"], 0.0), num["d"], num["alpha"])
+    area = sheet.evaluate("f3", h=np.maximum(m["h"], 0.0)).to("mm^2").magnitude
     return float(np.sum((area[1:] + area[:-1]) / 2 * np.diff(m["phi"])))
 
 
@@ -472,7 +476,7 @@ def valve_findings(sheet):
     h_lim, h_port = mm("h_lim"), mm("h_port")
     topic = "validity of (3)"
     if H > h_lim:
-        phi_lim = Phi / (2 * math.pi) * math.acos(1 - 2 * h_lim / H)
+        phi_lim = float(sheet.evaluate("phi_lim").to("deg").magnitude)
         out.append(
             Finding(
                 topic,
@@ -542,9 +546,9 @@ def valve_findings(sheet):
     for label, (w_b, w_n) in num["cases"].items():
         if label == "unworn":
             continue
-        raw = lambda phi, w_b=w_b, w_n=w_n: _worn(_h0(phi, H, Phi), H, num["p"], w_b, w_n)  # noqa: E731
+        raw = _raw_lift(sheet, w_b, w_n)
         grid = raw(np.linspace(0.0, Phi, 4097))
-        top, nose = float(grid.max()), _worn(H, H, num["p"], w_b, w_n)
+        top, nose = float(grid.max()), float(raw(Phi / 2))  # the nose: h0(Phi/2) = H
         if top <= 0:
             out.append(
                 Finding(
