@@ -84,6 +84,7 @@ class Translation:
     syms: list[Sym] = field(default_factory=list)
     title: str = ""
     ignored: list[str] = field(default_factory=list)  # regions that show and define nothing
+    origin: int = 0
 
 
 _BINARY = {"plus": "+", "minus": "-", "mult": "*", "div": "/", "pow": "^"}
@@ -205,7 +206,12 @@ class ExprTranslator(Visitor):
         if tag in OPERATOR_FUNCTIONS and len(args) == 1:
             return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.visit(args[0])])
         if tag == "id":
+            if _is_if(node) and hasattr(ex, "IfElse"):
+                cond, a, b = _if_args(node)
+                return ex.IfElse(self.visit(a), self.visit(cond), self.visit(b))
             return self._call(op, args)
+        if tag == "indexer" and len(args) == 2:
+            return self._index(args)
         if tag in _BINDERS:
             return self._binder(tag, args)
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
@@ -248,6 +254,28 @@ class ExprTranslator(Visitor):
         body, var = self._bound(args[1], args[0])
         rest = [self.visit(a) for a in args[2:]] if len(args) == 4 else [self.visit(args[1])]
         return self._builtin("root", "root", [body, var, *rest])
+
+    def visit_matrix(self, node: MNode) -> ex.Node:
+        """Mathcad's matrix (rows x cols, stored column by column) as [a, b] or [[a, b], ...]."""
+        if not hasattr(ex, "Matrix"):
+            raise Untranslatable("a matrix (vectors and matrices are not in the language yet)")
+        rows, cols = int(node.attrs.get("rows", 0)), int(node.attrs.get("cols", 0))
+        if rows * cols != len(node.children) or rows * cols == 0:
+            raise Untranslatable("a matrix whose size does not match its elements")
+        cells = [self.visit(c) for c in node.children]
+        return ex.Matrix(
+            tuple(tuple(cells[c * rows + r] for c in range(cols)) for r in range(rows))
+        )
+
+    def _index(self, args: list[MNode]) -> ex.Node:
+        if not hasattr(ex, "Index"):
+            raise Untranslatable("an array index (arrays are not in the language yet)")
+        target, index = args[0], args[1]
+        indices = [self.visit(i) for i in (index.children if index.tag == "sequence" else [index])]
+        shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
+        if shift:
+            indices = [ex.Binary("+", i, ex.Number(float(shift))) for i in indices]
+        return ex.Index(self.visit(target), tuple(indices))
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.visit(node.children[0])])
@@ -297,6 +325,9 @@ class Translator:
         self.forced = forced or {}  # region id -> why (found when the engine loads it)
         self.note: list[str] = []
         self.calls: dict[Sym, list[tuple[ex.Node, ...]]] = {}  # call sites of each function
+        self._index: Sym | None = None
+        self.origin = 0  # Mathcad's ORIGIN where the translation is
+        self.sheet_origin = 0  # the worksheet's [sheet] origin
 
     # -- symbols --------------------------------------------------------------
     def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
@@ -317,6 +348,8 @@ class Translator:
 
     # -- regions --------------------------------------------------------------
     def run(self, ws: Worksheet, regions: list[Region]) -> Translation:
+        self.origin = ws.origin
+        self.sheet_origin = self.out.origin = _first_index_origin(ws.origin, regions)
         # Mathcad evaluates global definitions (≡) first, top to bottom, then the others
         first = [r for r in regions if r.math is not None and r.math.tag == "globalDefine"]
         regions = first + [r for r in regions if r not in first]
@@ -413,6 +446,12 @@ class Translator:
                 self.stored_but_broken(region, evaluation, f"{_what(lhs.tag)} := ...")
             raise Untranslatable(f"a definition of {_what(lhs.tag)} is not in the language yet")
         key = _key(lhs)
+        if key == ("ORIGIN", "") and rhs.tag == "real":
+            self.origin = int(float(rhs.text))
+            self.out.items.append(
+                Item("note", region.id, value=f"ORIGIN := {self.origin} (the first index)")
+            )
+            return
         if rhs.tag == "range":
             self.range_variable(region, key, rhs)
             return
@@ -571,35 +610,83 @@ class Translator:
             self.out.results.append(Result(region.id, None, mathcad, "", []))
             self.skip(region.id, f"the result of {mathcad}", str(why))
             return
+        shape = _shape(result.children[0])
         if target is not None:  # a definition with its value shown: x := ... = value
-            rows = [(None, v) for v in values] if len(values) == 1 else None
-            if rows is None:
-                self.out.results.append(Result(region.id, None, mathcad, unit, []))
-                self.skip(region.id, f"the result of {mathcad}", "an array result")
+            if len(values) == 1:
+                self.out.results.append(
+                    Result(region.id, target, mathcad, unit, [(None, values[0])])
+                )
                 return
-            self.out.results.append(Result(region.id, target, mathcad, unit, rows))
+            try:
+                if target.broken:
+                    raise Untranslatable(target.broken)
+                self.array_result(region, ex.Name(target.token()), shape, values, unit, mathcad)
+            except Untranslatable as why:
+                self.broken_result(region, mathcad, unit, values, str(why))
+                if not target.broken:
+                    self.skip(region.id, f"the result of {mathcad}", str(why))
             return
         try:
             self.forced_region(region)
-            self.standalone(region, expr, unit, values, mathcad)
+            self.standalone(region, expr, unit, values, mathcad, shape)
         except Untranslatable as why:
-            sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
-            sym.broken = str(why)
-            rows = [(None, v) for v in values]
-            self.out.results.append(Result(region.id, sym, mathcad, unit, rows[:1]))
+            self.broken_result(region, mathcad, unit, values, str(why))
             raise
+
+    def broken_result(self, region: Region, mathcad: str, unit: str, values, why: str) -> None:
+        """Stored values whose evaluation is not translated: kept, so they count."""
+        sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
+        sym.broken = why
+        self.out.results.append(Result(region.id, sym, mathcad, unit, [(None, v) for v in values]))
+
+    def index_sym(self) -> Sym:
+        if self._index is None:
+            self._index = self.new_sym("param", "index", "an index", unit="")
+        return self._index
+
+    def array_result(self, region: Region, base: ex.Node, shape, values, unit, mathcad) -> None:
+        """A vector or matrix Mathcad shows: each element a printed value of a function of
+        its index (for a matrix, of the element's number row by row from 0)."""
+        if not hasattr(ex, "Index"):
+            raise Untranslatable("an array result (arrays are not in the language yet)")
+        rows, cols = shape
+        if rows * cols != len(values):
+            raise Untranslatable("an array result whose size does not match its values")
+        if not isinstance(base, ex.Name):
+            whole = self.new_sym("helper", f"result_{region.id}_value", mathcad, region.id)
+            self.out.items.append(Item("definition", region.id, sym=whole, body=base))
+            base = ex.Name(whole.token())
+        k = self.index_sym()
+        kn = ex.Name(k.token())
+        o = ex.Number(float(self.sheet_origin))
+        if cols == 1:
+            body = ex.Index(base, (kn,))
+            at = [(self.sheet_origin + r, values[r]) for r in range(rows)]
+        else:
+            row = ex.Call("floor", (ex.Binary("/", kn, ex.Number(float(cols))),))
+            col = ex.Binary("-", kn, ex.Binary("*", ex.Number(float(cols)), row))
+            body = ex.Index(base, (ex.Binary("+", o, row), ex.Binary("+", o, col)))
+            at = [
+                (float(r * cols + c), values[c * rows + r])
+                for r in range(rows)
+                for c in range(cols)
+            ]
+        sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
+        self.out.items.append(Item("function", region.id, sym=sym, params=[k], body=body))
+        self.out.results.append(Result(region.id, sym, mathcad, unit, at, k))
 
     def forced_region(self, region: Region) -> None:
         if region.id in self.forced:
             raise Untranslatable(self.forced[region.id])
 
-    def standalone(self, region: Region, expr: MNode, unit: str, values, mathcad: str) -> None:
+    def standalone(self, region: Region, expr: MNode, unit: str, values, mathcad: str, shape):
         et = ExprTranslator(self)
         body = et.visit(expr)
         ranges = list(dict.fromkeys(et.ranges))
         if not ranges:
             if len(values) != 1:
-                raise Untranslatable("an array result")
+                self.array_result(region, body, shape, values, unit, mathcad)
+                return
             sym = None
             if isinstance(body, ex.Name) and body.id.startswith("\x00"):
                 sym = next(s for s in self.out.syms if s.token() == body.id)
@@ -674,10 +761,41 @@ class _Renamer(Visitor):
     def visit_Call(self, n):
         return ex.Call(self.mapping.get(n.func, n.func), tuple(self.visit(a) for a in n.args))
 
+    def visit_Matrix(self, n):
+        return type(n)(tuple(tuple(self.visit(e) for e in row) for row in n.rows))
+
+    def visit_Index(self, n):
+        return type(n)(self.visit(n.target), tuple(self.visit(i) for i in n.indices))
+
+    def visit_IfElse(self, n):
+        return type(n)(self.visit(n.value), self.visit(n.condition), self.visit(n.other))
+
 
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
     return _Renamer(mapping).visit(node)
+
+
+def _has_index(node: MNode) -> bool:
+    if node.tag in ("indexer", "matcol"):
+        return True
+    return any(_has_index(c) for c in node.children)
+
+
+def _first_index_origin(origin: int, regions: list[Region]) -> int:
+    """ORIGIN where the worksheet first indexes an array (the worksheet's origin)."""
+    for r in regions:
+        if r.math is None:
+            continue
+        m = r.math
+        if m.tag == "define" and len(m.children) == 2:
+            lhs, rhs = m.children
+            if lhs.tag == "id" and _key(lhs) == ("ORIGIN", "") and rhs.tag == "real":
+                origin = int(float(rhs.text))
+                continue
+        if _has_index(m):
+            return origin
+    return origin
 
 
 def _if_args(node: MNode) -> list[MNode]:
@@ -807,9 +925,17 @@ def _unit_monomial(node: MNode) -> str:
     return " * ".join(parts)
 
 
+def _shape(node: MNode) -> tuple[int, int]:
+    """(rows, cols) of a stored result: (1, 1) for a scalar."""
+    inner = node.children[0] if node.tag == "unitedValue" and node.children else node
+    if inner.tag == "matrix":
+        return int(inner.attrs.get("rows", 0)), int(inner.attrs.get("cols", 0))
+    return 1, 1
+
+
 def _stored(node: MNode) -> tuple[str, list[float | str]]:
-    """(unit text, values) of a stored result: a number, a number with units, a column, a
-    text."""
+    """(unit text, values) of a stored result: a number, a number with units, a matrix (its
+    values column by column), a text."""
     if node.tag == "real":
         return "", [float(node.text)]
     if node.tag == "str":

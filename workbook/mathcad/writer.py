@@ -148,6 +148,8 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         f"title = {_q(tr.title or name)}",
         f"source = {_q('Mathcad worksheet ' + src.name)}",
     ]
+    if tr.origin and hasattr(ex, "Index"):
+        sheet.append(f"origin = {tr.origin}")
     inputs, definitions, arguments = ["[inputs]"], ["[definitions]"], ["[arguments]"]
     notes: list[str] = []
     units = [s for s in tr.syms if s.kind == "unit"]
