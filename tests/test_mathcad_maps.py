@@ -158,3 +158,15 @@ def test_function_argument_takes_the_unit_it_is_called_with(tmp_path, capsys):
     capsys.readouterr()
     main(["check", str(tmp_path / "beam.toml"), "--json"])
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
+
+
+def test_printed_text_where_the_sheet_computes_a_number_fails(tmp_path, capsys):
+    """A printed text ("OK", as Mathcad shows) is compared as text: a number is a FAIL."""
+    (tmp_path / "t.toml").write_text(
+        '[inputs]\nx = "2"\n\n[[printed]]\nfile = "t.csv"\n', encoding="utf-8"
+    )
+    (tmp_path / "t.csv").write_text('name,argument,value,unit\nx,,"OK",\nx,,2,\n', encoding="utf-8")
+    assert main(["check", str(tmp_path / "t.toml"), "--json"]) == 1
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 1, 1)
+    assert result["failures"][0]["printed"] == "OK"

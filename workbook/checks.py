@@ -17,7 +17,7 @@ from .template import PrintedSpec
 class PrintedRow:
     name: str
     at: float
-    value: float
+    value: float | str  # a text (Mathcad's "OK") is compared as text
     unit: str
     line: int
 
@@ -36,14 +36,17 @@ class CheckRow:
     rel_tolerance: float | None
     verdict: str  # pass | FAIL | misprint | info | error
     note: str = ""
+    computed_text: str | None = None  # what the sheet gives where a text is printed
 
     @property
     def abs_error(self) -> float | None:
-        return None if self.computed is None else abs(self.computed - self.printed)
+        if self.computed is None or isinstance(self.printed, str):
+            return None
+        return abs(self.computed - self.printed)
 
     @property
     def rel_error(self) -> float | None:
-        if self.computed is None or self.printed == 0:
+        if self.computed is None or isinstance(self.printed, str) or self.printed == 0:
             return None
         return abs(self.computed - self.printed) / abs(self.printed)
 
@@ -78,7 +81,9 @@ class Report:
                     "name": r.name,
                     "at": r.at,
                     "printed": _json_number(r.printed),
-                    "ours": _json_number(r.computed),
+                    "ours": r.computed_text
+                    if r.computed_text is not None
+                    else _json_number(r.computed),
                     "unit": r.unit,
                     **({"error": r.note} if r.verdict == "error" else {}),
                 }
@@ -106,11 +111,14 @@ class Report:
             )
             for r in rows:
                 comp = "-" if r.computed is None else f"{r.computed:.6g}"
+                if r.computed_text is not None:
+                    comp = r.computed_text
+                printed = r.printed if isinstance(r.printed, str) else f"{r.printed:.6g}"
                 ae = "-" if r.abs_error is None else f"{r.abs_error:.2e}"
                 re_ = "-" if r.rel_error is None else f"{100 * r.rel_error:.3f}%"
                 at = "" if r.at is None else f"{r.at:g}"
                 lines.append(
-                    f"  {r.name:<8}{at:>8}  {r.printed:>12.6g}  {comp:>12}  {ae:>10}  "
+                    f"  {r.name:<8}{at:>8}  {printed:>12}  {comp:>12}  {ae:>10}  "
                     f"{re_:>9}  {r.verdict}{'  ' + r.note if r.note else ''}"
                 )
         if self.findings:
@@ -142,7 +150,9 @@ class Report:
         return "\n".join(lines)
 
 
-def _json_number(value: float | None) -> float | None:
+def _json_number(value: float | str | None) -> float | str | None:
+    if isinstance(value, str):
+        return value
     return None if value is None or not math.isfinite(value) else value
 
 
@@ -167,6 +177,16 @@ def read_commented_csv(path, what: str):
     return header, rows
 
 
+def _number_or_text(cell: str) -> float | str:
+    """A printed value: a number, else a text (compared as text with what the sheet gives)."""
+    try:
+        return float(cell)
+    except ValueError:
+        if not cell.strip():
+            raise
+        return cell
+
+
 def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
     """Read a printed-values CSV: name, argument value, value, unit ('#' lines are comments)."""
     header, lines = read_commented_csv(spec.file, "printed values")
@@ -176,7 +196,8 @@ def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
             raise TemplateError(f"{spec.file}:{number}: expected name, argument, value, unit")
         try:
             at = float(cells[1]) if cells[1].strip() else math.nan
-            rows.append(PrintedRow(cells[0].strip(), at, float(cells[2]), cells[3].strip(), number))
+            value = _number_or_text(cells[2])
+            rows.append(PrintedRow(cells[0].strip(), at, value, cells[3].strip(), number))
         except ValueError:
             raise TemplateError(f"{spec.file}:{number}: not a number in {line!r}") from None
     return rows
@@ -214,6 +235,15 @@ def collect_findings(sheet) -> list[Finding]:
     return out
 
 
+def _text_row(base: dict, row: PrintedRow, q) -> CheckRow:
+    """A printed text (or a computed text where a number is printed): equal or FAIL."""
+    ours = q if isinstance(q, str) else f"{q:~}"
+    ok = isinstance(q, str) and q == row.value
+    verdict = "info" if base["role"] == "information" else ("pass" if ok else "FAIL")
+    note = "" if ok else f"computed {ours!r}"
+    return CheckRow(**base, computed=None, verdict=verdict, note=note, computed_text=ours)
+
+
 def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
     misprint = next((m for m in spec.misprints if m.name == row.name and m.at == row.at), None)
     base = dict(
@@ -232,6 +262,8 @@ def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
             q = sheet.evaluate(row.name, **{spec.argument: row.at})
         else:
             q = sheet.evaluate(row.name)
+        if isinstance(row.value, str) or isinstance(q, str):
+            return _text_row(base, row, q)
         computed = float(q.to(un.unit(row.unit)).magnitude)
     except WorkbookError as err:
         return CheckRow(**base, computed=None, verdict="error", note=str(err))

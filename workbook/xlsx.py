@@ -514,7 +514,11 @@ class WorkbookWriter:
             if r.at is not None:
                 ws.write_number(row, 2, r.at)
             ws.write_string(row, 3, r.unit)
-            ws.write_number(row, 4, r.printed, self.fmt["number"])
+            if isinstance(r.printed, str):  # a printed text and what the sheet gives
+                ws.write_string(row, 4, r.printed)
+                ws.write_string(row, 5, r.computed_text or "")
+            else:
+                ws.write_number(row, 4, r.printed, self.fmt["number"])
             live = False
             if r.computed is not None:
                 live = self._write_checked_value(ws, row, r)

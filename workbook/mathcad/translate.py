@@ -55,6 +55,7 @@ class Item:
     unit: str = ""  # display unit (pint text)
     range: tuple[ex.Node, ex.Node | None, ex.Node] | None = None
     range_values: list[float] | None = None
+    program: list | None = None  # lines of a program: (indent, [text or tree, ...])
 
 
 @dataclass
@@ -441,11 +442,18 @@ class Translator:
             fname, bound = lhs.children[0], lhs.children[1]
             self.function(region, fname, [c for c in bound.children if c.tag == "id"], rhs)
             return
+        if _is_indexer(lhs) and evaluation is None:
+            self.elements(region, lhs, rhs)
+            return
         if lhs.tag != "id":
             if evaluation is not None:
                 self.stored_but_broken(region, evaluation, f"{_what(lhs.tag)} := ...")
-            raise Untranslatable(f"a definition of {_what(lhs.tag)} is not in the language yet")
+            what = "an element assignment" if _is_indexer(lhs) else _what(lhs.tag)
+            raise Untranslatable(f"a definition of {what} is not in the language yet")
         key = _key(lhs)
+        if rhs.tag == "id" and self._range_of(rhs) is not None:  # j := i, a range again
+            self.range_alias(region, key, self._range_of(rhs))
+            return
         if key == ("ORIGIN", "") and rhs.tag == "real":
             self.origin = int(float(rhs.text))
             self.out.items.append(
@@ -489,7 +497,7 @@ class Translator:
         if literal is not None:
             return Item("input", region.id, value=literal, unit=display)
         if rhs.tag == "program":
-            return Item("definition", region.id, pieces=self.pieces(rhs, {}), unit=display)
+            return Item("definition", region.id, unit=display, **self.program(rhs, {}))
         if _is_if(rhs):
             return Item("definition", region.id, pieces=self.if_pieces(rhs, {}), unit=display)
         et = ExprTranslator(self)
@@ -500,6 +508,21 @@ class Translator:
                 "(a vector of values: arrays are not in the language yet)"
             )
         return Item("definition", region.id, body=body, unit=display)
+
+    def program(self, program: MNode, local) -> dict:
+        """A program made of `value if condition` lines and `otherwise` as a piecewise
+        definition; any other as a program of the language."""
+        try:
+            return {"pieces": self.pieces(program, local)}
+        except Untranslatable as why:
+            from .program import ProgramTranslator, available
+
+            if not available():
+                raise
+            try:
+                return {"program": ProgramTranslator(self, local).lines(program)}
+            except Untranslatable as why2:
+                raise why2 from why
 
     def pieces(self, program: MNode, local) -> list[tuple[ex.Node, ex.Node | None]]:
         """A Mathcad program made only of `value if condition` lines and `otherwise`."""
@@ -540,6 +563,81 @@ class Translator:
             raise Untranslatable("an if() over a range variable")
         return out
 
+    def _range_of(self, node: MNode) -> Item | None:
+        sym = self.scope.get(_key(node))
+        if sym is None or not sym.is_range or sym.broken:
+            return None
+        return next((i for i in self.out.items if i.sym is sym), None)
+
+    def range_alias(self, region: Region, key, item: Item) -> None:
+        sym = self.define(key, "var", region.id)
+        sym.is_range, sym.unit = True, item.sym.unit
+        self._forced(region, sym)
+        self.out.items.append(
+            Item(
+                "range",
+                region.id,
+                sym=sym,
+                range=item.range,
+                range_values=item.range_values,
+            )
+        )
+
+    def elements(self, region: Region, lhs: MNode, rhs: MNode) -> None:
+        """v[i] := f(i) over range variables with whole values (Mathcad builds the vector
+        element by element): the vector [v_of(0), v_of(1), ...] of a function v_of, 0 where
+        the range does not reach."""
+        target, index = lhs.children[1], lhs.children[2]
+        if target.tag != "id":
+            raise Untranslatable("an element assignment to something that is not a name")
+        key = _key(target)
+        sym = self.define(key, "var", region.id)
+        try:
+            self._forced(region, sym)
+            if not hasattr(ex, "Matrix"):
+                raise Untranslatable("an element assignment (vectors are not in the language yet)")
+            nodes = index.children if index.tag == "sequence" else [index]
+            ranges = [self._range_of(n) if n.tag == "id" else None for n in nodes]
+            if any(r is None for r in ranges) or len(ranges) > 2:
+                raise Untranslatable(
+                    "an element assignment v[k] := ... at a single index (the language "
+                    "defines whole vectors)"
+                )
+            values = [[int(v) for v in r.range_values] for r in ranges]
+            if any(v != r.range_values for v, r in zip(values, ranges)):
+                raise Untranslatable("an element assignment over a range of fractional values")
+            if any(min(v) < self.origin for v in values):
+                raise Untranslatable("an element assignment below ORIGIN")
+            size = [max(v) - self.origin + 1 for v in values]
+            if math.prod(size) > 10_000:
+                raise Untranslatable("an element assignment of more than 10,000 elements")
+            local, params = {}, []
+            for n, r in zip(nodes, ranges):
+                p = self.new_sym("param", r.sym.base, r.sym.mathcad, unit="")
+                local[_key(n)] = p
+                params.append(p)
+            et = ExprTranslator(self, local)
+            body = et.visit(rhs)
+            if et.ranges:
+                raise Untranslatable("an element assignment over another range variable")
+        except Untranslatable as why:
+            sym.broken = str(why)
+            raise
+        of = self.new_sym("func", sym.base + "_of", nm.mathcad_text(*key) + "[...]", region.id)
+        self.out.items.append(Item("function", region.id, sym=of, params=params, body=body))
+
+        def cell(*at: int) -> ex.Node:
+            if all(a in v for a, v in zip(at, values)):
+                return ex.Call(of.token(), tuple(ex.Number(float(a)) for a in at))
+            return ex.Number(0.0)
+
+        o = self.origin
+        if len(size) == 1:
+            rows = tuple((cell(o + r),) for r in range(size[0]))
+        else:
+            rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
+        self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
+
     def range_variable(self, region: Region, key, rng: MNode) -> None:
         sym = self.define(key, "var", region.id)
         sym.is_range = True
@@ -577,7 +675,7 @@ class Translator:
             psyms.append(ps)
         try:
             if body.tag == "program":
-                item = Item("function", region.id, params=psyms, pieces=self.pieces(body, local))
+                item = Item("function", region.id, params=psyms, **self.program(body, local))
             elif _is_if(body):
                 item = Item("function", region.id, params=psyms, pieces=self.if_pieces(body, local))
             else:
@@ -774,6 +872,10 @@ class _Renamer(Visitor):
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
     return _Renamer(mapping).visit(node)
+
+
+def _is_indexer(node: MNode) -> bool:
+    return node.tag == "apply" and len(node.children) == 3 and node.children[0].tag == "indexer"
 
 
 def _has_index(node: MNode) -> bool:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 import re
 import tempfile
 from dataclasses import dataclass, field
@@ -55,10 +54,10 @@ def _assign(tr: Translation) -> None:
     taken: dict[str, Sym] = {}
     lower: set[str] = set()
 
-    def claim(sym: Sym, share=None) -> None:
+    def claim(sym: Sym, share=None, alt=True) -> None:
         base = sym.base if sym.base not in reserved else sym.base + "_"
         # an argument named like a variable gets a trailing _ first (x and x_), then numbers
-        candidates = [base] + ([base + "_"] if share is not None else [])
+        candidates = [base] + ([base + "_"] if share is not None and alt else [])
         if sym.kind == "unit":  # a unit whose name the worksheet uses: kN_unit
             candidates.append(base + "_unit")
         n = 1
@@ -78,6 +77,9 @@ def _assign(tr: Translation) -> None:
     for sym in tr.syms:
         if sym.kind in ("var", "func", "helper", "bound") and not sym.is_range:
             claim(sym)
+    for sym in tr.syms:  # locals: never a name of the sheet; programs may share them
+        if sym.kind == "local":
+            claim(sym, share=lambda o: o.kind == "local", alt=False)
     for sym in arguments:
         claim(sym, share=lambda o, s=sym: (o.kind == "param" or o.is_range) and o.unit == s.unit)
     for sym in tr.syms:
@@ -192,7 +194,18 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             if item.params:
                 key = f"{key}({', '.join(p.final for p in item.params)})"
                 key = _q(key)
-            if item.pieces is not None:
+            if item.program is not None:
+                lines = []
+                for indent, parts in item.program:
+                    text = "".join(p if isinstance(p, str) else _text(p, mapping) for p in parts)
+                    lines.append(" " * indent + text)
+                value = (
+                    '"""\n'
+                    + "\n".join(lines).replace("\\", "\\\\").replace('"""', '\\"""')
+                    + '\n"""'
+                )
+                field_ = "program"
+            elif item.pieces is not None:
                 pieces = [
                     f"{_text(v, mapping)} if {_text(c, mapping)}"
                     if c is not None
@@ -222,10 +235,10 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         rows.append(f"# region {res.region}: {res.name}")
         for at, value in res.rows:
             at_text = "" if at is None else repr(float(at))
-            if isinstance(value, str):  # printed values are numbers: a text is not checked
-                rows.append(f"# region {res.region}: Mathcad shows the text {value!r}")
-                value = math.nan
-            val = repr(float(value))
+            if isinstance(value, str):  # a text, compared as text ("OK")
+                val = '"' + value.replace('"', '""') + '"'
+            else:
+                val = repr(float(value))
             rows.append(f"{sym_name},{at_text},{val},{pretty_unit(res.unit) if res.unit else ''}")
     printed: list[str] = []
     for arg, rows in groups.items():
