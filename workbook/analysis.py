@@ -51,13 +51,10 @@ def _range_for(sheet, names: set[str], rng, points: int = DEFAULT_POINTS):
     if rng is not None:
         return sheet.range_values(rng, "relation"), rng.var
     from . import expr as ex
+    from .uses import ranged_outputs
 
     lo, hi, var = math.inf, -math.inf, None
-    specs = [(t.range, [c.node for c in t.columns]) for t in sheet.spec.tables if t.range]
-    specs += [
-        (s.range or c.range, [s.y.node]) for c in sheet.spec.charts for s in c.series if not s.table
-    ]
-    for r, nodes in specs:
+    for r, nodes in ranged_outputs(sheet.spec):
         used = set().union(*(ex.names(n) for n in nodes))
         if used & names:
             x = sheet.range_values(r, "relation")

@@ -24,6 +24,7 @@ from .template import (
     resolve_parts,
     select_parts,
 )
+from .uses import names_used
 
 
 @dataclass
@@ -295,12 +296,7 @@ class Sheet:
 
     def column_node(self, col: ColumnSpec, var: str) -> ex.Node:
         """A bare function name as a column means that function of the range variable."""
-        node = col.node
-        if isinstance(node, ex.Name):
-            d = self.spec.definitions.get(node.id)
-            if d is not None and d.is_function and len(d.params) == 1:
-                return ex.Call(node.id, (ex.Name(var),))
-        return node
+        return tc.column_node(self.spec, col, var)
 
     def typed_column(self, col: ColumnSpec, var: str, what: str) -> tc.T:
         try:
@@ -418,37 +414,13 @@ class Sheet:
 
     def unused_inputs(self) -> list[str]:
         """Inputs that no table, chart, printed value or definition in use needs (in any part)."""
-        spec = self.full_spec
-        used: set[str] = set()
-        roots: list[ex.Node] = []
-        for t in spec.tables:
-            roots += [c.node for c in t.columns]
-            roots += [ex.Name(u) for u in t.uses]
-        for f in spec.findings:
-            roots += [ex.Name(str(u)) for u in f.get("uses", ())]
-        for c in spec.charts:
-            roots += [s.y.node for s in c.series if s.table is None]
-        for p in spec.printed:
-            roots += [ex.Name(n) for n in _printed_names(p)]
-        for r in spec.relations:
-            roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
-        for node in roots:
-            used |= tc.dependencies(spec, node)
-        return [n for n in spec.inputs if n not in used]
+        used = names_used(self.full_spec, hand_checks=True)
+        return [n for n in self.full_spec.inputs if n not in used]
 
     def _repr_html_(self) -> str:
         from .notebook import sheet_html
 
         return sheet_html(self)
-
-
-def _printed_names(p) -> set[str]:
-    try:
-        from .checks import read_printed
-
-        return {row.name for row in read_printed(p)}
-    except WorkbookError:
-        return set()
 
 
 def coerce_input(spec, raw, *, file: str | None = None):

@@ -23,6 +23,7 @@ from .builtins import excel_functions
 from .checks import tolerances
 from .errors import LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive, excel_name
+from .uses import names_used
 
 MAX_ROWS = 1_048_576
 ROW_TOKEN = "\x00"
@@ -665,29 +666,7 @@ def _nice(x: float, floor: bool) -> float:
 
 def needed_names(sheet) -> set[str]:
     """Inputs and definitions the workbook's tables, charts and checks depend on."""
-    roots: list[ex.Node] = []
-    for t in sheet.spec.tables:
-        roots += [ex.Name(u) for u in t.uses]
-        if t.range is not None:
-            roots += [sheet.column_node(c, t.range.var) for c in t.columns]
-            roots += [n for n in (t.range.first, t.range.second, t.range.last) if n is not None]
-    for c in sheet.spec.charts:
-        for s in c.series:
-            if s.table is None:
-                rng = s.range or c.range
-                roots.append(sheet.column_node(s.y, rng.var))
-                roots += [n for n in (rng.first, rng.second, rng.last) if n is not None]
-                x = _x_column(c, s, rng)
-                if x is not None:
-                    roots.append(sheet.column_node(x, rng.var))
-    for p in sheet.spec.printed:
-        from .checks import read_printed
-
-        roots += [ex.Name(r.name) for r in read_printed(p)]
-    out: set[str] = set()
-    for node in roots:
-        out |= tc.dependencies(sheet.spec, node)
-    return out
+    return names_used(sheet.spec)
 
 
 def write_workbook(

@@ -1,0 +1,67 @@
+"""Printed values: the CSV files of values a source document printed, read once."""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from .errors import TemplateError
+from .template import PrintedSpec
+
+
+@dataclass
+class PrintedRow:
+    name: str
+    at: float
+    value: float | str  # a text (Mathcad's "OK") is compared as text
+    unit: str
+    line: int
+
+
+def read_commented_csv(path, what: str):
+    """Read a CSV whose '#' lines and blank lines are comments.
+
+    Returns (header cells or None, [(line number, cells, line text), ...]).
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise TemplateError(f"cannot read {what} {path}: {exc.strerror}") from None
+    header, rows = None, []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        cells = next(csv.reader([line]))
+        if header is None:
+            header = cells
+        else:
+            rows.append((number, cells, line))
+    return header, rows
+
+
+def _number_or_text(cell: str) -> float | str:
+    """A printed value: a number, else a text (compared as text with what the sheet gives)."""
+    try:
+        return float(cell)
+    except ValueError:
+        if not cell.strip():
+            raise
+        return cell
+
+
+def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
+    """Read a printed-values CSV: name, argument value, value, unit ('#' lines are comments)."""
+    header, lines = read_commented_csv(spec.file, "printed values")
+    rows = []
+    for number, cells, line in lines:
+        if len(cells) != 4:
+            raise TemplateError(f"{spec.file}:{number}: expected name, argument, value, unit")
+        try:
+            at = float(cells[1]) if cells[1].strip() else math.nan
+            value = _number_or_text(cells[2])
+            rows.append(PrintedRow(cells[0].strip(), at, value, cells[3].strip(), number))
+        except ValueError:
+            raise TemplateError(f"{spec.file}:{number}: not a number in {line!r}") from None
+    return rows

@@ -1,0 +1,72 @@
+"""What a sheet's outputs use: the one place that lists the expressions a sheet shows.
+
+Tables, charts, printed values (and, for the hand checks, relations and findings) are the
+outputs; :func:`names_used` follows their expressions through the definitions to the inputs
+and blocks they need. The writer writes only those (``xlsx.needed_names``), ``Sheet``
+reports the inputs nothing uses, and the analysis finds the ranges that show a function.
+"""
+
+from __future__ import annotations
+
+from . import expr as ex
+from . import typecheck as tc
+from .errors import WorkbookError
+from .printed import read_printed
+from .template import RangeSpec, SheetSpec
+
+
+def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
+    """Each range of a table or chart series, with the expressions shown over it."""
+    out = []
+    for t in spec.tables:
+        if t.range is not None:
+            out.append((t.range, [tc.column_node(spec, c, t.range.var) for c in t.columns]))
+    for c in spec.charts:
+        for s in c.series:
+            rng = s.range or c.range
+            if s.table is not None or rng is None:
+                continue
+            nodes = [tc.column_node(spec, s.y, rng.var)]
+            x = s.x or c.x
+            if x is not None:
+                nodes.append(tc.column_node(spec, x, rng.var))
+            out.append((rng, nodes))
+    return out
+
+
+def output_roots(spec: SheetSpec, *, hand_checks: bool = False) -> list[ex.Node]:
+    """Expressions the outputs evaluate: columns, series and their range bounds, printed
+    values, the names tables declare they use; with ``hand_checks`` also the columns of block
+    tables, relations and the names findings declare (what the checks read)."""
+    roots: list[ex.Node] = []
+    for t in spec.tables:
+        roots += [ex.Name(u) for u in t.uses]
+        if t.range is None and hand_checks:
+            roots += [c.node for c in t.columns]
+    for rng, nodes in ranged_outputs(spec):
+        roots += nodes
+        roots += [n for n in (rng.first, rng.second, rng.last) if n is not None]
+    for p in spec.printed:
+        roots += [ex.Name(n) for n in printed_names(p)]
+    if hand_checks:
+        for f in spec.findings:
+            roots += [ex.Name(str(u)) for u in f.get("uses", ())]
+        for r in spec.relations:
+            roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
+    return roots
+
+
+def names_used(spec: SheetSpec, *, hand_checks: bool = False) -> set[str]:
+    """Inputs, definitions and blocks the outputs need, transitively."""
+    out: set[str] = set()
+    for node in output_roots(spec, hand_checks=hand_checks):
+        out |= tc.dependencies(spec, node)
+    return out
+
+
+def printed_names(p) -> set[str]:
+    """Names of a printed-values file (none if it cannot be read: the checks report that)."""
+    try:
+        return {row.name for row in read_printed(p)}
+    except WorkbookError:
+        return set()
