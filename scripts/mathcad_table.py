@@ -62,6 +62,26 @@ def reasons(toml: Path, failures: list[dict]) -> Counter:
     return counts
 
 
+def evaluations(toml: Path, failures: list[dict]) -> tuple[int, int]:
+    """(evaluations whose every stored value is reproduced, evaluations): one `=` of Mathcad
+    is one evaluation, whether it shows a number or a column of 11."""
+    bad = {(f["name"], f["at"]) for f in failures}
+    regions: dict[str, bool] = {}
+    for csv in toml.parent.glob(f"{toml.stem}.mathcad*.csv"):
+        region = None
+        for line in csv.read_text(encoding="utf-8").splitlines():
+            m = re.match(r"# region (\S+):", line)
+            if m:
+                region = m.group(1)
+                regions.setdefault(region, True)
+            elif region and line and not line.startswith(("#", "name,")):
+                cells = line.split(",")
+                at = float(cells[1]) if cells[1] else None
+                if (cells[0], at) in bad:
+                    regions[region] = False
+    return sum(regions.values()), len(regions)
+
+
 def _short(reason: str) -> str:
     reason = re.sub(r"uses \S+, which is not translated: ", "uses an untranslated name: ", reason)
     reason = re.sub(r"piece '.*?': ", "", reason)
@@ -87,12 +107,16 @@ def main() -> int:
             n, ok = res["printed"], res["reproduced"]
             pct = f"{100 * ok / n:.0f} %" if n else "-"
             why = "; ".join(f"{c} × {r}" for r, c in reasons(toml, res["failures"]).most_common())
+            good, total = evaluations(toml, res["failures"])
             rows.append(
-                f"| {name} | {n} | {ok} | {res['failed']} | {res['not_computable']} | {pct} | "
-                f"{why or '-'} |"
+                f"| {name} | {good} of {total} | {n} | {ok} | {res['failed']} | "
+                f"{res['not_computable']} | {pct} | {why or '-'} |"
             )
-    print("| file | results stored | reproduced | failed | not computable | share | why not |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | --- |")
+    print(
+        "| file | evaluations reproduced | values stored | reproduced | failed | not computable "
+        "| share of values | why not |"
+    )
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
     print("\n".join(rows))
     return 0
 
