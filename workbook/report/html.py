@@ -111,8 +111,9 @@ def _eq_box(*boxes: Box) -> Box:
 _EQ = Box("<mo>=</mo>", 1.2)
 
 
-def _lines(sym: Box, printer: MathML, node: ex.Node) -> list[str]:
-    """A formula too wide even scaled down: one line per term of its top-level sum."""
+def _lines(sym: Box, printer: MathML, node: ex.Node, strict: bool = False) -> list[str] | None:
+    """A formula too wide even scaled down: one line per term of its top-level sum (None
+    with ``strict`` when a term alone is still too wide)."""
     terms: list[tuple[str, ex.Node]] = []
 
     def split(n: ex.Node, sign: str) -> None:
@@ -129,7 +130,11 @@ def _lines(sym: Box, printer: MathML, node: ex.Node) -> list[str]:
         if op:
             body = _eq_box(Box(f"<mo>{_MINUS if op == '-' else '+'}</mo>", 1.0), body)
         head = _eq_box(sym, _EQ) if i == 0 else Box("", 0.0)
-        out.append(_fit(_eq_box(head, body), 0 if i == 0 else sym.width + 1.2))
+        lead = 0 if i == 0 else sym.width + 1.2
+        line = _eq_box(head, body)
+        if strict and _too_wide(line, lead):
+            return None
+        out.append(_fit(line, lead))
     return out
 
 
@@ -265,10 +270,13 @@ class Document:
         else:
             if d.body is not None and self._substitutes(d.body):
                 subst = self.substituted.box(d.body)
-                if _too_wide(subst, 1.2) and isinstance(d.body, ex.Binary):
-                    pieces += _lines(Box("", 0.0), self.substituted, d.body)
-                else:
+                if not _too_wide(subst, 1.2):
                     pieces.append(_fit(_eq_box(_EQ, subst)))
+                else:  # a line per term, or (a term still too wide) not shown
+                    lines = _lines(Box("", 0.0), self.substituted, d.body, strict=True)
+                    pieces += lines or []
+                    if not lines:
+                        notes.append("the formula with the values put in is too long to show")
             r = self.values.result(d.name)
             if isinstance(r, BaseException):
                 error = f"<p class='error'>not computed: {escape(_error_text(r))}</p>"
@@ -464,7 +472,7 @@ class Document:
             body.append(
                 f"<tr class='{_VERDICT_CLASS.get(r.verdict, '')}' data-name='{escape(r.name)}'>"
                 f"<td>{mm.math_element(mm.name_box(r.name))}</td><td class='num'>{at}</td>"
-                f"<td class='unit'>{escape(r.unit)}</td>"
+                f"<td class='unit'>{_unit_math(r.unit)}</td>"
                 f"<td class='num'>{num_html(r.printed, 12)}</td>"
                 f"<td class='num computed'>{comp}</td>"
                 f"<td class='num'>{abs_err}</td><td class='num'>{rel_err}</td>"
@@ -486,7 +494,8 @@ class Document:
             body.append(
                 f"<tr class='{_VERDICT_CLASS.get(f.verdict, '')}'><td>{escape(f.topic)}</td>"
                 f"<td>{escape(f.what)}</td><td class='num'>{value}</td>"
-                f"<td class='unit'>{escape(f.unit)}</td><td class='verdict'>{_mark(f.verdict)}</td>"
+                f"<td class='unit'>{_unit_math(f.unit)}</td>"
+                f"<td class='verdict'>{_mark(f.verdict)}</td>"
                 f"<td>{escape(f.note)}</td></tr>"
             )
         return (
@@ -515,7 +524,7 @@ class Document:
         out.append(
             "<p>Regenerate this document with:</p>"
             f"<pre class='command'>{escape(self.command)}</pre>"
-            f"<p class='meta'>Worksheet file: <code>{escape(str(self.spec.path))}</code>; "
+            f"<p class='meta'>Worksheet file: <code>{escape(self.spec.path.name)}</code>; "
             f"workbook {escape(__version__)}. Every number is the engine's, shown to "
             f"{mm.PRECISION} significant digits.</p>"
         )
@@ -546,6 +555,18 @@ def _mark(verdict: str) -> str:
         "info": "\u2139",
     }.get(verdict, "")
     return f"{sign} {escape(verdict)}".strip()
+
+
+def _unit_math(text: str) -> str:
+    """A unit written in a check or finding (``m/s^2``) as MathML, or as it is if pint does
+    not read it."""
+    if not text:
+        return ""
+    try:
+        shown = un.pretty(un.unit(text))
+    except Exception:
+        return escape(text)
+    return mm.math_element(mm.unit_box(shown)) if shown else escape(text)
 
 
 def _join_note(*parts: str) -> str:
@@ -596,6 +617,11 @@ CSS = """
 .workbook-report thead { display: table-header-group; }
 .workbook-report th { background: #eee; border-bottom: 1px solid #888; padding: 2px 6px;
   text-align: center; vertical-align: bottom; font-weight: 600; }
+.workbook-report table.inputs th:last-child, .workbook-report table.arguments th:last-child,
+.workbook-report table.checks th:last-child, .workbook-report table.findings th:nth-child(2),
+.workbook-report table.findings th:last-child { text-align: left; }
+.workbook-report table.checks, .workbook-report table.findings { width: 100%; }
+.workbook-report td.verdict { white-space: nowrap; }
 .workbook-report td { border-bottom: 1px solid #ddd; padding: 1px 6px; vertical-align: top; }
 .workbook-report td.num { text-align: right; font-variant-numeric: tabular-nums;
   white-space: nowrap; }

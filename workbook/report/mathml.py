@@ -274,7 +274,12 @@ class MathML(Visitor):
         if right.prec == PREC["neg"]:
             right = _parens(right)  # a − (−b), 2·(−x)
         if op == "*":
-            if left.numeric and not right.numeric and left.prec >= PREC["neg"]:
+            if (
+                left.numeric
+                and not right.numeric
+                and left.prec >= PREC["neg"]
+                and _leftmost(node.right) not in ("e", "E")  # 2e would read as a number
+            ):
                 sign = Box("<mo>\u2062</mo>", 0.1)  # 2a: invisible times after a number
             else:
                 sign = _mo(_TIMES, 0.6)
@@ -377,6 +382,19 @@ class MathML(Visitor):
             cond_widths.append(cond.width)
         xml = f"<mrow><mo stretchy='true'>{{</mo><mtable>{''.join(rows)}</mtable></mrow>"
         return Box(xml, max(widths, default=0) + max(cond_widths, default=0) + 2.0)
+
+
+def _leftmost(node: ex.Node) -> str:
+    """The first name or number printed for ``node`` (the left spine of the tree)."""
+    while True:
+        if isinstance(node, ex.Binary):
+            node = node.left
+        elif isinstance(node, ex.Name):
+            return node.id
+        elif isinstance(node, ex.Call):
+            return node.func
+        else:
+            return ""
 
 
 class _Arg:
