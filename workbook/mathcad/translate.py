@@ -36,6 +36,8 @@ class Sym:
     region: str = ""
     is_range: bool = False
     final: str = ""
+    hint: ex.Node | None = None  # a bound variable: an expression in its unit
+    hint_sym: Sym | None = None  # a bound variable: the parameter it stands for
 
     def token(self) -> str:
         return f"\x00{id(self)}"
@@ -223,7 +225,11 @@ class ExprTranslator(Visitor):
         if var.tag != "id":
             raise Untranslatable(f"a bound variable that is {_what(var.tag)}")
         key = _key(var)
-        sym = self.tr.new_sym("bound", nm.identifier(*key), nm.mathcad_text(*key))
+        # an argument of the sheet (the language declares a bound variable's unit there)
+        sym = self.tr.new_sym("param", nm.identifier(*key), nm.mathcad_text(*key))
+        outer = self.local.get(key) or self.tr.scope.get(key)
+        if outer is not None and (outer.kind == "param" or outer.is_range):
+            sym.hint_sym = outer  # d/dt f(t) inside a function of t: t's unit
         inner = ExprTranslator(self.tr, {**self.local, key: sym})
         tree = inner.visit(body)
         self.ranges += [r for r in inner.ranges if r is not sym]
@@ -246,6 +252,8 @@ class ExprTranslator(Visitor):
         if bounds is None or len(bounds.children) != 2:
             raise Untranslatable(f"{_what(tag)} over a range variable (no bounds)")
         a, b = (self.visit(c) for c in bounds.children)
+        if tag == "integral":
+            self.tr.sym_of(var).hint = a  # the variable's unit is its bounds'
         return self._builtin(name, tag, [body, var, a, b])
 
     def _root(self, args: list[MNode]) -> ex.Node:
@@ -254,6 +262,7 @@ class ExprTranslator(Visitor):
             raise Untranslatable(f"root() with {len(args)} arguments")
         body, var = self._bound(args[1], args[0])
         rest = [self.visit(a) for a in args[2:]] if len(args) == 4 else [self.visit(args[1])]
+        self.tr.sym_of(var).hint = rest[0]  # the unknown's unit is its bounds' (or guess's)
         return self._builtin("root", "root", [body, var, *rest])
 
     def visit_matrix(self, node: MNode) -> ex.Node:
@@ -336,6 +345,9 @@ class Translator:
         self.out.syms.append(sym)
         return sym
 
+    def sym_of(self, name: ex.Name) -> Sym:
+        return next(s for s in self.out.syms if s.token() == name.id)
+
     def unit_sym(self, name: str) -> Sym:
         if name not in self.units:
             self.units[name] = self.new_sym("unit", nm.identifier(name), name)
@@ -395,6 +407,12 @@ class Translator:
                         if unit is not None:
                             param.unit = unit
                             break
+        for sym in self.out.syms:  # variables bound by root, integral, diff
+            if sym.kind == "param" and not sym.unit:
+                if sym.hint is not None:
+                    sym.unit = units.of(sym.hint) or ""
+                elif sym.hint_sym is not None:
+                    sym.unit = sym.hint_sym.unit
 
     def skip(self, region: str, what: str, why: str) -> None:
         self.out.skipped.append(Skipped(region, what, why))

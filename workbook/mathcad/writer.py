@@ -75,7 +75,7 @@ def _assign(tr: Translation) -> None:
 
     arguments = [s for s in tr.syms if s.kind == "param" or s.is_range]
     for sym in tr.syms:
-        if sym.kind in ("var", "func", "helper", "bound") and not sym.is_range:
+        if sym.kind in ("var", "func", "helper") and not sym.is_range:
             claim(sym)
     for sym in tr.syms:  # locals: never a name of the sheet; programs may share them
         if sym.kind == "local":
