@@ -49,7 +49,7 @@ def test_root_with_two_roots_is_refused():
 
 
 def test_root_near_without_bracket():
-    with pytest.raises(NumericsError, match="no sign change found searching out"):
+    with pytest.raises(NumericsError, match="no sign change found searching from the guess"):
         root_near(lambda x: x**2 + 1, 1.0)
 
 

@@ -273,8 +273,18 @@ def cmd_bench(args) -> int:
 
     sheet = load_sheet(args)
     ref = sheet.spec.meta.get("bench")
+    from .numerics import bench
+
+    lines = bench.run(sheet)
+    if lines:
+        print(bench.text(sheet, lines))
     if not ref:
-        raise InputError(f'{sheet.name} declares no benchmark ([sheet] bench = "module.func")')
+        if lines:
+            return EXIT_OK
+        raise InputError(
+            f"{sheet.name} uses no numerical built-in (root, integral, maximum, ...) and "
+            'declares no benchmark ([sheet] bench = "module.func")'
+        )
     import pandas as pd
 
     df = blocks.get(ref, "bench").func(sheet, quick=args.quick)

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import DomainError
+from ..errors import DomainError, TemplateError
 
 Fn = Callable[..., object]
 
@@ -59,6 +59,27 @@ def current(default: Tolerance) -> Tolerance:
     return _current.get() or default
 
 
+_live: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "workbook_numerics_live", default=False
+)
+
+
+def live() -> bool:
+    """True inside :func:`live_forms`: built-ins compute what their Excel form computes."""
+    return _live.get()
+
+
+@contextlib.contextmanager
+def live_forms() -> Iterator[None]:
+    """Evaluate the built-ins' live Excel forms (a fixed Gauss-Legendre sum for an integral)
+    instead of the engine's methods, to say how far the workbook's formula is from the value."""
+    token = _live.set(True)
+    try:
+        yield
+    finally:
+        _live.reset(token)
+
+
 @contextlib.contextmanager
 def tolerance(tol: Tolerance) -> Iterator[None]:
     """Evaluate with ``tol`` instead of the sheet's tolerance (``workbook bench``'s reference)."""
@@ -102,3 +123,16 @@ def _u(unit: str) -> str:
 
 #: the tolerance of a sheet that sets none
 DEFAULT = Tolerance()
+
+
+def sheet_tolerance(meta: dict) -> Tolerance:
+    """``[sheet] tolerance = 1e-8`` (relative) and ``samples = 16``: the sheet's tolerance."""
+    rtol = meta.get("tolerance", DEFAULT.rtol)
+    samples = meta.get("samples", DEFAULT.samples)
+    if isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not 1e-15 <= rtol <= 1e-2:
+        raise TemplateError(
+            f"[sheet] tolerance = {rtol!r}: give a relative tolerance between 1e-15 and 0.01"
+        )
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 2 <= samples <= 10_000:
+        raise TemplateError(f"[sheet] samples = {samples!r}: give a whole number from 2 to 10000")
+    return Tolerance(rtol=float(rtol), samples=samples)

@@ -2,8 +2,9 @@
 
 Every piece of every row starts as one interval of a 21-point Gauss-Kronrod rule; intervals
 whose error estimate is above their share of the tolerance are halved, all rows together
-(one function call per level). A row whose error does not fall at least tenfold with a
-halving (an end-point singularity, where it falls only about twofold), or that has not
+(one function call per level). A row whose first estimate is off by more than ``ROUGH``,
+or whose error does not fall at least tenfold with a halving (an end-point singularity,
+where it falls only about twofold), or that has not
 converged after ``MAX_LEVELS`` halvings, is done again by ``scipy.integrate.tanhsinh``,
 which is made for such integrands.
 """
@@ -19,6 +20,10 @@ from .kronrod import gk21
 
 #: halvings of an interval before a row goes to tanh-sinh
 MAX_LEVELS = 5
+#: a first estimate this far off (relative to the integral of |f|) goes to tanh-sinh at once
+ROUGH = 1e-3
+#: an error this small relative to the integral of |f| is rounding: accepted (gk21's floor)
+ROUNDING = 51 * np.finfo(float).eps
 #: most intervals at once per row (on average) before the rest goes to tanh-sinh
 MAX_INTERVALS_PER_ROW = 64
 
@@ -82,16 +87,20 @@ def _adaptive(f, left, right, args, tol, n):
     for level in range(MAX_LEVELS + 1):
         if lo.size == 0:
             break
-        k, e, _ = gk21(f, lo, hi, [g[row] for g in args])
+        k, e, absk = gk21(f, lo, hi, [g[row] for g in args])
         evals += 21 * 2**level
         bad = ~(np.isfinite(k) & np.isfinite(e))
         if bad.any():  # tanh-sinh says where it is not finite, or copes (no node at the ends)
             pending[row[bad]] = True
-        if split_error is not None:  # slow convergence: not smooth, leave it to tanh-sinh
+        if split_error is None:  # far off at once: not smooth, leave it to tanh-sinh
+            pending[row[e > ROUGH * absk]] = True
+        else:  # slow convergence: not smooth either
             pending |= np.bincount(row, e, minlength=n) > 0.1 * split_error
         total = value + np.bincount(row, k, minlength=n)
         share = (hi - lo) / np.where(length[row] > 0, length[row], 1.0)
         allowed = np.maximum(tol.atol, tol.rtol * np.abs(total[row])) * share
+        # an error at the rounding level of the terms is as good as it gets (an integral of 0)
+        allowed = np.maximum(allowed, ROUNDING * absk)
         ok = (e <= allowed) & ~pending[row]
         value += np.bincount(row[ok], k[ok], minlength=n)
         error += np.bincount(row[ok], e[ok], minlength=n)

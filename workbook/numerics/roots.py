@@ -6,6 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..errors import WorkbookError
 from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
 
 
@@ -103,8 +104,10 @@ def root_near(
 ) -> Result:
     """A root of ``f(x, *args) = 0`` near ``guess`` for every row (``root(f, x, guess)``).
 
-    A bracket is searched outwards from the guess (``bracket_root``: steps growing by 2 from
-    1 % of the guess, or 0.01 for a guess of 0), then refined by ``find_root``.
+    A secant step from the guess says on which side the root is; a bracket is searched on
+    that side only (``bracket_root``, steps growing by 2 from 1.5 secant steps, so that the
+    search does not leave the function's domain on the other side), then refined by
+    ``find_root``.
     """
     from scipy.optimize.elementwise import bracket_root, find_root
 
@@ -112,23 +115,42 @@ def root_near(
     n = x0.size
     if n == 0:
         return Result(np.empty(shape), np.empty(shape))
-    step = np.where(x0 != 0, 0.01 * np.abs(x0), 0.01)
-    with np.errstate(all="ignore"):
-        br = bracket_root(f, x0 - step, x0 + step, args=tuple(args), maxiter=200)
-    failed = np.flatnonzero(~br.success)
+    h = np.where(x0 != 0, 1e-4 * np.abs(x0), 1e-4)
+    try:
+        f0 = call(f, x0, args)
+        f1 = call(f, x0 + h, args)
+        with np.errstate(all="ignore"):
+            slope = (f1 - f0) / h
+            secant = np.where(slope != 0, -f0 / slope, np.inf)
+        right = np.where(np.isfinite(secant), secant > 0, True)
+        step = np.where(np.isfinite(secant), np.maximum(1.5 * np.abs(secant), h), 100 * h)
+        xl0 = np.where(right, x0, x0 - step)
+        xr0 = np.where(right, x0 + step, x0)
+        xmin = np.where(right, x0, -np.inf)
+        xmax = np.where(right, np.inf, x0)
+        with np.errstate(all="ignore"):
+            br = bracket_root(f, xl0, xr0, xmin=xmin, xmax=xmax, args=tuple(args), maxiter=200)
+    except WorkbookError as err:
+        raise NumericsError(
+            f"root(): searching for a sign change from the guess {var} = {num(x0[0])}"
+            f"{_u(unit)}{' (and others)' if n > 1 else ''}, the expression left its domain "
+            f"({err.message}); give a bracket: root(EXPR, {var}, A, B)"
+        ) from None
+    failed = np.flatnonzero(~br.success & (f0 != 0))
     if failed.size:
         i = failed[0]
         raise NumericsError(
-            f"root(): no sign change found searching out from the guess {var} = {num(x0[i])}"
+            f"root(): no sign change found searching from the guess {var} = {num(x0[i])}"
             f"{_u(unit)}{row_text(label, i, n)} (searched [{num(br.bracket[0][i])}, "
             f"{num(br.bracket[1][i])}]{_u(unit)}, f = {num(br.f_bracket[0][i])} and "
             f"{num(br.f_bracket[1][i])}); give a bracket: root(EXPR, {var}, A, B)"
         )
     xl, xr = br.bracket
+    xl, xr = np.where(f0 == 0, x0, xl), np.where(f0 == 0, x0, xr)
     res = find_root(f, (xl, xr), args=tuple(args), tolerances=_tolerances(tol))
     _check_status(res, np.arange(n), np.minimum(xl, xr), np.maximum(xl, xr), label, n, unit)
     error = np.abs(res.bracket[1] - res.bracket[0])
-    evaluations = int(np.max(br.nfev)) + int(np.max(res.nfev))
+    evaluations = 2 + int(np.max(br.nfev)) + int(np.max(res.nfev))
     return Result(res.x.reshape(shape), error.reshape(shape), evaluations=evaluations)
 
 

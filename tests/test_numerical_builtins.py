@@ -1,0 +1,207 @@
+"""root, integral, maximum/argmax, sum/product and diff in worksheets, against scipy/mpmath."""
+
+from pathlib import Path
+
+import mpmath
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import workbook
+from workbook.errors import TemplateError, UnitError, WorkbookError
+from workbook.numerics import NumericsError
+
+PIPE = Path(__file__).parent / "data" / "pipe-flow.toml"
+EPS, D = 0.05e-3, 0.1
+
+
+@pytest.fixture(scope="module")
+def pipe():
+    return workbook.load(PIPE)
+
+
+def sheet(tmp_path, text: str):
+    path = tmp_path / "s.toml"
+    path.write_text(text, encoding="utf-8")
+    return workbook.load(path)
+
+
+def colebrook(f, re):
+    return 1 / np.sqrt(f) + 2 * np.log10(EPS / (3.7 * D) + 2.51 / (re * np.sqrt(f)))
+
+
+@pytest.mark.parametrize("name", ["friction", "friction_guess"])
+def test_colebrook_over_a_range_matches_brentq(pipe, name):
+    re = np.geomspace(4000, 1e8, 40)
+    got = pipe.evaluate(name, re).magnitude
+    want = [brentq(colebrook, 0.005, 0.1, args=(r,), xtol=1e-16, rtol=1e-15) for r in re]
+    assert np.max(np.abs(got - want) / want) < 1e-9  # the sheet's tolerance is 1e-10
+
+
+def test_flow_rate_of_the_power_law_profile_matches_the_beta_function(pipe):
+    R = np.array([10.0, 50.0, 120.0])  # mm
+    got = pipe.evaluate("Q", R).to("m^3/s").magnitude
+    for q, r in zip(got, R / 1000):
+        exact = 2 * mpmath.pi * r**2 * 2 * mpmath.beta(2, mpmath.mpf(8) / 7)
+        assert q == pytest.approx(float(exact), rel=1e-12)
+
+
+def test_tables_of_roots_and_integrals(pipe):
+    assert len(pipe.table("moody")) > 50
+    q = pipe.table("flow").iloc[:, 1].to_numpy()
+    assert np.all(np.diff(q) > 0)
+
+
+EXTREMA = """
+[inputs]
+A = "10 mm"
+omega = "100 1/s"
+[arguments]
+x = { unit = "" }
+c = { unit = "" }
+i = { unit = "" }
+t = { unit = "s" }
+[definitions]
+peak = "maximum(sin(x) + 0.1*x, x, 0, 10)"
+at = "argmax(sin(x) + 0.1*x, x, 0, 10)"
+low = "minimum(sin(x) + 0.1*x, x, 0, 10)"
+at_low = "argmin(sin(x) + 0.1*x, x, 0, 10)"
+"kinked(c)" = "integral(abs(x - c)*exp(x), x, 0, 2)"
+"pieces(c)" = "integral(step(x, c), x, 0, 2)"
+"step(x, c)" = ["x^2 if x <= c", "1 - x otherwise"]
+best = "argmin(kinked(c), c, -1, 3)"
+basel = "sum(1/i^2, i, 1, 10)"
+fact = "product(i, i, 1, 5)"
+"s(t)" = { expr = "A*sin(omega*t)*exp(-omega*t/10)", unit = "mm" }
+"v(t)" = { expr = "diff(s(t), t)", unit = "m/s" }
+"a(t)" = { expr = "diff(s(t), t, 2)", unit = "m/s^2" }
+"""
+
+
+@pytest.fixture(scope="module")
+def ext(tmp_path_factory):
+    path = tmp_path_factory.mktemp("ext") / "ext.toml"
+    path.write_text(EXTREMA, encoding="utf-8")
+    return workbook.load(path)
+
+
+def test_global_maximum_and_where_against_mpmath(ext):
+    x = mpmath.findroot(lambda x: mpmath.cos(x) + mpmath.mpf("0.1"), 7.9)
+    assert ext.evaluate("at").magnitude == pytest.approx(float(x), rel=1e-7)
+    assert ext.evaluate("peak").magnitude == pytest.approx(float(mpmath.sin(x) + x / 10), rel=1e-13)
+    x = mpmath.findroot(lambda x: mpmath.cos(x) + mpmath.mpf("0.1"), 4.6)
+    assert ext.evaluate("at_low").magnitude == pytest.approx(float(x), rel=1e-7)
+    assert ext.evaluate("low").magnitude == pytest.approx(float(mpmath.sin(x) + x / 10), rel=1e-13)
+
+
+def test_integrals_split_at_kinks_against_mpmath(ext):
+    c = np.array([-0.5, 0.3, 1.0, 1.7, 2.5])
+    got = ext.evaluate("kinked", c).magnitude
+    for v, ci in zip(got, c):
+        pts = [0, ci, 2] if 0 < ci < 2 else [0, 2]
+        want = mpmath.quad(lambda x, ci=ci: abs(x - ci) * mpmath.exp(x), pts)
+        assert v == pytest.approx(float(want), rel=1e-13)
+    got = ext.evaluate("pieces", c).magnitude
+    for v, ci in zip(got, c):
+        k = min(max(ci, 0), 2)
+        want = k**3 / 3 + ((1 - 2) ** 2 - (1 - k) ** 2) / 2 * -1
+        assert v == pytest.approx(want, rel=1e-12, abs=1e-14)
+
+
+def test_minimum_of_an_integral(ext):
+    # d/dc of integral |x - c| e^x over [0, 2] is 2 e^c - 1 - e^2: zero at ln((1 + e^2) / 2)
+    want = float(mpmath.log((1 + mpmath.e**2) / 2))
+    assert ext.evaluate("best").magnitude == pytest.approx(want, rel=1e-7)
+
+
+def test_sum_and_product(ext):
+    assert ext.evaluate("basel").magnitude == pytest.approx(sum(1 / i**2 for i in range(1, 11)))
+    assert ext.evaluate("fact").magnitude == 120
+
+
+def test_derivatives_against_mpmath(ext):
+    A, w = 0.01, 100.0
+    s = lambda t: A * mpmath.sin(w * t) * mpmath.exp(-w * t / 10)  # noqa: E731
+    for t in (0.0, 0.004, 0.03):
+        assert ext.evaluate("v", t).to("m/s").magnitude == pytest.approx(
+            float(mpmath.diff(s, t)), rel=1e-12, abs=1e-15
+        )
+        assert ext.evaluate("a", t).to("m/s^2").magnitude == pytest.approx(
+            float(mpmath.diff(s, t, 2)), rel=1e-12, abs=1e-12
+        )
+
+
+BASE = """
+[inputs]
+R = "50 mm"
+T = "2 s"
+[arguments]
+r = { unit = "mm" }
+"""
+
+
+@pytest.mark.parametrize(
+    "definition, message",
+    [
+        ('"integral(2*pi*r, r, 0, T)"', "the upper bound B is [time] (s), but the variable r"),
+        ('"integral(2*pi*r, r, T, R)"', "the lower bound A is [time]"),
+        ('"root(r - R, r, T)"', "the guess is [time]"),
+        ('"root(r - R, r, 0, T)"', "the upper bound B is [time]"),
+        ('"maximum(r, r, 0, T)"', "the upper bound B is [time]"),
+        ('"argmin(r, r, T, R)"', "the lower bound A is [time]"),
+    ],
+)
+def test_unit_mistakes_in_bounds_are_refused_at_load(tmp_path, definition, message):
+    with pytest.raises(UnitError) as err:
+        sheet(tmp_path, BASE + f"[definitions]\nbad = {definition}\n")
+    text = str(err.value)
+    assert message in text
+    assert "s.toml:8" in text and "'bad'" in text
+
+
+def test_bad_tolerance_is_refused_at_load(tmp_path):
+    with pytest.raises(TemplateError, match="tolerance"):
+        sheet(
+            tmp_path,
+            "[sheet]\ntolerance = 0.5\n" + BASE + '[definitions]\nq = "root(r - R, r, 0, R)"\n',
+        )
+
+
+@pytest.mark.parametrize(
+    "expr, message",
+    [
+        ("root(x^2 + 1, x, -3, 3)", r"no sign change .* signs \+{9}"),
+        ("root(x^2 - 1, x, -3, 3)", "more than one root"),
+        ("root(x^2 + 1, x, 1)", "no sign change found searching from the guess"),
+        ("integral(1/x, x, 0, 1)", "divergent"),
+        ("argmax(0*x + 1, x, 0, 1)", "flat"),
+    ],
+)
+def test_hard_cases_are_errors_naming_file_line_definition(tmp_path, expr, message):
+    s = sheet(tmp_path, f'[arguments]\nx = {{ unit = "" }}\n[definitions]\nbad = "{expr}"\n')
+    with pytest.raises(NumericsError, match=message) as err:
+        s.evaluate("bad")
+    assert "s.toml:4" in str(err.value) and "'bad'" in str(err.value)
+
+
+def test_rows_are_named_in_errors(pipe, tmp_path):
+    s = sheet(
+        tmp_path,
+        '[arguments]\nx = { unit = "" }\nc = { unit = "" }\n'
+        '[definitions]\n"g(c)" = "root(x^2 - c, x, 0, 2)"\n',
+    )
+    with pytest.raises(WorkbookError, match=r"for c = -1"):
+        s.evaluate("g", [1.0, -1.0])
+
+
+def test_loading_a_sheet_with_numerical_builtins_imports_no_scipy():
+    import subprocess
+    import sys
+
+    code = (
+        f"import sys, workbook; s = workbook.load({str(PIPE)!r}); "
+        "heavy = ('scipy.optimize', 'scipy.integrate', 'sympy', 'mpmath'); "
+        "print(sorted(m for m in heavy if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

@@ -1,0 +1,92 @@
+"""EXPR of a built-in that binds a variable, as the numpy hooks receive it."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from .. import typed as ty
+from .. import units as un
+from ._common import Result, Tolerance, current, num, sheet_tolerance
+
+
+class Bound:
+    """EXPR as a function of the bound variable, in the environment of the call.
+
+    ``bound(v)`` evaluates EXPR with the variable set to ``v`` (the rest of the environment as
+    in the call). SciPy's vectorised routines solve only the rows still unconverged and pass
+    their arguments compressed, so :meth:`over` gives ``f(x, row)``: EXPR with the
+    environment's arrays taken at the flat indices ``row`` of the call's shape.
+    """
+
+    def __init__(self, evaluator, body: ty.T, fn: Callable, var: ty.TParam, env: dict):
+        self.evaluator = evaluator
+        self.body, self.fn, self.env = body, fn, env
+        self.var = var.name
+        self.unit_text = un.pretty(var.unit)
+        used = _params(body) - {self.var}
+        self.arrays = {k: np.asarray(env[k]) for k in used if k in env and np.ndim(env[k]) > 0}
+        self.shape = np.broadcast_shapes(*(a.shape for a in self.arrays.values()))
+
+    def __call__(self, value):
+        return self.fn({**self.env, self.var: value})
+
+    @property
+    def tolerance(self) -> Tolerance:
+        """The sheet's tolerance, or the one :func:`workbook.numerics.tolerance` sets."""
+        return current(sheet_tolerance(self.evaluator.typer.spec.meta))
+
+    def _flat(self, shape) -> dict[str, np.ndarray]:
+        return {k: np.broadcast_to(a, shape).reshape(-1) for k, a in self.arrays.items()}
+
+    def over(self, shape: tuple[int, ...]) -> Callable:
+        """``f(x, row)`` for SciPy: the environment's arrays at the flat indices ``row``."""
+        flat, env, var, fn = self._flat(shape), self.env, self.var, self.fn
+
+        def f(x, row):
+            idx = np.asarray(row).astype(np.intp)
+            return fn({**env, **{k: a[idx] for k, a in flat.items()}, var: x})
+
+        return f
+
+    def describe_row(self, shape: tuple[int, ...]) -> Callable[[int], str]:
+        """'for Re = 10000' naming the values of the environment's arrays at one row."""
+        flat = self._flat(shape)
+        args = self.evaluator.typer.spec.arguments
+
+        def label(i: int) -> str:
+            if not flat:
+                return f"row {i + 1} of {math.prod(shape)}" if math.prod(shape) > 1 else ""
+            parts = []
+            for k, a in flat.items():
+                unit = un.pretty(args[k].unit) if k in args else ""
+                parts.append(f"{k} = {num(a[i])} {unit}".rstrip())
+            return "for " + ", ".join(parts)
+
+        return label
+
+    def breaks(self, shape: tuple[int, ...]) -> list[np.ndarray]:
+        """Points of the variable where EXPR may have a kink, per row (see numerics.kinks)."""
+        from .kinks import breaks
+
+        out = []
+        for t in breaks(self.evaluator.typer, self.body, self.var):
+            v = np.asarray(self.evaluator.compile(t)(self.env), dtype=float)
+            out.append(np.broadcast_to(v, shape))
+        return out
+
+    def record(self, name: str, result: Result) -> None:
+        """Keep the result's error estimate for ``workbook bench``."""
+        self.evaluator.records.append((name, result))
+
+
+def _params(t: ty.T) -> set[str]:
+    out, stack = set(), [t]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ty.TParam):
+            out.add(n.name)
+        stack.extend(ty.children(n))
+    return out

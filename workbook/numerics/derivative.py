@@ -1,0 +1,179 @@
+"""``diff(EXPR, X, N)``: the derivative as a typed tree, found by SymPy from EXPR's own tree.
+
+EXPR's typed tree is printed as SymPy (:class:`workbook.symbolic.SympyConverter`, inputs and
+definitions kept as symbols), differentiated, and read back into a typed tree whose leaves are
+EXPR's own parameters and references. Every back end then treats the derivative as any other
+formula: numpy evaluates it, Excel gets it as a live formula, SymPy sees it again.
+SymPy is imported only for sheets that call ``diff``.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+from .. import typed as ty
+from ..errors import TemplateError
+from ..visitor import Visitor
+
+_FUNCS = {
+    "sin": "sin",
+    "cos": "cos",
+    "tan": "tan",
+    "asin": "asin",
+    "acos": "acos",
+    "atan": "atan",
+    "sinh": "sinh",
+    "cosh": "cosh",
+    "tanh": "tanh",
+    "exp": "exp",
+    "log": "ln",
+    "Abs": "abs",
+    "sign": "sign",
+    "floor": "floor",
+    "ceiling": "ceil",
+    "Min": "min",
+    "Max": "max",
+    "atan2": "atan2",
+}
+_REL = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "==", "!=": "!="}
+
+
+def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
+    """The ``order``-th derivative of ``body`` with respect to ``var``, in ``unit``."""
+    import sympy as sp
+
+    from ..symbolic import NotSymbolic, SympyConverter
+
+    leaves = _leaves(typer, body)
+    refs = {n: t for n, t in leaves.items() if isinstance(t, ty.TRef)}
+    conv = SympyConverter(SimpleNamespace(typer=typer, values={}), keep=set(refs))
+    try:
+        expr = conv.convert(body)
+    except NotSymbolic as err:
+        raise TemplateError(f"diff(): {err.message}") from None
+    symbol = sp.Symbol(var.name, real=True)
+    d = sp.diff(expr, symbol, order)
+    nodes = {sp.Symbol(n, real=True): t for n, t in leaves.items()}
+    nodes[symbol] = var
+    out = _Back(nodes, typer.dimensionless).visit(d)
+    return ty.TScale(unit, child=out, factor=1.0)
+
+
+def _leaves(typer, body: ty.T) -> dict[str, ty.T]:
+    """Parameters and references of ``body``, also inside the sheet functions it calls."""
+    out: dict[str, ty.T] = {}
+    stack, seen = [body], set()
+    while stack:
+        n = stack.pop()
+        if isinstance(n, (ty.TParam, ty.TRef)):
+            out.setdefault(n.name, n)
+        if isinstance(n, ty.TCall) and n.name not in seen:
+            seen.add(n.name)
+            stack.append(typer.function(n.name).body)
+        stack.extend(ty.children(n))
+    return out
+
+
+class _Back(Visitor):
+    """A SymPy expression read back as a typed tree (inner nodes are plain numbers)."""
+
+    def __init__(self, nodes: dict, dimensionless):
+        self.nodes = nodes
+        self.dl = dimensionless
+
+    def visit(self, e, *args):
+        if not e.free_symbols and not getattr(e, "is_Relational", False) and e.is_number:
+            v = complex(e.evalf(30))
+            if v.imag or not math.isfinite(v.real):
+                raise TemplateError(f"diff(): the derivative holds {e}, not a finite number")
+            return ty.TConst(self.dl, value=v.real)
+        method = getattr(self, "visit_" + type(e).__name__, None)
+        if method is None:
+            method = self._function
+        return method(e)
+
+    def _function(self, e):
+        name = _FUNCS.get(type(e).__name__)
+        if name is None:
+            raise TemplateError(
+                f"diff(): the derivative contains {type(e).__name__} ({e}), which has no "
+                "formula in the worksheet language"
+            )
+        args = tuple(self.visit(a) for a in e.args)
+        if name in ("min", "max") and len(args) > 2:
+            out = args[0]
+            for a in args[1:]:
+                out = ty.TFunc(self.dl, func=name, args=(out, a))
+            return out
+        return ty.TFunc(self.dl, func=name, args=args)
+
+    def visit_Symbol(self, e):
+        if e not in self.nodes:  # pragma: no cover - every symbol came from the tree
+            raise TemplateError(f"diff(): unknown symbol {e}")
+        return self.nodes[e]
+
+    def visit_Add(self, e):
+        terms = [self.visit(a) for a in e.as_ordered_terms()]
+        out = terms[0]
+        for t in terms[1:]:
+            out = ty.TBinary(self.dl, op="+", left=out, right=t)
+        return out
+
+    def visit_Mul(self, e):
+        import sympy as sp
+
+        num, den = sp.fraction(e)
+        if den != 1:
+            return ty.TBinary(self.dl, op="/", left=self.visit(num), right=self.visit(den))
+        factors = [self.visit(a) for a in e.as_ordered_factors()]
+        out = factors[0]
+        for f in factors[1:]:
+            out = ty.TBinary(self.dl, op="*", left=out, right=f)
+        return out
+
+    def visit_Pow(self, e):
+        import sympy as sp
+
+        base, exp = e.args
+        if exp == sp.Rational(1, 2):
+            return ty.TFunc(self.dl, func="sqrt", args=(self.visit(base),))
+        if exp.is_number and exp < 0:
+            one = ty.TConst(self.dl, value=1.0)
+            return ty.TBinary(self.dl, op="/", left=one, right=self.visit(base ** (-exp)))
+        if base == sp.E:
+            return ty.TFunc(self.dl, func="exp", args=(self.visit(exp),))
+        return ty.TBinary(self.dl, op="^", left=self.visit(base), right=self.visit(exp))
+
+    def visit_exp(self, e):
+        return ty.TFunc(self.dl, func="exp", args=(self.visit(e.args[0]),))
+
+    def visit_Piecewise(self, e):
+        import sympy as sp
+
+        conds, values = [], []
+        for value, cond in e.args:
+            values.append(self.visit(value))
+            conds.append(None if cond == sp.true else self._condition(cond))
+        texts = tuple(str(v) for v, _ in e.args)
+        return ty.TPiecewise(self.dl, conditions=tuple(conds), values=tuple(values), texts=texts)
+
+    def visit_Heaviside(self, e):
+        import sympy as sp
+
+        u = e.args[0]
+        return self.visit(sp.Piecewise((1, u > 0), (sp.Rational(1, 2), sp.Eq(u, 0)), (0, True)))
+
+    def _condition(self, c):
+        import sympy as sp
+
+        if isinstance(c, (sp.And, sp.Or)):
+            op = "and" if isinstance(c, sp.And) else "or"
+            vals = tuple(self._condition(a) for a in c.args)
+            return ty.TLogic(self.dl, op=op, values=vals, boolean=True)
+        if isinstance(c, sp.Not):
+            return ty.TUnary(self.dl, op="not", child=self._condition(c.args[0]), boolean=True)
+        if getattr(c, "is_Relational", False) and c.rel_op in _REL:
+            operands = (self.visit(c.lhs), self.visit(c.rhs))
+            return ty.TCompare(self.dl, ops=(_REL[c.rel_op],), operands=operands, boolean=True)
+        raise TemplateError(f"diff(): cannot write the condition {c} in the worksheet language")

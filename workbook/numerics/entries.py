@@ -1,0 +1,324 @@
+"""Registry entries of the numerical built-ins: root, integral, maximum/minimum/argmax/argmin,
+product and diff (one :class:`workbook.builtins.Builtin` each; ``sum`` is in builtins.py).
+
+Each binds its variable (``binds=(0, 1)``): the unit rule checks the bounds or the guess
+against the variable's unit at load; the numpy hook receives EXPR as a
+:class:`workbook.numeric.Bound` and solves every row of a table in one vectorised call of
+:mod:`workbook.numerics`. SciPy is imported only when a hook runs.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import typed as ty
+from .. import units as un
+from ..builtins import Builtin, register
+from ..errors import NotLive, TemplateError, UnitError
+from ..expr import PREC
+from . import extrema, gauss, quadrature, roots, series
+from ._common import Result, live, sheet_tolerance
+
+ATOM = PREC["atom"]
+#: nodes of the Gauss-Legendre rule of an integral's live Excel form
+EXCEL_NODES = 20
+#: highest order of diff(EXPR, X, N)
+MAX_ORDER = 10
+
+
+# -- unit rules ---------------------------------------------------------------------------------
+def _variable(name: str, body: ty.T, var: ty.TParam) -> None:
+    if body.boolean:
+        raise TemplateError(f"{name}(): the expression is a condition, not a number")
+
+
+def _in_var_unit(ctx, t: ty.T, var: ty.TParam, name: str, what: str) -> ty.T:
+    """A bound or guess in the variable's unit; a mismatch names both units."""
+    if t.unit.dimensionality != var.unit.dimensionality and not _zero(t):
+        raise UnitError(
+            f"{name}(): {what} is {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}), but the "
+            f"variable {var.name} is {un.dims(var.unit)} ({un.pretty(var.unit) or '1'})"
+        )
+    return ctx.convert(t, var.unit, f"{name}(): {what}")
+
+
+def _zero(t: ty.T) -> bool:
+    return isinstance(t, ty.TConst) and t.value == 0.0 and not t.unit.dimensionality
+
+
+def _root_unit(ctx, name: str, args: tuple) -> ty.T:
+    body, var, *rest = args
+    _variable(name, body, var)
+    sheet_tolerance(ctx.spec.meta)
+    whats = ("the guess",) if len(rest) == 1 else ("the lower bound A", "the upper bound B")
+    rest = [_in_var_unit(ctx, t, var, name, w) for t, w in zip(rest, whats)]
+    return ty.TFunc(var.unit, func=name, args=(body, var, *rest))
+
+
+def _integral_unit(ctx, name: str, args: tuple) -> ty.T:
+    body, var, a, b = args
+    _variable(name, body, var)
+    sheet_tolerance(ctx.spec.meta)
+    a = _in_var_unit(ctx, a, var, name, "the lower bound A")
+    b = _in_var_unit(ctx, b, var, name, "the upper bound B")
+    return ty.TFunc(body.unit * var.unit, func=name, args=(body, var, a, b))
+
+
+def _extremum_unit(ctx, name: str, args: tuple) -> ty.T:
+    body, var, a, b = args
+    _variable(name, body, var)
+    sheet_tolerance(ctx.spec.meta)
+    a = _in_var_unit(ctx, a, var, name, "the lower bound A")
+    b = _in_var_unit(ctx, b, var, name, "the upper bound B")
+    unit = var.unit if name.startswith("arg") else body.unit
+    return ty.TFunc(unit, func=name, args=(body, var, a, b))
+
+
+def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
+    from .derivative import derivative
+
+    body, var, *rest = args
+    _variable(name, body, var)
+    order = 1
+    if rest:
+        n = rest[0]
+        ok = isinstance(n, ty.TConst) and not n.unit.dimensionality and n.value == int(n.value)
+        if not ok or not 1 <= n.value <= MAX_ORDER:
+            raise TemplateError(
+                f"diff(): the order N must be a whole number from 1 to {MAX_ORDER} written as "
+                "a number"
+            )
+        order = int(n.value)
+    return derivative(ctx, body, var, order, body.unit / var.unit**order)
+
+
+def _product_unit(ctx, name: str, args: tuple) -> ty.T:
+    body, var, a, b = args
+    _variable(name, body, var)
+    if var.unit.dimensionality or var.unit != ctx.dimensionless:
+        raise UnitError(f"{name}(): the index {var.name} must be a plain number (integers A..B)")
+    if body.unit.dimensionality:
+        raise UnitError(
+            f"{name}(): the factors must be plain numbers (the unit of a product would depend "
+            f"on the number of factors), got {un.dims(body.unit)}"
+        )
+    a = ctx.plain(a, f"{name}(): the first index")
+    b = ctx.plain(b, f"{name}(): the last index")
+    return ty.TFunc(body.unit, func=name, args=(body, var, a, b))
+
+
+# -- numpy hooks --------------------------------------------------------------------------------
+def _rows(of, *bounds):
+    """The shape of the call (the expression's arrays and the bounds), the function of
+    (x, row index) that scipy's routines call, and the row index array."""
+    shape = np.broadcast_shapes(of.shape, *(np.shape(b) for b in bounds))
+    f = of.over(shape)
+    idx = np.arange(math.prod(shape), dtype=float).reshape(shape)
+    return shape, f, idx
+
+
+def _root_numpy(of, a, b=None):
+    tol = of.tolerance
+    if b is None:
+        shape, f, idx = _rows(of, a)
+        res = roots.root_near(
+            f, a, (idx,), tol, var=of.var, unit=of.unit_text, label=of.describe_row(shape)
+        )
+    else:
+        shape, f, idx = _rows(of, a, b)
+        res = roots.root_in(
+            f, a, b, (idx,), tol, var=of.var, unit=of.unit_text, label=of.describe_row(shape)
+        )
+    of.record("root", res)
+    return _out(res.value)
+
+
+def _integral_numpy(of, a, b):
+    shape, f, idx = _rows(of, a, b)
+    if live():  # what the workbook's SUMPRODUCT computes
+        lo, hi, rows = (np.broadcast_to(v, shape).reshape(-1) for v in (a, b, idx))
+        value = gauss.pieces_value(f, np.vstack([lo, hi]), EXCEL_NODES, (rows,))
+        return _out(value.reshape(shape))
+    breaks = of.breaks(shape)
+    res = quadrature.integrate(
+        f,
+        a,
+        b,
+        (idx,),
+        of.tolerance,
+        breaks=breaks,
+        var=of.var,
+        unit=of.unit_text,
+        label=of.describe_row(shape),
+    )
+    of.record("integral", res)
+    return _out(res.value)
+
+
+def _extremum_numpy(name: str):
+    kind = "max" if name.endswith("max") or name == "maximum" else "min"
+    where = name.startswith("arg")
+
+    def hook(of, a, b):
+        shape, f, idx = _rows(of, a, b)
+        res = extrema.extremum(
+            f,
+            a,
+            b,
+            (idx,),
+            of.tolerance,
+            kind=kind,
+            need_where=where,
+            var=of.var,
+            unit=of.unit_text,
+            label=of.describe_row(shape),
+        )
+        if where:
+            res = Result(res.where, res.where_error, evaluations=res.evaluations)
+        of.record(name, res)
+        return _out(res.value)
+
+    return hook
+
+
+def _product_numpy(of, a, b):
+    shape, f, idx = _rows(of, a, b)
+    res = series.reduce(f, a, b, (idx,), kind="product", var=of.var)
+    return _out(res.value)
+
+
+def _out(v: np.ndarray):
+    return float(v) if np.ndim(v) == 0 else v
+
+
+# -- Excel --------------------------------------------------------------------------------------
+def _not_live(name: str, primitive: str):
+    def excel(body, args, consts):
+        raise NotLive(
+            f"{name}() is computed by {primitive} (error estimate below the sheet's tolerance); "
+            "its value is written as a number"
+        )
+
+    return excel
+
+
+def _integral_excel(body, args, consts) -> tuple[str, int]:
+    """A live integral: the EXCEL_NODES-point Gauss-Legendre rule on [A, B] as SUMPRODUCT
+    over constant arrays of nodes and weights (EXPR printed once, over the node array)."""
+    a, b = args
+    t, w = gauss.rule(EXCEL_NODES)
+    nodes = "{" + ",".join(repr(float(x)).upper() for x in t) + "}"
+    weights = "{" + ",".join(repr(float(x)).upper() for x in w) + "}"
+    width = f"(({b})-({a}))"
+    x = f"(({a})+{width}*{nodes})"
+    return f"{width}*SUMPRODUCT({weights}*({body(x)}))", PREC["*"]
+
+
+def _product_excel(body, args, consts) -> tuple[str, int]:
+    from ..builtins import MAX_EXCEL_TERMS, _bound
+
+    lo, hi = consts
+    if lo is None or hi is None:
+        raise NotLive("product() with bounds that are not constants has no live formula")
+    lo, hi = _bound(lo, "first"), _bound(hi, "last")
+    if hi < lo:
+        return "1", ATOM
+    if hi - lo + 1 > MAX_EXCEL_TERMS:
+        raise NotLive(f"product() of {hi - lo + 1} factors (written out up to {MAX_EXCEL_TERMS})")
+    terms = [body(str(i) if i >= 0 else f"({i})") for i in range(lo, hi + 1)]
+    return "(" + ")*(".join(terms) + ")", PREC["*"]
+
+
+def _unreachable(*args):  # pragma: no cover - diff's unit rule returns the derivative itself
+    raise AssertionError("diff() is replaced by its derivative when the sheet is loaded")
+
+
+# -- sympy --------------------------------------------------------------------------------------
+def _integral_sympy(sp, body, var, a, b):
+    return sp.Integral(body, (var, a, b))
+
+
+def _product_sympy(sp, body, var, a, b):
+    return sp.Product(body, (var, a, b)).doit()
+
+
+def _no_sympy(name: str):
+    def convert(sp, body, var, *rest):
+        from ..symbolic import NotSymbolic
+
+        raise NotSymbolic(f"{name}() is solved numerically: it has no formula to differentiate")
+
+    return convert
+
+
+register(
+    Builtin(
+        "root",
+        (3, 4),
+        _root_unit,
+        _root_numpy,
+        _not_live("root", "find_root (scipy.optimize.elementwise)"),
+        _no_sympy("root"),
+        doc="root(EXPR, X, A, B): the X in [A, B] where EXPR changes sign; "
+        "root(EXPR, X, GUESS): a root near GUESS",
+        binds=(0, 1),
+    )
+)
+register(
+    Builtin(
+        "integral",
+        4,
+        _integral_unit,
+        _integral_numpy,
+        _integral_excel,
+        _integral_sympy,
+        doc="integral(EXPR, X, A, B): the definite integral of EXPR for X from A to B",
+        binds=(0, 1),
+        excel_functions=("SUMPRODUCT",),
+    )
+)
+for _name, _text in (
+    ("maximum", "the largest value of EXPR for X in [A, B]"),
+    ("minimum", "the smallest value of EXPR for X in [A, B]"),
+    ("argmax", "the X in [A, B] where EXPR is largest"),
+    ("argmin", "the X in [A, B] where EXPR is smallest"),
+):
+    register(
+        Builtin(
+            _name,
+            4,
+            _extremum_unit,
+            _extremum_numpy(_name),
+            _not_live(_name, "sampling and find_minimum (scipy.optimize.elementwise)"),
+            _no_sympy(_name),
+            doc=f"{_name}(EXPR, X, A, B): {_text} (the global one among all local ones)",
+            binds=(0, 1),
+        )
+    )
+register(
+    Builtin(
+        "diff",
+        (2, 3),
+        _diff_unit,
+        _unreachable,
+        _unreachable,
+        _unreachable,
+        doc="diff(EXPR, X) or diff(EXPR, X, N): the (N-th) derivative of EXPR in X, "
+        "found symbolically at load (a formula like any other)",
+        binds=(0, 1),
+    )
+)
+register(
+    Builtin(
+        "product",
+        4,
+        _product_unit,
+        _product_numpy,
+        _product_excel,
+        _product_sympy,
+        doc="product(EXPR, I, A, B): EXPR multiplied over the integers I = A..B (1 if B < A)",
+        binds=(0, 1),
+    )
+)

@@ -1,0 +1,118 @@
+"""Where an integrand may have a kink or a jump, read from its typed tree.
+
+A piecewise condition comparing the variable with something free of it (``x <= L``), and
+``abs``, ``min``, ``max`` of the variable against such a value (``abs(x - c)``,
+``min(x, c)``), give a break point: the integral is split there so that every piece is
+smooth. Inside a sheet function called with the variable as an argument, the same is
+found for the parameter it is bound to; the function's other parameters are replaced by
+the arguments of the call. Kinks this walker does not recognise are left to the adaptive
+rule.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from .. import typed as ty
+from ..visitor import Visitor
+
+
+class Kinks(Visitor):
+    """Collects typed break points (in the variable's unit) of an expression in ``var``.
+
+    ``aliases`` maps a parameter to f where the parameter is the variable times f; ``subst``
+    maps a function's other parameters to the typed arguments of the call (None at the top,
+    where parameters are the environment's).
+    """
+
+    def __init__(self, typer):
+        self.typer = typer
+        self.found: list[ty.T] = []
+
+    def _children(self, t, aliases, subst):
+        for c in ty.children(t):
+            self.visit(c, aliases, subst)
+
+    visit_TConst = visit_TText = visit_TParam = visit_TRef = visit_TAggregate = _children
+    visit_TScale = visit_TUnary = visit_TBinary = visit_TLogic = visit_TBlock = _children
+    visit_TPiecewise = _children
+
+    def _linear(self, t: ty.T, aliases) -> float | None:
+        """The factor f if ``t`` is the variable times f, else None."""
+        if isinstance(t, ty.TParam) and t.name in aliases:
+            return aliases[t.name]
+        if isinstance(t, ty.TScale):
+            inner = self._linear(t.child, aliases)
+            return None if inner is None else inner * t.factor
+        return None
+
+    def _outer(self, t: ty.T, aliases, subst) -> ty.T | None:
+        """``t`` in the scope of the integral (parameters replaced), or None if it depends
+        on the variable or cannot be replaced."""
+        stack = [t]
+        while stack:
+            n = stack.pop()
+            if isinstance(n, ty.TParam):
+                if n.name in aliases or (subst is not None and n.name not in subst):
+                    return None
+            stack.extend(ty.children(n))
+        return t if not subst else _substitute(t, subst)
+
+    def _pair(self, x: ty.T, y: ty.T, aliases, subst) -> None:
+        for lin, other in ((x, y), (y, x)):
+            f = self._linear(lin, aliases)
+            if f:
+                outer = self._outer(other, aliases, subst)
+                if outer is not None:
+                    self.found.append(ty.TScale(outer.unit, child=outer, factor=1.0 / f))
+                return
+
+    def visit_TCompare(self, t: ty.TCompare, aliases, subst):
+        for x, y in zip(t.operands, t.operands[1:]):
+            self._pair(x, y, aliases, subst)
+        self._children(t, aliases, subst)
+
+    def visit_TFunc(self, t: ty.TFunc, aliases, subst):
+        if t.func == "abs" and isinstance(t.args[0], ty.TBinary) and t.args[0].op == "-":
+            self._pair(t.args[0].left, t.args[0].right, aliases, subst)
+        elif t.func in ("min", "max") and len(t.args) == 2:
+            self._pair(t.args[0], t.args[1], aliases, subst)
+        self._children(t, aliases, subst)
+
+    def visit_TCall(self, t: ty.TCall, aliases, subst):
+        self._children(t, aliases, subst)
+        f = self.typer.function(t.name)
+        inner, values = {}, {}
+        for p, a in zip(f.params, t.args):
+            factor = self._linear(a, aliases)
+            if factor:
+                inner[p] = factor
+            else:
+                outer = self._outer(a, aliases, subst)
+                if outer is not None:
+                    values[p] = outer
+        if inner:
+            self.visit(f.body, inner, values)
+
+
+def _substitute(t: ty.T, subst: dict[str, ty.T]) -> ty.T:
+    """``t`` with parameters replaced by typed trees (their units are the parameters')."""
+    if isinstance(t, ty.TParam):
+        return subst.get(t.name, t)
+    changes = {}
+    for field in dataclasses.fields(t):
+        v = getattr(t, field.name)
+        if isinstance(v, ty.T):
+            changes[field.name] = _substitute(v, subst)
+        elif isinstance(v, tuple) and any(isinstance(x, ty.T) for x in v):
+            changes[field.name] = tuple(
+                _substitute(x, subst) if isinstance(x, ty.T) else x for x in v
+            )
+    return dataclasses.replace(t, **changes) if changes else t
+
+
+def breaks(typer, body: ty.T, var: str) -> list[ty.T]:
+    """Typed break points of ``body`` in ``var`` (in the variable's unit), possibly repeated."""
+    k = Kinks(typer)
+    k.visit(body, {var: 1.0}, None)
+    return k.found

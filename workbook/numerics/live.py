@@ -1,0 +1,43 @@
+"""How far a live Excel form of a numerical built-in is from the engine's value (a comment)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import typed as ty
+from ._common import live_forms
+
+#: built-ins whose Excel form is live but approximate
+APPROXIMATE = {"integral": "a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)"}
+
+
+def _approximate(sheet, t: ty.T) -> set[str]:
+    found, stack, seen = set(), [t], set()
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ty.TFunc) and n.func in APPROXIMATE:
+            found.add(n.func)
+        if isinstance(n, ty.TCall) and n.name not in seen:
+            seen.add(n.name)
+            stack.append(sheet.typer.function(n.name).body)
+        stack.extend(ty.children(n))
+    return found
+
+
+def note(sheet, t: ty.T, env: dict, values) -> str | None:
+    """A cell comment for a live formula that holds an approximate live form: which form,
+    and its largest difference from the engine's ``values`` at the written inputs."""
+    found = _approximate(sheet, t)
+    if not found:
+        return None
+    with live_forms():
+        approx = np.asarray(sheet.evaluator.compile(t)(env), dtype=float)
+    values = np.asarray(values, dtype=float)
+    diff = float(np.max(np.abs(approx - values)))
+    scale = float(np.max(np.abs(values))) or 1.0
+    forms = "; ".join(f"{name}() is {APPROXIMATE[name]}" for name in sorted(found))
+    return (
+        f"Live formula: {forms}. At the inputs written here it differs from the engine's "
+        f"value by {diff:.2g} ({diff / scale:.1g} relative); the engine's value has an error "
+        "below the sheet's tolerance."
+    )
