@@ -3,10 +3,11 @@
 The engine side evaluates functions of tests/data/pipe-flow.toml for 10^4 arguments at
 once, from a fresh Sheet each time, at the sheet's tolerance (1e-10 relative): Colebrook's
 friction factor ``friction(Re)`` by ``root(EXPR, f, 0.005, 0.1)`` and the flow rate of a
-1/7 power-law profile ``Q(R)`` by ``integral(...)``. The other sides compute the same numbers in plain
-numpy at the same tolerance: a Python loop of ``brentq`` / ``quad``, and one call of SciPy's
-vectorised ``find_root`` / ``tanhsinh``. Each line also gives the largest relative error of
-every side against a tight reference (``brentq`` at 1e-15, ``quad`` at 1e-13) on 200 rows.
+1/7 power-law profile ``Q(R)`` by ``integral(...)``. The other sides compute the same
+numbers in plain numpy at the same tolerance: a Python loop of ``brentq`` / ``quad``, and
+one call of SciPy's vectorised ``find_root`` / ``tanhsinh``. Each line also gives the
+largest relative error of every side against a tight reference (``brentq`` at 1e-15,
+``quad`` at 1e-13) on 200 rows.
 """
 
 from __future__ import annotations
@@ -37,10 +38,11 @@ def flow(r, radius):
 
 def run(n: int = 10_000, reps: int = 5) -> list[Result]:
     """Ratios of the engine's time to a loop of brentq/quad and to find_root/tanhsinh."""
-    import workbook
     from scipy.integrate import quad, tanhsinh
     from scipy.optimize import brentq
     from scipy.optimize.elementwise import find_root
+
+    import workbook
 
     sheet = workbook.load(TEMPLATE)
     re = 4000.0 + 100.0 * np.arange(n)

@@ -382,3 +382,7 @@ register(
 def excel_functions() -> frozenset[str]:
     """Excel functions that the printed formulas of built-ins call."""
     return frozenset(f for b in REGISTRY.values() for f in b.excel_functions)
+
+
+# the numerical built-ins (root, integral, maximum, ..., product, diff) register themselves
+from .numerics import entries as _numerical  # noqa: E402, F401

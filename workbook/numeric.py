@@ -14,6 +14,7 @@ import numpy as np
 from . import typecheck as tc
 from .builtins import REGISTRY
 from .errors import DomainError, InputError
+from .numerics.bound import Bound
 from .visitor import Visitor
 
 Env = dict[str, object]
@@ -49,6 +50,7 @@ class Evaluator(Visitor):
         self.scalar_value = scalar_value  # (name, kind) -> magnitude in the ref's unit
         self.describe_args = describe_args
         self._functions: dict[str, Fn] = {}
+        self.records: list = []  # (built-in, numerics.Result) of each solve: workbook bench
 
     def function(self, name: str) -> Fn:
         """Compiled user function: env of its parameters -> magnitude in its unit."""
@@ -149,17 +151,17 @@ class Evaluator(Visitor):
         return lambda env: f(*[a(env) for a in args])
 
     def _binding(self, t: tc.TFunc, entry) -> Fn:
-        """A built-in binding a variable: its hook gets EXPR as a function of the variable."""
+        """A built-in binding a variable: its hook gets EXPR as a function of the variable
+        (a :class:`workbook.numerics.bound.Bound`: ``of(value)``, and the row-wise form
+        SciPy's vectorised solvers call)."""
         expr_at, var_at = entry.binds
-        body, var = self.compile(t.args[expr_at]), t.args[var_at].name
+        body_t, var_t = t.args[expr_at], t.args[var_at]
+        body = self.compile(body_t)
         rest = [self.compile(a) for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
         hook = entry.numpy
 
         def call(env):
-            def of(value):
-                return body({**env, var: value})
-
-            return hook(of, *[a(env) for a in rest])
+            return hook(Bound(self, body_t, body, var_t, env), *[a(env) for a in rest])
 
         return call
 

@@ -208,7 +208,17 @@ class WorkbookWriter:
             return False
         ws.write_formula(row, col, formula, fmt, value)
         self.formula_cells += 1
+        if not subst:
+            self._live_note(ws, row, col, t, {}, value)
         return True
+
+    def _live_note(self, ws, row, col, t: tc.T, env: dict, values) -> None:
+        """A comment on a live formula that holds an approximate live form (an integral)."""
+        from .numerics.live import note
+
+        text = note(self.sheet, t, env, values)
+        if text:
+            ws.write_comment(row, col, text)
 
     # -- range tables -------------------------------------------------------------------
     def plan_range_tables(self) -> None:
@@ -250,7 +260,9 @@ class WorkbookWriter:
         self._write_range_column(ws, spec, first, data.columns[0].values)
         var_ref = f"$A${ROW_TOKEN}"
         for j, col in enumerate(data.columns[1:], start=1):
-            self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n)
+            if self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n):
+                env = {data.var: data.columns[0].values}
+                self._live_note(ws, first - 1, j, col.typed, env, col.values)
             cells = ColumnCells(spec.sheet, j, first, first + n - 1, col.title)
             planned = self.planned.get((spec.name, col.text))
             if planned is not None and planned != cells:  # a MAX(...) already points there
@@ -306,7 +318,10 @@ class WorkbookWriter:
             return None
         return texts[0], texts[1], texts[2]
 
-    def _write_column(self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n):
+    def _write_column(
+        self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n
+    ) -> bool:
+        """Write one column, live formulas if it can be; True if it is live."""
         fmt = self.fmt["value"]
         try:
             template = self.printer.formula(col.typed, {var: var_ref})
@@ -315,7 +330,7 @@ class WorkbookWriter:
                 ws.write_number(first + i, j, float(col.values[i]), fmt)
             ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
             self.not_live.append(f"{table}.{col.text}")
-            return
+            return False
         pieces = template.split(ROW_TOKEN)
         write = ws.write_formula
         values = col.values.tolist()
@@ -323,6 +338,7 @@ class WorkbookWriter:
             row = first + i
             write(row, j, str(row + 1).join(pieces), fmt, values[i])
         self.formula_cells += n
+        return True
 
     # -- block tables --------------------------------------------------------------------
     def write_block_table(self, spec) -> None:
