@@ -158,10 +158,21 @@ def _text_of(el) -> str:
     """The text of a text region: paragraphs joined by newlines, subscripts inline."""
     paras = []
     for p in el.iter(f"{{{WS}}}p"):
-        paras.append(re.sub(r"\s+", " ", "".join(p.itertext())).strip())
+        paras.append(re.sub(r"\s+", " ", "".join(_own_text(p))).strip())
     if not paras:
-        paras = [re.sub(r"\s+", " ", "".join(el.itertext())).strip()]
+        paras = [re.sub(r"\s+", " ", "".join(_own_text(el))).strip()]
     return "\n".join(x for x in paras if x)
+
+
+def _own_text(el):
+    """The text of an element, without the math regions placed inside a paragraph."""
+    if el.text:
+        yield el.text
+    for child in el:
+        if isinstance(child.tag, str) and _local(child.tag) != "region":
+            yield from _own_text(child)
+        if child.tail:
+            yield child.tail
 
 
 def _worksheet(root, path: Path) -> Worksheet:
@@ -192,6 +203,10 @@ def _collect(parent, top: float, left: float, out: list[Region]) -> None:
     for el in parent.iterchildren(f"{{{WS}}}region"):
         region = _region(el, top, left)
         out.append(region)
+        text = el.find(f"{{{WS}}}text")
+        if text is not None:  # math regions placed inside a paragraph of text
+            for p in text.iter(f"{{{WS}}}p"):
+                _collect(p, top, left, out)
         area = el.find(f"{{{WS}}}area")
         if area is not None:
             _collect(area, dy_of(el, top), left + _float(el.get("left")), out)

@@ -375,8 +375,8 @@ class Translator:
                 continue
             if region.kind != "math":
                 what = {"plot": "a plot", "picture": "a picture"}.get(region.kind, "a component")
-                if region.kind == "reference":
-                    continue  # followed by the caller
+                if region.kind in ("reference", "area"):
+                    continue  # followed by the caller; an area holds regions read on their own
                 self.skip(region.id, what, "not translated: the language has no such region")
                 continue
             if region.math is None:
