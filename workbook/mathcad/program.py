@@ -58,7 +58,12 @@ class ProgramTranslator:
             s = stmts[i]
             nxt = stmts[i + 1] if i + 1 < len(stmts) else None
             if s.tag == "ifThen" and nxt is not None and nxt.tag == "otherwise":
-                if self._one_line(s.children[1]) and self._one_line(nxt.children[0]):
+                other = nxt.children[0]
+                if (
+                    self._one_line(s.children[1])
+                    and self._one_line(other)
+                    and other.tag not in _SIMPLE
+                ):
                     self._stmt(s, indent, out)
                     self._stmt(nxt, indent, out)
                 else:  # block form: if ... / otherwise

@@ -424,6 +424,8 @@ class Translator:
                 return f"{nm.mathcad_text(*_key(lhs))} := ..."
             if lhs.tag == "function":
                 return f"{nm.mathcad_text(*_key(lhs.children[0]))}(...) := ..."
+            if _is_indexer(lhs) and lhs.children[1].tag == "id":
+                return f"{nm.mathcad_text(*_key(lhs.children[1]))}[...] := ..."
             return f"{_what(lhs.tag)} := ..."
         if node.tag == "eval":
             return "an evaluation ( = )"
@@ -563,7 +565,10 @@ class Translator:
                 raise Untranslatable("a program over a range variable")
         if not out:
             raise Untranslatable("an empty program")
-        return out
+        # Mathcad runs every line and the program's value is the last one it ran: where
+        # conditions overlap, the last true `if` wins; pieces take the first true one
+        ifs = [p for p in out if p[1] is not None][::-1]
+        return ifs + [p for p in out if p[1] is None]
 
     def if_pieces(self, node: MNode, local) -> list[tuple[ex.Node, ex.Node | None]]:
         """Mathcad's if(cond, a, b), with further ifs in b, as pieces."""
