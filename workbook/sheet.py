@@ -66,6 +66,9 @@ class Sheet:
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
         self.typer = typer or tc.Typer(spec, input_units)
         self._memo: dict[str, object] = {}
+        # names evaluated through this sheet (by blocks, among others): what a block table or
+        # a finding reads counts as used, without a hand-kept list in the template
+        self.reads: set[str] = set()
         self.evaluator = Evaluator(
             self.typer, self.scalar_value, self.describe_call, self._column_values
         )
@@ -142,6 +145,8 @@ class Sheet:
         Plain numbers are taken in the unit the template declares for the argument.
         """
         Q = un.registry().Quantity
+        if name in self.spec.inputs or name in self.spec.definitions:
+            self.reads.add(name)
         if name in self.spec.inputs:
             return self.values[name]
         if name == "pi" and name not in self.spec.definitions:
@@ -413,8 +418,10 @@ class Sheet:
         return run_checks(self)
 
     def unused_inputs(self) -> list[str]:
-        """Inputs that no table, chart, printed value or definition in use needs (in any part)."""
-        used = names_used(self.full_spec, hand_checks=True)
+        """Inputs that no table, chart, printed value or definition in use needs (in any part),
+        nor anything evaluated through this sheet so far (``reads``: what the findings and block
+        tables read; a check runs the findings first)."""
+        used = names_used(self.full_spec, hand_checks=True, reads=self.reads)
         return [n for n in self.full_spec.inputs if n not in used]
 
     def _repr_html_(self) -> str:

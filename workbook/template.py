@@ -141,7 +141,6 @@ class TableSpec:
     sheet: str = "Listing"
     block: str | None = None
     line: int | None = None
-    uses: tuple[str, ...] = ()  # inputs a block table reads (for the unused-input report)
     part: str | None = None
 
 
@@ -784,7 +783,6 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
             str(raw.get("sheet", "Listing")),
             raw.get("block"),
             line,
-            tuple(str(u) for u in raw.get("uses", ())),
         )
     except WorkbookError as err:
         raise err.located(line=line, definition=f"table {name}") from None

@@ -34,13 +34,12 @@ def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
     return out
 
 
-def output_roots(spec: SheetSpec, *, hand_checks: bool = False) -> list[ex.Node]:
+def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> list[ex.Node]:
     """Expressions the outputs evaluate: columns, series and their range bounds, printed
-    values, the names tables declare they use; with ``hand_checks`` also the columns of block
-    tables, relations and the names findings declare (what the checks read)."""
-    roots: list[ex.Node] = []
+    values, the names ``reads`` that blocks evaluated through the sheet (``Sheet.reads``); with
+    ``hand_checks`` also the columns of block tables and the relations (what the checks read)."""
+    roots: list[ex.Node] = [ex.Name(n) for n in sorted(reads)]
     for t in spec.tables:
-        roots += [ex.Name(u) for u in t.uses]
         if t.range is None and hand_checks:
             roots += [c.node for c in t.columns]
     for rng, nodes in ranged_outputs(spec):
@@ -49,17 +48,15 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False) -> list[ex.Node]
     for p in spec.printed:
         roots += [ex.Name(n) for n in printed_names(p)]
     if hand_checks:
-        for f in spec.findings:
-            roots += [ex.Name(str(u)) for u in f.get("uses", ())]
         for r in spec.relations:
             roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
     return roots
 
 
-def names_used(spec: SheetSpec, *, hand_checks: bool = False) -> set[str]:
-    """Inputs, definitions and blocks the outputs need, transitively."""
+def names_used(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> set[str]:
+    """Inputs, definitions and blocks the outputs (and ``reads``) need, transitively."""
     out: set[str] = set()
-    for node in output_roots(spec, hand_checks=hand_checks):
+    for node in output_roots(spec, hand_checks=hand_checks, reads=reads):
         out |= tc.dependencies(spec, node)
     return out
 

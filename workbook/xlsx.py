@@ -682,7 +682,7 @@ def _nice(x: float, floor: bool) -> float:
 
 def needed_names(sheet) -> set[str]:
     """Inputs and definitions the workbook's tables, charts and checks depend on."""
-    return names_used(sheet.spec)
+    return names_used(sheet.spec, reads=sheet.reads)
 
 
 def write_workbook(

@@ -60,7 +60,7 @@ class Block:
 
 def input_magnitude(sheet, name: str, unit: str) -> float:
     """The sheet's input ``name`` as a plain number in ``unit``."""
-    return float(sheet.values[name].to(unit).magnitude)
+    return float(sheet.evaluate(name).to(unit).magnitude)
 
 
 def _ref(func: Callable) -> str:

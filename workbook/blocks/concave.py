@@ -158,7 +158,7 @@ def geometry_numbers(sheet) -> dict:
         return {
             "theta_geom": theta,
             "phiB_geom": phib,
-            "Theta": float(sheet.values["Theta"].magnitude),
+            "Theta": float(sheet.evaluate("Theta").magnitude),
             "h_err": float(hp[i] - he[i]),
             "h_err_at": float(x[i]),
             "h_exact_max": float(np.max(he)),
@@ -298,7 +298,9 @@ def _sweep_case(sheet, label: str, changes: dict) -> dict:
     except WorkbookError as err:
         row.update(status="invalid", reason=err.message)
         return row
-    geo = _geometry(sheet).with_inputs(**changes)
+    geo = _geometry(sheet)
+    same = {n: sheet.evaluate(n) for n in geo.spec.inputs if n in sheet.spec.inputs}
+    geo = geo.with_inputs(**{**same, **changes})
     try:
         row["theta_geom [deg]"] = float(geo.evaluate("theta_geom").to("deg").magnitude)
         row["phiB_geom [deg]"] = float(geo.evaluate("phiB_geom").to("deg").magnitude)

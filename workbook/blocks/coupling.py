@@ -407,7 +407,7 @@ def auto_method(sheet) -> str:
 
 
 def method_of(sheet) -> str:
-    return str(sheet.values["method"])
+    return str(sheet.evaluate("method"))
 
 
 def chosen_method(sheet) -> str:

@@ -529,7 +529,7 @@ def findings(sheet) -> list[Finding]:
         m = model(sheet)
     except InputError as err:
         return [Finding("inputs", err.message, None, "", "fail")]
-    variant = (sheet.values.get("transform"), sheet.values.get("ratio"))
+    variant = (sheet.evaluate("transform"), sheet.evaluate("ratio"))
     corrected = variant == ("rotation", "lobes")
     out.append(
         Finding(

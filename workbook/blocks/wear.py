@@ -399,7 +399,7 @@ def _measured(sheet):
 
         phi, h = read_measured_lift(_measured_path(sheet))
         dphi = float(phi[1] - phi[0])
-        omega = float(sheet.values["n"].to("deg/s").magnitude)
+        omega = float(sheet.evaluate("n").to("deg/s").magnitude)
         hs = savgol_filter(h, SG_WINDOW, SG_ORDER, mode="interp")
         d1 = savgol_filter(h, SG_WINDOW, SG_ORDER, deriv=1, delta=dphi, mode="interp")
         d2 = savgol_filter(h, SG_WINDOW, SG_ORDER, deriv=2, delta=dphi, mode="interp")
