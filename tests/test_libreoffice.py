@@ -99,3 +99,39 @@ def test_max_over_is_a_live_max_of_the_table_column(tmp_path):
     values = cell_values(recalculate(edited, tmp_path / "lo"))
     assert values[("Definitions", "B2")] == 25
     assert values[("Listing", "B17")] == 25  # the table that shows it
+
+
+def test_live_integral_follows_an_input_change(tmp_path):
+    """integral() is a live Gauss-Legendre SUMPRODUCT: LibreOffice's value after an edit is
+    the engine's new value, within the difference the cell's comment states."""
+    import re
+
+    import workbook
+
+    (tmp_path / "q.toml").write_text(
+        '[inputs]\nR = "50 mm"\nu_max = "2 m/s"\n\n[arguments]\nr = { unit = "mm" }\n\n'
+        "[definitions]\n"
+        '"u(r)" = { expr = "u_max*(1 - (r/R)^2)*exp(-r/R)", unit = "m/s" }\n'
+        'Q = { expr = "integral(2*pi*r*u(r), r, 0, R)", unit = "L/s" }\n'
+        'Q2 = { expr = "integral(2*pi*r*u(r), r, 0, R/2)", unit = "L/s" }\n\n'
+        '[[tables]]\nname = "flow"\nrange = "k := 1 .. 1"\n'
+        'columns = [{ expr = "Q", unit = "L/s" }, { expr = "Q2", unit = "L/s" }]\n'
+    )
+    sheet = workbook.load(tmp_path / "q.toml")
+    path = sheet.write_xlsx(tmp_path / "q.xlsx")
+    wb = openpyxl.load_workbook(path)
+    defs = wb["Definitions"]
+    rows = {defs.cell(r, 1).value: r for r in range(2, defs.max_row + 1)}
+    assert "SUMPRODUCT" in defs.cell(rows["Q"], 2).value
+    stated = re.search(r"by ([0-9.e+-]+) ", defs.cell(rows["Q"], 2).comment.text).group(1)
+    inputs = wb["Inputs"]
+    row = next(r for r in inputs.iter_rows() if r[0].value == "R")
+    row[1].value = 80
+    wb.save(tmp_path / "edited.xlsx")
+    values = cell_values(recalculate(tmp_path / "edited.xlsx", tmp_path / "lo"))
+    new = sheet.with_inputs(R="80 mm")
+    for name in ("Q", "Q2"):
+        want = new.evaluate(name).to("L/s").magnitude
+        got = values[("Definitions", f"B{rows[name]}")]
+        assert got == pytest.approx(want, rel=1e-9, abs=10 * float(stated) + 1e-12), name
+        assert got != pytest.approx(sheet.evaluate(name).to("L/s").magnitude, rel=1e-3)
