@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_builtins  # noqa: E402
 import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
 import bench_load  # noqa: E402
@@ -24,12 +25,14 @@ FULL = {
     "coldstart": lambda: bench_coldstart.run(reps=9),
     "write": lambda: bench_write.run(n=100_000, reps=5),
     "load": lambda: bench_load.run(reps=5),
+    "builtins": lambda: bench_builtins.run(n=10_000, reps=5),
 }
 QUICK = {
     "evaluate": lambda: bench_evaluate.run(n=1_000, reps=1),
     "coldstart": lambda: bench_coldstart.run(reps=1),
     "write": lambda: bench_write.run(n=50, reps=1),
     "load": lambda: bench_load.run(reps=1),
+    "builtins": lambda: bench_builtins.run(n=200, reps=1),
 }
 
 

@@ -20,6 +20,7 @@ from workbook.errors import LimitError
 BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
 sys.path.insert(0, str(BENCH))
 
+import bench_builtins  # noqa: E402
 import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
 import bench_load  # noqa: E402
@@ -31,6 +32,11 @@ def _check(results, n):
     for r in results:
         assert r.value > 0 and r.target > 0
         assert f"target <= {r.target:g}" in r.line()
+
+
+@pytest.mark.slow
+def test_builtins_bench_tiny():
+    _check(bench_builtins.run(n=200, reps=1), 4)
 
 
 def test_evaluate_bench_tiny():
