@@ -143,6 +143,22 @@ def check_numbers(sheet) -> int:
         else:
             assert rp.number(cell) == float(f"{v.magnitude:.12g}"), name
         count += 1
+    # every value put into a formula: the input, or the definition's result, with its unit
+    for el in doc.xpath("//mrow[@class='value'][@data-name]"):
+        name = el.get("data-name")
+        value, unit = rp.value_and_unit(el)
+        if name in sheet.spec.inputs:
+            q, spec = sheet.values[name], sheet.spec.inputs[name]
+            want = float(q.magnitude)
+            assert un.unit(unit) == (un.unit("") if spec.label else q.units), (name, unit)
+        else:
+            d = sheet.spec.definitions[name]
+            q = sheet.evaluate(name)
+            q = q.to(d.unit) if d.unit is not None else q
+            want = float(q.magnitude)
+            assert un.unit(unit) == un.unit(un.pretty(q.units)), (name, unit)
+        assert _same(value, want), (name, value, want)
+        count += 1
     # every scalar definition: its result and unit, or its error
     shown = {el.get("data-name"): el for el in doc.xpath("//mrow[@class='result']")}
     for name, d in sheet.spec.definitions.items():

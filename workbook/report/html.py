@@ -342,7 +342,8 @@ class Document:
             heads.append(f"{sym}<br><span class='unit'>{unit_html}</span>")
         columns = [c.values for c in data.columns]
         n = len(columns[0])
-        return f"<p class='range'>{range_math}: {n} rows</p>" + self._grid(heads, columns, n)
+        rows = f"{n:,} row{'s' if n != 1 else ''}"
+        return f"<p class='range'>{range_math}: {rows}</p>" + self._grid(heads, columns, n)
 
     def block_table(self, t) -> str:
         df = self.sheet.block_table_cached(t.name)
@@ -355,7 +356,8 @@ class Document:
         columns = [df[c].to_numpy(dtype=object) for c in df.columns]
         return (
             f"<p class='range'>computed by the solver block <code>{escape(t.block)}</code>: "
-            f"{len(df)} rows</p>" + self._grid(heads, columns, len(df))
+            f"{len(df):,} row{'s' if len(df) != 1 else ''}</p>"
+            + self._grid(heads, columns, len(df))
         )
 
     def _grid(self, heads: list[str], columns: list, n: int) -> str:
@@ -364,7 +366,7 @@ class Document:
         first; a long one shows its first and last rows."""
         if n <= 2 and len(heads) > 4:
             body = "".join(
-                f"<tr data-col='{j}'><th>{h}</th>"
+                f"<tr data-col='{j}'><th>{h.replace('<br>', ' ')}</th>"
                 + "".join(f"<td class='num'>{num_html(v)}</td>" for v in columns[j])
                 + "</tr>"
                 for j, h in enumerate(heads)
@@ -610,6 +612,7 @@ CSS = """
 .workbook-report .eq { line-height: 2.1; }
 .workbook-report .eq math { margin-right: .25em; }
 .workbook-report mtd { text-align: left; padding: .1em .6em .1em 0; }
+.workbook-report mfrac > * { math-style: normal; }
 .workbook-report .error { color: #b00020; }
 .workbook-report mtext.error { color: #b00020; }
 .workbook-report table { border-collapse: collapse; margin: .3em 0 .8em; font-size: 8.5pt; }

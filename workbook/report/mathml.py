@@ -95,7 +95,11 @@ def _mi(text: str) -> Box:
 
 
 def _parens(box: Box, open_: str = "(", close: str = ")") -> Box:
-    return Box(f"<mrow><mo>{open_}</mo>{box.xml}<mo>{close}</mo></mrow>", box.width + 0.7)
+    # Brackets stretch only around tall content: Chromium drops stretched brackets from the
+    # table headers it repeats on a new page (seen in the printed PDF).
+    tall = any(tag in box.xml for tag in ("<mfrac", "<mtable", "<munder", "<msqrt"))
+    mo = "<mo>" if tall else "<mo stretchy='false'>"
+    return Box(f"<mrow>{mo}{open_}</mo>{box.xml}{mo}{close}</mo></mrow>", box.width + 0.7)
 
 
 def _join(*boxes: Box, prec: float = ATOM, numeric: bool | None = None) -> Box:
@@ -248,7 +252,7 @@ class MathML(Visitor):
             return name_box(node.id)
         if isinstance(value, str):
             return text_box(f"\u201c{value}\u201d")
-        return quantity_box(*value)
+        return quantity_box(*value, attrs=f"class='value' data-name='{escape(node.id)}'")
 
     # -- operators ---------------------------------------------------------------------------
     def visit_Unary(self, node: ex.Unary) -> Box:
