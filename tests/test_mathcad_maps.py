@@ -170,3 +170,36 @@ def test_printed_text_where_the_sheet_computes_a_number_fails(tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["reproduced"], result["failed"]) == (2, 1, 1)
     assert result["failures"][0]["printed"] == "OK"
+
+
+def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
+    """x := 1, Given x^2 = 2, s := Find(x) = sqrt(2): root(x^2 - 2, x, guess)."""
+    import math
+
+    given = '<region region-id="2" left="0" top="40" align-y="40"><math>' + (
+        f'<ml:id xmlns:ml="{ML}">Given</ml:id></math></region>'
+    )
+    equation = '<region region-id="3" left="0" top="60" align-y="60"><math>' + (
+        f'<ml:apply xmlns:ml="{ML}"><ml:equal/>{_apply("pow", _id("x"), _real(2))}'
+        f"{_real(2)}</ml:apply></math></region>"
+    )
+    find = f"<ml:apply><ml:Find/>{_id('x')}</ml:apply>"
+    src = tmp_path / "solve.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("x") + _real(1)),
+            given,
+            equation,
+            _region(
+                4,
+                _id("s") + f"<ml:eval>{find}<ml:result>{_real(math.sqrt(2))}</ml:result></ml:eval>",
+            ),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "0 regions not translated" in capsys.readouterr().out
+    text = (tmp_path / "solve.toml").read_text(encoding="utf-8")
+    assert "root(x_^2 - 2, x_, x)" in text
+    main(["check", str(tmp_path / "solve.toml"), "--json"])
+    assert json.loads(capsys.readouterr().out)["reproduced"] == 1

@@ -217,6 +217,8 @@ class ExprTranslator(Visitor):
             return self._index(args)
         if tag in _BINDERS:
             return self._binder(tag, args)
+        if tag == "Find":
+            return self.tr.find(self, args)
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
 
     def _bound(self, var: MNode, body: MNode) -> tuple[ex.Node, ex.Node]:
@@ -336,6 +338,8 @@ class Translator:
         self.note: list[str] = []
         self.calls: dict[Sym, list[tuple[ex.Node, ...]]] = {}  # call sites of each function
         self._index: Sym | None = None
+        self.given: list[str] | None = None  # regions of the open solve block
+        self.constraints: list[MNode] = []
         self.origin = 0  # Mathcad's ORIGIN where the translation is
         self.sheet_origin = 0  # the worksheet's [sheet] origin
 
@@ -388,6 +392,7 @@ class Translator:
                 self.math(region)
             except Untranslatable as why:
                 self.skip(region.id, self.describe(region.math), str(why))
+        self.close_given("a solve block without Find")
         self.argument_units()
         return self.out
 
@@ -440,11 +445,53 @@ class Translator:
         elif node.tag == "eval":
             self.evaluation(region, node, None)
         elif node.tag == "id" and node.text.strip() == "Given":
-            raise Untranslatable("Given/Find solve blocks are not in the language yet")
+            self.close_given("a solve block without Find")
+            self.given = [region.id]
+            self.constraints = []
         elif node.tag == "apply" and node.children and node.children[0].tag in _COMPARE:
-            raise Untranslatable("a constraint of a solve block (Given ... Find)")
+            if self.given is None:
+                raise Untranslatable("an equation outside a solve block (Given ... Find)")
+            self.given.append(region.id)
+            self.constraints.append(node)
         else:  # a name or an expression alone: Mathcad shows nothing, defines nothing
             self.out.ignored.append(region.id)
+
+    def close_given(self, why: str | None) -> None:
+        """End the open solve block: its regions are listed if it was not translated."""
+        if self.given is not None and why is not None:
+            for rid in self.given:
+                self.skip(rid, "a region of a solve block (Given ... Find)", why)
+        self.given = None
+        self.constraints = []
+
+    def find(self, et: ExprTranslator, args: list[MNode]) -> ex.Node:
+        """Find(x) of a solve block with one equation in one unknown: root(lhs - rhs, x,
+        guess), the guess being x's value before the block, as Mathcad's."""
+        if self.given is None:
+            raise Untranslatable("Find without Given")
+        try:
+            if len(args) != 1 or args[0].tag != "id":
+                raise Untranslatable(
+                    f"a solve block in {len(args)} unknowns (the language solves one: root)"
+                )
+            eqs = [c for c in self.constraints if c.children[0].tag == "equal"]
+            if len(eqs) != 1 or len(self.constraints) != 1:
+                raise Untranslatable(
+                    "a solve block with inequalities or more than one equation (the language "
+                    "solves one equation in one unknown: root)"
+                )
+            lhs, rhs = eqs[0].children[1], eqs[0].children[2]
+            if "root" not in language_functions():
+                raise Untranslatable("root() is not in the language yet")
+            diff = MNode("apply", {}, "", [MNode("minus", {}, "", []), lhs, rhs])
+            body, var = et._bound(args[0], diff)
+            guess = et.visit(args[0])  # x's value before the block
+            self.sym_of(var).hint = guess
+        except Untranslatable as why:
+            self.close_given(str(why))
+            raise
+        self.close_given(None)
+        return ex.Call("root", (body, var, guess))
 
     def _forced(self, region: Region, sym: Sym | None) -> None:
         why = self.forced.get(region.id)
