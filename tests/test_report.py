@@ -70,6 +70,8 @@ def _shown(text: str) -> str:
         "log10(x) + ln(y) + exp(-z) + atan2(y, x)",
         "sum(R*sin(k*x)/k, k, 1, 3) + 2*sum(I^2 + 1, I, 1, n)",
         "floor(x/2) - ceil(-x) + abs(a - b)*sqrt(c)",
+        "integral(x^2 + 1, x, 0, a) + maximum(sin(x), x, 0, 3)*argmin(x^2 - x, x, -1, 1)",
+        "diff(x^3, x) - diff(x^3, x, 2) + product(I + 1, I, 1, n)",
     ],
 )
 def test_the_formula_shown_is_the_formula_written(text):

@@ -20,7 +20,8 @@ An entry says everything the engine needs to know about one function:
 * ``doc``: one line for the documentation;
 * ``mathml``: how a report writes a call (:mod:`workbook.report.mathml`): MathML in which
   ``{0}``, ``{1}``... are the arguments, ``{0:group}`` the argument bracketed unless it is a
-  product or tighter, ``{args}`` all of them with commas; empty: the name and the arguments in
+  product or tighter, ``{args}`` all of them with commas; a call whose arguments the template
+  does not all show (diff with N), or an empty template: the name and the arguments in
   brackets, ``sin(x)``. ``mathml_powered``: a power of a call is written on the name, as
   ``sin²(x)``.
 

@@ -276,14 +276,16 @@ register(
         _integral_sympy,
         doc="integral(EXPR, X, A, B): the definite integral of EXPR for X from A to B",
         binds=(0, 1),
+        mathml="<msubsup><mo>\u222b</mo>{2}{3}</msubsup>{0:group}<mo>\u2062</mo>"
+        "<mi mathvariant='normal'>d</mi>{1}",
         excel_functions=("SUMPRODUCT",),
     )
 )
-for _name, _text in (
-    ("maximum", "the largest value of EXPR for X in [A, B]"),
-    ("minimum", "the smallest value of EXPR for X in [A, B]"),
-    ("argmax", "the X in [A, B] where EXPR is largest"),
-    ("argmin", "the X in [A, B] where EXPR is smallest"),
+for _name, _text, _shown in (
+    ("maximum", "the largest value of EXPR for X in [A, B]", "max"),
+    ("minimum", "the smallest value of EXPR for X in [A, B]", "min"),
+    ("argmax", "the X in [A, B] where EXPR is largest", "arg\u2009max"),
+    ("argmin", "the X in [A, B] where EXPR is smallest", "arg\u2009min"),
 ):
     register(
         Builtin(
@@ -295,6 +297,8 @@ for _name, _text in (
             _no_sympy(_name),
             doc=f"{_name}(EXPR, X, A, B): {_text} (the global one among all local ones)",
             binds=(0, 1),
+            mathml=f"<munder><mi>{_shown}</mi><mrow>{{1}}<mo>\u2208</mo><mrow><mo>[</mo>{{2}}"
+            "<mo separator='true'>,</mo>{3}<mo>]</mo></mrow></mrow></munder>{0:group}",
         )
     )
 register(
@@ -308,6 +312,8 @@ register(
         doc="diff(EXPR, X) or diff(EXPR, X, N): the (N-th) derivative of EXPR in X, "
         "found symbolically at load (a formula like any other)",
         binds=(0, 1),
+        mathml="<mfrac><mi mathvariant='normal'>d</mi><mrow><mi mathvariant='normal'>d</mi>{1}"
+        "</mrow></mfrac>{0:group}",
     )
 )
 register(
@@ -320,5 +326,6 @@ register(
         _product_sympy,
         doc="product(EXPR, I, A, B): EXPR multiplied over the integers I = A..B (1 if B < A)",
         binds=(0, 1),
+        mathml="<munderover><mo>\u220f</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
     )
 )

@@ -279,7 +279,8 @@ class MathML(Visitor):
             right = _parens(right)  # a − (−b), 2·(−x)
         if op == "*":
             if (
-                left.numeric
+                self.values is None  # with values put in, every product shows its dot
+                and left.numeric
                 and not right.numeric
                 and left.prec >= PREC["neg"]
                 and _leftmost(node.right) not in ("e", "E")  # 2e would read as a number
@@ -351,7 +352,7 @@ class MathML(Visitor):
             args = [self.box(a) for a in node.args]
         finally:
             self.bound -= bound
-        if entry is not None and entry.mathml:
+        if entry is not None and entry.mathml and _fits(entry.mathml, len(args)):
             return self._registered(func, entry.mathml, args)
         # the sheet's own functions and solver blocks are named like values (R3 as R₃)
         head = _mi(func) if entry is not None else name_box(func)
@@ -411,6 +412,15 @@ class _Arg:
         if spec == "group" and self.box.prec < PREC["*"]:
             return _parens(self.box).xml
         return self.box.xml
+
+
+def _fits(template: str, n: int) -> bool:
+    """A registry template writes a call of ``n`` arguments only if it shows each of them
+    (diff(f, x, 2) is not written as the first derivative)."""
+    if "{args" in template:
+        return True
+    shown = {int(i) for i in re.findall(r"\{(\d+)", template)}
+    return shown == set(range(n))
 
 
 def _commas(boxes: list[Box]) -> Box:
