@@ -1015,7 +1015,9 @@ class _Units(Visitor):
             u = self.visit(node)
         except (_Unknown, Exception):  # noqa: BLE001 - unknown: the engine decides
             return None
-        return None if u is None else str(u)
+        if u is None:
+            return None
+        return "" if u.dimensionless else str(u)
 
     def _reg(self):
         from .. import units as un
@@ -1213,7 +1215,8 @@ def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNod
         raise Untranslatable("an empty range")
     if n > 100_000:
         raise Untranslatable("a range of more than 100,000 values")
-    return [a + k * step for k in range(n + 1)], ("" if unit == "" or not str(unit) else str(unit))
+    dimensionless = unit == "" or not str(unit) or unit.dimensionless
+    return [a + k * step for k in range(n + 1)], ("" if dimensionless else str(unit))
 
 
 class _Values(Visitor):

@@ -293,7 +293,7 @@ def _table_for(tr: Translation, arg: str, mapping) -> list[str]:
     cols = ", ".join(f'{_q(f + "(" + arg + ")")} = ""' for f in funcs)
     return [
         "",
-        "[[tables]]",
+        f"[[tables]]  # what Mathcad listed over {item.sym.mathcad} (region {item.region})",
         f"name = {_q('table_' + arg)}",
         f"range = {_q(arg + ' := ' + _range_text(item, mapping))}",
         f"columns = {{ {cols} }}",
