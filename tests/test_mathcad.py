@@ -75,3 +75,21 @@ def test_imported_worksheet_runs(name, tmp_path, capsys):
     out = tmp_path / "out.xlsx"
     assert main(["run", str(toml), "--out", str(out)]) == 0
     assert out.exists()
+
+
+def _has_arrays() -> bool:
+    import importlib.util
+
+    from workbook import expr as ex
+
+    return hasattr(ex, "Matrix") and importlib.util.find_spec("workbook.program") is not None
+
+
+@pytest.mark.skipif(not _has_arrays(), reason="the language has no vectors and programs yet")
+@pytest.mark.parametrize("name", ["lagrange-polynomial.xmcd", "fermat-spiral.xmcd"])
+def test_vectors_over_ranges_reproduce_every_stored_value(name, tmp_path, capsys):
+    """t1[i] := ..., A[i, j] := f(i, j) over ranges, columns and a matrix Mathcad showed."""
+    toml, _ = _import(name, tmp_path, capsys)
+    result = _check(toml, capsys)
+    assert result["failed"] == 0, result["failures"]
+    assert result["reproduced"] == result["printed"], result["failures"]

@@ -203,3 +203,33 @@ def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
     assert "root(x_^2 - 2, x_, x)" in text
     main(["check", str(tmp_path / "solve.toml"), "--json"])
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
+
+
+def _has_programs() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("workbook.program") is not None
+
+
+@pytest.mark.skipif(not _has_programs(), reason="the language has no programs yet")
+def test_program_with_a_loop(tmp_path, capsys):
+    """s(n) := | a <- 0 ; for i in 1..n: a <- a + i ; a |, and s(4) = 10 as stored."""
+    loop = (
+        f"<ml:for>{_id('i')}<ml:range>{_real(1)}{_id('n')}</ml:range>"
+        f"<ml:localDefine>{_id('a')}{_apply('plus', _id('a'), _id('i'))}</ml:localDefine>"
+        "</ml:for>"
+    )
+    start = f"<ml:localDefine>{_id('a')}{_real(0)}</ml:localDefine>"
+    program = f"<ml:program>{start}{loop}{_id('a')}</ml:program>"
+    call = f"<ml:apply>{_id('s')}{_real(4)}</ml:apply>"
+    src = tmp_path / "loop.xmcd"
+    src.write_text(
+        _worksheet(_function(1, "s", ["n"], program), _eval(2, call, _real(10))),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "0 regions not translated" in capsys.readouterr().out
+    text = (tmp_path / "loop.toml").read_text(encoding="utf-8")
+    assert "for i in 1 .. n" in text
+    main(["check", str(tmp_path / "loop.toml"), "--json"])
+    assert json.loads(capsys.readouterr().out)["reproduced"] == 1
