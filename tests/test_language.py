@@ -12,6 +12,8 @@ from workbook.template import load_spec
 DOC = Path(__file__).parent.parent / "docs" / "language.md"
 BLOCKS = re.findall(r"```toml\n(.*?)```", DOC.read_text(encoding="utf-8"), flags=re.S)
 RUNNABLE = [b for b in BLOCKS if "# expect:" in b]
+# data files the examples read (```csv NAME blocks), written beside each example
+FILES = re.findall(r"```csv (\S+)\n(.*?)```", DOC.read_text(encoding="utf-8"), flags=re.S)
 
 
 def test_the_reference_has_runnable_examples():
@@ -22,6 +24,8 @@ def test_the_reference_has_runnable_examples():
 def test_example(tmp_path, text):
     path = tmp_path / "example.toml"
     path.write_text(text, encoding="utf-8")
+    for name, content in FILES:
+        (tmp_path / name).write_text(content, encoding="utf-8")
     expects = re.findall(r"# expect: (.*)", text)
     errors = [e[len("error: ") :] for e in expects if e.startswith("error: ")]
     sheet = None

@@ -1,5 +1,6 @@
 """root, integral, maximum/argmax, sum/product and diff in worksheets, against scipy/mpmath."""
 
+import re
 from pathlib import Path
 
 import mpmath
@@ -205,3 +206,54 @@ def test_loading_a_sheet_with_numerical_builtins_imports_no_scipy():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+PUMP = "Q,H\n0,32.0\n10,31.2\n20,29.5\n30,26.4\n40,21.8\n50,15.9\n"
+DATA = """
+[data.pump]
+file = "pump.csv"
+columns = { Q = "m^3/h", H = "m" }
+[inputs]
+T = "2 s"
+[arguments]
+q = { unit = "L/s" }
+[definitions]
+"""
+
+
+def test_interpolation_against_scipy_and_numpy(tmp_path):
+    from scipy.interpolate import make_interp_spline
+
+    (tmp_path / "pump.csv").write_text(PUMP)
+    s = sheet(tmp_path, DATA + '"lin(q)" = "linterp(Q, H, q)"\n"cub(q)" = "cspline(Q, H, q)"\n')
+    q = np.linspace(0.0, 50 / 3.6, 23)  # L/s, the data's whole range
+    qh = q * 3.6  # m^3/h
+    xs = np.array([0, 10, 20, 30, 40, 50.0])
+    ys = np.array([32.0, 31.2, 29.5, 26.4, 21.8, 15.9])
+    assert s.evaluate("lin", q).to("m").magnitude == pytest.approx(np.interp(qh, xs, ys), rel=1e-13)
+    spline = make_interp_spline(xs, ys, k=3)  # not-a-knot ends
+    assert s.evaluate("cub", q).to("m").magnitude == pytest.approx(spline(qh), rel=1e-12)
+    with pytest.raises(NumericsError, match="outside the data"):
+        s.evaluate("lin", 20.0)
+
+
+@pytest.mark.parametrize(
+    "csv, definition, error, message",
+    [
+        (PUMP, '"linterp(Q, H, T)"', UnitError, "x is [time] (s), but the data column Q"),
+        (PUMP, '"linterp(Q, eta, T)"', TemplateError, "must be a column of a [data] table"),
+        (PUMP, '"2*Q"', TemplateError, "'Q' is a column of the data table 'pump'"),
+        (PUMP.replace("20,29.5", "5,29.5"), '"linterp(Q, H, 0)"', NumericsError, "increasing"),
+        (
+            PUMP.replace("31.2", "high"),
+            '"linterp(Q, H, 0)"',
+            TemplateError,
+            "'high' is not a number",
+        ),
+    ],
+)
+def test_data_mistakes_are_refused_at_load(tmp_path, csv, definition, error, message):
+    (tmp_path / "pump.csv").write_text(csv)
+    with pytest.raises(error, match=re.escape(message)) as err:
+        sheet(tmp_path, DATA + f"bad = {definition}\n")
+    assert "s.toml" in str(err.value)

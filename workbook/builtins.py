@@ -38,6 +38,10 @@ source order of the arguments (the variable as a ``TParam``). The hooks then rec
   their values when they are constants (else None);
 * ``sympy(sp, body, var, *exprs)``: ``body`` in the symbol ``var``.
 
+Built-ins that read measured data (``linterp(X, Y, x)``) set ``data_args``: the arguments
+at those positions must be names of ``[data]`` columns, typed as references of kind
+``data`` (the column's values, in its declared unit); such names are refused elsewhere.
+
 To add a built-in, write its rule and hooks and call :func:`register` at import of the module
 that defines it (a module of the package imported by :mod:`workbook`), e.g.::
 
@@ -99,6 +103,7 @@ class Builtin:
     domain: tuple[Domain, ...] = ()
     doc: str = ""
     binds: tuple[int, int] | None = None
+    data_args: tuple[int, ...] = ()  # arguments that name columns of [data] tables
     excel_functions: tuple[str, ...] = ()
     mathml: str = ""
     mathml_powered: bool = False

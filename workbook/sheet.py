@@ -213,6 +213,8 @@ class Sheet:
             return self.values[name]
         if kind == "builtin":
             return math.pi
+        if kind == "data":
+            return self.spec.data[name].values
         if name not in self._memo:
             d = self.spec.definitions[name]
             try:

@@ -23,6 +23,7 @@ from . import expr as ex
 from . import units as un
 from .builtins import REGISTRY
 from .errors import InputError, LimitError, TemplateError, WorkbookError
+from .measured import read_data
 
 MAX_RANGE_POINTS = 2_000_000
 MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
@@ -40,6 +41,7 @@ SECTIONS = {
     "findings",
     "sweep",
     "parts",
+    "data",
 }
 ALL_PARTS = "all"
 _PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
@@ -230,6 +232,7 @@ class SheetSpec:
     meta: dict[str, Any]
     text: str
     parts: dict[str, PartSpec] = field(default_factory=dict)
+    data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
 
     def line_of(self, key: str, section: str | None = None) -> int | None:
         return find_line(self.text, key, section)
@@ -502,6 +505,10 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
                 definition=pname,
             )
 
+    measured = read_data(
+        _table(data, "data"), path, lambda key, sec: find_line(text, key, sec), claim
+    )
+
     tables = [_table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
     charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
     printed = [_printed_spec(p, path, text) for p in _list(data, "printed")]
@@ -533,6 +540,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         meta=sheet,
         text=text,
         parts=parts,
+        data=measured,
     )
 
 

@@ -224,6 +224,12 @@ class Typer(Visitor):
     def _name(self, name: str, scope) -> T:
         if name in scope:
             return TParam(scope[name], name=name)
+        if name in self.spec.data:
+            col = self.spec.data[name]
+            raise TemplateError(
+                f"'{name}' is a column of the data table '{col.table}': use it in "
+                f"linterp(X, Y, x) or cspline(X, Y, x)"
+            )
         if name in self.spec.inputs:
             u = self.input_units[name]
             if u is None:
@@ -340,6 +346,8 @@ class Typer(Visitor):
         if entry is not None and entry.binds and name not in self.spec.definitions:
             if name not in self.spec.blocks:
                 return self._binding_call(node, scope)
+        if entry is not None and entry.data_args and name not in self.spec.definitions:
+            return self._data_call(node, scope)
         known = name in self.spec.definitions or name in self.spec.blocks or name in REGISTRY
         args = [self.visit(a, scope) for a in node.args] if known else []  # unknown: say so first
         for a in args:
@@ -411,6 +419,25 @@ class Typer(Visitor):
             elif i == expr_at:
                 body = self.visit(a, {**scope, var.id: unit})
                 args.append(self._number(body, f"argument {i + 1} of {name}()"))
+            else:
+                args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
+        return entry.unit_rule(self, name, tuple(args))
+
+    def _data_call(self, node: ex.Call, scope) -> T:
+        """A built-in reading [data] columns: those arguments are column names (their values)."""
+        name, entry = node.func, REGISTRY[node.func]
+        entry.check_arity(len(node.args))
+        args: list[T] = []
+        for i, a in enumerate(node.args):
+            if i in entry.data_args:
+                col = self.spec.data.get(a.id) if isinstance(a, ex.Name) else None
+                if col is None:
+                    known = ", ".join(self.spec.data) or "none: add a [data] table"
+                    raise TemplateError(
+                        f"{name}(): argument {i + 1} must be a column of a [data] table "
+                        f"(columns: {known}), got {ex.to_text(a)!r}"
+                    )
+                args.append(TRef(col.unit, name=a.id, kind="data"))
             else:
                 args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         return entry.unit_rule(self, name, tuple(args))

@@ -1,5 +1,6 @@
 """Registry entries of the numerical built-ins: root, integral, maximum/minimum/argmax/argmin,
-product and diff (one :class:`workbook.builtins.Builtin` each; ``sum`` is in builtins.py).
+product, diff, and linterp/cspline over [data] columns (one :class:`workbook.builtins.Builtin`
+each; ``sum`` is in builtins.py).
 
 Each binds its variable (``binds=(0, 1)``): the unit rule checks the bounds or the guess
 against the variable's unit at load; the numpy hook receives EXPR as a
@@ -329,3 +330,60 @@ register(
         mathml="<munderover><mo>\u220f</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
     )
 )
+
+
+# -- interpolation in [data] columns ------------------------------------------------------------
+def _interp_unit(ctx, name: str, args: tuple) -> ty.T:
+    from .interpolate import check_data
+
+    xs, ys, x = args
+    cx, cy = ctx.spec.data[xs.name], ctx.spec.data[ys.name]
+    if cx.table != cy.table:
+        raise TemplateError(
+            f"{name}(): {xs.name} is a column of '{cx.table}' and {ys.name} of '{cy.table}': "
+            "give two columns of one data table"
+        )
+    check_data(cx.values, cy.values, f"{name}({xs.name}, {ys.name}, ...) in {cx.file.name}")
+    if x.unit.dimensionality != xs.unit.dimensionality and not _zero(x):
+        raise UnitError(
+            f"{name}(): x is {un.dims(x.unit)} ({un.pretty(x.unit) or '1'}), but the data "
+            f"column {xs.name} is {un.dims(xs.unit)} ({un.pretty(xs.unit) or '1'})"
+        )
+    x = ctx.convert(x, xs.unit, f"{name}(): x")
+    return ty.TFunc(ys.unit, func=name, args=(xs, ys, x))
+
+
+def _interp_numpy(kind: str):
+    from .interpolate import interpolate
+
+    def hook(xs, ys, x):
+        return _out(interpolate(xs, ys, x, kind=kind, what=f"{_KINDS[kind]}()"))
+
+    return hook
+
+
+_KINDS = {"linear": "linterp", "cubic": "cspline"}
+
+
+def _interp_excel(args) -> tuple[str, int]:
+    raise NotLive("interpolation in a [data] table: its values are written as numbers")
+
+
+for _kind, _name in _KINDS.items():
+    register(
+        Builtin(
+            _name,
+            3,
+            _interp_unit,
+            _interp_numpy(_kind),
+            _interp_excel,
+            _no_sympy(_name),
+            doc=f"{_name}(X, Y, x): y at x, "
+            + (
+                "linear between the data points (Mathcad's linterp)"
+                if _kind == "linear"
+                else "on a cubic spline through the data points (Mathcad's interp(cspline(...)))"
+            ),
+            data_args=(0, 1),
+        )
+    )

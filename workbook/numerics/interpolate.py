@@ -28,13 +28,16 @@ def interpolate(xs, ys, x, *, kind: str = "linear", what: str = "linterp()", uni
     """y at x by linear interpolation (``linear``) or a not-a-knot cubic spline (``cubic``,
     Mathcad's cspline with cubic ends). x outside the data is an error, not an extrapolation."""
     x = np.asarray(x, dtype=float)
-    out = (x < xs[0]) | (x > xs[-1])
+    # unit conversions round: an end point a few ulps outside is the end point
+    slack = 1e-12 * max(float(np.max(np.abs(xs))), float(xs[-1] - xs[0]))
+    out = (x < xs[0] - slack) | (x > xs[-1] + slack)
     if out.any():
         v = x[out].flat[0] if x.ndim else float(x)
         raise NumericsError(
             f"{what}: x = {num(v)}{_u(unit)} is outside the data "
             f"[{num(xs[0])}, {num(xs[-1])}]{_u(unit)}"
         )
+    x = np.clip(x, xs[0], xs[-1])
     if kind == "linear":
         return np.interp(x, xs, ys)
     from scipy.interpolate import CubicSpline
