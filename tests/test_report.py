@@ -131,9 +131,14 @@ def _same(shown: float, engine: float, digits: int = 6) -> bool:
     return shown == float(f"{engine:.{digits}g}")
 
 
-def check_numbers(sheet) -> int:
+@pytest.fixture(scope="module")
+def concave_report(concave) -> str:
+    return render(concave)
+
+
+def check_numbers(sheet, text: str | None = None) -> int:
     """Compare every number of the report of ``sheet`` with the engine; returns how many."""
-    doc = rp.parse(render(sheet))
+    doc = rp.parse(text or render(sheet))
     count = 0
     # inputs
     for row in doc.xpath("//table[@class='inputs']/tbody/tr"):
@@ -254,8 +259,8 @@ def _compare_cells(cells, indices, values, name) -> int:
     return len(cells)
 
 
-def test_every_number_is_the_engines(concave):
-    assert check_numbers(concave) > 300
+def test_every_number_is_the_engines(concave, concave_report):
+    assert check_numbers(concave, concave_report) > 300
 
 
 @pytest.mark.slow
@@ -264,8 +269,8 @@ def test_every_number_is_the_engines_in_every_template(name):
     assert check_numbers(workbook.load(name)) > 10
 
 
-def test_substituted_values_are_the_inputs(concave):
-    doc = rp.parse(render(concave))
+def test_substituted_values_are_the_inputs(concave_report):
+    doc = rp.parse(concave_report)
     eq = doc.get_element_by_id("def-k")
     maths = eq.xpath(".//math")
     assert rp.formula_text(maths[0]) == "k==((R1+R3)/(R3-Rp))"
@@ -276,8 +281,8 @@ def test_substituted_values_are_the_inputs(concave):
 # -- the document --------------------------------------------------------------------------
 
 
-def test_the_document_is_self_contained(concave):
-    text = render(concave)
+def test_the_document_is_self_contained(concave, concave_report):
+    text = concave_report
     lower = text.lower()
     for banned in ("<script", "<link", "@import", "src=", "url(http", "<iframe", "<img"):
         assert banned not in lower, banned
@@ -324,8 +329,8 @@ def test_long_tables_show_their_ends(tmp_path):
     assert len(full.get_element_by_id("table-t").xpath(".//tbody/tr")) == 1801
 
 
-def test_the_notebook_shows_the_same_rendering(concave):
-    page = render(concave)
+def test_the_notebook_shows_the_same_rendering(concave, concave_report):
+    page = concave_report
     shown = concave._repr_html_()
     body = page[page.index("<header>") : page.index("</main>")].strip()
     assert body in shown and "<script" not in shown
@@ -371,3 +376,23 @@ def test_a_failed_write_keeps_the_old_file(tmp_path, monkeypatch):
         sheet.with_inputs(R="30 mm").report(out)
     assert out.read_text(encoding="utf-8") == before
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+@pytest.mark.slow
+def test_charts_leave_pyplot_alone_and_run_does_not_draw(tmp_path):
+    """Reports draw with a bare matplotlib Figure (a notebook's backend is left alone);
+    ``workbook run`` imports neither the report nor matplotlib."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, workbook\n"
+        "from workbook.cli import main\n"
+        f"main(['run', 'concave-cam', '--out', {str(tmp_path / 'c.xlsx')!r}])\n"
+        "print(sorted(m for m in ('matplotlib', 'workbook.report') if m in sys.modules))\n"
+        "from workbook.report import render\n"
+        "assert render(workbook.load('concave-cam')).count('<svg') == 2\n"
+        "print('matplotlib.pyplot' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.splitlines()[-2:] == ["[]", "False"], out.stdout
