@@ -78,11 +78,10 @@ def test_imported_worksheet_runs(name, tmp_path, capsys):
 
 
 def _has_arrays() -> bool:
-    import importlib.util
-
     from workbook import expr as ex
+    from workbook.mathcad.program import available
 
-    return hasattr(ex, "Matrix") and importlib.util.find_spec("workbook.program") is not None
+    return hasattr(ex, "Matrix") and available()
 
 
 @pytest.mark.skipif(not _has_arrays(), reason="the language has no vectors and programs yet")

@@ -206,9 +206,9 @@ def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
 
 
 def _has_programs() -> bool:
-    import importlib.util
+    from workbook.mathcad.program import available
 
-    return importlib.util.find_spec("workbook.program") is not None
+    return available()
 
 
 @pytest.mark.skipif(not _has_programs(), reason="the language has no programs yet")

@@ -24,10 +24,10 @@ _SIMPLE = ("localDefine", "return", "break", "continue")
 
 
 def available() -> bool:
-    """Whether the language has programs."""
-    import importlib.util
+    """Whether the language has programs (a definition may be a program)."""
+    from ..template import Definition
 
-    return importlib.util.find_spec("workbook.program") is not None
+    return "program" in getattr(Definition, "__dataclass_fields__", {})
 
 
 class ProgramTranslator:
