@@ -396,3 +396,11 @@ def test_charts_leave_pyplot_alone_and_run_does_not_draw(tmp_path):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.splitlines()[-2:] == ["[]", "False"], out.stdout
+
+
+def test_functions_point_to_their_tables_and_charts(concave_report):
+    doc = rp.parse(concave_report)
+    note = doc.get_element_by_id("def-h").xpath(".//p[@class='note']")[0].text_content()
+    assert "in mm" in note and "values in table curves, chart fig4" in note
+    brace = doc.get_element_by_id("def-h").xpath(".//mtable")[0]
+    assert len(brace.xpath("mtr")) == 3

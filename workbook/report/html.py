@@ -267,6 +267,9 @@ class Document:
                 unit = ""
             if unit:
                 notes.append(f"in {unit}")
+            shown = self._shown_in(d.name)
+            if shown:
+                notes.append("values in " + ", ".join(shown))
         else:
             if d.body is not None and self._substitutes(d.body):
                 subst = self.substituted.box(d.body)
@@ -297,6 +300,25 @@ class Document:
             f"<div class='definition' id='def-{escape(d.name)}'>"
             f"<div class='eq'>{' '.join(pieces)}</div>{note}{error}</div>"
         )
+
+    def _shown_in(self, name: str) -> list[str]:
+        """The tables and charts whose columns call function ``name`` directly."""
+        out = []
+        for t in self.spec.tables:
+            if t.range is not None and any(
+                name in ex.names(self.sheet.column_node(c, t.range.var)) for c in t.columns
+            ):
+                out.append(f"table {t.name}")
+        for c in self.spec.charts:
+            rng = c.range
+            if any(
+                s.table is None
+                and (s.range or rng) is not None
+                and name in ex.names(self.sheet.column_node(s.y, (s.range or rng).var))
+                for s in c.series
+            ):
+                out.append(f"chart {c.name}")
+        return out
 
     def _substitutes(self, node: ex.Node) -> bool:
         """True if the formula has names to put values in (and is not just one name)."""
