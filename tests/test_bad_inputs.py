@@ -8,14 +8,19 @@ Each corpus file is a template whose header comments say how to run it and what 
     # args: run FILE --set R1=40 kg   (optional; default `run FILE`; FILE is the corpus file)
     # setup: dir out.xlsx | text out.xlsx   (optional: make a folder or a text file first)
 
-The command runs in a subprocess from an empty temporary folder. Every case must exit with the
-expected status, print one paragraph on stderr starting with ``workbook:``, name the template
-file (and line and definition when given), and show no Python traceback; `--debug` must show one.
+The command runs from an empty temporary folder: in this process by default (the command
+line's ``main``; milliseconds a case), and in a fresh interpreter in the slow run (about a
+second a case), which must print the same. Every case must exit with the expected status,
+print one paragraph on stderr starting with ``workbook:``, name the template file (and line
+and definition when given), and show no Python traceback; `--debug` must show one.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import io
+import os
 import re
 import shlex
 import shutil
@@ -64,12 +69,17 @@ def read_case(path: Path) -> Case:
 CASES = sorted(CORPUS.glob("*.toml"))
 
 
-def run_case(case: Case, cwd: Path, *extra: str) -> subprocess.CompletedProcess:
+def _args(case: Case, cwd: Path) -> list[str]:
     template = cwd / case.path.name
-    shutil.copyfile(case.path, template)
-    args = [template.name if a == "FILE" else a for a in case.args]
+    if not template.exists():
+        shutil.copyfile(case.path, template)
+    return [template.name if a == "FILE" else a for a in case.args]
+
+
+def run_case(case: Case, cwd: Path, *extra: str) -> subprocess.CompletedProcess:
+    """The command line in a fresh interpreter."""
     return subprocess.run(
-        [sys.executable, "-c", CODE, *extra, *args],
+        [sys.executable, "-c", CODE, *extra, *_args(case, cwd)],
         capture_output=True,
         text=True,
         cwd=cwd,
@@ -77,11 +87,33 @@ def run_case(case: Case, cwd: Path, *extra: str) -> subprocess.CompletedProcess:
     )
 
 
+def run_in_process(case: Case, cwd: Path) -> subprocess.CompletedProcess:
+    """The command line's ``main`` in this process, from ``cwd``, with its output captured."""
+    import warnings
+
+    from workbook.cli import main
+
+    args = _args(case, cwd)
+    out, err = io.StringIO(), io.StringIO()
+    here = os.getcwd()
+    os.chdir(cwd)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            with warnings.catch_warnings():  # main() sets filters for the process
+                try:
+                    code = main(args)
+                except SystemExit as exc:  # argparse refuses the arguments
+                    code = exc.code
+    finally:
+        os.chdir(here)
+    return subprocess.CompletedProcess(args, code, out.getvalue(), err.getvalue())
+
+
 def test_corpus_is_large_enough():
     assert len(CASES) >= 40
 
 
-def _run_one(path: Path, root: Path):
+def _run_one(path: Path, root: Path, run=run_in_process):
     case = read_case(path)
     cwd = root / path.stem
     cwd.mkdir()
@@ -94,21 +126,41 @@ def _run_one(path: Path, root: Path):
         else:
             target.write_text("notes that are not a workbook\n")
             before = hashlib.sha256(target.read_bytes()).hexdigest()
-    return case, cwd, before, run_case(case, cwd)
+    return case, cwd, before, run(case, cwd)
 
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
-    """All cases, run four at a time (each is a fresh interpreter: ~1 s)."""
+    """All cases, one after the other in this process."""
     root = tmp_path_factory.mktemp("bad_inputs")
+    done = [_run_one(p, root) for p in CASES]
+    return {case.path.stem: (case, cwd, before, out) for case, cwd, before, out in done}
+
+
+@pytest.fixture(scope="module")
+def fresh_results(tmp_path_factory):
+    """All cases, each in a fresh interpreter (~1 s), four at a time."""
+    root = tmp_path_factory.mktemp("bad_inputs_fresh")
     with ThreadPoolExecutor(4) as pool:
-        done = pool.map(lambda p: _run_one(p, root), CASES)
+        done = pool.map(lambda p: _run_one(p, root, run_case), CASES)
         return {case.path.stem: (case, cwd, before, out) for case, cwd, before, out in done}
 
 
 @pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
 def test_bad_input(results, path):
-    case, cwd, before, out = results[path.stem]
+    _check(*results[path.stem])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
+def test_bad_input_in_a_fresh_interpreter(fresh_results, results, path):
+    _check(*fresh_results[path.stem])
+    _, _, _, here = results[path.stem]
+    _, _, _, fresh = fresh_results[path.stem]
+    assert (fresh.returncode, fresh.stderr) == (here.returncode, here.stderr)
+
+
+def _check(case: Case, cwd: Path, before: str | None, out: subprocess.CompletedProcess):
     err = out.stderr
     assert out.returncode == case.status, (out.returncode, err)
     assert "Traceback" not in err, err

@@ -57,6 +57,7 @@ def test_write_bench_tiny():
     _check(bench_write.run(n=30, reps=1), 2)
 
 
+@pytest.mark.slow
 def test_coldstart_bench_tiny():
     _check(bench_coldstart.run(reps=1), 2)  # the ratio, and the Mathcad sheet alone
 

@@ -1,7 +1,8 @@
-"""cam-wear: valve time-section, fuel-pump plunger, expanding-cam brake (SCENES.md section 5).
+"""cam-wear: valve time-section, fuel-pump plunger, expanding-cam brake.
 
-References are independent of the engine: the SCENES.md numbers, scipy.integrate.quad of the
-formulas written out here, and numerical differentiation / integration of the cam laws.
+References are independent of the engine: the reference example's numbers,
+scipy.integrate.quad of the formulas written out here, and numerical differentiation /
+integration of the cam laws.
 """
 
 import math
@@ -14,7 +15,7 @@ import pytest
 import workbook
 from workbook.errors import InputError, TemplateError, UnitError
 
-# -- the example of SCENES.md written out independently of the templates ---------------------
+# -- the reference example written out independently of the templates ------------------------
 D, D1, ALPHA = 40.0, 46.0, math.radians(45)
 H, PHI, P = 10.0, 240.0, 2.0
 WEAR = {"worn 1": (0.05, 0.40), "worn 2": (0.10, 0.80)}
@@ -369,6 +370,7 @@ def test_workbook_charts_show_unworn_and_worn(name, tmp_path):
     assert together, "no chart shows the unworn and the worn cam together"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_workbook_recalculates_in_libreoffice(name, tmp_path):
     from recalc import cell_values, formula_values, recalculate, soffice
@@ -412,6 +414,7 @@ def test_valve_velocity_and_acceleration_are_derivatives_of_the_lift(valve):
         assert mag(valve.evaluate(a, phi=phi), "m/s^2") == pytest.approx(da, abs=1e-2)
 
 
+@pytest.mark.slow
 def test_brake_workbook_follows_edited_inputs_in_libreoffice(tmp_path):
     import shutil
 

@@ -70,6 +70,7 @@ def test_bad_input_exit_2_without_traceback():
     assert out.returncode == 2 and "no template named" in out.stderr
 
 
+@pytest.mark.slow
 def test_export_profile_csv_for_cad(tmp_path):
     out = run(
         "run",
@@ -83,7 +84,7 @@ def test_export_profile_csv_for_cad(tmp_path):
     lines = (tmp_path / "profile.csv").read_text().splitlines()
     assert lines[0] == "x_mm,y_mm,z_mm"
     x, y, z = map(float, lines[1].split(","))
-    assert (x, y, z) == (46.0, 0.0, 0.0)  # SCENES.md: x_k = 46, y_k = 0 at phi = 0
+    assert (x, y, z) == (46.0, 0.0, 0.0)  # reference example: x_k = 46, y_k = 0 at phi = 0
     undercut = run(
         "run",
         "reducer-profile",

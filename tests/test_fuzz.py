@@ -112,12 +112,14 @@ FUZZ = settings(
 )
 
 
+@pytest.mark.slow
 @FUZZ
 @given(text=expressions())
 def test_generated_expressions(sheet, text):
     check(sheet, text)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(text=garbage())
 def test_generated_garbage(sheet, text):

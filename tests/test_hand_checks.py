@@ -258,6 +258,7 @@ def test_exact_lift_is_c1_at_the_transition(geometry):
     )
 
 
+@pytest.mark.slow
 def test_paper_against_exact(geometry):
     g = cc.geometry_numbers(geometry)
     theta, o2, o3 = _centres()
@@ -419,6 +420,7 @@ def test_workbook_holds_the_findings_and_tables(tmp_path, concave):
     assert len(wb["Charts"]._charts) == 5
 
 
+@pytest.mark.slow
 def test_geometry_workbook_recalculates_in_libreoffice(tmp_path, geometry):
     from recalc import cell_values, formula_values, recalculate, soffice
 

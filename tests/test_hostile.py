@@ -281,6 +281,7 @@ def test_solver_step_cap_stops_a_billion_steps():
     assert capped.stop_reason == "step cap" and capped.nsteps == 2000
 
 
+@pytest.mark.slow
 def test_solver_loop_asked_for_billions_of_steps(tmp_path):
     """The r0-synthesis VBA loop (workbook/blocks/r0.py) with dr = 1e-9 mm would need ~3e10
     steps: it is refused before it starts, by its step cap, under the same guard."""

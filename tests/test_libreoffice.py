@@ -9,7 +9,10 @@ from recalc import cell_values, formula_values, recalculate, soffice
 
 if soffice() is None and os.environ.get("CI"):
     raise RuntimeError("CI must run the LibreOffice recalculation tests: install libreoffice-calc")
-pytestmark = pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed")
+pytestmark = [
+    pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed"),
+    pytest.mark.slow,  # each test starts LibreOffice (10 s or more)
+]
 
 
 def assert_same(original, recalculated, rel=1e-9):

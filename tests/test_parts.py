@@ -46,6 +46,7 @@ def test_plain_run_leaves_out_the_hand_checks_and_their_imports(tmp_path):
     assert about["Regenerate with"] == "workbook run concave-cam"
 
 
+@pytest.mark.slow
 def test_part_adds_the_hand_checks(tmp_path):
     rc, modules = _fresh_run(tmp_path / "cc.xlsx", "--part", "hand-checks")
     assert rc == 0 and set(modules.split(",")) == set(HEAVY)

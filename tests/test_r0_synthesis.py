@@ -1,6 +1,6 @@
 """r0-synthesis: minimum cam radius for a pressure-angle limit (the VBA loop and the exact answer).
 
-References used here, none of them the solver under test: the numbers of SCENES.md section 2,
+References used here, none of them the solver under test: the numbers of the reference example,
 brute force over dense grids refined by scipy's bounded minimiser, mpmath at 40 digits, and a
 central-difference derivative of the rise laws.
 """
@@ -379,6 +379,7 @@ def _definitions(path):
     return {row[0].value: row[1].coordinate for row in ws.iter_rows(min_row=2)}
 
 
+@pytest.mark.slow
 def test_workbook_has_no_macro_and_live_r0(tmp_path, sheet):
     import openpyxl
 
@@ -407,6 +408,7 @@ def _recalc():
     return cell_values, formula_values, recalculate
 
 
+@pytest.mark.slow
 def test_libreoffice_recalculates_to_engine_values(tmp_path, sheet):
     cell_values, formula_values, recalculate = _recalc()
     path = sheet.write_xlsx(tmp_path / "r0.xlsx")
@@ -424,6 +426,7 @@ def test_libreoffice_recalculates_to_engine_values(tmp_path, sheet):
     assert len(cached) > 1000 and not bad, bad[:5]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("alpha_max, H", [(35.0, 16.0), (22.0, 20.0)])
 def test_changing_alpha_max_in_excel_moves_r0(tmp_path, sheet, alpha_max, H):
     import openpyxl

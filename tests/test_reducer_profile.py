@@ -1,8 +1,8 @@
-"""reducer-profile: tooth profile of a planetary roller reducer's cam (SCENES.md section 3).
+"""reducer-profile: tooth profile of a planetary roller reducer's cam.
 
 References that this file does not take from the engine:
-* the SCENES.md example coordinates (computed independently in double precision);
-* an mpmath implementation of formulas (1)-(5) written here from SCENES.md, with derivatives
+* the reference example's coordinates (computed independently in double precision);
+* an mpmath implementation of formulas (1)-(5) written here from the paper, with derivatives
   by mpmath.diff at 30 digits (the normal of (5));
 * the closed-form radius of curvature at a tooth valley of R(t) = e1 cos(Zt) + sqrt(r2^2 -
   e1^2 sin^2(Zt)): rho = (r2 - e1)^2 / (Z^2 (e1 - e1^2/r2) - (r2 - e1)).
@@ -60,16 +60,16 @@ def ref_practical(k, phi_deg, n, e1, r2, rp, sense):
         return [float(v) for v in (x, y, x + rps * dy / length, y - rps * dx / length)]
 
 
-# -- the SCENES.md example ------------------------------------------------------------------
+# -- the reference example -------------------------------------------------------------------
 
-SCENES = [  # phi, rho, a, x_t, y_t, x_k, y_k (n = 12, Z = 11, e1 = 2, r2 = 40, rp = 4, k = 0)
+EXAMPLE = [  # phi, rho, a, x_t, y_t, x_k, y_k (n = 12, Z = 11, e1 = 2, r2 = 40, rp = 4, k = 0)
     (0, 42, 0.0, 42, 0, 46, 0),
     (90, 39.95, -8.182, 39.5433, 5.6855, 42.7369, 8.0940),
     (180, 38, None, 36.4607, 10.7058, 40.2987, 11.8328),
 ]
 
 
-@pytest.mark.parametrize("row", SCENES, ids=[f"phi={r[0]}" for r in SCENES])
+@pytest.mark.parametrize("row", EXAMPLE, ids=[f"phi={r[0]}" for r in EXAMPLE])
 def test_scenes_example_coordinates(sheet, row):
     phi, rho, a, xt, yt, xk, yk = row
     assert sheet.evaluate("rho", 0, phi).to("mm").magnitude == pytest.approx(rho, abs=5e-3)
@@ -346,6 +346,7 @@ def test_workbook_chart_has_equal_axes(sheet, tmp_path):
     assert 'c:w val="0.76' in xml and 'c:h val="0.76' in xml  # square plot area
 
 
+@pytest.mark.slow
 def test_invalid_profile_is_still_written(sheet, tmp_path):
     import openpyxl
 
