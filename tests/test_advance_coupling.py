@@ -1,8 +1,8 @@
 """advance-coupling: steady curves and stiff dynamics of the centrifugal injection-advance coupling.
 
 References are not taken from the code under test where that is possible: the steady roots
-from mpmath.findroot on the equilibrium written out here from SCENES.md section 4, the printed
-example values of SCENES.md, eigenfrequencies from scipy.linalg.eigh on (K, M), the exact
+from mpmath.findroot on the equilibrium written out here from the paper, the values of the
+reference example, eigenfrequencies from scipy.linalg.eigh on (K, M), the exact
 solution (matrix exponential) checked against solve_ivp at rtol 1e-12, and the rigid-tooth
 limit from a 2-DOF ODE written out here and integrated with solve_ivp at rtol 1e-12.
 """
@@ -20,7 +20,7 @@ from workbook.blocks import coupling as cp
 from workbook.blocks import solvers as sv
 from workbook.errors import WorkbookError
 
-# SCENES.md section 4 example dimensions (SI)
+# the reference example's dimensions (SI)
 EX = dict(
     O1O=0.042,
     OC=0.036,
@@ -43,7 +43,7 @@ def sheet():
 
 
 def F_ref(phi, w, d):
-    """The equilibrium of SCENES.md, written out independently (mpmath numbers)."""
+    """The equilibrium of the paper, written out independently (mpmath numbers)."""
     import mpmath as mp
 
     G = d["MD0"] * d["OB"] / d["O1B"] * d["tg"]
@@ -165,7 +165,7 @@ def test_trend_findings_hold(sheet):
     found = {f.what: f for f in cp.findings(sheet)}
     for text in cp.TREND_TEXT.values():
         assert found[text].verdict == "ok"
-    assert found["phi2 at omega1 = 80 rad/s (SCENES.md: 0.070)"].verdict == "ok"
+    assert found["phi2 at omega1 = 80 rad/s (reference example: 0.070)"].verdict == "ok"
 
 
 def test_lift_off_speed_is_where_F_changes_sign(sheet):
@@ -229,7 +229,7 @@ def test_printed_and_corrected_forms_visible(sheet):
 
 # -- dynamics -----------------------------------------------------------------------------------
 def _undamped_freqs(c2):
-    """Nonzero eigenfrequencies of (K, M) written out here from SCENES.md (scipy.linalg.eigh)."""
+    """Nonzero eigenfrequencies of (K, M) written out here from the paper (scipy.linalg.eigh)."""
     from scipy.linalg import eigh
 
     st = root_ref(80.0)
@@ -252,7 +252,7 @@ def test_eigenvalues(sheet, c2, tooth):
     ref = _undamped_freqs(c2)
     got = np.sort(np.abs(lam.imag))[::2]
     np.testing.assert_allclose(got, ref, rtol=2e-3)  # light damping shifts them a little
-    assert abs(lam[-1].imag) == pytest.approx(tooth, rel=0.01)  # SCENES.md: ~707, ~7070
+    assert abs(lam[-1].imag) == pytest.approx(tooth, rel=0.01)  # reference example: ~707, ~7070
     assert np.all(lam.real < 0)
     assert np.all(cp.eigen(variant(sheet, c2), damping="as printed").real > 0)  # printed sign
 

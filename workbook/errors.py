@@ -75,12 +75,6 @@ class LimitError(WorkbookError):
     kind = "limit exceeded"
 
 
-class CheckFailed(WorkbookError):
-    """Printed values are not reproduced."""
-
-    kind = "check failed"
-
-
 class NotLive(Exception):
     """An expression cannot be a live Excel formula (a solver block, or too long).
 

@@ -76,12 +76,8 @@ class ArgumentSpec:
     plain: bool = False  # inside formulas the argument is a plain number in `unit` (Mathcad style)
 
     @property
-    def as_number(self) -> bool:
-        return self.plain
-
-    @property
     def binding_unit(self) -> pint.Unit:
-        return un.registry().dimensionless if self.as_number else self.unit
+        return un.registry().dimensionless if self.plain else self.unit
 
 
 @dataclass

@@ -6,7 +6,7 @@ needs it (so scipy is imported only by scenes that solve something). Only
 functions registered with one of the decorators below can be reached, so a
 template cannot call arbitrary Python.
 
-Three kinds:
+Five kinds:
 
 * ``@block(args={...}, returns="mm")``: called inside expressions like a
   function. It receives magnitudes (floats or numpy arrays) in the declared
@@ -17,6 +17,10 @@ Three kinds:
   ODE histories).
 * ``@findings_block``: ``func(sheet) -> list[Finding]``; shown by
   ``workbook check`` and in the Checks sheet.
+* ``@bench_block``: ``func(sheet, quick=False) -> pandas.DataFrame``; what
+  ``workbook bench NAME`` prints (``[sheet] bench = "module.func"``).
+* ``@export_block``: ``func(sheet, path) -> path``; writes a file for other programs
+  (``workbook run NAME --export PATH``, ``[sheet] export = "module.func"``).
 """
 
 from __future__ import annotations

@@ -645,7 +645,7 @@ def denominator_zero_speed(sheet, form: str = "printed") -> float:
 # ---------------------------------------------------------------------------------------------
 # findings
 # ---------------------------------------------------------------------------------------------
-SCENE_VALUES = ((50.0, 0.0), (80.0, 0.070), (110.0, 0.204))  # SCENES.md section 4, base case
+SCENE_VALUES = ((50.0, 0.0), (80.0, 0.070), (110.0, 0.204))  # the reference example, base case
 
 
 def trend_holds(sheet, key: str, ws) -> tuple[list[float], list[float], list[float]]:
@@ -700,7 +700,7 @@ def departures(sheet, key: str, ws, form: str = "printed", limit: float = 0.05):
 
 
 def _is_example(sheet) -> bool:
-    """Are the inputs that phi2 depends on those of the template (the SCENES.md example)?"""
+    """Are the inputs that phi2 depends on those of the template (the reference example)?"""
     used = tc.dependencies(sheet.spec, ex.Name("phi2")) & set(sheet.spec.inputs)
     return all(sheet.values[n] == sheet.spec.inputs[n].value for n in used)
 
@@ -719,7 +719,7 @@ def findings(sheet):
             out.append(
                 F(
                     "steady state",
-                    f"phi2 at omega1 = {w:g} rad/s (SCENES.md: {ref:.3f})",
+                    f"phi2 at omega1 = {w:g} rad/s (reference example: {ref:.3f})",
                     val,
                     "rad",
                     ok,
@@ -733,7 +733,7 @@ def findings(sheet):
                     val,
                     "rad",
                     "info",
-                    "inputs differ from the SCENES.md example",
+                    "inputs differ from the reference example",
                 )
             )
     stop = [float(w) for w, f0 in zip(ws, _v(sheet, "F0", "N*m", omega1=ws)) if f0 <= 0]

@@ -745,7 +745,7 @@ def findings(sheet) -> list[Finding]:
 
 
 # ----------------------------------------------------------------------------------------
-# CAD export (the command-line option is wired by the lead)
+# CAD export (workbook run reducer-profile --export PATH)
 # ----------------------------------------------------------------------------------------
 
 

@@ -362,13 +362,3 @@ def work_precision(
                     flush=True,
                 )
     return rows
-
-
-def fastest_within(rows: Sequence[StudyRow], target: float) -> StudyRow | None:
-    """The quickest finished row whose error is at most ``target``."""
-    ok = [
-        r
-        for r in rows
-        if r.stop_reason == "finished" and math.isfinite(r.error) and r.error <= target
-    ]
-    return min(ok, key=lambda r: r.elapsed) if ok else None

@@ -208,7 +208,7 @@ def _integrand(sheet, name):
     return lambda phi: np.asarray(fn({"phi": phi}), dtype=float)
 
 
-@__import__("functools").lru_cache(maxsize=None)
+@functools.cache
 def _legendre(n: int):
     """Gauss-Legendre nodes and weights on [-1, 1] (tabulated once, as a rule's table is)."""
     return np.polynomial.legendre.leggauss(n)
