@@ -1,4 +1,4 @@
-"""Command line: ``workbook list | run | check | bench | sweep | new | report``.
+"""Command line: ``workbook list | run | check | import | bench | sweep | new | report``.
 
 Exit status: 0 success, 1 printed values not reproduced (check), 2 bad input
 (template, units, values, paths), 3 internal error (a bug), 130 interrupted. No traceback

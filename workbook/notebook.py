@@ -1,7 +1,7 @@
 """A Sheet in Jupyter: the report's rendering, and its parts as DataFrames.
 
-``Sheet._repr_html_`` calls :func:`sheet_html`, which shows what ``workbook report`` writes
-(:mod:`workbook.report`). Tables are pandas DataFrames with the unit in every header
+Jupyter calls the Sheet's ``_repr_html_``, which is :func:`sheet_html`: what ``workbook
+report`` writes (:mod:`workbook.report`). Tables are pandas DataFrames with the unit in every header
 (``sheet.table(name)``, :func:`tables`). A value that fails is shown with its error instead of
 breaking the display.
 """
