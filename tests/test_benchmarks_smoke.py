@@ -115,7 +115,7 @@ def test_table_beyond_excel_rows_is_refused_with_csv_offer(tmp_path):
 
 
 def test_unit_check_happens_once_at_load(monkeypatch, tmp_path):
-    calls = {"_typed_body": 0, "_t": 0}
+    calls = {"_typed_body": 0, "visit": 0}
     for name in calls:
         original = getattr(tc.Typer, name)
 
