@@ -634,7 +634,7 @@ CSS = """
 .workbook-report .eq { line-height: 2.1; }
 .workbook-report .eq math { margin-right: .25em; }
 .workbook-report mtd { text-align: left; padding: .1em .6em .1em 0; }
-.workbook-report mfrac > * { math-style: normal; }
+.workbook-report mfrac > *, .workbook-report mtable { math-style: normal; }
 .workbook-report .error { color: #b00020; }
 .workbook-report mtext.error { color: #b00020; }
 .workbook-report table { border-collapse: collapse; margin: .3em 0 .8em; font-size: 8.5pt; }

@@ -284,6 +284,7 @@ class MathML(Visitor):
                 and not right.numeric
                 and left.prec >= PREC["neg"]
                 and _leftmost(node.right) not in ("e", "E")  # 2e would read as a number
+                and not (isinstance(node.left, ex.Number) and node.left.value == 0)  # 0⋅α
             ):
                 sign = Box("<mo>\u2062</mo>", 0.1)  # 2a: invisible times after a number
             else:
