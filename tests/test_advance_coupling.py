@@ -428,13 +428,6 @@ def test_ctrl_c_during_write_keeps_old_file(tmp_path, monkeypatch):
 
 
 # -- solver helpers -----------------------------------------------------------------------------
-def test_stable_root_helper():
-    r = sv.stable_root(lambda x: np.cos(x), 0.0, 3.0)
-    assert r.converged and r.x == pytest.approx(math.pi / 2, abs=1e-14)
-    r = sv.stable_root(lambda x: x - 1.0, 0.0, 3.0)  # only a + direction change: no stable root
-    assert not r.converged and r.reason == "no sign change"
-
-
 def test_bench_quick_is_fast(sheet):
     t = time.perf_counter()
     df = cp.bench(sheet, quick=True)

@@ -149,7 +149,7 @@ def test_set_wins_over_the_edited_file(tmp_path, generated, concave):
 
 SOLVER = """
 [sheet]
-title = "steady weight angle (solver block: values, not formulas)"
+title = "steady weight angle (a root: values, not formulas)"
 
 [inputs]
 m = "0.7 kg"
@@ -166,13 +166,13 @@ M_D0 = "1.2 N*m"
 
 [arguments]
 omega1 = { unit = "rad/s" }
-
-[blocks]
-phi2_root = "coupling.phi2_root"
+phi = { unit = "rad" }
 
 [definitions]
-"phi2(omega1)" = { unit = "rad", expr = \"""
-phi2_root(omega1, m, c1, phi20, lam_st, O1O, OC, OC1, OB, O1B, tan_gamma, M_D0)\""" }
+"Fc(phi, omega1)" = { unit = "N*m", expr = "2*m*omega1^2*(O1O - OC*cos(phi))*OC*sin(phi)" }
+"Fs(phi)" = { unit = "N*m", expr = "8*c1*(lam_st + OC1*(cos(phi20) - cos(phi)))*OC1*sin(phi)" }
+"F(phi, omega1)" = { unit = "N*m", expr = "Fc(phi, omega1) - Fs(phi) - M_D0*OB/O1B*tan_gamma" }
+"phi2(omega1)" = { unit = "rad", expr = "root(F(phi, omega1), phi, phi20, pi + 0*phi20) - phi20" }
 
 [[tables]]
 name = "steady"

@@ -23,8 +23,8 @@ import numpy as np
 
 from .. import expr as ex
 from .. import typecheck as tc
-from . import Finding, bench_block, block, findings_block, table_block
-from .solvers import METHODS, OdeRun, run_ode, stable_root, work_precision
+from . import Finding, bench_block, findings_block, table_block
+from .solvers import METHODS, OdeRun, run_ode, work_precision
 
 
 def _v(sheet, name: str, unit: str, **args):
@@ -40,42 +40,6 @@ def _key(sheet):
 def with_input(sheet, name: str, value: float, unit: str):
     """The sheet with one input replaced by ``value`` in ``unit``."""
     return sheet.with_inputs(**{name: f"{float(value)!r} {unit}"})
-
-
-# ---------------------------------------------------------------------------------------------
-# steady state
-# ---------------------------------------------------------------------------------------------
-_STEADY_SI = {  # the data of the steady equilibrium, in the SI units the block takes
-    "omega1": "rad/s",
-    "m": "kg",
-    "c1": "N/m",
-    "phi20": "rad",
-    "lam_st": "m",
-    "O1O": "m",
-    "OC": "m",
-    "OC1": "m",
-    "OB": "m",
-    "O1B": "m",
-    "tan_gamma": "",
-    "M_D0": "N*m",
-}
-
-
-@block(args=_STEADY_SI, returns="rad", vectorized=False)
-def phi2_root(omega1, m, c1, phi20, lam_st, O1O, OC, OC1, OB, O1B, tan_gamma, M_D0):
-    """Steady weight angle: stable root of the nonlinear equilibrium (0 on the stop)."""
-    G = M_D0 * OB / O1B * tan_gamma
-
-    def F(phi):
-        cent = 2 * m * omega1**2 * (O1O - OC * np.cos(phi)) * OC * np.sin(phi)
-        return (
-            cent - 8 * c1 * (lam_st + OC1 * (math.cos(phi20) - np.cos(phi))) * OC1 * np.sin(phi) - G
-        )
-
-    if float(F(np.asarray([phi20]))[0]) <= 0:
-        return 0.0  # on the stop
-    r = stable_root(F, phi20, math.pi - (1e-9 if G > 0 else 1e-6), n=512)
-    return r.x - phi20 if r.converged else math.nan
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,12 +1,7 @@
-"""Solver helpers for blocks: bracketed root finding and a bounded ODE runner.
+"""Solver helpers for blocks: a bounded ODE runner and a work-precision study.
 
 Any block module may use these; nothing here is registered as a block itself.
 scipy is imported inside the functions, so importing this module is cheap.
-
-Root finding::
-
-    r = stable_root(f, a, b)          # first + to - sign change of f on [a, b], refined by brentq
-    r.x, r.converged, r.reason
 
 ODE runs, in the style of ``scipy.integrate.solve_ivp`` (one result object, methods swappable)
 but bounded: a wall-clock budget and a step cap end a run that would otherwise take hours
@@ -33,71 +28,6 @@ import numpy as np
 
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 IMPLICIT = ("Radau", "BDF", "LSODA")  # methods that use a Jacobian
-
-
-# -- roots -----------------------------------------------------------------------------------
-@dataclass
-class RootResult:
-    """A root of a scalar function, or the reason there is none."""
-
-    x: float
-    converged: bool
-    reason: str  # "root" | "no sign change" | "not converged"
-    iterations: int = 0
-    bracket: tuple[float, float] | None = None
-
-
-def sign_changes(f: Callable[[np.ndarray], np.ndarray], a: float, b: float, n: int = 512):
-    """Brackets [x_k, x_k+1] of a uniform grid of n intervals where f changes sign.
-
-    ``f`` must accept a numpy array. Returns a list of (lo, hi, direction) with direction
-    -1 for a + to - change (a stable equilibrium of a generalized force) and +1 otherwise.
-    """
-    xs = np.linspace(a, b, n + 1)
-    fs = np.asarray(f(xs), dtype=float)
-    out = []
-    for k in range(n):
-        f0, f1 = fs[k], fs[k + 1]
-        if not (math.isfinite(f0) and math.isfinite(f1)):
-            continue
-        if f0 == 0.0:
-            out.append((xs[k], xs[k], -1 if f1 < 0 else 1))
-        elif f0 * f1 < 0:
-            out.append((xs[k], xs[k + 1], -1 if f1 < f0 else 1))
-    return out
-
-
-def stable_root(
-    f: Callable,
-    a: float,
-    b: float,
-    *,
-    n: int = 512,
-    xtol: float = 1e-14,
-    rtol: float = 4 * np.finfo(float).eps,
-    maxiter: int = 200,
-) -> RootResult:
-    """The first root of f on [a, b] where f goes from + to - (a stable equilibrium when f is
-    a generalized force), refined by brentq inside its grid bracket."""
-    from scipy.optimize import brentq
-
-    for lo, hi, direction in sign_changes(f, a, b, n):
-        if direction > 0:
-            continue
-        if lo == hi:
-            return RootResult(lo, True, "root", 0, (lo, hi))
-        g = lambda x: float(np.asarray(f(np.asarray([x])))[0])
-        x, info = brentq(
-            g, lo, hi, xtol=xtol, rtol=rtol, maxiter=maxiter, full_output=True, disp=False
-        )
-        return RootResult(
-            float(x),
-            bool(info.converged),
-            "root" if info.converged else "not converged",
-            int(info.iterations),
-            (lo, hi),
-        )
-    return RootResult(math.nan, False, "no sign change")
 
 
 # -- ODE runs ---------------------------------------------------------------------------------
