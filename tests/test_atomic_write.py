@@ -90,7 +90,7 @@ def test_failure_while_writing_the_csv_keeps_the_previous_csv(previous, monkeypa
         raise KeyboardInterrupt
 
     monkeypatch.setattr(pd.DataFrame, "to_csv", half_then_interrupt)
-    assert main(["run", "s.toml", "--out", "out.xlsx", "--csv", "t"]) == 130
+    assert main(["run", "s.toml", "--out", "out.xlsx", "--csv", "t", "--force"]) == 130
     assert digest(csv) == before_csv
     assert leftovers(previous) == []
 
@@ -98,7 +98,7 @@ def test_failure_while_writing_the_csv_keeps_the_previous_csv(previous, monkeypa
 def test_bad_input_changes_nothing(previous):
     before = digest(previous / "out.xlsx")
     (previous / "s.toml").write_text(TEMPLATE.replace('"R*sin(phi)"', '"R + phi"'))
-    assert main(["run", "s.toml", "--out", "out.xlsx", "--csv", "t"]) == 2
+    assert main(["run", "s.toml", "--out", "out.xlsx", "--csv", "t", "--force"]) == 2
     assert digest(previous / "out.xlsx") == before
     assert leftovers(previous) == []
 

@@ -37,7 +37,12 @@ def template_path(name_or_path: str | Path) -> Path:
         return path
     found = list_templates()
     if text not in found:
-        raise TemplateError(f"no template named '{text}' (installed: {', '.join(found)})")
+        from .fields import nearest
+
+        hint = nearest(text, found)
+        if Path(text + ".toml").is_file():
+            hint = f" (a file {text}.toml is here: write ./{text}.toml)"
+        raise TemplateError(f"no template named '{text}'{hint} (installed: {', '.join(found)})")
     return found[text]
 
 

@@ -9,10 +9,13 @@ import zipfile
 from pathlib import Path
 
 from .errors import InputError
+from .limits import writable_target
 
 
 def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None:
-    """Refuse a directory, a missing parent folder, or an existing file of another kind."""
+    """Refuse a directory, a missing parent folder, a FIFO or device, an existing file of
+    another kind; an existing CSV is overwritten only with ``force``."""
+    writable_target(path)
     if path.is_dir():
         raise InputError(
             f"output path {path} is a directory; give a file name like {path}/report.{kind}"
@@ -21,6 +24,8 @@ def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None
         raise InputError(f"output folder {path.parent} does not exist")
     if path.exists() and not force and kind == "xlsx" and not _is_xlsx(path):
         raise InputError(f"{path} exists and is not an xlsx workbook; use --force to overwrite it")
+    if path.exists() and not force and kind != "xlsx":
+        raise InputError(f"{path} exists; use --force to overwrite it")
 
 
 def _is_xlsx(path: Path) -> bool:
@@ -41,17 +46,82 @@ def _mode_for(path: Path) -> int:
         return 0o666 & ~umask
 
 
+def os_error(path: Path, exc: OSError) -> InputError:
+    """An error of the file system (disk full, read-only, name too long) as an input error."""
+    return InputError(f"cannot write {path}: {exc.strerror or exc}")
+
+
 @contextlib.contextmanager
 def replacing(path: Path):
     """Yield a temporary path beside ``path``; move it into place only if the block succeeds."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{path.name[:100]}.", suffix=".partial", dir=path.parent
+        )
+    except OSError as exc:
+        raise os_error(path, exc) from None
     os.close(fd)
     tmp_path = Path(tmp)
     try:
         yield tmp_path
         os.chmod(tmp_path, _mode_for(path))
         os.replace(tmp_path, path)
-    except BaseException:  # includes KeyboardInterrupt: the old file stays as it was
+    except BaseException as exc:  # includes KeyboardInterrupt: the old file stays as it was
         with contextlib.suppress(OSError):
             tmp_path.unlink()
+        if isinstance(exc, OSError):
+            raise os_error(path, exc) from None
         raise
+
+
+class Outputs:
+    """Several output files written as one: each is written to a temporary folder beside its
+    target, and all are moved into place only when every one is complete (an error in the
+    last leaves every earlier target as it was).
+
+        with Outputs(force=False) as outs:
+            tmp = outs.add(Path("a.xlsx"), "xlsx")   # checked now, before anything is written
+            ...write tmp...
+    """
+
+    def __init__(self, *, force: bool = False):
+        self.force = force
+        self.items: list[tuple[Path, Path]] = []  # (target, temporary path)
+
+    def add(self, path: Path, kind: str) -> Path:
+        """Check ``path`` as a target of ``kind`` and return the temporary path to write."""
+        path = Path(path)
+        check_target(path, kind=kind, force=self.force)
+        if any(os.path.abspath(t) == os.path.abspath(path) for t, _ in self.items):
+            raise InputError(f"{path} is named twice as an output")
+        try:
+            folder = tempfile.mkdtemp(
+                prefix=f".{path.name[:100]}.", suffix=".partial", dir=path.parent
+            )
+        except OSError as exc:
+            raise os_error(path, exc) from None
+        self.items.append((path, Path(folder) / path.name))
+        return self.items[-1][1]
+
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, kind, exc, tb) -> None:
+        try:
+            if kind is None:
+                for target, tmp in self.items:
+                    if not tmp.exists():
+                        raise RuntimeError(f"{target} was not written")
+                for target, tmp in self.items:
+                    try:
+                        os.chmod(tmp, _mode_for(target))
+                        os.replace(tmp, target)
+                    except OSError as err:
+                        raise os_error(target, err) from None
+        finally:
+            for _, tmp in self.items:
+                with contextlib.suppress(OSError):
+                    for leftover in tmp.parent.iterdir():
+                        leftover.unlink()
+                with contextlib.suppress(OSError):
+                    tmp.parent.rmdir()

@@ -5,8 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import pint
+
 from . import units as un
-from .errors import TemplateError, WorkbookError
+from .errors import TemplateError, UnitError, WorkbookError
 from .findings import Finding
 from .printed import PrintedRow, read_commented_csv, read_printed  # noqa: F401 - re-exported
 from .template import PrintedSpec
@@ -128,16 +130,26 @@ class Report:
             lines.append("")
             lines.append("inputs that no output uses: " + ", ".join(self.unused_inputs))
         lines.append("")
-        bad = self.failed
-        lines.append(
-            "result: "
-            + (
-                "all printed values reproduced"
-                if not bad
-                else f"{len(bad)} printed value(s) NOT reproduced"
-            )
-        )
+        lines.append("result: " + self.verdict())
         return "\n".join(lines)
+
+    def verdict(self) -> str:
+        """One line: how many printed values are reproduced, and failing findings."""
+        bad = self.failed
+        checked = [r for r in self.rows if r.role == "check"]
+        if bad:
+            text = f"{len(bad)} printed value(s) NOT reproduced"
+        elif checked:
+            text = f"all printed values reproduced ({len(checked)})"
+        else:
+            text = "no printed values to check"
+        failing = sum(f.verdict == "fail" for f in self.findings)
+        warnings = sum(f.verdict == "warning" for f in self.findings)
+        if failing:
+            text += f"; {failing} finding(s) FAIL"
+        if warnings:
+            text += f"; {warnings} warning(s)"
+        return text
 
 
 def _json_number(value: float | str | None) -> float | str | None:
@@ -208,6 +220,14 @@ def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
         if isinstance(row.value, str) or isinstance(q, str):
             return _text_row(base, row, q)
         computed = float(q.to(un.unit(row.unit)).magnitude)
+    except pint.DimensionalityError:
+        raise UnitError(
+            f"{row.name} is {un.dims(q.units)} ({un.pretty(q.units) or 'dimensionless'}), but "
+            f"its printed unit {row.unit!r} is {un.dims(un.unit(row.unit))}",
+            file=str(spec.file),
+            line=row.line,
+            definition=row.name,
+        ) from None
     except WorkbookError as err:
         return CheckRow(**base, computed=None, verdict="error", note=str(err))
     ok = within(computed, row.value, spec.tolerance, spec.rel_tolerance)

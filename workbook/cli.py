@@ -184,43 +184,106 @@ def cmd_list(args) -> int:
     return EXIT_OK
 
 
+MAX_SUMMARY_SCALARS = 20  # scalar results printed by `run` (all are on the Results sheet)
+
+
 def cmd_run(args) -> int:
+    """Compute, then write the workbook and every --csv and --export file as one: all targets
+    are checked and all contents computed before any file is replaced. Findings with verdict
+    warning or fail are printed; exit 1 (after writing) when one fails. Printed values that an
+    override (--set) no longer reproduces are counted in the summary, not an error."""
+    from .atomic import Outputs
+    from .errors import InputError
+
+    if args.out and Path(args.out).suffix.lower() != ".xlsx":
+        raise InputError(
+            f"--out {args.out}: workbook run writes an Excel workbook; name it *.xlsx "
+            "(a table as CSV: --csv TABLE)"
+        )
     sheet = load_sheet(args, args.part or None)
     out = Path(args.out) if args.out else Path("reports") / f"{sheet.name}.xlsx"
     if not args.out:
         out.parent.mkdir(parents=True, exist_ok=True)
-    report = sheet.check()
     exporter = None
     if args.export:
         from . import blocks
-        from .errors import InputError
 
         ref = sheet.spec.meta.get("export")
         if not ref:
             raise InputError(f'{sheet.name} has no export ([sheet] export = "module.func")')
         exporter = blocks.get(ref, "export").func
-    frames = {table: sheet.table(table) for table in args.csv}  # all computed before writing
-    sheet.write_xlsx(out, force=args.force, command=_command_line(args), report=report)
-    for table, frame in frames.items():
-        from .atomic import check_target, replacing
-
-        path = out.with_name(f"{out.stem}.{table}.csv")
-        check_target(path, kind="csv", force=args.force)
-        with replacing(path) as tmp:
-            frame.to_csv(tmp, index=False)
+    csv_paths = {table: out.with_name(f"{out.stem}.{table}.csv") for table in args.csv}
+    with Outputs(force=args.force) as outs:
+        xlsx_tmp = outs.add(out, "xlsx")
+        csv_tmps = {table: outs.add(path, "csv") for table, path in csv_paths.items()}
+        export_tmp = outs.add(Path(args.export), "csv") if exporter else None
+        frames = {table: sheet.table(table) for table in args.csv}  # all computed first
+        report = sheet.check()
+        for table, frame in frames.items():
+            write_csv(frame, csv_tmps[table])
+        if exporter is not None:
+            exporter(sheet, export_tmp)
+        sheet.write_xlsx(xlsx_tmp, force=True, command=_command_line(args), report=report)
+    for path in csv_paths.values():
         print(f"wrote {path}")
     if exporter is not None:
-        print(f"wrote {exporter(sheet, Path(args.export))}")
+        print(f"wrote {args.export}")
     n_checked = sum(r.role == "check" for r in report.rows)
     n_ok = sum(r.role == "check" and r.verdict in ("pass", "misprint") for r in report.rows)
     summary = f"{len(sheet.spec.tables)} tables, {len(sheet.spec.charts)} charts"
     if n_checked:
         summary += f", {n_ok} of {n_checked} printed values reproduced"
     print(f"wrote {out}: {summary}")
+    _print_scalars(sheet)
     for name in sheet.left_out:
         part = sheet.full_spec.parts[name]
         print(f"left out part {name} ({part.title}): add it with --part {name}")
-    return EXIT_OK
+    return _print_findings(report)
+
+
+def _print_scalars(sheet) -> None:
+    """The scalar results, one a line (the first MAX_SUMMARY_SCALARS of them)."""
+    from .errors import WorkbookError
+    from .units import pretty
+
+    names = [n for n, d in sheet.spec.definitions.items() if not d.is_function]
+    for name in names[:MAX_SUMMARY_SCALARS]:
+        try:
+            q = sheet.scalar_quantity(name)
+            print(f"  {name} = {float(q.magnitude):.6g} {pretty(q.units)}".rstrip())
+        except WorkbookError as err:
+            print(f"  {name}: error: {err.message}")
+    if len(names) > MAX_SUMMARY_SCALARS:
+        print(f"  ... and {len(names) - MAX_SUMMARY_SCALARS} more on the Results sheet")
+
+
+def _print_findings(report) -> int:
+    """Print the findings with verdict warning or fail (stderr); EXIT_CHECK if one fails."""
+    for f in report.findings:
+        if f.verdict in ("warning", "fail"):
+            note = f" ({f.note})" if f.note else ""
+            print(f"workbook: {f.verdict}: [{f.topic}] {f.what}{note}", file=sys.stderr)
+    return EXIT_CHECK if any(f.verdict == "fail" for f in report.findings) else EXIT_OK
+
+
+def write_csv(frame, path: Path) -> None:
+    """A table as CSV; a text cell or header that starts with = + - @ (which a spreadsheet
+    would run as a formula) is written with a leading apostrophe. Numbers are as they are."""
+    frame = frame.rename(columns=lambda c: csv_text(str(c)))
+    for name in frame.columns:
+        if frame[name].dtype == object:
+            frame[name] = frame[name].map(lambda v: csv_text(v) if isinstance(v, str) else v)
+    try:
+        frame.to_csv(path, index=False)
+    except OSError as exc:
+        from .atomic import os_error
+
+        raise os_error(path, exc) from None
+
+
+def csv_text(text: str) -> str:
+    """``text`` safe for a CSV cell that a spreadsheet opens: no leading = + - @ tab or CR."""
+    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
 
 
 def cmd_report(args) -> int:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 
+from . import excel_names
 from . import typecheck as tc
 from .builtins import REGISTRY
 from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
@@ -62,9 +63,7 @@ _RESERVED = {
 
 def excel_name(name: str) -> str:
     """A defined name Excel and LibreOffice will not read as a cell reference or function."""
-    if _CELL.match(name) or _R1C1.match(name) or name.lower() in _RESERVED or len(name) == 1:
-        return name + "_"
-    return name
+    return excel_names.single(name)
 
 
 def number(value: float) -> str:

@@ -7,7 +7,9 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import TemplateError
+from . import units as un
+from .errors import TemplateError, WorkbookError
+from .limits import MAX_CSV_BYTES, read_text
 from .template import PrintedSpec
 
 
@@ -25,15 +27,17 @@ def read_commented_csv(path, what: str):
 
     Returns (header cells or None, [(line number, cells, line text), ...]).
     """
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise TemplateError(f"cannot read {what} {path}: {exc.strerror}") from None
+    text = read_text(Path(path), what=what, max_bytes=MAX_CSV_BYTES)
     header, rows = None, []
     for number, line in enumerate(text.splitlines(), start=1):
         if not line.strip() or line.lstrip().startswith("#"):
             continue
-        cells = next(csv.reader([line]))
+        try:
+            cells = next(csv.reader([line]))
+        except csv.Error as exc:
+            raise TemplateError(
+                f"cannot read the line as CSV ({exc})", file=str(path), line=number
+            ) from None
         if header is None:
             header = cells
         else:
@@ -61,7 +65,13 @@ def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
         try:
             at = float(cells[1]) if cells[1].strip() else math.nan
             value = _number_or_text(cells[2])
-            rows.append(PrintedRow(cells[0].strip(), at, value, cells[3].strip(), number))
         except ValueError:
             raise TemplateError(f"{spec.file}:{number}: not a number in {line!r}") from None
+        if math.isinf(at) or (isinstance(value, float) and not math.isfinite(value)):
+            raise TemplateError(f"{spec.file}:{number}: not a finite number in {line!r}")
+        try:  # the unit is read now: a misspelt one is an error naming the line
+            un.unit(cells[3], what=f"{spec.file}:{number}: unit")
+        except WorkbookError as err:
+            raise TemplateError(err.message) from None
+        rows.append(PrintedRow(cells[0].strip(), at, value, cells[3].strip(), number))
     return rows

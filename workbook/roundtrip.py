@@ -11,7 +11,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .errors import InputError, WorkbookError
+from .errors import InputError, LimitError, WorkbookError
+
+MAX_INPUT_ROWS = 10_000
 
 
 def read_inputs(sheet, path) -> dict:
@@ -72,12 +74,21 @@ def _unit_text(q) -> str:
 def _rows(path: Path) -> list[tuple[int, str, object, str]]:
     import openpyxl
 
-    if not path.is_file():
-        raise InputError(f"--inputs {path}: no such file")
+    from .limits import check_xlsx_archive
+
+    check_xlsx_archive(path, what="--inputs", sheet="Inputs")
     try:
-        wb = openpyxl.load_workbook(path, data_only=True, read_only=True)
-    except Exception as exc:  # zipfile / xml errors: not a workbook
-        raise InputError(f"--inputs {path}: cannot read it as an xlsx workbook ({exc})") from None
+        return _read_rows(openpyxl, path)
+    except WorkbookError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - zip, XML, bad indexes: the file is not readable
+        raise InputError(
+            f"--inputs {path}: cannot read it as an xlsx workbook ({type(exc).__name__}: {exc})"
+        ) from None
+
+
+def _read_rows(openpyxl, path: Path) -> list[tuple[int, str, object, str]]:
+    wb = openpyxl.load_workbook(path, data_only=True, read_only=True)
     try:
         if "Inputs" not in wb.sheetnames:
             raise InputError(
@@ -105,6 +116,8 @@ def _rows(path: Path) -> list[tuple[int, str, object, str]]:
                     )
                 raise InputError(f"{path}, Inputs!B{r} ({name}) is empty")
             out.append((r, str(name).strip(), value, "" if unit is None else str(unit).strip()))
+            if len(out) > MAX_INPUT_ROWS:
+                raise LimitError(f"--inputs {path}: more than {MAX_INPUT_ROWS:,} input rows")
         return out
     finally:
         wb.close()
@@ -128,22 +141,31 @@ def _formulas(path: Path) -> dict[int, str]:
 
 
 def _raw(spec, value, unit: str, where: str):
-    """The cell value and unit as the text ``--set`` would get."""
+    """The cell value and unit as the text ``--set`` would get.
+
+    A cell holds a number, or text that the quantity reader accepts ("45.5 mm"); a date, a
+    time, a boolean or an error value is refused naming the cell (a date would otherwise be
+    read as its year or serial number).
+    """
+    from .quantity import check_unit_text, split_quantity
+
     if spec.options:
-        return str(value).strip()
-    if isinstance(value, bool):
-        raise InputError(f"{where}: {spec.name} is {value!r}, expected a number")
-    if isinstance(value, (int, float)):
-        number = float(value)
+        if not isinstance(value, str):
+            raise InputError(f"{where}: {spec.name} is {value!r}, expected one of its choices")
+        return value.strip()
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise InputError(
+            f"{where}: {spec.name} holds {_cell_kind(value)} ({value!s}), expected a number"
+        )
+    if isinstance(value, str):
+        number, typed_unit = split_quantity(value, what=f"{where} ({spec.name})")
+        if typed_unit:  # a value typed with its unit into the cell ("45 mm") is read as it stands
+            return value.strip()
     else:
-        text = str(value).strip().replace(",", ".") if str(value).count(",") == 1 else str(value)
-        try:
-            number = float(text)
-        except ValueError:
-            # a value typed with its unit into the cell ("45 mm") is read as it stands
-            return text
+        number = float(value)
     if not math.isfinite(number):
         raise InputError(f"{where}: {spec.name} = {value!r} is not a finite number")
+    check_unit_text(unit, what=f"{where} unit of {spec.name}")
     # a plain-number input shown with a label (phi_n: 38 "deg") is the number itself
     if spec.label and unit == spec.label:
         return number
@@ -151,3 +173,15 @@ def _raw(spec, value, unit: str, where: str):
         # like --set R3=45: a number without a unit is refused for a dimensioned input
         return number if spec.unit.dimensionless else f"{number!r}"
     return f"{number!r} {unit}"
+
+
+def _cell_kind(value) -> str:
+    import datetime
+
+    if isinstance(value, bool):
+        return "a TRUE/FALSE value"
+    if isinstance(value, (datetime.datetime, datetime.date)):
+        return "a date"
+    if isinstance(value, (datetime.time, datetime.timedelta)):
+        return "a time"
+    return f"a {type(value).__name__} value"

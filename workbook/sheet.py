@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -14,6 +15,7 @@ from . import expr as ex
 from . import typecheck as tc
 from . import units as un
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
+from .fields import nearest
 from .numeric import Evaluator
 from .template import (
     ColumnSpec,
@@ -25,6 +27,8 @@ from .template import (
     select_parts,
 )
 from .uses import names_used
+
+_UNKNOWN = re.compile(r"^unknown (?:name|function) '([^']+)'")
 
 
 @dataclass
@@ -90,6 +94,7 @@ class Sheet:
             try:
                 self.typer.function(name) if d.is_function else self.typer.scalar(name)
             except WorkbookError as err:
+                self._suggest(err)
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
             except RecursionError:
                 raise LimitError(
@@ -120,7 +125,9 @@ class Sheet:
             if spec is None:
                 known = ", ".join(self.spec.inputs)
                 raise InputError(
-                    f"'{name}' is not an input of {self.name} (inputs: {known})", file=self.file
+                    f"'{name}' is not an input of {self.name}"
+                    f"{nearest(name, self.spec.inputs)} (inputs: {known})",
+                    file=self.file,
                 )
             try:
                 values[name] = coerce_input(spec, raw, file=self.file)
@@ -155,18 +162,37 @@ class Sheet:
         if d is None:
             if name in self.spec.blocks:
                 raise InputError(f"'{name}' is a block; evaluate a definition that calls it")
-            raise InputError(f"'{name}' is not defined in {self.name}", file=self.file)
+            raise InputError(
+                f"'{name}' is not defined in {self.name}"
+                f"{nearest(name, [*self.spec.inputs, *self.spec.definitions])}",
+                file=self.file,
+            )
         try:
             if not d.is_function:
                 if args or kwargs:
                     raise InputError(f"'{name}' takes no arguments")
-                return Q(self.scalar_value(name, "definition"), self.typer.scalar(name).unit)
+                return self.scalar_quantity(name)
             f = self.typer.function(name)
             env = self._bind(name, d.params, args, kwargs)
             out = self.evaluator.function(name)(env)
-            return Q(np.asarray(out, dtype=float) if np.ndim(out) else float(out), f.unit)
+            q = Q(np.asarray(out, dtype=float) if np.ndim(out) else float(out), f.unit)
+            return q.to("") if un.is_compound_ratio(f.unit) else q
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
+
+    def scalar_typed(self, name: str) -> tc.T:
+        """The typed tree of scalar definition ``name`` in the unit it is shown in: a
+        dimensionless product of units (``kg*mm/m^2/Pa/s^2``) becomes a plain number."""
+        t = self.typer.scalar(name)
+        if un.is_compound_ratio(t.unit):
+            t = self.typer.convert(t, un.registry().dimensionless, f"'{name}'")
+        return t
+
+    def scalar_quantity(self, name: str) -> pint.Quantity:
+        """The value of scalar definition ``name`` in the unit it is shown in."""
+        t = self.typer.scalar(name)
+        q = un.registry().Quantity(self.scalar_value(name, "definition"), t.unit)
+        return q.to("") if un.is_compound_ratio(t.unit) else q
 
     def _bind(self, fname: str, params, args, kwargs) -> dict:
         if len(args) > len(params):
@@ -312,9 +338,24 @@ class Sheet:
                 t = self.typer.convert(
                     t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}"
                 )
+            elif un.is_compound_ratio(t.unit):
+                t = self.typer.convert(t, un.registry().dimensionless, what)
             return t
         except WorkbookError as err:
+            self._suggest(err)
             raise self._locate(err, what) from None
+
+    def known_names(self) -> list[str]:
+        """Every name a formula of this sheet may use (for "did you mean" suggestions)."""
+        spec = self.full_spec
+        return [*spec.inputs, *spec.definitions, *spec.arguments, *spec.blocks, *ex.FUNCTIONS]
+
+    def _suggest(self, err: WorkbookError) -> None:
+        """Add the nearest known names to an "unknown name 'x'" or "unknown function" error."""
+        m = _UNKNOWN.match(err.message)
+        if m and "did you mean" not in err.message:
+            err.message += nearest(m.group(1), self.known_names())
+            err.args = (err.message,)
 
     def _locate(self, err: WorkbookError, what: str) -> WorkbookError:
         """Give an error from a table or chart the line of the definition that failed, or else
@@ -355,9 +396,10 @@ class Sheet:
                 f"with --part {hidden.part} (Python: sheet.with_parts({hidden.part!r}))",
                 file=self.file,
             )
+        names = [t.name for t in self.spec.tables]
         raise InputError(
-            f"no table '{name}' in {self.name} (tables: "
-            f"{', '.join(t.name for t in self.spec.tables)})"
+            f"no table '{name}' in {self.name}{nearest(name, names)} (tables: "
+            f"{', '.join(names) or 'none'})"
         )
 
     def table_data(self, name: str) -> TableData:

@@ -23,6 +23,7 @@ from . import expr as ex
 from . import units as un
 from .builtins import REGISTRY
 from .errors import InputError, LimitError, TemplateError, WorkbookError
+from .fields import Fields, nearest
 from .measured import read_data
 
 MAX_RANGE_POINTS = 2_000_000
@@ -44,6 +45,56 @@ SECTIONS = {
     "data",
 }
 ALL_PARTS = "all"
+
+# The keys each table of a template may hold (anything else is a misspelling: refused).
+SHEET_KEYS = (
+    "name",
+    "title",
+    "source",
+    "description",
+    "bench",
+    "export",
+    "about",
+    "hand_checks",
+    "measured_lift",
+)
+INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
+ARGUMENT_KEYS = ("unit", "note", "plain")
+DEFINITION_KEYS = ("expr", "pieces", "unit", "note")
+PART_KEYS = ("title", "note")
+TABLE_KEYS = ("name", "title", "range", "columns", "sheet", "block", "part")
+COLUMN_KEYS = ("expr", "unit", "title")
+CHART_KEYS = (
+    "name",
+    "title",
+    "range",
+    "x",
+    "x_title",
+    "y_title",
+    "y2_title",
+    "series",
+    "log_x",
+    "log_y",
+    "equal_axes",
+    "part",
+)
+AXIS_KEYS = ("expr", "title", "unit")
+SERIES_KEYS = ("y", "unit", "name", "line", "axis", "marker", "x", "x_unit", "range", "table")
+PRINTED_KEYS = (
+    "file",
+    "title",
+    "argument",
+    "tolerance",
+    "rel_tolerance",
+    "role",
+    "misprints",
+    "note",
+    "part",
+)
+MISPRINT_KEYS = ("name", "at", "note", "corrected")
+RELATION_KEYS = ("relation", "range", "unit", "part")
+FINDING_KEYS = ("block", "title", "part")
+SWEEP_KEYS = ("outputs", "units")
 _PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
 
 
@@ -342,24 +393,27 @@ def _depth_at(text: str, pos: int) -> int:
     return text[:pos].count("(") - text[:pos].count(")")
 
 
-def _quantity_or_none(value, what: str):
-    return None if value is None else un.quantity(value, what=what)
+def _bound(f: Fields, key: str, name: str):
+    """An input's ``min`` or ``max``: a quantity; a plain number is in the input's unit."""
+    if key not in f:
+        return None
+    value = f.raw[key]
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise TemplateError(f'input {name}: {key} must be a value like "0 mm", got {value!r}')
+    return un.quantity(value, what=f"{name} {key}")
 
 
 def load_spec(path: Path, name: str | None = None) -> SheetSpec:
     """Read and validate a template file."""
+    from .limits import read_text
+
     file = str(path)
     try:
-        if path.stat().st_size > MAX_TEMPLATE_BYTES:
-            raise LimitError(
-                f"template is {path.stat().st_size:,} bytes (limit {MAX_TEMPLATE_BYTES:,})",
-                file=file,
-            )
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise TemplateError(f"cannot read template: {exc.strerror}", file=file) from None
-    except UnicodeDecodeError:
-        raise TemplateError("template is not UTF-8 text", file=file) from None
+        text = read_text(path, what="template", max_bytes=MAX_TEMPLATE_BYTES)
+    except InputError as err:  # not UTF-8, not a regular file
+        raise TemplateError(err.message, file=file, line=err.line) from None
+    except WorkbookError as err:
+        raise err.located(file=file) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -376,6 +430,28 @@ def load_spec(path: Path, name: str | None = None) -> SheetSpec:
         raise err.located(file=file) from None
 
 
+def _fields(raw: dict, allowed, what: str, text: str, section: str) -> Fields:
+    """Fields of a [section] table; an unknown key's error names its line."""
+    try:
+        return Fields(raw, allowed, what)
+    except TemplateError as err:
+        bad = next((k for k in raw if k not in allowed), None)
+        raise err.located(line=find_line(text, bad, section) if bad else None) from None
+
+
+_SHEET_NAME_BAD = re.compile(r"[\[\]:*?/\\']")
+
+
+def sheet_name(name: str, what: str) -> str:
+    """A worksheet name Excel accepts: 1 to 31 characters, none of ``[]:*?/\\``, no leading or
+    trailing apostrophe (the writer quotes names in formulas)."""
+    if not name.strip() or len(name) > 31 or _SHEET_NAME_BAD.search(name):
+        raise TemplateError(
+            f"{what}: sheet name {name!r} must be 1 to 31 characters without [ ] : * ? / \\ '"
+        )
+    return name
+
+
 def _table(data: dict, key: str) -> dict:
     value = data.get(key, {})
     if not isinstance(value, dict):
@@ -388,10 +464,24 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     if unknown:
         key = sorted(unknown)[0]
         raise TemplateError(
-            f"unknown section [{key}] (known: {', '.join(sorted(SECTIONS))})",
+            f"unknown section [{key}]{nearest(key, SECTIONS)} "
+            f"(known: {', '.join(sorted(SECTIONS))})",
             line=find_line(text, key) or _section_line(text, key),
         )
     sheet = _table(data, "sheet")
+    fields = _fields(sheet, SHEET_KEYS, "[sheet]", text, "sheet")
+    for key in ("name", "title", "source", "description", "bench", "export", "measured_lift"):
+        fields.text(key)
+    fields.flag("hand_checks")
+    for key, value in fields.table("about").items():
+        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
+            raise TemplateError(
+                f"[sheet] about: {key} must be text, got {value!r}",
+                line=find_line(text, key, "sheet"),
+            )
+    sweep = _fields(_table(data, "sweep"), SWEEP_KEYS, "[sweep]", text, "sweep")
+    for key in SWEEP_KEYS:
+        sweep.table(key)
     if "name" in sheet and not re.match(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$", str(sheet["name"])):
         raise TemplateError(  # the name becomes reports/NAME.xlsx: no folders, no '..'
             f"[sheet] name {str(sheet['name'])[:80]!r} must be letters, digits, '-', '_', '.'",
@@ -441,12 +531,9 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
                 definition=key,
             )
         try:
+            f = Fields(raw, ARGUMENT_KEYS, f"argument {key}")
             arguments[key] = ArgumentSpec(
-                key,
-                un.unit(raw.get("unit", ""), what=key),
-                str(raw.get("note", "")),
-                line,
-                bool(raw.get("plain", False)),
+                key, un.unit(f.text("unit"), what=key), f.text("note"), line, f.flag("plain")
             )
         except WorkbookError as err:
             raise err.located(line=line, definition=key) from None
@@ -510,6 +597,14 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     printed = [_printed_spec(p, path, text) for p in _list(data, "printed")]
     relations = [_relation_spec(r, text) for r in _list(data, "relations")]
     findings = _list(data, "findings")
+    for raw in findings:
+        f = Fields(raw, FINDING_KEYS, "[[findings]]")
+        try:
+            f.text("block"), f.text("title"), f.text("part", None)
+        except WorkbookError as err:
+            raise err.located(
+                line=_value_line(text, str(raw.get("block", "[[findings]]")))
+            ) from None
     names_seen = set()
     for t in tables:
         if t.name in names_seen:
@@ -554,7 +649,11 @@ def _parts(raw: dict, text: str) -> dict[str, PartSpec]:
             raise TemplateError(
                 'a part is declared as { title = "...", note = "..." }', line=line, definition=key
             )
-        parts[key] = PartSpec(key, str(value.get("title", key)), str(value.get("note", "")), line)
+        try:
+            f = Fields(value, PART_KEYS, f"part {key}")
+            parts[key] = PartSpec(key, f.text("title", key), f.text("note"), line)
+        except WorkbookError as err:
+            raise err.located(line=line, definition=key) from None
     return parts
 
 
@@ -654,30 +753,39 @@ def _input(key: str, raw, line) -> InputSpec:
         raise TemplateError(
             'an input is written  R1 = "20 mm"  or  R1 = { value = "20 mm", note = "..." }'
         )
-    options = tuple(str(o) for o in raw.get("options", ()))
-    note = str(raw.get("note", ""))
+    f = Fields(raw, INPUT_KEYS, f"input {key}")
+    options = f.texts("options")
+    note = f.text("note")
     if options:
-        value = str(raw["value"])
+        value = f.text("value")
         if value not in options:
             raise InputError(f"value {value!r} is not one of {', '.join(options)}")
+        for other in ("unit", "min", "max", "positive", "label"):
+            if other in f:
+                raise TemplateError(f"input {key}: a choice input takes no {other}")
         return InputSpec(key, value, None, note, options, line=line)
+    if isinstance(raw["value"], (list, dict)):
+        raise TemplateError(f'input {key}: value must be one number with its unit ("20 mm")')
     q = un.quantity(raw["value"], what=key)
-    if "unit" in raw:  # show the input in a declared unit
-        target = un.unit(str(raw["unit"]), what=key)
+    if "unit" in f:  # show the input in a declared unit
+        target = un.unit(f.text("unit"), what=key)
         try:
             q = q.to(target)
         except pint.DimensionalityError:
-            raise InputError(f"value {raw['value']!r} cannot be shown in {raw['unit']!r}") from None
+            raise InputError(
+                f"value {raw['value']!r} is {un.dims(q.units)}, and cannot be shown in "
+                f"{raw['unit']!r} ({un.dims(target)})"
+            ) from None
     spec = InputSpec(
         key,
         q,
         q.units,
         note,
-        minimum=_quantity_or_none(raw.get("min"), key),
-        maximum=_quantity_or_none(raw.get("max"), key),
-        positive=bool(raw.get("positive", False)),
+        minimum=_bound(f, "min", key),
+        maximum=_bound(f, "max", key),
+        positive=f.flag("positive"),
         line=line,
-        label=str(raw.get("label", "")),
+        label=f.text("label"),
     )
     check_input_value(spec, q)
     return spec
@@ -714,11 +822,14 @@ def check_input_value(spec: InputSpec, q: pint.Quantity) -> None:
 def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
     note, unit_text = "", None
     if isinstance(raw, dict):
-        note = str(raw.get("note", ""))
-        unit_text = raw.get("unit")
-        if "expr" in raw:
+        f = Fields(raw, DEFINITION_KEYS, f"definition {name}")
+        note = f.text("note")
+        unit_text = f.text("unit", None)
+        if "expr" in f and "pieces" in f:
+            raise TemplateError("a definition has either expr or pieces, not both")
+        if "expr" in f:
             raw = raw["expr"]
-        elif "pieces" in raw:
+        elif "pieces" in f:
             raw = raw["pieces"]
         else:
             raise TemplateError(
@@ -755,6 +866,11 @@ def _column(
 def _columns(raw, default_var, what) -> list[ColumnSpec]:
     cols = []
     if isinstance(raw, dict):
+        for k, v in raw.items():
+            if not isinstance(v, str):
+                raise TemplateError(
+                    f'{what}: column {k!r}: its unit must be text like "mm", got {v!r}'
+                )
         raw = [{"expr": k, "unit": v} for k, v in raw.items()]
     if not isinstance(raw, list):
         raise TemplateError(f'{what}: columns are {{ h1 = "mm", v1 = "m/s" }}')
@@ -763,29 +879,31 @@ def _columns(raw, default_var, what) -> list[ColumnSpec]:
             item = {"expr": item}
         if not isinstance(item, dict) or "expr" not in item:
             raise TemplateError(f'{what}: a column is {{ expr = "h1", unit = "mm" }}')
+        f = Fields(item, COLUMN_KEYS, f"{what}, column {item['expr']!r}")
         cols.append(
-            _column(
-                str(item["expr"]), item.get("unit"), default_var, what, str(item.get("title", ""))
-            )
+            _column(f.text("expr"), f.text("unit", None), default_var, what, f.text("title"))
         )
     return cols
 
 
 def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
     name = str(raw.get("name", f"table{index + 1}"))
-    line = find_line(text, "name") if False else _name_line(text, name)
+    line = _name_line(text, name)
     try:
-        rng = parse_range(raw["range"], what=f"table {name}") if "range" in raw else None
+        f = Fields(raw, TABLE_KEYS, f"table {name}")
+        f.text("name"), f.text("part", None)
+        rng = parse_range(f.text("range"), what=f"table {name}") if "range" in f else None
         cols = _columns(raw.get("columns", []), rng.var if rng else None, f"table {name}")
-        if not raw.get("block") and rng is None:
+        block = f.text("block", None)
+        if not block and rng is None:
             raise TemplateError(f"table {name} needs a range (or a block)")
         return TableSpec(
             name,
-            str(raw.get("title", name)),
+            f.text("title", name),
             rng,
             cols,
-            str(raw.get("sheet", "Listing")),
-            raw.get("block"),
+            sheet_name(f.text("sheet", "Listing"), f"table {name}"),
+            block,
             line,
         )
     except WorkbookError as err:
@@ -805,48 +923,46 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
     line = _name_line(text, name)
     what = f"chart {name}"
     try:
-        rng = parse_range(raw["range"], what=what) if "range" in raw else None
+        f = Fields(raw, CHART_KEYS, what)
+        f.text("name"), f.text("part", None)
+        rng = parse_range(f.text("range"), what=what) if "range" in f else None
         x_raw = raw.get("x", rng.var if rng else None)
         x_title = ""
         if isinstance(x_raw, dict):
-            x_title = str(x_raw.get("title", ""))
-            x = _column(str(x_raw["expr"]), x_raw.get("unit"), None, what, x_title)
+            fx = Fields(x_raw, AXIS_KEYS, f"{what}, x")
+            x_title = fx.text("title")
+            expr = fx.required_text("expr", 'x = { expr = "phi" }')
+            x = _column(expr, fx.text("unit", None), None, what, x_title)
         elif x_raw is not None:
-            x = _column(str(x_raw), None, None, what)
+            x = _column(Fields({"x": x_raw}, ("x",), what).text("x"), None, None, what)
         else:
             x = None
         series = []
-        for s in raw.get("series", []):
-            if not isinstance(s, dict):
-                raise TemplateError(f'{what}: a series is {{ y = "h", unit = "mm" }}')
+        for raw_s in f.tables("series"):
+            label = raw_s.get("name", raw_s.get("y", len(series) + 1))
+            s = Fields(raw_s, SERIES_KEYS, f"{what}, series {label!r}")
+            y_text = s.required_text("y", 'y = "h1"')
+            common = dict(
+                name=s.text("name", y_text),
+                line=s.text("line", "solid"),
+                axis=s.text("axis", "primary"),
+                marker=s.flag("marker"),
+            )
             if "table" in s:
                 series.append(
                     SeriesSpec(
                         y=_column("0", None, None, what),
-                        name=str(s.get("name", s.get("y", ""))),
-                        line=str(s.get("line", "solid")),
-                        axis=str(s.get("axis", "primary")),
-                        marker=bool(s.get("marker", False)),
-                        table=str(s["table"]),
-                        x_column=str(s.get("x", "")),
-                        y_column=str(s.get("y", "")),
+                        table=s.text("table"),
+                        x_column=s.text("x"),
+                        y_column=y_text,
+                        **common,
                     )
                 )
                 continue
-            y = _column(str(s["y"]), s.get("unit"), None, what, str(s.get("name", s["y"])))
-            srange = parse_range(s["range"], what=what) if "range" in s else None
-            sx = _column(str(s["x"]), s.get("x_unit"), None, what) if "x" in s else None
-            series.append(
-                SeriesSpec(
-                    y,
-                    str(s.get("name", s["y"])),
-                    str(s.get("line", "solid")),
-                    str(s.get("axis", "primary")),
-                    bool(s.get("marker", False)),
-                    sx,
-                    srange,
-                )
-            )
+            y = _column(y_text, s.text("unit", None), None, what, common["name"])
+            srange = parse_range(s.text("range"), what=what) if "range" in s else None
+            sx = _column(s.text("x"), s.text("x_unit", None), None, what) if "x" in s else None
+            series.append(SeriesSpec(y, x=sx, range=srange, **common))
         if not series:
             raise TemplateError(f"{what} has no series")
         for s in series:
@@ -856,16 +972,16 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
                 raise TemplateError(f"{what}: axis must be primary or secondary")
         return ChartSpec(
             name,
-            str(raw.get("title", name)),
+            f.text("title", name),
             rng,
             x,
-            x_title or str(raw.get("x_title", "")),
-            str(raw.get("y_title", "")),
-            str(raw.get("y2_title", "")),
+            x_title or f.text("x_title"),
+            f.text("y_title"),
+            f.text("y2_title"),
             series,
-            bool(raw.get("log_x", False)),
-            bool(raw.get("log_y", False)),
-            bool(raw.get("equal_axes", False)),
+            f.flag("log_x"),
+            f.flag("log_y"),
+            f.flag("equal_axes"),
             line,
         )
     except WorkbookError as err:
@@ -875,33 +991,49 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
 def _printed_spec(raw: dict, path: Path, text: str) -> PrintedSpec:
     if "file" not in raw:
         raise TemplateError('[[printed]] needs file = "...csv"')
-    misprints = [
-        Misprint(
-            str(m["name"]),
-            float(m["at"]),
-            str(m.get("note", "")),
-            float(m["corrected"]) if "corrected" in m else None,
+    line = _value_line(text, str(raw["file"]))
+    try:
+        return _printed_fields(raw, path, text)
+    except WorkbookError as err:
+        raise err.located(line=line, definition=f"printed {raw['file']}") from None
+
+
+def _printed_fields(raw: dict, path: Path, text: str) -> PrintedSpec:
+    f = Fields(raw, PRINTED_KEYS, "[[printed]]")
+    f.text("part", None)
+    misprints = []
+    for m in f.tables("misprints"):
+        fm = Fields(m, MISPRINT_KEYS, "[[printed]] misprint")
+        misprints.append(
+            Misprint(
+                fm.required_text("name", 'name = "h1"'),
+                fm.number("at") if fm.required("at", "at = 20") is not None else None,
+                fm.text("note"),
+                fm.number("corrected"),
+            )
         )
-        for m in raw.get("misprints", [])
-    ]
-    rel = Path(str(raw["file"]))
+    rel = Path(f.text("file"))
     if rel.is_absolute() or ".." in rel.parts:
         raise TemplateError(  # a worksheet reads only files in its own folder
             f"[[printed]] file {str(raw['file'])!r} must be a file name beside the template",
             line=_value_line(text, str(raw["file"])),
         )
-    role = str(raw.get("role", "check"))
+    role = f.text("role", "check")
     if role not in ("check", "information"):
         raise TemplateError("[[printed]] role is 'check' or 'information'")
+    tolerance, rel_tolerance = f.number("tolerance"), f.number("rel_tolerance")
+    for key, value in (("tolerance", tolerance), ("rel_tolerance", rel_tolerance)):
+        if value is not None and value < 0:
+            raise TemplateError(f"[[printed]] {key} must not be negative, got {value:g}")
     return PrintedSpec(
-        path.parent / str(raw["file"]),
-        str(raw.get("title", raw["file"])),
-        str(raw.get("argument", "")),
-        float(raw["tolerance"]) if "tolerance" in raw else None,
-        float(raw["rel_tolerance"]) if "rel_tolerance" in raw else None,
+        path.parent / f.text("file"),
+        f.text("title", f.text("file")),
+        f.text("argument"),
+        tolerance,
+        rel_tolerance,
         role,
         misprints,
-        str(raw.get("note", "")),
+        f.text("note"),
     )
 
 
@@ -914,14 +1046,23 @@ def _relation_spec(raw: dict, text: str) -> RelationSpec:
     rel = raw.get("relation")
     if not isinstance(rel, str):
         raise TemplateError('[[relations]] needs relation = "v1 = omega * d(h1)/d(phi)"')
-    line = find_line(text, "relation") if False else _value_line(text, rel)
+    line = _value_line(text, rel)
+    try:
+        f = Fields(raw, RELATION_KEYS, f"relation {rel!r}")
+        f.text("part", None), f.text("range"), f.text("unit")
+    except WorkbookError as err:
+        raise err.located(line=line) from None
     m = _RELATION.match(rel)
     if not m:
         raise TemplateError(
             f"cannot read relation {rel!r} (write 'v1 = omega * d(h1)/d(phi)')", line=line
         )
     factor = m.group(2).strip().rstrip("*").strip() or "1"
-    rng = parse_range(raw["range"], what=rel) if "range" in raw else None
+    try:
+        rng = parse_range(raw["range"], what=rel) if "range" in raw else None
+        un.unit(f.text("unit", "rad"), what=rel)
+    except WorkbookError as err:
+        raise err.located(line=line) from None
     return RelationSpec(
         rel,
         m.group(1),

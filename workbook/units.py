@@ -8,6 +8,8 @@ import math
 import pint
 
 from .errors import InputError
+from .fields import nearest
+from .quantity import check_unit_text, split_quantity
 
 
 @functools.cache
@@ -60,7 +62,8 @@ def _cache_folder():
 def quantity(value, unit: str | None = None, *, what: str = "value") -> pint.Quantity:
     """Parse ``"20 mm"``, a number, or a pint quantity into a Quantity of the shared registry.
 
-    ``unit`` is the unit a plain number is taken in.
+    ``unit`` is the unit a plain number is taken in. Text goes through the one quantity
+    reader (:func:`workbook.quantity.split_quantity`): one number, then a unit.
     """
     ureg = registry()
     if isinstance(value, pint.Quantity):
@@ -68,40 +71,61 @@ def quantity(value, unit: str | None = None, *, what: str = "value") -> pint.Qua
     if isinstance(value, bool):
         raise InputError(f"{what}: expected a number with a unit, got {value!r}")
     if isinstance(value, (int, float)):
-        return ureg.Quantity(float(value), unit or "")
+        return ureg.Quantity(_finite_float(value, what), unit or "")
     if isinstance(value, str):
-        text = value.strip()
+        number, text = split_quantity(value, what=what)
         if not text:
-            raise InputError(f"{what}: empty value")
-        try:
-            q = ureg.Quantity(text)
-        except Exception as exc:  # pint raises many types for unparsable text
-            raise InputError(f"{what}: cannot read {value!r} as a quantity ({exc})") from None
-        if not isinstance(q, pint.Quantity):
-            q = ureg.Quantity(float(q), "")
-        if unit and q.dimensionless and str(q.units) == "dimensionless":
-            q = ureg.Quantity(q.magnitude, unit)
-        return q
+            return ureg.Quantity(number, unit or "")
+        return ureg.Quantity(number, _parsed_unit(text, what, value))
+    if not isinstance(value, (list, tuple)) and type(value).__name__ != "ndarray":
+        raise InputError(f"{what}: cannot read {value!r} as a quantity")
     try:
         import numpy as np
 
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{what}: cannot read {value!r} as a quantity") from None
     return ureg.Quantity(arr, unit or "")
 
 
+def _finite_float(value, what: str) -> float:
+    try:
+        return float(value)
+    except OverflowError:  # a TOML integer beyond a double
+        raise InputError(f"{what}: {value} is too large for a number") from None
+
+
 def unit(text: str, *, what: str = "unit") -> pint.Unit:
     """Parse a unit string ('' or '1' for dimensionless)."""
-    ureg = registry()
+    if text is not None and not isinstance(text, str):
+        raise InputError(f'{what}: a unit is text like "mm", got {text!r}')
     text = (text or "").strip()
     if text in ("", "1", "-"):
-        return ureg.dimensionless
+        return registry().dimensionless
+    return _parsed_unit(check_unit_text(text, what=what), what, text)
+
+
+@functools.lru_cache(maxsize=512)
+def _unit_of(text: str) -> pint.Unit:
+    return registry().Quantity(1, text).units
+
+
+@functools.cache
+def _unit_names() -> tuple[str, ...]:
+    return tuple(n for n in dir(registry()) if not n.startswith("_"))
+
+
+def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
+    """pint's unit for a text the quantity reader accepted (a clear error for unknown names)."""
     try:
-        q = ureg.Quantity(1, text)
-        return q.units
-    except Exception as exc:
-        raise InputError(f"{what}: unknown unit {text!r} ({exc})") from None
+        return _unit_of(text)
+    except pint.UndefinedUnitError as exc:
+        names = [str(n) for n in (getattr(exc, "unit_names", ()) or ())]
+        bad = ", ".join(repr(n) for n in names) or "a name"
+        near = nearest(names[0], _unit_names()) if names else ""
+        raise InputError(f"{what}: cannot read {shown!r}: {bad} is not a unit{near}") from None
+    except Exception as exc:  # noqa: BLE001 - pint raises many kinds for malformed text
+        raise InputError(f"{what}: cannot read {shown!r} as a unit ({exc})") from None
 
 
 def factor(src: pint.Unit, dst: pint.Unit) -> float:
@@ -127,6 +151,13 @@ def is_angle(u: pint.Unit) -> bool:
         or "revolution" in str(u)
         or "turn" in str(u)
     )
+
+
+def is_compound_ratio(u: pint.Unit) -> bool:
+    """True for a dimensionless unit that is a leftover product of units (``kg*mm/m^2/Pa/s^2``),
+    which reads better as a plain number; angles and named ratios (percent) are kept."""
+    text = str(u)
+    return not u.dimensionality and ("/" in text or "*" in text) and not is_angle(u)
 
 
 def pretty(u: pint.Unit) -> str:

@@ -21,12 +21,21 @@ from . import units as un
 from .atomic import check_target, replacing
 from .builtins import excel_functions
 from .checks import tolerances
-from .errors import LimitError, WorkbookError
-from .excel import ExcelPrinter, NotLive, excel_name
+from .errors import InputError, LimitError, WorkbookError
+from .excel import ExcelPrinter, NotLive
+from .excel_names import ExcelNames
 from .uses import names_used
 
 MAX_ROWS = 1_048_576
 ROW_TOKEN = "\x00"
+PROGRESS_CELLS = 200_000  # a table with more cells than this reports its progress on stderr
+
+
+def write_labels(ws, row: int, col: int, texts, fmt=None) -> None:
+    """Write texts as text cells: a title like "=1+1" or "http://..." stays text, never a
+    formula or a link (xlsxwriter's ``write``/``write_row`` would convert them)."""
+    for j, text in enumerate(texts):
+        ws.write_string(row, col + j, str(text), fmt)
 
 
 @dataclass
@@ -107,7 +116,10 @@ class WorkbookWriter:
         self.command = command or " ".join(
             ["workbook", "run", sheet.name] + [f"--part {p}" for p in sorted(sheet.parts)]
         )
-        self.wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
+        self.wb = xlsxwriter.Workbook(
+            str(path),
+            {"nan_inf_to_errors": True, "strings_to_formulas": False, "strings_to_urls": False},
+        )
         self.wb.set_properties(
             {
                 "title": sheet.spec.title,
@@ -115,7 +127,10 @@ class WorkbookWriter:
                 "author": "workbook " + __version__,
             }
         )
-        self.printer = ExcelPrinter(sheet.typer)
+        spec = sheet.spec
+        scalars = [n for n, d in spec.definitions.items() if not d.is_function]
+        self.names = ExcelNames([*spec.inputs, *scalars])
+        self.printer = ExcelPrinter(sheet.typer, self.names.mapping)
         self.fmt = style.add_formats(self.wb)
         self.columns: dict[tuple, ColumnCells] = {}
         self.block_columns: dict[tuple[str, str], ColumnCells] = {}
@@ -135,7 +150,7 @@ class WorkbookWriter:
     # -- inputs and definitions -------------------------------------------------------
     def write_inputs(self, needed: set[str]) -> None:
         ws = self.ws("Inputs")
-        ws.write_row(0, 0, ["Name", "Value", "Unit", "Note"], self.fmt["header"])
+        write_labels(ws, 0, 0, ["Name", "Value", "Unit", "Note"], self.fmt["header"])
         ws.set_column(0, 0, 12)
         ws.set_column(1, 1, 14)
         ws.set_column(2, 2, 10)
@@ -158,14 +173,7 @@ class WorkbookWriter:
             if name not in needed:
                 note = (note + "; " if note else "") + "not used by any output of this workbook"
             ws.write_string(row, 3, note)
-            xname = excel_name(name)
-            self.wb.define_name(xname, f"=Inputs!$B${row + 1}")
-            if xname != name:
-                ws.write_comment(
-                    row,
-                    0,
-                    f"Defined name {xname} (Excel reads '{name}' as a cell reference or function)",
-                )
+            self._define(ws, row, name, f"=Inputs!$B${row + 1}")
             row += 1
         ws.write_string(
             row + 1,
@@ -181,22 +189,75 @@ class WorkbookWriter:
         if not defs:
             return
         ws = self.ws("Definitions")
-        ws.write_row(
-            0, 0, ["Name", "Value", "Unit", "Formula (worksheet)", "Note"], self.fmt["header"]
+        write_labels(
+            ws, 0, 0, ["Name", "Value", "Unit", "Formula (worksheet)", "Note"], self.fmt["header"]
         )
         ws.set_column(0, 0, 12)
         ws.set_column(1, 1, 16)
         ws.set_column(3, 3, 50)
         ws.set_column(4, 4, 50)
         for row, d in enumerate(defs, start=1):
-            t = self.sheet.typer.scalar(d.name)
-            value = self.sheet.scalar_value(d.name, "definition")
+            t = self.sheet.scalar_typed(d.name)
+            value = self.sheet.scalar_quantity(d.name).magnitude
             ws.write_string(row, 0, d.name)
             self._write_cell(ws, row, 1, t, {}, float(value), self.fmt["number"], d.name)
             ws.write_string(row, 2, un.pretty(t.unit))
             ws.write_string(row, 3, d.text)
             ws.write_string(row, 4, d.note)
-            self.wb.define_name(excel_name(d.name), f"=Definitions!$B${row + 1}")
+            self._define(ws, row, d.name, f"=Definitions!$B${row + 1}")
+        self.on_definitions = {d.name for d in defs}
+
+    def _define(self, ws, row: int, name: str, ref: str) -> None:
+        """Give the cell of ``name`` its defined name; a renamed one gets a comment saying why."""
+        self.wb.define_name(self.names[name], ref)
+        if self.names[name] != name:
+            ws.write_comment(row, 0, self.names.why(name))
+
+    def write_results(self) -> None:
+        """The Results sheet: every scalar definition (those the tables use refer to the
+        Definitions sheet), a live formula where possible, its unit and note. A definition
+        that cannot be computed shows the error as text in its cell."""
+        defs = [d for d in self.sheet.spec.definitions.values() if not d.is_function]
+        if not defs:
+            return
+        done = getattr(self, "on_definitions", set())
+        ws = self.ws("Results")
+        start = self.rows["Results"]
+        if start:
+            start += 1
+            ws.write_string(start, 0, "Scalar results", self.fmt["title"])
+            start += 1
+        write_labels(
+            ws,
+            start,
+            0,
+            ["Name", "Value", "Unit", "Formula (worksheet)", "Note"],
+            self.fmt["header"],
+        )
+        ws.set_column(0, 0, 12)
+        ws.set_column(1, 1, 16)
+        ws.set_column(3, 4, 50)
+        for row, d in enumerate(defs, start=start + 1):
+            ws.write_string(row, 0, d.name)
+            ws.write_string(row, 3, d.text)
+            ws.write_string(row, 4, d.note)
+            try:
+                t = self.sheet.scalar_typed(d.name)
+                q = self.sheet.scalar_quantity(d.name)
+            except WorkbookError as err:
+                ws.write_string(row, 1, f"error: {err.message}", self.fmt["fail"])
+                continue
+            unit = un.pretty(t.unit)
+            ws.write_string(row, 2, unit)
+            value = float(q.magnitude)
+            if d.name in done:
+                ref = self.names[d.name]
+                ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
+                self.formula_cells += 1
+            else:
+                self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
+                self._define(ws, row, d.name, f"='Results'!$B${row + 1}")
+        self.rows["Results"] = start + len(defs) + 2
 
     def _write_cell(self, ws, row, col, t: tc.T, subst, value: float, fmt, what: str) -> bool:
         try:
@@ -255,11 +316,14 @@ class WorkbookWriter:
             )
         ws.write_string(start, 0, spec.title, self.fmt["title"])
         heads = [un.header(c.title, c.unit) for c in data.columns]
-        ws.write_row(start + 1, 0, heads, self.fmt["header"])
+        write_labels(ws, start + 1, 0, heads, self.fmt["header"])
         first = start + 2
         self._write_range_column(ws, spec, first, data.columns[0].values)
         var_ref = f"$A${ROW_TOKEN}"
+        report = n * len(data.columns) > PROGRESS_CELLS
         for j, col in enumerate(data.columns[1:], start=1):
+            if report:
+                _progress(f"table {spec.name}: column {j} of {len(data.columns) - 1} ({n:,} rows)")
             if self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n):
                 env = {data.var: data.columns[0].values}
                 self._live_note(ws, first - 1, j, col.typed, env, col.values)
@@ -349,7 +413,7 @@ class WorkbookWriter:
         if start + n + 3 > MAX_ROWS:
             raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}")
         ws.write_string(start, 0, spec.title, self.fmt["title"])
-        ws.write_row(start + 1, 0, [str(c) for c in df.columns], self.fmt["header"])
+        write_labels(ws, start + 1, 0, [str(c) for c in df.columns], self.fmt["header"])
         ws.write_comment(
             start + 1,
             0,
@@ -448,7 +512,7 @@ class WorkbookWriter:
                 elif s.line == "none":
                     line = {"none": True}
                 opts = {
-                    "name": s.name,
+                    "name": self._chart_text(ws, s.name),
                     "categories": _range_ref(xcells),
                     "values": _range_ref(ycells),
                     "line": line,
@@ -457,11 +521,12 @@ class WorkbookWriter:
                 if s.axis == "secondary":
                     opts["y2_axis"] = True
                 c.add_series(opts)
-            c.set_title({"name": chart.title})
+            c.set_title({"name": self._chart_text(ws, chart.title)})
             xaxis = style.axis(
-                chart.x_title or (chart.x.title if chart.x else ""), label_position="low"
+                self._chart_text(ws, chart.x_title or (chart.x.title if chart.x else "")),
+                label_position="low",
             )
-            yaxis = style.axis(chart.y_title)
+            yaxis = style.axis(self._chart_text(ws, chart.y_title))
             if chart.log_x:
                 xaxis["log_base"] = 10
             if chart.log_y:
@@ -476,8 +541,22 @@ class WorkbookWriter:
             c.set_x_axis(xaxis)
             c.set_y_axis(yaxis)
             if any(s.axis == "secondary" for s in chart.series):
-                c.set_y2_axis({"name": chart.y2_title})
+                c.set_y2_axis({"name": self._chart_text(ws, chart.y2_title)})
             row = style.place_chart(ws, row, c, size)
+
+    def _chart_text(self, ws, text: str):
+        """A chart title or series name as xlsxwriter takes it. xlsxwriter reads a text that
+        starts with '=' as a formula; such a text is written into a cell of the Charts sheet
+        (column P) and the chart refers to that cell, so it shows exactly as written."""
+        if not text.startswith("="):
+            return text
+        row = self.rows["Charts"]
+        if row == 0:
+            ws.write_string(0, 15, "Chart labels", self.fmt["header"])
+            row = 1
+        ws.write_string(row, 15, text)
+        self.rows["Charts"] = row + 1
+        return ["Charts", row, 15]
 
     def _common_span(self, chart) -> tuple[float, float]:
         values = []
@@ -519,7 +598,7 @@ class WorkbookWriter:
             "Verdict",
             "Note",
         ]
-        ws.write_row(0, 0, heads, self.fmt["header"])
+        write_labels(ws, 0, 0, heads, self.fmt["header"])
         ws.set_column(0, 0, 34)
         ws.set_column(4, 8, 12)
         ws.set_column(9, 9, 10)
@@ -581,7 +660,8 @@ class WorkbookWriter:
         if report.findings:
             row += 1
             ws.write_string(row, 0, "Findings", self.fmt["title"])
-            ws.write_row(
+            write_labels(
+                ws,
                 row + 1,
                 0,
                 ["Topic", "What", "", "Unit", "Value", "", "", "", "", "Verdict", "Note"],
@@ -650,6 +730,15 @@ class WorkbookWriter:
             ),
             ("Macros", "none"),
         ]
+        if self.names.renamed:
+            rows.append(
+                (
+                    "Renamed for Excel",
+                    "; ".join(f"{k} is {v}" for k, v in self.names.renamed.items())
+                    + " (Excel's defined names ignore case and must not read as cells or "
+                    "functions)",
+                )
+            )
         for name, part in self.sheet.full_spec.parts.items():
             state = (
                 "included"
@@ -662,6 +751,12 @@ class WorkbookWriter:
         for i, (k, v) in enumerate(rows, start=2):
             ws.write_string(i, 0, k, self.fmt["header"])
             ws.write_string(i, 1, v, self.fmt["wrap"])
+
+
+def _progress(text: str) -> None:
+    import sys
+
+    print(f"workbook: writing {text}", file=sys.stderr, flush=True)
 
 
 def _x_column(chart, s, rng):
@@ -705,7 +800,16 @@ def write_workbook(
             else:
                 w.write_range_table(t)
         w.write_charts()
+        w.write_results()
         w.write_checks(report)
         w.write_about()
-        w.wb.close()
+        try:
+            w.wb.close()
+        except Exception as exc:  # xlsxwriter wraps the OSError (disk full, read-only)
+            cause = exc.__context__ if isinstance(exc.__context__, OSError) else exc
+            if isinstance(cause, OSError) or type(exc).__name__ == "FileCreateError":
+                raise InputError(
+                    f"cannot write {path}: {getattr(cause, 'strerror', cause)}"
+                ) from None
+            raise
     return path

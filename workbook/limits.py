@@ -1,0 +1,154 @@
+"""Limits on the files the engine reads and writes: regular files of bounded size only.
+
+A path given by a user may name a device (``/dev/zero``), a FIFO (a read or a write blocks
+forever), a sparse file of gigabytes, or an xlsx whose members inflate to gigabytes (a zip
+bomb). Each is refused here, before any parser sees it, with an error of kind
+``limit exceeded`` or ``input error`` (exit status 2).
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import zipfile
+from pathlib import Path
+
+from .errors import InputError, LimitError
+
+MAX_CSV_BYTES = 20_000_000  # a printed-values CSV
+MAX_INPUTS_XLSX_BYTES = 200_000_000  # an edited workbook given to --inputs (compressed)
+MAX_XLSX_MEMBER_BYTES = 64_000_000  # one member of it that is read, decompressed
+MAX_XLSX_MEMBERS = 10_000
+
+
+def regular_file(path: Path, *, what: str, max_bytes: int) -> int:
+    """Refuse a path that is missing, not a regular file, or larger than ``max_bytes``.
+
+    Returns the size. ``stat`` does not open the file, so a FIFO or a device never blocks.
+    """
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise InputError(f"{what} {path}: no such file") from None
+    except OSError as exc:
+        raise InputError(f"{what} {path}: cannot read it ({exc.strerror})") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(f"{what} {path} is not a regular file ({_kind(st.st_mode)})")
+    if st.st_size > max_bytes:
+        raise LimitError(f"{what} {path} is {st.st_size:,} bytes (limit {max_bytes:,})")
+    return st.st_size
+
+
+def read_text(path: Path, *, what: str, max_bytes: int) -> str:
+    """The UTF-8 text of a regular file of at most ``max_bytes`` (a UTF-8 BOM is dropped).
+
+    Errors carry the file (and for bad UTF-8 the line) as their location.
+    """
+    file = str(path)
+    try:
+        regular_file(path, what=what, max_bytes=max_bytes)
+        try:
+            with open(path, "rb") as f:
+                data = f.read(max_bytes + 1)
+        except OSError as exc:
+            raise InputError(f"cannot read the {what} ({exc.strerror})") from None
+        if len(data) > max_bytes:  # the file grew after the check
+            raise LimitError(f"{what} is more than {max_bytes:,} bytes")
+        try:
+            return data.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            line = data[: exc.start].count(b"\n") + 1
+            raise InputError(
+                f"{what} is not UTF-8 text (byte {exc.start}); save it as UTF-8", line=line
+            ) from None
+    except InputError as err:
+        raise err.located(file=file) from None
+
+
+def _kind(mode: int) -> str:
+    for test, name in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a named pipe"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return name
+    return "not a plain file"
+
+
+def check_xlsx_archive(path: Path, *, what: str, sheet: str) -> None:
+    """Refuse an xlsx whose members would inflate beyond :data:`MAX_XLSX_MEMBER_BYTES` each,
+    before openpyxl decompresses anything. Of the worksheets only ``sheet`` is checked (the
+    others are not read; a workbook with a long table stays readable).
+
+    zipfile stops reading a member at the size its header declares, so checking the declared
+    sizes bounds what is decompressed.
+    """
+    regular_file(path, what=what, max_bytes=MAX_INPUTS_XLSX_BYTES)
+    try:
+        with zipfile.ZipFile(path) as z:
+            infos = z.infolist()
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+        raise InputError(f"{what} {path}: cannot read it as an xlsx workbook ({exc})") from None
+    if len(infos) > MAX_XLSX_MEMBERS:
+        raise LimitError(f"{what} {path} has {len(infos):,} members (limit {MAX_XLSX_MEMBERS:,})")
+    wanted = _sheet_member(path, sheet, {i.filename: i.file_size for i in infos}, what)
+    for info in infos:
+        name = info.filename
+        if name.startswith("xl/worksheets/") and name.endswith(".xml") and name != wanted:
+            continue
+        if info.file_size > MAX_XLSX_MEMBER_BYTES:
+            raise LimitError(
+                f"{what} {path}: member {info.filename} inflates to {info.file_size:,} bytes "
+                f"(limit {MAX_XLSX_MEMBER_BYTES:,})"
+            )
+
+
+def writable_target(path: Path) -> None:
+    """Refuse an output path that exists and is not a regular file (a FIFO, a device, a
+    socket): writing to it would block or go elsewhere, with or without ``--force``."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise InputError(f"output path {path}: {exc.strerror}") from None
+    if stat.S_ISDIR(st.st_mode):
+        return  # the caller names the folder
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(
+            f"output path {path} is {_kind(st.st_mode)}; only regular files are written "
+            "(--force does not change that)"
+        )
+
+
+def _sheet_member(path: Path, sheet: str, sizes: dict[str, int], what: str) -> str | None:
+    """The archive member of worksheet ``sheet`` (from xl/workbook.xml and its rels)."""
+    from defusedxml import ElementTree
+
+    names = ("xl/workbook.xml", "xl/_rels/workbook.xml.rels")
+    if any(sizes.get(n, 0) > MAX_XLSX_MEMBER_BYTES for n in names):
+        raise LimitError(f"{what} {path}: its workbook part is too large")
+    try:
+        with zipfile.ZipFile(path) as z:
+            book = ElementTree.fromstring(z.read(names[0]))
+            rels = ElementTree.fromstring(z.read(names[1]))
+    except Exception:  # noqa: BLE001 - missing or malformed: openpyxl will name the fault
+        return None
+    rid = next(
+        (
+            value
+            for el in book.iter()
+            if el.tag.endswith("}sheet") and el.get("name") == sheet
+            for key, value in el.attrib.items()
+            if key.endswith("}id")
+        ),
+        None,
+    )
+    for el in rels.iter():
+        if el.get("Id") == rid and rid is not None:
+            target = el.get("Target", "")
+            return target.lstrip("/") if target.startswith("/") else "xl/" + target
+    return None
