@@ -124,5 +124,247 @@ def test_names_equal_but_for_case_recalculate_to_the_engine_values(tmp_path):
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
     values = cell_values(recalculate(path, tmp_path / "lo"))
-    got = {values[("Definitions", f"A{r}")]: values[("Definitions", f"B{r}")] for r in range(2, 6)}
+    got = {values[("Results", f"A{r}")]: values[("Results", f"B{r}")] for r in range(2, 6)}
     assert got == pytest.approx({"C": 3.0, "q": 2.5, "r": 7 / 3, "ratio": 2.0})
+
+
+# -- results nobody uses, findings -----------------------------------------------------------
+
+SCALARS = """
+[inputs]
+rho = "1000 kg/m^3"
+v = "2 m/s"
+L = "100 mm"
+mu = "1e-3 Pa*s"
+
+[definitions]
+Re = { expr = "rho*v*L/mu", note = "Reynolds number" }
+half = "L/2"
+"""
+
+
+def test_scalars_are_written_printed_and_simplified(tmp_path):
+    write(tmp_path / "s.toml", SCALARS)
+    out = cli(tmp_path, "run", "s.toml", "--out", "s.xlsx")
+    assert out.returncode == 0, out.stderr
+    assert "Re = 200000\n" in out.stdout and "half = 50 mm" in out.stdout
+    ws = openpyxl.load_workbook(tmp_path / "s.xlsx", data_only=True)["Results"]
+    rows = {r[0]: r[1:] for r in ws.iter_rows(min_row=2, values_only=True)}
+    assert rows["Re"][:2] == (200000, "") and rows["Re"][3] == "Reynolds number"
+    assert rows["half"][:2] == (50, "mm")
+    check = cli(tmp_path, "check", "s.toml")
+    assert check.returncode == 0 and "no printed values to check" in check.stdout
+    assert "all printed values reproduced" not in check.stdout
+
+
+# -- template keys and value types ------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ('[inputs]\nR = { value = "1 mm", postive = true }\n', "did you mean positive?"),
+        ('[inputs]\nR = { value = "1 mm", unti = "cm" }\n', "did you mean unit?"),
+        ('[sheet]\nabout = 5\n[inputs]\nR = "1 mm"\n', "about must be a table"),
+        ('[inputs]\nR = { value = "a", options = 5 }\n', "options must be a list"),
+        ('[inputs]\nR = "1 mm"\n[[printed]]\nfile = "x.csv"\ntolerance = "abc"\n', "a number"),
+        (
+            '[inputs]\nR = "1 mm"\n[[tables]]\nname = "t"\nrange = "x := 0 .. 1"\ncolums = {}\n',
+            "did you mean columns?",
+        ),
+        ('[sweep]\noutput = { a = "R" }\n[inputs]\nR = "1 mm"\n', "did you mean outputs?"),
+    ],
+)
+def test_template_keys_and_types_are_checked(tmp_path, text, message):
+    with pytest.raises(WorkbookError) as err:
+        workbook.load(write(tmp_path / "t.toml", text))
+    assert message in str(err.value)
+    assert "t.toml" in str(err.value)
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + b'[inputs]\nR = "2 mm"\n[definitions]\nd = "2*R"\n')
+    assert workbook.load(path).evaluate("d").magnitude == 4
+
+
+def test_a_template_name_that_is_a_file_here_is_suggested(tmp_path):
+    write(tmp_path / "mine.toml", '[inputs]\nR = "1 mm"\n')
+    out = cli(tmp_path, "run", "mine")
+    assert out.returncode == 2 and "write ./mine.toml" in out.stderr
+
+
+# -- files: devices, FIFOs, sizes, zip bombs -----------------------------------------------
+
+
+PRINTED = '[inputs]\nR = "1 mm"\n[definitions]\nd = "2*R"\n[[printed]]\nfile = "p.csv"\n'
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device", "sparse", "latin1", "dimension"])
+def test_printed_values_file_is_checked(tmp_path, kind):
+    csv = tmp_path / "p.csv"
+    if kind == "fifo":
+        os.mkfifo(csv)
+    elif kind == "device":
+        csv.symlink_to("/dev/zero")
+    elif kind == "sparse":
+        with open(csv, "wb") as f:
+            f.truncate(4 * 2**30)
+    elif kind == "latin1":
+        csv.write_bytes("name,argument,value,unit\nd,,2,mm # \xb5\n".encode("latin-1"))
+    else:
+        csv.write_text("name,argument,value,unit\nd,,2,kg\n")
+    write(tmp_path / "t.toml", PRINTED)
+    start = time.monotonic()
+    out = cli(tmp_path, "check", "t.toml", timeout=60)
+    assert time.monotonic() - start < 30
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr
+    expected = {
+        "fifo": "not a regular file (a named pipe)",
+        "device": "not a regular file (a character device)",
+        "sparse": "limit exceeded",
+        "latin1": "not UTF-8 text",
+        "dimension": "but its printed unit 'kg' is [mass]",
+    }[kind]
+    assert expected in out.stderr
+
+
+def _inputs_workbook(tmp_path) -> Path:
+    write(tmp_path / "t.toml", '[inputs]\nR = "1 mm"\n[definitions]\nd = "2*R"\n')
+    assert cli(tmp_path, "run", "t.toml", "--out", "t.xlsx").returncode == 0
+    return tmp_path / "t.xlsx"
+
+
+def _rezip(src: Path, dst: Path, replace: dict[str, bytes]) -> Path:
+    import zipfile
+
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            zout.writestr(item.filename, replace.get(item.filename, zin.read(item.filename)))
+    return dst
+
+
+@pytest.mark.parametrize("kind", ["bomb", "xml", "nan", "shared", "laughs", "date", "comma"])
+def test_inputs_workbook_is_checked(tmp_path, kind):
+    import zipfile
+
+    good = _inputs_workbook(tmp_path)
+    with zipfile.ZipFile(good) as z:
+        sheet = z.read("xl/worksheets/sheet1.xml").decode()
+    bad = tmp_path / "bad.xlsx"
+    value = '<c r="B2" s="2"><v>1</v></c>'
+    assert value in sheet, sheet[:2000]
+    if kind == "bomb":
+        _rezip(good, bad, {"xl/styles.xml": b" " * 200_000_000})
+    elif kind == "xml":
+        _rezip(good, bad, {"xl/worksheets/sheet1.xml": sheet.replace(value, "<c r=").encode()})
+    elif kind == "nan":
+        text = sheet.replace(value, '<c r="B2" s="1"><v>NaN</v></c>')
+        _rezip(good, bad, {"xl/worksheets/sheet1.xml": text.encode()})
+    elif kind == "shared":
+        text = sheet.replace(value, '<c r="B2" t="s"><v>99999</v></c>')
+        _rezip(good, bad, {"xl/worksheets/sheet1.xml": text.encode()})
+    elif kind == "laughs":
+        dtd = (
+            '<?xml version="1.0"?><!DOCTYPE lolz [<!ENTITY lol "lol">'
+            '<!ENTITY lol2 "&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;&lol;">]>'
+        )
+        text = dtd + sheet.split("?>", 1)[1].replace(
+            value, '<c r="B2" t="inlineStr"><is><t>&lol2;</t></is></c>'
+        )
+        _rezip(good, bad, {"xl/worksheets/sheet1.xml": text.encode()})
+    elif kind in ("date", "comma"):
+        wb = openpyxl.load_workbook(good)
+        import datetime
+
+        wb["Inputs"]["B2"] = datetime.date(2024, 1, 2) if kind == "date" else "1,5"
+        wb.save(bad)
+    out = cli(tmp_path, "run", "t.toml", "--inputs", "bad.xlsx", "--out", "new.xlsx")
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr and not (tmp_path / "new.xlsx").exists()
+    expected = {
+        "bomb": "limit exceeded",
+        "date": "Inputs!B2: R holds a date",
+        "comma": "decimal comma",
+    }.get(kind, "cannot read it as an xlsx workbook")  # NaN: openpyxl refuses it itself
+    assert expected in out.stderr
+
+
+def test_outputs_that_are_not_regular_files_are_refused(tmp_path):
+    write(tmp_path / "t.toml", '[inputs]\nR = "1 mm"\n[definitions]\nd = "2*R"\n')
+    os.mkfifo(tmp_path / "fifo.xlsx")
+    out = cli(tmp_path, "run", "t.toml", "--out", "fifo.xlsx", timeout=60)
+    assert out.returncode == 2 and "a named pipe" in out.stderr
+    (tmp_path / "dev.xlsx").symlink_to("/dev/null")
+    out = cli(tmp_path, "run", "t.toml", "--out", "dev.xlsx", "--force", timeout=60)
+    assert out.returncode == 2 and "a character device" in out.stderr
+    assert os.path.exists("/dev/null") and not os.path.isfile("/dev/null")
+    out = cli(tmp_path, "run", "t.toml", "--out", "x.csv")
+    assert out.returncode == 2 and "name it *.xlsx" in out.stderr
+    out = cli(tmp_path, "run", "t.toml", "--out", "x" * 300 + ".xlsx")
+    assert out.returncode == 2 and "File name too long" in out.stderr
+
+
+# -- injection ---------------------------------------------------------------------------------
+
+INJECT = """
+[inputs]
+R = "10 mm"
+
+[arguments]
+phi = { unit = "deg" }
+
+[definitions]
+"y(phi)" = "R*sin(phi)"
+
+[[tables]]
+name = "t"
+title = "=HYPERLINK(\\"http://x\\")"
+range = "phi := 0, 30 .. 90"
+columns = [
+  { expr = "y", unit = "mm", title = "=1+1" },
+  { expr = "2*y(phi)", unit = "mm", title = "http://example.com" },
+]
+
+[[charts]]
+name = "c"
+title = "=SUM(1)"
+range = "phi := 0 .. 90"
+x = { expr = "phi", title = "@x" }
+y_title = "+y"
+series = [{ y = "y", unit = "mm", name = "=A1" }]
+"""
+
+
+def test_labels_are_text_never_formulas_or_links(tmp_path):
+    write(tmp_path / "t.toml", INJECT)
+    out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t")
+    assert out.returncode == 0, out.stderr
+    wb = openpyxl.load_workbook(tmp_path / "t.xlsx")
+    ws = wb["Listing"]
+    assert ws["A1"].value == '=HYPERLINK("http://x")' and ws["A1"].data_type == "s"
+    assert ws["B2"].value == "=1+1 [mm]" and ws["B2"].data_type == "s"
+    assert ws["C2"].data_type == "s" and not ws._hyperlinks
+    import zipfile
+
+    with zipfile.ZipFile(tmp_path / "t.xlsx") as z:
+        chart = z.read("xl/charts/chart1.xml").decode()
+    assert "<c:f>Charts!$P$2</c:f>" in chart or "Charts!$P$" in chart
+    assert "SUM(1)" not in chart.replace("=SUM(1)", "")
+    lines = (tmp_path / "t.t.csv").read_text().splitlines()
+    assert lines[0].startswith("phi [deg],'=1+1 [mm],http://example.com [mm]")
+
+
+def test_csv_and_export_overwrite_only_with_force(tmp_path):
+    write(tmp_path / "t.toml", INJECT)
+    (tmp_path / "t.t.csv").write_text("keep\n")
+    before = None
+    out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t")
+    assert out.returncode == 2 and "--force" in out.stderr
+    assert (tmp_path / "t.t.csv").read_text() == "keep\n"
+    assert not (tmp_path / "t.xlsx").exists(), before  # nothing replaced before the check
+    out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t", "--csv", "nosuch")
+    assert out.returncode == 2 and not (tmp_path / "t.xlsx").exists()
+    out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t", "--force")
+    assert out.returncode == 0 and (tmp_path / "t.t.csv").read_text() != "keep\n"
