@@ -24,7 +24,7 @@ def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None
         raise InputError(f"output folder {path.parent} does not exist")
     if path.exists() and not force and kind == "xlsx" and not _is_xlsx(path):
         raise InputError(f"{path} exists and is not an xlsx workbook; use --force to overwrite it")
-    if path.exists() and not force and kind != "xlsx":
+    if path.exists() and not force and kind == "csv":  # a CSV cannot be recognised as ours
         raise InputError(f"{path} exists; use --force to overwrite it")
 
 
@@ -125,3 +125,21 @@ class Outputs:
                         leftover.unlink()
                 with contextlib.suppress(OSError):
                     tmp.parent.rmdir()
+
+
+def write_csv(frame, path: Path) -> None:
+    """A table (pandas DataFrame) as CSV; a text cell or header that starts with = + - @ (which
+    a spreadsheet would run as a formula) gets a leading apostrophe. Numbers are as they are."""
+    frame = frame.rename(columns=lambda c: csv_text(str(c)))
+    for name in frame.columns:
+        if frame[name].dtype == object:
+            frame[name] = frame[name].map(lambda v: csv_text(v) if isinstance(v, str) else v)
+    try:
+        frame.to_csv(path, index=False)
+    except OSError as exc:
+        raise os_error(path, exc) from None
+
+
+def csv_text(text: str) -> str:
+    """``text`` safe for a CSV cell that a spreadsheet opens: no leading = + - @ tab or CR."""
+    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text

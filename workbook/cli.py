@@ -192,7 +192,7 @@ def cmd_run(args) -> int:
     are checked and all contents computed before any file is replaced. Findings with verdict
     warning or fail are printed; exit 1 (after writing) when one fails. Printed values that an
     override (--set) no longer reproduces are counted in the summary, not an error."""
-    from .atomic import Outputs
+    from .atomic import Outputs, write_csv
     from .errors import InputError
 
     if args.out and Path(args.out).suffix.lower() != ".xlsx":
@@ -264,26 +264,6 @@ def _print_findings(report) -> int:
             note = f" ({f.note})" if f.note else ""
             print(f"workbook: {f.verdict}: [{f.topic}] {f.what}{note}", file=sys.stderr)
     return EXIT_CHECK if any(f.verdict == "fail" for f in report.findings) else EXIT_OK
-
-
-def write_csv(frame, path: Path) -> None:
-    """A table as CSV; a text cell or header that starts with = + - @ (which a spreadsheet
-    would run as a formula) is written with a leading apostrophe. Numbers are as they are."""
-    frame = frame.rename(columns=lambda c: csv_text(str(c)))
-    for name in frame.columns:
-        if frame[name].dtype == object:
-            frame[name] = frame[name].map(lambda v: csv_text(v) if isinstance(v, str) else v)
-    try:
-        frame.to_csv(path, index=False)
-    except OSError as exc:
-        from .atomic import os_error
-
-        raise os_error(path, exc) from None
-
-
-def csv_text(text: str) -> str:
-    """``text`` safe for a CSV cell that a spreadsheet opens: no leading = + - @ tab or CR."""
-    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
 
 
 def cmd_report(args) -> int:

@@ -15,7 +15,7 @@ from .driver import SweepResult
 
 def write(result: SweepResult, path: Path, *, force: bool = False, command: str = "") -> Path:
     """Write the sweep: ``.csv`` (the table) or ``.xlsx`` (table, chart, about), atomically."""
-    from ..atomic import check_target, replacing
+    from ..atomic import check_target, replacing, write_csv
 
     path = Path(path)
     kind = "csv" if path.suffix.lower() == ".csv" else "xlsx"
@@ -24,7 +24,7 @@ def write(result: SweepResult, path: Path, *, force: bool = False, command: str 
     check_target(path, kind=kind, force=force)
     with replacing(path) as tmp:
         if kind == "csv":
-            result.table.to_csv(tmp, index=False)
+            write_csv(result.table, tmp)
         else:
             _write_xlsx(result, tmp, command)
     return path
@@ -34,13 +34,17 @@ def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
     import xlsxwriter
 
     from .. import __version__
+    from ..xlsx import write_labels
 
     df = result.table
-    wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
+    wb = xlsxwriter.Workbook(
+        str(path),
+        {"nan_inf_to_errors": True, "strings_to_formulas": False, "strings_to_urls": False},
+    )
     fmt = style.add_formats(wb)
     head, num, bad = fmt["header"], fmt["number"], fmt["fail"]
     ws = wb.add_worksheet("Sweep")
-    ws.write_row(0, 0, list(df.columns), head)
+    write_labels(ws, 0, 0, [str(c) for c in df.columns], head)
     for i, row in enumerate(df.itertuples(index=False), start=1):
         for j, v in enumerate(row):
             if v is None or (isinstance(v, float) and math.isnan(v)):
