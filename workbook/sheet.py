@@ -14,6 +14,7 @@ import pint
 from . import expr as ex
 from . import typecheck as tc
 from . import units as un
+from .builtins import REGISTRY
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .fields import nearest
 from .numeric import Evaluator
@@ -348,7 +349,7 @@ class Sheet:
     def known_names(self) -> list[str]:
         """Every name a formula of this sheet may use (for "did you mean" suggestions)."""
         spec = self.full_spec
-        return [*spec.inputs, *spec.definitions, *spec.arguments, *spec.blocks, *ex.FUNCTIONS]
+        return [*spec.inputs, *spec.definitions, *spec.arguments, *spec.blocks, *REGISTRY]
 
     def _suggest(self, err: WorkbookError) -> None:
         """Add the nearest known names to an "unknown name 'x'" or "unknown function" error."""
