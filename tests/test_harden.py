@@ -368,3 +368,17 @@ def test_csv_and_export_overwrite_only_with_force(tmp_path):
     assert out.returncode == 2 and not (tmp_path / "t.xlsx").exists()
     out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t", "--force")
     assert out.returncode == 0 and (tmp_path / "t.t.csv").read_text() != "keep\n"
+
+
+def test_every_sheet_key_the_engine_reads_is_a_known_key():
+    import re
+
+    from workbook.template import SHEET_KEYS
+
+    source = Path(workbook.__file__).parent
+    read = {
+        m.group(1)
+        for path in source.rglob("*.py")
+        for m in re.finditer(r"meta(?:\.get\(|\[)\"(\w+)\"", path.read_text(encoding="utf-8"))
+    }
+    assert read and read <= set(SHEET_KEYS), read - set(SHEET_KEYS)

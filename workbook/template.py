@@ -57,7 +57,9 @@ SHEET_KEYS = (
     "about",
     "hand_checks",
     "measured_lift",
-)
+    "samples",
+    "tolerance",
+)  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
 INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
 ARGUMENT_KEYS = ("unit", "note", "plain")
 DEFINITION_KEYS = ("expr", "pieces", "unit", "note")
@@ -473,6 +475,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     for key in ("name", "title", "source", "description", "bench", "export", "measured_lift"):
         fields.text(key)
     fields.flag("hand_checks")
+    fields.number("samples"), fields.number("tolerance")
     for key, value in fields.table("about").items():
         if not isinstance(value, (str, int, float)) or isinstance(value, bool):
             raise TemplateError(
