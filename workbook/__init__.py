@@ -9,20 +9,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .data import data_dir
+from .data import list_templates
 from .errors import WorkbookError
+from .version import __version__
 
-__version__ = "0.1.0"
 __all__ = ["load", "list_templates", "template_path", "Sheet", "WorkbookError", "__version__"]
-
-
-def list_templates() -> dict[str, Path]:
-    """Installed templates: name -> path."""
-    out = {}
-    for entry in data_dir("templates").iterdir():
-        if entry.name.endswith(".toml"):
-            out[entry.name[: -len(".toml")]] = Path(str(entry))
-    return dict(sorted(out.items()))
 
 
 def template_path(name_or_path: str | Path) -> Path:

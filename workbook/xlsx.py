@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, style
 from . import expr as ex
+from . import style
 from . import typecheck as tc
 from . import units as un
 from .atomic import check_target, replacing
@@ -25,6 +25,7 @@ from .errors import InputError, LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
 from .excel_names import ExcelNames
 from .uses import names_used
+from .version import __version__
 
 MAX_ROWS = 1_048_576
 ROW_TOKEN = "\x00"

@@ -13,10 +13,11 @@ from typing import TYPE_CHECKING
 
 from .. import expr as ex
 from . import names as nm
+from .symbols import Sym, Untranslatable, what
+from .symbols import key as name_key
 
 if TYPE_CHECKING:
     from .reader import MNode
-    from .translate import Sym, Translator
 
 Line = tuple[int, list]  # (indent, parts: text or expression trees)
 
@@ -33,12 +34,13 @@ def available() -> bool:
 class ProgramTranslator:
     """One Mathcad program (its locals shared by all its lines)."""
 
-    def __init__(self, tr: Translator, local: dict):
-        from .translate import Untranslatable
-
+    def __init__(self, tr, local: dict, expressions):
+        """``tr``: the worksheet's Translator; ``expressions``: the class that translates one
+        expression in a scope (``expressions(tr, scope)``)."""
         if not available():
             raise Untranslatable("a program (programs are not in the language yet)")
         self.tr = tr
+        self.expressions = expressions
         self.scope = dict(local)  # parameters, then locals as they are assigned
         self.locals: dict[tuple[str, str], Sym] = {}
 
@@ -49,8 +51,6 @@ class ProgramTranslator:
 
     # -- statements ---------------------------------------------------------------------------
     def _block(self, stmts: list[MNode], indent: int, out: list[Line]) -> None:
-        from .translate import Untranslatable
-
         if not stmts:
             raise Untranslatable("an empty program block")
         i = 0
@@ -87,8 +87,6 @@ class ProgramTranslator:
         self._body(body, indent + 4, out)
 
     def _stmt(self, s: MNode, indent: int, out: list[Line]) -> None:
-        from .translate import Untranslatable, _what
-
         tag = s.tag
         if tag == "localDefine":
             out.append((indent, self._assign(s)))
@@ -122,7 +120,7 @@ class ProgramTranslator:
         elif tag == "program":
             self._block(s.children, indent, out)
         elif tag in ("tryCatch", "onError"):
-            raise Untranslatable(f"{_what(tag)} in a program")
+            raise Untranslatable(f"{what(tag)} in a program")
         else:
             out.append((indent, [self._expr(s)]))
 
@@ -136,8 +134,6 @@ class ProgramTranslator:
         return [self._expr(body)]
 
     def _assign(self, s: MNode) -> list:
-        from .translate import Untranslatable
-
         lhs, rhs = s.children
         if lhs.tag != "id":
             raise Untranslatable("an element assignment (v[i] <- ...) in a program")
@@ -145,11 +141,9 @@ class ProgramTranslator:
         return [self._local(lhs), " := ", value]
 
     def _local(self, node: MNode) -> ex.Node:
-        from .translate import Untranslatable, _key
-
         if node.tag != "id":
             raise Untranslatable("a program local that is not a name")
-        key = _key(node)
+        key = name_key(node)
         sym = self.locals.get(key)
         if sym is None:
             sym = self.tr.new_sym("local", nm.identifier(*key), nm.mathcad_text(*key))
@@ -167,9 +161,7 @@ class ProgramTranslator:
         return [*head, " .. ", self._expr(rng.children[1])]
 
     def _expr(self, node: MNode) -> ex.Node:
-        from .translate import ExprTranslator, Untranslatable
-
-        et = ExprTranslator(self.tr, self.scope)
+        et = self.expressions(self.tr, self.scope)
         tree = et.visit(node)
         if et.ranges:
             raise Untranslatable("a program over a range variable")

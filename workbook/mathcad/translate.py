@@ -17,30 +17,10 @@ from ..visitor import Visitor
 from . import names as nm
 from .functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS, language_functions
 from .reader import MNode, Region, Worksheet
+from .symbols import Sym, Untranslatable
+from .symbols import key as _key
+from .symbols import what as _what
 from .units import FORMULA_UNITS, result_unit
-
-
-class Untranslatable(Exception):
-    """A construct the language cannot express (yet): the message says what and why."""
-
-
-@dataclass(eq=False)
-class Sym:
-    """A name of the generated worksheet; its final identifier is chosen at the end."""
-
-    kind: str  # var | func | param | unit | helper
-    base: str  # preferred identifier
-    mathcad: str  # the name as Mathcad shows it
-    unit: str = ""  # params and range variables: their unit (pint text)
-    broken: str = ""  # why it is not translated
-    region: str = ""
-    is_range: bool = False
-    final: str = ""
-    hint: ex.Node | None = None  # a bound variable: an expression in its unit
-    hint_sym: Sym | None = None  # a bound variable: the parameter it stands for
-
-    def token(self) -> str:
-        return f"\x00{id(self)}"
 
 
 @dataclass
@@ -105,38 +85,12 @@ _BINDERS = {
     "integral": "integral",
     "derivative": "diff",
 }
-_WHAT = {
-    "indexer": "an array index",
-    "matcol": "a matrix column",
-    "matrix": "a matrix",
-    "summation": "a summation",
-    "product": "a product (of a range)",
-    "derivative": "a derivative",
-    "integral": "an integral",
-    "program": "a program",
-    "Find": "a solve block (Given/Find)",
-    "Maximize": "a solve block (Maximize)",
-    "Minimize": "a solve block (Minimize)",
-    "lambda": "a lambda function",
-    "symEval": "a symbolic evaluation",
-    "vectorize": "a vectorised expression",
-    "range": "a range",
-    "str": "a text",
-}
-
-
-def _what(tag: str) -> str:
-    return _WHAT.get(tag, f"Mathcad's <{tag}>")
 
 
 def _uses(sym: Sym) -> str:
     """Why a use of an untranslated name is untranslated: the name and the first reason."""
     root = sym.broken.split(", which is not translated: ", 1)[-1]
     return f"uses {sym.mathcad}, which is not translated: {root}"
-
-
-def _key(node: MNode) -> tuple[str, str]:
-    return node.text.strip(), node.attrs.get("subscript", "")
 
 
 class ExprTranslator(Visitor):
@@ -587,7 +541,7 @@ class Translator:
             if not available():
                 raise
             try:
-                return {"program": ProgramTranslator(self, local).lines(program)}
+                return {"program": ProgramTranslator(self, local, ExprTranslator).lines(program)}
             except Untranslatable as why2:
                 raise why2 from why
 

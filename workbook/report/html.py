@@ -15,10 +15,10 @@ from html import escape
 
 import numpy as np
 
-from .. import __version__
 from .. import expr as ex
 from .. import units as un
 from ..errors import WorkbookError
+from ..version import __version__
 from . import mathml as mm
 from .mathml import Box, MathML
 
@@ -599,7 +599,7 @@ def _join_note(*parts: str) -> str:
 
 def regenerate_command(sheet, sets: dict[str, str] | None = None) -> str:
     """``workbook report NAME --part ... --set ...`` for this sheet."""
-    from .. import list_templates
+    from ..data import list_templates
 
     installed = list_templates().get(sheet.name)
     same = installed is not None and installed.resolve() == sheet.spec.path.resolve()

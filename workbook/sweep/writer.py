@@ -33,7 +33,7 @@ def write(result: SweepResult, path: Path, *, force: bool = False, command: str 
 def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
     import xlsxwriter
 
-    from .. import __version__
+    from ..version import __version__
     from ..xlsx import write_labels
 
     df = result.table

@@ -1,0 +1,65 @@
+"""What the translation's modules share: the untranslatable construct, the names of the
+generated worksheet, and how a Mathcad element is named in messages."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .. import expr as ex
+
+if TYPE_CHECKING:
+    from .reader import MNode
+
+
+class Untranslatable(Exception):
+    """A construct the language cannot express (yet): the message says what and why."""
+
+
+@dataclass(eq=False)
+class Sym:
+    """A name of the generated worksheet; its final identifier is chosen at the end."""
+
+    kind: str  # var | func | param | unit | helper
+    base: str  # preferred identifier
+    mathcad: str  # the name as Mathcad shows it
+    unit: str = ""  # params and range variables: their unit (pint text)
+    broken: str = ""  # why it is not translated
+    region: str = ""
+    is_range: bool = False
+    final: str = ""
+    hint: ex.Node | None = None  # a bound variable: an expression in its unit
+    hint_sym: Sym | None = None  # a bound variable: the parameter it stands for
+
+    def token(self) -> str:
+        return f"\x00{id(self)}"
+
+
+WHAT = {  # Mathcad tag -> what it is, in messages
+    "indexer": "an array index",
+    "matcol": "a matrix column",
+    "matrix": "a matrix",
+    "summation": "a summation",
+    "product": "a product (of a range)",
+    "derivative": "a derivative",
+    "integral": "an integral",
+    "program": "a program",
+    "Find": "a solve block (Given/Find)",
+    "Maximize": "a solve block (Maximize)",
+    "Minimize": "a solve block (Minimize)",
+    "lambda": "a lambda function",
+    "symEval": "a symbolic evaluation",
+    "vectorize": "a vectorised expression",
+    "range": "a range",
+    "str": "a text",
+}
+
+
+def what(tag: str) -> str:
+    """A Mathcad element as a message names it: ``a matrix``, ``Mathcad's <foo>``."""
+    return WHAT.get(tag, f"Mathcad's <{tag}>")
+
+
+def key(node: MNode) -> tuple[str, str]:
+    """A Mathcad name and its literal subscript."""
+    return node.text.strip(), node.attrs.get("subscript", "")
