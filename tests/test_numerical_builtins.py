@@ -257,3 +257,45 @@ def test_data_mistakes_are_refused_at_load(tmp_path, csv, definition, error, mes
     with pytest.raises(error, match=re.escape(message)) as err:
         sheet(tmp_path, DATA + f"bad = {definition}\n")
     assert "s.toml" in str(err.value)
+
+
+SOLVE = """
+[inputs]
+R = "2 m"
+theta = "0.3"
+T = "1 s"
+[[solve]]
+unknowns = { x = "1 m", y = "50 cm" }
+equations = [EQUATIONS]
+[definitions]
+d = { expr = "sqrt(x^2 + y^2)", unit = "mm" }
+"""
+
+
+def test_given_find_against_the_closed_form(tmp_path):
+    s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"'))
+    assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-13)
+    assert s.evaluate("y").to("m").magnitude == pytest.approx(2 * np.sin(0.3), rel=1e-13)
+    assert s.evaluate("d").to("mm").magnitude == pytest.approx(2000, rel=1e-13)
+    s.write_xlsx(tmp_path / "s.xlsx")  # what uses x and y is written as numbers
+
+
+@pytest.mark.parametrize(
+    "equations, error, message",
+    [
+        ('"x^2 + y^2 == R", "y == x*tan(theta)"', UnitError, "the left side is [length] ** 2"),
+        ('"x == T", "y == x"', UnitError, "the right side [time] (s)"),
+        ('"x + y == R"', TemplateError, "2 unknown(s) and 1 equation(s)"),
+        ('"x + y == R", "2*x"', TemplateError, "an equation is written LEFT == RIGHT"),
+    ],
+)
+def test_given_find_mistakes_are_refused_at_load(tmp_path, equations, error, message):
+    with pytest.raises(error, match=re.escape(message)) as err:
+        sheet(tmp_path, SOLVE.replace("EQUATIONS", equations))
+    assert "s.toml:8" in str(err.value) and "solve x, y" in str(err.value)
+
+
+def test_given_find_not_converging_shows_residuals(tmp_path):
+    s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
+    with pytest.raises(NumericsError, match=r"did not converge.*x\^2 \+ R\^2 == 0: residual"):
+        s.evaluate("d")

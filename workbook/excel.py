@@ -118,6 +118,12 @@ class ExcelPrinter(Visitor):
     def visit_TRef(self, t, s):
         if t.kind == "builtin":
             return "PI()", ATOM
+        if t.kind in ("solve", "data"):
+            raise NotLive(
+                f"{t.name} is found by a [[solve]] block (scipy.optimize.root)"
+                if t.kind == "solve"
+                else f"{t.name} is a column of measured data"
+            )
         return self.names.get(t.name, excel_name(t.name)), ATOM
 
     def visit_TScale(self, t, s):

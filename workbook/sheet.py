@@ -91,6 +91,13 @@ class Sheet:
 
     def check_units(self) -> None:
         """Infer the unit of every definition, table column and chart series (load time)."""
+        for block in self.spec.solves:
+            from .given_find import typed_equations
+
+            try:
+                typed_equations(self.typer, block)
+            except WorkbookError as err:
+                raise err.located(file=self.file, line=block.line, definition=block.what) from None
         for name, d in self.spec.definitions.items():
             try:
                 self.typer.function(name) if d.is_function else self.typer.scalar(name)
@@ -160,6 +167,9 @@ class Sheet:
         if name == "pi" and name not in self.spec.definitions:
             return Q(math.pi, "")
         d = self.spec.definitions.get(name)
+        block = self.spec.solve_of(name)
+        if d is None and block is not None:
+            return Q(self._solved(name), block.unknowns[name].units)
         if d is None:
             if name in self.spec.blocks:
                 raise InputError(f"'{name}' is a block; evaluate a definition that calls it")
@@ -242,6 +252,8 @@ class Sheet:
             return math.pi
         if kind == "data":
             return self.spec.data[name].values
+        if kind == "solve":
+            return self._solved(name)
         if name not in self._memo:
             d = self.spec.definitions[name]
             try:
@@ -259,6 +271,19 @@ class Sheet:
                     )
             self._memo[name] = value
         return self._memo[name]
+
+    def _solved(self, name: str) -> float:
+        """An unknown of a [[solve]] block (the block is solved once per sheet)."""
+        from .given_find import solve_block
+
+        block = self.spec.solve_of(name)
+        key = ("solve", block.index)
+        if key not in self._memo:
+            try:
+                self._memo[key] = solve_block(self, block)
+            except WorkbookError as err:
+                raise err.located(file=self.file, line=block.line, definition=block.what) from None
+        return self._memo[key][name]
 
     def _column_values(self, table: str, column: str) -> np.ndarray:
         """Values of one column of a range table (for max_over/min_over), memoised."""

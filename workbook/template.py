@@ -24,6 +24,7 @@ from . import units as un
 from .builtins import REGISTRY
 from .errors import InputError, LimitError, TemplateError, WorkbookError
 from .fields import Fields, nearest
+from .given_find import read_solves
 from .measured import read_data
 
 MAX_RANGE_POINTS = 2_000_000
@@ -43,6 +44,7 @@ SECTIONS = {
     "sweep",
     "parts",
     "data",
+    "solve",
 }
 ALL_PARTS = "all"
 
@@ -282,6 +284,11 @@ class SheetSpec:
     text: str
     parts: dict[str, PartSpec] = field(default_factory=dict)
     data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
+    solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
+
+    def solve_of(self, name: str):
+        """The [[solve]] block that finds ``name``, or None."""
+        return next((s for s in self.solves if name in s.unknowns), None)
 
     def line_of(self, key: str, section: str | None = None) -> int | None:
         return find_line(self.text, key, section)
@@ -595,6 +602,8 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         _table(data, "data"), path, lambda key, sec: find_line(text, key, sec), claim
     )
 
+    solves = read_solves(_list(data, "solve"), lambda v: _value_line(text, v), claim)
+
     tables = [_table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
     charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
     printed = [_printed_spec(p, path, text) for p in _list(data, "printed")]
@@ -635,6 +644,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         text=text,
         parts=parts,
         data=measured,
+        solves=solves,
     )
 
 

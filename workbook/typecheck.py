@@ -224,6 +224,9 @@ class Typer(Visitor):
     def _name(self, name: str, scope) -> T:
         if name in scope:
             return TParam(scope[name], name=name)
+        block = self.spec.solve_of(name)
+        if block is not None:
+            return TRef(block.unknowns[name].units, name=name, kind="solve")
         if name in self.spec.data:
             col = self.spec.data[name]
             raise TemplateError(

@@ -47,9 +47,10 @@ def solve(
     if not (np.isfinite(r).all() and np.max(np.abs(r)) <= limit):
         lines = "; ".join(f"{e}: residual {num(v)}" for e, v in zip(equations, r))
         at = ", ".join(f"{n} = {num(v)}" for n, v in zip(names, x))
+        why = " ".join(str(sol.message).split()).rstrip(".")
         raise NumericsError(
-            f"solve did not converge ({sol.message.strip().rstrip('.')}): at {at} the relative "
-            f"residuals are {lines} (limit {limit:g}); try other guesses"
+            f"solve did not converge ({why}): at {at} the relative residuals are {lines} "
+            f"(limit {limit:g}); try other guesses"
         )
     try:
         jac = np.asarray(sol.fjac).T @ np.triu(_unpack_r(sol.r, x0.size))

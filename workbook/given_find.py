@@ -1,0 +1,135 @@
+"""``[[solve]]`` blocks: Mathcad's Given/Find, a system of equations in named unknowns.
+
+::
+
+    [[solve]]
+    unknowns = { x = "1 m", y = "0.5 m" }          # guesses; their units are the unknowns'
+    equations = ["x^2 + y^2 == R^2", "y == x*tan(theta)"]
+
+The unknowns are names for the rest of the sheet (references of kind ``solve``). The
+equations are typed when the sheet is loaded (each side in the unknowns' units; the two sides
+of an equation must agree), and solved when a value is first needed, by
+:func:`workbook.numerics.given.solve`. Not converging is an error that lists every equation's
+residual. In the workbook the unknowns, and what uses them, are written as numbers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pint
+
+from . import expr as ex
+from . import typed as ty
+from . import units as un
+from .errors import TemplateError, UnitError, WorkbookError
+
+#: most unknowns of one block
+MAX_UNKNOWNS = 50
+
+
+@dataclass(frozen=True, eq=False)
+class SolveSpec:
+    """One [[solve]] block as written: unknowns with guesses, equations as (lhs, rhs, text)."""
+
+    index: int
+    unknowns: dict[str, pint.Quantity]
+    equations: tuple[tuple[ex.Node, ex.Node, str], ...]
+    line: int | None
+
+    @property
+    def what(self) -> str:
+        return f"solve {', '.join(self.unknowns)}"
+
+
+def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
+    """The [[solve]] blocks of a template (names claimed; equations parsed, not typed)."""
+    out = []
+    for i, block in enumerate(raw):
+        if not isinstance(block, dict) or set(block) != {"unknowns", "equations"}:
+            raise TemplateError(
+                '[[solve]] needs unknowns = { x = "1 m", ... } and equations = ["... == ...", ...]'
+            )
+        unknowns, equations = block["unknowns"], block["equations"]
+        line = find_value_line(str(equations[0])) if equations else None
+        what = f"solve {', '.join(map(str, unknowns))}"
+        try:
+            if not isinstance(unknowns, dict) or not unknowns or len(unknowns) > MAX_UNKNOWNS:
+                raise TemplateError(f"[[solve]] unknowns: 1 to {MAX_UNKNOWNS} names with guesses")
+            if not isinstance(equations, list) or len(equations) != len(unknowns):
+                raise TemplateError(
+                    f"[[solve]] has {len(unknowns)} unknown(s) and "
+                    f"{len(equations) if isinstance(equations, list) else 0} equation(s): give "
+                    "one equation per unknown"
+                )
+            guesses = {}
+            for name, guess in unknowns.items():
+                claim(name, "solve", line)
+                guesses[name] = un.quantity(str(guess), None, what=name)
+            eqs = tuple(_equation(e) for e in equations)
+        except WorkbookError as err:
+            raise err.located(line=line, definition=what) from None
+        out.append(SolveSpec(i, guesses, eqs, line))
+    return out
+
+
+def _equation(text) -> tuple[ex.Node, ex.Node, str]:
+    node = ex.parse(str(text), what="equation")
+    if not (isinstance(node, ex.Compare) and node.ops == ("==",)):
+        raise TemplateError(f"an equation is written LEFT == RIGHT, got {str(text)!r}")
+    return node.operands[0], node.operands[1], str(text)
+
+
+def typed_equations(typer, block: SolveSpec) -> list[tuple[ty.T, ty.T]]:
+    """Both sides of every equation, typed with the unknowns in scope (rhs in lhs's unit)."""
+    scope = {n: q.units for n, q in block.unknowns.items()}
+    out = []
+    for lhs, rhs, text in block.equations:
+        left = typer.expression(lhs, scope, block.what)
+        right = typer.expression(rhs, scope, block.what)
+        zero = [
+            isinstance(s, ty.TConst) and s.value == 0 and not s.unit.dimensionality
+            for s in (left, right)
+        ]
+        if zero[0] and not zero[1]:  # 0 == x: zero in the other side's unit
+            left = ty.TConst(right.unit, value=0.0)
+        if left.unit.dimensionality != right.unit.dimensionality and not zero[1]:
+            raise UnitError(
+                f"equation {text!r}: the left side is {un.dims(left.unit)} "
+                f"({un.pretty(left.unit) or '1'}), the right side {un.dims(right.unit)} "
+                f"({un.pretty(right.unit) or '1'})"
+            )
+        out.append((left, typer.convert(right, left.unit, f"equation {text!r}")))
+    return out
+
+
+def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
+    """The unknowns' values (magnitudes in their guesses' units)."""
+    from .numerics import current, sheet_tolerance
+    from .numerics.given import solve
+
+    names = list(block.unknowns)
+    sides = [
+        (sheet.evaluator.compile(lhs), sheet.evaluator.compile(rhs))
+        for lhs, rhs in typed_equations(sheet.typer, block)
+    ]
+
+    def residuals(x):
+        env = dict(zip(names, (float(v) for v in x)))
+        out = []
+        for left, right in sides:
+            a, b = float(left(env)), float(right(env))
+            out.append((a - b) / (abs(a) + abs(b) or 1.0))
+        return np.array(out)
+
+    guess = [q.magnitude for q in block.unknowns.values()]
+    result = solve(
+        residuals,
+        guess,
+        guess,
+        current(sheet_tolerance(sheet.spec.meta)),
+        names=names,
+        equations=[text for _, _, text in block.equations],
+    )
+    return dict(zip(names, (float(v) for v in result.value)))
