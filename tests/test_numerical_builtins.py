@@ -299,3 +299,22 @@ def test_given_find_not_converging_shows_residuals(tmp_path):
     s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
     with pytest.raises(NumericsError, match=r"did not converge.*x\^2 \+ R\^2 == 0: residual"):
         s.evaluate("d")
+
+
+def test_rows_are_solved_in_chunks_with_the_same_results(pipe, tmp_path, monkeypatch):
+    from workbook.numerics import entries
+
+    re_ = np.geomspace(4000, 1e8, 40)
+    R = np.linspace(10, 100, 23)
+    whole = pipe.with_inputs().evaluate("friction", re_).magnitude, pipe.evaluate("Q", R).magnitude
+    monkeypatch.setattr(entries, "CHUNK", 7)
+    chunked = pipe.with_inputs()
+    assert np.array_equal(chunked.evaluate("friction", re_).magnitude, whole[0])
+    assert np.array_equal(chunked.evaluate("Q", R).magnitude, whole[1])
+    s = sheet(
+        tmp_path,
+        '[arguments]\nx = { unit = "" }\nc = { unit = "" }\n'
+        '[definitions]\n"g(c)" = "root(x^2 - c, x, 0, 2)"\n',
+    )
+    with pytest.raises(NumericsError, match=r"for c = -1\)"):
+        s.evaluate("g", [1.0] * 10 + [-1.0])

@@ -23,6 +23,8 @@ from . import extrema, gauss, quadrature, roots, series
 from ._common import Result, live, sheet_tolerance
 
 ATOM = PREC["atom"]
+#: rows solved at once (a bracket's samples take rows x samples memory)
+CHUNK = 20_000
 #: nodes of the Gauss-Legendre rule of an integral's live Excel form
 EXCEL_NODES = 20
 #: highest order of diff(EXPR, X, N)
@@ -111,48 +113,82 @@ def _product_unit(ctx, name: str, args: tuple) -> ty.T:
 
 
 # -- numpy hooks --------------------------------------------------------------------------------
-def _rows(of, *bounds):
-    """The shape of the call (the expression's arrays and the bounds), the function of
-    (x, row index) that scipy's routines call, and the row index array."""
+def _solve(of, solve, *bounds) -> Result:
+    """``solve(f, *bounds, idx, label)`` for every row of the call, ``CHUNK`` rows at a time
+    (the samples of a bracket take rows x samples memory); one Result in the call's shape.
+
+    The rows are the broadcast of the expression's arrays and the bounds; ``f(x, idx)`` is
+    EXPR at the flat rows ``idx`` (scipy passes them compressed to the unconverged rows)."""
     shape = np.broadcast_shapes(of.shape, *(np.shape(b) for b in bounds))
-    f = of.over(shape)
-    idx = np.arange(math.prod(shape), dtype=float).reshape(shape)
-    return shape, f, idx
+    f, label = of.over(shape), of.describe_row(shape)
+    flat = [np.broadcast_to(np.asarray(b, dtype=float), shape).reshape(-1) for b in bounds]
+    n = math.prod(shape)
+    idx = np.arange(n, dtype=float)
+    parts = []
+    for lo in range(0, max(n, 1), CHUNK):
+        sl = slice(lo, lo + CHUNK)
+        parts.append(solve(f, *[b[sl] for b in flat], idx[sl], lambda i, lo=lo: label(i + lo)))
+    first = parts[0]
+
+    def join(attr):
+        if getattr(first, attr) is None:
+            return None
+        return np.concatenate([np.ravel(getattr(r, attr)) for r in parts]).reshape(shape)
+
+    return Result(
+        join("value"),
+        join("error"),
+        join("where"),
+        join("where_error"),
+        evaluations=max(r.evaluations for r in parts),
+    )
 
 
 def _root_numpy(of, a, b=None):
-    tol = of.tolerance
+    tol, var, unit = of.tolerance, of.var, of.unit_text
     if b is None:
-        shape, f, idx = _rows(of, a)
-        res = roots.root_near(
-            f, a, (idx,), tol, var=of.var, unit=of.unit_text, label=of.describe_row(shape)
+        res = _solve(
+            of,
+            lambda f, a, idx, label: roots.root_near(
+                f, a, (idx,), tol, var=var, unit=unit, label=label
+            ),
+            a,
         )
     else:
-        shape, f, idx = _rows(of, a, b)
-        res = roots.root_in(
-            f, a, b, (idx,), tol, var=of.var, unit=of.unit_text, label=of.describe_row(shape)
+        res = _solve(
+            of,
+            lambda f, a, b, idx, label: roots.root_in(
+                f, a, b, (idx,), tol, var=var, unit=unit, label=label
+            ),
+            a,
+            b,
         )
     of.record("root", res)
     return _out(res.value)
 
 
 def _integral_numpy(of, a, b):
-    shape, f, idx = _rows(of, a, b)
     if live():  # what the workbook's SUMPRODUCT computes
-        lo, hi, rows = (np.broadcast_to(v, shape).reshape(-1) for v in (a, b, idx))
-        value = gauss.pieces_value(f, np.vstack([lo, hi]), EXCEL_NODES, (rows,))
-        return _out(value.reshape(shape))
+        res = _solve(
+            of,
+            lambda f, a, b, idx, label: Result(
+                gauss.pieces_value(f, np.vstack([a, b]), EXCEL_NODES, (idx,)), np.zeros(a.shape)
+            ),
+            a,
+            b,
+        )
+        return _out(res.value)
+    shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
     breaks = of.breaks(shape)
-    res = quadrature.integrate(
-        f,
+    tol, var, unit = of.tolerance, of.var, of.unit_text
+    res = _solve(
+        of,
+        lambda f, a, b, *rest: quadrature.integrate(
+            f, a, b, (rest[-2],), tol, breaks=rest[:-2], var=var, unit=unit, label=rest[-1]
+        ),
         a,
         b,
-        (idx,),
-        of.tolerance,
-        breaks=breaks,
-        var=of.var,
-        unit=of.unit_text,
-        label=of.describe_row(shape),
+        *breaks,
     )
     of.record("integral", res)
     return _out(res.value)
@@ -163,18 +199,23 @@ def _extremum_numpy(name: str):
     where = name.startswith("arg")
 
     def hook(of, a, b):
-        shape, f, idx = _rows(of, a, b)
-        res = extrema.extremum(
-            f,
+        tol, var, unit = of.tolerance, of.var, of.unit_text
+        res = _solve(
+            of,
+            lambda f, a, b, idx, label: extrema.extremum(
+                f,
+                a,
+                b,
+                (idx,),
+                tol,
+                kind=kind,
+                need_where=where,
+                var=var,
+                unit=unit,
+                label=label,
+            ),
             a,
             b,
-            (idx,),
-            of.tolerance,
-            kind=kind,
-            need_where=where,
-            var=of.var,
-            unit=of.unit_text,
-            label=of.describe_row(shape),
         )
         if where:
             res = Result(res.where, res.where_error, evaluations=res.evaluations)
@@ -185,8 +226,13 @@ def _extremum_numpy(name: str):
 
 
 def _product_numpy(of, a, b):
-    shape, f, idx = _rows(of, a, b)
-    res = series.reduce(f, a, b, (idx,), kind="product", var=of.var)
+    var = of.var
+    res = _solve(
+        of,
+        lambda f, a, b, idx, label: series.reduce(f, a, b, (idx,), kind="product", var=var),
+        a,
+        b,
+    )
     return _out(res.value)
 
 
