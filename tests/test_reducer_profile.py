@@ -17,7 +17,7 @@ import pytest
 
 import workbook
 from workbook.blocks import reducer
-from workbook.errors import InputError, TemplateError
+from workbook.errors import InputError
 
 
 @pytest.fixture(scope="module")
@@ -299,24 +299,13 @@ def test_fractional_roller_count_is_refused(sheet):
 # -- the symbolic converter -------------------------------------------------------------------
 
 
-def test_sympy_form_is_the_templates_own(sheet):
-
-    m = reducer.model(sheet)
-    assert {str(x) for x in m.exprs["x_t"].free_symbols} == {"k", "phi"}
-    f = {x.what: x for x in sheet.check().findings}
-    same = next(x for k, x in f.items() if k.startswith("sympy form"))
-    assert same.verdict == "ok" and same.value < 1e-12
-
-
-def test_blocks_need_the_definitions_they_differentiate(tmp_path):
-    path = tmp_path / "pw.toml"
-    path.write_text(
-        '[inputs]\nc = "2 mm"\n[arguments]\nphi = { unit = "deg" }\n'
-        '[definitions]\n"f(phi)" = { expr = "c*sin(phi)", unit = "mm" }\n',
-        encoding="utf-8",
-    )
-    with pytest.raises(TemplateError, match="x_t"):
-        reducer.model(workbook.load(path))
+def test_derivatives_are_those_of_the_profile(sheet):
+    """diff(x_t), diff(y_t), and the tangent of (5), against central differences."""
+    phi, k, h = np.array([7.0, 33.0, 200.0]), np.array([1.0, 5.0, 11.0]), 1e-5
+    for f, d in (("x_t", "dx_t"), ("y_t", "dy_t"), ("x_k", "dx_k"), ("y_k", "dy_k")):
+        up, down = (sheet.evaluate(f, k=k, phi=phi + s).to("mm").magnitude for s in (h, -h))
+        got = sheet.evaluate(d, k=k, phi=phi).to("mm/deg").magnitude
+        np.testing.assert_allclose(got, (up - down) / (2 * h), rtol=0, atol=1e-8)
 
 
 # -- workbook, chart and CAD export ------------------------------------------------------------

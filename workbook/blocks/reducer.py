@@ -1,12 +1,10 @@
 """Planetary roller reducer: tooth profile of the cam (template ``reducer-profile``).
 
 Kireev, Kovalev, Ershov (2003), formulas (1)-(5). The template defines the theoretical
-profile ``x_t(k, phi)``, ``y_t(k, phi)`` of roller k; this module
+profile ``x_t(k, phi)``, ``y_t(k, phi)`` of roller k, their symbolic derivatives (``diff``),
+the practical profile (5) ``x_k``, ``y_k`` and the curvature ``kappa_n``. This module reads
+them through the sheet and
 
-* turns those definitions (the engine's typed trees) into sympy expressions with
-  :mod:`workbook.symbolic` and differentiates them symbolically in phi: the normal of (5) and
-  the curvature of the theoretical profile come from these exact derivatives (no hand-written
-  derivative formulas, no finite differences);
 * tabulates the theoretical and practical profile of every roller (block tables);
 * checks closure (the traces of all n rollers must coincide) by the distance of every
   point of rollers 1..n-1 from the trace of roller 0 (nearest point on the curve, refined by
@@ -14,11 +12,8 @@ profile ``x_t(k, phi)``, ``y_t(k, phi)`` of roller k; this module
 * checks undercut: the smallest radius of curvature of the concave parts of the theoretical
   profile, the packing limit, and where the practical profile gets cusps and loops.
 
-Names the blocks read from the template: inputs n, e1, r2, rp, dphi; definitions Z, i_a,
-rp_s, x_t(k, phi), y_t(k, phi), rho(k, phi), a(phi), R_closed(psi).
-
-sympy and scipy are imported inside functions (the engine imports this module only when a
-template asks for it).
+scipy is imported inside functions (the engine imports this module only when a template
+asks for it).
 """
 
 from __future__ import annotations
@@ -29,19 +24,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import symbolic
-from .. import units as un
-from ..errors import InputError, TemplateError
+from ..errors import InputError
 from . import Finding, export_block, findings_block, table_block
 
 #: The closure check passes when the traces agree to this distance (mm).
 CLOSURE_TOL_MM = 1e-9
 #: Step of the dense sampling used to find nearest points and curvature extremes (deg of phi).
 _SAMPLE_DEG = 0.25
-
-# ----------------------------------------------------------------------------------------
-# the model of one sheet (built once per Sheet object)
-# ----------------------------------------------------------------------------------------
 
 
 @dataclass
@@ -59,8 +48,15 @@ class Undercut:
         return rp < self.rho_min and rp < self.packing
 
 
+_UNITS = {"x_t": "mm", "y_t": "mm", "dx_t": "mm/deg", "dy_t": "mm/deg"}
+_UNITS.update({"ddx_t": "mm/deg^2", "ddy_t": "mm/deg^2", "x_k": "mm", "y_k": "mm"})
+_UNITS.update({"dx_k": "mm/deg", "dy_k": "mm/deg", "kappa_n": "1/mm"})
+
+
 @dataclass
 class Model:
+    """The sheet's profile functions of (k, phi in deg) as numbers, and the scene's data."""
+
     sheet: object
     n: int
     Z: float
@@ -68,69 +64,31 @@ class Model:
     turns: int  # eccentric turns after which roller 0 has traced the whole closed profile
     e1: float
     r2: float
-    rp: float
     rp_s: float
     dphi: float
-    phi_unit: object
-    exprs: dict
-    _f: object
-    memo: dict = field(default_factory=dict)  # derived data computed once (k-d trees)
+    memo: dict = field(default_factory=dict)
 
-    @property
-    def sign(self) -> float:
-        return 1.0 if self.rp_s >= 0 else -1.0
-
-    def deg(self, phi_deg):
-        """Eccentric angle in degrees -> magnitude in the template's unit of phi."""
-        return np.asarray(phi_deg, dtype=float) * un.factor(un.unit("deg"), self.phi_unit)
+    def __call__(self, name: str, k, phi_deg):
+        shape = np.broadcast(np.asarray(k), np.asarray(phi_deg)).shape
+        out = self.sheet.evaluate(name, k=k, phi=phi_deg).to(_UNITS[name]).magnitude
+        return np.broadcast_to(np.asarray(out, dtype=float), shape)
 
     def derivs(self, k, phi_deg):
         """x_t, y_t and their first and second derivatives per degree of phi (arrays)."""
-        k = np.asarray(k, dtype=float)
-        phi = self.deg(phi_deg)
-        shape = np.broadcast(k, phi).shape
-        out = self._f(k, phi)
-        scale = un.factor(un.unit("deg"), self.phi_unit)
-        vals = [np.broadcast_to(np.asarray(v, dtype=float), shape) for v in out]
-        x, y, dx, dy, ddx, ddy = vals
-        return x, y, dx * scale, dy * scale, ddx * scale**2, ddy * scale**2
+        names = ("x_t", "y_t", "dx_t", "dy_t", "ddx_t", "ddy_t")
+        return tuple(self(n, k, phi_deg) for n in names)
 
-    def normal(self, dx, dy):
-        """Unit normal of (5) on the offset side: sign(rp_s) * (y', -x') / |t'|."""
-        length = np.hypot(dx, dy)
-        if np.any(length == 0):
-            raise InputError(
-                "the theoretical profile has a point where its tangent vanishes; "
-                "the normal of (5) is undefined there"
-            )
-        return self.sign * dy / length, -self.sign * dx / length
-
-    def practical(self, k, phi_deg, xt=None, yt=None):
-        x, y, dx, dy, _, _ = self.derivs(k, phi_deg)
-        xt = x if xt is None else xt
-        yt = y if yt is None else yt
-        nx, ny = self.normal(dx, dy)
-        return xt + self.rp * nx, yt + self.rp * ny
+    def practical(self, k, phi_deg):
+        """(x_k, y_k) of (5)."""
+        return self("x_k", k, phi_deg), self("y_k", k, phi_deg)
 
     def kappa_n(self, k, phi_deg):
-        """Curvature of the theoretical profile toward the offset side, 1/mm.
-
-        Positive on the concave parts (the centre of curvature lies on the roller side):
-        the offset by rp is regular while rp * kappa_n < 1.
-        """
-        _, _, dx, dy, ddx, ddy = self.derivs(k, phi_deg)
-        kappa_left = (dx * ddy - dy * ddx) / np.hypot(dx, dy) ** 3
-        return -self.sign * kappa_left
+        """Curvature of the theoretical profile toward the offset side, 1/mm."""
+        return self("kappa_n", k, phi_deg)
 
     def offset_point_and_tangent(self, phi_deg, k=0):
-        """Practical-profile point and its derivative per degree (exact, from x'', y'')."""
-        x, y, dx, dy, ddx, ddy = self.derivs(k, phi_deg)
-        L = np.hypot(dx, dy)
-        dL = (dx * ddx + dy * ddy) / L
-        nx, ny = self.sign * dy / L, -self.sign * dx / L
-        dnx = self.sign * (ddy / L - dy * dL / L**2)
-        dny = -self.sign * (ddx / L - dx * dL / L**2)
-        return x + self.rp * nx, y + self.rp * ny, dx + self.rp * dnx, dy + self.rp * dny
+        """Practical-profile point and its derivative per degree (exact, from diff)."""
+        return tuple(self(n, k, phi_deg) for n in ("x_k", "y_k", "dx_k", "dy_k"))
 
     @property
     def period(self) -> float:
@@ -145,7 +103,7 @@ def _mag(sheet, name: str, unit: str) -> float:
 
 
 def model(sheet) -> Model:
-    """The symbolic model of ``sheet`` (built once, cached per Sheet object)."""
+    """The model of ``sheet`` (built once, cached per Sheet object)."""
     m = _MODELS.get(sheet)
     if m is None:
         m = _build(sheet)
@@ -170,51 +128,23 @@ def validate(sheet) -> None:
 
 
 def _build(sheet) -> Model:
-    import sympy as sp
-
-    spec = sheet.spec
-    for name in ("x_t", "y_t"):
-        d = spec.definitions.get(name)
-        if d is None or d.params != ("k", "phi"):
-            raise TemplateError(f"the reducer blocks need a definition {name}(k, phi)")
-    missing = [x for x in ("n", "e1", "r2", "rp", "dphi") if x not in spec.inputs]
-    missing += [x for x in ("Z", "i_a", "rp_s", "rp_packing") if x not in spec.definitions]
-    if missing:
-        raise TemplateError("the reducer blocks need " + ", ".join(missing))
     validate(sheet)
-    n = int(round(_mag(sheet, "n", "")))
     i_a = _mag(sheet, "i_a", "")
     if i_a == 0:
         raise InputError("the cam does not turn (a/phi = 0): no profile is traced")
     turns = int(round(1 / abs(i_a)))
     if abs(turns * abs(i_a) - 1) > 1e-9:
         raise InputError(f"a/phi = {i_a:g} is not 1/(whole number): the trace never closes")
-    k, phi = symbolic.symbol("k"), symbolic.symbol("phi")
-    exprs = {}
-    for name in ("x_t", "y_t"):
-        expr = symbolic.to_sympy(sheet, name, {"k": k, "phi": phi})
-        to_mm = un.factor(sheet.typer.function(name).unit, un.unit("mm"))
-        exprs[name] = expr if to_mm == 1.0 else expr * symbolic.exact_number(to_mm)
-    X, Y = exprs["x_t"], exprs["y_t"]
-    dX, dY = sp.diff(X, phi), sp.diff(Y, phi)
-    ddX, ddY = sp.diff(dX, phi), sp.diff(dY, phi)
-    exprs.update({"dx_t": dX, "dy_t": dY, "ddx_t": ddX, "ddy_t": ddY})
-    func = sp.lambdify((k, phi), [X, Y, dX, dY, ddX, ddY], modules="numpy", cse=True)
-    rp = _mag(sheet, "rp", "mm")
     return Model(
         sheet=sheet,
-        n=n,
+        n=int(round(_mag(sheet, "n", ""))),
         Z=_mag(sheet, "Z", ""),
         i_a=i_a,
         turns=turns,
         e1=_mag(sheet, "e1", "mm"),
         r2=_mag(sheet, "r2", "mm"),
-        rp=rp,
         rp_s=_mag(sheet, "rp_s", "mm"),
         dphi=_mag(sheet, "dphi", "deg"),
-        phi_unit=spec.arguments["phi"].unit,
-        exprs=exprs,
-        _f=func,
     )
 
 
@@ -222,10 +152,6 @@ def _grid(last_deg: float, step_deg: float) -> np.ndarray:
     from ..template import range_values
 
     return range_values(0.0, step_deg, last_deg, what="reducer grid")
-
-
-def _engine(sheet, name: str, unit: str, *args) -> np.ndarray:
-    return np.asarray(sheet.evaluate(name, *args).to(unit).magnitude, dtype=float)
 
 
 # ----------------------------------------------------------------------------------------
@@ -284,7 +210,7 @@ def closed_form_deviation(m: Model) -> float:
     PHI = np.tile(phi, m.n)
     x, y, *_ = m.derivs(K, PHI)
     psi = np.degrees(np.arctan2(y, x))
-    R = _engine(sheet, "R_closed", "mm", psi)
+    R = sheet.evaluate("R_closed", psi=psi).to("mm").magnitude
     return float(np.max(np.abs(np.hypot(x, y) - R)))
 
 
@@ -416,15 +342,14 @@ def roller_table(sheet):
     phi = _grid(360.0, m.dphi)
     K = np.repeat(np.arange(m.n), phi.size)
     PHI = np.tile(phi, m.n)
-    xt = _engine(sheet, "x_t", "mm", K, PHI)
-    yt = _engine(sheet, "y_t", "mm", K, PHI)
-    xk, yk = m.practical(K, PHI, xt, yt)
+    xt, yt = m("x_t", K, PHI), m("y_t", K, PHI)
+    xk, yk = m.practical(K, PHI)
     return pd.DataFrame(
         {
             "k": K,
             "phi [deg]": PHI,
-            "a [deg]": _engine(sheet, "a", "deg", PHI),
-            "rho [mm]": _engine(sheet, "rho", "mm", K, PHI),
+            "a [deg]": sheet.evaluate("a", phi=PHI).to("deg").magnitude,
+            "rho [mm]": sheet.evaluate("rho", k=K, phi=PHI).to("mm").magnitude,
             "x_t [mm]": xt,
             "y_t [mm]": yt,
             "x_k [mm]": xk,
@@ -440,9 +365,8 @@ def profile_table(sheet):
 
     m = model(sheet)
     phi = _grid(m.period, m.dphi)
-    xt = _engine(sheet, "x_t", "mm", 0, phi)
-    yt = _engine(sheet, "y_t", "mm", 0, phi)
-    xk, yk = m.practical(0, phi, xt, yt)
+    xt, yt = m("x_t", 0, phi), m("y_t", 0, phi)
+    xk, yk = m.practical(0, phi)
     kap = m.kappa_n(0, phi)
     regular = (1.0 - abs(m.rp_s) * kap > 0).astype(int)
     df = pd.DataFrame(
@@ -552,27 +476,6 @@ def findings(sheet) -> list[Finding]:
                 "info",
             )
         )
-
-    # the symbolic model must reproduce the worksheet formulas it was built from
-    phi = _grid(360.0, max(m.dphi, 5.0))
-    worst = 0.0
-    for k in sorted({0, m.n // 2, m.n - 1}):
-        x, y, *_ = m.derivs(k, phi)
-        worst = max(
-            worst,
-            float(np.max(np.abs(x - _engine(sheet, "x_t", "mm", k, phi)))),
-            float(np.max(np.abs(y - _engine(sheet, "y_t", "mm", k, phi)))),
-        )
-    out.append(
-        Finding(
-            "profile",
-            "sympy form of x_t, y_t (used for the normal) against the "
-            "worksheet formulas: largest difference",
-            worst,
-            "mm",
-            "ok" if worst < 1e-9 else "fail",
-        )
-    )
 
     c = closure(m)
     ok = c["max"] <= CLOSURE_TOL_MM
@@ -770,9 +673,7 @@ def export_profile_csv(sheet, path, *, allow_invalid: bool = False, header: bool
             + "; reduce rp (or export anyway with allow_invalid=True)"
         )
     phi = _grid(m.period, m.dphi)[:-1]
-    xt = _engine(sheet, "x_t", "mm", 0, phi)
-    yt = _engine(sheet, "y_t", "mm", 0, phi)
-    xk, yk = m.practical(0, phi, xt, yt)
+    xk, yk = m.practical(0, phi)
     path = Path(path)
     check_target(path, kind="csv")
     lines = ["x_mm,y_mm,z_mm"] if header else []
