@@ -230,7 +230,7 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         sym_name = res.sym.final if res.sym is not None else f"result_{res.region}"
         if not res.rows:
             rows.append(f"# region {res.region}: {res.name}: the stored result cannot be read")
-            rows.append(f"{sym_name},,nan,")
+            rows.append(f'{sym_name},,"(a result that cannot be read)",')  # counted, not computable
             continue
         rows.append(f"# region {res.region}: {res.name}")
         for at, value in res.rows:
