@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import pint
 
 from . import units as un
+from . import verdicts as V
 from .errors import TemplateError, UnitError, WorkbookError
 from .findings import Finding
 from .printed import PrintedRow, read_commented_csv, read_printed  # noqa: F401 - re-exported
@@ -26,7 +27,7 @@ class CheckRow:
     computed: float | None
     tolerance: float | None
     rel_tolerance: float | None
-    verdict: str  # pass | FAIL | misprint | info | error
+    verdict: str  # one of verdicts.ROW_VERDICTS
     note: str = ""
     computed_text: str | None = None  # what the sheet gives where a text is printed
 
@@ -52,20 +53,20 @@ class Report:
 
     @property
     def failed(self) -> list[CheckRow]:
-        return [r for r in self.rows if r.verdict in ("FAIL", "error")]
+        return [r for r in self.rows if r.verdict in V.ROW_FAILED]
 
     @property
     def ok(self) -> bool:
-        return not self.failed and not any(f.verdict == "fail" for f in self.findings)
+        return not self.failed and not any(f.verdict in V.FINDING_FAILED for f in self.findings)
 
     def summary(self) -> dict:
         """Counts of the checked printed values and the ones not reproduced (``check --json``):
         failed (computed, outside the tolerance) and not computable (an error)."""
         checked = [r for r in self.rows if r.role == "check"]
-        bad = [r for r in checked if r.verdict in ("FAIL", "error")]
+        bad = [r for r in checked if r.verdict in V.ROW_FAILED]
         return {
             "printed": len(checked),
-            "reproduced": sum(r.verdict in ("pass", "misprint") for r in checked),
+            "reproduced": sum(r.verdict in V.REPRODUCED for r in checked),
             "failed": sum(r.verdict == "FAIL" for r in checked),
             "not_computable": sum(r.verdict == "error" for r in checked),
             "failures": [
@@ -91,7 +92,7 @@ class Report:
             by_source.setdefault(r.source, []).append(r)
         for source, rows in by_source.items():
             role = rows[0].role
-            n_ok = sum(r.verdict in ("pass", "misprint", "info") for r in rows)
+            n_ok = sum(r.verdict in V.NOT_FAILED for r in rows)
             lines.append("")
             lines.append(
                 f"{source} ({'information' if role == 'information' else 'checked'}): "

@@ -229,7 +229,9 @@ def cmd_run(args) -> int:
     if exporter is not None:
         print(f"wrote {args.export}")
     n_checked = sum(r.role == "check" for r in report.rows)
-    n_ok = sum(r.role == "check" and r.verdict in ("pass", "misprint") for r in report.rows)
+    from .verdicts import REPRODUCED
+
+    n_ok = sum(r.role == "check" and r.verdict in REPRODUCED for r in report.rows)
     summary = f"{len(sheet.spec.tables)} tables, {len(sheet.spec.charts)} charts"
     if n_checked:
         summary += f", {n_ok} of {n_checked} printed values reproduced"
@@ -259,11 +261,13 @@ def _print_scalars(sheet) -> None:
 
 def _print_findings(report) -> int:
     """Print the findings with verdict warning or fail (stderr); EXIT_CHECK if one fails."""
+    from .verdicts import FINDING_FAILED, FINDING_FLAGGED
+
     for f in report.findings:
-        if f.verdict in ("warning", "fail"):
+        if f.verdict in FINDING_FLAGGED:
             note = f" ({f.note})" if f.note else ""
             print(f"workbook: {f.verdict}: [{f.topic}] {f.what}{note}", file=sys.stderr)
-    return EXIT_CHECK if any(f.verdict == "fail" for f in report.findings) else EXIT_OK
+    return EXIT_CHECK if any(f.verdict in FINDING_FAILED for f in report.findings) else EXIT_OK
 
 
 def cmd_report(args) -> int:

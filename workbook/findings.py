@@ -13,5 +13,5 @@ class Finding:
     what: str
     value: float | None = None
     unit: str = ""
-    verdict: str = "info"  # "ok" | "info" | "warning" | "fail"
+    verdict: str = "info"  # one of verdicts.FINDING_VERDICTS
     note: str = ""

@@ -18,6 +18,7 @@ from . import expr as ex
 from . import style
 from . import typecheck as tc
 from . import units as un
+from . import verdicts as V
 from .atomic import check_target, replacing
 from .builtins import excel_functions
 from .checks import tolerances
@@ -641,9 +642,7 @@ class WorkbookWriter:
                 shown.append(f"{100 * rel:g}%")
             tol_text = " or ".join(shown)
             ws.write_string(row, 8, tol_text)
-            fmt = (
-                self.fmt["pass"] if r.verdict in ("pass", "misprint", "info") else self.fmt["fail"]
-            )
+            fmt = self.fmt["pass"] if r.verdict in V.NOT_FAILED else self.fmt["fail"]
             if live and r.role == "check" and r.verdict in ("pass", "FAIL"):
                 # the engine's own test (checks.within): within the absolute OR the relative bound
                 tests = []
@@ -675,7 +674,7 @@ class WorkbookWriter:
                 ws.write_string(row, 3, f.unit)
                 if f.value is not None and math.isfinite(f.value):
                     ws.write_number(row, 4, float(f.value), self.fmt["number"])
-                fmt = self.fmt["fail"] if f.verdict in ("fail", "warning") else self.fmt["pass"]
+                fmt = self.fmt["fail"] if f.verdict in V.FINDING_FLAGGED else self.fmt["pass"]
                 ws.write_string(row, 9, f.verdict, fmt)
                 ws.write_string(row, 10, f.note, self.fmt["wrap"])
                 row += 1

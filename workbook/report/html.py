@@ -18,6 +18,7 @@ import numpy as np
 from .. import expr as ex
 from .. import units as un
 from ..errors import WorkbookError
+from ..verdicts import NOT_FAILED
 from ..version import __version__
 from . import mathml as mm
 from .mathml import Box, MathML
@@ -455,7 +456,7 @@ class Document:
             by_source.setdefault(r.source, []).append(r)
         for source, rows in by_source.items():
             role = rows[0].role
-            good = sum(r.verdict in ("pass", "misprint", "info") for r in rows)
+            good = sum(r.verdict in NOT_FAILED for r in rows)
             kind = "for information" if role == "information" else "checked"
             out.append(
                 f"<h3>{escape(source)}</h3><p class='summary'>{kind}: {good} of {len(rows)} "
