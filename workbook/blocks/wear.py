@@ -17,8 +17,7 @@ Valve (templates/cam-wear-valve.toml):
 * ``valve_findings``: validity of (3), port cap, (1) and (2) against (3), wear deeper than the
   lift, the measured-lift time-section and noise gains.
 
-Pump (cam-wear-pump.toml): ``worn_lift_inverse`` (the unworn lift at which the worn cam
-reaches a given lift: a root of the wear model) and ``pump_findings``.
+Pump (cam-wear-pump.toml): ``pump_findings``.
 
 Brake (cam-wear-brake.toml): ``shoe_integrals`` (the pressure integrals behind A and B by
 scipy.integrate.quad, as a table against the closed forms) and ``brake_findings``.
@@ -688,24 +687,6 @@ def valve_findings(sheet):
 # ---------------------------------------------------------------------------------------------
 # Pump
 # ---------------------------------------------------------------------------------------------
-@block(
-    args={"h": "mm", "w_b": "mm", "w_n": "mm", "H": "mm", "p": ""}, returns="mm", vectorized=False
-)
-def worn_lift_inverse(h, w_b, w_n, H, p):
-    """Unworn lift h0 at which the worn lift h0 - w(h0) first reaches h (H if it never does)."""
-    from scipy.optimize import brentq
-
-    g = lambda x: _worn(x, H, p, w_b, w_n) - h  # noqa: E731
-    xs = np.linspace(0.0, H, 1025)
-    gs = g(xs)
-    for k in range(len(xs) - 1):
-        if gs[k] == 0.0:
-            return float(xs[k])
-        if gs[k] < 0 < gs[k + 1]:
-            return float(brentq(g, xs[k], xs[k + 1], xtol=1e-14, rtol=1e-15))
-    return float(H) if gs[-1] >= 0 else float(H)
-
-
 @findings_block
 def pump_findings(sheet):
     """Active stroke within the acceleration section; (4)-(6) as printed; delivery with wear."""
