@@ -318,3 +318,35 @@ def test_rows_are_solved_in_chunks_with_the_same_results(pipe, tmp_path, monkeyp
     )
     with pytest.raises(NumericsError, match=r"for c = -1\)"):
         s.evaluate("g", [1.0] * 10 + [-1.0])
+
+
+ALL = Path(__file__).parent / "data" / "numerical-builtins.toml"
+
+
+def test_every_builtin_runs_from_a_plain_template(tmp_path, capsys):
+    """root (both forms), integral, diff, sum, product, maximum, argmax, Given/Find and data
+    interpolation in one template, through the command line; values against closed forms."""
+    from workbook.cli import main
+
+    assert main(["run", str(ALL), "--out", str(tmp_path / "all.xlsx")]) == 0
+    s = workbook.load(ALL)
+    R, u_max = 0.05, 2.0
+    beta = float(mpmath.beta(2, mpmath.mpf(8) / 7))
+    assert s.evaluate("flow").to("m^3/s").magnitude == pytest.approx(
+        2 * np.pi * R**2 * u_max * beta
+    )
+    half = 50 * (1 - 2.0**-7)  # (1 - r/R)^(1/7) = 1/2
+    assert s.evaluate("r_half").to("mm").magnitude == pytest.approx(half, rel=1e-12)
+    assert s.evaluate("r_near").to("mm").magnitude == pytest.approx(half, rel=1e-12)
+    # s = A sin(wt) exp(-wt/10): v is largest at t = 0 (A w); s is largest where tan(wt) = 10
+    assert s.evaluate("v_peak").to("m/s").magnitude == pytest.approx(1.0, rel=1e-12)
+    assert s.evaluate("t_peak").to("s").magnitude == pytest.approx(np.arctan(10) / 100, rel=1e-7)
+    assert s.evaluate("basel").magnitude == pytest.approx(sum(1 / k**2 for k in range(1, 101)))
+    assert s.evaluate("fact").magnitude == 720
+    assert s.evaluate("dist").to("m").magnitude == pytest.approx(2.0, rel=1e-12)
+    capsys.readouterr()
+    assert main(["bench", str(ALL)]) == 0
+    out = capsys.readouterr().out
+    for name in ("flow", "r_half", "r_near", "v_peak", "t_peak"):
+        line = next(x for x in out.splitlines() if x.startswith(name + " "))
+        assert line.endswith("ok"), line

@@ -87,7 +87,7 @@ def root_in(
         res = find_root(f, (xl, xr), args=tuple(g[todo] for g in args), tolerances=_tolerances(tol))
         _check_status(res, todo, lo, hi, label, n, unit)
         value[todo] = res.x
-        error[todo] = np.abs(res.bracket[1] - res.bracket[0])
+        error[todo] = _error(res, tol)
         evaluations += int(np.max(res.nfev))
     return Result(value.reshape(shape), error.reshape(shape), evaluations=evaluations)
 
@@ -149,9 +149,19 @@ def root_near(
     xl, xr = np.where(f0 == 0, x0, xl), np.where(f0 == 0, x0, xr)
     res = find_root(f, (xl, xr), args=tuple(args), tolerances=_tolerances(tol))
     _check_status(res, np.arange(n), np.minimum(xl, xr), np.maximum(xl, xr), label, n, unit)
-    error = np.abs(res.bracket[1] - res.bracket[0])
+    error = _error(res, tol)
     evaluations = 2 + int(np.max(br.nfev)) + int(np.max(res.nfev))
     return Result(res.x.reshape(shape), error.reshape(shape), evaluations=evaluations)
+
+
+def _error(res, tol: Tolerance) -> np.ndarray:
+    """The final bracket's width; where the function is exactly 0 (the search stops there,
+    with a bracket that may still be wide), the tolerance asked for: the computed function's
+    own rounding moves its zero by a few units in the last place."""
+    width = np.abs(res.bracket[1] - res.bracket[0])
+    x = np.abs(res.x)
+    asked = np.maximum(tol.rtol * x + tol.atol, 4 * np.spacing(x))
+    return np.where(np.asarray(res.f_x) == 0, np.minimum(asked, width), width)
 
 
 def _check_status(res, idx, lo, hi, label, n, unit) -> None:
