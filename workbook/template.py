@@ -45,6 +45,7 @@ SECTIONS = {
     "parts",
     "data",
     "solve",
+    "ode",
 }
 ALL_PARTS = "all"
 
@@ -61,10 +62,11 @@ SHEET_KEYS = (
     "measured_lift",
     "samples",
     "tolerance",
+    "origin",
 )  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
 INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
 ARGUMENT_KEYS = ("unit", "note", "plain")
-DEFINITION_KEYS = ("expr", "pieces", "unit", "note")
+DEFINITION_KEYS = ("expr", "pieces", "program", "unit", "note")
 PART_KEYS = ("title", "note")
 TABLE_KEYS = ("name", "title", "range", "columns", "sheet", "block", "part")
 COLUMN_KEYS = ("expr", "unit", "title")
@@ -152,10 +154,24 @@ class Definition:
     note: str = ""
     unit: pint.Unit | None = None  # display unit, optional
     line: int | None = None
+    program: Any = None  # workbook.program.Program: a body of statements
+    ode: tuple[str, int] | None = None  # a state of an [[ode]]: (ode name, state index)
 
     @property
     def is_function(self) -> bool:
         return bool(self.params)
+
+    def expressions(self) -> list[ex.Node]:
+        """Every expression the definition's value is made of (for dependencies)."""
+        if self.body is not None:
+            return [self.body]
+        if self.branches is not None:
+            return [x for b in self.branches for x in (b.value, b.condition) if x is not None]
+        if self.program is not None:
+            from .program import expressions
+
+            return list(expressions(self.program.body))
+        return []  # an ODE state: its section's expressions are listed by the sheet
 
 
 @dataclass
@@ -285,10 +301,16 @@ class SheetSpec:
     parts: dict[str, PartSpec] = field(default_factory=dict)
     data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
     solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
+    odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.ode.OdeSpec
 
     def solve_of(self, name: str):
         """The [[solve]] block that finds ``name``, or None."""
         return next((s for s in self.solves if name in s.unknowns), None)
+
+    @property
+    def origin(self) -> int:
+        """The first index of vectors and matrices (Mathcad's ORIGIN; [sheet] origin)."""
+        return int(self.meta.get("origin", 0))
 
     def line_of(self, key: str, section: str | None = None) -> int | None:
         return find_line(self.text, key, section)
@@ -590,6 +612,14 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         except WorkbookError as err:
             raise err.located(line=line, definition=dname) from None
 
+    odes = _odes(data, text, arguments, definitions, claim)
+    origin = sheet.get("origin", 0)
+    if isinstance(origin, bool) or not isinstance(origin, int) or abs(origin) > 1_000_000:
+        raise TemplateError(
+            f"[sheet] origin is the first index of vectors, an integer (0 or 1), got {origin!r}",
+            line=find_line(text, "origin", "sheet"),
+        )
+
     for pname in arguments:
         if pname in inputs or pname in definitions:
             raise TemplateError(
@@ -645,7 +675,50 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         parts=parts,
         data=measured,
         solves=solves,
+        odes=odes,
     )
+
+
+def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
+    """``[[ode]]`` sections; each state becomes a definition, a function of the time."""
+    from .ode import parse_spec
+
+    out = {}
+    for k, raw in enumerate(_list(data, "ode")):
+        name = raw.get("name") if isinstance(raw, dict) else None
+        line = _name_line(text, name) if isinstance(name, str) else _section_line(text, "ode")
+        try:
+            spec = parse_spec(raw, where=f"[[ode]] {k + 1}", line=line)
+        except WorkbookError as err:
+            raise err.located(line=line) from None
+        if spec.name in out:
+            raise TemplateError(f"two [[ode]] sections are named '{spec.name}'", line=line)
+        if spec.var not in arguments:
+            raise TemplateError(
+                f"ode '{spec.name}': the time variable '{spec.var}' has no declared unit: "
+                f'add it to [arguments] (e.g. {spec.var} = {{ unit = "s" }})',
+                line=line,
+            )
+        if arguments[spec.var].plain:
+            raise TemplateError(
+                f"ode '{spec.name}': the time variable '{spec.var}' must not be plain",
+                line=line,
+            )
+        for i, st in enumerate(spec.states):
+            claim(st.name, f"ode {spec.name}", _name_line(text, st.name) or line)
+            definitions[st.name] = Definition(
+                st.name,
+                (spec.var,),
+                None,
+                None,
+                f"solution of ode '{spec.name}': {st.name}' = {st.derivative_text}",
+                f"state of ode '{spec.name}', initial value {st.initial_text}",
+                None,
+                line,
+                ode=(spec.name, i),
+            )
+        out[spec.name] = spec
+    return out
 
 
 def _parts(raw: dict, text: str) -> dict[str, PartSpec]:
@@ -844,9 +917,17 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
             raw = raw["expr"]
         elif "pieces" in f:
             raw = raw["pieces"]
+        elif "program" in raw:
+            from . import program
+
+            body = program.parse(raw["program"], what=f"program of '{name}'")
+            display = un.unit(unit_text, what=name) if unit_text is not None else None
+            text = raw["program"].strip()
+            return Definition(name, params, None, None, text, note, display, line, body)
         else:
             raise TemplateError(
-                'a definition with a note is written { expr = "...", note = "..." }'
+                'a definition with a note is written { expr = "...", note = "..." } '
+                '(or { program = """...""" })'
             )
     display = un.unit(unit_text, what=name) if unit_text is not None else None
     what = name
