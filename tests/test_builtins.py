@@ -121,7 +121,7 @@ def test_the_sheet_with_sums_is_written(tmp_path):
     [
         ("sum(I, 2*I, 1, 3)", "must be the name of the variable"),
         ("sum(I, R, 1, 3)", "already an input"),
-        ("sum(I, I, 1)", "takes 4 argument(s), got 3"),
+        ("sum(I, I, 1)", "takes 1 argument (a vector) or 4 (EXPR, I, A, B), got 3"),
         ("sum(s, s, 1, 3)", "must be a plain number"),
         ("sum(I, I, R, 3)", "needs a dimensionless argument"),
         ("sum(I*R, I, 1, 3) + 1", "cannot add"),

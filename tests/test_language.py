@@ -72,9 +72,26 @@ def test_example(tmp_path, text):
             sheet.write_xlsx(tmp_path / "chart.xlsx")
             continue
         lhs, _, rhs = line.partition(" = ")
-        value, _, unit = rhs.partition(" ")
         name, _, args = lhs.partition("(")
         args = [float(a) for a in args.rstrip(")").split(",") if a]
+        if rhs.startswith('"'):  # a text
+            assert sheet.evaluate(name, *args) == rhs.strip('"'), line
+            continue
+        if rhs.startswith("["):  # a vector or matrix: [1, 2] (a column) or [[1, 2], [3, 4]]
+            import ast
+
+            import numpy as np
+
+            cut = rhs.rindex("]") + 1
+            want = np.array(ast.literal_eval(rhs[:cut]), dtype=float)
+            want = want.reshape(-1, 1) if want.ndim == 1 else want
+            unit = rhs[cut:].strip()
+            q = sheet.evaluate(name, *args)
+            got = q.to(unit).magnitude if unit else q.to("").magnitude
+            assert got.shape == want.shape, line
+            assert np.allclose(got, want, rtol=1e-9, atol=1e-9), line
+            continue
+        value, _, unit = rhs.partition(" ")
         q = sheet.evaluate(name, *args)
         got = q.to(unit).magnitude if unit else q.to("").magnitude
         digits = len(value.split(".")[1]) if "." in value else 0

@@ -624,10 +624,11 @@ class TypedText(Visitor):
         return "-" + self.text(t.child, PREC["neg"]), PREC["neg"]
 
     def visit_TBinary(self, t: tc.TBinary) -> tuple[str, int]:
-        p = PREC[t.op]
-        if t.op == "^":
+        op = {"@": "*", "@^": "^"}.get(t.op, t.op)  # matrix product and power
+        p = PREC[op]
+        if op == "^":
             return f"{self.text(t.left, p + 1)}^{self.text(t.right, p)}", p
-        return f"{self.text(t.left, p)} {t.op} {self.text(t.right, p + 1)}", p
+        return f"{self.text(t.left, p)} {op} {self.text(t.right, p + 1)}", p
 
     def visit_TCompare(self, t: tc.TCompare) -> tuple[str, int]:
         p = PREC["cmp"]
@@ -653,6 +654,20 @@ class TypedText(Visitor):
 
     def visit_TPiecewise(self, t: tc.TPiecewise) -> tuple[str, int]:
         return "; ".join(t.texts), PREC["or"] - 1
+
+    def visit_TMatrix(self, t: tc.TMatrix) -> tuple[str, int]:
+        rows = ["[" + ", ".join(self.text(e) for e in row) + "]" for row in t.rows]
+        return "[" + ", ".join(rows) + "]", PREC["atom"]
+
+    def visit_TIndex(self, t: tc.TIndex) -> tuple[str, int]:
+        inner = ", ".join(self.text(i) for i in t.indices)
+        return f"{self.text(t.target, PREC['atom'])}[{inner}]", PREC["atom"]
+
+    def visit_TProgram(self, t: tc.TProgram) -> tuple[str, int]:
+        return f"the program of {t.name}", PREC["atom"]
+
+    def visit_TOde(self, t: tc.TOde) -> tuple[str, int]:
+        return f"{t.name}({', '.join(self.text(a) for a in t.args)})", PREC["atom"]
 
 
 def typed_text(t: tc.T, parent: int = 0) -> str:

@@ -54,7 +54,6 @@ and document it in docs/language.md. Nothing else in the engine lists built-ins.
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -107,6 +106,7 @@ class Builtin:
     excel_functions: tuple[str, ...] = ()
     mathml: str = ""
     mathml_powered: bool = False
+    arrays: bool = False  # takes vectors/matrices: the hooks get ``shapes=`` (workbook.matrix)
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""
@@ -183,14 +183,6 @@ def _excel_ceil(args: list[str]) -> tuple[str, int]:
 
 
 # -- the classic built-ins -----------------------------------------------------------------------
-def _minimum(*values):
-    return functools.reduce(np.minimum, values)
-
-
-def _maximum(*values):
-    return functools.reduce(np.maximum, values)
-
-
 _SQRT = Domain("sqrt of a negative number", lambda v: v < 0, "sqrt({})")
 
 
@@ -287,8 +279,6 @@ _simple(
     same_unit,
     mathml=mathml_fence("|", "|"),
 )
-_simple("min", _minimum, "MIN", lambda sp, *a: sp.Min(*a), "smallest argument", same_unit, (), None)
-_simple("max", _maximum, "MAX", lambda sp, *a: sp.Max(*a), "largest argument", same_unit, (), None)
 _simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
 register(
     Builtin(
@@ -325,6 +315,14 @@ MAX_EXCEL_TERMS = 64
 
 
 def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    if len(args) == 1:  # sum(v): the elements of a vector or matrix
+        if args[0].shape is None:
+            raise TemplateError("sum(v) takes a vector or matrix; or write sum(EXPR, I, A, B)")
+        return ty.TFunc(args[0].unit, func=name, args=args)
+    if len(args) != 4:
+        raise TemplateError(
+            f"sum() takes 1 argument (a vector) or 4 (EXPR, I, A, B), got {len(args)}"
+        )
     body, var, a, b = args
     if var.unit.dimensionality or var.unit != ctx.dimensionless:
         raise UnitError(f"sum(): the index {var.name} must be a plain number (integers A..B)")
@@ -343,7 +341,11 @@ def _bound(value, which: str) -> int:
     return int(x)
 
 
-def _sum_numpy(fn, a, b):
+def _sum_numpy(fn, a=None, b=None, *, shapes=None):
+    if shapes is not None:  # sum(v)
+        from .matrix import reduce
+
+        return reduce("sum", fn, matrix=(True,))
     lo, hi = _bound(a, "first"), _bound(b, "last")
     if hi - lo + 1 > MAX_TERMS:
         raise LimitError(f"sum(): {hi - lo + 1} terms (limit {MAX_TERMS})")
@@ -353,7 +355,9 @@ def _sum_numpy(fn, a, b):
     return out
 
 
-def _sum_excel(body, args, consts) -> tuple[str, int]:
+def _sum_excel(body, args=None, consts=None, *, shapes=None) -> tuple[str, int]:
+    if shapes is not None:  # sum(v): body is the printed vector
+        return f"SUM({body[0]})", PREC["atom"]
     lo, hi = consts
     if lo is None or hi is None:
         raise NotLive("sum() with bounds that are not constants has no live formula")
@@ -373,14 +377,17 @@ def _sum_sympy(sp, body, var, a, b):
 register(
     Builtin(
         "sum",
-        4,
+        (1, 4),
         _sum_unit,
         _sum_numpy,
         _sum_excel,
         _sum_sympy,
-        doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A)",
+        doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A); "
+        "sum(v): the sum of the elements of a vector or matrix",
         binds=(0, 1),
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
+        excel_functions=("SUM",),
+        arrays=True,
     )
 )
 
@@ -392,3 +399,12 @@ def excel_functions() -> frozenset[str]:
 
 # the numerical built-ins (root, integral, maximum, ..., product, diff) register themselves
 from .numerics import entries as _numerical  # noqa: E402, F401
+
+
+def _register_arrays() -> None:
+    from .matrix import _register
+
+    _register()
+
+
+_register_arrays()  # min, max, mean and the vector and matrix built-ins (workbook.matrix)

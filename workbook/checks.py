@@ -178,6 +178,10 @@ def collect_findings(sheet) -> list[Finding]:
     from . import blocks
 
     out: list[Finding] = []
+    if sheet.spec.odes:
+        from .ode import sheet_findings
+
+        out.extend(sheet_findings(sheet))
     for entry in sheet.spec.findings:
         ref = entry.get("block")
         if not isinstance(ref, str):

@@ -325,20 +325,26 @@ def cmd_bench(args) -> int:
     lines = bench.run(sheet)
     if lines:
         print(bench.text(sheet, lines))
-    if not ref:
+    if not ref and not sheet.spec.odes:
         if lines:
             return EXIT_OK
         raise InputError(
-            f"{sheet.name} uses no numerical built-in (root, integral, maximum, ...) and "
-            'declares no benchmark ([sheet] bench = "module.func")'
+            f"{sheet.name} uses no numerical built-in (root, integral, maximum, ...), has no "
+            '[[ode]] and declares no benchmark ([sheet] bench = "module.func")'
         )
     import pandas as pd
 
-    df = blocks.get(ref, "bench").func(sheet, quick=args.quick)
+    tables = []
+    if sheet.spec.odes:
+        from .ode import sheet_bench
+
+        tables.append(pd.DataFrame(sheet_bench(sheet, quick=args.quick)))
+    if ref:
+        tables.append(blocks.get(ref, "bench").func(sheet, quick=args.quick))
     with pd.option_context(
         "display.max_rows", 500, "display.width", 200, "display.max_columns", 50
     ):
-        print(df.to_string(index=False))
+        print("\n\n".join(df.to_string(index=False) for df in tables))
     return EXIT_OK
 
 

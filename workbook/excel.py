@@ -93,6 +93,7 @@ class ExcelPrinter(Visitor):
         self.ranges: dict[tuple[str, str], str] = {}
 
     def formula(self, t: tc.T, subst: dict[str, str]) -> str:
+        self.array = False  # set when the formula computes with arrays (an array formula)
         text = "=" + self.print(t, subst)
         if len(text) > MAX_FORMULA:
             raise NotLive(f"formula is {len(text)} characters long (Excel's limit {MAX_FORMULA})")
@@ -116,6 +117,8 @@ class ExcelPrinter(Visitor):
         return s[t.name], ATOM
 
     def visit_TRef(self, t, s):
+        if t.shape is not None:
+            self.array = True
         if t.kind == "builtin":
             return "PI()", ATOM
         if t.kind in ("solve", "data"):
@@ -138,6 +141,12 @@ class ExcelPrinter(Visitor):
         return "-" + self._wrap(t.child, s, ATOM - 1), ADD
 
     def visit_TBinary(self, t, s):
+        if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
+            self.array = True
+            if t.op == "@":
+                return f"MMULT({self.print(t.left, s)}, {self.print(t.right, s)})", ATOM
+            if t.op == "@^":
+                return _matrix_power(self.print(t.left, s), int(t.right.value)), ATOM
         if t.op == "^":
             return f"{self._wrap(t.left, s, POW)}^{self._wrap(t.right, s, POW)}", POW
         level = ADD if t.op in "+-" else MUL
@@ -157,7 +166,11 @@ class ExcelPrinter(Visitor):
 
     def visit_TFunc(self, t, s):
         entry = REGISTRY[t.func]
-        if not entry.binds:
+        if entry.arrays and any(a.shape is not None for a in t.args):
+            self.array = True
+            shapes = tuple(a.shape for a in t.args)
+            return entry.excel([self.print(a, s) for a in t.args], shapes=shapes)
+        if not entry.binds or len(t.args) <= max(entry.binds):
             return entry.excel([self.print(a, s) for a in t.args])
         expr_at, var_at = entry.binds
         body, var = t.args[expr_at], t.args[var_at].name
@@ -192,3 +205,42 @@ class ExcelPrinter(Visitor):
             v = self.print(val, s)
             tail = v if cond is None else f"IF({self.print(cond, s)}, {v}, {tail})"
         return tail, ATOM
+
+    def visit_TMatrix(self, t, s):
+        self.array = True
+        if not all(isinstance(e, tc.TConst) for row in t.rows for e in row):
+            raise NotLive("a matrix written with formulas inside an expression (name it)")
+        rows = (",".join(number(e.value) for e in row) for row in t.rows)
+        return "{" + ";".join(rows) + "}", ATOM
+
+    def visit_TIndex(self, t, s):
+        target = self.print(t.target, s)
+        idx = [self._index(i, t.origin, s) for i in t.indices]
+        if len(idx) == 1 and t.target.shape[1] == 1:
+            return f"INDEX({target}, {idx[0]})", ATOM
+        return f"INDEX({target}, {idx[0]}, {idx[1]})", ATOM
+
+    def _index(self, i, origin: int, s) -> str:
+        if isinstance(i, tc.TConst):
+            return number(i.value + 1 - origin)
+        shift = 1 - origin
+        text = self._wrap(i, s, ADD)
+        return text if shift == 0 else f"{text}+{shift}" if shift > 0 else f"{text}{shift}"
+
+    def visit_TProgram(self, t, s):
+        from .program import excel_value
+
+        return excel_value(t.program, lambda e, sub: self.print(e, sub), s), ATOM
+
+    def visit_TOde(self, t, s):
+        raise NotLive(f"{t.name}() is the solution of ode '{t.ode}'; its values are numbers")
+
+
+def _matrix_power(m: str, n: int) -> str:
+    if n == 0:
+        raise NotLive("M^0 (the identity) has no formula here")
+    base = m if n > 0 else f"MINVERSE({m})"
+    out = base
+    for _ in range(abs(n) - 1):
+        out = f"MMULT({out}, {base})"
+    return out

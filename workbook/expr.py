@@ -74,6 +74,30 @@ class Call(Node):
     args: tuple[Node, ...]
 
 
+@dataclass(frozen=True)
+class Matrix(Node):
+    """``[1, 2, 3]`` (a column vector, as Mathcad's) or ``[[4, 1], [2, 3]]`` (by rows)."""
+
+    rows: tuple[tuple[Node, ...], ...]
+
+
+@dataclass(frozen=True)
+class Index(Node):
+    """``v[i]`` or ``M[i, j]`` (counted from the sheet's origin)."""
+
+    target: Node
+    indices: tuple[Node, ...]
+
+
+@dataclass(frozen=True)
+class IfElse(Node):
+    """``VALUE if CONDITION otherwise OTHER`` (Python's ``else`` is read too)."""
+
+    value: Node
+    condition: Node
+    other: Node
+
+
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Pow: "^"}
 _CMPOPS = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
 _IDENT = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
@@ -98,6 +122,8 @@ def parse(text: str, *, what: str = "expression") -> Node:
         depth = _paren_depth(source)
         if depth > MAX_DEPTH:
             raise LimitError(f"{what}: parentheses nested {depth} deep (limit {MAX_DEPTH})")
+    if "otherwise" in source:
+        source = _otherwise_as_else(source)
     try:
         tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
@@ -106,6 +132,26 @@ def parse(text: str, *, what: str = "expression") -> Node:
     except (RecursionError, MemoryError):
         raise LimitError(f"{what}: expression nested too deeply (limit {MAX_DEPTH})") from None
     return _convert(tree.body, _short(text), what, 0)
+
+
+def _otherwise_as_else(source: str) -> str:
+    """The word ``otherwise`` (outside strings) as Python's ``else``."""
+    import io
+    import tokenize
+
+    try:
+        tokens = list(tokenize.generate_tokens(io.StringIO(source).readline))
+    except (tokenize.TokenError, SyntaxError):
+        return source  # ast.parse says what is wrong
+    starts = [0]
+    for line in source.splitlines(keepends=True):
+        starts.append(starts[-1] + len(line))
+    out = source
+    for tok in reversed(tokens):
+        if tok.type == tokenize.NAME and tok.string == "otherwise":
+            at = starts[tok.start[0] - 1] + tok.start[1]
+            out = out[:at] + "else" + out[at + len("otherwise") :]
+    return out
 
 
 def _short(text: str, limit: int = 80) -> str:
@@ -180,8 +226,50 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
         if any(isinstance(a, ast.Starred) for a in node.args):
             raise TemplateError(f"{what}: starred arguments are not allowed in {text!r}")
         return Call(node.func.id, tuple(_convert(a, text, what, d) for a in node.args))
+    if isinstance(node, ast.List):
+        return _matrix(node, text, what, d)
+    if isinstance(node, ast.Subscript):
+        index = node.slice
+        items = index.elts if isinstance(index, ast.Tuple) else [index]
+        if not 1 <= len(items) <= 2 or any(isinstance(i, (ast.Slice, ast.Starred)) for i in items):
+            raise TemplateError(f"{what}: write v[i] or M[i, j] (no slices) in {text!r}")
+        return Index(
+            _convert(node.value, text, what, d),
+            tuple(_convert(i, text, what, d) for i in items),
+        )
+    if isinstance(node, ast.IfExp):
+        return IfElse(
+            _convert(node.body, text, what, d),
+            _convert(node.test, text, what, d),
+            _convert(node.orelse, text, what, d),
+        )
     kind = type(node).__name__
     raise TemplateError(f"{what}: {kind} is not allowed in worksheet expressions ({text!r})")
+
+
+def _matrix(node: ast.List, text: str, what: str, depth: int) -> Matrix:
+    """``[a, b]`` is a column; ``[[a, b], [c, d]]`` a matrix by rows (``[[a, b]]`` a row)."""
+    if not node.elts:
+        raise TemplateError(f"{what}: an empty vector [] in {text!r}")
+    nested = [isinstance(e, ast.List) for e in node.elts]
+    if any(nested) and not all(nested):
+        raise TemplateError(
+            f"{what}: write a vector [a, b, c] or a matrix by rows [[a, b], [c, d]], "
+            f"not a mix, in {text!r}"
+        )
+    if not any(nested):
+        return Matrix(tuple((_convert(e, text, what, depth),) for e in node.elts))
+    rows = []
+    for r in node.elts:
+        if any(isinstance(e, ast.List) for e in r.elts) or not r.elts:
+            raise TemplateError(f"{what}: a matrix has two levels of brackets, in {text!r}")
+        rows.append(tuple(_convert(e, text, what, depth) for e in r.elts))
+    if len({len(r) for r in rows}) != 1:
+        lengths = ", ".join(str(len(r)) for r in rows)
+        raise TemplateError(
+            f"{what}: the rows of a matrix differ in length ({lengths}) in {text!r}"
+        )
+    return Matrix(tuple(rows))
 
 
 class _Children(Visitor):
@@ -206,6 +294,15 @@ class _Children(Visitor):
 
     def visit_Call(self, node: Call) -> tuple[Node, ...]:
         return node.args
+
+    def visit_Matrix(self, node: Matrix) -> tuple[Node, ...]:
+        return tuple(e for row in node.rows for e in row)
+
+    def visit_Index(self, node: Index) -> tuple[Node, ...]:
+        return (node.target, *node.indices)
+
+    def visit_IfElse(self, node: IfElse) -> tuple[Node, ...]:
+        return (node.value, node.condition, node.other)
 
 
 _CHILDREN = _Children()
@@ -291,6 +388,21 @@ class TextPrinter(Visitor):
     def visit_Logic(self, node: Logic) -> tuple[str, int]:
         p = PREC[node.op]
         return f" {node.op} ".join(self.text(v, p + 1) for v in node.values), p
+
+    def visit_Matrix(self, node: Matrix) -> tuple[str, int]:
+        if all(len(r) == 1 for r in node.rows):
+            return "[" + ", ".join(self.text(r[0]) for r in node.rows) + "]", PREC["atom"]
+        rows = ("[" + ", ".join(self.text(e) for e in r) + "]" for r in node.rows)
+        return "[" + ", ".join(rows) + "]", PREC["atom"]
+
+    def visit_Index(self, node: Index) -> tuple[str, int]:
+        inner = ", ".join(self.text(i) for i in node.indices)
+        return f"{self.text(node.target, PREC['atom'])}[{inner}]", PREC["atom"]
+
+    def visit_IfElse(self, node: IfElse) -> tuple[str, int]:
+        p = PREC["or"] - 1
+        cond = self.text(node.condition, p + 1)
+        return f"{self.text(node.value, p + 1)} if {cond} otherwise {self.text(node.other, p)}", p
 
 
 def to_text(node: Node) -> str:

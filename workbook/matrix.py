@@ -227,3 +227,356 @@ def _index_values(i, origin: int, n: int, word: str, what: str):
 
 def submatrix(m, ir: int, jr: int, ic: int, jc: int):
     return np.asarray(m, dtype=float)[ir : jr + 1, ic : jc + 1]
+
+
+# -- the built-ins of vectors and matrices (registry entries) ----------------------------------
+def _register() -> None:
+    """Register the matrix built-ins (called once, at the end of workbook.builtins)."""
+    from . import typed as ty
+    from .builtins import Builtin, register
+    from .errors import NotLive, TemplateError
+    from .expr import PREC
+
+    atom = PREC["atom"]
+
+    def shape_text(s) -> str:
+        from .typearrays import shape_text as st
+
+        return st(s)
+
+    def need(args, k: int, name: str, what: str = "a vector or matrix"):
+        a = args[k]
+        if a.shape is None:
+            raise TemplateError(f"{name}(): argument {k + 1} must be {what}, got a number")
+        return a.shape
+
+    def vector(args, k: int, name: str) -> int:
+        s = need(args, k, name, "a vector")
+        if s[1] != 1:
+            raise TemplateError(
+                f"{name}(): argument {k + 1} must be a vector, got a {shape_text(s)}"
+            )
+        return s[0]
+
+    def square(args, name: str) -> int:
+        s = need(args, 0, name, "a square matrix")
+        if s[0] != s[1]:
+            raise TemplateError(f"{name}() needs a square matrix, got a {shape_text(s)}")
+        return s[0]
+
+    def not_symbolic(name):
+        def hook(sp, *a):
+            from .symbolic import NotSymbolic
+
+            raise NotSymbolic(f"{name}() of a matrix is not differentiated symbolically")
+
+        return hook
+
+    def call(function: str, template: str = "{}"):
+        def printed(args, shapes=None):
+            return f"{function}({template.format(*args)})", atom
+
+        return printed
+
+    def not_live(why: str):
+        def printed(args, shapes=None):
+            raise NotLive(why)
+
+        return printed
+
+    def entry(name, arity, rule, numpy, excel, doc, uses=()):
+        register(
+            Builtin(
+                name,
+                arity,
+                rule,
+                numpy,
+                excel,
+                not_symbolic(name),
+                doc=doc,
+                excel_functions=uses,
+                arrays=True,
+            )
+        )
+
+    def func(unit, name, args, shape):
+        return ty.TFunc(unit, func=name, args=tuple(args), shape=shape)
+
+    # transpose, det, inverse, lsolve
+    def r_transpose(ctx, name, args):
+        r, c = need(args, 0, name)
+        return func(args[0].unit, name, args, (c, r))
+
+    def r_det(ctx, name, args):
+        n = square(args, name)
+        return func(args[0].unit ** n, name, args, None)
+
+    def r_inverse(ctx, name, args):
+        n = square(args, name)
+        return func(1 / args[0].unit, name, args, (n, n))
+
+    def r_lsolve(ctx, name, args):
+        n = square(args, name)
+        m = vector(args, 1, name)
+        if m != n:
+            raise TemplateError(f"lsolve(M, v): M is {n}x{n} but v has {m} elements")
+        return func(args[1].unit / args[0].unit, name, args, (n, 1))
+
+    entry(
+        "transpose",
+        1,
+        r_transpose,
+        lambda m, shapes: transpose(m),
+        call("TRANSPOSE"),
+        "rows and columns swapped",
+        ("TRANSPOSE",),
+    )
+    entry(
+        "det",
+        1,
+        r_det,
+        lambda m, shapes: det(m),
+        call("MDETERM"),
+        "determinant of a square matrix",
+        ("MDETERM",),
+    )
+    entry(
+        "inverse",
+        1,
+        r_inverse,
+        lambda m, shapes: inverse(m),
+        call("MINVERSE"),
+        "inverse of a square matrix (a singular one is an error)",
+        ("MINVERSE",),
+    )
+    entry(
+        "lsolve",
+        2,
+        r_lsolve,
+        lambda m, v, shapes: lsolve(m, v),
+        call("MMULT", "MINVERSE({}), {}"),
+        "solution x of M x = v",
+        ("MMULT", "MINVERSE"),
+    )
+
+    # eigenvalues and eigenvectors
+    def r_eigenvals(ctx, name, args):
+        n = square(args, name)
+        return func(args[0].unit, name, args, (n, 1))
+
+    def r_eigenvecs(ctx, name, args):
+        n = square(args, name)
+        return func(ctx.dimensionless, name, args, (n, n))
+
+    entry(
+        "eigenvals",
+        1,
+        r_eigenvals,
+        lambda m, shapes: eigenvals(m),
+        not_live("eigenvalues have no spreadsheet formula"),
+        "eigenvalues of a square matrix, ascending (real ones only)",
+    )
+    entry(
+        "eigenvecs",
+        1,
+        r_eigenvecs,
+        lambda m, shapes: eigenvecs(m),
+        not_live("eigenvectors have no spreadsheet formula"),
+        "unit eigenvectors as columns, in the order of eigenvals",
+    )
+
+    # vectors
+    def r_cross(ctx, name, args):
+        for k in (0, 1):
+            if vector(args, k, name) != 3:
+                raise TemplateError("cross() takes two vectors of 3 elements")
+        return func(args[0].unit * args[1].unit, name, args, (3, 1))
+
+    def r_dot(ctx, name, args):
+        n, m = vector(args, 0, name), vector(args, 1, name)
+        if n != m:
+            raise TemplateError(f"dot(): the vectors have {n} and {m} elements")
+        return func(args[0].unit * args[1].unit, name, args, None)
+
+    def r_norm(ctx, name, args):
+        vector(args, 0, name)
+        return func(args[0].unit, name, args, None)
+
+    def x_cross(args, shapes=None):
+        a, b = args
+        e = [
+            f"INDEX({a},{i})*INDEX({b},{j})-INDEX({a},{j})*INDEX({b},{i})"
+            for i, j in ((2, 3), (3, 1), (1, 2))
+        ]
+        return f"CHOOSE({{1;2;3}},{','.join(e)})", atom
+
+    entry(
+        "cross",
+        2,
+        r_cross,
+        lambda a, b, shapes: cross(a, b),
+        x_cross,
+        "cross product of two vectors of 3",
+        ("CHOOSE", "INDEX"),
+    )
+    entry(
+        "dot",
+        2,
+        r_dot,
+        lambda a, b, shapes: dot(a, b),
+        call("SUMPRODUCT", "{}, {}"),
+        "dot product of two vectors",
+        ("SUMPRODUCT",),
+    )
+    entry(
+        "norm",
+        1,
+        r_norm,
+        lambda v, shapes: norm(v),
+        call("SQRT", "SUMSQ({})"),
+        "length (Euclidean norm) of a vector",
+        ("SQRT", "SUMSQ"),
+    )
+
+    # joining and cutting
+    def r_join(axis: int):
+        def rule(ctx, name, args):
+            shapes = [need(args, k, name) for k in range(len(args))]
+            keep = 1 - axis
+            if len({s[keep] for s in shapes}) != 1:
+                word = "rows" if axis == 1 else "columns"
+                raise TemplateError(
+                    f"{name}(): the matrices must have the same number of {word} "
+                    f"({', '.join(shape_text(s) for s in shapes)})"
+                )
+            unit = args[0].unit
+            conv = [ctx.convert(a, unit, f"{name}(): argument {k + 1}") for k, a in enumerate(args)]
+            total = sum(s[axis] for s in shapes)
+            shape = (shapes[0][0], total) if axis == 1 else (total, shapes[0][1])
+            return func(unit, name, conv, shape)
+
+        return rule
+
+    entry(
+        "augment",
+        (2, None),
+        r_join(1),
+        lambda *m, shapes: augment(*m),
+        not_live("augment() is written as values"),
+        "matrices side by side (same rows)",
+    )
+    entry(
+        "stack",
+        (2, None),
+        r_join(0),
+        lambda *m, shapes: stack(*m),
+        not_live("stack() is written as values"),
+        "matrices one above the other (same columns)",
+    )
+
+    def r_submatrix(ctx, name, args):
+        r, c = need(args, 0, name)
+        origin = ctx.spec.origin
+        bounds = []
+        for k, a in enumerate(args[1:], start=2):
+            a = ctx.plain(a, f"submatrix(): argument {k}")
+            if not isinstance(a, ty.TConst) or a.value != int(a.value):
+                raise TemplateError(f"submatrix(): argument {k} must be a constant integer")
+            bounds.append(int(a.value) - origin)
+        ir, jr, ic, jc = bounds
+        if not (0 <= ir <= jr < r and 0 <= ic <= jc < c):
+            raise TemplateError(
+                f"submatrix(M, {ir + origin}, {jr + origin}, {ic + origin}, {jc + origin}) is "
+                f"outside the {shape_text((r, c))} (origin {origin})"
+            )
+        consts = [ty.TConst(ctx.dimensionless, value=float(b)) for b in bounds]
+        return func(args[0].unit, name, [args[0], *consts], (jr - ir + 1, jc - ic + 1))
+
+    entry(
+        "submatrix",
+        5,
+        r_submatrix,
+        lambda m, ir, jr, ic, jc, shapes: submatrix(m, int(ir), int(jr), int(ic), int(jc)),
+        not_live("submatrix() is written as values"),
+        "submatrix(M, first row, last row, first column, last column)",
+    )
+
+    # sizes (constants at load)
+    def r_size(kind: str):
+        def rule(ctx, name, args):
+            r, c = need(args, 0, name)
+            if kind in ("length", "last") and c != 1:
+                raise TemplateError(f"{name}() takes a vector, got a {shape_text((r, c))}")
+            value = {"rows": r, "cols": c, "length": r, "last": r - 1 + ctx.spec.origin}[kind]
+            return ty.TConst(ctx.dimensionless, value=float(value))
+
+        return rule
+
+    for kind, doc in (
+        ("rows", "number of rows"),
+        ("cols", "number of columns"),
+        ("length", "number of elements of a vector"),
+        ("last", "index of the last element of a vector (with the sheet's origin)"),
+    ):
+        entry(kind, 1, r_size(kind), lambda m, shapes: None, not_live(kind), doc)
+
+    # reductions: max and min of numbers and of the elements of matrices; mean
+    def r_reduce(ctx, name, args):
+        first = next((a for a in args if a.shape is not None), args[0])
+        conv = [ctx.convert(a, first.unit, f"{name}() arguments") for a in args]
+        return func(first.unit, name, conv, None)
+
+    def numpy_reduce(kind: str):
+        def hook(*values, shapes):
+            if not any(s is not None for s in shapes):
+                if kind in ("max", "min"):
+                    red = np.maximum if kind == "max" else np.minimum
+                    out = values[0]
+                    for v in values[1:]:
+                        out = red(out, v)
+                    return out
+            return reduce(kind, *values, matrix=tuple(s is not None for s in shapes))
+
+        return hook
+
+    def sympy_reduce(kind: str):
+        def hook(sp, *a):
+            return (sp.Max if kind == "max" else sp.Min)(*a)
+
+        return hook
+
+    for kind, excel_name, doc in (
+        ("max", "MAX", "largest argument (or element of vectors and matrices)"),
+        ("min", "MIN", "smallest argument (or element of vectors and matrices)"),
+    ):
+        register(
+            Builtin(
+                kind,
+                None,
+                r_reduce,
+                numpy_reduce(kind),
+                _excel_list(excel_name),
+                sympy_reduce(kind),
+                doc=doc,
+                excel_functions=(excel_name,),
+                arrays=True,
+            )
+        )
+    entry(
+        "mean",
+        None,
+        r_reduce,
+        numpy_reduce("mean"),
+        _excel_list("AVERAGE"),
+        "mean of the arguments (or of the elements of vectors and matrices)",
+        ("AVERAGE",),
+    )
+
+
+def _excel_list(function: str):
+    from .expr import PREC
+
+    def printed(args, shapes=None):
+        return f"{function}({', '.join(args)})", PREC["atom"]
+
+    return printed

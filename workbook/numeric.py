@@ -6,6 +6,7 @@ float magnitudes (no pint in the hot path) and attaches the unit at the end.
 
 from __future__ import annotations
 
+import functools
 import operator
 from collections.abc import Callable
 
@@ -96,6 +97,8 @@ class Evaluator(Visitor):
 
     def visit_TBinary(self, t: tc.TBinary) -> Fn:
         left, right = self.compile(t.left), self.compile(t.right)
+        if t.left.shape is not None or t.right.shape is not None:
+            return _matrix_binary(t, left, right)
         if t.op == "^":
             if isinstance(t.right, tc.TConst):
                 n = t.right.value
@@ -139,8 +142,10 @@ class Evaluator(Visitor):
     def visit_TFunc(self, t: tc.TFunc) -> Fn:
         entry = REGISTRY[t.func]
         f = entry.numpy
-        if entry.binds:
+        if entry.binds and len(t.args) > max(entry.binds):
             return self._binding(t, entry)
+        if entry.arrays:
+            f = functools.partial(f, shapes=tuple(a.shape for a in t.args))
         args = [self.compile(a) for a in t.args]
         if len(args) == 1:
             a0 = args[0]
@@ -190,6 +195,83 @@ class Evaluator(Visitor):
             [self.compile(v) for v in t.values],
         )
 
+    def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
+        from .matrix import build
+
+        rows = [[self.compile(e) for e in row] for row in t.rows]
+        if all(isinstance(e, tc.TConst) for row in t.rows for e in row):
+            value = np.array([[e.value for e in row] for row in t.rows])
+            return lambda env: value
+        return lambda env: build([[e(env) for e in row] for row in rows])
+
+    def visit_TIndex(self, t: tc.TIndex) -> Fn:
+        from .analysis import typed_text
+        from .matrix import index
+
+        target = self.compile(t.target)
+        idx = [self.compile(i) for i in t.indices]
+        shape, origin = t.target.shape, t.origin
+        what = typed_text(t)
+        if len(idx) == 1:
+            i0 = idx[0]
+            return lambda env: index(target(env), i0(env), origin=origin, shape=shape, what=what)
+        i0, j0 = idx
+        return lambda env: index(
+            target(env), i0(env), j0(env), origin=origin, shape=shape, what=what
+        )
+
+    def visit_TProgram(self, t: tc.TProgram) -> Fn:
+        from .program import NoValue, compile_program
+
+        run = compile_program(t.program, self.compile, t.name)
+        params, is_text, name = t.params, t.text, t.name
+
+        def program(env):
+            arrays = {p: env[p] for p in params if p in env and np.ndim(env[p]) > 0}
+            try:
+                if not arrays:
+                    return run(env)
+                keys = list(arrays)
+                shaped = np.broadcast_arrays(*[np.asarray(arrays[k]) for k in keys])
+                out = np.empty(shaped[0].shape, dtype=object if is_text else float)
+                for ix in np.ndindex(out.shape):
+                    out[ix] = run({**env, **{k: float(a[ix]) for k, a in zip(keys, shaped)}})
+                return out
+            except NoValue:
+                raise InputError(
+                    f"the program of '{name}' ended without a value (no return, and no value "
+                    "line was reached)",
+                    definition=name,
+                ) from None
+
+        return program
+
+    def visit_TOde(self, t: tc.TOde) -> Fn:
+        time = self.compile(t.args[0])
+        k, name = t.state, t.ode
+        solution = self.ode_solution
+
+        def state(env):
+            return solution(name)(k, time(env))
+
+        return state
+
+    def ode_solution(self, name: str):
+        """The solution of ``[[ode]] name`` (solved once per sheet, when first needed)."""
+        from .ode import solve_typed
+
+        cache = self.__dict__.setdefault("_odes", {})
+        if name not in cache:
+            cache[name] = None  # solving: a derivative that asks for the solution is circular
+            try:
+                cache[name] = solve_typed(self.typer.ode(name), self.compile)
+            except BaseException:
+                del cache[name]
+                raise
+        elif cache[name] is None:
+            raise InputError(f"ode '{name}': its derivatives refer to its own solution")
+        return cache[name]
+
     def _block(self, t: tc.TBlock) -> Fn:
         from . import blocks
 
@@ -225,7 +307,7 @@ def _piecewise(t: tc.TPiecewise, conds: list, values: list) -> Fn:
         shaped = np.broadcast_arrays(*[arrays[k] for k in keys])
         shape = shaped[0].shape
         full = {**env, **dict(zip(keys, shaped))}
-        out = np.empty(shape, dtype=float)
+        out = np.empty(shape, dtype=object if t.text else float)
         todo = np.ones(shape, dtype=bool)
         for cond, val in zip(conds, values):
             if cond is None:
@@ -241,6 +323,20 @@ def _piecewise(t: tc.TPiecewise, conds: list, values: list) -> Fn:
         raise _NoPiece({k: full[k][todo] for k in keys}, texts)
 
     return evaluate
+
+
+def _matrix_binary(t: tc.TBinary, left: Fn, right: Fn) -> Fn:
+    """An operator with a vector or matrix operand (matrix axes first, see workbook.matrix)."""
+    from . import matrix as mx
+
+    if t.op == "@":
+        return lambda env: mx.matmul(left(env), right(env))
+    if t.op == "@^":
+        n = int(t.right.value)
+        return lambda env: mx.power(left(env), n)
+    op = {**_ARITH, "^": np.power}[t.op]
+    lm, rm = t.left.shape is not None, t.right.shape is not None
+    return lambda env: mx.elementwise(op, left(env), right(env), lm, rm)
 
 
 class _NoPiece(Exception):
@@ -260,6 +356,8 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
                 f"{name}: no piece applies {where}; its pieces are: " + "; ".join(miss.texts),
                 definition=name,
             ) from None
+        if isinstance(out, np.ndarray) and out.dtype == object:
+            return out  # texts
         if isinstance(out, np.ndarray):
             bad = ~np.isfinite(out)
             if bad.any():

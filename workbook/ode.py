@@ -427,3 +427,117 @@ def bench_rows(
         }
     )
     return out
+
+
+# -- an [[ode]] of a sheet ----------------------------------------------------------------------
+@dataclass(frozen=True)
+class TypedOde:
+    """The typed expressions of one section: derivatives in state unit per time unit,
+    initial values in the state's unit, the time bounds in the time variable's unit."""
+
+    spec: OdeSpec
+    time_unit: object  # pint.Unit
+    units: tuple  # pint.Unit of each state
+    derivatives: tuple  # typed nodes
+    initials: tuple
+    first: object
+    last: object
+
+
+def type_ode(typer, spec: OdeSpec) -> TypedOde:
+    """Type a section's expressions (units are checked here, at load)."""
+    from . import units as un
+    from .errors import WorkbookError
+
+    time_unit = typer.spec.arguments[spec.var].unit
+    dimensionless = un.registry().dimensionless
+    units = []
+    for s in spec.states:
+        try:
+            units.append(un.unit(s.unit, what=f"ode '{spec.name}', state '{s.name}'"))
+        except WorkbookError as err:
+            raise err.located(line=spec.line, definition=s.name) from None
+    scope = {spec.var: time_unit, **{s.name: u for s, u in zip(spec.states, units)}}
+
+    def in_unit(node, unit, what: str, plain_ok: bool):
+        t = typer.expression(node, scope if not plain_ok else {}, what)
+        if plain_ok and t.unit == dimensionless and not t.boolean:
+            return t  # a plain number is taken in the declared unit (as range bounds)
+        try:
+            return typer.convert(t, unit, what)
+        except WorkbookError as err:
+            raise err.located(line=spec.line, definition=what) from None
+
+    ders, inits = [], []
+    for s, u in zip(spec.states, units):
+        ders.append(in_unit(s.derivative, u / time_unit, f"{s.name}' (ode '{spec.name}')", False))
+        inits.append(in_unit(s.initial, u, f"initial {s.name} (ode '{spec.name}')", True))
+    first = in_unit(spec.first, time_unit, f"time range of ode '{spec.name}'", True)
+    last = in_unit(spec.last, time_unit, f"time range of ode '{spec.name}'", True)
+    return TypedOde(spec, time_unit, tuple(units), tuple(ders), tuple(inits), first, last)
+
+
+def problem(typed: TypedOde, compile_expr: Callable):
+    """(fun, t0, t1, y0) of a section, compiled with the numpy back end."""
+    spec = typed.spec
+    names = [s.name for s in spec.states]
+    ders = [compile_expr(d) for d in typed.derivatives]
+    var = spec.var
+
+    def fun(t, y):
+        env = {var: float(t), **{n: float(v) for n, v in zip(names, y)}}
+        return np.array([float(d(env)) for d in ders])
+
+    y0 = [float(compile_expr(i)({})) for i in typed.initials]
+    t0, t1 = float(compile_expr(typed.first)({})), float(compile_expr(typed.last)({}))
+    return fun, t0, t1, y0
+
+
+def solve_typed(typed: TypedOde, compile_expr: Callable) -> Solution:
+    """Compile the derivatives with the numpy back end and integrate."""
+    from . import units as un
+
+    spec = typed.spec
+    fun, t0, t1, y0 = problem(typed, compile_expr)
+    return solve(
+        fun,
+        t0,
+        t1,
+        y0,
+        name=spec.name,
+        states=tuple(s.name for s in spec.states),
+        method=spec.method,
+        rtol=spec.rtol,
+        atol=spec.atol,
+        max_time=spec.max_time,
+        max_steps=spec.max_steps,
+        time_unit=un.pretty(typed.time_unit),
+    )
+
+
+def sheet_findings(sheet) -> list:
+    """One finding per [[ode]]: the method, and why "auto" chose it; a run that failed."""
+    from .errors import WorkbookError
+    from .findings import Finding
+
+    out = []
+    for name in sheet.spec.odes:
+        try:
+            sol = sheet.evaluator.ode_solution(name)
+        except WorkbookError as err:
+            out.append(Finding(f"ode {name}", "the run did not finish", None, "", "fail", str(err)))
+            continue
+        out.append(
+            Finding(f"ode {name}", f"solved with {sol.method}", None, "", "info", sol.finding())
+        )
+    return out
+
+
+def sheet_bench(sheet, quick: bool = False) -> list[dict]:
+    """Error against run time of every method on each [[ode]] of the sheet."""
+    rows = []
+    for name in sheet.spec.odes:
+        fun, t0, t1, y0 = problem(sheet.typer.ode(name), sheet.evaluator.compile)
+        rtols = (1e-3, 1e-6) if quick else (1e-3, 1e-6, 1e-9)
+        rows += bench_rows(fun, t0, t1, y0, name=name, rtols=rtols)
+    return rows

@@ -186,6 +186,8 @@ class Sheet:
             f = self.typer.function(name)
             env = self._bind(name, d.params, args, kwargs)
             out = self.evaluator.function(name)(env)
+            if f.body.text:
+                return out if np.ndim(out) == 0 else np.asarray(out, dtype=object)
             q = Q(np.asarray(out, dtype=float) if np.ndim(out) else float(out), f.unit)
             return q.to("") if un.is_compound_ratio(f.unit) else q
         except WorkbookError as err:
@@ -199,9 +201,12 @@ class Sheet:
             t = self.typer.convert(t, un.registry().dimensionless, f"'{name}'")
         return t
 
-    def scalar_quantity(self, name: str) -> pint.Quantity:
-        """The value of scalar definition ``name`` in the unit it is shown in."""
+    def scalar_quantity(self, name: str) -> pint.Quantity | str:
+        """The value of scalar definition ``name`` in the unit it is shown in (a text as
+        it is)."""
         t = self.typer.scalar(name)
+        if t.text:
+            return self.scalar_value(name, "definition")
         q = un.registry().Quantity(self.scalar_value(name, "definition"), t.unit)
         return q.to("") if un.is_compound_ratio(t.unit) else q
 
@@ -260,7 +265,9 @@ class Sheet:
                 value = self.evaluator.compile(self.typer.scalar(name))({})
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=name) from None
-            if np.ndim(value) == 0:
+            if isinstance(value, str):
+                pass  # a text: "OK"
+            elif np.ndim(value) == 0:
                 value = float(value)
                 if not math.isfinite(value):
                     raise DomainError(
@@ -269,6 +276,13 @@ class Sheet:
                         line=d.line,
                         definition=name,
                     )
+            elif not np.all(np.isfinite(value)):
+                raise DomainError(
+                    f"{name} has elements that are not finite numbers; its formula is {d.text}",
+                    file=self.file,
+                    line=d.line,
+                    definition=name,
+                )
             self._memo[name] = value
         return self._memo[name]
 
@@ -395,10 +409,21 @@ class Sheet:
     def column(self, col: ColumnSpec, var: str, values: np.ndarray, what: str) -> Column:
         t = self.typed_column(col, var, what)
         fn = self.evaluator.compile(t)
+        if t.shape is not None:
+            raise self._locate(
+                TemplateError(
+                    f"column '{col.text}' is a vector or matrix; a column is one value a row "
+                    f"(index it: {col.text}[i])"
+                ),
+                what,
+            )
         try:
             out = fn({var: values})
         except WorkbookError as err:
             raise self._locate(err, what) from None
+        if t.text:
+            out = np.broadcast_to(np.asarray(out, dtype=object), values.shape).copy()
+            return Column(col.title, t.unit, out, t, col.text)
         out = np.broadcast_to(np.asarray(out, dtype=float), values.shape).copy()
         bad = ~np.isfinite(out)
         if bad.any():

@@ -135,6 +135,8 @@ class SympyConverter(Visitor):
 
     def visit_TBinary(self, t, env):
         sp = _sympy()
+        if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
+            raise NotSymbolic("vectors and matrices are not differentiated symbolically")
         a, b = self.convert(t.left, env), self.convert(t.right, env)
         if t.op == "+":
             return a + b
@@ -182,6 +184,17 @@ class SympyConverter(Visitor):
         raise NotSymbolic(
             f"{t.name}() is a solver block ({t.ref}): it has no formula to differentiate"
         )
+
+    def visit_TMatrix(self, t, env):
+        raise NotSymbolic("vectors and matrices are not differentiated symbolically")
+
+    visit_TIndex = visit_TMatrix
+
+    def visit_TProgram(self, t, env):
+        raise NotSymbolic(f"the program of {t.name} is statements, not one formula")
+
+    def visit_TOde(self, t, env):
+        raise NotSymbolic(f"{t.name}() is the solution of ode '{t.ode}', a numerical result")
 
     def visit_TAggregate(self, t, env):
         raise NotSymbolic(

@@ -17,6 +17,7 @@ from . import units as un
 from .builtins import REGISTRY
 from .errors import LimitError, TemplateError, UnitError, WorkbookError
 from .template import Definition, SheetSpec
+from .typearrays import ArrayTyping
 from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
     T,
     TAggregate,
@@ -26,9 +27,13 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TCompare,
     TConst,
     TFunc,
+    TIndex,
     TLogic,
+    TMatrix,
+    TOde,
     TParam,
     TPiecewise,
+    TProgram,
     TRef,
     TScale,
     TText,
@@ -41,7 +46,7 @@ from .visitor import Visitor
 MAX_CHAIN = 100
 
 
-class Typer(Visitor):
+class Typer(ArrayTyping, Visitor):
     """Types the definitions of one sheet (lazily, each once, with cycle detection).
 
     ``visit(node, scope)`` types an expression node (one ``visit_<Node>`` per kind of
@@ -115,8 +120,15 @@ class Typer(Visitor):
             )
         self._stack.append(d.name)
         try:
+            if d.program is not None:
+                return self.program_body(d, scope)
+            if d.ode is not None:
+                return self.ode_body(d, scope)
             if d.branches is None:
-                return self._not_text(self.visit(d.body, scope), f"'{d.name}'")
+                body = self.visit(d.body, scope)
+                if body.boolean:
+                    raise TemplateError("the value is a comparison, not a number")
+                return body if body.text else self._not_text(body, f"'{d.name}'")
             return self._piecewise(d, scope)
         except WorkbookError as err:
             raise err.located(file=str(self.spec.path), line=d.line, definition=d.name) from None
@@ -126,14 +138,22 @@ class Typer(Visitor):
     def _piecewise(self, d: Definition, scope) -> T:
         conds, values, texts = [], [], []
         first_unit = None
+        is_text = None
         for b in d.branches:
             v = self.visit(b.value, scope)
             if v.boolean:
                 raise TemplateError(f"piece {b.text!r} has a condition as its value")
-            self._not_text(v, f"piece {b.text!r}")
+            if v.shape is not None:
+                raise TemplateError(f"piece {b.text!r}: the pieces of a function are numbers")
+            if is_text is None:
+                is_text = v.text
+            elif v.text != is_text:
+                raise TemplateError(f"piece {b.text!r}: text and numbers mixed in one function")
+            if not v.text:
+                self._not_text(v, f"piece {b.text!r}")
             if first_unit is None:
                 first_unit = v.unit
-            else:
+            elif not v.text:
                 v = self.convert(
                     v, first_unit, f"piece {b.text!r} (first piece is in {un.dims(first_unit)})"
                 )
@@ -146,13 +166,19 @@ class Typer(Visitor):
             values.append(v)
             texts.append(b.text)
         return TPiecewise(
-            first_unit, conditions=tuple(conds), values=tuple(values), texts=tuple(texts)
+            first_unit,
+            conditions=tuple(conds),
+            values=tuple(values),
+            texts=tuple(texts),
+            text=bool(is_text),
         )
 
     def convert(self, t: T, target: pint.Unit, where: str) -> T:
         """``t`` in the unit ``target`` (an explicit factor), or a UnitError naming ``where``."""
         if t.unit == target:
             return t
+        if t.text:
+            raise TemplateError(f"{where}: text where a number is wanted")
         if _is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
             return TConst(target, value=0.0)
         if t.unit.dimensionality != target.dimensionality:
@@ -163,7 +189,7 @@ class Typer(Visitor):
         f = un.factor(t.unit, target)
         if f == 1.0:
             return _with_unit(t, target)
-        return TScale(target, child=t, factor=f)
+        return TScale(target, child=t, factor=f, shape=t.shape)
 
     def plain(self, t: T, where: str) -> T:
         """Convert to a plain number (radians for angles); refuse dimensioned values."""
@@ -183,8 +209,10 @@ class Typer(Visitor):
 
     def _not_text(self, t: T, where: str) -> T:
         """Refuse text and choice inputs where a number is needed (found by the fuzz test)."""
-        if isinstance(t, TText):
-            raise TemplateError(f"{where}: text can only be compared with a choice input (==)")
+        if t.text:
+            raise TemplateError(
+                f"{where}: text is not a number (text can only be compared with == and !=)"
+            )
         if isinstance(t, TRef) and t.kind == "choice":
             opts = ", ".join(self.spec.inputs[t.name].options)
             raise TemplateError(
@@ -197,7 +225,7 @@ class Typer(Visitor):
         return TConst(self.dimensionless, value=node.value)
 
     def visit_Text(self, node: ex.Text, scope) -> T:
-        return TText(self.dimensionless, value=node.value)
+        return TText(self.dimensionless, value=node.value, text=True)
 
     def visit_Name(self, node: ex.Name, scope) -> T:
         return self._name(node.id, scope)
@@ -213,7 +241,7 @@ class Typer(Visitor):
             return child
         if isinstance(child, TConst):
             return TConst(child.unit, value=-child.value)
-        return TUnary(child.unit, op="-", child=child)
+        return TUnary(child.unit, op="-", child=child, shape=child.shape)
 
     def visit_Logic(self, node: ex.Logic, scope) -> T:
         vals = tuple(self.visit(v, scope) for v in node.values)
@@ -245,7 +273,8 @@ class Typer(Visitor):
                     f"'{name}' is a function of {', '.join(d.params)}: "
                     f"write {name}({', '.join(d.params)})"
                 )
-            return TRef(self.scalar(name).unit, name=name, kind="definition")
+            body = self.scalar(name)
+            return TRef(body.unit, name=name, kind="definition", shape=body.shape, text=body.text)
         if name == "pi":
             return TRef(self.dimensionless, name="pi", kind="builtin")
         if name in self.spec.arguments:
@@ -258,8 +287,8 @@ class Typer(Visitor):
         left = self._number(self.visit(node.left, scope), f"'{node.op}'")
         right = self._number(self.visit(node.right, scope), f"'{node.op}'")
         op = node.op
-        if isinstance(left, TText) or isinstance(right, TText):
-            raise TemplateError("text can only be compared with a choice input (==)")
+        if left.shape is not None or right.shape is not None:
+            return self.matrix_binary(op, left, right)
         if op in "+-":
             if _is_zero(left) and not _is_zero(right):
                 left = TConst(right.unit, value=0.0)
@@ -313,21 +342,22 @@ class Typer(Visitor):
     def visit_Compare(self, node: ex.Compare, scope) -> T:
         ops = list(node.operands)
         typed = [self.visit(o, scope) for o in ops]
-        texts = [isinstance(t, TText) for t in typed]
+        if any(t.shape is not None for t in typed):
+            raise TemplateError("cannot compare a vector or matrix; compare its elements, v[i]")
+        texts = [t.text or (isinstance(t, TRef) and t.kind == "choice") for t in typed]
         if any(texts):
-            if len(typed) != 2 or node.ops[0] not in ("==", "!=") or sum(texts) != 1:
-                raise TemplateError(
-                    'text can only be compared with a choice input: law == "stepped"'
-                )
-            other = typed[1] if texts[0] else typed[0]
-            if not (isinstance(other, TRef) and other.kind == "choice"):
-                raise TemplateError("text can only be compared with a choice input")
-            opts = self.spec.inputs[other.name].options
-            text = (typed[0] if texts[0] else typed[1]).value
-            if text not in opts:
-                raise TemplateError(
-                    f"{text!r} is not one of the options of '{other.name}': {', '.join(opts)}"
-                )
+            if len(typed) != 2 or node.ops[0] not in ("==", "!="):
+                raise TemplateError('text is compared with == or != only: law == "stepped"')
+            if not all(texts):
+                raise TemplateError("cannot compare text with a number")
+            for a, b in ((typed[0], typed[1]), (typed[1], typed[0])):
+                if isinstance(a, TRef) and a.kind == "choice" and isinstance(b, TText):
+                    opts = self.spec.inputs[a.name].options
+                    if b.value not in opts:
+                        raise TemplateError(
+                            f"{b.value!r} is not one of the options of '{a.name}': "
+                            f"{', '.join(opts)}"
+                        )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
         first = next((t for t in typed if not _is_zero(t)), typed[0])
         out = []
@@ -346,9 +376,11 @@ class Typer(Visitor):
         if name in AGGREGATES and name not in self.spec.definitions:
             return self._aggregate(node)
         entry = REGISTRY.get(name)
-        if entry is not None and entry.binds and name not in self.spec.definitions:
-            if name not in self.spec.blocks:
-                return self._binding_call(node, scope)
+        local = name in self.spec.definitions or name in self.spec.blocks
+        if name == "vectorize" and not local:
+            return self.vectorize(node, scope)
+        if entry is not None and entry.binds and not local and len(node.args) > max(entry.binds):
+            return self._binding_call(node, scope)
         if entry is not None and entry.data_args and name not in self.spec.definitions:
             return self._data_call(node, scope)
         known = name in self.spec.definitions or name in self.spec.blocks or name in REGISTRY
@@ -364,16 +396,18 @@ class Typer(Visitor):
                     f"{name}() takes {len(d.params)} argument(s) "
                     f"({', '.join(d.params)}), got {len(args)}"
                 )
+            self._scalar_args(name, args)
             f = self.function(name)
             conv = tuple(
                 self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
                 for i, (a, u) in enumerate(zip(args, f.param_units))
             )
-            return TCall(f.unit, name=name, args=conv)
+            return TCall(f.unit, name=name, args=conv, shape=f.body.shape, text=f.body.text)
         if name in self.spec.blocks:
             from . import blocks
 
             blk = blocks.get(self.spec.blocks[name], "function")
+            self._scalar_args(name, args)
             if len(args) != len(blk.args):
                 raise TemplateError(
                     f"{name}() takes {len(blk.args)} argument(s) "
@@ -395,7 +429,15 @@ class Typer(Visitor):
             raise TemplateError(f"unknown function '{name}'")
         entry = REGISTRY[name]
         entry.check_arity(len(args))
-        return entry.unit_rule(self, name, tuple(args))
+        typed = entry.unit_rule(self, name, tuple(args))
+        return typed if entry.arrays else self.elementwise_call(name, entry, tuple(args), typed)
+
+    def _scalar_args(self, name: str, args) -> None:
+        for a in args:
+            if a.shape is not None:
+                raise TemplateError(
+                    f"{name}() takes numbers; pass elements (v[i]) rather than a vector or matrix"
+                )
 
     def _binding_call(self, node: ex.Call, scope) -> T:
         """A built-in that binds a variable: EXPR is typed with the variable in scope."""
@@ -520,11 +562,17 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         d = spec.definitions.get(n)
         if d is None:
             continue
-        bodies = (
-            [d.body]
-            if d.body is not None
-            else [x for b in d.branches for x in (b.value, b.condition) if x is not None]
-        )
+        local: set[str] = set(d.params)
+        bodies = d.expressions()
+        if d.program is not None:
+            from .program import names as program_names
+
+            todo.extend(program_names(d.program) - local)
+            continue
+        if d.ode is not None:
+            o = spec.odes[d.ode[0]]
+            local |= {o.var} | {s.name for s in o.states}
+            bodies = [o.first, o.last] + [x for s in o.states for x in (s.initial, s.derivative)]
         for body in bodies:
-            todo.extend(m for m in ex.names(body) if m not in d.params)
+            todo.extend(m for m in ex.names(body) if m not in local)
     return out

@@ -18,10 +18,13 @@ from .visitor import Visitor
 
 @dataclass(frozen=True, eq=False)
 class T:
-    """Base of typed nodes: the unit the value is in; ``boolean`` for conditions."""
+    """Base of typed nodes: the unit the value is in; ``boolean`` for conditions; ``shape``
+    (rows, columns) for a vector or matrix (None for a scalar); ``text`` for a string value."""
 
     unit: pint.Unit
     boolean: bool = field(default=False, kw_only=True)
+    shape: tuple[int, int] | None = field(default=None, kw_only=True)
+    text: bool = field(default=False, kw_only=True)
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,6 +125,42 @@ class TPiecewise(T):
 
 
 @dataclass(frozen=True, eq=False)
+class TMatrix(T):
+    """A vector or matrix written out: ``rows`` of typed elements, all in ``unit``."""
+
+    rows: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TIndex(T):
+    """``v[i]`` or ``M[i, j]``: indices are plain numbers counted from ``origin``."""
+
+    target: T = None
+    indices: tuple = ()
+    origin: int = 0
+
+
+@dataclass(frozen=True, eq=False)
+class TProgram(T):
+    """A function body written as statements (:mod:`workbook.program`); ``program`` is the
+    typed program, ``params`` the names of the arguments it reads."""
+
+    name: str = ""
+    program: object = None  # workbook.program.TypedProgram
+    params: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TOde(T):
+    """State ``state`` of the ODE ``ode`` at the time ``args[0]`` (in the time unit)."""
+
+    ode: str = ""
+    state: int = 0
+    name: str = ""
+    args: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
 class TypedFunction:
     name: str
     params: tuple[str, ...]
@@ -162,6 +201,20 @@ class _Children(Visitor):
 
     def visit_TPiecewise(self, t: TPiecewise) -> tuple[T, ...]:
         return tuple(t.values) + tuple(c for c in t.conditions if c is not None)
+
+    def visit_TMatrix(self, t: TMatrix) -> tuple[T, ...]:
+        return tuple(e for row in t.rows for e in row)
+
+    def visit_TIndex(self, t: TIndex) -> tuple[T, ...]:
+        return (t.target, *t.indices)
+
+    def visit_TProgram(self, t: TProgram) -> tuple[T, ...]:
+        from .program import typed_expressions
+
+        return tuple(typed_expressions(t.program))
+
+    def visit_TOde(self, t: TOde) -> tuple[T, ...]:
+        return tuple(t.args)
 
 
 _CHILDREN = _Children()

@@ -188,6 +188,10 @@ class WorkbookWriter:
         defs = [
             d for n, d in self.sheet.spec.definitions.items() if not d.is_function and n in needed
         ]
+        matrices = [d for d in defs if self.sheet.typer.scalar(d.name).shape is not None]
+        defs = [d for d in defs if d not in matrices]
+        if matrices:
+            self.write_matrices(matrices)
         if not defs:
             return
         ws = self.ws("Definitions")
@@ -202,7 +206,8 @@ class WorkbookWriter:
             t = self.sheet.scalar_typed(d.name)
             value = self.sheet.scalar_quantity(d.name).magnitude
             ws.write_string(row, 0, d.name)
-            self._write_cell(ws, row, 1, t, {}, float(value), self.fmt["number"], d.name)
+            value = value if t.text else float(value)
+            self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             ws.write_string(row, 2, un.pretty(t.unit))
             ws.write_string(row, 3, d.text)
             ws.write_string(row, 4, d.note)
@@ -261,15 +266,70 @@ class WorkbookWriter:
                 self._define(ws, row, d.name, f"='Results'!$B${row + 1}")
         self.rows["Results"] = start + len(defs) + 2
 
+    def write_matrices(self, defs) -> None:
+        """Vector and matrix definitions, each a named block of cells: elements written out
+        are a formula each; an operation on matrices is one live array formula over the block
+        (MMULT, MINVERSE, TRANSPOSE, ...); eigenvalues and the like are numbers."""
+        ws = self.ws("Matrices")
+        ws.set_column(0, 0, 14)
+        row = 0
+        for d in defs:
+            t = self.sheet.typer.scalar(d.name)
+            value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
+            r, c = t.shape
+            ws.write_string(row, 0, d.name, self.fmt["header"])
+            ws.write_string(row, 1, f"{un.pretty(t.unit) or '1'}   {d.text}   {d.note}".strip())
+            top = row + 1
+            self._write_block(ws, top, t, value, d.name)
+            last = f"{_col_letter(c)}${top + r}"
+            self.wb.define_name(excel_name(d.name), f"=Matrices!$B${top + 1}:${last}")
+            row = top + r + 1
+
+    def _write_block(self, ws, top: int, t: tc.T, value, what: str) -> None:
+        r, c = t.shape
+        fmt = self.fmt["number"]
+        body = t
+        while isinstance(body, tc.TScale) and body.factor == 1.0:
+            body = body.child
+        if isinstance(body, tc.TMatrix):  # written out: one cell per element
+            for i, row in enumerate(body.rows):
+                for j, e in enumerate(row):
+                    if isinstance(e, tc.TConst):
+                        ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
+                    else:
+                        self._write_cell(ws, top + i, 1 + j, e, {}, float(value[i, j]), fmt, what)
+            return
+        try:
+            formula = self.printer.formula(t, {})
+        except NotLive as why:
+            for i in range(r):
+                for j in range(c):
+                    ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
+            ws.write_comment(top, 1, f"Values, not formulas: {why}")
+            self.not_live.append(what)
+            return
+        ws.write_array_formula(top, 1, top + r - 1, c, formula, fmt, float(value[0, 0]))
+        for i in range(r):  # the cached values of the other cells of the array
+            for j in range(c):
+                if i or j:
+                    ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
+        self.formula_cells += 1
+
     def _write_cell(self, ws, row, col, t: tc.T, subst, value: float, fmt, what: str) -> bool:
         try:
             formula = self.printer.formula(t, subst)
         except NotLive as why:
-            ws.write_number(row, col, value, fmt)
+            if isinstance(value, str):
+                ws.write_string(row, col, value, fmt)
+            else:
+                ws.write_number(row, col, value, fmt)
             ws.write_comment(row, col, f"A value, not a formula: {why}")
             self.not_live.append(what)
             return False
-        ws.write_formula(row, col, formula, fmt, value)
+        if self.printer.array:  # computes with vectors or matrices: an array formula
+            ws.write_array_formula(row, col, row, col, formula, fmt, value)
+        else:
+            ws.write_formula(row, col, formula, fmt, value)
         self.formula_cells += 1
         if not subst:
             self._live_note(ws, row, col, t, {}, value)
@@ -393,12 +453,18 @@ class WorkbookWriter:
             template = self.printer.formula(col.typed, {var: var_ref})
         except NotLive as why:
             for i in range(n):
-                ws.write_number(first + i, j, float(col.values[i]), fmt)
+                v = col.values[i]
+                if isinstance(v, str):
+                    ws.write_string(first + i, j, v, fmt)
+                else:
+                    ws.write_number(first + i, j, float(v), fmt)
             ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
             self.not_live.append(f"{table}.{col.text}")
             return False
         pieces = template.split(ROW_TOKEN)
         write = ws.write_formula
+        if self.printer.array:  # computes with vectors or matrices: one-cell array formulas
+            write = lambda r, c, f, fm, v: ws.write_array_formula(r, c, r, c, f, fm, v)  # noqa: E731
         values = col.values.tolist()
         for i in range(n):
             row = first + i

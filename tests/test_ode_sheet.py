@@ -1,0 +1,97 @@
+"""[[ode]] sections in a worksheet: units at load, the solution as functions of time against
+closed forms, the automatic choice on a stiff system, blow-up and budget errors, findings."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import workbook
+from workbook.checks import run_checks
+from workbook.sheet import Sheet
+from workbook.template import load_spec
+
+HEAD = """
+[inputs]
+k = "2 1/s"
+y0 = "1 m"
+lam = "20000 1/s"
+
+[arguments]
+t = { unit = "s" }
+"""
+
+
+def _sheet(tmp_path, text: str) -> Sheet:
+    path = tmp_path / "o.toml"
+    path.write_text(HEAD + text, encoding="utf-8")
+    return Sheet(load_spec(path))
+
+
+def ode(name, states, time="t := 0 .. 3", extra=""):
+    rows = ",\n".join(
+        f'  {{ name = "{n}", unit = "{u}", initial = "{i}", derivative = "{d}" }}'
+        for n, u, i, d in states
+    )
+    return f'\n[[ode]]\nname = "{name}"\ntime = "{time}"\n{extra}\nstates = [\n{rows}\n]\n'
+
+
+def test_solution_against_the_closed_form_in_a_table(tmp_path):
+    sheet = _sheet(
+        tmp_path,
+        ode("decay", [("y", "m", "y0", "-k*y")], extra="rtol = 1e-10\natol = 1e-13")
+        + '\n[[tables]]\nname = "sol"\nrange = "t := 0, 0.25 .. 3"\ncolumns = { y = "mm" }\n',
+    )
+    table = sheet.table("sol")
+    t = table.iloc[:, 0].to_numpy()
+    np.testing.assert_allclose(table.iloc[:, 1], 1000 * np.exp(-2 * t), rtol=1e-8)
+    # the workbook writes the states as numbers with a comment (no formula exists)
+    sheet.write_xlsx(tmp_path / "o.xlsx")
+
+
+def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):
+    sheet = _sheet(
+        tmp_path,
+        ode(
+            "stiff",
+            [
+                ("a", "m", "0", "-lam*(a - y0*cos(k*t))"),
+                ("b", "m", "y0", "-k*b"),
+            ],
+            time="t := 0 .. 2",
+            extra="rtol = 1e-8\natol = 1e-11",
+        ),
+    )
+    sol = sheet.evaluator.ode_solution("stiff")
+    assert sol.method == "Radau"
+    assert "stiff" in sol.choice.reason
+    findings = [f for f in run_checks(sheet).findings if f.topic == "ode stiff"]
+    assert findings and "Radau" in findings[0].note and "-2e+04" in findings[0].note
+    np.testing.assert_allclose(
+        sheet.evaluate("b", [0.5, 2]).to("m").magnitude, np.exp(-2 * np.array([0.5, 2])), rtol=1e-7
+    )
+
+
+def test_units_of_derivatives_are_checked_at_load(tmp_path):
+    with pytest.raises(workbook.WorkbookError, match=r"y' \(ode 'bad'\)") as info:
+        _sheet(tmp_path, ode("bad", [("y", "m", "y0", "k")]))
+    assert "o.toml" in str(info.value) and "cannot be converted" in str(info.value)
+    with pytest.raises(workbook.WorkbookError, match="not one of auto"):
+        _sheet(tmp_path, ode("bad", [("y", "m", "y0", "-k*y")], extra='method = "Euler"'))
+    with pytest.raises(workbook.WorkbookError, match="has no declared unit"):
+        _sheet(tmp_path, ode("bad", [("y", "m", "y0", "-k*y")], time="tau := 0 .. 1"))
+
+
+def test_a_solution_that_blows_up_is_stopped_and_said_why(tmp_path):
+    sheet = _sheet(tmp_path, ode("boom", [("y", "m", "y0", "y^2/y0*k")], time="t := 0 .. 1"))
+    with pytest.raises(workbook.WorkbookError, match="blows up") as info:
+        sheet.evaluate("y", 0.9)
+    assert "ode 'boom'" in str(info.value)
+    report = run_checks(sheet)
+    assert any(f.verdict == "fail" and "blows up" in f.note for f in report.findings)
+
+
+def test_time_outside_the_range_is_an_error(tmp_path):
+    sheet = _sheet(tmp_path, ode("decay", [("y", "m", "y0", "-k*y")]))
+    with pytest.raises(workbook.WorkbookError, match="outside the time range"):
+        sheet.evaluate("y", [1, 5])

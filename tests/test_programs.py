@@ -1,0 +1,174 @@
+"""Programs (function bodies as statements) and text values: parsing, typing, running, and
+the live nested IF they become in the workbook (recalculated by the formulas package)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import workbook
+from workbook import program as pg
+from workbook.sheet import Sheet
+from workbook.template import load_spec
+
+
+def _sheet(tmp_path, text: str) -> Sheet:
+    path = tmp_path / "p.toml"
+    path.write_text(text, encoding="utf-8")
+    return Sheet(load_spec(path))
+
+
+HEAD = '[inputs]\nf_d = "235 MPa"\n[arguments]\nx = { unit = "" }\ns = { unit = "MPa" }\n'
+
+
+def prog(name: str, body: str) -> str:
+    return f'"{name}" = {{ program = """\n{body}\n""" }}\n'
+
+
+def test_loops_against_python(tmp_path):
+    sheet = _sheet(
+        tmp_path,
+        HEAD
+        + "[definitions]\n"
+        + prog(
+            "collatz(x)",
+            "n := 0\nwhile x != 1\n"
+            "    x := x/2 if x - 2*floor(x/2) == 0 otherwise 3*x + 1\n"
+            "    n := n + 1\nn",
+        )
+        + prog(
+            "primes(x)",
+            "count := 1\nfor k in 3 .. x\n    p := 1\n    for d in 2 .. k - 1\n"
+            "        p := 0 if k - d*floor(k/d) == 0 otherwise p\n"
+            "        break if p == 0\n    count := count + p\ncount",
+        )
+        + prog(
+            "odd_sum(x)",
+            "acc := 0\nfor k in 1 .. x\n"
+            "    continue if k - 2*floor(k/2) == 0\n    acc := acc + k\nacc",
+        ),
+    )
+
+    def collatz(n):
+        steps = 0
+        while n != 1:
+            n = n // 2 if n % 2 == 0 else 3 * n + 1
+            steps += 1
+        return steps
+
+    xs = [1, 6, 27, 97]
+    np.testing.assert_array_equal(sheet.evaluate("collatz", xs).magnitude, [collatz(x) for x in xs])
+    primes = sum(1 for k in range(2, 101) if all(k % d for d in range(2, k)))
+    assert sheet.evaluate("primes", 100).magnitude == primes
+    assert sheet.evaluate("odd_sum", 9).magnitude == 1 + 3 + 5 + 7 + 9
+
+
+def test_if_branches_returns_and_units(tmp_path):
+    sheet = _sheet(
+        tmp_path,
+        HEAD
+        + "[definitions]\n"
+        + prog("check(s)", '"OK" if s <= f_d\n"not OK" otherwise')
+        + prog(
+            "cap(s)",
+            "limit := 0.9*f_d\nif s < 0\n    return 0\n"
+            "else if s > limit\n    return limit\notherwise\n    s",
+        ),
+    )
+    assert sheet.evaluate("check", 200) == "OK"
+    assert list(sheet.evaluate("check", [100, 300])) == ["OK", "not OK"]
+    np.testing.assert_allclose(
+        sheet.evaluate("cap", [-5, 100, 300]).to("MPa").magnitude, [0, 100, 0.9 * 235]
+    )
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        ("if x > 0\n    x", "no value"),  # ends without a value for x <= 0
+        ("x + f_d", "cannot add"),
+        ("a := s\na := x\na", "cannot be converted"),
+        ('"OK" if x > 0\n1 otherwise', "a number here, text in another branch"),
+        ("break", "'break' outside a loop"),
+        ("for k in 1 .. 3\nk", "needs an indented block"),
+        ("a = 1\na", "':='"),
+        ("x\n    x", "unexpected indent"),
+        ("f_d := 1\nf_d", "a name of the sheet"),
+        ("if x\n    return 1\n0 otherwise", "a condition must be a comparison"),
+    ],
+)
+def test_program_errors_at_load(tmp_path, body, message):
+    text = HEAD + "[definitions]\n" + prog("g(x, s)", body)
+    if message == "no value":
+        sheet = _sheet(tmp_path, text)
+        with pytest.raises(workbook.WorkbookError, match="ended without a value"):
+            sheet.evaluate("g", -1, 1)
+        return
+    with pytest.raises(workbook.WorkbookError, match=message) as info:
+        _sheet(tmp_path, text)
+    assert "p.toml" in str(info.value)
+
+
+def test_a_while_that_never_ends_is_stopped_by_the_step_limit(tmp_path):
+    sheet = _sheet(
+        tmp_path, HEAD + "[definitions]\n" + prog("loop(x)", "while x > 0\n    x := x + 1\nx")
+    )
+    with pytest.raises(workbook.WorkbookError, match=r"ran 1,000,000 statements") as info:
+        sheet.evaluate("loop", 1)
+    assert "in 'loop'" in str(info.value) and "limit exceeded" in str(info.value)
+    assert pg.MAX_STEPS == 1_000_000
+
+
+def test_text_values_conditions_and_comparisons(tmp_path):
+    sheet = _sheet(
+        tmp_path,
+        HEAD
+        + "[definitions]\n"
+        + 'u = "0.2*f_d/f_d + 0.6"\n'
+        + 'verdict = "\\"OK\\" if u <= 1 otherwise \\"not OK\\""\n'
+        + 'same = "1 if verdict == \\"OK\\" otherwise 0"\n'
+        + 'grade = ["\\"A\\" if u < 0.5", "\\"B\\" otherwise"]\n',
+    )
+    assert sheet.evaluate("verdict") == "OK"
+    assert sheet.evaluate("same").magnitude == 1
+    assert sheet.evaluate("grade") == "B"
+    for bad, message in [
+        ('z = "verdict + 1"', "text is not a number"),
+        ('z = "verdict < \\"b\\""', "compared with == or != only"),
+        ('z = "1 if u < 1 otherwise \\"no\\""', "gives text on one side"),
+    ]:
+        with pytest.raises(workbook.WorkbookError, match=message):
+            _sheet(
+                tmp_path, HEAD + "[definitions]\n" + 'verdict = "\\"OK\\""\nu = "1"\n' + bad + "\n"
+            )
+
+
+def test_a_program_of_branches_is_a_live_nested_if(tmp_path):
+    import formulas  # an independent Excel evaluator
+
+    sheet = _sheet(
+        tmp_path,
+        HEAD
+        + "[definitions]\n"
+        + prog(
+            "cap(s)", "limit := 0.9*f_d\nif s < 0\n    return 0\ns if s <= limit\nlimit otherwise"
+        )
+        + prog("check(s)", '"OK" if s <= f_d\n"not OK" otherwise')
+        + '\n[[tables]]\nname = "t"\nrange = "s := -50, 100 .. 350"\n'
+        + 'columns = { cap = "MPa", check = "" }\n',
+    )
+    path = sheet.write_xlsx(tmp_path / "p.xlsx")
+    model = formulas.ExcelModel().loads(str(path)).finish()
+    solution = model.calculate()
+    got = {}
+    for key, value in solution.items():
+        if "LISTING" in key.upper() and "!" in key and ":" not in key.split("!")[1]:
+            got[key.split("!")[1].upper()] = value.value[0, 0]
+    table = sheet.table("t")
+    for i in range(len(table)):
+        row = 3 + i
+        assert float(got[f"B{row}"]) == pytest.approx(table.iloc[i, 1], rel=1e-12)
+        assert got[f"C{row}"] == table.iloc[i, 2]
+    assert not math.isnan(float(got["B3"]))
