@@ -35,7 +35,7 @@ class Kinks(Visitor):
 
     visit_TConst = visit_TText = visit_TParam = visit_TRef = visit_TAggregate = _children
     visit_TScale = visit_TUnary = visit_TBinary = visit_TLogic = visit_TBlock = _children
-    visit_TPiecewise = _children
+    visit_TPiecewise = visit_TMatrix = visit_TIndex = visit_TProgram = visit_TOde = _children
 
     def _linear(self, t: ty.T, aliases) -> float | None:
         """The factor f if ``t`` is the variable times f, else None."""

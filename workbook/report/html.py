@@ -53,9 +53,13 @@ class Values:
             d = self.sheet.spec.definitions[name]
             try:
                 q = self.sheet.evaluate(name)
+                if isinstance(q, str):  # a text: "OK"
+                    self._results[name] = q
+                    return q
                 if d.unit is not None:
                     q = q.to(d.unit)
-                self._results[name] = (float(q.magnitude), un.pretty(q.units))
+                mag = q.magnitude if np.ndim(q.magnitude) else float(q.magnitude)
+                self._results[name] = (mag, un.pretty(q.units))
             except Exception as err:  # shown in the report, never blank
                 self._results[name] = err
         return self._results[name]
@@ -73,7 +77,9 @@ class Values:
         d = sheet.spec.definitions.get(name)
         if d is not None and not d.is_function:
             r = self.result(name)
-            return None if isinstance(r, BaseException) else r
+            if isinstance(r, BaseException) or (isinstance(r, tuple) and np.ndim(r[0])):
+                return None  # an error, or a matrix: the name stays in the formula
+            return r
         return None
 
 
@@ -285,6 +291,10 @@ class Document:
             if isinstance(r, BaseException):
                 error = f"<p class='error'>not computed: {escape(_error_text(r))}</p>"
                 result = mm.text_box("not computed", "error")
+            elif isinstance(r, str):
+                result = mm.text_box(f"\u201c{r}\u201d")
+            elif np.ndim(r[0]):
+                result = mm.matrix_box(r[0], r[1])
             else:
                 attrs = f"class='result' data-name='{escape(d.name)}'"
                 result = mm.quantity_box(r[0], r[1], attrs=attrs)

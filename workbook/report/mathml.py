@@ -208,6 +208,18 @@ def quantity_box(value: float, unit: str, digits: int = PRECISION, attrs: str = 
     return Box(xml, num.width + 0.25 + u.width, min(num.prec, PREC["*"]), numeric=True)
 
 
+def matrix_box(values, unit: str, digits: int = PRECISION) -> Box:
+    """A vector or matrix of numbers in brackets, with its unit after."""
+    rows = [[number_box(float(v), digits) for v in row] for row in values]
+    widths = [max(r[j].width for r in rows) for j in range(len(rows[0]))]
+    xml = "".join("<mtr>" + "".join(f"<mtd>{b.xml}</mtd>" for b in r) + "</mtr>" for r in rows)
+    box = _parens(Box(f"<mtable>{xml}</mtable>", sum(widths) + 0.6 * len(widths)), "[", "]")
+    if not unit:
+        return box
+    u = unit_box(unit)
+    return Box(f"{box.xml}<mspace width='0.25em'/>{u.xml}", box.width + 0.25 + u.width)
+
+
 def text_box(text: str, cls: str = "") -> Box:
     attr = f" class='{cls}'" if cls else ""
     return Box(f"<mtext{attr}>{escape(text)}</mtext>", 0.5 * len(text))
@@ -332,6 +344,34 @@ class MathML(Visitor):
                 boxes.append(text_box(f"\u00a0{node.op}\u00a0"))
             boxes.append(self.wrap(v, p + 1))
         return _join(*boxes, prec=p, numeric=False)
+
+    def visit_Matrix(self, node: ex.Matrix) -> Box:
+        cells = [[self.box(e) for e in row] for row in node.rows]
+        widths = [max(r[j].width for r in cells) for j in range(len(cells[0]))]
+        rows = "".join(
+            "<mtr>" + "".join(f"<mtd>{b.row()}</mtd>" for b in r) + "</mtr>" for r in cells
+        )
+        return _parens(Box(f"<mtable>{rows}</mtable>", sum(widths) + 0.6 * len(widths)), "[", "]")
+
+    def visit_Index(self, node: ex.Index) -> Box:
+        target = self.wrap(node.target, ATOM)
+        idx = [self.box(i) for i in node.indices]
+        inner = _join(
+            *[x for k, b in enumerate(idx) for x in ((_mo(",", 0.3),) if k else ()) + (b,)]
+        )
+        return Box(f"<msub>{target.row()}{inner.row()}</msub>", target.width + 0.7 * inner.width)
+
+    def visit_IfElse(self, node: ex.IfElse) -> Box:
+        p = PREC["or"] - 1
+        return _join(
+            self.wrap(node.value, p + 1),
+            text_box("\u00a0if\u00a0"),
+            self.wrap(node.condition, p + 1),
+            text_box(",\u00a0otherwise\u00a0"),
+            self.wrap(node.other, p),
+            prec=p,
+            numeric=False,
+        )
 
     def visit_Call(self, node: ex.Call) -> Box:
         func = node.func
