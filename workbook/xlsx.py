@@ -204,9 +204,9 @@ class WorkbookWriter:
         ws.set_column(4, 4, 50)
         for row, d in enumerate(defs, start=1):
             t = self.sheet.scalar_typed(d.name)
-            value = self.sheet.scalar_quantity(d.name).magnitude
+            q = self.sheet.scalar_quantity(d.name)
             ws.write_string(row, 0, d.name)
-            value = value if t.text else float(value)
+            value = q if t.text else float(q.magnitude)
             self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             ws.write_string(row, 2, un.pretty(t.unit))
             ws.write_string(row, 3, d.text)
@@ -225,6 +225,11 @@ class WorkbookWriter:
         Definitions sheet), a live formula where possible, its unit and note. A definition
         that cannot be computed shows the error as text in its cell."""
         defs = [d for d in self.sheet.spec.definitions.values() if not d.is_function]
+        matrices = [d for d in defs if self._shape(d.name) is not None]
+        written = getattr(self, "on_matrices", set())
+        if [d for d in matrices if d.name not in written]:
+            self.write_matrices([d for d in matrices if d.name not in written])
+        defs = [d for d in defs if d not in matrices]
         if not defs:
             return
         done = getattr(self, "on_definitions", set())
@@ -256,7 +261,7 @@ class WorkbookWriter:
                 continue
             unit = un.pretty(t.unit)
             ws.write_string(row, 2, unit)
-            value = float(q.magnitude)
+            value = q if t.text else float(q.magnitude)
             if d.name in done:
                 ref = self.names[d.name]
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
@@ -272,7 +277,8 @@ class WorkbookWriter:
         (MMULT, MINVERSE, TRANSPOSE, ...); eigenvalues and the like are numbers."""
         ws = self.ws("Matrices")
         ws.set_column(0, 0, 14)
-        row = 0
+        row = self.rows.get("Matrices", 0)
+        self.on_matrices = getattr(self, "on_matrices", set()) | {d.name for d in defs}
         for d in defs:
             t = self.sheet.typer.scalar(d.name)
             value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
@@ -282,8 +288,16 @@ class WorkbookWriter:
             top = row + 1
             self._write_block(ws, top, t, value, d.name)
             last = f"{_col_letter(c)}${top + r}"
-            self.wb.define_name(excel_name(d.name), f"=Matrices!$B${top + 1}:${last}")
+            self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
             row = top + r + 1
+        self.rows["Matrices"] = row
+
+    def _shape(self, name: str):
+        """(rows, columns) of a definition's value, None for a number (or one in error)."""
+        try:
+            return self.sheet.typer.scalar(name).shape
+        except WorkbookError:
+            return None
 
     def _write_block(self, ws, top: int, t: tc.T, value, what: str) -> None:
         r, c = t.shape
