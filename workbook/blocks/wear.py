@@ -1,17 +1,11 @@
-"""Solver blocks of the cam-wear sheets (Ivashko, Buikus, Osuchukwu 2006).
+"""Blocks of the cam-wear sheets (Ivashko, Buikus, Osuchukwu 2006).
 
-Valve (templates/cam-wear-valve.toml):
+Every formula is the template's, read through the sheet; the time-sections are the template's
+integrals, split where the integrand has a kink. Valve (templates/cam-wear-valve.toml):
 
-* ``time_section_3`` / ``time_section_eff``: the valve's time-section, the integral of the
-  flow area over cam angle, for the unworn cam (w_b = w_n = 0) or a worn one. The lift law,
-  wear model and flow area are the template's; they are repeated here in numpy because a
-  function block receives numbers, not the sheet (tests/test_cam_wear.py checks that both
-  agree). The integral is split where the integrand has a kink (the worn lift reaching zero,
-  the validity limit of (3), the port cap) and each piece is integrated by 64-point
-  Gauss-Legendre on 8 sub-intervals, which is exact to rounding for these smooth pieces.
 * ``quadrature_unworn`` / ``quadrature_worn`` (tables) and ``bench``: trapezoid, Simpson and
   Gauss-Legendre at increasing point counts, error against the converged value and run time.
-  They integrate the template's own functions (the compiled sheet), not the copies above.
+  They integrate the template's own functions (the compiled sheet).
 * ``measured_lift`` (table): a worn lift given as measured points (CSV with units in the
   header); velocity and acceleration by a Savitzky-Golay filter whose noise gain is reported.
 * ``valve_findings``: validity of (3), port cap, (1) and (2) against (3), wear deeper than the
@@ -35,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import Finding, bench_block, block, findings_block, input_magnitude, table_block
+from . import Finding, bench_block, findings_block, input_magnitude, table_block
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -45,128 +39,6 @@ def _cached(sheet, key, make):
     if key not in store:
         store[key] = make()
     return store[key]
-
-
-# ---------------------------------------------------------------------------------------------
-# Valve: the template's formulas in numpy (kept equal to the template by the tests)
-# ---------------------------------------------------------------------------------------------
-def _f3(h, d, alpha):
-    """Flow area (3): pi*(d*h*cos(a) + h^2*cos(a)^2*sin(a))."""
-    return math.pi * (d * h * math.cos(alpha) + h**2 * math.cos(alpha) ** 2 * math.sin(alpha))
-
-
-def _f_eff(h, d, d1, alpha, d_stem):
-    """(3) up to its validity limit, the second regime above it, capped at the port area."""
-    w = (d1 - d) / 2
-    h_lim = (d1 - d) / math.sin(2 * alpha)
-    second = math.pi * (d + d1) / 2 * np.sqrt((h - w * math.tan(alpha)) ** 2 + w**2)
-    area = np.where(h <= h_lim, _f3(h, d, alpha), second)
-    return np.minimum(area, math.pi / 4 * (d**2 - d_stem**2))
-
-
-def _h0(phi, H, Phi):
-    phi = np.asarray(phi, dtype=float)
-    inside = (phi >= 0) & (phi <= Phi)
-    return np.where(inside, H * (1 - np.cos(2 * np.pi * phi / Phi)) / 2, 0.0)
-
-
-def _worn(h0, H, p, w_b, w_n):
-    """Worn lift before clipping at zero: h0 - w(h0), w = w_b + (w_n - w_b)*(h0/H)^p."""
-    return h0 - (w_b + (w_n - w_b) * (h0 / H) ** p)
-
-
-def _hw(phi, H, Phi, p, w_b, w_n):
-    return np.maximum(0.0, _worn(_h0(phi, H, Phi), H, p, w_b, w_n))
-
-
-def _kinks(lift, Phi, levels, n=2048):
-    """Angles in (0, Phi) where lift(phi) crosses one of the levels (brentq in grid brackets)."""
-    from scipy.optimize import brentq
-
-    xs = np.linspace(0.0, Phi, n + 1)
-    out = []
-    for level in levels:
-        g = lift(xs) - level
-        for k in range(n):
-            if g[k] == 0.0 and 0 < xs[k] < Phi:
-                out.append(xs[k])
-            elif g[k] * g[k + 1] < 0:
-                out.append(
-                    brentq(
-                        lambda x, level=level: float(lift(x)) - level,
-                        xs[k],
-                        xs[k + 1],
-                        xtol=1e-13,
-                        rtol=1e-15,
-                    )
-                )
-    return sorted(set(out))
-
-
-def _gl_pieces(func, points, nodes=64, sub=8):
-    """Composite Gauss-Legendre over the pieces between successive points."""
-    x, w = np.polynomial.legendre.leggauss(nodes)
-    total = 0.0
-    for a, b in zip(points[:-1], points[1:]):
-        edges = np.linspace(a, b, sub + 1)
-        for lo, hi in zip(edges[:-1], edges[1:]):
-            mid, half = (lo + hi) / 2, (hi - lo) / 2
-            total += half * float(np.dot(w, func(mid + half * x)))
-    return total
-
-
-def _time_section(area, H, Phi, p, w_b, w_n, levels):
-    lift = (
-        (lambda phi: _h0(phi, H, Phi))
-        if (w_b == 0 and w_n == 0)
-        else (lambda phi: _hw(phi, H, Phi, p, w_b, w_n))
-    )
-    raw = (
-        (lambda phi: _h0(phi, H, Phi))
-        if (w_b == 0 and w_n == 0)
-        else (lambda phi: _worn(_h0(phi, H, Phi), H, p, w_b, w_n))
-    )
-    if float(np.max(raw(np.linspace(0, Phi, 4097)))) <= 0:
-        return 0.0  # the wear is deeper than the lift: the valve never opens
-    cuts = _kinks(raw, Phi, [0.0]) + _kinks(lift, Phi, [lv for lv in levels if lv > 0])
-    points = sorted({0.0, float(Phi), *cuts})
-    return _gl_pieces(lambda phi: area(lift(phi)), points)
-
-
-@block(
-    args={"d": "mm", "alpha": "rad", "H": "mm", "Phi": "deg", "p": "", "w_b": "mm", "w_n": "mm"},
-    returns="mm^2*deg",
-    vectorized=False,
-)
-def time_section_3(d, alpha, H, Phi, p, w_b, w_n):
-    """Time-section in angular units, integral of (3) f(h(phi)) dphi over the whole lift."""
-    return _time_section(lambda h: _f3(h, d, alpha), H, Phi, p, w_b, w_n, [])
-
-
-@block(
-    args={
-        "d": "mm",
-        "d1": "mm",
-        "alpha": "rad",
-        "d_stem": "mm",
-        "H": "mm",
-        "Phi": "deg",
-        "p": "",
-        "w_b": "mm",
-        "w_n": "mm",
-    },
-    returns="mm^2*deg",
-    vectorized=False,
-)
-def time_section_eff(d, d1, alpha, d_stem, H, Phi, p, w_b, w_n):
-    """Time-section with (3) up to its validity limit, the second regime above, the port cap."""
-    h_lim = (d1 - d) / math.sin(2 * alpha)
-    w = (d1 - d) / 2
-    r = (math.pi / 4 * (d**2 - d_stem**2)) / (math.pi * (d + d1) / 2)
-    h_port = w * math.tan(alpha) + math.sqrt(max(r**2 - w**2, 0.0))
-    return _time_section(
-        lambda h: _f_eff(h, d, d1, alpha, d_stem), H, Phi, p, w_b, w_n, [h_lim, h_port]
-    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -193,12 +65,6 @@ def _valve_numbers(sheet) -> dict:
             "worn 2": (q("w_b2", "mm"), q("w_n2", "mm")),
         },
     )
-
-
-def _raw_lift(sheet, w_b: float, w_n: float):
-    """The template's worn lift before the cut at zero, h_raw(phi, w_b, w_n): degrees in, mm out."""
-    fn = sheet.evaluator.function("h_raw")
-    return lambda phi: np.asarray(fn({"phi": phi, "wb": w_b, "wn": w_n}), dtype=float)
 
 
 def _integrand(sheet, name):
@@ -247,11 +113,11 @@ def _study(sheet, case: str, quick: bool):
             if method == "Gauss-Legendre split":
                 if case == "unworn":
                     continue
-                raw = _raw_lift(sheet, w_b, w_n)
 
-                def run(n=n, raw=raw):
-                    cuts = _kinks(raw, Phi, [0.0], n=64) or [0.0, Phi]
-                    x, w = _rule("Gauss-Legendre", n, cuts[0], cuts[-1])
+                def run(n=n, w_b=w_b, w_n=w_n):
+                    fresh = sheet.with_inputs()  # the opening angle is found in every run
+                    a = float(fresh.evaluate("phi_o", wb=w_b, wn=w_n).to("deg").magnitude)
+                    x, w = _rule("Gauss-Legendre", n, a, Phi - a)
                     return float(np.dot(w, f(x)))
             else:
                 x, w = _rule(method, n, 0.0, Phi)
@@ -545,9 +411,9 @@ def valve_findings(sheet):
     for label, (w_b, w_n) in num["cases"].items():
         if label == "unworn":
             continue
-        raw = _raw_lift(sheet, w_b, w_n)
-        grid = raw(np.linspace(0.0, Phi, 4097))
-        top, nose = float(grid.max()), float(raw(Phi / 2))  # the nose: h0(Phi/2) = H
+        at = dict(wb=w_b, wn=w_n)
+        top = float(sheet.evaluate("top", **at).to("mm").magnitude)
+        nose = float(sheet.evaluate("h_raw", phi=Phi / 2, **at).to("mm").magnitude)  # h0 = H
         if top <= 0:
             out.append(
                 Finding(
@@ -561,8 +427,7 @@ def valve_findings(sheet):
                 )
             )
             continue
-        cuts = _kinks(raw, Phi, [0.0])
-        opened = float(np.mean(grid > 0) * Phi)
+        o, c = (float(sheet.evaluate(k, **at).to("deg").magnitude) for k in ("phi_o", "phi_c"))
         if nose <= 0:
             out.append(
                 Finding(
@@ -573,16 +438,15 @@ def valve_findings(sheet):
                     top,
                     "mm",
                     "warning",
-                    f"greatest worn lift; open for about {opened:.1f} deg in all",
+                    f"greatest worn lift; open for {2 * (c - o):.1f} deg in all",
                 )
             )
             continue
-        span = (cuts[-1] - cuts[0]) if len(cuts) >= 2 else Phi
         out.append(
             Finding(
                 "wear against lift",
                 f"{label}: the valve opens for",
-                span,
+                Phi - 2 * o,
                 "deg",
                 "info",
                 f"unworn {Phi:g} deg; greatest worn lift {top:.3f} mm",
