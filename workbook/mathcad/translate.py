@@ -175,7 +175,7 @@ class ExprTranslator(Visitor):
             return self.tr.find(self, args)
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
 
-    def _bound(self, var: MNode, body: MNode) -> tuple[ex.Node, ex.Node]:
+    def bound(self, var: MNode, body: MNode) -> tuple[ex.Node, ex.Node]:
         """A variable bound by a sum, product, integral, derivative or root, and the body in
         which it is bound."""
         if var.tag != "id":
@@ -200,7 +200,7 @@ class ExprTranslator(Visitor):
         bvars = lam.children[0].children
         if len(bvars) != 1:
             raise Untranslatable(f"{_what(tag)} over {len(bvars)} variables")
-        body, var = self._bound(bvars[0], lam.children[1])
+        body, var = self.bound(bvars[0], lam.children[1])
         if tag == "derivative":
             if bounds is not None:
                 raise Untranslatable("a derivative with bounds")
@@ -216,7 +216,7 @@ class ExprTranslator(Visitor):
         """Mathcad's root(f(x), x, a, b), or root(f(x), x) from the current value of x."""
         if len(args) not in (2, 4):
             raise Untranslatable(f"root() with {len(args)} arguments")
-        body, var = self._bound(args[1], args[0])
+        body, var = self.bound(args[1], args[0])
         rest = [self.visit(a) for a in args[2:]] if len(args) == 4 else [self.visit(args[1])]
         self.tr.sym_of(var).hint = rest[0]  # the unknown's unit is its bounds' (or guess's)
         return self._builtin("root", "root", [body, var, *rest])
@@ -438,7 +438,7 @@ class Translator:
             if "root" not in language_functions():
                 raise Untranslatable("root() is not in the language yet")
             diff = MNode("apply", {}, "", [MNode("minus", {}, "", []), lhs, rhs])
-            body, var = et._bound(args[0], diff)
+            body, var = et.bound(args[0], diff)
             guess = et.visit(args[0])  # x's value before the block
             self.sym_of(var).hint = guess
         except Untranslatable as why:
