@@ -113,6 +113,7 @@ ratio = "Rp/rp"
 """
 
 
+@pytest.mark.slow  # starts LibreOffice
 def test_names_equal_but_for_case_recalculate_to_the_engine_values(tmp_path):
     from recalc import cell_values, recalculate, soffice
 
