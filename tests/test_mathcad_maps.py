@@ -200,7 +200,8 @@ def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
     assert "0 regions not translated" in capsys.readouterr().out
     text = (tmp_path / "solve.toml").read_text(encoding="utf-8")
-    assert "root(x_^2 - 2, x_, x)" in text
+    assert 'unknowns = { x_2 = "1.0" }' in text and 'equations = ["x_2^2 == 2"]' in text
+    assert 's = { expr = "x_2"' in text
     main(["check", str(tmp_path / "solve.toml"), "--json"])
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 

@@ -38,6 +38,7 @@ class Item:
     range: tuple[ex.Node, ex.Node | None, ex.Node] | None = None
     range_values: list[float] | None = None
     program: list | None = None  # lines of a program: (indent, [text or tree, ...])
+    solve: tuple | None = None  # a solve block: ([(unknown, guess text)], equations, regions)
 
 
 @dataclass
@@ -403,8 +404,9 @@ class Translator:
             self.given = [region.id]
             self.constraints = []
         elif node.tag == "apply" and node.children and node.children[0].tag in _COMPARE:
-            if self.given is None:
-                raise Untranslatable("an equation outside a solve block (Given ... Find)")
+            if self.given is None:  # a comparison shown outside a solve block: nothing
+                self.out.ignored.append(region.id)
+                return
             self.given.append(region.id)
             self.constraints.append(node)
         else:  # a name or an expression alone: Mathcad shows nothing, defines nothing
@@ -419,10 +421,19 @@ class Translator:
         self.constraints = []
 
     def find(self, et: ExprTranslator, args: list[MNode]) -> ex.Node:
-        """Find(x) of a solve block with one equation in one unknown: root(lhs - rhs, x,
-        guess), the guess being x's value before the block, as Mathcad's."""
+        """Find(x, ...) of a solve block: a [[solve]] block of the language (its unknowns are
+        names of their own, the guesses the values the variables had before the block, as in
+        Mathcad's), or root(lhs - rhs, x, guess) for one equation where there is none."""
         if self.given is None:
             raise Untranslatable("Find without Given")
+        if _has_solve():
+            try:
+                tree = self.solve_block(et, args)
+            except Untranslatable as why:
+                self.close_given(str(why))
+                raise
+            self.close_given(None)
+            return tree
         try:
             if len(args) != 1 or args[0].tag != "id":
                 raise Untranslatable(
@@ -797,6 +808,49 @@ class Translator:
         self.out.items.append(Item("function", region.id, sym=sym, params=[k], body=body))
         self.out.results.append(Result(region.id, sym, mathcad, unit, at, k))
 
+    def solve_block(self, et: ExprTranslator, args: list[MNode]) -> ex.Node:
+        if self.given[0] in self.forced:
+            raise Untranslatable(self.forced[self.given[0]])
+        if not args or any(a.tag != "id" for a in args):
+            raise Untranslatable("Find of something that is not a list of names")
+        if any(c.children[0].tag != "equal" for c in self.constraints):
+            raise Untranslatable("a solve block with inequalities (the language's are equations)")
+        if len(self.constraints) != len(args):
+            raise Untranslatable(
+                f"a solve block of {len(self.constraints)} equations in {len(args)} unknowns"
+            )
+        if len(args) > 1 and not hasattr(ex, "Matrix"):
+            raise Untranslatable("Find of several unknowns (a vector: not in the language yet)")
+        values = _Values(self)
+        local, unknowns = {}, []
+        for a in args:
+            key = _key(a)
+            try:
+                q = values.visit(et.visit(a))  # the guess: the value before the block
+            except Untranslatable:
+                raise
+            except Exception:  # noqa: BLE001 - pint's errors alike
+                raise Untranslatable(f"the guess of {nm.mathcad_text(*key)} is not known") from None
+            sym = self.new_sym("var", nm.identifier(*key), nm.mathcad_text(*key), self.given[0])
+            local[key] = sym
+            magnitude = float(q.magnitude)
+            unit = "" if q.dimensionless else f" {q.units:~}"
+            unknowns.append((sym, f"{magnitude!r}{unit}"))
+        inner = ExprTranslator(self, {**et.local, **local})
+        equations = []
+        for c in self.constraints:
+            left, right = inner.visit(c.children[1]), inner.visit(c.children[2])
+            equations.append(ex.Compare(("==",), (left, right)))
+        if inner.ranges:
+            raise Untranslatable("a solve block over a range variable")
+        self.out.items.append(
+            Item("solve", self.given[0], solve=(unknowns, equations, list(self.given)))
+        )
+        names = [ex.Name(sym.token()) for sym, _ in unknowns]
+        if len(names) == 1:
+            return names[0]
+        return ex.Matrix(tuple((n,) for n in names))
+
     def forced_region(self, region: Region) -> None:
         if region.id in self.forced:
             raise Untranslatable(self.forced[region.id])
@@ -900,6 +954,13 @@ def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
 
 def _is_indexer(node: MNode) -> bool:
     return node.tag == "apply" and len(node.children) == 3 and node.children[0].tag == "indexer"
+
+
+def _has_solve() -> bool:
+    """Whether the language has [[solve]] blocks (Given ... Find)."""
+    from ..template import SECTIONS
+
+    return "solve" in SECTIONS
 
 
 def _has_index(node: MNode) -> bool:

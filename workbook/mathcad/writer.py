@@ -166,9 +166,13 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             seen_args.add(sym.final)
             arguments.append(f"{sym.final} = {{ unit = {_q(pretty_unit(sym.unit))} }}")
     tables: list[str] = []
+    solves: list[str] = []
     for item in tr.items:
         if item.kind == "note":
             notes += _comment(item.value)
+            continue
+        if item.kind == "solve":
+            solves += _solve(item, mapping, out)
             continue
         if item.sym is None or item.sym.broken:
             continue
@@ -265,8 +269,26 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
     for section in (inputs, arguments, definitions):
         if len(section) > 1:
             parts += section + [""]
-    out.toml = "\n".join(parts + tables + printed) + "\n"
+    out.toml = "\n".join(parts + solves + tables + printed) + "\n"
     return out
+
+
+def _solve(item: Item, mapping, out: Rendered) -> list[str]:
+    """A [[solve]] block: Mathcad's Given, its equations and Find."""
+    unknowns, equations, regions = item.solve
+    if any(sym.broken for sym, _ in unknowns):
+        return []
+    for sym, _ in unknowns:
+        out.region_of[sym.final] = item.region
+    tag = f"(region {item.region})"
+    guesses = ", ".join(f"{sym.final} = {_q(g)}" for sym, g in unknowns)
+    eqs = ", ".join(_q(_text(e, mapping)) for e in equations)
+    return [
+        f"[[solve]]  # Given ... Find, regions {', '.join(regions)} {tag}",
+        f"unknowns = {{ {guesses} }}  # {tag}",
+        f"equations = [{eqs}]  # {tag}",
+        "",
+    ]
 
 
 def _range_text(item: Item, mapping) -> str:
