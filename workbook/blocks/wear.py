@@ -13,8 +13,7 @@ integrals, split where the integrand has a kink. Valve (templates/cam-wear-valve
 
 Pump (cam-wear-pump.toml): ``pump_findings``.
 
-Brake (cam-wear-brake.toml): ``shoe_integrals`` (the pressure integrals behind A and B by
-scipy.integrate.quad, as a table against the closed forms) and ``brake_findings``.
+Brake (cam-wear-brake.toml): ``brake_findings``.
 
 scipy is imported inside the functions.
 """
@@ -674,34 +673,6 @@ def pump_findings(sheet):
 # ---------------------------------------------------------------------------------------------
 # Brake
 # ---------------------------------------------------------------------------------------------
-def shoe_factors_by_quadrature(r, s, alpha0, alpha1, psi, mu=1.0):
-    """A and B from the forces on a pivoted shoe, integrated by scipy.integrate.quad.
-
-    Drum centre at the origin, pivot Q = (s, 0); a lining point P = r*(cos a, sin a) carries
-    the pressure p = sin(a + psi) (p_max*b = 1), the normal force p*r*da along -n (n radial)
-    and the friction force mu*p*r*da along t = (-sin a, cos a). The moments about Q are cross
-    products (P - Q) x force; A and B are those moments over r times the friction-torque
-    integral, as in F*h = (A -/+ mu*B)*M/mu. Angles in radians, lengths in any one unit.
-    Returns dict(A, B, D, M_N, M_F, torque) (per unit p_max*b).
-    """
-    from scipy.integrate import quad
-
-    def cross(ax, ay, bx, by):
-        return ax * by - ay * bx
-
-    def arm(a, fx, fy):
-        return cross(r * math.cos(a) - s, r * math.sin(a), fx, fy)
-
-    p = lambda a: math.sin(a + psi)  # noqa: E731
-    opts = dict(epsabs=0.0, epsrel=1e-13, limit=200)
-    # normal force on the shoe from the drum points inward (-n): its moment about Q
-    m_n = quad(lambda a: arm(a, -math.cos(a), -math.sin(a)) * p(a) * r, alpha0, alpha1, **opts)[0]
-    m_f = quad(lambda a: arm(a, -math.sin(a), math.cos(a)) * p(a) * r, alpha0, alpha1, **opts)[0]
-    torque = quad(lambda a: p(a) * r * r, alpha0, alpha1, **opts)[0]  # friction torque / mu
-    d = quad(p, alpha0, alpha1, **opts)[0]
-    return dict(A=m_n / torque, B=m_f / torque, D=d, M_N=m_n, M_F=m_f, torque=torque)
-
-
 def _brake_numbers(sheet):
     q = functools.partial(input_magnitude, sheet)
     return dict(
@@ -715,61 +686,17 @@ def _brake_numbers(sheet):
     )
 
 
-@table_block
-def shoe_integrals(sheet):
-    """A and B of both shoes by quad of the shoe forces, against the template's closed forms."""
-    import pandas as pd
-
-    b = _brake_numbers(sheet)
-    rows = []
-    for shoe, psi, a_name, b_name in ((1, b["phi1"], "A1", "B1"), (2, -b["phi2"], "A2", "B2")):
-        qd = shoe_factors_by_quadrature(b["r"], b["s"], b["alpha0"], b["alpha1"], psi)
-        a_c = float(sheet.evaluate(a_name).to("").magnitude)
-        b_c = float(sheet.evaluate(b_name).to("").magnitude)
-        a_p = float(sheet.evaluate("A_10", psi=math.degrees(psi)).to("").magnitude)
-        b_p = float(sheet.evaluate("B_11", psi=math.degrees(psi)).to("").magnitude)
-        rows.append(
-            (
-                shoe,
-                math.degrees(psi),
-                qd["A"],
-                a_c,
-                abs(qd["A"] - a_c),
-                a_p,
-                qd["B"],
-                b_c,
-                abs(qd["B"] - b_c),
-                b_p,
-            )
-        )
-    return pd.DataFrame(
-        rows,
-        columns=[
-            "shoe",
-            "psi [deg]",
-            "A by quad",
-            "A closed form",
-            "A difference",
-            "A (10) printed",
-            "B by quad",
-            "B closed form",
-            "B difference",
-            "B (11) printed",
-        ],
-    )
-
-
 @findings_block
 def brake_findings(sheet):
     """A, B against quadrature; printed (10), (11); self-locking; (8) and (12); wear; units."""
     out = []
     b = _brake_numbers(sheet)
-    df = shoe_integrals(sheet)
+    df = sheet.table("shoe_integrals")
     worst = float(max(df["A difference"].max(), df["B difference"].max()))
     out.append(
         Finding(
             "shoe factors",
-            "A and B closed forms against quad of the shoe forces: largest difference",
+            "A and B closed forms against the integrals of the shoe forces: largest difference",
             worst,
             "",
             "ok" if worst < 1e-9 else "fail",
