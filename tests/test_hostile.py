@@ -18,7 +18,7 @@ import time
 
 import pytest
 
-from workbook import expr, template, typecheck
+from workbook import expr, ranges, template, typecheck
 
 MEMORY = 1536 * 2**20  # bytes of address space for one run
 CPU_SECONDS = 60
@@ -167,12 +167,12 @@ HOSTILE = {
     "range_1e10_points": (
         HEAD + 's = "1"\n\n[[tables]]\nname = "t"\nrange = "x := 0, 1 .. 1e10"\n'
         'columns = { "2*x" = "" }\n',
-        f"range has 10,000,000,001 points (limit {template.MAX_RANGE_POINTS:,})",
+        f"range has 10,000,000,001 points (limit {ranges.MAX_RANGE_POINTS:,})",
     ),
     "range_infinite_points": (
         HEAD + 's = "1"\n\n[[tables]]\nname = "t"\nrange = "x := 0, 1e-300 .. 1e300"\n'
         'columns = { "2*x" = "" }\n',
-        f"points (limit {template.MAX_RANGE_POINTS:,})",
+        f"points (limit {ranges.MAX_RANGE_POINTS:,})",
     ),
     "chart_range_1e10": (
         HEAD + '"y(x)" = "x"\n\n[[charts]]\nname = "c"\nrange = "x := 0 .. 1e10"\n'
@@ -256,7 +256,7 @@ def test_limits_are_documented():
     for value in (
         expr.MAX_TEXT,
         expr.MAX_DEPTH,
-        template.MAX_RANGE_POINTS,
+        ranges.MAX_RANGE_POINTS,
         template.MAX_TEMPLATE_BYTES,
         typecheck.MAX_CHAIN,
     ):

@@ -77,7 +77,7 @@ _STATE_KEYS = {"name", "unit", "initial", "derivative", "note"}
 
 def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
     """Read one ``[[ode]]`` table (raises TemplateError naming the key)."""
-    from .template import parse_range
+    from .ranges import parse_range
 
     if not isinstance(raw, dict):
         raise TemplateError(f"{where}: an [[ode]] entry is a table", line=line)

@@ -239,7 +239,7 @@ _FOR = re.compile(r"^([A-Za-z][A-Za-z0-9_]*)\s+(?:in|∈)\s+(.+)$")
 
 
 def _for(text: str, body, number: int, where: str) -> For:
-    from .template import parse_range
+    from .ranges import parse_range
 
     m = _FOR.match(text)
     if not m:
@@ -547,7 +547,7 @@ def compile_program(
     typed: TypedProgram, compile_expr: Callable[[Any], Callable], name: str
 ) -> Callable[[dict], Any]:
     """A closure env -> value for scalar arguments (the back end loops over arrays)."""
-    from .template import range_values
+    from .ranges import range_values
 
     steps = [0]
 

@@ -18,12 +18,11 @@ from .builtins import REGISTRY
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .fields import nearest
 from .numeric import Evaluator
+from .ranges import RangeSpec, range_values
 from .template import (
     ColumnSpec,
-    RangeSpec,
     SheetSpec,
     check_input_value,
-    range_values,
     resolve_parts,
     select_parts,
 )

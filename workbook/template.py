@@ -6,7 +6,6 @@ The template is data: TOML parsed by the standard library, expressions parsed by
 
 from __future__ import annotations
 
-import math
 import re
 
 try:
@@ -26,8 +25,8 @@ from .errors import InputError, LimitError, TemplateError, WorkbookError
 from .fields import Fields, nearest
 from .given_find import read_solves
 from .measured import read_data
+from .ranges import RangeSpec, parse_range
 
-MAX_RANGE_POINTS = 2_000_000
 MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
 
 SECTIONS = {
@@ -185,15 +184,6 @@ class PartSpec:
 
 
 @dataclass
-class RangeSpec:
-    var: str
-    first: ex.Node
-    second: ex.Node | None
-    last: ex.Node
-    text: str
-
-
-@dataclass
 class ColumnSpec:
     text: str
     node: ex.Node
@@ -332,74 +322,6 @@ def find_line(text: str, key: str, section: str | None = None) -> int | None:
 
 
 _SIGNATURE = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
-_RANGE = re.compile(r"^\s*(?:([A-Za-z][A-Za-z0-9_]*)\s*:=\s*)?(.+?)\s*\.\.\s*(.+?)\s*$")
-
-
-def parse_range(text: str, *, default_var: str | None = None, what: str = "range") -> RangeSpec:
-    """Parse Mathcad's range form ``phi := first, second .. last`` (or ``first .. last``)."""
-    if not isinstance(text, str):
-        raise TemplateError(f"{what}: expected a range like 'phi := 0, 5 .. 22'")
-    m = _RANGE.match(text)
-    if not m:
-        raise TemplateError(f"{what}: cannot read range {text!r} (expected 'phi := 0, 5 .. 22')")
-    var, head, last = m.group(1) or default_var, m.group(2), m.group(3)
-    if not var:
-        raise TemplateError(f"{what}: range {text!r} names no variable (write 'phi := 0, 5 .. 22')")
-    parts = _split_top(head, ",")
-    if len(parts) > 2:
-        raise TemplateError(f"{what}: range {text!r} has more than two values before '..'")
-    first = ex.parse(parts[0], what=what)
-    second = ex.parse(parts[1], what=what) if len(parts) == 2 else None
-    return RangeSpec(var, first, second, ex.parse(last, what=what), text.strip())
-
-
-def range_values(first: float, second: float | None, last: float, *, what: str = "range"):
-    """Values of a range; the last value is always included (as the paper's listings show)."""
-    import numpy as np
-
-    for v in (first, last) + ((second,) if second is not None else ()):
-        if not math.isfinite(v):
-            raise TemplateError(f"{what}: range bounds must be finite numbers")
-    step = (second - first) if second is not None else (1.0 if last >= first else -1.0)
-    if step == 0:
-        raise TemplateError(f"{what}: range step is zero (first and second value are equal)")
-    if (last - first) * step < 0:
-        raise TemplateError(
-            f"{what}: range step {step:g} goes away from the last value {last:g} "
-            f"(first {first:g}); reverse the step's sign"
-        )
-    span = (last - first) / step * (1 + 1e-12) + 1e-9
-    if not span < MAX_RANGE_POINTS:  # also refuses an infinite span (1e308 / 1e-300)
-        raise LimitError(
-            f"{what}: range has {span + 1:,.0f} points (limit {MAX_RANGE_POINTS:,}); "
-            "use a larger step"
-        )
-    count = math.floor(span) + 1
-    values = first + step * np.arange(count, dtype=float)  # first + k*step: no drift
-    if abs(values[-1] - last) > 1e-9 * max(1.0, abs(step)):
-        values = np.append(values, last)
-    else:
-        values[-1] = last
-    return values
-
-
-def _split_top(text: str, sep: str) -> list[str]:
-    """Split at ``sep`` outside parentheses."""
-    parts, depth, cur = [], 0, []
-    for ch in text:
-        if ch == "(":
-            depth += 1
-        elif ch == ")":
-            depth -= 1
-        if ch == sep and depth == 0:
-            parts.append("".join(cur))
-            cur = []
-        else:
-            cur.append(ch)
-    parts.append("".join(cur))
-    return [p.strip() for p in parts]
-
-
 _IF = re.compile(r"\bif\b")
 
 

@@ -12,7 +12,8 @@ from . import expr as ex
 from . import typecheck as tc
 from .errors import WorkbookError
 from .printed import read_printed
-from .template import RangeSpec, SheetSpec
+from .ranges import RangeSpec
+from .template import SheetSpec
 
 
 def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:

@@ -149,7 +149,7 @@ def _build(sheet) -> Model:
 
 
 def _grid(last_deg: float, step_deg: float) -> np.ndarray:
-    from ..template import range_values
+    from ..ranges import range_values
 
     return range_values(0.0, step_deg, last_deg, what="reducer grid")
 

@@ -25,12 +25,12 @@ class Output:
     text: str
     node: ex.Node
     reduction: str | None = None
-    range: object | None = None  # template.RangeSpec
+    range: object | None = None  # ranges.RangeSpec
     unit_text: str | None = None
 
     @classmethod
     def parse(cls, name: str, text: str, unit: str | None = None) -> Output:
-        from ..template import parse_range
+        from ..ranges import parse_range
 
         if not ex.is_identifier(name):
             raise InputError(f"sweep output name {name!r} is not a valid name (letters, digits, _)")
