@@ -266,10 +266,13 @@ def test_paper_against_exact(geometry):
     psi = theta - math.atan2(b[1], b[0])
     v_peak = 2 * A * 1e-3 * OMEGA * math.sin(psi)  # lambda = 1 on the nose
     assert g["v_exact_peak"] == pytest.approx(v_peak, rel=1e-12)
-    assert g["v_exact_grid_max"] <= v_peak + 1e-12
+    # maximum over the whole lift: at the transition (a kink), found to about 1e-8
+    assert g["v_exact_top"] == pytest.approx(v_peak, rel=1e-7) and g["v_exact_top"] <= v_peak
     assert g["v_paper_peak"] == pytest.approx(3.151546, abs=1e-6)
+    assert g["v_paper_at"] == pytest.approx(22.0, abs=1e-5)  # v1's end, where v2 takes over
     assert g["v_paper_peak"] / g["v_exact_peak"] - 1 == pytest.approx(0.3474, abs=1e-3)
-    assert g["h_err"] == pytest.approx(-0.4746, abs=1e-3) and g["h_err_at"] == pytest.approx(85.66)
+    assert g["h_err"] == pytest.approx(-0.4746, abs=1e-3)
+    assert g["h_err_at"] == pytest.approx(85.66, abs=0.01)
     report = geometry.check()
     assert report.ok
     text = report.text()
