@@ -11,6 +11,7 @@ value at a tight tolerance.
 from __future__ import annotations
 
 import math
+import re
 
 import formulas
 import pytest
@@ -18,6 +19,7 @@ from conftest import write_template
 from recalc import formula_values
 
 import workbook
+from workbook.builtins import REGISTRY
 
 REL = 1e-13
 
@@ -54,6 +56,9 @@ CASES = [
     ("hyperbolic", "sinh(a/b) + cosh(a/b) - tanh(a/b)", None),
     ("inverse_trig", "asin(a/c) + acos(a/c) + atan(b/c)", None),
     ("sqrt_of_sum", "sqrt(a + b + c)", None),
+    ("tangent", "tan(a/c) - tan(-x/4)", None),
+    ("sum_bound", "sum(u^2 - a*u, u, 1, 4)", None),  # unrolled: (1^2-a_*1)+...
+    ("product_bound", "product(u + a, u, 1, 3)/x", None),
     ("pick_first", "pick(a)", None),
     ("pick_middle", "pick(b)", None),
     ("pick_last", "pick(c)", None),
@@ -139,6 +144,13 @@ def _close(got, expected) -> bool:
         return math.isclose(float(got), expected, rel_tol=REL, abs_tol=1e-300)
     except (TypeError, ValueError):  # an Excel error value
         return False
+
+
+def test_every_plain_builtin_is_printed_here():
+    """Every built-in of one or two numbers (the registry) is called by some case."""
+    plain = {n for n, b in REGISTRY.items() if not (b.binds or b.arrays or b.data_args)}
+    called = {n for _, text, _ in CASES for n in re.findall(r"([a-z_][a-z0-9_]*)\(", text)}
+    assert plain - called == set()
 
 
 def test_every_formula_cell_matches_the_formulas_package(golden):
