@@ -14,6 +14,8 @@ MAX_RANGE_POINTS = 2_000_000
 
 @dataclass
 class RangeSpec:
+    """A range variable as written: ``var := first, second .. last`` (second may be None)."""
+
     var: str
     first: ex.Node
     second: ex.Node | None

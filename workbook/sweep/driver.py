@@ -23,6 +23,8 @@ QUICK_SECONDS = 2.0  # auto mode: solver cases that would all run within this st
 
 @dataclass
 class SweepResult:
+    """A finished sweep: the table (swept inputs, outputs, error per case) and how it ran."""
+
     sheet_name: str
     table: object  # pandas DataFrame: input columns, output columns, error
     varies: list[Vary]
@@ -34,9 +36,11 @@ class SweepResult:
 
     @property
     def failed(self) -> int:
+        """Number of cases that failed."""
         return int(self.table["error"].notna().sum()) if "error" in self.table else 0
 
     def summary(self) -> str:
+        """One line: cases, outputs, mode, seconds, failures."""
         n = len(self.table)
         text = f"{n} cases, {len(self.outputs)} outputs, {self.mode}, {self.seconds:.2f} s"
         if self.failed:

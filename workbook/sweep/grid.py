@@ -25,6 +25,7 @@ class Vary:
     unit: str = ""  # pint unit text of the magnitudes ('' for a choice or dimensionless)
 
     def header(self, sheet) -> str:
+        """The table's column header: the name and the input's unit."""
         spec = sheet.spec.inputs[self.name]
         if spec.options:
             return self.name
@@ -104,6 +105,7 @@ def grid(varies: list[Vary]) -> list[dict]:
 
 
 def as_varies(sheet, vary) -> list[Vary]:
+    """The swept inputs from a list of Vary or a dict ``{name: values or 'FIRST..LAST:N'}``."""
     if isinstance(vary, dict):
         out = []
         for name, values in vary.items():

@@ -30,6 +30,7 @@ class Output:
 
     @classmethod
     def parse(cls, name: str, text: str, unit: str | None = None) -> Output:
+        """Read ``text`` as an expression or a reduction over a range."""
         from ..ranges import parse_range
 
         if not ex.is_identifier(name):
@@ -99,6 +100,8 @@ def template_outputs(spec) -> dict[str, Output]:
 
 @dataclass
 class TypedOutput:
+    """An output typed against the sheet, with the unit and factor it is shown in."""
+
     out: Output
     t: tc.T
     unit: object  # pint.Unit shown
@@ -107,6 +110,7 @@ class TypedOutput:
 
 
 def type_output(sheet, out: Output) -> TypedOutput:
+    """Type ``out`` against ``sheet`` (a mistake is one error for the whole sweep)."""
     what = f"sweep output {out.name}"
     scope = {}
     if out.range is not None:
@@ -133,6 +137,7 @@ def type_output(sheet, out: Output) -> TypedOutput:
 
 
 def reduce_values(kind: str, values: np.ndarray, grid: np.ndarray, axis: int = -1):
+    """max, min, mean of ``values`` along ``axis``, or the ``grid`` value at argmax/argmin."""
     if kind == "max":
         return values.max(axis=axis)
     if kind == "min":
@@ -172,6 +177,7 @@ def evaluate_outputs(sheet, outputs: list[Output]) -> dict[str, float]:
 
 
 def as_outputs(sheet, outputs) -> list[Output]:
+    """The outputs from a list, a dict ``{name: text or None}`` or the template's ``[sweep]``."""
     if outputs is None:
         found = list(template_outputs(sheet.spec).values())
         if not found:

@@ -95,6 +95,7 @@ def run_case(task: tuple) -> tuple[int, dict | None, str | None, float]:
 
 
 def base_values(sheet) -> dict:
+    """The sheet's input values as plain data (magnitude and unit text, or a choice)."""
     out = {}
     for name, v in sheet.values.items():
         out[name] = v if isinstance(v, str) else (float(v.magnitude), str(v.units))
@@ -102,6 +103,7 @@ def base_values(sheet) -> dict:
 
 
 def make_tasks(sheet, outs: list[Output], cases: list[dict]) -> list[tuple]:
+    """One plain-data task per case (see :func:`run_case`)."""
     template = _prime(sheet)
     base = base_values(sheet)
     spec = tuple((o.name, o.text, o.unit_text) for o in outs)
@@ -109,6 +111,7 @@ def make_tasks(sheet, outs: list[Output], cases: list[dict]) -> list[tuple]:
 
 
 def run_tasks(tasks: list[tuple], mode: str, scheduler, workers: int | None, timeout: float = 20.0):
+    """Run the tasks serially, in a process pool or on Dask; yield run_case's results."""
     if mode == "serial" or (mode == "processes" and len(tasks) == 1):
         for task in tasks:
             yield run_case(task)

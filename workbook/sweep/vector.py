@@ -30,12 +30,14 @@ class CaseEvaluator(Evaluator):
         self._depends: dict[str, bool] = {}
 
     def depends(self, name: str) -> bool:
+        """Whether definition ``name`` depends on a swept input."""
         if name not in self._depends:
             deps = tc.dependencies(self.spec, ex.Name(name))
             self._depends[name] = bool(deps & self.swept)
         return self._depends[name]
 
     def compile(self, t):
+        """Compile as the Evaluator does, with swept inputs read from the environment."""
         if isinstance(t, tc.TRef):
             if t.kind == "input" and t.name in self.swept:
                 key = "\x00" + t.name
