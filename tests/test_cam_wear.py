@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook.errors import InputError, TemplateError, UnitError
+from workbook.errors import InputError, UnitError
 
 # -- the reference example written out independently of the templates ------------------------
 D, D1, ALPHA = 40.0, 46.0, math.radians(45)
@@ -189,18 +189,15 @@ def test_measured_lift_noise_gain(valve, tmp_path):
     assert a_err < 0.02 * np.abs(m["a_true"]).max() and ac_err > 10 * a_err
     ts_m = wear.measured_time_section(valve)
     assert ts_m == pytest.approx(float(mag(valve.evaluate("TS2"), "mm^2*deg")), rel=2e-3)
-    # a table without units in the header is refused with a clear message
-    bad = tmp_path / "bad.csv"
-    bad.write_text("phi,h\n" + "\n".join(f"{i},{i}" for i in range(40)), encoding="utf-8")
-    with pytest.raises(InputError, match="names no unit"):
-        wear.read_measured_lift(bad)
-    rad = tmp_path / "rad.csv"  # any angle and length units are converted
-    rad.write_text(
-        "phi [rad],h [m]\n" + "\n".join(f"{i * 0.01},{i * 1e-4}" for i in range(40)),
-        encoding="utf-8",
+    # the angles must increase in equal steps (the filter's condition): a clear error
+    text = (valve.spec.path.parent / "cam-wear-valve.measured-lift.csv").read_text("utf-8")
+    (tmp_path / "cam-wear-valve.measured-lift.csv").write_text(
+        text.replace("\n4,", "\n5,", 1), encoding="utf-8"
     )
-    phi_r, h_r = wear.read_measured_lift(rad)
-    assert phi_r[1] == pytest.approx(math.degrees(0.01)) and h_r[1] == pytest.approx(0.1)
+    toml = valve.spec.path.read_text("utf-8")
+    (tmp_path / "valve.toml").write_text(toml, encoding="utf-8")
+    with pytest.raises(InputError, match="equal steps"):
+        wear.measured_points(workbook.load(tmp_path / "valve.toml"))
 
 
 # -- pump ----------------------------------------------------------------------------------------
@@ -337,16 +334,6 @@ def test_brake_self_locking_and_units(brake):
     # the lining lifting off (negative pressure) is reported
     lift_off = brake.with_inputs(phi2="40 deg")
     assert any(x.topic == "pressure" and x.verdict == "warning" for x in lift_off.check().findings)
-
-
-def test_measured_lift_path_stays_beside_the_template(valve):
-    from workbook.blocks import wear
-
-    class Fake:
-        spec = type("S", (), {"meta": {"measured_lift": "../x.csv"}, "path": valve.spec.path})
-
-    with pytest.raises(TemplateError, match="beside"):
-        wear._measured_path(Fake())
 
 
 # -- workbooks -------------------------------------------------------------------------------------

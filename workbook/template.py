@@ -58,7 +58,6 @@ SHEET_KEYS = (
     "export",
     "about",
     "hand_checks",
-    "measured_lift",
     "samples",
     "tolerance",
     "origin",
@@ -423,7 +422,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         )
     sheet = _table(data, "sheet")
     fields = _fields(sheet, SHEET_KEYS, "[sheet]", text, "sheet")
-    for key in ("name", "title", "source", "description", "bench", "export", "measured_lift"):
+    for key in ("name", "title", "source", "description", "bench", "export"):
         fields.text(key)
     fields.flag("hand_checks")
     fields.number("samples"), fields.number("tolerance")

@@ -24,7 +24,6 @@ import functools
 import math
 import time
 import weakref
-from pathlib import Path
 
 import numpy as np
 
@@ -201,67 +200,29 @@ SG_WINDOW = 15  # points (30 deg at a 2 deg spacing); cubic Savitzky-Golay
 SG_ORDER = 3
 
 
-def read_measured_lift(path: Path):
-    """Read ``phi [deg],h [mm]`` (any angle and length units; '#' lines are comments).
-
-    Returns (phi in deg, h in mm) as numpy arrays, checked: finite, increasing, evenly spaced.
-    """
+def measured_points(sheet):
+    """The measured lift of the template's [data.measured_lift] (phi in deg, h in mm), checked
+    for what the Savitzky-Golay filter needs: enough points, increasing in equal steps."""
     from .. import units as un
-    from ..checks import read_commented_csv
     from ..errors import InputError
 
-    header, lines = read_commented_csv(path, "measured lift")
-    rows = []
-    for number, cells, line in lines:
-        if len(cells) != 2:
-            raise InputError(f"{path}:{number}: expected two values (angle, lift)")
-        try:
-            rows.append((float(cells[0]), float(cells[1])))
-        except ValueError:
-            raise InputError(f"{path}:{number}: not a number in {line!r}") from None
-    if header is None or len(header) != 2:
-        raise InputError(f"{path}: the first line must be a header like 'phi [deg],h [mm]'")
-    units = []
-    for cell, want in zip(header, ("deg", "mm")):
-        inside = cell[cell.find("[") + 1 : cell.rfind("]")] if "[" in cell else ""
-        if not inside:
-            raise InputError(f"{path}: header {cell!r} names no unit (write e.g. 'h [mm]')")
-        try:
-            units.append(un.factor(un.unit(inside), un.unit(want)))
-        except Exception:
-            raise InputError(
-                f"{path}: header {cell!r}: {inside!r} is not convertible to {want}"
-            ) from None
-    if len(rows) < 2 * SG_WINDOW:
-        raise InputError(f"{path}: {len(rows)} points; at least {2 * SG_WINDOW} are needed")
-    data = np.array(rows)
-    phi, h = data[:, 0] * units[0], data[:, 1] * units[1]
-    if not np.all(np.isfinite(data)):
-        raise InputError(f"{path}: not every value is a finite number")
+    phi, h = (sheet.spec.data[n] for n in ("phi_m", "h_m"))
+    where = f"{phi.file.name} ([data.measured_lift])"
+    phi = phi.values * un.factor(phi.unit, un.unit("deg"))
+    h = h.values * un.factor(h.unit, un.unit("mm"))
+    if len(phi) < 2 * SG_WINDOW:
+        raise InputError(f"{where}: {len(phi)} points; at least {2 * SG_WINDOW} are needed")
     step = np.diff(phi)
     if np.any(step <= 0) or np.ptp(step) > 1e-6 * step.mean():
-        raise InputError(f"{path}: the angles must increase in equal steps")
+        raise InputError(f"{where}: the angles must increase in equal steps")
     return phi, h
-
-
-def _measured_path(sheet) -> Path:
-    from ..errors import TemplateError
-
-    name = Path(
-        str(sheet.spec.meta.get("measured_lift", f"{sheet.spec.path.stem}.measured-lift.csv"))
-    )
-    if name.is_absolute() or ".." in name.parts:  # a worksheet reads only files beside it
-        raise TemplateError(
-            f"[sheet] measured_lift {str(name)!r} must be a file name beside the template"
-        )
-    return sheet.spec.path.parent / name
 
 
 def _measured(sheet):
     def make():
         from scipy.signal import savgol_coeffs, savgol_filter
 
-        phi, h = read_measured_lift(_measured_path(sheet))
+        phi, h = measured_points(sheet)
         dphi = float(phi[1] - phi[0])
         omega = float(sheet.evaluate("n").to("deg/s").magnitude)
         hs = savgol_filter(h, SG_WINDOW, SG_ORDER, mode="interp")
