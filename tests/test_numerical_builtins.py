@@ -295,6 +295,15 @@ def test_given_find_mistakes_are_refused_at_load(tmp_path, equations, error, mes
     assert "s.toml:8" in str(err.value) and "solve x, y" in str(err.value)
 
 
+def test_given_find_with_a_side_that_is_zero(tmp_path):
+    """`EXPR == 0` (common in Mathcad's solve blocks): a residual relative to sides that move
+    with x would be a step of +-1 there; a linear system is solved exactly."""
+    eqs = '"x + 2*y - R == 0", "x - y == 0"'
+    s = sheet(tmp_path, SOLVE.replace("EQUATIONS", eqs))
+    assert s.evaluate("x").to("m").magnitude == pytest.approx(2 / 3, rel=1e-12)
+    assert s.evaluate("y").to("m").magnitude == pytest.approx(2 / 3, rel=1e-12)
+
+
 def test_given_find_not_converging_shows_residuals(tmp_path):
     s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
     with pytest.raises(NumericsError, match=r"did not converge.*x\^2 \+ R\^2 == 0: residual"):

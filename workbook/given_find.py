@@ -115,15 +115,21 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
         for lhs, rhs in typed_equations(sheet.typer, block)
     ]
 
-    def residuals(x):
+    def values(x):
         env = dict(zip(names, (float(v) for v in x)))
-        out = []
-        for left, right in sides:
-            a, b = float(left(env)), float(right(env))
-            out.append((a - b) / (abs(a) + abs(b) or 1.0))
-        return np.array(out)
+        return [(float(left(env)), float(right(env))) for left, right in sides]
 
     guess = [q.magnitude for q in block.unknowns.values()]
+    # each residual relative to the size of its two sides at the guess: a fixed scale keeps
+    # the residuals smooth (a scale that moves with x makes `expr == 0` a step, +-1)
+    with np.errstate(all="ignore"):
+        start = values(guess)
+    scales = [abs(a) + abs(b) if np.isfinite(abs(a) + abs(b)) else 0.0 for a, b in start]
+    scales = [s or 1.0 for s in scales]
+
+    def residuals(x):
+        return np.array([(a - b) / s for (a, b), s in zip(values(x), scales)])
+
     result = solve(
         residuals,
         guess,
