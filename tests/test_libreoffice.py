@@ -138,3 +138,34 @@ def test_live_integral_follows_an_input_change(tmp_path):
         got = values[("Definitions", f"B{rows[name]}")]
         assert got == pytest.approx(want, rel=1e-9, abs=10 * float(stated) + 1e-12), name
         assert got != pytest.approx(sheet.evaluate(name).to("L/s").magnitude, rel=1e-3)
+
+
+def test_live_root_follows_an_input_change(tmp_path):
+    """root(EXPR, X, A, B) of a scalar definition is live as bisection steps in helper cells:
+    after an edit LibreOffice finds the engine's new root; a bracket without a sign change
+    shows #N/A, not a number."""
+    import workbook
+
+    (tmp_path / "r.toml").write_text(
+        '[inputs]\neps = "0.05 mm"\nD = "100 mm"\nRe_op = "100000"\n\n'
+        '[arguments]\nRe = { unit = "" }\nf = { unit = "" }\n\n[definitions]\n'
+        '"colebrook(f, Re)" = "1/sqrt(f) + 2*log10(eps/(3.7*D) + 2.51/(Re*sqrt(f)))"\n'
+        'f_op = "root(colebrook(f, Re_op), f, 0.005, 0.1)"\n\n'
+        '[[tables]]\nname = "op"\nrange = "k := 1 .. 1"\ncolumns = [{ expr = "f_op" }]\n'
+    )
+    sheet = workbook.load(tmp_path / "r.toml")
+    path = sheet.write_xlsx(tmp_path / "r.xlsx")
+    wb = openpyxl.load_workbook(path)
+    cell = wb["Definitions"]["B2"]
+    assert wb["Definitions"]["A2"].value == "f_op" and "Solver steps" in cell.value
+    row = next(r for r in wb["Inputs"].iter_rows() if r[0].value == "Re_op")
+    for value, expected in ((1e6, sheet.with_inputs(Re_op="1e6")), (10.0, None)):
+        row[1].value = value
+        wb.save(tmp_path / "edited.xlsx")
+        got = cell_values(recalculate(tmp_path / "edited.xlsx", tmp_path / f"lo{value:g}"))
+        if expected is None:  # Re = 10: no root in [0.005, 0.1]
+            assert got[("Definitions", "B2")] == "#N/A"
+        else:
+            want = expected.evaluate("f_op").magnitude
+            assert got[("Definitions", "B2")] == pytest.approx(want, rel=1e-12)
+            assert want != pytest.approx(sheet.evaluate("f_op").magnitude, rel=1e-3)

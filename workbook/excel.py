@@ -91,6 +91,10 @@ class ExcelPrinter(Visitor):
         self.names = names or {}
         # (table, column) -> absolute cell range, filled by the writer for max_over()/min_over()
         self.ranges: dict[tuple[str, str], str] = {}
+        # the writer's allocator of helper cells (a root's bisection steps), set while it
+        # writes scalar definitions; a binding hook finds it as ``body.helpers`` (and EXPR's
+        # typed tree, the variable and the other arguments as body.typed, .var, .rest)
+        self.helpers = None
 
     def formula(self, t: tc.T, subst: dict[str, str]) -> str:
         self.array = False  # set when the formula computes with arrays (an array formula)
@@ -180,6 +184,8 @@ class ExcelPrinter(Visitor):
         def printed(value: str) -> str:
             return self.print(body, {**s, var: value})
 
+        printed.helpers = self.helpers
+        printed.typed, printed.var, printed.rest = body, var, rest
         return entry.excel(printed, [self.print(a, s) for a in rest], consts)
 
     def visit_TCall(self, t, s):

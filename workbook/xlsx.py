@@ -207,7 +207,11 @@ class WorkbookWriter:
             q = self.sheet.scalar_quantity(d.name)
             ws.write_string(row, 0, d.name)
             value = q if t.text else float(q.magnitude)
-            self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
+            self.printer.helpers = HelperCells(self, d.name)
+            try:
+                self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
+            finally:
+                self.printer.helpers = None
             ws.write_string(row, 2, un.pretty(t.unit))
             ws.write_string(row, 3, d.text)
             ws.write_string(row, 4, d.note)
@@ -267,7 +271,11 @@ class WorkbookWriter:
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
                 self.formula_cells += 1
             else:
+                self.printer.helpers = HelperCells(self, d.name)
+            try:
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
+            finally:
+                self.printer.helpers = None
                 self._define(ws, row, d.name, f"='Results'!$B${row + 1}")
         self.rows["Results"] = start + len(defs) + 2
 
@@ -893,3 +901,41 @@ def write_workbook(
                 ) from None
             raise
     return path
+
+
+class HelperCells:
+    """Cells of the 'Solver steps' sheet that a live form needs (a root's bisection steps).
+
+    ``helpers(title, rows, headers)`` reserves a block under a title and returns a
+    :class:`HelperBlock`, whose cells are live formulas with cached values;
+    ``helpers.value(t, env)`` is the engine's value of a typed tree, for those values."""
+
+    SHEET = "Solver steps"
+
+    def __init__(self, writer, what: str):
+        self.writer, self.what = writer, what
+
+    def value(self, t: tc.T, env: dict) -> float:
+        """The engine's value of a typed tree (for a helper cell's cached value)."""
+        return float(self.writer.sheet.evaluator.compile(t)(env))
+
+    def __call__(self, title: str, rows: int, headers: list[str]) -> HelperBlock:
+        ws = self.writer.ws(self.SHEET)
+        start = self.writer.rows[self.SHEET]
+        ws.write_string(start, 0, f"{self.what}: {title}", self.writer.fmt["title"])
+        write_labels(ws, start + 1, 1, headers, self.writer.fmt["header"])
+        self.writer.rows[self.SHEET] = start + rows + 3
+        return HelperBlock(ws, self.SHEET, start + 2)
+
+
+class HelperBlock:
+    """A block of helper cells: ``ref(i, j)`` is the absolute reference of row i, column j."""
+
+    def __init__(self, ws, sheet: str, first: int):
+        self.ws, self.sheet, self.first = ws, sheet, first
+
+    def ref(self, i: int, j: int) -> str:
+        return f"'{self.sheet}'!${_col_letter(j + 1)}${self.first + i + 1}"
+
+    def write(self, i: int, j: int, formula: str, value: float) -> None:
+        self.ws.write_formula(self.first + i, j + 1, formula, None, value)

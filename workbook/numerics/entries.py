@@ -25,6 +25,8 @@ from ._common import Result, live, sheet_tolerance
 ATOM = PREC["atom"]
 #: rows solved at once (a bracket's samples take rows x samples memory)
 CHUNK = 20_000
+#: bisection steps of a root's live Excel form (a bracket halves 60 times: full precision)
+BISECTION_STEPS = 60
 #: nodes of the Gauss-Legendre rule of an integral's live Excel form
 EXCEL_NODES = 20
 #: highest order of diff(EXPR, X, N)
@@ -144,8 +146,28 @@ def _solve(of, solve, *bounds) -> Result:
     )
 
 
+def _bisection(f, a, b, idx) -> np.ndarray:
+    """What the workbook's bisection steps compute (``_root_excel``), row by row."""
+    lo, hi = a.copy(), b.copy()
+    flo = np.asarray(f(lo, idx), dtype=float)
+    for _ in range(BISECTION_STEPS):
+        mid = (lo + hi) / 2
+        left = flo * np.asarray(f(mid, idx), dtype=float) <= 0
+        lo, hi = np.where(left, lo, mid), np.where(left, mid, hi)
+        flo = np.asarray(f(lo, idx), dtype=float)
+    return (lo + hi) / 2
+
+
 def _root_numpy(of, a, b=None):
     tol, var, unit = of.tolerance, of.var, of.unit_text
+    if live() and b is not None:
+        res = _solve(
+            of,
+            lambda f, a, b, idx, label: Result(_bisection(f, a, b, idx), np.zeros(a.shape)),
+            a,
+            b,
+        )
+        return _out(res.value)
     if b is None:
         res = _solve(
             of,
@@ -251,6 +273,60 @@ def _not_live(name: str, primitive: str):
     return excel
 
 
+def _root_excel(body, args, consts) -> tuple[str, int]:
+    """A live root of a scalar definition: BISECTION_STEPS bisection steps in helper cells
+    (lo, hi, mid, f(lo), f(mid) a row, each with its cached value); #N/A when f(A) and f(B)
+    have the same sign."""
+    helpers = getattr(body, "helpers", None)
+    free = helpers is not None and len(args) == 2
+    free = (
+        free and not (_params(body.typed) - {body.var}) and not any(_params(a) for a in body.rest)
+    )
+    if not free:
+        raise NotLive(
+            "root() is computed by find_root (scipy.optimize.elementwise) to the sheet's "
+            "tolerance; its value is written as a number (a live root is written for a scalar "
+            "definition with a bracket, as bisection steps)"
+        )
+    a, b = args
+    if max(len(body(a)), len(body(b))) > 2000:
+        raise NotLive("root(): the expression is too long for bisection steps in helper cells")
+
+    def f(x: float) -> float:
+        return helpers.value(body.typed, {body.var: x})
+
+    lo, hi = (helpers.value(t, {}) for t in body.rest)
+    headers = ["lo", "hi", "mid", "f(lo)", "f(mid)"]
+    block = helpers("root() by bisection", BISECTION_STEPS + 1, headers)
+    r = block.ref
+    block.write(0, 0, f"={a}", lo)
+    block.write(0, 1, f"={b}", hi)
+    flo = fmid = mid = 0.0
+    for k in range(BISECTION_STEPS + 1):
+        if k:
+            left = f"{r(k - 1, 3)}*{r(k - 1, 4)}<=0"
+            lo, hi = (lo, mid) if flo * fmid <= 0 else (mid, hi)
+            block.write(k, 0, f"=IF({left},{r(k - 1, 0)},{r(k - 1, 2)})", lo)
+            block.write(k, 1, f"=IF({left},{r(k - 1, 2)},{r(k - 1, 1)})", hi)
+        mid = (lo + hi) / 2
+        flo, fmid = f(lo), f(mid)
+        block.write(k, 2, f"=({r(k, 0)}+{r(k, 1)})/2", mid)
+        block.write(k, 3, "=" + body(r(k, 0)), flo)
+        block.write(k, 4, "=" + body(r(k, 2)), fmid)
+    same_sign = f"{r(0, 3)}*({body(r(0, 1))})>0"
+    return f"IF({same_sign},NA(),{r(BISECTION_STEPS, 2)})", ATOM
+
+
+def _params(t: ty.T) -> set[str]:
+    out, stack = set(), [t]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ty.TParam):
+            out.add(n.name)
+        stack.extend(ty.children(n))
+    return out
+
+
 def _integral_excel(body, args, consts) -> tuple[str, int]:
     """A live integral: the EXCEL_NODES-point Gauss-Legendre rule on [A, B] as SUMPRODUCT
     over constant arrays of nodes and weights (EXPR printed once, over the node array)."""
@@ -306,11 +382,12 @@ register(
         (3, 4),
         _root_unit,
         _root_numpy,
-        _not_live("root", "find_root (scipy.optimize.elementwise)"),
+        _root_excel,
         _no_sympy("root"),
         doc="root(EXPR, X, A, B): the X in [A, B] where EXPR changes sign; "
         "root(EXPR, X, GUESS): a root near GUESS",
         binds=(0, 1),
+        excel_functions=("IF", "NA"),
     )
 )
 register(

@@ -8,7 +8,11 @@ from .. import typed as ty
 from ._common import live_forms
 
 #: built-ins whose Excel form is live but approximate
-APPROXIMATE = {"integral": "a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)"}
+APPROXIMATE = {
+    "integral": "a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)",
+    "root": "60 bisection steps on the sheet 'Solver steps' (#N/A when f(A) and f(B) have "
+    "the same sign; with more than one root in [A, B] it may find another one than the engine)",
+}
 
 
 def _approximate(sheet, t: ty.T) -> set[str]:
