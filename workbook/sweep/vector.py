@@ -73,6 +73,14 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
         blocks = sorted(deps & set(sheet.spec.blocks))
         if blocks:
             why.append(f"{out.name} needs the solver block(s) {', '.join(blocks)}")
+        stepwise = sorted(
+            n
+            for n in deps
+            if n in sheet.spec.definitions
+            and (sheet.spec.definitions[n].program is not None or sheet.spec.definitions[n].ode)
+        )
+        if stepwise:
+            why.append(f"{out.name} uses programs or ODE solutions ({', '.join(stepwise)})")
         aggregates = sorted(deps & {"max_over", "min_over"} - set(sheet.spec.definitions))
         if aggregates:
             why.append(f"{out.name} uses the table aggregate {', '.join(aggregates)}()")
