@@ -224,3 +224,15 @@ def test_a_computed_index_out_of_range_is_an_error(tmp_path):
         s.evaluate("g", [0, 5])
     with pytest.raises(workbook.WorkbookError, match="index 0.5 is not an integer"):
         s.evaluate("g", 0.5)
+
+
+def test_run_prints_matrices_and_texts(tmp_path, capsys):
+    from pathlib import Path
+
+    from workbook.cli import main
+
+    data = Path(__file__).parent / "data" / "arrays.toml"
+    assert main(["run", str(data), "--out", str(tmp_path / "a.xlsx")]) == 0
+    out = capsys.readouterr().out
+    assert "K = [[8., 2.], [4., 6.]] kN/m" in out
+    assert 'verdict = "OK"' in out

@@ -252,6 +252,15 @@ def _print_scalars(sheet) -> None:
     for name in names[:MAX_SUMMARY_SCALARS]:
         try:
             q = sheet.scalar_quantity(name)
+            if isinstance(q, str):  # a text: "OK"
+                print(f'  {name} = "{q}"')
+                continue
+            if getattr(q.magnitude, "ndim", 0):  # a vector or matrix, one row a line
+                import numpy as np
+
+                rows = np.array2string(q.magnitude, precision=6, separator=", ")
+                print(f"  {name} = {rows.replace(chr(10), '')} {pretty(q.units)}".rstrip())
+                continue
             print(f"  {name} = {float(q.magnitude):.6g} {pretty(q.units)}".rstrip())
         except WorkbookError as err:
             print(f"  {name}: error: {err.message}")
