@@ -46,7 +46,13 @@ def test_solution_against_the_closed_form_in_a_table(tmp_path):
     t = table.iloc[:, 0].to_numpy()
     np.testing.assert_allclose(table.iloc[:, 1], 1000 * np.exp(-2 * t), rtol=1e-8)
     # the workbook writes the states as numbers with a comment (no formula exists)
-    sheet.write_xlsx(tmp_path / "o.xlsx")
+    import openpyxl
+
+    ws = openpyxl.load_workbook(sheet.write_xlsx(tmp_path / "o.xlsx"))["Listing"]
+    header = next(c for c in ws[2] if c.value and str(c.value).startswith("y"))
+    assert "solution of ode 'decay'" in header.comment.text
+    cells = [ws.cell(row=r, column=header.column).value for r in range(3, 3 + len(table))]
+    np.testing.assert_allclose(cells, table.iloc[:, 1], rtol=1e-12)
 
 
 def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):

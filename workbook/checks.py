@@ -224,6 +224,15 @@ def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
             q = sheet.evaluate(row.name)
         if isinstance(row.value, str) or isinstance(q, str):
             return _text_row(base, row, q)
+        if getattr(q.magnitude, "ndim", 0):
+            raise TemplateError(
+                f"'{row.name}' is a vector or matrix and a printed value is one number: "
+                f"check an element through a definition (e.g. {row.name}_0 = "
+                f'"{row.name}[0]")',
+                file=str(spec.file),
+                line=row.line,
+                definition=row.name,
+            )
         computed = float(q.to(un.unit(row.unit)).magnitude)
     except pint.DimensionalityError:
         raise UnitError(
