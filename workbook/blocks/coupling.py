@@ -197,7 +197,7 @@ def model(sheet, *, rigid: bool = False, damping: str = "corrected") -> LinearMo
     kw = _v(sheet, "k_w", "N*m")
     K3 = H3 + np.diag([0.0, 0.0 if on_stop else kw, 0.0])
     M_D0 = _v(sheet, "M_D0", "N*m")
-    f0 = np.array([M_D0, _v(sheet, "G", "N*m") + kw * phi2, -M_D0])  # M0 + the weights
+    f0 = np.array([M_D0, _v(sheet, "Q2_dyn", "N*m"), -M_D0])  # M0 + the weights
     fp = np.array([0.0, 0.0, -_v(sheet, "pump_amp", "N*m")])
     k = _v(sheet, "k_gear", "")
     if rigid:
@@ -206,7 +206,7 @@ def model(sheet, *, rigid: bool = False, damping: str = "corrected") -> LinearMo
         K3 = K3 - H3  # the tooth does no work on a rigid-tooth motion
     else:
         C = np.eye(3)
-        x0 = np.array([0.0, phi2, k * phi2 - _v(sheet, "delta_tooth", "rad")])
+        x0 = np.array([0.0, phi2, _v(sheet, "psi_dyn", "rad")])
     if on_stop:  # weights held on the stop: drop phi2 (and its constant force)
         f0[1] = 0.0
         keep = [0] if rigid else [0, 2]
@@ -219,7 +219,7 @@ def model(sheet, *, rigid: bool = False, damping: str = "corrected") -> LinearMo
         C.T @ K3 @ C,
         C.T @ f0,
         C.T @ fp,
-        _v(sheet, "pump_order", "") * w,
+        _v(sheet, "Omega_pump", "rad/s"),
         C,
         x0,
         "rigid tooth" if rigid else "3 DOF",
