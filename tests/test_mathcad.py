@@ -69,7 +69,15 @@ def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
     assert "AddTrainInTable" in text  # a function of the referenced iSET_module.xmcd
 
 
-@pytest.mark.parametrize("name", ["circle-area-and-plots.xmcd", "wind-load.xmcd"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "circle-area-and-plots.xmcd",
+        "wind-load.xmcd",
+        "timber-beam.xmcd",  # texts ("OK")
+        "lagrange-polynomial.xmcd",  # vectors
+    ],
+)
 def test_imported_worksheet_runs(name, tmp_path, capsys):
     toml, _ = _import(name, tmp_path, capsys)
     out = tmp_path / "out.xlsx"

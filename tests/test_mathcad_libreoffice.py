@@ -18,7 +18,14 @@ pytestmark = [
 
 
 @pytest.mark.parametrize(
-    "name", ["wind-load.xmcd", "timber-beam.xmcd", "circle-area-and-plots.xmcd"]
+    "name",
+    [
+        "wind-load.xmcd",
+        "timber-beam.xmcd",
+        "circle-area-and-plots.xmcd",
+        "lagrange-polynomial.xmcd",
+        "points-and-lines.xmcd",
+    ],
 )
 def test_imported_workbook_recalculates_to_engine_values(name, tmp_path, capsys):
     assert main(["import", str(DATA / name), "--out", str(tmp_path)]) == 0
