@@ -64,9 +64,12 @@ def split_quantity(text: str, *, what: str = "value") -> tuple[float | int, str]
 
 
 def _refuse_list(text: str, what: str) -> None:
-    if re.match(r"^[+-]?\d+,\d+(?:\s|$)", text):
+    if re.match(r"^[+-]?\d+,\d+(?![\d,])", text):
         fixed = re.sub(r"^([+-]?\d+),(\d+)", r"\1.\2", text)
-        raise InputError(f"{what}: {text!r} has a decimal comma; write a decimal point: {fixed!r}")
+        raise InputError(
+            f"{what}: {text!r} has a decimal comma; write a decimal point: {fixed!r} "
+            "(no thousands separators)"
+        )
     raise InputError(
         f"{what}: {text!r} is not one value (lists, brackets and commas are not accepted; "
         "write one number and its unit, like '45.5 mm')"

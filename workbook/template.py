@@ -404,6 +404,32 @@ def sheet_name(name: str, what: str) -> str:
     return name
 
 
+WRITER_SHEETS = ("Inputs", "Definitions", "Charts", "Checks", "About")  # the writer's own
+
+
+def _check_sheet_names(tables: list[TableSpec]) -> None:
+    """Excel compares sheet names ignoring case: a table's sheet may not be one of the
+    writer's own sheets, nor another table's sheet spelt with other capitals."""
+    seen: dict[str, str] = {}
+    for t in tables:
+        key = t.sheet.casefold()
+        own = next((w for w in WRITER_SHEETS if w.casefold() == key), None)
+        if own is not None:
+            raise TemplateError(
+                f"table {t.name}: sheet {t.sheet!r} is the workbook's own {own} sheet; "
+                "choose another name",
+                line=t.line,
+                definition=f"table {t.name}",
+            )
+        if seen.setdefault(key, t.sheet) != t.sheet:
+            raise TemplateError(
+                f"table {t.name}: sheet {t.sheet!r} and {seen[key]!r} are one sheet in Excel "
+                "(names ignore case); spell them alike",
+                line=t.line,
+                definition=f"table {t.name}",
+            )
+
+
 def _table(data: dict, key: str) -> dict:
     value = data.get(key, {})
     if not isinstance(value, dict):
@@ -568,6 +594,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             raise err.located(
                 line=_value_line(text, str(raw.get("block", "[[findings]]")))
             ) from None
+    _check_sheet_names(tables)
     names_seen = set()
     for t in tables:
         if t.name in names_seen:
@@ -909,6 +936,12 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
         f.text("name"), f.text("part", None)
         rng = parse_range(f.text("range"), what=f"table {name}") if "range" in f else None
         cols = _columns(raw.get("columns", []), rng.var if rng else None, f"table {name}")
+        shown = [(c.title, None if c.unit is None else str(c.unit)) for c in cols]
+        twice = next((c for c, k in zip(cols, shown) if shown.count(k) > 1), None)
+        if twice is not None:
+            raise TemplateError(
+                f"table {name}: column {twice.title!r} is listed twice in the same unit"
+            )
         block = f.text("block", None)
         if not block and rng is None:
             raise TemplateError(f"table {name} needs a range (or a block)")

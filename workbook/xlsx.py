@@ -237,8 +237,9 @@ class WorkbookWriter:
         if not defs:
             return
         done = getattr(self, "on_definitions", set())
-        ws = self.ws("Results")
-        start = self.rows["Results"]
+        name = next((n for n in self.sheets if n.casefold() == "results"), "Results")
+        ws = self.ws(name)  # below the tables of a "Results" sheet, if the template has one
+        start = self.rows[name]
         if start:
             start += 1
             ws.write_string(start, 0, "Scalar results", self.fmt["title"])
@@ -270,14 +271,14 @@ class WorkbookWriter:
                 ref = self.names[d.name]
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
                 self.formula_cells += 1
-            else:
-                self.printer.helpers = HelperCells(self, d.name)
+                continue
+            self.printer.helpers = HelperCells(self, d.name)
             try:
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             finally:
                 self.printer.helpers = None
-                self._define(ws, row, d.name, f"='Results'!$B${row + 1}")
-        self.rows["Results"] = start + len(defs) + 2
+            self._define(ws, row, d.name, f"='{name}'!$B${row + 1}")
+        self.rows[name] = start + len(defs) + 2
 
     def write_matrices(self, defs) -> None:
         """Vector and matrix definitions, each a named block of cells: elements written out
@@ -384,6 +385,8 @@ class WorkbookWriter:
             first = start + 2
             for j, col in enumerate(t.columns, start=1):
                 cells = ColumnCells(t.sheet, j, first, first + n - 1, col.title)
+                if (t.name, col.text) in self.planned:  # the same text in another unit:
+                    continue  # max_over(t, col) reads the first
                 self.planned[(t.name, col.text)] = cells
                 self.printer.ranges[(t.name, col.text)] = _cells_text(cells)
             rows[t.sheet] = first + n + 2
@@ -413,7 +416,8 @@ class WorkbookWriter:
                 self._live_note(ws, first - 1, j, col.typed, env, col.values)
             cells = ColumnCells(spec.sheet, j, first, first + n - 1, col.title)
             planned = self.planned.get((spec.name, col.text))
-            if planned is not None and planned != cells:  # a MAX(...) already points there
+            first = next(c for c in data.columns[1:] if c.text == col.text) is col
+            if first and planned is not None and planned != cells:  # a MAX(...) points there
                 raise RuntimeError(f"table {spec.name} written at {cells}, planned at {planned}")
             self.columns[(spec.range.text, spec.sheet, col.text, str(col.unit))] = cells
         self.columns[(spec.range.text, spec.sheet, data.var, "var")] = ColumnCells(

@@ -7,6 +7,7 @@ overrides, the output texts); each process loads the Sheet once.
 from __future__ import annotations
 
 import os
+import re
 import time
 from pathlib import Path
 
@@ -129,7 +130,7 @@ def run_tasks(tasks: list[tuple], mode: str, scheduler, workers: int | None, tim
             method = "fork"
         else:
             method = "forkserver" if "forkserver" in methods else "spawn"
-        n = max(1, min(workers or os.cpu_count() or 1, len(tasks)))
+        n = max(1, min(pool_size(workers), len(tasks)))
         pool = ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context(method))
         futures = {pool.submit(run_case, t): t[0] for t in tasks}
         try:
@@ -157,6 +158,8 @@ def _run_dask(tasks: list[tuple], scheduler, timeout: float = 20.0):
             "--scheduler needs dask.distributed: pip install 'workbook[dask]'"
         ) from None
     own = not isinstance(scheduler, Client)
+    if own:
+        check_scheduler(scheduler, timeout)
     try:
         client = Client(scheduler, timeout=f"{timeout}s") if own else scheduler
     except OSError as err:
@@ -173,3 +176,63 @@ def _run_dask(tasks: list[tuple], scheduler, timeout: float = 20.0):
     finally:
         if own:
             client.close()
+
+
+def pool_size(workers: int | None) -> int:
+    """Processes of the local pool: ``workers``, at most the CPU count (more would only
+    queue; a process per case of a large grid would exhaust memory)."""
+    cpus = os.cpu_count() or 1
+    if workers is None:
+        return cpus
+    if workers < 1:
+        raise InputError(f"--workers {workers}: give at least 1")
+    if workers > cpus:
+        import sys
+
+        print(
+            f"workbook: --workers {workers} is more than the {cpus} CPUs; using {cpus} processes",
+            file=sys.stderr,
+        )
+    return min(workers, cpus)
+
+
+_ADDRESS = re.compile(
+    r"^(?:(tcp|tls)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9][A-Za-z0-9.-]*):(\d{1,5})$"
+)
+
+
+def check_scheduler(address, timeout: float) -> None:
+    """Refuse an address that is not ``[tcp|tls]://HOST:PORT``, and a TCP server that is not a
+    Dask scheduler: a scheduler sends its handshake as soon as it accepts a connection; a
+    server that says nothing within ``timeout`` seconds (a web server waits for a request)
+    would make the client wait forever."""
+    import socket
+
+    text = str(address).strip()
+    m = _ADDRESS.match(text)
+    if not isinstance(address, str) or m is None or not 0 < int(m.group(3)) < 65536:
+        raise InputError(
+            f"--scheduler {text[:100]!r}: write the Dask scheduler's address as "
+            "tcp://HOST:PORT (or tls://HOST:PORT)"
+        )
+    if m.group(1) == "tls":
+        return  # a TLS server waits for the client: nothing to probe before the client's timeout
+    host = m.group(2).strip("[]")
+    try:
+        conn = socket.create_connection((host, int(m.group(3))), timeout=timeout)
+    except OSError as err:
+        raise InputError(f"cannot reach the Dask scheduler at {text}: {err}") from None
+    try:
+        conn.settimeout(timeout)
+        first = conn.recv(8)
+    except TimeoutError:
+        raise InputError(
+            f"--scheduler {text}: the server there sent no Dask handshake within {timeout:g} s "
+            "(is it a Dask scheduler?)"
+        ) from None
+    except OSError as err:
+        raise InputError(f"cannot reach the Dask scheduler at {text}: {err}") from None
+    finally:
+        conn.close()
+    if not first:
+        raise InputError(f"--scheduler {text}: the server closed the connection at once")
