@@ -6,6 +6,8 @@ import math
 import re
 from dataclasses import dataclass
 
+import pint
+
 from . import expr as ex
 from .errors import LimitError, TemplateError
 
@@ -21,6 +23,8 @@ class RangeSpec:
     second: ex.Node | None
     last: ex.Node
     text: str
+    # the unit of a bound written as a quantity ("25 N"): its node is then the number
+    units: tuple[pint.Unit | None, ...] = (None, None, None)
 
 
 _RANGE = re.compile(r"^\s*(?:([A-Za-z][A-Za-z0-9_]*)\s*:=\s*)?(.+?)\s*\.\.\s*(.+?)\s*$")
@@ -39,9 +43,24 @@ def parse_range(text: str, *, default_var: str | None = None, what: str = "range
     parts = split_top(head, ",")
     if len(parts) > 2:
         raise TemplateError(f"{what}: range {text!r} has more than two values before '..'")
-    first = ex.parse(parts[0], what=what)
-    second = ex.parse(parts[1], what=what) if len(parts) == 2 else None
-    return RangeSpec(var, first, second, ex.parse(last, what=what), text.strip())
+    texts = [parts[0], parts[1] if len(parts) == 2 else None, last]
+    bounds = [None if t is None else _bound_node(t, what) for t in texts]
+    nodes = [None if b is None else b[0] for b in bounds]
+    units = tuple(None if b is None else b[1] for b in bounds)
+    return RangeSpec(var, nodes[0], nodes[1], nodes[2], text.strip(), units)
+
+
+_QUANTITY_BOUND = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*[^\W\d]")
+
+
+def _bound_node(text: str, what: str) -> tuple[ex.Node, pint.Unit | None]:
+    """A range bound: an expression, or a quantity like ``25 N`` (its number and unit)."""
+    if _QUANTITY_BOUND.match(text.strip()):
+        from . import units as un
+
+        q = un.quantity(text, what=f"{what}: range bound")
+        return ex.Number(float(q.magnitude)), q.units
+    return ex.parse(text, what=what), None
 
 
 def range_values(first: float, second: float | None, last: float, *, what: str = "range"):

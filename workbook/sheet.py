@@ -26,6 +26,7 @@ from .template import (
     resolve_parts,
     select_parts,
 )
+from .typed import TConst
 from .uses import names_used
 
 _UNKNOWN = re.compile(r"^unknown (?:name|function) '([^']+)'")
@@ -341,11 +342,14 @@ class Sheet:
         spec = self.spec.arguments.get(rng.var)
         dimensionless = un.registry().dimensionless
         out: list[tc.T | None] = []
-        for node in (rng.first, rng.second, rng.last):
+        for node, unit in zip((rng.first, rng.second, rng.last), rng.units):
             if node is None:
                 out.append(None)
                 continue
-            t = self.typer.expression(node, {}, what)
+            if unit is not None:  # a quantity bound ("25 N")
+                t = TConst(unit, value=float(node.value))
+            else:
+                t = self.typer.expression(node, {}, what)
             if t.unit.dimensionality and spec is None:
                 raise TemplateError(
                     f"{what}: range bound has units but '{rng.var}' has no declared unit"
