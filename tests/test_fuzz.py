@@ -128,3 +128,298 @@ def test_generated_garbage(sheet, text):
 
 def test_budget_is_at_least_ten_thousand():
     assert PER_TEST * 2 >= 10_000
+
+
+# -- quantity and unit text; template value types --------------------------------------------
+# Every text a user types as a value or unit goes through one reader (workbook.quantity); every
+# table of a template through checked fields. Generated texts and TOML values must give a
+# quantity or a WorkbookError, quickly: never another exception, never a long computation.
+
+QUANTITY_TOKENS = [
+    "0",
+    "45",
+    "45.5",
+    "-3",
+    "+2",
+    ".5",
+    "1e3",
+    "1e999",
+    "nan",
+    "inf",
+    "9",
+    "2000",
+    ",",
+    ";",
+    " ",
+    "  ",
+    "mm",
+    "MPa",
+    "m",
+    "s",
+    "kg",
+    "N",
+    "deg",
+    "rad",
+    "1/s",
+    "°",
+    "%",
+    "percent",
+    "µm",
+    "Ω",
+    "furlongz",
+    "*",
+    "/",
+    "^",
+    "**",
+    "(",
+    ")",
+    "[",
+    "]",
+    "{",
+    "}",
+    "-",
+    "+",
+    "e",
+    "9**9**9",
+    "2**2000",
+    "__import__",
+    "'",
+    '"',
+    "\\",
+    "\n",
+    "\t",
+    "x" * 50,
+]
+SLOW_EXAMPLES = int(os.environ.get("FUZZ_SLOW_EXAMPLES", "10000"))
+FAST_EXAMPLES = int(os.environ.get("FUZZ_FAST_EXAMPLES", "100"))
+CASE_SECONDS = 10.0
+
+
+def quantity_texts():
+    token = st.sampled_from(QUANTITY_TOKENS)
+    return st.one_of(
+        st.lists(token, max_size=10).map("".join),
+        st.tuples(st.floats(allow_nan=True), st.lists(token, max_size=5).map("".join)).map(
+            lambda t: f"{t[0]!r} {t[1]}"
+        ),
+        st.text(max_size=40),
+        st.integers(min_value=0, max_value=400).map(lambda n: "1" + "0" * n + " mm"),
+    )
+
+
+def check_quantity(text: str) -> None:
+    import time
+
+    from workbook import units as un
+
+    start = time.monotonic()
+    for read in (lambda: un.quantity(text, what="q"), lambda: un.unit(text, what="u")):
+        try:
+            q = read()
+            assert q is not None
+        except WorkbookError as err:
+            assert str(err)
+        except Exception as exc:  # pragma: no cover - the property
+            pytest.fail(f"{type(exc).__name__} escaped for {text!r}: {exc}")
+    assert time.monotonic() - start < CASE_SECONDS, text
+
+
+def toml_values():
+    """TOML values of every type: texts (quantities and junk), numbers, booleans, dates,
+    arrays and tables."""
+    scalar = st.one_of(
+        quantity_texts(),
+        st.sampled_from(['"20 mm"', '"a"', '"R*2"', '"phi := 0 .. 10"', '"="', '"=1+1"']).map(
+            lambda s: s[1:-1]
+        ),
+        st.integers(min_value=-(2**63), max_value=2**63 - 1),
+        st.floats(allow_nan=True, allow_infinity=True),
+        st.booleans(),
+        st.dates(),
+    )
+    return st.recursive(
+        scalar,
+        lambda inner: st.one_of(
+            st.lists(inner, max_size=3),
+            st.dictionaries(st.sampled_from(KEYS), inner, max_size=3),
+        ),
+        max_leaves=6,
+    )
+
+
+KEYS = [
+    "value",
+    "unit",
+    "note",
+    "options",
+    "min",
+    "max",
+    "positive",
+    "label",
+    "plain",
+    "expr",
+    "pieces",
+    "name",
+    "title",
+    "range",
+    "columns",
+    "sheet",
+    "block",
+    "part",
+    "x",
+    "y",
+    "series",
+    "file",
+    "tolerance",
+    "rel_tolerance",
+    "role",
+    "misprints",
+    "at",
+    "postive",
+    "unti",
+    "colums",
+    "about",
+    "outputs",
+    "units",
+    "line",
+    "axis",
+    "marker",
+    "log_x",
+    "equal_axes",
+]
+
+
+def toml_literal(value) -> str:
+    import datetime
+    import json
+    import math
+
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return (
+            "nan"
+            if math.isnan(value)
+            else ("inf" if value > 0 else "-inf")
+            if math.isinf(value)
+            else repr(value)
+        )
+    if isinstance(value, datetime.date):
+        return value.isoformat()
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_literal(v) for v in value) + "]"
+    return "{ " + ", ".join(f"{k} = {toml_literal(v)}" for k, v in value.items()) + " }"
+
+
+SLOTS = [  # where a generated value goes in an otherwise good template
+    ("inputs", "R1"),
+    ("inputs", "law"),
+    ("arguments", "phi"),
+    ("definitions", "k"),
+    ("definitions", '"h(phi)"'),
+    ("sheet", "title"),
+    ("sheet", "about"),
+    ("sweep", "outputs"),
+    ("parts", "extra"),
+]
+ARRAY_SLOTS = ["tables", "charts", "printed"]
+
+
+def templates():
+    slot = st.tuples(st.sampled_from(SLOTS), toml_values())
+    item = st.tuples(
+        st.sampled_from(ARRAY_SLOTS),
+        st.dictionaries(st.sampled_from(KEYS), toml_values(), max_size=5),
+    )
+    return st.tuples(st.lists(slot, max_size=3), st.lists(item, max_size=2))
+
+
+BASE = {
+    "inputs": {"R1": '"20 mm"', "law": '{ value = "a", options = ["a", "b"] }'},
+    "arguments": {"phi": '{ unit = "deg" }'},
+    "definitions": {"k": '"2*R1"', '"h(phi)"': '"R1*sin(phi)"'},
+}
+
+
+def template_text(slots, items) -> str:
+    sections = {name: dict(body) for name, body in BASE.items()}
+    for (section, key), value in slots:
+        sections.setdefault(section, {})[key] = toml_literal(value)
+    lines = []
+    for name, body in sections.items():
+        lines.append(f"[{name}]")
+        lines += [f"{k} = {v}" for k, v in body.items()]
+    for section, table in items:
+        lines.append(f"[[{section}]]")
+        lines += [f"{k} = {toml_literal(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def check_template(folder, slots, items) -> None:
+    import time
+
+    from workbook.template import load_spec as load
+
+    text = template_text(slots, items)
+    path = folder / "fuzz.toml"
+    path.write_text(text, encoding="utf-8")
+    start = time.monotonic()
+    try:
+        sheet = Sheet(load(path))
+        sheet.evaluate("k")
+        for t in sheet.spec.tables:
+            sheet.table(t.name) if not t.block else None
+    except WorkbookError as err:
+        assert str(err)
+    except Exception as exc:  # pragma: no cover - the property
+        pytest.fail(f"{type(exc).__name__} escaped for\n{text}\n{exc}")
+    assert time.monotonic() - start < CASE_SECONDS, text
+
+
+def _fuzz(examples: int):
+    return settings(
+        max_examples=examples,
+        derandomize=True,
+        deadline=None,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+    )
+
+
+@_fuzz(FAST_EXAMPLES)
+@given(text=quantity_texts())
+def test_quantity_text(text):
+    check_quantity(text)
+
+
+@_fuzz(FAST_EXAMPLES)
+@given(case=templates())
+def test_template_values(fuzz_folder, case):
+    check_template(fuzz_folder, *case)
+
+
+@pytest.mark.slow
+@_fuzz(SLOW_EXAMPLES)
+@given(text=quantity_texts())
+def test_quantity_text_many(text):
+    check_quantity(text)
+
+
+@pytest.mark.slow
+@_fuzz(SLOW_EXAMPLES)
+@given(case=templates())
+def test_template_values_many(fuzz_folder, case):
+    check_template(fuzz_folder, *case)
+
+
+@pytest.fixture(scope="module")
+def fuzz_folder(tmp_path_factory):
+    return tmp_path_factory.mktemp("fuzz-templates")
+
+
+def test_slow_budget_is_at_least_ten_thousand_each():
+    assert SLOW_EXAMPLES >= 10_000

@@ -416,8 +416,8 @@ class WorkbookWriter:
                 self._live_note(ws, first - 1, j, col.typed, env, col.values)
             cells = ColumnCells(spec.sheet, j, first, first + n - 1, col.title)
             planned = self.planned.get((spec.name, col.text))
-            first = next(c for c in data.columns[1:] if c.text == col.text) is col
-            if first and planned is not None and planned != cells:  # a MAX(...) points there
+            is_first = next(c for c in data.columns[1:] if c.text == col.text) is col
+            if is_first and planned is not None and planned != cells:  # a MAX(...) points there
                 raise RuntimeError(f"table {spec.name} written at {cells}, planned at {planned}")
             self.columns[(spec.range.text, spec.sheet, col.text, str(col.unit))] = cells
         self.columns[(spec.range.text, spec.sheet, data.var, "var")] = ColumnCells(
