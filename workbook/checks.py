@@ -31,6 +31,13 @@ class CheckRow:
     note: str = ""
     computed_text: str | None = None  # what the sheet gives where a text is printed
 
+    def __post_init__(self):
+        if self.verdict not in V.ROW_VERDICTS:
+            raise ValueError(
+                f"printed value {self.name!r}: verdict {self.verdict!r} is not one of "
+                f"{', '.join(V.ROW_VERDICTS)}"
+            )
+
     @property
     def abs_error(self) -> float | None:
         if self.computed is None or isinstance(self.printed, str):
