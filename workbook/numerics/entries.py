@@ -17,7 +17,7 @@ import numpy as np
 from .. import typed as ty
 from .. import units as un
 from ..builtins import Builtin, register
-from ..errors import NotLive, TemplateError, UnitError
+from ..errors import NotLive, TemplateError, UnitError, WorkbookError
 from ..expr import PREC
 from . import extrema, gauss, quadrature, roots, series
 from ._common import Result, live, sheet_tolerance
@@ -295,21 +295,29 @@ def _root_excel(body, args, consts) -> tuple[str, int]:
     def f(x: float) -> float:
         return helpers.value(body.typed, {body.var: x})
 
-    lo, hi = (helpers.value(t, {}) for t in body.rest)
+    try:  # the cached values: the same steps in the engine, before any cell is written
+        rows = []
+        lo, hi = (helpers.value(t, {}) for t in body.rest)
+        for _ in range(BISECTION_STEPS + 1):
+            mid = (lo + hi) / 2
+            flo, fmid = f(lo), f(mid)
+            rows.append((lo, hi, mid, flo, fmid))
+            lo, hi = (lo, mid) if flo * fmid <= 0 else (mid, hi)
+    except WorkbookError as err:
+        raise NotLive(
+            f"root(): the bisection steps leave the expression's domain ({err.message})"
+        ) from None
     headers = ["lo", "hi", "mid", "f(lo)", "f(mid)"]
     block = helpers("root() by bisection", BISECTION_STEPS + 1, headers)
     r = block.ref
-    block.write(0, 0, f"={a}", lo)
-    block.write(0, 1, f"={b}", hi)
-    flo = fmid = mid = 0.0
-    for k in range(BISECTION_STEPS + 1):
+    for k, (lo, hi, mid, flo, fmid) in enumerate(rows):
         if k:
             left = f"{r(k - 1, 3)}*{r(k - 1, 4)}<=0"
-            lo, hi = (lo, mid) if flo * fmid <= 0 else (mid, hi)
             block.write(k, 0, f"=IF({left},{r(k - 1, 0)},{r(k - 1, 2)})", lo)
             block.write(k, 1, f"=IF({left},{r(k - 1, 2)},{r(k - 1, 1)})", hi)
-        mid = (lo + hi) / 2
-        flo, fmid = f(lo), f(mid)
+        else:
+            block.write(0, 0, f"={a}", lo)
+            block.write(0, 1, f"={b}", hi)
         block.write(k, 2, f"=({r(k, 0)}+{r(k, 1)})/2", mid)
         block.write(k, 3, "=" + body(r(k, 0)), flo)
         block.write(k, 4, "=" + body(r(k, 2)), fmid)
