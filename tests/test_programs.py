@@ -172,3 +172,31 @@ def test_a_program_of_branches_is_a_live_nested_if(tmp_path):
         assert float(got[f"B{row}"]) == pytest.approx(table.iloc[i, 1], rel=1e-12)
         assert got[f"C{row}"] == table.iloc[i, 2]
     assert not math.isnan(float(got["B3"]))
+
+
+def test_programs_build_vectors_and_matrices_element_by_element(tmp_path):
+    sheet = _sheet(
+        tmp_path,
+        '[inputs]\nL = "2 m"\n[arguments]\nx = { unit = "" }\n[definitions]\n'
+        + prog("powers(x)", "v := [0, 0, 0, 0]\nfor k in 0 .. 3\n    v[k] := x^k\nv")
+        + prog(
+            "grid(x)",
+            "M := [[0, 0, 0], [0, 0, 0]]*L\nfor i in 0 .. 1\n    for j in 0 .. 2\n"
+            "        M[i, j] := (i + 10*j + x)*L\nreturn M",
+        )
+        + 'table = "powers(3)"\n',
+    )
+    xs = np.array([0.5, 2.0, 3.0])
+    got = sheet.evaluate("powers", xs).magnitude  # matrix axes first, then the argument's
+    np.testing.assert_allclose(got[:, 0, :].T, np.vander(xs, 4, increasing=True))
+    i, j = np.mgrid[0:2, 0:3]
+    np.testing.assert_allclose(sheet.evaluate("grid", 1).to("m").magnitude, (i + 10 * j + 1) * 2.0)
+    np.testing.assert_allclose(sheet.evaluate("table").magnitude[:, 0], [1, 3, 9, 27])
+    for body, message in [
+        ("w[0] := 1\nw", "not a local vector or matrix"),
+        ("v := [1, 2]\nv := 3\nv", "was a vector of 2, here it is given a number"),
+        ("v := [1, 2]\nv[2] := 1\nv", "element index 2 is out of range"),
+        ("v := [1, 2]\nif x > 0\n    return v\n0 otherwise", "gives a number here"),
+    ]:
+        with pytest.raises(workbook.WorkbookError, match=message):
+            _sheet(tmp_path, '[arguments]\nx = { unit = "" }\n[definitions]\n' + prog("f(x)", body))

@@ -225,6 +225,17 @@ def _index_values(i, origin: int, n: int, word: str, what: str):
     return k if k.ndim else int(k)
 
 
+def element_index(shape, indices, origin: int, what: str) -> tuple[int, int]:
+    """(row, column) of ``v[i]`` or ``M[i, j]`` in a matrix of ``shape`` (checked)."""
+    r, c = shape[:2]
+    if len(indices) == 1:
+        return _index_values(indices[0], origin, r, "element", what), 0
+    return (
+        _index_values(indices[0], origin, r, "row", what),
+        _index_values(indices[1], origin, c, "column", what),
+    )
+
+
 def submatrix(m, ir: int, jr: int, ic: int, jc: int):
     return np.asarray(m, dtype=float)[ir : jr + 1, ic : jc + 1]
 

@@ -225,6 +225,7 @@ class Evaluator(Visitor):
 
         run = compile_program(t.program, self.compile, t.name)
         params, is_text, name = t.params, t.text, t.name
+        matrix = tuple(t.shape or ())
 
         def program(env):
             arrays = {p: env[p] for p in params if p in env and np.ndim(env[p]) > 0}
@@ -233,9 +234,12 @@ class Evaluator(Visitor):
                     return run(env)
                 keys = list(arrays)
                 shaped = np.broadcast_arrays(*[np.asarray(arrays[k]) for k in keys])
-                out = np.empty(shaped[0].shape, dtype=object if is_text else float)
-                for ix in np.ndindex(out.shape):
-                    out[ix] = run({**env, **{k: float(a[ix]) for k, a in zip(keys, shaped)}})
+                grid = shaped[0].shape
+                out = np.empty(matrix + grid, dtype=object if is_text else float)
+                lead = (slice(None),) * len(matrix)  # a matrix value: its axes come first
+                for ix in np.ndindex(grid):
+                    one = {**env, **{k: float(a[ix]) for k, a in zip(keys, shaped)}}
+                    out[lead + ix] = run(one)
                 return out
             except NoValue:
                 raise InputError(

@@ -35,6 +35,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from . import expr as ex
 from .errors import LimitError, TemplateError
 
@@ -55,6 +57,16 @@ class Stmt:
 class Assign(Stmt):
     name: str
     value: Any
+
+
+@dataclass(frozen=True)
+class SetItem(Stmt):
+    """``v[i] := EXPR`` or ``M[i, j] := EXPR``: an element of a local vector or matrix."""
+
+    name: str
+    indices: tuple
+    value: Any
+    origin: int = 0
 
 
 @dataclass(frozen=True)
@@ -290,8 +302,14 @@ def _plain(text: str, number: int, where: str) -> Stmt:
     if ":=" in text:
         name, _, value = text.partition(":=")
         name = name.strip()
+        if "[" in name:
+            target = _expr(name, where)
+            if isinstance(target, ex.Index) and isinstance(target.target, ex.Name):
+                return SetItem(number, target.target.id, target.indices, _expr(value, where))
         if not ex.is_identifier(name):
-            raise TemplateError(f"{where}: cannot assign to {name!r} (a local is a plain name)")
+            raise TemplateError(
+                f"{where}: cannot assign to {name!r} (a local is a plain name, or v[i], M[i, j])"
+            )
         return Assign(number, name, _expr(value, where))
     if re.match(r"^[A-Za-z][A-Za-z0-9_]*\s*=[^=]", text):
         raise TemplateError(f"{where}: a local is given its value with ':=' (not '=')")
@@ -340,6 +358,9 @@ def expressions(block: tuple[Stmt, ...]):
     for s in walk(block):
         if isinstance(s, (Assign, Value, Return)):
             yield s.value
+        elif isinstance(s, SetItem):
+            yield from s.indices
+            yield s.value
         elif isinstance(s, If):
             for c, _ in s.branches:
                 yield c
@@ -383,6 +404,10 @@ class ExprTyping:
     is_text: Callable[[Any], bool]
     is_zero: Callable[[Any], bool]  # a bare literal 0 (fits any unit)
     unit_of: Callable[[Any], Any]
+    shape_of: Callable[[Any], Any] = lambda t: None  # (rows, columns) of a matrix, or None
+    scope_entry: Callable[[Any, Any], Any] = lambda unit, shape: unit  # a local in the scope
+    index: Callable[[Any, dict, tuple, str], Any] = None  # (index expr, scope, shape, word)
+    origin: int = 0
 
 
 @dataclass(frozen=True)
@@ -392,6 +417,7 @@ class TypedProgram:
     text: bool  # the program's value is text ("OK")
     loops: bool
     source: str
+    shape: Any = None  # (rows, columns) when the program gives a vector or matrix
 
 
 def type_program(
@@ -410,7 +436,12 @@ def type_program(
     if state.value_unit is None and not state.value_text:
         raise TemplateError("the program gives no value (no return and no value line)")
     unit = state.value_unit if not state.value_text else typing.unit_of(state.first_value)
-    return TypedProgram(body, unit, state.value_text, has_loops(program), program.text)
+    if unit is None:  # only bare zeros
+        unit = typing.unit_of(state.first_value)
+    loops = has_loops(program) or any(isinstance(s, SetItem) for s in walk(program.body))
+    return TypedProgram(
+        body, unit, state.value_text, loops, program.text, state.value_shape
+    )
 
 
 class _TypeState:
@@ -423,6 +454,8 @@ class _TypeState:
         self.value_unit = None
         self.value_text = False
         self.first_value = None
+        self.value_shape = _UNSET
+        self.local_shapes: dict[str, Any] = {}
 
     def where(self, s: Stmt) -> str:
         return f"program line {s.line}"
@@ -452,6 +485,14 @@ class _TypeState:
         t = self.expr(e, s)
         if self.t.is_boolean(t):
             raise TemplateError(f"{self.where(s)}: the value is a comparison, not a number")
+        shape = self.t.shape_of(t)
+        if self.value_shape is _UNSET:
+            self.value_shape = shape
+        elif shape != self.value_shape:
+            raise TemplateError(
+                f"{self.where(s)}: the program gives {_shape_words(shape)} here and "
+                f"{_shape_words(self.value_shape)} elsewhere"
+            )
         if self.t.is_text(t):
             if self.first_value is not None and not self.value_text:
                 raise TemplateError(f"{self.where(s)}: text here, a number in another branch")
@@ -474,6 +515,13 @@ class _TypeState:
                 f"{self.where(s)}: '{s.name}' is a name of the sheet; give the local another name"
             )
         t = self.number(s.value, s, f"the value of '{s.name}'")
+        shape = self.t.shape_of(t)
+        if s.name in self.local_shapes and self.local_shapes[s.name] != shape:
+            raise TemplateError(
+                f"{self.where(s)}: '{s.name}' was {_shape_words(self.local_shapes[s.name])}, "
+                f"here it is given {_shape_words(shape)}"
+            )
+        self.local_shapes[s.name] = shape
         unit = self.local_units.get(s.name) or self.hints.get(s.name)
         if unit is None:
             if self.t.is_zero(t):
@@ -483,8 +531,28 @@ class _TypeState:
             self.local_units[s.name] = unit
         else:
             self.local_units[s.name] = unit
-        self.scope[s.name] = unit
+        self.scope[s.name] = self.t.scope_entry(unit, shape)
         return Assign(s.line, s.name, self.t.convert(t, unit, f"{self.where(s)}: '{s.name}'"))
+
+    def set_item(self, s: SetItem):
+        shape = self.local_shapes.get(s.name)
+        if shape is None:
+            raise TemplateError(
+                f"{self.where(s)}: '{s.name}' is not a local vector or matrix of the program "
+                f"(give it one first, e.g. {s.name} := [0, 0, 0])"
+            )
+        if len(s.indices) == 1 and shape[1] != 1:
+            raise TemplateError(f"{self.where(s)}: '{s.name}' is a matrix: write {s.name}[i, j]")
+        words = ("row", "column") if len(s.indices) == 2 else ("element",)
+        idx = tuple(
+            self.t.index(i, self.scope, n, w) for i, n, w in zip(s.indices, shape, words)
+        )
+        t = self.number(s.value, s, f"an element of '{s.name}'")
+        if self.t.shape_of(t) is not None:
+            raise TemplateError(f"{self.where(s)}: an element is a number, not a matrix")
+        unit = self.local_units.get(s.name) or self.t.unit_of(t)
+        value = self.t.convert(t, unit, f"{self.where(s)}: an element of '{s.name}'")
+        return SetItem(s.line, s.name, idx, value, self.t.origin)
 
     def block(self, block):
         out = []
@@ -495,6 +563,8 @@ class _TypeState:
     def stmt(self, s: Stmt) -> Stmt:
         if isinstance(s, Assign):
             return self.assign(s)
+        if isinstance(s, SetItem):
+            return self.set_item(s)
         if isinstance(s, Value):
             return Value(s.line, self.value(s.value, s))
         if isinstance(s, Return):
@@ -520,6 +590,16 @@ class _TypeState:
         if isinstance(s, While):
             return While(s.line, self.cond(s.condition, s), self.block(s.body))
         raise TypeError(s)  # pragma: no cover
+
+
+_UNSET = object()
+
+
+def _shape_words(shape) -> str:
+    if shape is None:
+        return "a number"
+    r, c = shape
+    return f"a {r}x{c} matrix" if c != 1 else f"a vector of {r}"
 
 
 # -- running ----------------------------------------------------------------------------------
@@ -576,10 +656,25 @@ def compile_program(
 
             def assign(env, last):
                 tick(s)
-                env[n] = f(env)
+                value = f(env)  # a matrix is copied: its elements may be set later
+                env[n] = np.array(value, dtype=float) if np.ndim(value) else value
                 return last
 
             return assign
+        if isinstance(s, SetItem):
+            from .matrix import element_index
+
+            f, n, origin = compile_expr(s.value), s.name, s.origin
+            idx = [compile_expr(i) for i in s.indices]
+
+            def set_item(env, last):
+                tick(s)
+                target = env[n]
+                at = element_index(target.shape, [i(env) for i in idx], origin, f"{n}[...]")
+                target[at] = f(env)
+                return last
+
+            return set_item
         if isinstance(s, Value):
             f = compile_expr(s.value)
 
@@ -670,12 +765,12 @@ def compile_program(
         try:
             out = main(local, _NONE)
         except _Return as r:
-            return r.value
+            return np.array(r.value) if np.ndim(r.value) else r.value
         except (_Break, _Continue):
             raise TemplateError(f"'break'/'continue' outside a loop in '{name}'") from None
         if out is _NONE:
             raise NoValue(name)
-        return out
+        return np.array(out) if np.ndim(out) else out
 
     return run
 
@@ -691,6 +786,8 @@ def excel_value(typed: TypedProgram, printed: Callable[[Any, dict], str], subst:
 
     def run(stmts: list[Stmt], s: dict, last: str | None) -> str:
         for k, st in enumerate(stmts):
+            if isinstance(st, SetItem):  # pragma: no cover - typed as a loop (values)
+                raise NotLive("a program that sets elements is written as values")
             if isinstance(st, Assign):
                 s = {**s, st.name: f"({printed(st.value, s)})"}
             elif isinstance(st, Value):

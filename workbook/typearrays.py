@@ -95,22 +95,26 @@ class ArrayTyping:
                 f"{ex.to_text(node.target)} is a {shape_text(target.shape)}: "
                 "write M[i, j] (one index is for a vector)"
             )
-        origin = self.spec.origin
         idx = []
         for k, (i, size) in enumerate(zip(node.indices, (r, c) if n == 2 else (r,))):
             word = ("row", "column")[k] if n == 2 else "element"
-            t = self.plain(self._number(self.visit(i, scope), "an index"), f"the {word} index")
-            if t.shape is not None:
-                raise TemplateError(f"the {word} index is a matrix; an index is a number")
-            if isinstance(t, TConst):
-                v = t.value
-                if v != int(v) or not origin <= v < origin + size:
-                    raise TemplateError(
-                        f"{ex.to_text(node)}: {word} index {v:g} is out of range "
-                        f"({size} {word}s: {origin} .. {origin + size - 1} with origin {origin})"
-                    )
-            idx.append(t)
-        return TIndex(target.unit, target=target, indices=tuple(idx), origin=origin)
+            idx.append(self.typed_index(i, scope, size, word, ex.to_text(node)))
+        return TIndex(target.unit, target=target, indices=tuple(idx), origin=self.spec.origin)
+
+    def typed_index(self, i: ex.Node, scope, size: int, word: str, what: str) -> T:
+        """An index: a plain number; a constant one is checked against ``size`` here."""
+        origin = self.spec.origin
+        t = self.plain(self._number(self.visit(i, scope), "an index"), f"the {word} index")
+        if t.shape is not None:
+            raise TemplateError(f"the {word} index is a matrix; an index is a number")
+        if isinstance(t, TConst):
+            v = t.value
+            if v != int(v) or not origin <= v < origin + size:
+                raise TemplateError(
+                    f"{what}: {word} index {v:g} is out of range "
+                    f"({size} {word}s: {origin} .. {origin + size - 1} with origin {origin})"
+                )
+        return t
 
     def visit_IfElse(self, node: ex.IfElse, scope) -> T:
         value = self.visit(node.value, scope)
@@ -242,10 +246,7 @@ class ArrayTyping:
         from .typecheck import _is_zero
 
         def type_expr(node, sc):
-            t = self.visit(node, sc)
-            if t.shape is not None:
-                raise TemplateError("programs work on numbers and text; index vectors: v[i]")
-            return t
+            return self.visit(node, sc)
 
         def convert(t, unit, where):
             if t.text:
@@ -259,11 +260,20 @@ class ArrayTyping:
             is_text=lambda t: t.text,
             is_zero=_is_zero,
             unit_of=lambda t: t.unit,
+            shape_of=lambda t: t.shape,
+            scope_entry=lambda unit, shape: unit if shape is None else (unit, shape),
+            index=lambda i, sc, size, word: self.typed_index(i, sc, size, word, "an element"),
+            origin=self.spec.origin,
         )
         reserved = frozenset(self.spec.inputs) | frozenset(self.spec.definitions)
         typed = pg.type_program(d.program, dict(scope), typing, reserved=reserved - set(scope))
         return TProgram(
-            typed.unit, name=d.name, program=typed, params=tuple(d.params), text=typed.text
+            typed.unit,
+            name=d.name,
+            program=typed,
+            params=tuple(d.params),
+            text=typed.text,
+            shape=typed.shape,
         )
 
     def ode_body(self, d, scope: dict[str, pint.Unit]) -> T:

@@ -251,6 +251,9 @@ class Typer(ArrayTyping, Visitor):
 
     def _name(self, name: str, scope) -> T:
         if name in scope:
+            if isinstance(scope[name], tuple):  # a program's local vector: (unit, shape)
+                unit, shape = scope[name]
+                return TParam(unit, name=name, shape=shape)
             return TParam(scope[name], name=name)
         block = self.spec.solve_of(name)
         if block is not None:
