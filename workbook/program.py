@@ -439,9 +439,7 @@ def type_program(
     if unit is None:  # only bare zeros
         unit = typing.unit_of(state.first_value)
     loops = has_loops(program) or any(isinstance(s, SetItem) for s in walk(program.body))
-    return TypedProgram(
-        body, unit, state.value_text, loops, program.text, state.value_shape
-    )
+    return TypedProgram(body, unit, state.value_text, loops, program.text, state.value_shape)
 
 
 class _TypeState:
@@ -544,9 +542,7 @@ class _TypeState:
         if len(s.indices) == 1 and shape[1] != 1:
             raise TemplateError(f"{self.where(s)}: '{s.name}' is a matrix: write {s.name}[i, j]")
         words = ("row", "column") if len(s.indices) == 2 else ("element",)
-        idx = tuple(
-            self.t.index(i, self.scope, n, w) for i, n, w in zip(s.indices, shape, words)
-        )
+        idx = tuple(self.t.index(i, self.scope, n, w) for i, n, w in zip(s.indices, shape, words))
         t = self.number(s.value, s, f"an element of '{s.name}'")
         if self.t.shape_of(t) is not None:
             raise TemplateError(f"{self.where(s)}: an element is a number, not a matrix")
