@@ -100,3 +100,22 @@ def test_vectors_over_ranges_reproduce_every_stored_value(name, tmp_path, capsys
     result = _check(toml, capsys)
     assert result["failed"] == 0, result["failures"]
     assert result["reproduced"] == result["printed"], result["failures"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name",
+    sorted(
+        p.relative_to(DATA).as_posix()
+        for p in DATA.rglob("*.xmcd")
+        if p.name != "iSET_module.xmcd"  # a library that frame/example.xmcd references
+    ),
+)
+def test_no_stored_result_is_reproduced_wrongly(name, tmp_path, capsys):
+    """Every value Mathcad stored is reproduced or not computable (its region listed), never
+    a different number: e.g. the solve blocks use Mathcad's Levenberg-Marquardt, whose root
+    differs from the hybrid method's in parabola-ellipse.xmcd."""
+    toml, _ = _import(name, tmp_path, capsys)
+    result = _check(toml, capsys)
+    assert result["failed"] == 0, result["failures"]
+    assert result["reproduced"] + result["not_computable"] == result["printed"]

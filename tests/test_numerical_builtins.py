@@ -304,6 +304,18 @@ def test_given_find_with_a_side_that_is_zero(tmp_path):
     assert s.evaluate("y").to("m").magnitude == pytest.approx(2 / 3, rel=1e-12)
 
 
+def test_given_find_by_levenberg_marquardt(tmp_path):
+    """The method Mathcad's Find uses: the same closed form; an unknown method is refused."""
+    text = SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"')
+    s = sheet(
+        tmp_path, text.replace("[definitions]", 'method = "levenberg-marquardt"\n[definitions]')
+    )
+    assert s.spec.solves[0].method == "levenberg-marquardt"
+    assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-12)
+    with pytest.raises(TemplateError, match="one of hybrid, levenberg-marquardt"):
+        sheet(tmp_path, text.replace("[definitions]", 'method = "newton"\n[definitions]'))
+
+
 def test_given_find_not_converging_shows_residuals(tmp_path):
     s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
     with pytest.raises(NumericsError, match=r"did not converge.*x\^2 \+ R\^2 == 0: residual"):

@@ -37,6 +37,7 @@ class SolveSpec:
     unknowns: dict[str, pint.Quantity]
     equations: tuple[tuple[ex.Node, ex.Node, str], ...]
     line: int | None
+    method: str = "hybrid"  # or "levenberg-marquardt" (Mathcad's Find)
 
     @property
     def what(self) -> str:
@@ -47,9 +48,20 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
     """The [[solve]] blocks of a template (names claimed; equations parsed, not typed)."""
     out = []
     for i, block in enumerate(raw):
-        if not isinstance(block, dict) or set(block) != {"unknowns", "equations"}:
+        if not isinstance(block, dict) or not (
+            {"unknowns", "equations"} <= set(block) <= {"unknowns", "equations", "method"}
+        ):
             raise TemplateError(
                 '[[solve]] needs unknowns = { x = "1 m", ... } and equations = ["... == ...", ...]'
+                ' (and optionally method = "hybrid" or "levenberg-marquardt")'
+            )
+        from .numerics.given import METHODS
+
+        method = block.get("method", "hybrid")
+        if method not in METHODS:
+            raise TemplateError(
+                f"[[solve]] method {str(method)!r}: one of {', '.join(METHODS)}",
+                line=find_value_line(str(method)),
             )
         unknowns, equations = block["unknowns"], block["equations"]
         line = find_value_line(str(equations[0])) if equations else None
@@ -70,7 +82,7 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
             eqs = tuple(_equation(e) for e in equations)
         except WorkbookError as err:
             raise err.located(line=line, definition=what) from None
-        out.append(SolveSpec(i, guesses, eqs, line))
+        out.append(SolveSpec(i, guesses, eqs, line, method))
     return out
 
 
@@ -137,5 +149,6 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
         current(sheet_tolerance(sheet.spec.meta)),
         names=names,
         equations=[text for _, _, text in block.equations],
+        method=block.method,
     )
     return dict(zip(names, (float(v) for v in result.value)))

@@ -173,7 +173,7 @@ class ExprTranslator(Visitor):
         if tag in _BINDERS:
             return self._binder(tag, args)
         if tag == "Find":
-            return self.tr.find(self, args)
+            return self.tr.find(self, args, op.attrs.get("method", ""))
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
 
     def bound(self, var: MNode, body: MNode) -> tuple[ex.Node, ex.Node]:
@@ -420,7 +420,7 @@ class Translator:
         self.given = None
         self.constraints = []
 
-    def find(self, et: ExprTranslator, args: list[MNode]) -> ex.Node:
+    def find(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         """Find(x, ...) of a solve block: a [[solve]] block of the language (its unknowns are
         names of their own, the guesses the values the variables had before the block, as in
         Mathcad's), or root(lhs - rhs, x, guess) for one equation where there is none."""
@@ -428,7 +428,7 @@ class Translator:
             raise Untranslatable("Find without Given")
         if _has_solve():
             try:
-                tree = self.solve_block(et, args)
+                tree = self.solve_block(et, args, method)
             except Untranslatable as why:
                 self.close_given(str(why))
                 raise
@@ -808,7 +808,7 @@ class Translator:
         self.out.items.append(Item("function", region.id, sym=sym, params=[k], body=body))
         self.out.results.append(Result(region.id, sym, mathcad, unit, at, k))
 
-    def solve_block(self, et: ExprTranslator, args: list[MNode]) -> ex.Node:
+    def solve_block(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         if self.given[0] in self.forced:
             raise Untranslatable(self.forced[self.given[0]])
         if not args or any(a.tag != "id" for a in args):
@@ -843,8 +843,15 @@ class Translator:
             equations.append(ex.Compare(("==",), (left, right)))
         if inner.ranges:
             raise Untranslatable("a solve block over a range variable")
+        # Mathcad's Levenberg-Marquardt where its Find used it (its default for equations)
+        lm = method == "levenberg" and _solve_methods()
         self.out.items.append(
-            Item("solve", self.given[0], solve=(unknowns, equations, list(self.given)))
+            Item(
+                "solve",
+                self.given[0],
+                solve=(unknowns, equations, list(self.given)),
+                value="levenberg-marquardt" if lm else "",
+            )
         )
         names = [ex.Name(sym.token()) for sym, _ in unknowns]
         if len(names) == 1:
@@ -961,6 +968,14 @@ def _has_solve() -> bool:
     from ..template import SECTIONS
 
     return "solve" in SECTIONS
+
+
+def _solve_methods() -> bool:
+    """Whether [[solve]] blocks take a method."""
+    import importlib
+
+    given = importlib.import_module("workbook.numerics.given")
+    return "levenberg-marquardt" in getattr(given, "METHODS", {})
 
 
 def _has_index(node: MNode) -> bool:

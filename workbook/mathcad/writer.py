@@ -287,6 +287,7 @@ def _solve(item: Item, mapping, out: Rendered) -> list[str]:
         f"[[solve]]  # Given ... Find, regions {', '.join(regions)} {tag}",
         f"unknowns = {{ {guesses} }}  # {tag}",
         f"equations = [{eqs}]  # {tag}",
+        *([f"method = {_q(item.value)}"] if item.value else []),
         "",
     ]
 

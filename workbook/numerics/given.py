@@ -8,6 +8,10 @@ import numpy as np
 
 from ._common import DEFAULT, NumericsError, Result, Tolerance, num
 
+#: the methods of a [[solve]] block: Powell's hybrid method (the default), or Levenberg-Marquardt
+#: (Mathcad's Find); from the same guess they may reach different roots of a system with several
+METHODS = {"hybrid": "hybr", "levenberg-marquardt": "lm"}
+
 
 def solve(
     residuals: Callable[[np.ndarray], np.ndarray],
@@ -17,6 +21,7 @@ def solve(
     *,
     names: Sequence[str] = (),
     equations: Sequence[str] = (),
+    method: str = "hybrid",
 ) -> Result:
     """Unknowns x with ``residuals(x) == 0`` (one residual per equation, each divided by the
     size of its terms so that all are relative), starting from ``guess``.
@@ -40,7 +45,8 @@ def solve(
         return np.where(np.isfinite(r), r, 1e300)
 
     with np.errstate(all="ignore"):
-        sol = root(scaled, x0 / s, method="hybr", options={"xtol": max(tol.rtol, 1e-15)})
+        scipy_method = METHODS[method]
+        sol = root(scaled, x0 / s, method=scipy_method, options={"xtol": max(tol.rtol, 1e-15)})
     x = sol.x * s
     r = np.asarray(residuals(x), dtype=float)
     limit = max(tol.rtol * 100, 1e-12)
