@@ -402,3 +402,13 @@ def test_every_sheet_key_the_engine_reads_is_a_known_key():
         for m in re.finditer(r"meta(?:\.get\(|\[)\"(\w+)\"", path.read_text(encoding="utf-8"))
     }
     assert read and read <= set(SHEET_KEYS), read - set(SHEET_KEYS)
+
+
+def test_data_table_file_is_checked(tmp_path):
+    os.mkfifo(tmp_path / "p.csv")
+    write(
+        tmp_path / "t.toml",
+        '[data.pump]\nfile = "p.csv"\ncolumns = { x = "mm" }\n[inputs]\nR = "1 mm"\n',
+    )
+    out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", timeout=60, fresh=True)
+    assert out.returncode == 2 and "not a regular file (a named pipe)" in out.stderr

@@ -42,27 +42,25 @@ def regular_file(path: Path, *, what: str, max_bytes: int) -> int:
 def read_text(path: Path, *, what: str, max_bytes: int) -> str:
     """The UTF-8 text of a regular file of at most ``max_bytes`` (a UTF-8 BOM is dropped).
 
-    Errors carry the file (and for bad UTF-8 the line) as their location.
+    Errors name the path; one about bad UTF-8 carries the file and line as its location.
     """
-    file = str(path)
+    regular_file(path, what=what, max_bytes=max_bytes)
     try:
-        regular_file(path, what=what, max_bytes=max_bytes)
-        try:
-            with open(path, "rb") as f:
-                data = f.read(max_bytes + 1)
-        except OSError as exc:
-            raise InputError(f"cannot read the {what} ({exc.strerror})") from None
-        if len(data) > max_bytes:  # the file grew after the check
-            raise LimitError(f"{what} is more than {max_bytes:,} bytes")
-        try:
-            return data.decode("utf-8-sig")
-        except UnicodeDecodeError as exc:
-            line = data[: exc.start].count(b"\n") + 1
-            raise InputError(
-                f"{what} is not UTF-8 text (byte {exc.start}); save it as UTF-8", line=line
-            ) from None
-    except InputError as err:
-        raise err.located(file=file) from None
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise InputError(f"{what} {path}: cannot read it ({exc.strerror})") from None
+    if len(data) > max_bytes:  # the file grew after the check
+        raise LimitError(f"{what} {path} is more than {max_bytes:,} bytes")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise InputError(
+            f"{what} is not UTF-8 text (byte {exc.start}); save it as UTF-8",
+            file=str(path),
+            line=line,
+        ) from None
 
 
 def _kind(mode: int) -> str:

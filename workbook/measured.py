@@ -74,11 +74,13 @@ def _table(table: str, spec, path: Path, line, claim) -> dict[str, DataColumn]:
             f'[data.{table}] columns = {{ X = "unit", ... }} names the columns used'
         )
     file = path.parent / rel
+    from .limits import MAX_CSV_BYTES, read_text
+
+    text = read_text(file, what=f"[data.{table}] file", max_bytes=MAX_CSV_BYTES)
     try:
-        with open(file, newline="", encoding="utf-8") as fh:
-            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
-    except OSError as err:
-        raise TemplateError(f"[data.{table}]: cannot read {file}: {err.strerror}") from None
+        rows = [r for r in csv.reader(text.splitlines()) if r and not r[0].lstrip().startswith("#")]
+    except csv.Error as err:
+        raise TemplateError(f"[data.{table}]: cannot read {file.name} as CSV ({err})") from None
     if not rows:
         raise TemplateError(f"[data.{table}]: {file.name} is empty")
     header = [h.strip() for h in rows[0]]
