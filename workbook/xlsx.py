@@ -895,6 +895,8 @@ def write_workbook(
         w.write_results()
         w.write_checks(report)
         w.write_about()
+        if w.formula_cells > PROGRESS_CELLS:
+            _progress(f"{path.name}: saving {w.formula_cells:,} formula cells")
         try:
             w.wb.close()
         except Exception as exc:  # xlsxwriter wraps the OSError (disk full, read-only)
