@@ -371,3 +371,28 @@ def test_every_builtin_runs_from_a_plain_template(tmp_path, capsys):
     for name in ("flow", "r_half", "r_near", "v_peak", "t_peak"):
         line = next(x for x in out.splitlines() if x.startswith(name + " "))
         assert line.endswith("ok"), line
+
+
+def test_bounds_of_a_plain_argument_are_in_its_declared_unit(tmp_path):
+    """phi is a plain number of degrees (Mathcad's phi*deg): a bound of 120 deg is 120, not
+    2.09 (radians), and a plain 120 is taken as degrees, as range bounds are."""
+    s = sheet(
+        tmp_path,
+        '[inputs]\nphi_max = "120 deg"\n'
+        '[arguments]\nphi = { unit = "deg", plain = true }\npsi = { unit = "deg" }\n'
+        '[definitions]\ndeg = "pi/180"\n'
+        'top = "argmax(sin(phi*deg), phi, 0, phi_max)"\n'
+        'top2 = "argmax(sin(phi*deg), phi, 0, 120)"\n'
+        'top3 = { expr = "argmax(sin(psi), psi, 0, phi_max)", unit = "deg" }\n'
+        'area = "integral(sin(phi*deg), phi, 0, phi_max)"\n',
+    )
+    for name in ("top", "top2", "top3"):
+        assert s.evaluate(name).magnitude == pytest.approx(90.0, rel=1e-7)
+    want = (1 - np.cos(np.radians(120))) * 180 / np.pi  # per degree of phi
+    assert s.evaluate("area").magnitude == pytest.approx(want, rel=1e-13)
+    with pytest.raises(UnitError, match=r"the upper bound B is \[length\]"):
+        sheet(
+            tmp_path,
+            '[inputs]\nL = "1 m"\n[arguments]\nphi = { unit = "deg", plain = true }\n'
+            '[definitions]\nbad = "integral(phi, phi, 0, L)"\n',
+        )

@@ -40,7 +40,19 @@ def _variable(name: str, body: ty.T, var: ty.TParam) -> None:
 
 
 def _in_var_unit(ctx, t: ty.T, var: ty.TParam, name: str, what: str) -> ty.T:
-    """A bound or guess in the variable's unit; a mismatch names both units."""
+    """A bound or guess in the variable's unit; a mismatch names both units. For a
+    ``plain = true`` argument (a plain number of its declared unit, Mathcad's phi*deg) a
+    bound with a unit is converted to the declared unit and a plain number is taken as
+    already in it, as range bounds are."""
+    arg = ctx.spec.arguments.get(var.name)
+    if arg is not None and arg.plain and (t.unit.dimensionality or t.unit != ctx.dimensionless):
+        if t.unit.dimensionality != arg.unit.dimensionality and not _zero(t):
+            raise UnitError(
+                f"{name}(): {what} is {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}), but the "
+                f"variable {var.name} is {un.dims(arg.unit)} ({un.pretty(arg.unit) or '1'})"
+            )
+        t = ctx.convert(t, arg.unit, f"{name}(): {what}")
+        return ty.TScale(var.unit, child=t, factor=1.0)
     if t.unit.dimensionality != var.unit.dimensionality and not _zero(t):
         raise UnitError(
             f"{name}(): {what} is {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}), but the "
