@@ -234,3 +234,19 @@ def test_program_with_a_loop(tmp_path, capsys):
     assert "for i in 1 .. n" in text
     main(["check", str(tmp_path / "loop.toml"), "--json"])
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
+
+
+def test_element_assignment_to_a_vector_the_program_has_not_given(tmp_path, capsys):
+    """Mathcad grows v by v[i] <- ...; the language's locals keep their shape: listed."""
+    body = (
+        f"<ml:program><ml:localDefine><ml:apply><ml:indexer/>{_id('v')}{_real(0)}</ml:apply>"
+        f"{_id('n')}</ml:localDefine>{_id('v')}</ml:program>"
+    )
+    src = tmp_path / "grow.xmcd"
+    src.write_text(_worksheet(_function(1, "g", ["n"], body)), encoding="utf-8")
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "grow.toml").read_text(encoding="utf-8")
+    if _has_programs():
+        assert "a vector the program has not given first" in text
+    else:
+        assert "region 1: g(...) := ...:" in text

@@ -135,10 +135,24 @@ class ProgramTranslator:
 
     def _assign(self, s: MNode) -> list:
         lhs, rhs = s.children
+        if lhs.tag == "apply" and len(lhs.children) == 3 and lhs.children[0].tag == "indexer":
+            return self._element(lhs, rhs)
         if lhs.tag != "id":
-            raise Untranslatable("an element assignment (v[i] <- ...) in a program")
+            raise Untranslatable("an assignment to something that is not a name in a program")
         value = self._expr(rhs)  # the right side sees the local's previous value
         return [self._local(lhs), " := ", value]
+
+    def _element(self, lhs: MNode, rhs: MNode) -> list:
+        """v[i] <- value: an element of a local vector the program has given already (Mathcad
+        also grows a vector that way; the language keeps a local's shape)."""
+        target = lhs.children[1]
+        if target.tag != "id" or name_key(target) not in self.locals:
+            raise Untranslatable(
+                "an element assignment to a vector the program has not given first (Mathcad "
+                "grows it; the language's locals keep their shape)"
+            )
+        index = self._expr(lhs)  # v[i] as an expression: the index tree, shifted by ORIGIN
+        return [index, " := ", self._expr(rhs)]
 
     def _local(self, node: MNode) -> ex.Node:
         if node.tag != "id":
