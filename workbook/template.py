@@ -23,8 +23,6 @@ from . import units as un
 from .builtins import REGISTRY
 from .errors import InputError, LimitError, TemplateError, WorkbookError
 from .fields import Fields, nearest
-from .given_find import read_solves
-from .measured import read_data
 from .ranges import RangeSpec, parse_range
 
 MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
@@ -574,6 +572,9 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
                 line=arguments[pname].line,
                 definition=pname,
             )
+
+    from .given_find import read_solves
+    from .measured import read_data
 
     measured = read_data(
         _table(data, "data"), path, lambda key, sec: find_line(text, key, sec), claim

@@ -19,7 +19,6 @@ from .. import units as un
 from ..builtins import Builtin, register
 from ..errors import NotLive, TemplateError, UnitError, WorkbookError
 from ..expr import PREC
-from . import extrema, gauss, quadrature, roots, series
 from ._common import Result, live, sheet_tolerance
 
 ATOM = PREC["atom"]
@@ -171,6 +170,8 @@ def _bisection(f, a, b, idx) -> np.ndarray:
 
 
 def _root_numpy(of, a, b=None):
+    from . import roots
+
     tol, var, unit = of.tolerance, of.var, of.unit_text
     if live() and b is not None:
         res = _solve(
@@ -202,6 +203,8 @@ def _root_numpy(of, a, b=None):
 
 
 def _integral_numpy(of, a, b):
+    from . import gauss, quadrature
+
     if live():  # what the workbook's SUMPRODUCT computes
         res = _solve(
             of,
@@ -233,6 +236,8 @@ def _extremum_numpy(name: str):
     where = name.startswith("arg")
 
     def hook(of, a, b):
+        from . import extrema
+
         tol, var, unit = of.tolerance, of.var, of.unit_text
         res = _solve(
             of,
@@ -260,6 +265,8 @@ def _extremum_numpy(name: str):
 
 
 def _product_numpy(of, a, b):
+    from . import series
+
     var = of.var
     res = _solve(
         of,
@@ -351,6 +358,8 @@ def _integral_excel(body, args, consts) -> tuple[str, int]:
     """A live integral: the EXCEL_NODES-point Gauss-Legendre rule on [A, B] as SUMPRODUCT
     over constant arrays of nodes and weights (EXPR printed once, over the node array)."""
     a, b = args
+    from . import gauss
+
     t, w = gauss.rule(EXCEL_NODES)
     nodes = "{" + ",".join(repr(float(x)).upper() for x in t) + "}"
     weights = "{" + ",".join(repr(float(x)).upper() for x in w) + "}"
@@ -497,9 +506,9 @@ def _interp_unit(ctx, name: str, args: tuple) -> ty.T:
 
 
 def _interp_numpy(kind: str):
-    from .interpolate import interpolate
-
     def hook(xs, ys, x):
+        from .interpolate import interpolate
+
         return _out(interpolate(xs, ys, x, kind=kind, what=f"{_KINDS[kind]}()"))
 
     return hook
