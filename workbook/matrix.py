@@ -529,7 +529,7 @@ def _register() -> None:
         ("length", "number of elements of a vector"),
         ("last", "index of the last element of a vector (with the sheet's origin)"),
     ):
-        entry(kind, 1, r_size(kind), lambda m, shapes: None, not_live(kind), doc)
+        entry(kind, 1, r_size(kind), _typed_as_constant, not_live(kind), doc)
 
     # reductions: max and min of numbers and of the elements of matrices; mean
     def r_reduce(ctx, name, args):
@@ -582,6 +582,11 @@ def _register() -> None:
         "mean of the arguments (or of the elements of vectors and matrices)",
         ("AVERAGE",),
     )
+
+
+def _typed_as_constant(*values, shapes):
+    """rows, cols, length and last are constants of the typed tree, never evaluated."""
+    raise TypeError("a size of a matrix is a constant at load")  # pragma: no cover
 
 
 def _excel_list(function: str):
