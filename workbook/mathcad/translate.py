@@ -1154,7 +1154,9 @@ def _stored(node: MNode) -> tuple[str, list[float | str]]:
         unit = ""
         for c in node.children:
             if c.tag == "matrix":
-                raise Untranslatable("a nested array result (arrays are not in the language yet)")
+                raise Untranslatable(
+                    "a nested array result (an array of arrays is not in the language)"
+                )
             u, v = _stored(c)
             unit = unit or u
             values += v
