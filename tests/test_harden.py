@@ -412,3 +412,43 @@ def test_data_table_file_is_checked(tmp_path):
     )
     out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", timeout=60, fresh=True)
     assert out.returncode == 2 and "not a regular file (a named pipe)" in out.stderr
+
+
+# -- sweep: scheduler and workers ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("address", ["http://x:1", "tcp://:80", "tcp://h:99999", "inproc://x", 5])
+def test_a_scheduler_address_is_checked(address):
+    from workbook.sweep.runners import check_scheduler
+
+    with pytest.raises(InputError, match="tcp://HOST:PORT"):
+        check_scheduler(address, 1.0)
+
+
+def test_a_server_that_is_not_a_scheduler_is_refused_within_the_timeout():
+    import socket
+    import threading
+
+    from workbook.sweep.runners import check_scheduler
+
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    accepted = []
+    thread = threading.Thread(target=lambda: accepted.append(server.accept()), daemon=True)
+    thread.start()  # accepts, then says nothing (as a web server waiting for a request)
+    start = time.monotonic()
+    try:
+        with pytest.raises(InputError, match="no Dask handshake within 1 s"):
+            check_scheduler(f"tcp://127.0.0.1:{port}", 1.0)
+    finally:
+        server.close()
+    assert time.monotonic() - start < 5
+
+
+def test_workers_are_at_most_the_cpu_count(capsys):
+    from workbook.sweep.runners import pool_size
+
+    assert pool_size(100_000) == (os.cpu_count() or 1)
+    assert "more than the" in capsys.readouterr().err
+    with pytest.raises(InputError):
+        pool_size(0)
