@@ -5,6 +5,7 @@ The text is split into statements here and every expression goes through
 :func:`workbook.expr.parse`, so nothing is ever evaluated by Python::
 
     a := x^2                      # a local (Mathcad's a <- x^2; '←' is read too)
+    v := [0, 0, 0]                # a local vector; v[i] := ... sets an element
     for i in 1 .. n               # Mathcad's range form: first[, second] .. last
         a := a + i
         break if a > 100          # any simple statement may end in 'if CONDITION'
