@@ -467,3 +467,10 @@ def test_workers_are_at_most_the_cpu_count(capsys):
     assert "more than the" in capsys.readouterr().err
     with pytest.raises(InputError):
         pool_size(0)
+
+
+def test_no_command_replaces_a_fifo(tmp_path):
+    os.mkfifo(tmp_path / "new.toml")
+    out = cli(tmp_path, "new", "new", "--out", "new.toml", "--force")  # stat only: no hang
+    assert out.returncode == 2 and "a named pipe" in out.stderr
+    assert not (tmp_path / "new.toml").is_file()

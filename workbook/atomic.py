@@ -53,7 +53,11 @@ def os_error(path: Path, exc: OSError) -> InputError:
 
 @contextlib.contextmanager
 def replacing(path: Path):
-    """Yield a temporary path beside ``path``; move it into place only if the block succeeds."""
+    """Yield a temporary path beside ``path``; move it into place only if the block succeeds.
+
+    ``path`` must be new or a regular file: moving a file over a device or FIFO would replace
+    the node itself."""
+    writable_target(path)
     try:
         fd, tmp = tempfile.mkstemp(
             prefix=f".{path.name[:100]}.", suffix=".partial", dir=path.parent
