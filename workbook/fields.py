@@ -19,7 +19,8 @@ def nearest(name: str, known: Iterable[str], *, n: int = 3) -> str:
     import difflib
 
     known = [k for k in known if isinstance(k, str)]
-    close = difflib.get_close_matches(name, known, n=n, cutoff=0.6)
+    cutoff = 0.6 if len(name) > 3 else 0.5  # R2 -> R1: one letter of two differs
+    close = difflib.get_close_matches(name, known, n=n, cutoff=cutoff)
     if not close:  # a name differing only in case or underscores (ks -> k_s)
         squash = {k.lower().replace("_", ""): k for k in known}
         hit = squash.get(name.lower().replace("_", ""))
