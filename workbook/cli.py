@@ -261,7 +261,8 @@ def _print_scalars(sheet) -> None:
                 rows = np.array2string(q.magnitude, precision=6, separator=", ")
                 print(f"  {name} = {rows.replace(chr(10), '')} {pretty(q.units)}".rstrip())
                 continue
-            print(f"  {name} = {float(q.magnitude):.6g} {pretty(q.units)}".rstrip())
+            value = float(q.magnitude) + 0.0  # -0 shows as 0
+            print(f"  {name} = {value:.6g} {pretty(q.units)}".rstrip())
         except WorkbookError as err:
             print(f"  {name}: error: {err.message}")
     if len(names) > MAX_SUMMARY_SCALARS:
