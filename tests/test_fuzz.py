@@ -191,7 +191,7 @@ QUANTITY_TOKENS = [
     "x" * 50,
 ]
 SLOW_EXAMPLES = int(os.environ.get("FUZZ_SLOW_EXAMPLES", "10000"))
-FAST_EXAMPLES = int(os.environ.get("FUZZ_FAST_EXAMPLES", "100"))
+FAST_EXAMPLES = int(os.environ.get("FUZZ_FAST_EXAMPLES", "50"))
 CASE_SECONDS = 10.0
 
 
