@@ -62,6 +62,22 @@ class Block:
         return (self.func.__doc__ or "").strip().splitlines()[0] if self.func.__doc__ else ""
 
 
+_CACHE: dict = {}
+
+
+def cached(sheet, key, make):
+    """``make()`` computed once per template, input values and ``key``, and kept (many input
+    variations, as in a sweep, start the store afresh). A result is stored only when complete:
+    a Ctrl-C leaves no half-filled entry."""
+    full = (str(sheet.spec.path), tuple(sorted((k, str(v)) for k, v in sheet.values.items())), key)
+    if full not in _CACHE:
+        value = make()
+        if len(_CACHE) > 512:
+            _CACHE.clear()
+        _CACHE[full] = value
+    return _CACHE[full]
+
+
 def input_magnitude(sheet, name: str, unit: str) -> float:
     """The sheet's input ``name`` as a plain number in ``unit``."""
     return float(sheet.evaluate(name).to(unit).magnitude)

@@ -22,26 +22,11 @@ import time
 
 import numpy as np
 
-from . import Finding, bench_block, findings_block, input_magnitude, table_block
+from . import Finding, bench_block, cached, findings_block, input_magnitude, table_block
 
 STABILITY_ANGLES = (1e-6, 1e-3, 1.0)  # deg
 BENCH_POINTS = (3.0, 8.0, 13.0, 18.0)  # deg, inside the flank 0 .. 22
 MIN_ERROR = 1e-18  # errors that are exactly 0 are shown as this (log charts)
-
-_CACHE: dict = {}
-
-
-def _key(sheet, what: str):
-    return (what, str(sheet.spec.path), tuple(sorted((k, str(v)) for k, v in sheet.values.items())))
-
-
-def _cached(sheet, what: str, compute):
-    key = _key(sheet, what)
-    if key not in _CACHE:
-        if len(_CACHE) > 32:
-            _CACHE.clear()
-        _CACHE[key] = compute()
-    return _CACHE[key]
 
 
 _mag = input_magnitude
@@ -61,7 +46,7 @@ def lift_reference(sheet, phi_deg: float, digits: int = 50) -> float:
 
     from .. import symbolic
 
-    expr = _cached(
+    expr = cached(
         sheet,
         "h1 sympy",
         lambda: symbolic.to_sympy(sheet, "h1", {"phi": symbolic.symbol("phi", real=False)}),
@@ -95,13 +80,13 @@ def stability(sheet):
     """Lift formula (1) and its stable form against a 50-digit reference at small angles."""
     import pandas as pd
 
-    return pd.DataFrame(_cached(sheet, "stability", lambda: _stability(sheet)))
+    return pd.DataFrame(cached(sheet, "stability", lambda: _stability(sheet)))
 
 
 @findings_block
 def stability_findings(sheet) -> list[Finding]:
     out = []
-    for r in _cached(sheet, "stability", lambda: _stability(sheet)):
+    for r in cached(sheet, "stability", lambda: _stability(sheet)):
         phi = r["phi [deg]"]
         out.append(
             Finding(
@@ -158,7 +143,7 @@ def geometry_numbers(sheet) -> dict:
         )
         return out
 
-    return _cached(sheet, "geometry", compute)
+    return cached(sheet, "geometry", compute)
 
 
 @findings_block
@@ -325,7 +310,7 @@ def sweep_rows(sheet) -> list[dict]:
             warnings.simplefilter("ignore")
             return [_sweep_case(sheet, label, changes) for label, changes in SWEEP]
 
-    return _cached(sheet, "sweep", compute)
+    return cached(sheet, "sweep", compute)
 
 
 @table_block
@@ -390,7 +375,7 @@ def _exact_derivatives(sheet, points):
 
     from .. import symbolic
 
-    expr = _cached(
+    expr = cached(
         sheet,
         "h1 sympy",
         lambda: symbolic.to_sympy(sheet, "h1", {"phi": symbolic.symbol("phi", real=False)}),
@@ -470,7 +455,7 @@ def derivatives(sheet):
     """Velocity and acceleration from the lift: relative error and run time against the step."""
     import pandas as pd
 
-    rows, _ = _cached(sheet, "bench full", lambda: _derivative_bench(sheet, quick=False))
+    rows, _ = cached(sheet, "bench full", lambda: _derivative_bench(sheet, quick=False))
     return pd.DataFrame(rows)
 
 
@@ -479,7 +464,7 @@ def bench(sheet, quick: bool = False):
     """``workbook bench concave-cam``: error against run time of four differentiation methods."""
     import pandas as pd
 
-    rows, setup = _cached(
+    rows, setup = cached(
         sheet, f"bench {'quick' if quick else 'full'}", lambda: _derivative_bench(sheet, quick)
     )
     out = []
@@ -501,7 +486,7 @@ def bench(sheet, quick: bool = False):
 
 @findings_block
 def bench_findings(sheet) -> list[Finding]:
-    rows, setup = _cached(sheet, "bench full", lambda: _derivative_bench(sheet, quick=False))
+    rows, setup = cached(sheet, "bench full", lambda: _derivative_bench(sheet, quick=False))
     out = []
     for m in METHODS:
         for q, label in (("v", "velocity"), ("j", "acceleration")):

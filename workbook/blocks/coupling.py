@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import expr as ex
 from .. import typecheck as tc
-from . import Finding, bench_block, findings_block, table_block
+from . import Finding, bench_block, cached, findings_block, table_block
 from .solvers import METHODS, OdeRun, run_ode, work_precision
 
 
@@ -31,10 +31,6 @@ def _v(sheet, name: str, unit: str, **args):
     """A definition or input of the sheet as a number (or array) in ``unit``."""
     out = sheet.evaluate(name, **args).to(unit).magnitude
     return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
-
-
-def _key(sheet):
-    return (str(sheet.spec.path), tuple(sorted((k, str(v)) for k, v in sheet.values.items())))
 
 
 def with_input(sheet, name: str, value: float, unit: str):
@@ -93,7 +89,7 @@ def family(sheet, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
             }
         return out
 
-    return _cached(("family", _key(sheet), key, tuple(ws)), build)
+    return cached(sheet, ("family", key, tuple(ws)), build)
 
 
 def _family_table(sheet, key: str):
@@ -347,18 +343,6 @@ CHOICE_C2 = 1e10  # the stiff case the default solver is judged on
 STALL_C2 = 1e14  # the extreme case where explicit methods stall
 STUDY_T = 0.1  # s: the workbook's shortened study runs over min(t_end, STUDY_T)
 
-_CACHE: dict = {}
-
-
-def _cached(key, compute):
-    """Results are stored only when complete (a Ctrl-C leaves no half-filled entry)."""
-    if key not in _CACHE:
-        value = compute()
-        if len(_CACHE) > 512:  # many input variations (sweeps): start afresh
-            _CACHE.clear()
-        _CACHE[key] = value
-    return _CACHE[key]
-
 
 def at_c2(sheet, c2: float):
     return with_input(sheet, "c2", c2, "N/m")
@@ -399,7 +383,7 @@ def case(sheet, n_out: int = 401) -> Case:
         ex_, rr = pr.model.outputs(pr.exact()), rg.model.outputs(rg.exact())
         return Case(_v(sheet, "c2", "N/m"), pr, ex_, rr, float(np.max(np.abs(ex_ - rr))))
 
-    return _cached(("case", _key(sheet), n_out), build)
+    return cached(sheet, ("case", n_out), build)
 
 
 def _dev(cs: Case, run: OdeRun, against: np.ndarray) -> float:
@@ -461,9 +445,7 @@ def study(
                 print(f"[{label}] c2 = {c2:.0e} N/m done", file=sys.stderr, flush=True)
         return pd.DataFrame(rows)
 
-    return _cached(
-        ("study", _key(sheet), tuple(c2s), tuple(rtols), tuple(methods), max_time), build
-    )
+    return cached(sheet, ("study", tuple(c2s), tuple(rtols), tuple(methods), max_time), build)
 
 
 def _blank(df):
@@ -545,7 +527,7 @@ def default_run(sheet):
         )
         return cs, run
 
-    return _cached(("history", _key(sheet), method), build)
+    return cached(sheet, ("history", method), build)
 
 
 @table_block

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from ..errors import InputError, LimitError
-from . import Finding, bench_block, block, findings_block, table_block
+from . import Finding, bench_block, block, cached, findings_block, table_block
 
 LOOP_CAP = 100_000  # iterations of the r0 loop
 
@@ -157,7 +157,6 @@ def findings(sheet) -> list[Finding]:
 BENCH_DR = (1.0, 0.1, 0.01, 0.001)
 BENCH_GRIDS = (13, 101, 1001, 10001, 100001)
 WORKBOOK_GRIDS = (13, 101, 1001, 10001)
-_CACHE: dict = {}
 
 
 def _timed(func, min_time=0.02, max_reps=100_000):
@@ -182,39 +181,34 @@ def run_bench(sheet, drs=BENCH_DR, grids=BENCH_GRIDS):
     time is the grid's required S0 (the template's, at every angle) and the stepping."""
     import pandas as pd
 
-    key = (str(sheet.spec.path), tuple(sorted((k, str(v)) for k, v in sheet.values.items())))
-    key += (tuple(drs), tuple(grids))
-    if key in _CACHE:
-        return _CACHE[key].copy()
-    e = _mm(sheet, "e")
-    r0, t_direct = _timed(lambda: _mm(sheet.with_inputs(), "r0"), min_time=0.05)
-    rows = []
-    for dr in drs:
-        for n in grids:
+    def build():
+        e = _mm(sheet, "e")
+        r0, t_direct = _timed(lambda: _mm(sheet.with_inputs(), "r0"), min_time=0.05)
+        rows = []
+        for dr in drs:
+            for n in grids:
 
-            def run(dr=dr, n=n):
-                s0 = float(np.max(_mm(sheet, "S0_req", x=np.arange(n) / (n - 1))))
-                return loop(e, dr, s0, r0)
+                def run(dr=dr, n=n):
+                    s0 = float(np.max(_mm(sheet, "S0_req", x=np.arange(n) / (n - 1))))
+                    return loop(e, dr, s0, r0)
 
-            (r, k), t_loop = _timed(run, min_time=0.02)
-            rows.append(
-                {
-                    "dr [mm]": dr,
-                    "angles": n,
-                    "steps": k,
-                    "r0 loop [mm]": r,
-                    "r0 direct [mm]": r0,
-                    "loop error [mm]": r - r0,
-                    "loop time [s]": t_loop,
-                    "direct time [s]": t_direct,
-                    "loop/direct time": t_loop / t_direct,
-                }
-            )
-    df = pd.DataFrame(rows)
-    while len(_CACHE) >= 8:  # a few input sets per process are enough
-        _CACHE.pop(next(iter(_CACHE)))
-    _CACHE[key] = df
-    return df.copy()
+                (r, k), t_loop = _timed(run, min_time=0.02)
+                rows.append(
+                    {
+                        "dr [mm]": dr,
+                        "angles": n,
+                        "steps": k,
+                        "r0 loop [mm]": r,
+                        "r0 direct [mm]": r0,
+                        "loop error [mm]": r - r0,
+                        "loop time [s]": t_loop,
+                        "direct time [s]": t_direct,
+                        "loop/direct time": t_loop / t_direct,
+                    }
+                )
+        return pd.DataFrame(rows)
+
+    return cached(sheet, ("bench", tuple(drs), tuple(grids)), build).copy()
 
 
 @bench_block

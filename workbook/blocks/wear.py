@@ -23,21 +23,10 @@ from __future__ import annotations
 import functools
 import math
 import time
-import weakref
 
 import numpy as np
 
-from . import Finding, bench_block, findings_block, input_magnitude, table_block
-
-_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _cached(sheet, key, make):
-    store = _CACHE.setdefault(sheet, {})
-    if key not in store:
-        store[key] = make()
-    return store[key]
-
+from . import Finding, bench_block, cached, findings_block, input_magnitude, table_block
 
 # ---------------------------------------------------------------------------------------------
 # Valve: quadrature against run time
@@ -133,14 +122,14 @@ def _study(sheet, case: str, quick: bool):
     return ref, rows
 
 
-def _study_cached(sheet, case, quick=False):
-    return _cached(sheet, ("study", case, quick), lambda: _study(sheet, case, quick))
+def _studycached(sheet, case, quick=False):
+    return cached(sheet, ("study", case, quick), lambda: _study(sheet, case, quick))
 
 
 def _wide(sheet, case):
     import pandas as pd
 
-    ref, rows = _study_cached(sheet, case)
+    ref, rows = _studycached(sheet, case)
     floor = 1e-16 * abs(ref)
     out = {"points": list(_POINTS)}
     for method in _METHODS:
@@ -256,7 +245,7 @@ def _measured(sheet):
             a_true=truth["a_w2"].to("m/s^2").magnitude,
         )
 
-    return _cached(sheet, "measured", make)
+    return cached(sheet, "measured", make)
 
 
 @table_block
