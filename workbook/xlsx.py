@@ -492,9 +492,12 @@ class WorkbookWriter:
         if self.printer.array:  # computes with vectors or matrices: one-cell array formulas
             write = lambda r, c, f, fm, v: ws.write_array_formula(r, c, r, c, f, fm, v)  # noqa: E731
         values = col.values.tolist()
-        for i in range(n):
-            row = first + i
-            write(row, j, str(row + 1).join(pieces), fmt, values[i])
+        for lo in range(0, n, PROGRESS_CELLS):
+            if lo:  # a long column says how far it is
+                _progress(f"table {table}: {col.title}, row {lo:,} of {n:,}")
+            for i in range(lo, min(n, lo + PROGRESS_CELLS)):
+                row = first + i
+                write(row, j, str(row + 1).join(pieces), fmt, values[i])
         self.formula_cells += n
         return True
 
