@@ -163,7 +163,7 @@ def test_loop_gives_listed_values(sheet, dr, expected):
 
 
 def test_loop_steps_from_e_without_drift(sheet):
-    r, k = R.loop(6.0, 0.1, mm(sheet.evaluate("S0_grid")), mm(sheet.evaluate("r0")))
+    r, k = R.loop(6.0, 0.1, mm(sheet.evaluate("r0_grid")), mm(sheet.evaluate("r0")))
     assert k == 323 and r == 6.0 + 323 * 0.1
     drifted = 6.0
     for _ in range(323):

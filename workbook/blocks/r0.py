@@ -32,23 +32,23 @@ def _mm(sheet, name: str, **args):
     return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
 
 
-@block(args={"e": "mm", "dr": "mm", "S0_grid": "mm", "r0": "mm"}, returns="mm", vectorized=False)
-def loop_r0(e, dr, S0_grid, r0):
+@block(args={"e": "mm", "dr": "mm", "r0_grid": "mm", "r0": "mm"}, returns="mm", vectorized=False)
+def loop_r0(e, dr, r0_grid, r0):
     """r0 by the paper's VBA loop: e + k*dr until |alpha| <= alpha_max on the grid."""
-    return loop(e, dr, S0_grid, r0)[0]
+    return loop(e, dr, r0_grid, r0)[0]
 
 
-def loop(e: float, dr: float, s0_grid: float, r0: float, cap: int = LOOP_CAP) -> tuple[float, int]:
+def loop(e: float, dr: float, r0_grid: float, r0: float, cap: int = LOOP_CAP) -> tuple[float, int]:
     """(r0, k) of the loop r0 = e + k*dr; ``r0`` is the direct answer (for the messages)."""
     if not dr > 0:
         raise InputError(f"the loop step dr = {dr:g} mm must be positive")
-    if s0_grid <= 0:
+    if r0_grid <= e:
         raise InputError(
             "alpha_max does not bound r0: the pressure angle stays below it for every r0 > e "
-            f"(the required S0 is at most {s0_grid:.3g} mm at every angle), so choose r0 from "
+            "(the required S0 is at most 0 at every angle of the grid), so choose r0 from "
             "other limits (roller, strength, undercutting)"
         )
-    need = max(1, math.ceil((math.hypot(s0_grid, e) - e) / dr - 1e-9))
+    need = max(1, math.ceil((r0_grid - e) / dr - 1e-9))
     if need > cap:  # a hopeless run stops before it starts
         raise LimitError(
             f"the loop would need {need:,} steps of dr = {dr:g} mm to reach r0 = "
@@ -56,7 +56,7 @@ def loop(e: float, dr: float, s0_grid: float, r0: float, cap: int = LOOP_CAP) ->
         )
     for k in range(1, cap + 1):
         r = e + k * dr  # e + k*dr: r0 += dr would drift in floating point
-        if math.sqrt(r * r - e * e) >= s0_grid:
+        if r >= r0_grid:  # |alpha| <= alpha_max at every angle of the grid
             break
     if k == 1:
         raise InputError(
@@ -96,12 +96,11 @@ def findings(sheet) -> list[Finding]:
             "direct r0", f"r0 over the continuous angle (critical phi = {phi:.6g} deg)", r0, "mm"
         )
     )
-    s0 = float(np.max(_mm(sheet, "S0_req", x=np.arange(2_000_001) / 2_000_000)))
-    brute = math.hypot(max(s0, 0.0), e) - r0
+    brute = _mm(sheet.with_inputs(n_grid=1_000_001), "r0_grid") - r0
     out.append(
         Finding(
             "direct r0",
-            "brute force over 2,000,001 angles minus direct r0",
+            "brute force over 1,000,001 angles (r0_grid) minus direct r0",
             brute,
             "mm",
             "ok" if -1e-6 <= brute <= 1e-12 else "fail",
@@ -189,8 +188,7 @@ def run_bench(sheet, drs=BENCH_DR, grids=BENCH_GRIDS):
             for n in grids:
 
                 def run(dr=dr, n=n):
-                    s0 = float(np.max(_mm(sheet, "S0_req", x=np.arange(n) / (n - 1))))
-                    return loop(e, dr, s0, r0)
+                    return loop(e, dr, _mm(sheet.with_inputs(n_grid=n), "r0_grid"), r0)
 
                 (r, k), t_loop = _timed(run, min_time=0.02)
                 rows.append(
