@@ -316,6 +316,19 @@ def test_given_find_by_levenberg_marquardt(tmp_path):
         sheet(tmp_path, text.replace("[definitions]", 'method = "newton"\n[definitions]'))
 
 
+def test_given_find_conditions_are_checked_at_the_root(tmp_path):
+    """Mathcad's inequalities beside the equations: the root found must meet them."""
+    text = SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"')
+    met = text.replace("[definitions]", 'conditions = ["x > 0 m"]\n[definitions]')
+    s = sheet(tmp_path, met.replace('"x > 0 m"', '"x > 0"'))
+    assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-12)
+    s = sheet(tmp_path, met.replace('"x > 0 m"', '"x < 0"'))
+    with pytest.raises(NumericsError, match="does not meet the condition 'x < 0'"):
+        s.evaluate("x")
+    with pytest.raises(TemplateError, match="a condition is written LEFT < RIGHT"):
+        sheet(tmp_path, met.replace('"x > 0 m"', '"x == 0"'))
+
+
 def test_given_find_not_converging_shows_residuals(tmp_path):
     s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
     with pytest.raises(NumericsError, match=r"did not converge.*x\^2 \+ R\^2 == 0: residual"):

@@ -38,6 +38,7 @@ class SolveSpec:
     equations: tuple[tuple[ex.Node, ex.Node, str], ...]
     line: int | None
     method: str = "hybrid"  # or "levenberg-marquardt" (Mathcad's Find)
+    conditions: tuple[tuple[ex.Node, str], ...] = ()  # inequalities the root must meet
 
     @property
     def what(self) -> str:
@@ -49,7 +50,9 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
     out = []
     for i, block in enumerate(raw):
         if not isinstance(block, dict) or not (
-            {"unknowns", "equations"} <= set(block) <= {"unknowns", "equations", "method"}
+            {"unknowns", "equations"}
+            <= set(block)
+            <= {"unknowns", "equations", "method", "conditions"}
         ):
             raise TemplateError(
                 '[[solve]] needs unknowns = { x = "1 m", ... } and equations = ["... == ...", ...]'
@@ -80,10 +83,28 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
                 claim(name, "solve", line)
                 guesses[name] = un.quantity(str(guess), None, what=name)
             eqs = tuple(_equation(e) for e in equations)
+            conditions = block.get("conditions", [])
+            if not isinstance(conditions, list):
+                raise TemplateError('[[solve]] conditions = ["x > 0", ...] (a list)')
+            conds = tuple(_condition(c) for c in conditions)
         except WorkbookError as err:
             raise err.located(line=line, definition=what) from None
-        out.append(SolveSpec(i, guesses, eqs, line, method))
+        out.append(SolveSpec(i, guesses, eqs, line, method, conds))
     return out
+
+
+def _condition(text) -> tuple[ex.Node, str]:
+    """An inequality the root must meet (Mathcad's ``x > 3`` beside the equations)."""
+    node = ex.parse(str(text), what="condition")
+    if not (isinstance(node, ex.Compare) and set(node.ops) <= {"<", "<=", ">", ">="}):
+        raise TemplateError(f"a condition is written LEFT < RIGHT (or <=, >, >=), got {text!r}")
+    return node, str(text)
+
+
+def typed_conditions(typer, block: SolveSpec) -> list[tuple[ty.T, str]]:
+    """The conditions, typed with the unknowns in scope (units checked at load)."""
+    scope = {n: q.units for n, q in block.unknowns.items()}
+    return [(typer.expression(node, scope, block.what), text) for node, text in block.conditions]
 
 
 def _equation(text) -> tuple[ex.Node, ex.Node, str]:
@@ -113,6 +134,7 @@ def typed_equations(typer, block: SolveSpec) -> list[tuple[ty.T, ty.T]]:
                 f"({un.pretty(right.unit) or '1'})"
             )
         out.append((left, typer.convert(right, left.unit, f"equation {text!r}")))
+    typed_conditions(typer, block)  # checked with the equations, when the sheet is loaded
     return out
 
 
@@ -151,4 +173,14 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
         equations=[text for _, _, text in block.equations],
         method=block.method,
     )
-    return dict(zip(names, (float(v) for v in result.value)))
+    found = dict(zip(names, (float(v) for v in result.value)))
+    for cond, text in typed_conditions(sheet.typer, block):
+        if not bool(sheet.evaluator.compile(cond)(dict(found))):
+            from .numerics import NumericsError
+
+            at = ", ".join(f"{n} = {v:.6g}" for n, v in found.items())
+            raise NumericsError(
+                f"the root found from the guesses ({at}) does not meet the condition {text!r}; "
+                "try other guesses"
+            )
+    return found

@@ -69,6 +69,7 @@ class Translation:
     title: str = ""
     ignored: list[str] = field(default_factory=list)  # regions that show and define nothing
     origin: int = 0
+    solve_tolerance: float = 1e-3  # Mathcad's TOL (its default, or the largest the sheet sets)
 
 
 _BINARY = {"plus": "+", "minus": "-", "mult": "*", "div": "/", "pow": "^"}
@@ -486,6 +487,12 @@ class Translator:
         if rhs.tag == "id" and self._range_of(rhs) is not None:  # j := i, a range again
             self.range_alias(region, key, self._range_of(rhs))
             return
+        if key == ("TOL", "") and _quantity_text(rhs) is not None:
+            try:
+                tol = float(_Values(self).quantity(rhs).magnitude)
+                self.out.solve_tolerance = max(self.out.solve_tolerance, tol)
+            except Exception:  # noqa: BLE001 - a TOL that is not a number: the default
+                pass
         if key == ("ORIGIN", "") and rhs.tag == "real":
             self.origin = int(float(rhs.text))
             self.out.items.append(
@@ -813,12 +820,14 @@ class Translator:
             raise Untranslatable(self.forced[self.given[0]])
         if not args or any(a.tag != "id" for a in args):
             raise Untranslatable("Find of something that is not a list of names")
-        if any(c.children[0].tag != "equal" for c in self.constraints):
+        eqs = [c for c in self.constraints if c.children[0].tag == "equal"]
+        ineqs = [c for c in self.constraints if c.children[0].tag != "equal"]
+        if ineqs and not _solve_conditions():
             raise Untranslatable("a solve block with inequalities (the language's are equations)")
-        if len(self.constraints) != len(args):
-            raise Untranslatable(
-                f"a solve block of {len(self.constraints)} equations in {len(args)} unknowns"
-            )
+        if any(c.children[0].tag not in _INEQUALITY for c in ineqs):
+            raise Untranslatable("a solve block with a condition that is not < <= > >=")
+        if len(eqs) != len(args):
+            raise Untranslatable(f"a solve block of {len(eqs)} equations in {len(args)} unknowns")
         if len(args) > 1 and not hasattr(ex, "Matrix"):
             raise Untranslatable("Find of several unknowns (a vector: not in the language yet)")
         values = _Values(self)
@@ -838,9 +847,10 @@ class Translator:
             unknowns.append((sym, f"{magnitude!r}{unit}"))
         inner = ExprTranslator(self, {**et.local, **local})
         equations = []
-        for c in self.constraints:
+        for c in eqs:
             left, right = inner.visit(c.children[1]), inner.visit(c.children[2])
             equations.append(ex.Compare(("==",), (left, right)))
+        conditions = [inner.visit(c) for c in ineqs]  # checked at the root found
         if inner.ranges:
             raise Untranslatable("a solve block over a range variable")
         # Mathcad's Levenberg-Marquardt where its Find used it (its default for equations)
@@ -849,7 +859,7 @@ class Translator:
             Item(
                 "solve",
                 self.given[0],
-                solve=(unknowns, equations, list(self.given)),
+                solve=(unknowns, equations, list(self.given), conditions),
                 value="levenberg-marquardt" if lm else "",
             )
         )
@@ -968,6 +978,16 @@ def _has_solve() -> bool:
     from ..template import SECTIONS
 
     return "solve" in SECTIONS
+
+
+_INEQUALITY = {"lessThan", "greaterThan", "lessOrEqual", "greaterOrEqual"}
+
+
+def _solve_conditions() -> bool:
+    """Whether [[solve]] blocks take conditions (inequalities the root must meet)."""
+    from ..given_find import SolveSpec
+
+    return "conditions" in getattr(SolveSpec, "__dataclass_fields__", {})
 
 
 def _solve_methods() -> bool:

@@ -227,10 +227,11 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
     if notes:
         definitions += notes
     # printed values: one CSV per argument (scalars: no argument)
-    groups: dict[str, list[str]] = {}
+    groups: dict[tuple[str, bool], list[str]] = {}
+    solved = _from_solve_blocks(tr)
     for res in tr.results:
         arg = res.argument.final if res.argument is not None else ""
-        rows = groups.setdefault(arg, [])
+        rows = groups.setdefault((arg, res.sym is not None and res.sym.token() in solved), [])
         sym_name = res.sym.final if res.sym is not None else f"result_{res.region}"
         if not res.rows:
             rows.append(f"# region {res.region}: {res.name}: the stored result cannot be read")
@@ -245,8 +246,11 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
                 val = repr(float(value))
             rows.append(f"{sym_name},{at_text},{val},{pretty_unit(res.unit) if res.unit else ''}")
     printed: list[str] = []
-    for arg, rows in groups.items():
-        fname = f"{name}.mathcad.csv" if not arg else f"{name}.mathcad.{arg}.csv"
+    for (arg, from_solve), rows in groups.items():
+        fname = f"{name}.mathcad{'.solve' if from_solve else ''}{'.' + arg if arg else ''}.csv"
+        title = "Mathcad results" + (" over " + arg if arg else "")
+        if from_solve:
+            title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
         out.csv[fname] = (
             "# Mathcad's stored results (imported by `workbook import`)\nname,argument,value,unit\n"
             + "\n".join(rows)
@@ -256,11 +260,14 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             "",
             "[[printed]]",
             f"file = {_q(fname)}",
-            f"title = {_q('Mathcad results' + (' over ' + arg if arg else ''))}",
+            f"title = {_q(title)}",
         ]
         if arg:
             printed.append(f"argument = {_q(arg)}")
-        printed.append(f"rel_tolerance = {REL_TOLERANCE}")
+        if from_solve:  # Mathcad's solver stops at its TOL: its roots are that close
+            printed.append(f"rel_tolerance = {tr.solve_tolerance!r}")
+        else:
+            printed.append(f"rel_tolerance = {REL_TOLERANCE}")
         printed.append(f"tolerance = {ABS_TOLERANCE}")
         table = _table_for(tr, arg, mapping)
         if table:
@@ -273,9 +280,24 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
     return out
 
 
+def _from_solve_blocks(tr: Translation) -> set[str]:
+    """Tokens of the names whose value comes from a solve block (its unknowns, and what uses
+    them): their stored values are as close as Mathcad's solver went (TOL)."""
+    found = {sym.token() for i in tr.items if i.kind == "solve" for sym, _ in i.solve[0]}
+    for item in tr.items:  # in Mathcad's order: what an item uses is before it
+        if item.sym is None or item.kind not in ("definition", "function"):
+            continue
+        trees = [item.body] if item.body is not None else []
+        trees += [t for piece in item.pieces or [] for t in piece if t is not None]
+        trees += [p for _, parts in item.program or [] for p in parts if not isinstance(p, str)]
+        if any(ex.names(t) & found for t in trees):
+            found.add(item.sym.token())
+    return found
+
+
 def _solve(item: Item, mapping, out: Rendered) -> list[str]:
     """A [[solve]] block: Mathcad's Given, its equations and Find."""
-    unknowns, equations, regions = item.solve
+    unknowns, equations, regions, conditions = item.solve
     if any(sym.broken for sym, _ in unknowns):
         return []
     for sym, _ in unknowns:
@@ -288,6 +310,11 @@ def _solve(item: Item, mapping, out: Rendered) -> list[str]:
         f"unknowns = {{ {guesses} }}  # {tag}",
         f"equations = [{eqs}]  # {tag}",
         *([f"method = {_q(item.value)}"] if item.value else []),
+        *(
+            [f"conditions = [{', '.join(_q(_text(c, mapping)) for c in conditions)}]"]
+            if conditions
+            else []
+        ),
         "",
     ]
 
