@@ -374,6 +374,10 @@ def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
 def _region_of(err: WorkbookError, rendered: Rendered) -> str | None:
     if err.definition and err.definition in rendered.region_of:
         return rendered.region_of[err.definition]
+    if err.definition and err.definition.startswith("solve "):  # a [[solve]] block's name
+        first = err.definition[len("solve ") :].split(",")[0].strip()
+        if first in rendered.region_of:
+            return rendered.region_of[first]
     if err.line:
         lines = rendered.toml.splitlines()
         if 0 < err.line <= len(lines):
