@@ -474,3 +474,47 @@ def test_no_command_replaces_a_fifo(tmp_path):
     out = cli(tmp_path, "new", "new", "--out", "new.toml", "--force")  # stat only: no hang
     assert out.returncode == 2 and "a named pipe" in out.stderr
     assert not (tmp_path / "new.toml").is_file()
+
+
+# -- piecewise definitions at their edges --------------------------------------------------
+
+CHOICE_DIFF = """
+[inputs]
+mode = { value = "a", options = ["a", "b"] }
+[arguments]
+x = { unit = "" }
+[definitions]
+"f(x)" = ["2*x if mode == \\"a\\"", "3*x otherwise"]
+"g(x)" = "diff(f(x), x)"
+"""
+
+NO_PIECE = """
+[inputs]
+a = "5"
+[definitions]
+s = ["1 if a < 2", "2 if a < 3"]
+"""
+
+
+def test_a_derivative_across_a_condition_on_a_choice_is_refused(tmp_path):
+    # Found once per sheet for every value of the input, the derivative cannot know the word:
+    # comparing a symbol with it silently took the last piece (3 for mode a).
+    path = write(tmp_path / "d.toml", CHOICE_DIFF)
+    with pytest.raises(WorkbookError, match="choice 'mode'"):
+        workbook.load(path).evaluate("g", x=1)
+    out = cli(tmp_path, "run", str(path), "--out", str(tmp_path / "d.xlsx"))
+    assert out.returncode == 2 and "choice 'mode'" in out.stderr
+
+
+def test_a_scalar_piecewise_with_no_true_piece_is_an_input_error(tmp_path):
+    path = write(tmp_path / "p.toml", NO_PIECE)
+    with pytest.raises(InputError, match="no piece applies") as err:
+        workbook.load(path).evaluate("s")
+    assert err.value.definition == "s" and err.value.line == 5
+    # a scalar no table uses is listed by run with its error, not left out
+    out = cli(tmp_path, "run", str(path), "--out", str(tmp_path / "p.xlsx"))
+    assert "s: error: no piece applies" in out.stdout
+    # a table that needs it stops the run with the location
+    write(path, NO_PIECE + '[[tables]]\nname = "t"\nrange = "x := 0 .. 2"\ncolumns = { s = "" }\n')
+    out = cli(tmp_path, "run", str(path), "--out", str(tmp_path / "p.xlsx"))
+    assert out.returncode == 2 and "no piece applies" in out.stderr and "p.toml:5" in out.stderr

@@ -343,8 +343,12 @@ def _matrix_binary(t: tc.TBinary, left: Fn, right: Fn) -> Fn:
     return lambda env: mx.elementwise(op, left(env), right(env), lm, rm)
 
 
-class _NoPiece(Exception):
+class _NoPiece(InputError):
+    """No piece of a piecewise definition applies: an input error wherever it surfaces
+    (a function says for which arguments; a scalar definition gets its location from the sheet)."""
+
     def __init__(self, env, texts):
+        super().__init__("no piece applies; its pieces are: " + "; ".join(texts))
         self.env, self.texts = env, texts
 
 

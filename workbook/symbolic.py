@@ -110,12 +110,20 @@ class SympyConverter(Visitor):
         name, kind = t.name, t.kind
         if name in self.symbols:
             return self.symbols[name]
+        if kind == "choice":
+            # A choice is a word, not a number: with no value to compare (a derivative found
+            # once for every value of the input) a condition on it has no symbolic form, and
+            # comparing a symbol with the word would silently pick the last piece.
+            if name not in self.sheet.values:
+                raise NotSymbolic(
+                    f"a condition on the choice '{name}' has no symbolic form; "
+                    "write one function per option and choose between their results"
+                )
+            return self.sheet.values[name]
         if name in self.keep:
             return sp.Symbol(name, real=True)
         if kind == "builtin":
             return sp.pi
-        if kind == "choice":
-            return self.sheet.values[name]
         if kind == "input":
             if self.true_pi and name == "pi":
                 return sp.pi
