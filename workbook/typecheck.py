@@ -70,7 +70,7 @@ class Typer(ArrayTyping, Visitor):
                 raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
             body = self._typed_body(d, {})
             if d.unit is not None:
-                body = self.convert(body, d.unit, f"the declared unit of '{name}'")
+                body = self.convert(body, d.unit, _declared(name, d.unit))
             self.scalars[name] = body
         return self.scalars[name]
 
@@ -80,7 +80,7 @@ class Typer(ArrayTyping, Visitor):
             scope = {p: self.spec.arguments[p].binding_unit for p in d.params}
             body = self._typed_body(d, scope)
             if d.unit is not None:
-                body = self.convert(body, d.unit, f"the declared unit of '{name}'")
+                body = self.convert(body, d.unit, _declared(name, d.unit))
             self.functions[name] = TypedFunction(name, d.params, tuple(scope.values()), body)
         return self.functions[name]
 
@@ -579,3 +579,8 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         for body in bodies:
             todo.extend(m for m in ex.names(body) if m not in local)
     return out
+
+
+def _declared(name: str, unit: pint.Unit) -> str:
+    """Where a formula's unit meets its declared one: the computed unit comes first."""
+    return f"the formula of '{name}' (declared in {un.pretty(unit) or '1'})"
