@@ -68,6 +68,8 @@ OPERATORS = {
     "half": ("u^0.5", mpmath.sqrt, (0, 1e3), True),
     "cube_of_negative": ("u^3", lambda u: u**3, (-10, 0), False),
     "reciprocal": ("u^-1", lambda u: 1 / u, (0.1, 1e3), False),
+    "fourth": ("u^4", lambda u: u**4, (-10, 10), False),
+    "three_halves": ("u^1.5", lambda u: u ** mpmath.mpf(1.5), (0, 1e3), False),
     "neg_pow": ("-u^2", lambda u: -(u**2), (-10, 10), True),
 }
 

@@ -95,6 +95,7 @@ class ExcelPrinter(Visitor):
         # writes scalar definitions; a binding hook finds it as ``body.helpers`` (and EXPR's
         # typed tree, the variable and the other arguments as body.typed, .var, .rest)
         self.helpers = None
+        self._calls: dict[tuple, tuple[str, int]] = {}  # (function, argument texts) -> printed
 
     def formula(self, t: tc.T, subst: dict[str, str]) -> str:
         self.array = False  # set when the formula computes with arrays (an array formula)
@@ -189,9 +190,21 @@ class ExcelPrinter(Visitor):
         return entry.excel(printed, [self.print(a, s) for a in rest], consts)
 
     def visit_TCall(self, t, s):
+        # Excel has no user functions: the body is inlined. A call met again with the same
+        # arguments reuses its text, and a text beyond Excel's limit stops the printing at
+        # once (NotLive: the writer writes the values as numbers), so nested calls such as
+        # f_i(x) = (f_{i-1}(x) + f_{i-1}(x))/2 cost the limit, not 2^depth.
         f = self.typer.function(t.name)
         inner = {p: self._wrap(a, s, ATOM - 1) for p, a in zip(f.params, t.args)}
-        return self.visit(f.body, inner)
+        key = (t.name, tuple(inner.values()))
+        if key not in self._calls:
+            text, level = self.visit(f.body, inner)
+            if len(text) > MAX_FORMULA:
+                raise NotLive(
+                    f"{t.name}() inlined is longer than Excel's limit of {MAX_FORMULA} characters"
+                )
+            self._calls[key] = (text, level)
+        return self._calls[key]
 
     def visit_TBlock(self, t, s):
         raise NotLive(f"{t.name}() is a solver block ({t.ref}); its values are written as numbers")

@@ -2,13 +2,20 @@
 
 Units were resolved by :mod:`workbook.typecheck`, so evaluation works on bare
 float magnitudes (no pint in the hot path) and attaches the unit at the end.
+
+Within one evaluation (``with evaluator.sharing():``, which every ``Sheet`` entry point
+opens) a subtree that occurs more than once among the sheet's definitions
+(:mod:`workbook.subtrees`) is computed once per environment: a call ``f(x)`` written twice,
+``sin(phi*deg)`` in h1, v1 and j1, the pieces of h, v and j that share their conditions.
 """
 
 from __future__ import annotations
 
 import functools
+import math
 import operator
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -16,6 +23,8 @@ from . import typecheck as tc
 from .builtins import REGISTRY
 from .errors import DomainError, InputError
 from .numerics.bound import Bound
+from .subtrees import plan
+from .typed import children
 from .visitor import Visitor
 
 Env = dict[str, object]
@@ -28,6 +37,13 @@ _CMP = {
     ">=": operator.ge,
     "==": operator.eq,
     "!=": operator.ne,
+}
+# Powers by products and square roots (x^1.5, x^3 and x^4 in Evaluator._power_by_parts):
+# several times faster than np.power, within 2 ulp (tests/test_numeric_golden.py, mpmath).
+_POWERS = {
+    2.0: np.square,
+    0.5: np.sqrt,
+    -1.0: lambda x: np.true_divide(1.0, x),
 }
 # np.true_divide: x/0 of plain floats gives inf/nan (a DomainError later), not ZeroDivisionError
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": np.true_divide}
@@ -52,11 +68,42 @@ class Evaluator(Visitor):
         self.describe_args = describe_args
         self._functions: dict[str, Fn] = {}
         self.records: list = []  # (built-in, numerics.Result) of each solve: workbook bench
+        self.plan = plan(typer)
+        self._shared: dict | None = None  # values of shared subtrees, during one evaluation
+
+    @contextmanager
+    def sharing(self) -> Iterator[None]:
+        """One evaluation: shared subtrees are computed once inside (nested: the outer one)."""
+        if self._shared is not None:
+            yield
+            return
+        self._shared = {}
+        try:
+            yield
+        finally:
+            self._shared = None
+
+    def _kept(self, key: int, fn: Fn) -> Fn:
+        """``fn`` computed once per environment during an evaluation."""
+
+        def run(env):
+            cache = self._shared
+            if cache is None:
+                return fn(env)
+            k = (key, tuple([(n, id(v)) for n, v in env.items()]))
+            hit = cache.get(k)
+            if hit is None:
+                # the environment's values are kept with the result, so no id is reused
+                hit = cache[k] = (fn(env), tuple(env.values()))
+            return hit[0]
+
+        return run
 
     def function(self, name: str) -> Fn:
         """Compiled user function: env of its parameters -> magnitude in its unit."""
         if name not in self._functions:
             f = self.typer.function(name)
+            self.plan.update(self.typer)
             self._functions[name] = _checked(
                 name, f.params, self.compile(f.body), self.describe_args
             )
@@ -65,7 +112,9 @@ class Evaluator(Visitor):
 
     def compile(self, t: tc.T) -> Fn:
         """A closure computing ``t`` from an environment of parameter values."""
-        return self.visit(t)
+        fn = self.visit(t)
+        key = self.plan.shared(t)
+        return fn if key is None else self._kept(key, fn)
 
     def visit_TConst(self, t: tc.TConst) -> Fn:
         v = t.value
@@ -84,7 +133,15 @@ class Evaluator(Visitor):
         return lambda env: get(name, kind)
 
     def visit_TScale(self, t: tc.TScale) -> Fn:
-        child, f = self.compile(t.child), t.factor
+        f = t.factor
+        c = t.child
+        if f != 1.0 and isinstance(c, tc.TBinary) and c.op == "*":
+            # a unit factor joins the constant side of a product: (omega*R)*x*f = x*(omega*R*f)
+            for const, other in ((c.left, c.right), (c.right, c.left)):
+                if _constant(const):
+                    k, x = self.compile(const), self.compile(other)
+                    return lambda env: x(env) * (k(env) * f)
+        child = self.compile(c)
         if f == 1.0:
             return child
         return lambda env: child(env) * f
@@ -102,14 +159,28 @@ class Evaluator(Visitor):
         if t.op == "^":
             if isinstance(t.right, tc.TConst):
                 n = t.right.value
-                if n == 2.0:
-                    return lambda env: np.square(left(env))
-                if n == 0.5:
-                    return lambda env: np.sqrt(left(env))
+                if n in (1.5, 3.0, 4.0):
+                    return self._power_by_parts(t, n)
+                short = _POWERS.get(n)
+                if short is not None:
+                    return lambda env: short(left(env))
                 return lambda env: np.power(left(env), n)
             return lambda env: np.power(left(env), right(env))
         op = _ARITH[t.op]
         return lambda env: op(left(env), right(env))
+
+    def _power_by_parts(self, t: tc.TBinary, n: float) -> Fn:
+        """x^1.5 = x*sqrt(x), x^3 = x*x^2, x^4 = (x^2)^2: the sqrt(x) or x^2 written
+        elsewhere in the sheet is then computed once (and a product is cheaper than a power)."""
+        base = self.compile(t.left)
+        if n == 1.5:
+            root = self.compile(tc.TFunc(t.left.unit**0.5, func="sqrt", args=(t.left,)))
+            return lambda env: base(env) * root(env)
+        two = tc.TConst(t.right.unit, value=2.0)
+        square = self.compile(tc.TBinary(t.left.unit**2, op="^", left=t.left, right=two))
+        if n == 3.0:
+            return lambda env: base(env) * square(env)
+        return lambda env: np.square(square(env))
 
     def visit_TCompare(self, t: tc.TCompare) -> Fn:
         parts = [self.compile(o) for o in t.operands]
@@ -166,7 +237,14 @@ class Evaluator(Visitor):
         hook = entry.numpy
 
         def call(env):
-            return hook(Bound(self, body_t, body, var_t, env), *[a(env) for a in rest])
+            values = [a(env) for a in rest]
+            # EXPR is evaluated at many values of the variable (a solver's iterations): its
+            # values are not kept, the evaluation's memory stays bounded
+            kept, self._shared = self._shared, None
+            try:
+                return hook(Bound(self, body_t, body, var_t, env), *values)
+            finally:
+                self._shared = kept
 
         return call
 
@@ -189,11 +267,11 @@ class Evaluator(Visitor):
         return lambda env: float(red(get(t.table, t.column)))
 
     def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
-        return _piecewise(
-            t,
-            [None if k is None else self.compile(k) for k in t.conditions],
-            [self.compile(v) for v in t.values],
-        )
+        conds = [None if k is None else self.compile(k) for k in t.conditions]
+        split = _partition(conds, t.texts)
+        keys = tuple(None if k is None else self.plan.keys.key(k) for k in t.conditions)
+        split = self._kept(self.plan.keys.signature("pieces", keys), split)
+        return _piecewise(t, conds, [self.compile(v) for v in t.values], split)
 
     def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
         from .matrix import build
@@ -297,34 +375,52 @@ class Evaluator(Visitor):
         return looped
 
 
-def _piecewise(t: tc.TPiecewise, conds: list, values: list) -> Fn:
-    texts = t.texts
+def _constant(t: tc.T) -> bool:
+    """True if ``t`` does not depend on the environment (no parameter in it)."""
+    if isinstance(t, tc.TParam):
+        return False
+    return all(_constant(c) for c in children(t))
 
-    def evaluate(env):
-        arrays = {k: v for k, v in env.items() if isinstance(v, np.ndarray) and v.ndim > 0}
-        if not arrays:
-            for cond, val in zip(conds, values):
-                if cond is None or bool(cond(env)):
-                    return val(env)
-            raise _NoPiece(env, texts)
-        keys = list(arrays)
-        shaped = np.broadcast_arrays(*[arrays[k] for k in keys])
+
+def _partition(conds: list, texts: tuple) -> Fn:
+    """env with arrays -> (shape, [(piece, mask, env of the piece's points)]): first true wins."""
+
+    def split(env):
+        keys = [k for k, v in env.items() if isinstance(v, np.ndarray) and v.ndim > 0]
+        shaped = np.broadcast_arrays(*[env[k] for k in keys])
         shape = shaped[0].shape
         full = {**env, **dict(zip(keys, shaped))}
-        out = np.empty(shape, dtype=object if t.text else float)
         todo = np.ones(shape, dtype=bool)
-        for cond, val in zip(conds, values):
+        pieces = []
+        for i, cond in enumerate(conds):
             if cond is None:
                 take = todo
             else:
                 take = todo & np.broadcast_to(np.asarray(cond(full), dtype=bool), shape)
             if take.any():
-                sub = {**env, **{k: full[k][take] for k in keys}}
-                out[take] = val(sub)
-                todo &= ~take
+                pieces.append((i, take, {**env, **{k: full[k][take] for k in keys}}))
+                todo = todo & ~take
             if not todo.any():
-                return out
+                return shape, pieces
         raise _NoPiece({k: full[k][todo] for k in keys}, texts)
+
+    return split
+
+
+def _piecewise(t: tc.TPiecewise, conds: list, values: list, split: Fn) -> Fn:
+    texts = t.texts
+
+    def evaluate(env):
+        if not any(isinstance(v, np.ndarray) and v.ndim > 0 for v in env.values()):
+            for cond, val in zip(conds, values):
+                if cond is None or bool(cond(env)):
+                    return val(env)
+            raise _NoPiece(env, texts)
+        shape, pieces = split(env)
+        out = np.empty(shape, dtype=object if t.text else float)
+        for i, take, sub in pieces:
+            out[take] = values[i](sub)
+        return out
 
     return evaluate
 
@@ -367,6 +463,10 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
         if isinstance(out, np.ndarray) and out.dtype == object:
             return out  # texts
         if isinstance(out, np.ndarray):
+            # one pass without a temporary array: a NaN or an infinity makes the sum not
+            # finite (an overflowing sum of finite values is looked at point by point)
+            if math.isfinite(np.sum(out)):
+                return out
             bad = ~np.isfinite(out)
             if bad.any():
                 sub = {

@@ -154,11 +154,24 @@ class Sheet:
         return [p for p in self.full_spec.parts if p not in self.parts]
 
     # -- evaluation -------------------------------------------------------------------
-    def evaluate(self, name: str, *args, **kwargs) -> pint.Quantity | str:
+    def evaluate(self, name: str | list[str], *args, **kwargs):
         """Evaluate a definition (or an input) by name; function arguments by name or position.
 
-        Plain numbers are taken in the unit the template declares for the argument.
+        Plain numbers are taken in the unit the template declares for the argument. A list
+        of names gives the list of their values, computed together: what they share (the
+        same sub-expression of the same arguments) is computed once.
         """
+        if not isinstance(name, str):
+            kwargs = {
+                k: self.argument_magnitude(k, v) if k in self.spec.arguments else v
+                for k, v in kwargs.items()
+            }
+            with self.evaluator.sharing():
+                return [self.evaluate(n, *args, **kwargs) for n in name]
+        with self.evaluator.sharing():
+            return self._evaluate(name, *args, **kwargs)
+
+    def _evaluate(self, name: str, *args, **kwargs) -> pint.Quantity | str:
         Q = un.registry().Quantity
         if name in self.spec.inputs or name in self.spec.definitions:
             self.reads.add(name)
@@ -467,7 +480,8 @@ class Sheet:
         arg = self.spec.arguments.get(var)
         var_unit = arg.unit if arg else un.registry().dimensionless
         cols = [Column(var, var_unit, values, None, var)]
-        cols += [self.column(c, var, values, what) for c in spec.columns]
+        with self.evaluator.sharing():  # what the columns share is computed once
+            cols += [self.column(c, var, values, what) for c in spec.columns]
         return TableData(name, spec.title, var, var_unit, cols)
 
     def table(self, name: str):

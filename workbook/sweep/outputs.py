@@ -151,29 +151,35 @@ def reduce_values(kind: str, values: np.ndarray, grid: np.ndarray, axis: int = -
 def evaluate_outputs(sheet, outputs: list[Output]) -> dict[str, float]:
     """The outputs of one sheet (one case), each a float in its shown unit."""
     result = {}
-    for out in outputs:
-        typed = type_output(sheet, out)
-        fn = sheet.evaluator.compile(typed.t)
-        if out.range is None:
-            value = np.asarray(fn({}), dtype=float)
-            if value.ndim:
-                raise InputError(f"sweep output {out.name} is not one number")
-            value = float(value)
-        else:
-            grid = sheet.range_values(out.range, f"sweep output {out.name}")
-            vals = np.broadcast_to(np.asarray(fn({out.range.var: grid}), dtype=float), grid.shape)
-            bad = ~np.isfinite(vals)
-            if bad.any():
-                raise InputError(
-                    f"sweep output {out.name}: not a finite number at "
-                    f"{out.range.var} = {grid[bad][0]:g}"
-                )
-            value = float(reduce_values(out.reduction, vals, grid))
-        value *= typed.factor
-        if not math.isfinite(value):
-            raise InputError(f"sweep output {out.name} is not a finite number ({value})")
-        result[out.name] = value
+    with sheet.evaluator.sharing():  # subtrees shared by the outputs computed once
+        for out in outputs:
+            result[out.name] = _output_value(sheet, out)
     return result
+
+
+def _output_value(sheet, out: Output) -> float:
+    """One output of one case, a float in its shown unit."""
+    typed = type_output(sheet, out)
+    fn = sheet.evaluator.compile(typed.t)
+    if out.range is None:
+        value = np.asarray(fn({}), dtype=float)
+        if value.ndim:
+            raise InputError(f"sweep output {out.name} is not one number")
+        value = float(value)
+    else:
+        grid = sheet.range_values(out.range, f"sweep output {out.name}")
+        vals = np.broadcast_to(np.asarray(fn({out.range.var: grid}), dtype=float), grid.shape)
+        bad = ~np.isfinite(vals)
+        if bad.any():
+            raise InputError(
+                f"sweep output {out.name}: not a finite number at "
+                f"{out.range.var} = {grid[bad][0]:g}"
+            )
+        value = float(reduce_values(out.reduction, vals, grid))
+    value *= typed.factor
+    if not math.isfinite(value):
+        raise InputError(f"sweep output {out.name} is not a finite number ({value})")
+    return value
 
 
 def as_outputs(sheet, outputs) -> list[Output]:

@@ -36,29 +36,28 @@ class CaseEvaluator(Evaluator):
             self._depends[name] = bool(deps & self.swept)
         return self._depends[name]
 
-    def compile(self, t):
-        """Compile as the Evaluator does, with swept inputs read from the environment."""
-        if isinstance(t, tc.TRef):
-            if t.kind == "input" and t.name in self.swept:
-                key = "\x00" + t.name
-                return lambda env: env[key]
-            if t.kind == "definition" and self.depends(t.name):
-                return self.compile(self.typer.scalar(t.name))
-            return super().compile(t)
-        if isinstance(t, tc.TCall):
-            f = self.function(t.name)
-            params = self.typer.function(t.name).params
-            args = [self.compile(a) for a in t.args]
-            keys = self.keys
+    def visit_TRef(self, t):
+        """Swept inputs are read from the environment."""
+        if t.kind == "input" and t.name in self.swept:
+            key = "\x00" + t.name
+            return lambda env: env[key]
+        if t.kind == "definition" and self.depends(t.name):
+            return self.compile(self.typer.scalar(t.name))
+        return super().visit_TRef(t)
 
-            def call(env):
-                inner = {p: a(env) for p, a in zip(params, args)}
-                for k in keys:
-                    inner[k] = env[k]
-                return f(inner)
+    def visit_TCall(self, t):
+        f = self.function(t.name)
+        params = self.typer.function(t.name).params
+        args = [self.compile(a) for a in t.args]
+        keys = self.keys
 
-            return call
-        return super().compile(t)
+        def call(env):
+            inner = {p: a(env) for p, a in zip(params, args)}
+            for k in keys:
+                inner[k] = env[k]
+            return f(inner)
+
+        return call
 
 
 def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[str]:
@@ -128,7 +127,8 @@ def vector_cases(sheet, outputs: list[Output], varies: list[Vary], cases: list[d
 
     def solve(idx):
         try:
-            cols = vector_block(mags, idx, typed, fns, grids)
+            with ev.sharing():  # subtrees shared by the outputs computed once per block
+                cols = vector_block(mags, idx, typed, fns, grids)
         except bad:
             if one is None:
                 raise
