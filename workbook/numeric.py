@@ -12,7 +12,6 @@ opens) a subtree that occurs more than once among the sheet's definitions
 from __future__ import annotations
 
 import functools
-import math
 import operator
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -465,7 +464,7 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
         if isinstance(out, np.ndarray):
             # one pass without a temporary array: a NaN or an infinity makes the sum not
             # finite (an overflowing sum of finite values is looked at point by point)
-            if math.isfinite(np.sum(out)):
+            if np.isfinite(np.sum(out)):
                 return out
             bad = ~np.isfinite(out)
             if bad.any():
