@@ -3,8 +3,8 @@
 Units were resolved by :mod:`workbook.typecheck`, so evaluation works on bare
 float magnitudes (no pint in the hot path) and attaches the unit at the end.
 
-Within one evaluation (``with evaluator.sharing():``, which every ``Sheet`` entry point
-opens) a subtree that occurs more than once among the sheet's definitions
+Within one evaluation (``with evaluator.sharing():``, which ``Sheet`` entry points open, and
+any shared subtree called outside one opens for its call) a subtree that occurs more than once among the sheet's definitions
 (:mod:`workbook.subtrees`) is computed once per environment: a call ``f(x)`` written twice,
 ``sin(phi*deg)`` in h1, v1 and j1, the pieces of h, v and j that share their conditions.
 """
@@ -87,8 +87,9 @@ class Evaluator(Visitor):
 
         def run(env):
             cache = self._shared
-            if cache is None:
-                return fn(env)
+            if cache is None:  # called outside an evaluation: this call is one
+                with self.sharing():
+                    return run(env)
             k = (key, tuple([(n, id(v)) for n, v in env.items()]))
             hit = cache.get(k)
             if hit is None:
