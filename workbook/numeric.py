@@ -4,9 +4,10 @@ Units were resolved by :mod:`workbook.typecheck`, so evaluation works on bare
 float magnitudes (no pint in the hot path) and attaches the unit at the end.
 
 Within one evaluation (``with evaluator.sharing():``, which ``Sheet`` entry points open, and
-any shared subtree called outside one opens for its call) a subtree that occurs more than once among the sheet's definitions
-(:mod:`workbook.subtrees`) is computed once per environment: a call ``f(x)`` written twice,
-``sin(phi*deg)`` in h1, v1 and j1, the pieces of h, v and j that share their conditions.
+any shared subtree called outside one opens for its call) a subtree that occurs more than
+once among the sheet's definitions (:mod:`workbook.subtrees`) is computed once per
+environment: a call ``f(x)`` written twice, ``sin(phi*deg)`` in h1, v1 and j1, the pieces of
+h, v and j that share their conditions.
 """
 
 from __future__ import annotations
