@@ -6,7 +6,8 @@ An entry says everything the engine needs to know about one function:
   for one or more;
 * ``unit_rule(ctx, name, args) -> T``: the typed node (:mod:`workbook.typed`) of a call whose
   arguments are already typed; ``ctx`` is the typer (:class:`UnitContext`), which offers
-  ``convert(t, unit, where)``, ``plain(t, where)`` and ``dimensionless``;
+  ``convert(t, unit, where)``, ``plain(t, where)``, ``meeting(values)`` (bare numbers next
+  to an angle in degrees take its unit) and ``dimensionless``;
 * ``numpy(*values)``: the function on numpy arrays (magnitudes in the units the rule chose);
 * ``excel(args) -> (text, level)``: the Excel formula from the printed arguments, with the
   precedence level of the result (:data:`workbook.expr.PREC`); it raises
@@ -78,6 +79,8 @@ class UnitContext(Protocol):
 
     def plain(self, t: ty.T, where: str) -> ty.T: ...
 
+    def meeting(self, values) -> list[ty.T]: ...
+
 
 @dataclass(frozen=True)
 class Domain:
@@ -144,7 +147,9 @@ def plain_in(ctx: UnitContext, name: str, args: tuple) -> ty.T:
 
 
 def same_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
-    """The result in the unit of the first argument; the others converted to it."""
+    """The result in the unit of the first argument; the others converted to it (a bare
+    number next to an angle in degrees is in degrees: max(theta, 45))."""
+    args = tuple(ctx.meeting(args))
     first = args[0]
     rest = tuple(ctx.convert(a, first.unit, f"{name}() arguments") for a in args[1:])
     return ty.TFunc(first.unit, func=name, args=(first, *rest))

@@ -8,7 +8,9 @@ tree, so the unit logic lives only here.
 
 from __future__ import annotations
 
+import functools
 import math
+import re
 
 import pint
 
@@ -70,7 +72,7 @@ class Typer(ArrayTyping, Visitor):
                 raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
             body = self._typed_body(d, {})
             if d.unit is not None:
-                body = self.convert(body, d.unit, _declared(name, d.unit))
+                body = self.declared(body, d.unit, _declared(name, d.unit))
             self.scalars[name] = body
         return self.scalars[name]
 
@@ -80,7 +82,7 @@ class Typer(ArrayTyping, Visitor):
             scope = {p: self.spec.arguments[p].binding_unit for p in d.params}
             body = self._typed_body(d, scope)
             if d.unit is not None:
-                body = self.convert(body, d.unit, _declared(name, d.unit))
+                body = self.declared(body, d.unit, _declared(name, d.unit))
             self.functions[name] = TypedFunction(name, d.params, tuple(scope.values()), body)
         return self.functions[name]
 
@@ -191,6 +193,16 @@ class Typer(ArrayTyping, Visitor):
             return _with_unit(t, target)
         return TScale(target, child=t, factor=f, shape=t.shape)
 
+    def meeting(self, values) -> list[T]:
+        """Bare numbers among ``values`` next to an angle in degrees take its unit."""
+        return meeting(values)
+
+    def declared(self, t: T, unit: pint.Unit, where: str) -> T:
+        """``t`` shown in a declared unit: a bare number is in it when it is an angle unit."""
+        if is_bare(t) and is_angle(unit):
+            return TConst(unit, value=t.value)
+        return self.convert(t, unit, where)
+
     def plain(self, t: T, where: str) -> T:
         """Convert to a plain number (radians for angles); refuse dimensioned values."""
         if t.boolean:
@@ -293,6 +305,7 @@ class Typer(ArrayTyping, Visitor):
         if left.shape is not None or right.shape is not None:
             return self.matrix_binary(op, left, right)
         if op in "+-":
+            left, right = meeting((left, right))
             if _is_zero(left) and not _is_zero(right):
                 left = TConst(right.unit, value=0.0)
             if right.unit.dimensionality != left.unit.dimensionality and not _is_zero(right):
@@ -307,6 +320,7 @@ class Typer(ArrayTyping, Visitor):
                 return TConst(left.unit * right.unit, value=left.value * right.value)
             return TBinary(left.unit * right.unit, op=op, left=left, right=right)
         if op == "/":
+            self._no_bare_ratio(node, left, right)
             if isinstance(left, TConst) and isinstance(right, TConst) and right.value != 0:
                 return TConst(left.unit / right.unit, value=left.value / right.value)
             return TBinary(left.unit / right.unit, op=op, left=left, right=right)
@@ -335,6 +349,19 @@ class Typer(ArrayTyping, Visitor):
             return TConst(self.dimensionless, value=v)
         return TBinary(self.dimensionless, op="^", left=left, right=right)
 
+    def _no_bare_ratio(self, node: ex.Binary, left: T, right: T) -> None:
+        """theta/90 of an angle in degrees would be a plain number of degrees: refused."""
+        angle, bare = (left, right) if is_bare(right) else (right, left)
+        u = angle_in(angle.unit) if is_bare(bare) and not is_bare(angle) else ""
+        if not u:
+            return
+        raise UnitError(
+            f"a plain number and an angle in {u} do not divide: '{ex.to_text(node)}' would be "
+            f"a plain number of {u}, not a ratio; divide by an angle (an input "
+            f'right = "90 {u}", then theta/right), multiply by a number (0.5*theta halves '
+            f"the angle theta), or declare the argument plain = true (plain numbers, as Mathcad)"
+        )
+
     def _mismatch(self, op, left, right):
         verb = "add" if op == "+" else "subtract"
         raise UnitError(
@@ -362,6 +389,7 @@ class Typer(ArrayTyping, Visitor):
                             f"{', '.join(opts)}"
                         )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
+        typed = meeting(typed)
         first = next((t for t in typed if not _is_zero(t)), typed[0])
         out = []
         for t in typed:
@@ -532,8 +560,47 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     scope = {var: arg.binding_unit if arg else typer.dimensionless}
     t = typer.expression(column_node(typer.spec, col, var), scope, what)
     if col.unit is not None:
-        t = typer.convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
+        t = typer.declared(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
+
+
+def is_angle(unit: pint.Unit) -> bool:
+    """An angle unit other than the radian (deg, grad, arcmin...)."""
+    if unit.dimensionality:
+        return False
+    factor, root = un.registry().get_root_units(unit)
+    return factor != 1 and root == un.registry().radian
+
+
+@functools.lru_cache(maxsize=256)
+def _angle_in(text: str) -> str:
+    reg = un.registry()
+    for name in re.findall(r"[A-Za-z_]+", text):
+        if is_angle(reg.Unit(name)):
+            return un.pretty(reg.Unit(name))
+    return ""
+
+
+def angle_in(unit: pint.Unit) -> str:
+    """The angle unit other than the radian that ``unit`` has as a factor ('deg' for mm*deg),
+    or '' (also when the angles cancel: deg*min/revolution is a time)."""
+    reg = un.registry()
+    if "radian" not in str(reg.get_root_units(unit)[1]):
+        return ""
+    return _angle_in(str(unit))
+
+
+def is_bare(t: T) -> bool:
+    """A plain number written in the expression (a literal, or literals folded)."""
+    return isinstance(t, TConst) and t.unit == un.registry().dimensionless
+
+
+def meeting(values) -> list[T]:
+    """Bare numbers among values that meet an angle (deg, ...) take its unit: theta <= 90."""
+    angle = next((v.unit for v in values if not is_bare(v) and is_angle(v.unit)), None)
+    if angle is None:
+        return list(values)
+    return [TConst(angle, value=v.value) if is_bare(v) else v for v in values]
 
 
 def _is_zero(t: T) -> bool:
