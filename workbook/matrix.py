@@ -533,6 +533,7 @@ def _register() -> None:
 
     # reductions: max and min of numbers and of the elements of matrices; mean
     def r_reduce(ctx, name, args):
+        args = tuple(ctx.meeting(args))  # max(theta, 45): 45 degrees next to an angle
         first = next((a for a in args if a.shape is not None), args[0])
         conv = [ctx.convert(a, first.unit, f"{name}() arguments") for a in args]
         return func(first.unit, name, conv, None)
