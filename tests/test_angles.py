@@ -89,14 +89,32 @@ def test_the_table_column_uses_degrees(sheet):
 
 
 @pytest.mark.parametrize(
-    "expr", ["theta/90", "90/theta", "R*theta/90", "sin(theta/2)", "theta/2 + 1"]
+    "definition",
+    [
+        '"bad(theta)" = { expr = "R*theta/90", unit = "mm" }',
+        '"bad(theta)" = { expr = "R*(1 - theta/90)", unit = "mm" }',
+        '"bad(theta)" = { expr = "theta/90*R", unit = "m" }',
+    ],
 )
-def test_a_bare_number_dividing_an_angle_is_refused(tmp_path, expr):
-    text = SHEET.replace("[definitions]\n", f'[definitions]\n"bad(theta)" = "{expr}"\n')
+def test_an_angle_divided_by_a_bare_number_and_used_as_a_number_is_refused(tmp_path, definition):
+    text = SHEET.replace("[definitions]\n", f"[definitions]\n{definition}\n")
     path = tmp_path / "bad.toml"
     path.write_text(text, encoding="utf-8")
-    with pytest.raises(WorkbookError, match="a plain number and an angle in deg do not divide"):
+    with pytest.raises(WorkbookError, match="an angle in deg divided by the plain number 90"):
         Sheet(load_spec(path))
+
+
+def test_an_angle_divided_by_a_number_stays_an_angle(tmp_path):
+    text = SHEET.replace(
+        "[definitions]\n",
+        '[definitions]\n"halfway(theta)" = { expr = "theta/2", unit = "deg" }\n'
+        '"chord(theta)" = { expr = "2*R*sin(theta/2)", unit = "mm" }\n',
+    )
+    path = tmp_path / "ok.toml"
+    path.write_text(text, encoding="utf-8")
+    sheet = Sheet(load_spec(path))
+    assert _mag(sheet.evaluate("halfway", 90), "deg") == pytest.approx(45.0, rel=1e-15)
+    assert _mag(sheet.evaluate("chord", 60), "mm") == pytest.approx(10.0, rel=1e-15)
 
 
 def _run(*args, cwd):
@@ -113,9 +131,11 @@ def test_workbook_run(tmp_path):
     ws = openpyxl.load_workbook(tmp_path / "angles.xlsx")["Listing"]
     lift = [ws.cell(r, 2).value for r in range(1, 12)]
     assert any(isinstance(v, str) and "<=90" in v.replace(" ", "") for v in lift), lift
-    bad = SHEET.replace("[definitions]\n", '[definitions]\n"bad(theta)" = "theta/90"\n')
+    bad = SHEET.replace(
+        "[definitions]\n", '[definitions]\n"bad(theta)" = { expr = "R*theta/90", unit = "mm" }\n'
+    )
     (tmp_path / "bad.toml").write_text(bad, encoding="utf-8")
     done = _run("run", "bad.toml", "--out", "bad.xlsx", cwd=tmp_path)
     assert done.returncode == 2
     assert "bad.toml" in done.stderr and "Traceback" not in done.stderr
-    assert "do not divide" in done.stderr and "plain = true" in done.stderr
+    assert "divided by the plain number 90" in done.stderr and "plain = true" in done.stderr

@@ -20,7 +20,7 @@ from .builtins import REGISTRY
 from .errors import LimitError, TemplateError, UnitError, WorkbookError
 from .template import Definition, SheetSpec
 from .typearrays import ArrayTyping
-from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
+from .typed import (
     T,
     TAggregate,
     TBinary,
@@ -28,19 +28,15 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TCall,
     TCompare,
     TConst,
-    TFunc,
-    TIndex,
     TLogic,
-    TMatrix,
-    TOde,
     TParam,
     TPiecewise,
-    TProgram,
     TRef,
     TScale,
     TText,
     TUnary,
     TypedFunction,
+    children,  # noqa: F401 - the typed nodes are part of this module's interface
 )
 from .visitor import Visitor
 
@@ -175,10 +171,14 @@ class Typer(ArrayTyping, Visitor):
             text=bool(is_text),
         )
 
-    def convert(self, t: T, target: pint.Unit, where: str) -> T:
-        """``t`` in the unit ``target`` (an explicit factor), or a UnitError naming ``where``."""
+    def convert(self, t: T, target: pint.Unit, where: str, *, angle: bool = False) -> T:
+        """``t`` in the unit ``target`` (an explicit factor), or a UnitError naming ``where``.
+
+        ``angle``: ``t`` is used as an angle (the argument of sin, cos...)."""
         if t.unit == target:
             return t
+        if not angle:
+            self._no_bare_ratio(t, target, where)
         if t.text:
             raise TemplateError(f"{where}: text where a number is wanted")
         if _is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
@@ -212,7 +212,7 @@ class Typer(ArrayTyping, Visitor):
                 f"{where} needs a dimensionless argument, got {un.dims(t.unit)} "
                 f"({un.pretty(t.unit)})"
             )
-        return self.convert(t, self.dimensionless, where)
+        return self.convert(t, self.dimensionless, where, angle=True)
 
     def _number(self, t: T, where: str) -> T:
         if t.boolean:
@@ -320,7 +320,6 @@ class Typer(ArrayTyping, Visitor):
                 return TConst(left.unit * right.unit, value=left.value * right.value)
             return TBinary(left.unit * right.unit, op=op, left=left, right=right)
         if op == "/":
-            self._no_bare_ratio(node, left, right)
             if isinstance(left, TConst) and isinstance(right, TConst) and right.value != 0:
                 return TConst(left.unit / right.unit, value=left.value / right.value)
             return TBinary(left.unit / right.unit, op=op, left=left, right=right)
@@ -349,17 +348,20 @@ class Typer(ArrayTyping, Visitor):
             return TConst(self.dimensionless, value=v)
         return TBinary(self.dimensionless, op="^", left=left, right=right)
 
-    def _no_bare_ratio(self, node: ex.Binary, left: T, right: T) -> None:
-        """theta/90 of an angle in degrees would be a plain number of degrees: refused."""
-        angle, bare = (left, right) if is_bare(right) else (right, left)
-        u = angle_in(angle.unit) if is_bare(bare) and not is_bare(angle) else ""
-        if not u:
+    def _no_bare_ratio(self, t: T, target: pint.Unit, where: str) -> None:
+        """An angle in degrees divided by a plain number (theta/90) is a plain number of
+        degrees: used as a plain number (or in mm...) it would silently be in radians."""
+        u = angle_in(t.unit)
+        if not u or angle_in(target):
+            return
+        ratio = _bare_ratio(t)
+        if ratio is None:
             return
         raise UnitError(
-            f"a plain number and an angle in {u} do not divide: '{ex.to_text(node)}' would be "
-            f"a plain number of {u}, not a ratio; divide by an angle (an input "
-            f'right = "90 {u}", then theta/right), multiply by a number (0.5*theta halves '
-            f"the angle theta), or declare the argument plain = true (plain numbers, as Mathcad)"
+            f"{where}: an angle in {u} divided by the plain number {ratio:g} is a plain number "
+            f"of {u}, not a ratio (at 90 {u}, theta/90 is 0.01745 as a plain number); divide "
+            f'by an angle (an input right = "90 {u}", then theta/right), or declare the '
+            f"argument plain = true (plain numbers, as Mathcad)"
         )
 
     def _mismatch(self, op, left, right):
@@ -588,6 +590,21 @@ def angle_in(unit: pint.Unit) -> str:
     if "radian" not in str(reg.get_root_units(unit)[1]):
         return ""
     return _angle_in(str(unit))
+
+
+def _bare_ratio(t: T) -> float | None:
+    """The plain number that divides an angle in degrees somewhere in ``t`` (None: none)."""
+    if isinstance(t, TBinary) and t.op == "/":
+        for angle, bare in ((t.left, t.right), (t.right, t.left)):
+            if is_bare(bare) and not is_bare(angle) and angle_in(angle.unit):
+                return bare.value
+    if isinstance(t, TCall):
+        return None  # a function's body is checked where it is typed
+    for c in children(t):
+        found = _bare_ratio(c)
+        if found is not None:
+            return found
+    return None
 
 
 def is_bare(t: T) -> bool:
