@@ -20,6 +20,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from . import typecheck as tc
+from . import typed as ty
 from .builtins import REGISTRY
 from .errors import DomainError, InputError
 from .numerics.bound import Bound
@@ -175,10 +176,10 @@ class Evaluator(Visitor):
         elsewhere in the sheet is then computed once (and a product is cheaper than a power)."""
         base = self.compile(t.left)
         if n == 1.5:
-            root = self.compile(tc.TFunc(t.left.unit**0.5, func="sqrt", args=(t.left,)))
+            root = self.compile(ty.TFunc(t.left.unit**0.5, func="sqrt", args=(t.left,)))
             return lambda env: base(env) * root(env)
-        two = tc.TConst(t.right.unit, value=2.0)
-        square = self.compile(tc.TBinary(t.left.unit**2, op="^", left=t.left, right=two))
+        two = ty.TConst(t.right.unit, value=2.0)
+        square = self.compile(ty.TBinary(t.left.unit**2, op="^", left=t.left, right=two))
         if n == 3.0:
             return lambda env: base(env) * square(env)
         return lambda env: np.square(square(env))

@@ -20,7 +20,7 @@ from .builtins import REGISTRY
 from .errors import LimitError, TemplateError, UnitError, WorkbookError
 from .template import Definition, SheetSpec
 from .typearrays import ArrayTyping
-from .typed import (
+from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
     T,
     TAggregate,
     TBinary,
@@ -28,15 +28,20 @@ from .typed import (
     TCall,
     TCompare,
     TConst,
+    TFunc,
+    TIndex,
     TLogic,
+    TMatrix,
+    TOde,
     TParam,
     TPiecewise,
+    TProgram,
     TRef,
     TScale,
     TText,
     TUnary,
     TypedFunction,
-    children,  # noqa: F401 - the typed nodes are part of this module's interface
+    children,
 )
 from .visitor import Visitor
 
@@ -564,6 +569,11 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     if col.unit is not None:
         t = typer.declared(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
+
+
+def _declared(name: str, unit: pint.Unit) -> str:
+    """Where a formula's unit meets its declared one: the computed unit comes first."""
+    return f"the formula of '{name}' (declared in {un.pretty(unit) or '1'})"
 
 
 def is_angle(unit: pint.Unit) -> bool:
