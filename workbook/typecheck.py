@@ -571,11 +571,6 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     return t
 
 
-def _declared(name: str, unit: pint.Unit) -> str:
-    """Where a formula's unit meets its declared one: the computed unit comes first."""
-    return f"the formula of '{name}' (declared in {un.pretty(unit) or '1'})"
-
-
 def is_angle(unit: pint.Unit) -> bool:
     """An angle unit other than the radian (deg, grad, arcmin...)."""
     if unit.dimensionality:
