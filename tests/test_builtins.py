@@ -12,9 +12,10 @@ import pytest
 from workbook import WorkbookError, symbolic
 from workbook import typed as ty
 from workbook.analysis import typed_text
-from workbook.builtins import REGISTRY, Builtin, register
+from workbook.builtins import Builtin, register
 from workbook.excel import ExcelPrinter
 from workbook.numeric import Evaluator
+from workbook.registry import REGISTRY
 from workbook.sheet import Sheet
 from workbook.symbolic import SympyConverter
 from workbook.template import load_spec

@@ -19,7 +19,7 @@ from conftest import write_template
 from recalc import formula_values
 
 import workbook
-from workbook.builtins import REGISTRY
+from workbook.registry import REGISTRY
 
 REL = 1e-13
 

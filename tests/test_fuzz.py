@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from workbook import WorkbookError
 from workbook import expr as ex
-from workbook.builtins import REGISTRY
+from workbook.registry import REGISTRY
 from workbook.sheet import Sheet
 from workbook.template import load_spec
 

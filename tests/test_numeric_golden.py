@@ -16,7 +16,7 @@ import pytest
 from conftest import write_template
 
 import workbook
-from workbook.builtins import REGISTRY
+from workbook.registry import REGISTRY
 
 mp = mpmath.mp
 

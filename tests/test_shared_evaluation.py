@@ -9,8 +9,8 @@ import time
 import numpy as np
 import pytest
 
-from workbook.builtins import REGISTRY
 from workbook.excel import ExcelPrinter
+from workbook.registry import REGISTRY
 from workbook.sheet import Sheet
 from workbook.sweep import sweep
 from workbook.template import load_spec

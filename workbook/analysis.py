@@ -24,9 +24,9 @@ import numpy as np
 from . import typecheck as tc
 from . import units as un
 from .blocks import Finding
-from .builtins import REGISTRY
 from .errors import WorkbookError
 from .expr import PREC
+from .registry import REGISTRY
 from .typed import children
 from .visitor import Visitor
 

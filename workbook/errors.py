@@ -75,6 +75,12 @@ class LimitError(WorkbookError):
     kind = "limit exceeded"
 
 
+class NotSymbolic(WorkbookError):
+    """The expression contains something SymPy cannot represent (a solver block)."""
+
+    kind = "not symbolic"
+
+
 class NotLive(Exception):
     """An expression cannot be a live Excel formula (a solver block, or too long).
 

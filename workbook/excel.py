@@ -11,9 +11,9 @@ import re
 
 from . import excel_names
 from . import typecheck as tc
-from .builtins import REGISTRY
 from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
 from .expr import PREC
+from .registry import REGISTRY
 from .visitor import Visitor
 
 MAX_FORMULA = 8192  # Excel's limit on formula length

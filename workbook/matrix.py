@@ -241,19 +241,15 @@ def submatrix(m, ir: int, jr: int, ic: int, jc: int):
 
 
 # -- the built-ins of vectors and matrices (registry entries) ----------------------------------
-def _register() -> None:
-    """Register the matrix built-ins (called once, at the end of workbook.builtins)."""
+def register_entries() -> None:
+    """Register the matrix built-ins (called once, by workbook.registry)."""
     from . import typed as ty
-    from .builtins import Builtin, register
-    from .errors import NotLive, TemplateError
+    from .entry import Builtin, register
+    from .errors import NotLive, NotSymbolic, TemplateError
     from .expr import PREC
+    from .typed import shape_text
 
     atom = PREC["atom"]
-
-    def shape_text(s) -> str:
-        from .typearrays import shape_text as st
-
-        return st(s)
 
     def need(args, k: int, name: str, what: str = "a vector or matrix"):
         a = args[k]
@@ -277,8 +273,6 @@ def _register() -> None:
 
     def not_symbolic(name):
         def hook(sp, *a):
-            from .symbolic import NotSymbolic
-
             raise NotSymbolic(f"{name}() of a matrix is not differentiated symbolically")
 
         return hook

@@ -21,9 +21,9 @@ import numpy as np
 
 from . import typecheck as tc
 from . import typed as ty
-from .builtins import REGISTRY
 from .errors import DomainError, InputError
 from .numerics.bound import Bound
+from .registry import REGISTRY
 from .subtrees import plan
 from .typed import children
 from .visitor import Visitor

@@ -371,11 +371,6 @@ def expressions(block: tuple[Stmt, ...]):
             yield s.condition
 
 
-def typed_expressions(typed: TypedProgram) -> list:
-    """Every typed expression of a typed program."""
-    return list(expressions(typed.body))
-
-
 def names(program: Program) -> set[str]:
     """Names the program refers to that it does not define itself (locals, loop variables)."""
     local = set()
@@ -419,6 +414,10 @@ class TypedProgram:
     loops: bool
     source: str
     shape: Any = None  # (rows, columns) when the program gives a vector or matrix
+
+    def expressions(self) -> list:
+        """Every typed expression of the program."""
+        return list(expressions(self.body))
 
 
 def type_program(

@@ -14,11 +14,11 @@ import pint
 from . import expr as ex
 from . import typecheck as tc
 from . import units as un
-from .builtins import REGISTRY
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .fields import nearest
 from .numeric import Evaluator
 from .ranges import RangeSpec, range_values
+from .registry import REGISTRY
 from .template import (
     ColumnSpec,
     SheetSpec,

@@ -28,17 +28,11 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from . import typecheck as tc
+from . import typed as ty
 from . import units as un
-from .builtins import REGISTRY
-from .errors import WorkbookError
+from .errors import NotSymbolic, WorkbookError  # noqa: F401 - NotSymbolic is part of this module's interface
+from .registry import REGISTRY
 from .visitor import Visitor
-
-
-class NotSymbolic(WorkbookError):
-    """The expression contains something SymPy cannot represent (a solver block)."""
-
-    kind = "not symbolic"
 
 
 def _sympy():
@@ -77,7 +71,7 @@ class SympyConverter(Visitor):
         self._bodies: dict[str, tuple] = {}
 
     # -- entry points -------------------------------------------------------------------
-    def convert(self, t: tc.T, env: dict | None = None):
+    def convert(self, t: ty.T, env: dict | None = None):
         """SymPy expression of ``t``; ``env`` maps parameters to SymPy expressions."""
         return self.visit(t, env or {})
 
@@ -235,7 +229,7 @@ def to_sympy(sheet, name_or_typed, symbols: dict | None = None, *, keep=(), true
             if d is None:
                 if name_or_typed in sheet.spec.inputs:
                     return conv.convert(
-                        tc.TRef(sheet.typer.unit_of(name_or_typed), name=name_or_typed), {}
+                        ty.TRef(sheet.typer.unit_of(name_or_typed), name=name_or_typed), {}
                     )
                 raise NotSymbolic(f"'{name_or_typed}' is not defined in {sheet.name}")
             if d.is_function:
@@ -281,7 +275,7 @@ def lambdify(sheet, expr, *params: str, modules="numpy"):
     return sp.lambdify([symbol(p) for p in params], expr, modules=modules)
 
 
-def text(sheet, t: tc.T, keep=None) -> str:
+def text(sheet, t: ty.T, keep=None) -> str:
     """Readable text of a typed sub-expression (inputs and scalar definitions kept as names)."""
     sp = _sympy()
     if keep is None:

@@ -20,10 +20,10 @@ import pint
 
 from . import expr as ex
 from . import units as un
-from .builtins import REGISTRY
 from .errors import InputError, LimitError, TemplateError, WorkbookError
 from .fields import Fields, nearest
 from .ranges import RangeSpec, parse_range
+from .registry import REGISTRY
 
 MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
 

@@ -33,15 +33,12 @@ from .typed import (
     TParam,
     TPiecewise,
     TProgram,
+    is_zero,
+    shape_text,
 )
 
 #: Most elements of one matrix written out.
 MAX_ELEMENTS = 10_000
-
-
-def shape_text(shape) -> str:
-    r, c = shape
-    return f"{r}x{c} matrix" if c != 1 else f"vector of {r}"
 
 
 class ArrayTyping:
@@ -63,14 +60,14 @@ class ArrayTyping:
                     what = "a comparison" if e.boolean else "text" if e.text else "a matrix"
                     raise TemplateError(f"{where} is {what}; elements are numbers")
                 self._number(e, where)
-                if first is None and not _zero(e):
+                if first is None and not is_zero(e):
                     first = (e, i, j)
         unit = first[0].unit if first else self.dimensionless
         rows = []
         for i, row in enumerate(typed):
             out = []
             for j, e in enumerate(row):
-                if not _zero(e) and e.unit.dimensionality != unit.dimensionality:
+                if not is_zero(e) and e.unit.dimensionality != unit.dimensionality:
                     f, fi, fj = first
                     raise UnitError(
                         f"a matrix has one unit: element [{i}, {j}] is {un.dims(e.unit)} "
@@ -134,7 +131,7 @@ class ArrayTyping:
         if not value.text:
             self._number(value, "a value")
             self._number(other, "a value")
-            if _zero(value) and not _zero(other):
+            if is_zero(value) and not is_zero(other):
                 unit = other.unit
             value = self.convert(value, unit, "the value if the condition holds")
             other = self.convert(other, unit, f"the value otherwise ({ex.to_text(node.other)})")
@@ -157,7 +154,7 @@ class ArrayTyping:
                     f"cannot {'add' if op == '+' else 'subtract'} a {shape_text(rs)} "
                     f"{'to' if op == '+' else 'from'} a {shape_text(ls)}"
                 )
-            if right.unit.dimensionality != left.unit.dimensionality and not _zero(right):
+            if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
                 self._mismatch(op, left, right)
             right = self.convert(right, left.unit, "sum")
             return TBinary(left.unit, op=op, left=left, right=right, shape=ls or rs)
@@ -243,7 +240,6 @@ class ArrayTyping:
     # -- definitions written as programs or as ODE states ----------------------------------
     def program_body(self, d, scope: dict[str, pint.Unit]) -> T:
         from . import program as pg
-        from .typecheck import _is_zero
 
         def type_expr(node, sc):
             return self.visit(node, sc)
@@ -258,7 +254,7 @@ class ArrayTyping:
             convert=convert,
             is_boolean=lambda t: t.boolean,
             is_text=lambda t: t.text,
-            is_zero=_is_zero,
+            is_zero=is_zero,
             unit_of=lambda t: t.unit,
             shape_of=lambda t: t.shape,
             scope_entry=lambda unit, shape: unit if shape is None else (unit, shape),
@@ -299,9 +295,3 @@ class ArrayTyping:
             finally:
                 self._stack.pop()
         return cache[name]
-
-
-def _zero(t: T) -> bool:
-    from .typecheck import _is_zero
-
-    return _is_zero(t)

@@ -16,8 +16,8 @@ import pint
 
 from . import expr as ex
 from . import units as un
-from .builtins import REGISTRY
 from .errors import LimitError, TemplateError, UnitError, WorkbookError
+from .registry import REGISTRY
 from .template import Definition, SheetSpec
 from .typearrays import ArrayTyping
 from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
@@ -42,6 +42,7 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TUnary,
     TypedFunction,
     children,
+    is_zero,
 )
 from .visitor import Visitor
 
@@ -65,6 +66,15 @@ class Typer(ArrayTyping, Visitor):
         self.dimensionless = un.registry().dimensionless
 
     # -- public -------------------------------------------------------------------
+    def sympy_converter(self, keep: set[str]):
+        """A :class:`workbook.symbolic.SympyConverter` of this sheet's typed trees (no values:
+        inputs and the definitions in ``keep`` stay symbols)."""
+        from types import SimpleNamespace
+
+        from .symbolic import SympyConverter
+
+        return SympyConverter(SimpleNamespace(typer=self, values={}), keep=keep)
+
     def scalar(self, name: str) -> T:
         """Typed body of a scalar definition."""
         if name not in self.scalars:
@@ -186,7 +196,7 @@ class Typer(ArrayTyping, Visitor):
             self._no_bare_ratio(t, target, where)
         if t.text:
             raise TemplateError(f"{where}: text where a number is wanted")
-        if _is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
+        if is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
             return TConst(target, value=0.0)
         if t.unit.dimensionality != target.dimensionality:
             raise UnitError(
@@ -311,9 +321,9 @@ class Typer(ArrayTyping, Visitor):
             return self.matrix_binary(op, left, right)
         if op in "+-":
             left, right = meeting((left, right))
-            if _is_zero(left) and not _is_zero(right):
+            if is_zero(left) and not is_zero(right):
                 left = TConst(right.unit, value=0.0)
-            if right.unit.dimensionality != left.unit.dimensionality and not _is_zero(right):
+            if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
                 self._mismatch(op, left, right)
             right = self.convert(right, left.unit, "sum")
             if isinstance(left, TConst) and isinstance(right, TConst):
@@ -397,11 +407,11 @@ class Typer(ArrayTyping, Visitor):
                         )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
         typed = meeting(typed)
-        first = next((t for t in typed if not _is_zero(t)), typed[0])
+        first = next((t for t in typed if not is_zero(t)), typed[0])
         out = []
         for t in typed:
             self._number(t, "comparison")
-            if t.unit.dimensionality != first.unit.dimensionality and not _is_zero(t):
+            if t.unit.dimensionality != first.unit.dimensionality and not is_zero(t):
                 raise UnitError(
                     f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
                     f"with {un.dims(t.unit)} ({un.pretty(t.unit)})"
@@ -623,16 +633,6 @@ def meeting(values) -> list[T]:
     if angle is None:
         return list(values)
     return [TConst(angle, value=v.value) if is_bare(v) else v for v in values]
-
-
-def _is_zero(t: T) -> bool:
-    """A dimensionless literal zero, which agrees with any unit."""
-    return (
-        isinstance(t, TConst)
-        and t.value == 0.0
-        and not t.unit.dimensionality
-        and (t.unit == un.registry().dimensionless)
-    )
 
 
 def _with_unit(t: T, unit: pint.Unit) -> T:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import pint
 
+from . import units as un
 from .visitor import Visitor
 
 
@@ -83,7 +84,7 @@ class TLogic(T):
 
 @dataclass(frozen=True, eq=False)
 class TFunc(T):
-    """Call of a built-in function (an entry of :data:`workbook.builtins.REGISTRY`).
+    """Call of a built-in function (an entry of :data:`workbook.registry.REGISTRY`).
 
     For a built-in that binds a variable, ``args`` keeps the source order: the typed
     expression, a :class:`TParam` naming the bound variable, then the other arguments.
@@ -209,15 +210,29 @@ class _Children(Visitor):
         return (t.target, *t.indices)
 
     def visit_TProgram(self, t: TProgram) -> tuple[T, ...]:
-        from .program import typed_expressions
-
-        return tuple(typed_expressions(t.program))
+        return tuple(t.program.expressions())
 
     def visit_TOde(self, t: TOde) -> tuple[T, ...]:
         return tuple(t.args)
 
 
 _CHILDREN = _Children()
+
+
+def is_zero(t: T) -> bool:
+    """A dimensionless literal zero, which agrees with any unit."""
+    return (
+        isinstance(t, TConst)
+        and t.value == 0.0
+        and not t.unit.dimensionality
+        and (t.unit == un.registry().dimensionless)
+    )
+
+
+def shape_text(shape) -> str:
+    """``3x2 matrix`` or ``vector of 3``, for messages."""
+    r, c = shape
+    return f"{r}x{c} matrix" if c != 1 else f"vector of {r}"
 
 
 def children(t: T) -> tuple[T, ...]:

@@ -20,11 +20,11 @@ from . import typecheck as tc
 from . import units as un
 from . import verdicts as V
 from .atomic import check_target, replacing
-from .builtins import excel_functions
 from .checks import tolerances
 from .errors import InputError, LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
 from .excel_names import ExcelNames
+from .registry import excel_functions
 from .uses import names_used
 from .version import __version__
 
@@ -50,7 +50,7 @@ class ColumnCells:
 
 
 # Functions of Excel 2007 that need no "_xlfn." prefix that the printer writes for operators,
-# conditions and aggregates; the built-ins add theirs (workbook.builtins.excel_functions()).
+# conditions and aggregates; the built-ins add theirs (workbook.registry.excel_functions()).
 _CLASSIC = frozenset("AND IF INT MAX MIN NA NOT OR PI POWER SUM".split())
 _CALLED = re.compile(r"([A-Za-z_][A-Za-z0-9._]*)\(")
 

@@ -35,6 +35,6 @@ OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpos
 
 def language_functions() -> set[str]:
     """The built-in function names of the language (its registry)."""
-    from ..builtins import REGISTRY
+    from ..registry import REGISTRY
 
     return set(REGISTRY)

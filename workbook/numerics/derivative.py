@@ -10,10 +10,9 @@ SymPy is imported only for sheets that call ``diff``.
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
 
 from .. import typed as ty
-from ..errors import TemplateError
+from ..errors import NotSymbolic, TemplateError
 from ..visitor import Visitor
 
 _FUNCS = {
@@ -43,11 +42,9 @@ def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
     """The ``order``-th derivative of ``body`` with respect to ``var``, in ``unit``."""
     import sympy as sp
 
-    from ..symbolic import NotSymbolic, SympyConverter
-
     leaves = _leaves(typer, body)
     refs = {n: t for n, t in leaves.items() if isinstance(t, ty.TRef)}
-    conv = SympyConverter(SimpleNamespace(typer=typer, values={}), keep=set(refs))
+    conv = typer.sympy_converter(keep=set(refs))
     try:
         expr = conv.convert(body)
     except NotSymbolic as err:

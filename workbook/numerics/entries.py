@@ -16,8 +16,8 @@ import numpy as np
 
 from .. import typed as ty
 from .. import units as un
-from ..builtins import Builtin, register
-from ..errors import NotLive, TemplateError, UnitError, WorkbookError
+from ..entry import Builtin, register
+from ..errors import NotLive, NotSymbolic, TemplateError, UnitError, WorkbookError
 from ..expr import PREC
 from ._common import Result, live, sheet_tolerance
 
@@ -398,8 +398,6 @@ def _product_sympy(sp, body, var, a, b):
 
 def _no_sympy(name: str):
     def convert(sp, body, var, *rest):
-        from ..symbolic import NotSymbolic
-
         raise NotSymbolic(f"{name}() is solved numerically: it has no formula to differentiate")
 
     return convert

@@ -15,8 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from html import escape
 
-from .. import builtins as bi
 from .. import expr as ex
+from .. import registry as bi
 from ..visitor import Visitor
 
 PREC = ex.PREC  # the one precedence table of the language

@@ -1,0 +1,87 @@
+"""One built-in function: the :class:`Builtin` record, the registry it is kept in, and
+:func:`register` (the fields are described in :mod:`workbook.builtins`; the complete registry,
+every module's entries registered, is :data:`workbook.registry.REGISTRY`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+import pint
+
+from . import typed as ty
+from .errors import TemplateError
+
+Arity = int | tuple[int, int | None] | None
+
+
+class UnitContext(Protocol):
+    """What a unit rule may ask of the typer."""
+
+    dimensionless: pint.Unit
+
+    def convert(self, t: ty.T, target: pint.Unit, where: str) -> ty.T: ...
+
+    def plain(self, t: ty.T, where: str) -> ty.T: ...
+
+    def meeting(self, values) -> list[ty.T]: ...
+
+
+@dataclass(frozen=True)
+class Domain:
+    """A restricted domain of argument ``arg``: ``bad(values)`` marks values outside it."""
+
+    kind: str  # "sqrt of a negative number"
+    bad: Callable[[np.ndarray], np.ndarray]
+    shown: str  # "sqrt({})", filled with the argument's text
+    arg: int = 0
+
+
+@dataclass(frozen=True)
+class Builtin:
+    """One built-in function (see the module docstring for the meaning of each field)."""
+
+    name: str
+    arity: Arity
+    unit_rule: Callable[..., ty.T]
+    numpy: Callable[..., Any]
+    excel: Callable[..., tuple[str, int]]
+    sympy: Callable[..., Any]
+    domain: tuple[Domain, ...] = ()
+    doc: str = ""
+    binds: tuple[int, int] | None = None
+    data_args: tuple[int, ...] = ()  # arguments that name columns of [data] tables
+    excel_functions: tuple[str, ...] = ()
+    mathml: str = ""
+    mathml_powered: bool = False
+    arrays: bool = False  # takes vectors/matrices: the hooks get ``shapes=`` (workbook.matrix)
+
+    def check_arity(self, n: int) -> None:
+        """Raise a TemplateError if ``n`` arguments do not fit."""
+        a = self.arity
+        if a is None:
+            if n < 1:
+                raise TemplateError(f"{self.name}() needs at least one argument")
+            return
+        if isinstance(a, int):
+            if n != a:
+                raise TemplateError(f"{self.name}() takes {a} argument(s), got {n}")
+            return
+        lo, hi = a
+        if n < lo or (hi is not None and n > hi):
+            span = f"{lo} or more" if hi is None else f"{lo} to {hi}"
+            raise TemplateError(f"{self.name}() takes {span} arguments, got {n}")
+
+
+#: Every built-in function by name.
+REGISTRY: dict[str, Builtin] = {}
+
+
+def register(entry: Builtin) -> Builtin:
+    """Add a built-in; a name can be registered once."""
+    if entry.name in REGISTRY:
+        raise ValueError(f"built-in {entry.name}() is registered twice")
+    REGISTRY[entry.name] = entry
+    return entry

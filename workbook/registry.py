@@ -1,0 +1,19 @@
+"""The complete registry of built-in functions: the plain ones of :mod:`workbook.builtins`, the
+numerical ones of :mod:`workbook.numerics.entries` and the vector and matrix ones of
+:mod:`workbook.matrix`. Every back end reads built-ins from here."""
+
+from __future__ import annotations
+
+from . import builtins as _plain  # noqa: F401 - registers the plain built-ins on import
+from . import matrix
+from .entry import REGISTRY
+from .numerics import entries as _numerical  # noqa: F401 - root, integral, ..., diff register
+
+matrix.register_entries()  # min, max, mean and the vector and matrix built-ins
+
+__all__ = ["REGISTRY", "excel_functions"]
+
+
+def excel_functions() -> frozenset[str]:
+    """Excel functions that the printed formulas of built-ins call."""
+    return frozenset(f for b in REGISTRY.values() for f in b.excel_functions)
