@@ -78,7 +78,7 @@ def root_ref(w, **changes):
 
 
 # -- steady state ------------------------------------------------------------------------------
-def test_steady_values_match_scenes(sheet):
+def test_steady_values_match_reference(sheet):
     got = sheet.evaluate("phi2", omega1=[50, 80, 110]).to("rad").magnitude
     assert got[0] == 0.0  # on the stop at 50 rad/s
     assert abs(got[1] - 0.070) <= 1e-3
@@ -98,7 +98,7 @@ def test_root_against_mpmath(sheet, w):
         ("m", ["0.65 kg", "0.7 kg", "0.75 kg", "0.8 kg"], [0.181, 0.204, 0.228, 0.253]),
     ],
 )
-def test_families_at_110_match_scenes(sheet, name, values, expected):
+def test_families_at_110_match_reference(sheet, name, values, expected):
     for v, e in zip(values, expected):
         got = float(sheet.with_inputs(**{name: v}).evaluate("phi2", omega1=110).magnitude)
         assert abs(got - e) <= 1e-3, (name, v, got, e)

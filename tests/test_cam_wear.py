@@ -68,7 +68,7 @@ def test_flow_area_reference_values(valve):
     assert f == pytest.approx([f3(1.0), f3(5.0)], rel=1e-13)
 
 
-def test_time_sections_against_scenes_and_quad(valve):
+def test_time_sections_against_reference_and_quad(valve):
     ts0 = float(mag(valve.evaluate("TS0"), "mm^2*deg"))
     assert ts0 == pytest.approx(116_626, rel=1e-3)
     assert ts0 == pytest.approx(quad_ts(), rel=1e-10)

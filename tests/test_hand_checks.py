@@ -1,4 +1,4 @@
-"""Issue 3: the hand calculation of the concave cam checked by the engine.
+"""The hand calculation of the concave cam checked by the engine.
 
 References are computed here independently (closed forms, plane geometry with numpy,
 mpmath at 50 digits), not taken from the engine.

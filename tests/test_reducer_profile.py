@@ -70,7 +70,7 @@ EXAMPLE = [  # phi, rho, a, x_t, y_t, x_k, y_k (n = 12, Z = 11, e1 = 2, r2 = 40,
 
 
 @pytest.mark.parametrize("row", EXAMPLE, ids=[f"phi={r[0]}" for r in EXAMPLE])
-def test_scenes_example_coordinates(sheet, row):
+def test_reference_example_coordinates(sheet, row):
     phi, rho, a, xt, yt, xk, yk = row
     assert sheet.evaluate("rho", 0, phi).to("mm").magnitude == pytest.approx(rho, abs=5e-3)
     if a is not None:
