@@ -518,3 +518,21 @@ def test_a_scalar_piecewise_with_no_true_piece_is_an_input_error(tmp_path):
     write(path, NO_PIECE + '[[tables]]\nname = "t"\nrange = "x := 0 .. 2"\ncolumns = { s = "" }\n')
     out = cli(tmp_path, "run", str(path), "--out", str(tmp_path / "p.xlsx"))
     assert out.returncode == 2 and "no piece applies" in out.stderr and "p.toml:5" in out.stderr
+
+
+PIECES_IN_DEGREES = """
+[arguments]
+theta = { unit = "deg" }
+[definitions]
+"f(theta)" = { expr = ["90 if theta > 90", "theta otherwise"], unit = "deg" }
+"g(theta)" = ["theta if theta < 90", "90 otherwise"]
+"""
+
+
+def test_a_bare_number_among_pieces_in_degrees_is_in_degrees(tmp_path):
+    # "90 otherwise" beside theta in deg was 90 rad = 5156.6 deg
+    sheet = workbook.load(write(tmp_path / "a.toml", PIECES_IN_DEGREES))
+    for name in ("f", "g"):
+        got = sheet.evaluate(name, theta=[45, 120])
+        assert str(got.units) == "degree"
+        assert list(got.magnitude) == [45.0, 90.0]

@@ -152,6 +152,7 @@ class Typer(ArrayTyping, Visitor):
         conds, values, texts = [], [], []
         first_unit = None
         is_text = None
+        typed = []
         for b in d.branches:
             v = self.visit(b.value, scope)
             if v.boolean:
@@ -162,6 +163,10 @@ class Typer(ArrayTyping, Visitor):
                 is_text = v.text
             elif v.text != is_text:
                 raise TemplateError(f"piece {b.text!r}: text and numbers mixed in one function")
+            typed.append(v)
+        if not is_text:
+            typed = meeting(typed)  # "90 if ...", "theta otherwise": 90 is 90 deg
+        for b, v in zip(d.branches, typed):
             if not v.text:
                 self._not_text(v, f"piece {b.text!r}")
             if first_unit is None:
