@@ -238,3 +238,14 @@ def shape_text(shape) -> str:
 def children(t: T) -> tuple[T, ...]:
     """The direct sub-trees of ``t`` (values, then conditions, for a piecewise node)."""
     return _CHILDREN.visit(t)
+
+
+def parameters(t: T) -> set[str]:
+    """Names of the parameters (function arguments, bound variables) that ``t`` refers to."""
+    out, stack = set(), [t]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, TParam):
+            out.add(n.name)
+        stack.extend(children(n))
+    return out

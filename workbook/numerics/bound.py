@@ -26,7 +26,7 @@ class Bound:
         self.body, self.fn, self.env = body, fn, env
         self.var = var.name
         self.unit_text = un.pretty(var.unit)
-        used = _params(body) - {self.var}
+        used = ty.parameters(body) - {self.var}
         self.arrays = {k: np.asarray(env[k]) for k in used if k in env and np.ndim(env[k]) > 0}
         self.shape = np.broadcast_shapes(*(a.shape for a in self.arrays.values()))
 
@@ -80,13 +80,3 @@ class Bound:
     def record(self, name: str, result: Result) -> None:
         """Keep the result's error estimate for ``workbook bench``."""
         self.evaluator.records.append((name, result))
-
-
-def _params(t: ty.T) -> set[str]:
-    out, stack = set(), [t]
-    while stack:
-        n = stack.pop()
-        if isinstance(n, ty.TParam):
-            out.add(n.name)
-        stack.extend(ty.children(n))
-    return out

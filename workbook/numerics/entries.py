@@ -299,7 +299,9 @@ def _root_excel(body, args, consts) -> tuple[str, int]:
     helpers = getattr(body, "helpers", None)
     free = helpers is not None and len(args) == 2
     free = (
-        free and not (_params(body.typed) - {body.var}) and not any(_params(a) for a in body.rest)
+        free
+        and not (ty.parameters(body.typed) - {body.var})
+        and not any(ty.parameters(a) for a in body.rest)
     )
     if not free:
         raise NotLive(
@@ -342,16 +344,6 @@ def _root_excel(body, args, consts) -> tuple[str, int]:
         block.write(k, 4, "=" + body(r(k, 2)), fmid)
     same_sign = f"{r(0, 3)}*({body(r(0, 1))})>0"
     return f"IF({same_sign},NA(),{r(BISECTION_STEPS, 2)})", ATOM
-
-
-def _params(t: ty.T) -> set[str]:
-    out, stack = set(), [t]
-    while stack:
-        n = stack.pop()
-        if isinstance(n, ty.TParam):
-            out.add(n.name)
-        stack.extend(ty.children(n))
-    return out
 
 
 def _integral_excel(body, args, consts) -> tuple[str, int]:
