@@ -150,7 +150,10 @@ class ExprTranslator(Visitor):
             args = args[0].children
         tag = op.tag
         if tag in _BINARY and len(args) == 2:
-            return ex.Binary(_BINARY[tag], self.visit(args[0]), self.visit(args[1]))
+            left, right = self.visit(args[0]), self.visit(args[1])
+            if tag == "div":
+                left, right = self._radians(left, right), self._radians(right, left)
+            return ex.Binary(_BINARY[tag], left, right)
         if tag in _COMPARE and len(args) == 2:
             return ex.Compare((_COMPARE[tag],), (self.visit(args[0]), self.visit(args[1])))
         if tag == "neg" and len(args) == 1:
@@ -176,6 +179,24 @@ class ExprTranslator(Visitor):
         if tag == "Find":
             return self.tr.find(self, args, op.attrs.get("method", ""))
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
+
+    def _radians(self, node: ex.Node, other: ex.Node) -> ex.Node:
+        """``node / rad`` where ``node`` is an angle in degrees (or another angle unit) and
+        ``other`` a bare number: Mathcad's angles are plain numbers in radians, so its
+        ``alpha*pi/180`` of ``alpha = 6 deg`` is 0.1047*pi/180; the language refuses an angle
+        divided by a bare number (a plain number of degrees), so the angle is made the plain
+        number in radians Mathcad divides."""
+        if not isinstance(other, ex.Number) or isinstance(node, ex.Number):
+            return node
+        try:
+            unit = _Units(self.tr).visit(node)
+        except Exception:  # noqa: BLE001 - unknown: left as written
+            return node
+        from ..typecheck import angle_in
+
+        if unit is None or not angle_in(unit):
+            return node
+        return ex.Binary("/", node, ex.Name(self.tr.unit_sym("rad").token()))
 
     def bound(self, var: MNode, body: MNode) -> tuple[ex.Node, ex.Node]:
         """A variable bound by a sum, product, integral, derivative or root, and the body in
