@@ -66,6 +66,11 @@ def test_example(tmp_path, text):
             got = result.table.iloc[0][f"{out} [{unit}]" if unit else out]
             assert got == pytest.approx(float(number), abs=0.6 * 10**-digits), line
             continue
+        if line.startswith("finding "):  # finding WHAT -> VERDICT
+            what, _, verdict = line[len("finding ") :].rpartition(" -> ")
+            found = {f.what: f.verdict for f in sheet.check().findings}
+            assert found.get(what) == verdict, (line, found)
+            continue
         if line.startswith("chart "):
             _, name, _, _, n = line.split()
             assert len(next(c for c in sheet.spec.charts if c.name == name).series) == int(n)

@@ -189,6 +189,10 @@ def collect_findings(sheet) -> list[Finding]:
         from .ode import sheet_findings
 
         out.extend(sheet_findings(sheet))
+    if sheet.spec.checks:
+        from .declared_checks import check_findings
+
+        out.extend(check_findings(sheet))
     for entry in sheet.spec.findings:
         ref = entry.get("block")
         if not isinstance(ref, str):

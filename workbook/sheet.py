@@ -125,6 +125,15 @@ class Sheet:
                         )
                     self.typed_column(s.y, rng.var, f"chart {c.name}")
 
+        if self.full_spec.checks:
+            from .declared_checks import type_checks
+
+            type_checks(self)
+
+    def at_template_inputs(self) -> bool:
+        """Are the inputs the template's own (the worked example it lists)?"""
+        return all(bool(self.values[n] == i.value) for n, i in self.spec.inputs.items())
+
     def with_inputs(self, **changes) -> Sheet:
         """A new Sheet with some inputs replaced (``"40 mm"``, a pint Quantity, or a number)."""
         values = dict(self.values)

@@ -20,6 +20,7 @@ import pint
 
 from . import expr as ex
 from . import units as un
+from .declared_checks import read_check
 from .errors import InputError, LimitError, TemplateError, WorkbookError
 from .fields import Fields, nearest
 from .ranges import RangeSpec, parse_range
@@ -38,6 +39,7 @@ SECTIONS = {
     "printed",
     "relations",
     "findings",
+    "checks",
     "sweep",
     "parts",
     "data",
@@ -289,6 +291,7 @@ class SheetSpec:
     data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
     solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
     odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.ode.OdeSpec
+    checks: list[Any] = field(default_factory=list)  # declared_checks.CheckSpec, [[checks]]
 
     def solve_of(self, name: str):
         """The [[solve]] block that finds ``name``, or None."""
@@ -586,6 +589,11 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
     printed = [_printed_spec(p, path, text) for p in _list(data, "printed")]
     relations = [_relation_spec(r, text) for r in _list(data, "relations")]
+    headers = _header_lines(text, "checks")
+    checks = [
+        read_check(raw, headers[i] if i < len(headers) else None)
+        for i, raw in enumerate(_list(data, "checks"))
+    ]
     findings = _list(data, "findings")
     for raw in findings:
         f = Fields(raw, FINDING_KEYS, "[[findings]]")
@@ -623,6 +631,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         text=text,
         parts=parts,
         data=measured,
+        checks=checks,
         solves=solves,
         odes=odes,
     )
@@ -702,6 +711,8 @@ def _assign_parts(data: dict, parts: dict[str, PartSpec], text: str, *specs: lis
             item.part = _part_of(raw, parts, section, text, getattr(item, "line", None))
     for raw in _list(data, "findings"):
         _part_of(raw, parts, "findings", text, None)
+    for raw in _list(data, "checks"):
+        _part_of(raw, parts, "checks", text, None)
     tables, charts = specs[0], specs[1]
     table_part = {t.name: t.part for t in tables}
     for c in charts:
@@ -743,6 +754,7 @@ def select_parts(spec: SheetSpec, chosen: frozenset[str]) -> SheetSpec:
         printed=[p for p in spec.printed if keep(p.part)],
         relations=[r for r in spec.relations if keep(r.part)],
         findings=[f for f in spec.findings if keep(f.get("part"))],
+        checks=[c for c in spec.checks if keep(c.part)],
     )
 
 
@@ -768,6 +780,12 @@ def _section_line(text: str, key: str) -> int | None:
         if line.strip().strip("[]").strip() == key:
             return number
     return None
+
+
+def _header_lines(text: str, key: str) -> list[int]:
+    """The lines of the ``[[key]]`` headers, in order (the i-th entry of an array of tables)."""
+    pattern = re.compile(r"^\s*\[\[\s*" + re.escape(key) + r"\s*\]\]")
+    return [n for n, line in enumerate(text.splitlines(), start=1) if pattern.match(line)]
 
 
 def _list(data: dict, key: str) -> list:
