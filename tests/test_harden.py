@@ -194,6 +194,12 @@ def test_scalars_are_written_printed_and_simplified(tmp_path):
             "did you mean columns?",
         ),
         ('[sweep]\noutput = { a = "R" }\n[inputs]\nR = "1 mm"\n', "did you mean outputs?"),
+        ('[inputs]\nR_1 = "1 mm"\n[definitions]\nd = "2*R1"\n', "'R1' (did you mean R_1?)"),
+        (
+            '[arguments]\ntheta = { unit = "deg" }\n[definitions]\n"f(theta)" = "sin(thta)"\n',
+            "'thta' (did you mean theta?)",
+        ),
+        ('[definitions]\nd = "sqr(2)"\n', "function 'sqr' (did you mean sqrt"),
     ],
 )
 def test_template_keys_and_types_are_checked(tmp_path, text, message):

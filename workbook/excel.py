@@ -7,8 +7,6 @@ definitions are referred to by defined names.
 
 from __future__ import annotations
 
-import re
-
 from . import excel_names
 from . import typecheck as tc
 from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
@@ -17,48 +15,6 @@ from .registry import REGISTRY
 from .visitor import Visitor
 
 MAX_FORMULA = 8192  # Excel's limit on formula length
-
-_CELL = re.compile(r"^[A-Za-z]{1,3}[0-9]+$")
-_R1C1 = re.compile(r"^([Rr][0-9]*)?([Cc][0-9]*)?$")
-# Excel function names that a defined name must not shadow (LibreOffice reads
-# some of them without brackets), plus the boolean literals.
-_RESERVED = {
-    "pi",
-    "e",
-    "true",
-    "false",
-    "sin",
-    "cos",
-    "tan",
-    "asin",
-    "acos",
-    "atan",
-    "atan2",
-    "sqrt",
-    "exp",
-    "ln",
-    "log",
-    "log10",
-    "abs",
-    "sign",
-    "int",
-    "min",
-    "max",
-    "if",
-    "and",
-    "or",
-    "not",
-    "na",
-    "sum",
-    "rand",
-    "row",
-    "column",
-    "index",
-    "degrees",
-    "radians",
-    "power",
-    "mod",
-}
 
 
 def excel_name(name: str) -> str:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,7 +17,6 @@ from .errors import DomainError, InputError, LimitError, TemplateError, Workbook
 from .fields import nearest
 from .numeric import Evaluator
 from .ranges import RangeSpec, range_values
-from .registry import REGISTRY
 from .template import (
     ColumnSpec,
     SheetSpec,
@@ -28,8 +26,6 @@ from .template import (
 )
 from .typed import TConst
 from .uses import names_used
-
-_UNKNOWN = re.compile(r"^unknown (?:name|function) '([^']+)'")
 
 
 @dataclass
@@ -102,7 +98,6 @@ class Sheet:
             try:
                 self.typer.function(name) if d.is_function else self.typer.scalar(name)
             except WorkbookError as err:
-                self._suggest(err)
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
             except RecursionError:
                 raise LimitError(
@@ -407,20 +402,7 @@ class Sheet:
                 t = self.typer.convert(t, un.registry().dimensionless, what)
             return t
         except WorkbookError as err:
-            self._suggest(err)
             raise self._locate(err, what) from None
-
-    def known_names(self) -> list[str]:
-        """Every name a formula of this sheet may use (for "did you mean" suggestions)."""
-        spec = self.full_spec
-        return [*spec.inputs, *spec.definitions, *spec.arguments, *spec.blocks, *REGISTRY]
-
-    def _suggest(self, err: WorkbookError) -> None:
-        """Add the nearest known names to an "unknown name 'x'" or "unknown function" error."""
-        m = _UNKNOWN.match(err.message)
-        if m and "did you mean" not in err.message:
-            err.message += nearest(m.group(1), self.known_names())
-            err.args = (err.message,)
 
     def _locate(self, err: WorkbookError, what: str) -> WorkbookError:
         """Give an error from a table or chart the line of the definition that failed, or else

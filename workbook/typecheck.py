@@ -17,6 +17,7 @@ import pint
 from . import expr as ex
 from . import units as un
 from .errors import LimitError, TemplateError, UnitError, WorkbookError
+from .fields import nearest
 from .registry import REGISTRY
 from .template import Definition, SheetSpec
 from .typearrays import ArrayTyping
@@ -117,8 +118,15 @@ class Typer(ArrayTyping, Visitor):
     def _definition(self, name: str) -> Definition:
         d = self.spec.definitions.get(name)
         if d is None:
-            raise TemplateError(f"unknown name '{name}'")
+            raise self._unknown("name", name)
         return d
+
+    def _unknown(self, kind: str, name: str, scope=()) -> TemplateError:
+        """``unknown name 'x'`` with the nearest names a formula of this sheet may use."""
+        spec = self.spec
+        known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
+        known.update(dict.fromkeys([*spec.blocks, *REGISTRY]))
+        return TemplateError(f"unknown {kind} '{name}'{nearest(name, known)}")
 
     def _typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
         if d.name in self._stack:
@@ -316,7 +324,7 @@ class Typer(ArrayTyping, Visitor):
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
         if name in REGISTRY or name in self.spec.blocks:
             raise TemplateError(f"'{name}' is a function: call it as {name}(...)")
-        raise TemplateError(f"unknown name '{name}'")
+        raise self._unknown("name", name, scope)
 
     def visit_Binary(self, node: ex.Binary, scope) -> T:
         left = self._number(self.visit(node.left, scope), f"'{node.op}'")
@@ -479,7 +487,7 @@ class Typer(ArrayTyping, Visitor):
                 )
             if name in self.spec.inputs or name in scope:
                 raise TemplateError(f"'{name}' is a value, not a function; write {name}")
-            raise TemplateError(f"unknown function '{name}'")
+            raise self._unknown("function", name, scope)
         entry = REGISTRY[name]
         entry.check_arity(len(args))
         typed = entry.unit_rule(self, name, tuple(args))
