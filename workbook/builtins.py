@@ -62,7 +62,6 @@ import numpy as np
 
 from . import typed as ty
 from .entry import (  # noqa: F401 - the entry record is part of this module's interface
-    REGISTRY,
     Arity,
     Builtin,
     Domain,

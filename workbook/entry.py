@@ -75,13 +75,15 @@ class Builtin:
             raise TemplateError(f"{self.name}() takes {span} arguments, got {n}")
 
 
-#: Every built-in function by name.
-REGISTRY: dict[str, Builtin] = {}
+# Every built-in function by name, filled as the modules that define entries are imported.
+# Read it as workbook.registry.REGISTRY, which imports all of them first (a module
+# reading it from here could see only some).
+ENTRIES: dict[str, Builtin] = {}
 
 
 def register(entry: Builtin) -> Builtin:
     """Add a built-in; a name can be registered once."""
-    if entry.name in REGISTRY:
+    if entry.name in ENTRIES:
         raise ValueError(f"built-in {entry.name}() is registered twice")
-    REGISTRY[entry.name] = entry
+    ENTRIES[entry.name] = entry
     return entry

@@ -6,10 +6,13 @@ from __future__ import annotations
 
 from . import builtins as _plain  # noqa: F401 - registers the plain built-ins on import
 from . import matrix
-from .entry import REGISTRY
+from .entry import ENTRIES
 from .numerics import entries as _numerical  # noqa: F401 - root, integral, ..., diff register
 
 matrix.register_entries()  # min, max, mean and the vector and matrix built-ins
+
+#: Every built-in function by name.
+REGISTRY = ENTRIES
 
 __all__ = ["REGISTRY", "excel_functions"]
 
