@@ -6,7 +6,6 @@ integration of the cam laws.
 """
 
 import math
-import time
 import zipfile
 
 import numpy as np
@@ -136,30 +135,29 @@ def test_wear_deeper_than_the_lift(valve):
     assert any(x.verdict == "warning" and "opens twice" in x.what for x in f)
 
 
-def test_quadrature_bench_quick_and_convergence(valve):
-    from workbook.blocks import wear
-
-    t0 = time.perf_counter()
-    df = wear.bench(valve, quick=True)
-    assert time.perf_counter() - t0 < 5
-    assert set(df["method"]) == {"trapezoid", "Simpson", "Gauss-Legendre", "Gauss-Legendre split"}
-    worn = df[df["case"] == "worn 2"]
-    split = worn[worn["method"] == "Gauss-Legendre split"].set_index("points")
-    plain = worn[worn["method"] == "Gauss-Legendre"].set_index("points")
-    # split at the kinks: spectral; over the kinks: slow
-    assert split.loc[17, "relative error"] < 1e-12
-    assert plain.loc[129, "relative error"] > 1e-7
-    # unworn: a trigonometric polynomial over one period, the trapezoid rule is exact
-    unworn = df[(df["case"] == "unworn") & (df["method"] == "trapezoid")]
-    assert unworn["relative error"].max() < 1e-13
-    assert (df["time [ms]"] > 0).all()
-
-
-def test_quadrature_tables_for_the_workbook(valve):
-    for name in ("quadrature_unworn", "quadrature_worn"):
-        df = valve.table(name)
-        assert list(df["points"]) == [5, 9, 17, 33, 65, 129, 257, 513, 1025]
-        assert (df.filter(like="error").to_numpy() > 0).all()  # log axes
+def test_quadrature_study_against_numpy(valve):
+    """The template's trapezoid and Simpson columns against the rules written out with numpy."""
+    df = valve.table("quadrature")
+    assert list(df["points"]) == [5, 9, 17, 33, 65, 129, 257, 513, 1025]
+    ts0, ts2 = quad_ts(), quad_ts(*WEAR["worn 2"])
+    for i, n in enumerate(df["points"].astype(int)):
+        x = np.linspace(0, PHI, n)
+        w = np.full(n, 2.0)
+        w[1::2] = 4.0
+        w[0] = w[-1] = 1.0
+        for case, (wb, wn), ts in (("unworn", (0.0, 0.0), ts0), ("worn", WEAR["worn 2"], ts2)):
+            y = f3(hw(x, wb, wn))
+            trap = np.trapezoid(y, x)
+            simp = float(w @ y) * (x[1] - x[0]) / 3
+            assert df[f"{case} trapezoid [deg*mm^2]"][i] == pytest.approx(trap, rel=1e-13)
+            assert df[f"{case} Simpson [deg*mm^2]"][i] == pytest.approx(simp, rel=1e-13)
+            err = df[f"{case} trapezoid error [deg*mm^2]"][i]
+            assert err == pytest.approx(max(abs(trap - ts), 1e-16 * ts0), rel=1e-3, abs=1e-9)
+    # unworn: a trigonometric polynomial over one period, the trapezoid rule is exact; worn: the
+    # kinks where the worn lift leaves zero slow both rules down
+    assert (df["unworn trapezoid error [deg*mm^2]"] < 1e-13 * ts0).all()
+    assert df["worn trapezoid error [deg*mm^2]"].iloc[-1] > 1e-8 * ts2
+    assert (df.filter(like="error").to_numpy() > 0).all()  # log axes
 
 
 def test_measured_lift_noise_gain(valve, tmp_path):

@@ -269,13 +269,19 @@ def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
 
 
 def _bound(value, which: str) -> int:
-    v = np.asarray(value, dtype=float)
-    if v.ndim and v.size > 1 and not np.all(v == v.flat[0]):
-        raise InputError(f"sum(): the {which} index must be one number, not vary")
-    x = float(v.flat[0]) if v.ndim else float(v)
+    x = float(np.asarray(value, dtype=float).flat[0])
     if not math.isfinite(x) or x != math.floor(x):
         raise InputError(f"sum(): the {which} index must be an integer, got {x:g}")
     return int(x)
+
+
+def _bounds(value, which: str) -> np.ndarray:
+    """The bound of every row (a table's rows may each have their own)."""
+    v = np.atleast_1d(np.asarray(value, dtype=float))
+    bad = v[~np.isfinite(v) | (v != np.floor(v))]
+    if bad.size:
+        raise InputError(f"sum(): the {which} index must be an integer, got {bad[0]:g}")
+    return v.astype(np.int64)
 
 
 def _sum_numpy(fn, a=None, b=None, *, shapes=None):
@@ -283,12 +289,16 @@ def _sum_numpy(fn, a=None, b=None, *, shapes=None):
         from .matrix import reduce
 
         return reduce("sum", fn, matrix=(True,))
-    lo, hi = _bound(a, "first"), _bound(b, "last")
-    if hi - lo + 1 > MAX_TERMS:
-        raise LimitError(f"sum(): {hi - lo + 1} terms (limit {MAX_TERMS})")
+    lo, hi = _bounds(a, "first"), _bounds(b, "last")
+    first, last = int(lo.min()), int(hi.max())
+    if last - first + 1 > MAX_TERMS:
+        raise LimitError(f"sum(): {last - first + 1} terms (limit {MAX_TERMS})")
+    same = lo.size == hi.size == 1 or (np.all(lo == lo[0]) and np.all(hi == hi[0]))
     out = 0.0
-    for i in range(lo, hi + 1):  # each term is a numpy evaluation over the sheet's arrays
-        out = out + fn(float(i))
+    for i in range(first, last + 1):  # each term is a numpy evaluation over the sheet's arrays
+        term = fn(float(i))
+        # bounds that vary over a table's rows: the term counts only where i is in a row's range
+        out = out + (term if same else np.where((lo <= i) & (i <= hi), term, 0 * term))
     return out
 
 

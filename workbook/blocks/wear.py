@@ -3,9 +3,6 @@
 Every formula is the template's, read through the sheet; the time-sections are the template's
 integrals, split where the integrand has a kink. Valve (templates/cam-wear-valve.toml):
 
-* ``quadrature_unworn`` / ``quadrature_worn`` (tables) and ``bench``: trapezoid, Simpson and
-  Gauss-Legendre at increasing point counts, error against the converged value and run time.
-  They integrate the template's own functions (the compiled sheet).
 * ``measured_lift`` (table): a worn lift given as measured points (CSV with units in the
   header); velocity and acceleration by a Savitzky-Golay filter whose noise gain is reported.
 * ``valve_findings``: validity of (3), port cap, (1) and (2) against (3), wear deeper than the
@@ -22,18 +19,10 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 
 import numpy as np
 
-from . import Finding, bench_block, cached, findings_block, input_magnitude, table_block
-
-# ---------------------------------------------------------------------------------------------
-# Valve: quadrature against run time
-# ---------------------------------------------------------------------------------------------
-_POINTS = (5, 9, 17, 33, 65, 129, 257, 513, 1025)
-_POINTS_QUICK = (5, 9, 17, 33, 65, 129)
-_METHODS = ("trapezoid", "Simpson", "Gauss-Legendre", "Gauss-Legendre split")
+from . import Finding, cached, findings_block, input_magnitude, table_block
 
 
 def _valve_numbers(sheet) -> dict:
@@ -52,134 +41,6 @@ def _valve_numbers(sheet) -> dict:
             "worn 2": (q("w_b2", "mm"), q("w_n2", "mm")),
         },
     )
-
-
-def _integrand(sheet, name):
-    """The template's function name(phi) compiled: plain degrees in, mm^2 out."""
-    fn = sheet.evaluator.function(name)
-    return lambda phi: np.asarray(fn({"phi": phi}), dtype=float)
-
-
-@functools.cache
-def _legendre(n: int):
-    """Gauss-Legendre nodes and weights on [-1, 1] (tabulated once, as a rule's table is)."""
-    return np.polynomial.legendre.leggauss(n)
-
-
-def _rule(method: str, n: int, a: float, b: float):
-    if method == "trapezoid":
-        x = np.linspace(a, b, n)
-        w = np.full(n, (b - a) / (n - 1))
-        w[0] = w[-1] = w[0] / 2
-    elif method == "Simpson":
-        x = np.linspace(a, b, n)
-        hstep = (b - a) / (n - 1)
-        w = np.full(n, 2.0)
-        w[1::2] = 4.0
-        w[0] = w[-1] = 1.0
-        w *= hstep / 3
-    else:
-        t, w = _legendre(n)
-        x = (a + b) / 2 + (b - a) / 2 * t
-        w = w * (b - a) / 2
-    return x, w
-
-
-def _study(sheet, case: str, quick: bool):
-    """Rows (method, points, value, error, time) for one wear case."""
-    num = _valve_numbers(sheet)
-    w_b, w_n = num["cases"][case]
-    f = _integrand(sheet, {"unworn": "fA0", "worn 1": "fA1", "worn 2": "fA2"}[case])
-    Phi = num["Phi"]
-    ts = {"unworn": "TS0", "worn 1": "TS1", "worn 2": "TS2"}[case]
-    ref = float(sheet.evaluate(ts).to("mm^2*deg").magnitude)
-    budget = 0.002 if quick else 0.02  # seconds of repeated runs per point, at least 3 runs
-    rows = []
-    for method in _METHODS:
-        for n in _POINTS_QUICK if quick else _POINTS:
-            if method == "Gauss-Legendre split":
-                if case == "unworn":
-                    continue
-
-                def run(n=n, w_b=w_b, w_n=w_n):
-                    fresh = sheet.with_inputs()  # the opening angle is found in every run
-                    a = float(fresh.evaluate("phi_o", wb=w_b, wn=w_n).to("deg").magnitude)
-                    x, w = _rule("Gauss-Legendre", n, a, Phi - a)
-                    return float(np.dot(w, f(x)))
-            else:
-                x, w = _rule(method, n, 0.0, Phi)
-
-                def run(x=x, w=w):
-                    return float(np.dot(w, f(x)))
-
-            best, spent, runs = math.inf, 0.0, 0
-            while runs < 3 or (spent < budget and runs < 200):
-                t0 = time.perf_counter()
-                value = run()
-                took = time.perf_counter() - t0
-                best, spent, runs = min(best, took), spent + took, runs + 1
-            rows.append((method, n, value, abs(value - ref), best))
-    return ref, rows
-
-
-def _studycached(sheet, case, quick=False):
-    return cached(sheet, ("study", case, quick), lambda: _study(sheet, case, quick))
-
-
-def _wide(sheet, case):
-    import pandas as pd
-
-    ref, rows = _studycached(sheet, case)
-    floor = 1e-16 * abs(ref)
-    out = {"points": list(_POINTS)}
-    for method in _METHODS:
-        mine = {n: (val, err, t) for m, n, val, err, t in rows if m == method}
-        if not mine:
-            continue
-        out[f"{method} value [mm^2*deg]"] = [mine[n][0] for n in _POINTS]
-        out[f"{method} error [mm^2*deg]"] = [max(mine[n][1], floor) for n in _POINTS]
-        out[f"{method} time [ms]"] = [1e3 * mine[n][2] for n in _POINTS]
-    return pd.DataFrame(out)
-
-
-@table_block
-def quadrature_unworn(sheet):
-    """Time-section of the unworn cam by trapezoid, Simpson, Gauss-Legendre: error and time."""
-    return _wide(sheet, "unworn")
-
-
-@table_block
-def quadrature_worn(sheet):
-    """Time-section of the heavily worn cam (a kink where the worn lift reaches zero)."""
-    return _wide(sheet, "worn 2")
-
-
-@bench_block
-def bench(sheet, quick=False):
-    """Time-section by trapezoid, Simpson and Gauss-Legendre: error against run time."""
-    import pandas as pd
-
-    frames = []
-    for case in ("unworn", "worn 2"):
-        ref, rows = _study(sheet, case, quick)
-        frames.append(
-            pd.DataFrame(
-                [
-                    (case, m, n, v, e, e / abs(ref) if ref else math.nan, 1e3 * t)
-                    for m, n, v, e, t in rows
-                ],
-                columns=[
-                    "case",
-                    "method",
-                    "points",
-                    "value [mm^2*deg]",
-                    "error [mm^2*deg]",
-                    "relative error",
-                    "time [ms]",
-                ],
-            )
-        )
-    return pd.concat(frames, ignore_index=True)
 
 
 # ---------------------------------------------------------------------------------------------
