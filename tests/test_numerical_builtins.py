@@ -312,7 +312,7 @@ def test_given_find_by_levenberg_marquardt(tmp_path):
     )
     assert s.spec.solves[0].method == "levenberg-marquardt"
     assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-12)
-    with pytest.raises(TemplateError, match="one of hybrid, levenberg-marquardt"):
+    with pytest.raises(TemplateError, match="one of hybrid, levenberg-marquardt, nearest"):
         sheet(tmp_path, text.replace("[definitions]", 'method = "newton"\n[definitions]'))
 
 
@@ -327,6 +327,58 @@ def test_given_find_conditions_are_checked_at_the_root(tmp_path):
         s.evaluate("x")
     with pytest.raises(TemplateError, match="a condition is written LEFT < RIGHT"):
         sheet(tmp_path, met.replace('"x > 0 m"', '"x == 0"'))
+
+
+def test_given_find_levenberg_marquardt_honours_the_conditions(tmp_path):
+    """Levenberg-Marquardt solves with the conditions (Mathcad's Find): x^2 = 4 from the guess
+    -1 reaches -2, but with x > 1 the guess is first moved to meet it and the root is 2 (the
+    hybrid method reaches -2 and reports the condition unmet)."""
+    text = """
+[[solve]]
+unknowns = { x = "-1" }
+equations = ["x^2 == 4"]
+method = "levenberg-marquardt"
+"""
+    assert sheet(tmp_path, text).evaluate("x").magnitude == pytest.approx(-2, rel=1e-9)
+    cond = text + 'conditions = ["x > 1"]\n'
+    assert sheet(tmp_path, cond).evaluate("x").magnitude == pytest.approx(2, rel=1e-9)
+    hybrid = cond.replace('method = "levenberg-marquardt"', "")
+    with pytest.raises(NumericsError, match="does not meet the condition 'x > 1'"):
+        sheet(tmp_path, hybrid).evaluate("x")
+
+
+def test_given_find_fewer_equations_than_unknowns(tmp_path):
+    """One equation in two unknowns (Mathcad's Find of an underdetermined block): the point
+    on the circle that MINPACK's Levenberg-Marquardt reaches from (1 m, 1 m), as scipy's
+    leastsq with the residuals padded to two (Mathcad's answer in the worksheets measured);
+    the hybrid method refuses it."""
+    from scipy.optimize import leastsq
+
+    text = SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2"').replace('"50 cm"', '"1 m"')
+    lm = text.replace("[definitions]", 'method = "levenberg-marquardt"\n[definitions]')
+    s = sheet(tmp_path, lm)
+    x, y = s.evaluate("x").to("m").magnitude, s.evaluate("y").to("m").magnitude
+    want = leastsq(lambda z: [z[0] ** 2 + z[1] ** 2 - 4, 0.0], [1.0, 1.0], xtol=1e-14)[0]
+    assert (x, y) == pytest.approx(tuple(want), rel=1e-9)
+    assert x**2 + y**2 == pytest.approx(4, rel=1e-9)
+    with pytest.raises(TemplateError, match=re.escape('(or fewer, with method = "levenberg')):
+        sheet(tmp_path, text)
+
+
+def test_given_find_nearest_root_meeting_the_conditions(tmp_path):
+    """`nearest`: of the roots of sin(phi) = 1/2 (pi/6 and 5 pi/6, plus 2 pi k) with phi < 0,
+    the one nearest the guess 0 is 5 pi/6 - 2 pi."""
+    text = """
+[[solve]]
+unknowns = { phi = "0" }
+equations = ["sin(phi) == 0.5"]
+method = "nearest"
+conditions = ["phi < 0"]
+"""
+    s = sheet(tmp_path, text)
+    assert s.evaluate("phi").magnitude == pytest.approx(5 * np.pi / 6 - 2 * np.pi, rel=1e-9)
+    s = sheet(tmp_path, text.replace("phi < 0", "phi > 1"))
+    assert s.evaluate("phi").magnitude == pytest.approx(5 * np.pi / 6, rel=1e-9)
 
 
 def test_given_find_not_converging_shows_residuals(tmp_path):

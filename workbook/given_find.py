@@ -56,7 +56,7 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
         ):
             raise TemplateError(
                 '[[solve]] needs unknowns = { x = "1 m", ... } and equations = ["... == ...", ...]'
-                ' (and optionally method = "hybrid" or "levenberg-marquardt")'
+                ' (and optionally method = "hybrid", "levenberg-marquardt" or "nearest")'
             )
         from .numerics.given import METHODS
 
@@ -72,11 +72,17 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
         try:
             if not isinstance(unknowns, dict) or not unknowns or len(unknowns) > MAX_UNKNOWNS:
                 raise TemplateError(f"[[solve]] unknowns: 1 to {MAX_UNKNOWNS} names with guesses")
-            if not isinstance(equations, list) or len(equations) != len(unknowns):
+            fewer = method != "hybrid"  # least squares: fewer equations than unknowns
+            if not (
+                isinstance(equations, list)
+                and equations
+                and (len(equations) <= len(unknowns) if fewer else len(equations) == len(unknowns))
+            ):
                 raise TemplateError(
                     f"[[solve]] has {len(unknowns)} unknown(s) and "
                     f"{len(equations) if isinstance(equations, list) else 0} equation(s): give "
                     "one equation per unknown"
+                    + ("" if fewer else ' (or fewer, with method = "levenberg-marquardt")')
                 )
             guesses = {}
             for name, guess in unknowns.items():
@@ -138,6 +144,31 @@ def typed_equations(typer, block: SolveSpec) -> list[tuple[ty.T, ty.T]]:
     return out
 
 
+def _violations(sheet, block: SolveSpec, names: list[str]):
+    """x -> how far x is outside each condition (0 inside), relative to the size of the two
+    sides at the guess: residuals for the solvers that honour the conditions while solving."""
+    scope = {n: q.units for n, q in block.unknowns.items()}
+    pairs = []  # (smaller side, larger side) of every comparison of a chain
+    for node, text in block.conditions:
+        sides = [sheet.typer.expression(o, scope, block.what) for o in node.operands]
+        for op, a, b in zip(node.ops, sides, sides[1:]):
+            b = sheet.typer.convert(b, a.unit, f"condition {text!r}")
+            lo, hi = (a, b) if op in ("<", "<=") else (b, a)
+            pairs.append((sheet.evaluator.compile(lo), sheet.evaluator.compile(hi)))
+    guess = dict(zip(names, (q.magnitude for q in block.unknowns.values())))
+    with np.errstate(all="ignore"):
+        sizes = [abs(float(lo(guess))) + abs(float(hi(guess))) for lo, hi in pairs]
+    sizes = [z if np.isfinite(z) and z else 1.0 for z in sizes]
+
+    def violations(x):
+        env = dict(zip(names, (float(v) for v in x)))
+        return np.array(
+            [max(float(lo(env)) - float(hi(env)), 0.0) / z for (lo, hi), z in zip(pairs, sizes)]
+        )
+
+    return violations
+
+
 def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
     """The unknowns' values (magnitudes in their guesses' units)."""
     from .numerics import current, sheet_tolerance
@@ -172,6 +203,7 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
         names=names,
         equations=[text for _, _, text in block.equations],
         method=block.method,
+        violations=_violations(sheet, block, names) if block.conditions else None,
     )
     found = dict(zip(names, (float(v) for v in result.value)))
     for cond, text in typed_conditions(sheet.typer, block):

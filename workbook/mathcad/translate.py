@@ -847,7 +847,8 @@ class Translator:
             raise Untranslatable("a solve block with inequalities (the language's are equations)")
         if any(c.children[0].tag not in _INEQUALITY for c in ineqs):
             raise Untranslatable("a solve block with a condition that is not < <= > >=")
-        if len(eqs) != len(args):
+        method = _METHODS.get(method, "") if _solve_methods() else ""
+        if len(eqs) != len(args) and not (0 < len(eqs) < len(args) and method):
             raise Untranslatable(f"a solve block of {len(eqs)} equations in {len(args)} unknowns")
         if len(args) > 1 and not hasattr(ex, "Matrix"):
             raise Untranslatable("Find of several unknowns (a vector: not in the language yet)")
@@ -874,14 +875,12 @@ class Translator:
         conditions = [inner.visit(c) for c in ineqs]  # checked at the root found
         if inner.ranges:
             raise Untranslatable("a solve block over a range variable")
-        # Mathcad's Levenberg-Marquardt where its Find used it (its default for equations)
-        lm = method == "levenberg" and _solve_methods()
         self.out.items.append(
             Item(
                 "solve",
                 self.given[0],
                 solve=(unknowns, equations, list(self.given), conditions),
-                value="levenberg-marquardt" if lm else "",
+                value=method,
             )
         )
         names = [ex.Name(sym.token()) for sym, _ in unknowns]
@@ -1001,6 +1000,13 @@ def _has_solve() -> bool:
     return "solve" in SECTIONS
 
 
+#: the solver Mathcad's Find used (its AutoSelect stores the one that succeeded) -> the
+#: [[solve]] method that reaches the same root: Mathcad's Levenberg-Marquardt is MINPACK's;
+#: where it fell back to its conjugate-gradient solver (the Levenberg-Marquardt root missed a
+#: condition), the root nearest the guess that meets the conditions is the one it reports in
+#: the worksheets measured; the others (linear, quasi-Newton): the default method
+_METHODS = {"levenberg": "levenberg-marquardt", "conjugate": "nearest"}
+
 _INEQUALITY = {"lessThan", "greaterThan", "lessOrEqual", "greaterOrEqual"}
 
 
@@ -1016,7 +1022,7 @@ def _solve_methods() -> bool:
     import importlib
 
     given = importlib.import_module("workbook.numerics.given")
-    return "levenberg-marquardt" in getattr(given, "METHODS", {})
+    return "nearest" in getattr(given, "METHODS", {})
 
 
 def _has_index(node: MNode) -> bool:
