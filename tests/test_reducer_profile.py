@@ -17,7 +17,7 @@ import pytest
 
 import workbook
 from workbook.blocks import reducer
-from workbook.errors import InputError
+from workbook.errors import InputError, WorkbookError
 
 
 @pytest.fixture(scope="module")
@@ -133,9 +133,8 @@ def test_offset_lies_at_distance_rp_at_every_point(sheet, sense):
 
 def test_normal_includes_the_cam_rotation(sheet):
     """Without da/dphi the tangent would vanish at theta_k - phi = 0; with it, it does not."""
-    m = reducer.model(sheet)
-    _, _, dx, dy, _, _ = m.derivs(0, np.array([0.0, 180.0]))
-    assert np.all(np.hypot(dx, dy) > 1e-3)
+    dx, dy = (sheet.evaluate(d, k=0, phi=np.array([0.0, 180.0])) for d in ("dx_t", "dy_t"))
+    assert np.all(np.hypot(dx, dy).to("mm/deg").magnitude > 1e-3)
 
 
 # -- closure: all n traces coincide ----------------------------------------------------------
@@ -146,12 +145,11 @@ def test_normal_includes_the_cam_rotation(sheet):
 )
 def test_closure_holds(sheet, n, sense, Z):
     s = sheet.with_inputs(n=n, sense=sense)
-    m = reducer.model(s)
-    assert m.Z == Z and m.turns == Z
-    c = reducer.closure(m)
+    assert s.evaluate("Z").magnitude == Z and s.evaluate("turns").magnitude == Z
+    c = reducer.closure(s)
     assert c["points"] == (n - 1) * 181
     assert c["max"] < 1e-9
-    assert reducer.closed_form_deviation(m) < 1e-9
+    assert reducer.closed_form_deviation(s) < 1e-9
     f = [x for x in s.check().findings if x.topic == "closure"]
     assert f[0].verdict == "ok" and f[0].value < 1e-9
 
@@ -162,7 +160,7 @@ def test_closure_holds(sheet, n, sense, Z):
 )
 def test_printed_variants_do_not_close(sheet, changes):
     s = sheet.with_inputs(**changes)
-    c = reducer.closure(reducer.model(s))
+    c = reducer.closure(s)
     assert c["max"] > 1.0  # millimetres apart
     f = [x for x in s.check().findings if x.topic == "closure"]
     assert f[0].verdict == "fail" and "do not coincide" in f[0].note
@@ -190,16 +188,16 @@ def valley_radius(n, e1, r2, sense):
 @pytest.mark.parametrize("n,sense", [(12, "same"), (12, "opposite"), (7, "opposite")])
 def test_smallest_concave_radius(sheet, n, sense):
     s = sheet.with_inputs(n=n, sense=sense)
-    uc = reducer.undercut(reducer.model(s))
-    assert uc.concave
-    assert uc.rho_min == pytest.approx(valley_radius(n, 2, 40, sense), rel=1e-9)
+    assert s.evaluate("kappa_max").magnitude > 0
+    rho_min = s.evaluate("rho_min").to("mm").magnitude
+    assert rho_min == pytest.approx(valley_radius(n, 2, 40, sense), rel=1e-9)
 
 
 def test_example_limit_is_7_525(sheet):
-    uc = reducer.undercut(reducer.model(sheet))
-    assert uc.rho_min == pytest.approx(7.525, abs=5e-4)
-    assert uc.phi_at == pytest.approx(180, abs=1e-6)  # at the valley, roller 0
-    assert uc.packing == pytest.approx(9.8351, abs=1e-4)
+    assert sheet.evaluate("rho_min").to("mm").magnitude == pytest.approx(7.525, abs=5e-4)
+    # at the valley, roller 0
+    assert sheet.evaluate("phi_valley").to("deg").magnitude == pytest.approx(180, abs=1e-6)
+    assert sheet.evaluate("rp_packing").to("mm").magnitude == pytest.approx(9.8351, abs=1e-4)
 
 
 def test_rp_7_5_regular(sheet):
@@ -218,11 +216,10 @@ def test_rp_7_6_undercut(sheet):
     f = [x for x in report.findings if x.topic == "undercut"]
     verdict = next(x for x in f if x.what.startswith("INVALID PROFILE"))
     assert verdict.verdict == "fail" and "7.52475" in verdict.what
-    m = reducer.model(s)
-    uc = reducer.undercut(m)
-    assert len(uc.cusps) == 22 and len(uc.loops) == 11
+    uc = reducer.undercut(s)
+    assert len(uc["cusps"]) == 22 and len(uc["loops"]) == 11
     # each cusp: the practical curve stops (its tangent vanishes) - an independent check
-    for c in uc.cusps[:4]:
+    for c in uc["cusps"][:4]:
 
         def xk(phi, sign):
             return ref_practical(0, float(phi), 12, 2, 40, 7.6, "same")[sign]
@@ -233,18 +230,18 @@ def test_rp_7_6_undercut(sheet):
         speed_far = abs(xk(c["phi"] + 20, 2) - xk(c["phi"] + 20 - 2 * h, 2)) / (2 * h)
         assert math.hypot(vx, vy) < 1e-4 * max(speed_far, 1e-3)
     # each loop: two different eccentric angles give the same point
-    for lp in uc.loops[:3]:
+    for lp in uc["loops"][:3]:
         p1 = ref_practical(0, lp["phi1"], 12, 2, 40, 7.6, "same")[2:]
         p2 = ref_practical(0, lp["phi2"], 12, 2, 40, 7.6, "same")[2:]
         assert abs(lp["phi2"] - lp["phi1"]) > 1
         assert p1 == pytest.approx(p2, abs=1e-9)
         assert p1 == pytest.approx([lp["x"], lp["y"]], abs=1e-9)
     # the first loop sits on the valley's symmetry line, polar angle 180/Z deg
-    assert uc.loops[0]["psi"] == pytest.approx(180 / 11, abs=1e-9)
+    assert uc["loops"][0]["psi"] == pytest.approx(180 / 11, abs=1e-9)
     # the profile is still tabulated, marked invalid where the offset folds back
     prof = s.table("profile")
     assert (prof["regular"] == 0).sum() > 0
-    assert "undercut" in prof.attrs["invalid"]
+    assert s.evaluate("regular").magnitude == 0
     ut = s.table("undercut")
     assert list(ut["kind"]).count("cusp") == 22
 
@@ -260,10 +257,10 @@ def test_packing_limit_verdict(sheet):
 def test_concave_parts_exist_when_z2_e1_exceeds_r2(sheet, factor, concave):
     e1 = factor * 40 / 121
     s = sheet.with_inputs(e1=f"{e1} mm")
-    uc = reducer.undercut(reducer.model(s))
-    assert uc.concave is concave
+    assert (s.evaluate("kappa_max").magnitude > 0) is concave
     if not concave:
-        assert math.isinf(uc.rho_min)
+        with pytest.raises(InputError, match="no piece applies"):
+            s.evaluate("rho_min")  # no concave part: no radius, never a number
         assert s.with_inputs(rp="9 mm").check().ok
 
 
@@ -288,6 +285,8 @@ def test_e1_not_below_r2_is_refused_clearly(sheet, e1):
     assert len(f) == 1 and f[0].verdict == "fail"
     assert "not smaller than r2" in f[0].what and "cannot be assembled" in f[0].what
     with pytest.raises(InputError, match="not smaller than r2"):
+        s.table("rollers")
+    with pytest.raises(WorkbookError, match="is not a finite number"):
         s.table("profile")
 
 
