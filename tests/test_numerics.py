@@ -48,6 +48,23 @@ def test_root_with_two_roots_is_refused():
         root_in(lambda x: x**2 - 1, -3, 3)
 
 
+def test_root_near_searches_both_sides_of_the_guess():
+    """The secant at the guess may point away from every root: (x+1) e^x = 2 from x = -3
+    (the secant says left, where the function tends to -2) has its root on the right; of
+    roots on both sides the nearer one is taken (x^3 - 3x from 0.9: sqrt 3, not 0); a side
+    where the function has no value (log of a negative number) is not searched. Each against
+    scipy's brentq in the bracket around it."""
+    f = lambda x: (x + 1) * np.exp(x) - 2  # noqa: E731
+    got = root_near(f, np.array([-3.0, -5.0, 4.0]), (), TIGHT)
+    want = brentq(f, -3, 4, xtol=1e-15, rtol=1e-15)
+    assert got.value == pytest.approx(want, rel=1e-13)
+    got = root_near(lambda x: x**3 - 3 * x, 0.9, (), TIGHT)
+    assert got.value == pytest.approx(brentq(lambda x: x**3 - 3 * x, 1, 2, xtol=1e-15), rel=1e-13)
+    with np.errstate(invalid="ignore"):
+        got = root_near(lambda x: np.log(x) - 1, 0.5, (), TIGHT)
+    assert got.value == pytest.approx(np.e, rel=1e-13)
+
+
 def test_root_near_without_bracket():
     with pytest.raises(NumericsError, match="no sign change found searching from the guess"):
         root_near(lambda x: x**2 + 1, 1.0)

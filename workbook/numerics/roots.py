@@ -104,12 +104,13 @@ def root_near(
 ) -> Result:
     """A root of ``f(x, *args) = 0`` near ``guess`` for every row (``root(f, x, guess)``).
 
-    A secant step from the guess says on which side the root is; a bracket is searched on
-    that side only (``bracket_root``, steps growing by 2 from 1.5 secant steps, so that the
-    search does not leave the function's domain on the other side), then refined by
-    ``find_root``.
+    The function is sampled on both sides of the guess at distances growing by 2 (from a
+    quarter of the secant step, so that a root nearer than the secant says is not stepped
+    over); the first interval where it changes sign, the nearest the guess, is refined by
+    ``find_root`` (both sides at once: the nearer root). A side where the function leaves its
+    domain (an error, or not a finite number) is not searched further.
     """
-    from scipy.optimize.elementwise import bracket_root, find_root
+    from scipy.optimize.elementwise import find_root
 
     shape, (x0, *args) = rows(guess, *args)
     n = x0.size
@@ -119,39 +120,93 @@ def root_near(
     try:
         f0 = call(f, x0, args)
         f1 = call(f, x0 + h, args)
-        with np.errstate(all="ignore"):
-            slope = (f1 - f0) / h
-            secant = np.where(slope != 0, -f0 / slope, np.inf)
-        right = np.where(np.isfinite(secant), secant > 0, True)
-        step = np.where(np.isfinite(secant), np.maximum(1.5 * np.abs(secant), h), 100 * h)
-        xl0 = np.where(right, x0, x0 - step)
-        xr0 = np.where(right, x0 + step, x0)
-        xmin = np.where(right, x0, -np.inf)
-        xmax = np.where(right, np.inf, x0)
-        with np.errstate(all="ignore"):
-            br = bracket_root(f, xl0, xr0, xmin=xmin, xmax=xmax, args=tuple(args), maxiter=200)
     except WorkbookError as err:
         raise NumericsError(
-            f"root(): searching for a sign change from the guess {var} = {num(x0[0])}"
-            f"{_u(unit)}{' (and others)' if n > 1 else ''}, the expression left its domain "
-            f"({err.message}); give a bracket: root(EXPR, {var}, A, B)"
+            f"root(): at the guess {var} = {num(x0[0])}{_u(unit)}"
+            f"{' (and others)' if n > 1 else ''} the expression has no value ({err.message})"
         ) from None
-    failed = np.flatnonzero(~br.success & (f0 != 0))
+    with np.errstate(all="ignore"):
+        slope = (f1 - f0) / h
+        secant = np.where(slope != 0, -f0 / slope, np.inf)
+    step = np.where(np.isfinite(secant), np.maximum(0.25 * np.abs(secant), h), 100 * h)
+    brackets, evaluations = _brackets_both_sides(f, x0, f0, step, args)
+    found = np.isfinite(brackets[..., 0]).any(axis=0)
+    failed = np.flatnonzero(~found & (f0 != 0))
     if failed.size:
         i = failed[0]
         raise NumericsError(
             f"root(): no sign change found searching from the guess {var} = {num(x0[i])}"
-            f"{_u(unit)}{row_text(label, i, n)} (searched [{num(br.bracket[0][i])}, "
-            f"{num(br.bracket[1][i])}]{_u(unit)}, f = {num(br.f_bracket[0][i])} and "
-            f"{num(br.f_bracket[1][i])}); give a bracket: root(EXPR, {var}, A, B)"
+            f"{_u(unit)}{row_text(label, i, n)} on either side (up to "
+            f"{num(step[i] * (2.0**_DOUBLINGS - 1))}{_u(unit)} away, or where the expression "
+            f"has a value); give a bracket: root(EXPR, {var}, A, B)"
         )
-    xl, xr = br.bracket
-    xl, xr = np.where(f0 == 0, x0, xl), np.where(f0 == 0, x0, xr)
-    res = find_root(f, (xl, xr), args=tuple(args), tolerances=_tolerances(tol))
-    _check_status(res, np.arange(n), np.minimum(xl, xr), np.maximum(xl, xr), label, n, unit)
-    error = _error(res, tol)
-    evaluations = 2 + int(np.max(br.nfev)) + int(np.max(res.nfev))
-    return Result(res.x.reshape(shape), error.reshape(shape), evaluations=evaluations)
+    value, error = np.where(f0 == 0, x0, np.nan), np.zeros(n)
+    for side in (0, 1):  # the sign change on each side, then the nearer root of the two
+        idx = np.flatnonzero((f0 != 0) & np.isfinite(brackets[side, :, 0]))
+        if not idx.size:
+            continue
+        lo, hi = brackets[side, idx, 0], brackets[side, idx, 1]
+        res = find_root(f, (lo, hi), args=tuple(a[idx] for a in args), tolerances=_tolerances(tol))
+        _check_status(res, idx, brackets[side, :, 0], brackets[side, :, 1], label, n, unit)
+        evaluations += int(np.max(res.nfev))
+        distance = np.abs(value[idx] - x0[idx])
+        take = ~(np.abs(res.x - x0[idx]) >= distance)  # nearer, or the first found (NaN)
+        value[idx[take]] = res.x[take]
+        error[idx[take]] = _error(res, tol)[take]
+    return Result(value.reshape(shape), error.reshape(shape), evaluations=evaluations)
+
+
+#: how many times the distance from the guess doubles (from the first step) in root_near
+_DOUBLINGS = 60
+
+
+def _brackets_both_sides(f, x0, f0, step, args) -> tuple[np.ndarray, int]:
+    """[side, row, (lo, hi)]: the interval nearest ``x0`` where ``f`` changes sign, on the
+    right (side 0) and on the left (side 1), NaN where none was found; both sides are
+    searched to the same distance, which stops at the first distance with a sign change."""
+    n = x0.size
+    out = np.full((2, n, 2), np.nan)
+    prev_x = np.stack([x0, x0])
+    prev_f = np.stack([f0, f0])
+    alive = np.stack([f0 != 0, f0 != 0]) & np.isfinite(np.stack([f0, f0]))
+    evaluations = 2
+    for k in range(1, _DOUBLINGS + 1):
+        active = alive.any(axis=0) & ~np.isfinite(out[..., 0]).any(axis=0)
+        if not active.any():
+            break
+        for side, sign in ((0, 1.0), (1, -1.0)):
+            idx = np.flatnonzero(active & alive[side])
+            if not idx.size:
+                continue
+            x = x0[idx] + sign * step[idx] * (2.0**k - 1)
+            fx = _values(f, x, [a[idx] for a in args])
+            evaluations += 1
+            ok = np.isfinite(fx)
+            alive[side, idx[~ok]] = False
+            change = ok & (np.sign(fx) * np.sign(prev_f[side, idx]) <= 0)
+            rows_ = idx[change]
+            a, b = prev_x[side, rows_], x[change]
+            out[side, rows_, 0], out[side, rows_, 1] = np.minimum(a, b), np.maximum(a, b)
+            prev_x[side, idx], prev_f[side, idx] = x, fx
+    return out, evaluations
+
+
+def _values(f, x, args) -> np.ndarray:
+    """f at every row, NaN where the expression has no value (the row is evaluated alone)."""
+    try:
+        with np.errstate(all="ignore"):
+            return np.asarray(call(f, x, args), dtype=float)
+    except WorkbookError:
+        out = np.full(x.size, np.nan)
+        for i in range(x.size):
+            try:
+                with np.errstate(all="ignore"):
+                    out[i] = float(
+                        np.asarray(call(f, x[i : i + 1], [a[i : i + 1] for a in args]))[0]
+                    )
+            except WorkbookError:
+                pass
+        return out
 
 
 def _error(res, tol: Tolerance) -> np.ndarray:
