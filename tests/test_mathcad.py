@@ -126,3 +126,60 @@ def test_no_stored_result_is_reproduced_wrongly(name, tmp_path, capsys):
     }
     wrong = [f for f in result["failures"] if "error" not in f]
     assert all(f["name"] in from_solve for f in wrong), wrong
+
+
+def test_solve_blocks_reach_the_roots_mathcad_found(tmp_path, capsys):
+    """parabola-ellipse: intersections by solve blocks with several roots, inequalities beside
+    the equations, one equation in two unknowns; each root is the one Mathcad stored (within
+    its TOL), from Mathcad's guesses and its solver (Levenberg-Marquardt, or the root nearest
+    the guess where it used its conjugate-gradient solver)."""
+    toml, _ = _import("parabola-ellipse.xmcd", tmp_path, capsys)
+    text = toml.read_text(encoding="utf-8")
+    assert 'method = "nearest"' in text and 'conditions = ["t_4 < 0.9"]' in text
+    result = _check(toml, capsys)
+    assert result["failed"] == 0, result["failures"]
+    assert result["reproduced"] == result["printed"], result["failures"]
+
+
+def _charts(xlsx: Path) -> list:
+    import openpyxl
+
+    book = openpyxl.load_workbook(xlsx)
+    return [c for ws in book.worksheets for c in ws._charts]
+
+
+def test_plots_become_native_charts(tmp_path, capsys):
+    """fermat-spiral: an X-Y plot of y(x) over the range x, two polar plots of r(phi) (x = r
+    cos(phi), y = r sin(phi)), and one whose second trace uses a name Mathcad could not
+    define (listed); `workbook run` draws each as a native chart."""
+    toml, _ = _import("fermat-spiral.xmcd", tmp_path, capsys)
+    text = toml.read_text(encoding="utf-8")
+    charts = re.findall(r"^\[\[charts\]\]  # Mathcad's plot \(region (\d+)\)$", text, re.M)
+    assert charts == ["10", "34", "37", "107"]
+    assert '{ x = "x", y = "y(x)" }' in text
+    assert '{ x = "r(phi) * cos(phi)", y = "r(phi) * sin(phi)" }' in text
+    assert re.search(r"^#   region 107: a plot \(traces left out\): trace 2: uses x1", text, re.M)
+    out = tmp_path / "out.xlsx"
+    assert main(["run", str(toml), "--out", str(out)]) == 0
+    assert len(_charts(out)) == 4
+
+
+def test_a_plot_item_that_is_not_gzip_or_too_large_is_listed(tmp_path, capsys):
+    """A plot's binary item is untrusted: not gzip, or larger than the limit once unpacked
+    (a bomb), is listed as not translated, never unpacked beyond the limit."""
+    import base64
+    import gzip
+
+    from workbook.mathcad.plot import MAX_PLOT_BYTES
+
+    src = (DATA / "fermat-spiral.xmcd").read_text(encoding="utf-8")
+    bomb = base64.b64encode(gzip.compress(b"\0" * (MAX_PLOT_BYTES + 1))).decode()
+    bad = re.sub(r'(<item item-id="5"[^>]*>)[^<]*', lambda m: m.group(1) + "bm90IGd6aXA=", src)
+    bad = re.sub(r'(<item item-id="16"[^>]*>)[^<]*', lambda m: m.group(1) + bomb, bad)
+    (tmp_path / "in").mkdir()
+    path = tmp_path / "in" / "hostile.xmcd"
+    path.write_text(bad, encoding="utf-8")
+    assert main(["import", str(path), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "hostile.toml").read_text(encoding="utf-8")
+    assert "region 10: a plot: a plot whose binary item is not gzip" in text
+    assert "a plot whose binary item is larger than" in text

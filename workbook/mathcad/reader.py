@@ -49,6 +49,7 @@ class Region:
     href: str = ""  # reference regions: the referenced file
     disabled: bool = False
     plot: MNode | None = None  # plot regions: the plot's data
+    binary: str = ""  # plot regions: the binary item with the plot's definition (base64)
 
 
 @dataclass
@@ -189,6 +190,15 @@ def _worksheet(root, path: Path) -> Worksheet:
     if regions is None:
         raise InputError(f"{path}: a Mathcad worksheet without <regions>")
     _collect(regions, 0.0, 0.0, ws.regions)
+    binary = root.find(f"{{{WS}}}binaryContent")
+    items = {
+        item.get("item-id"): item.text or ""
+        for item in (binary if binary is not None else ())
+        if isinstance(item.tag, str) and item.get("item-id")
+    }
+    for region in ws.regions:  # a plot's definition is a binary item (decoded when translated)
+        if region.kind == "plot" and region.plot is not None:
+            region.binary = items.get(region.plot.attrs.get("item-idref", ""), "")
     ws.regions.sort(key=lambda r: (r.top, r.left))  # Mathcad's order: top down, left to right
     return ws
 

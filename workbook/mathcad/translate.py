@@ -39,6 +39,7 @@ class Item:
     range_values: list[float] | None = None
     program: list | None = None  # lines of a program: (indent, [text or tree, ...])
     solve: tuple | None = None  # a solve block: ([(unknown, guess text)], equations, regions)
+    chart: list | None = None  # a plot: its traces, [(x tree, y tree, range item)]
 
 
 @dataclass
@@ -354,6 +355,12 @@ class Translator:
                         self.out.title = region.text.splitlines()[0][:120]
                     self.out.items.append(Item("note", region.id, value=region.text))
                 continue
+            if region.kind == "plot":
+                try:
+                    self.plot(region)
+                except Untranslatable as why:
+                    self.skip(region.id, "a plot", str(why))
+                continue
             if region.kind != "math":
                 what = {"plot": "a plot", "picture": "a picture"}.get(region.kind, "a component")
                 if region.kind in ("reference", "area"):
@@ -372,6 +379,47 @@ class Translator:
         self.close_given("a solve block without Find")
         self.argument_units()
         return self.out
+
+    def plot(self, region: Region) -> None:
+        """An X-Y plot: a chart whose series are its traces, each over the range variable its
+        expressions use (Mathcad plots a trace at every value of it)."""
+        from .plot import payload, traces
+
+        if not region.binary:
+            raise Untranslatable("a plot without its binary item (its definition)")
+        self.forced_region(region)
+        series, why = [], []
+        pairs, polar = traces(payload(region.binary))
+        for n, (x, y) in enumerate(pairs, 1):
+            try:
+                series.append(self.trace(x, y))
+            except Untranslatable as err:
+                why.append(f"trace {n}: {err}")
+        if not series:
+            raise Untranslatable("; ".join(why))
+        if why:
+            self.skip(region.id, "a plot (traces left out)", "; ".join(why))
+        self.out.items.append(Item("chart", region.id, chart=series, value="polar" * polar))
+
+    def trace(self, x: MNode, y: MNode) -> tuple:
+        et = ExprTranslator(self)
+        xt, yt = et.visit(x), et.visit(y)
+        ranges = list(dict.fromkeys(et.ranges))
+        if not ranges:
+            raise Untranslatable(
+                "no range variable (a vector against a vector, or a single point: "
+                "a chart draws over a range)"
+            )
+        if len(ranges) > 1:
+            names = ", ".join(r.mathcad for r in ranges)
+            raise Untranslatable(f"over two range variables at once ({names})")
+        item = next(
+            (i for i in reversed(self.out.items) if i.kind == "range" and i.sym is ranges[0]),
+            None,
+        )
+        if item is None or ranges[0].broken:
+            raise Untranslatable(f"the range variable {ranges[0].mathcad} is not translated")
+        return xt, yt, item
 
     def argument_units(self) -> None:
         """Mathcad's functions are untyped: an argument takes the unit of the values the

@@ -167,12 +167,16 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             arguments.append(f"{sym.final} = {{ unit = {_q(pretty_unit(sym.unit))} }}")
     tables: list[str] = []
     solves: list[str] = []
+    charts: list[str] = []
     for item in tr.items:
         if item.kind == "note":
             notes += _comment(item.value)
             continue
         if item.kind == "solve":
             solves += _solve(item, mapping, out)
+            continue
+        if item.kind == "chart":
+            charts += _chart(item, mapping)
             continue
         if item.sym is None or item.sym.broken:
             continue
@@ -276,7 +280,7 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
     for section in (inputs, arguments, definitions):
         if len(section) > 1:
             parts += section + [""]
-    out.toml = "\n".join(parts + solves + tables + printed) + "\n"
+    out.toml = "\n".join(parts + solves + tables + charts + printed) + "\n"
     return out
 
 
@@ -316,6 +320,38 @@ def _solve(item: Item, mapping, out: Rendered) -> list[str]:
             else []
         ),
         "",
+    ]
+
+
+def _chart(item: Item, mapping) -> list[str]:
+    """A [[charts]] entry: Mathcad's X-Y plot, one series per trace over its range."""
+    series = [(x, y, rng) for x, y, rng in item.chart if not rng.sym.broken]
+    if not series:
+        return []
+    tag = f"(region {item.region})"
+    polar = item.value == "polar"
+    kind = "Mathcad polar plot" if polar else "Mathcad plot"
+    first = series[0][2]
+    lines = []
+    for x, y, rng in series:
+        parts = [f"x = {_q(_text(x, mapping))}", f"y = {_q(_text(y, mapping))}"]
+        if rng is not first:
+            parts.append(f"range = {_q(rng.sym.final + ' := ' + _range_text(rng, mapping))}")
+        lines.append(f"  {{ {', '.join(parts)} }},")
+    x_title = ", ".join(dict.fromkeys(_text(x, mapping) for x, _, _ in series))
+    y_title = ", ".join(dict.fromkeys(_text(y, mapping) for _, y, _ in series))
+    return [
+        "",
+        f"[[charts]]  # Mathcad's plot {tag}",
+        f"name = {_q('plot_' + item.region)}  # {tag}",
+        f"title = {_q(kind + ', region ' + item.region)}",
+        *(["equal_axes = true"] if polar else []),
+        f"range = {_q(first.sym.final + ' := ' + _range_text(first, mapping))}",
+        f"x_title = {_q(x_title)}",
+        f"y_title = {_q(y_title)}",
+        "series = [",
+        *lines,
+        "]",
     ]
 
 
@@ -360,7 +396,8 @@ def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
         for fname, text in rendered.csv.items():
             (Path(tmp) / fname).write_text(text, encoding="utf-8")
         try:
-            workbook.load(str(path))
+            sheet = workbook.load(str(path))
+            _draw_charts(sheet)
         except WorkbookError as err:
             region = _region_of(err, rendered)
             if region is None:
@@ -369,6 +406,23 @@ def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
                 ) from None
             return region, f"the engine refuses it: {err.message}"
     return None
+
+
+def _draw_charts(sheet) -> None:
+    """Compute every series of the charts translated from plots, as ``workbook run`` will
+    (a trace Mathcad drew may fail here: an index beyond a vector), located at its line."""
+    for chart in sheet.spec.charts:
+        for s in chart.series:
+            rng = s.range or chart.range
+            what = f"chart {chart.name}"
+            try:
+                values = sheet.range_values(rng, what)
+                for col in (s.x, s.y):
+                    if col is not None:
+                        sheet.column(col, rng.var, values, what)
+            except WorkbookError as err:  # the chart's region, not the definition's
+                err.line, err.definition = chart.line, None
+                raise
 
 
 def _region_of(err: WorkbookError, rendered: Rendered) -> str | None:
