@@ -461,3 +461,118 @@ def test_bounds_of_a_plain_argument_are_in_its_declared_unit(tmp_path):
             '[inputs]\nL = "1 m"\n[arguments]\nphi = { unit = "deg", plain = true }\n'
             '[definitions]\nbad = "integral(phi, phi, 0, L)"\n',
         )
+
+
+# -- diff: the unit at load, the derivative (SymPy) at first use ---------------------------------
+HEAVY_CODE = (
+    "import sys, workbook\n{body}\n"
+    "heavy = ('sympy', 'mpmath', 'scipy.optimize', 'scipy.integrate')\n"
+    "print(','.join(m for m in heavy if m in sys.modules) or '-')"
+)
+
+
+def _heavy_imports(body: str, *argv: str) -> str:
+    import subprocess
+    import sys
+
+    code = HEAVY_CODE.format(body=body)
+    done = subprocess.run(
+        [sys.executable, "-c", code, *argv], capture_output=True, text=True, check=True
+    )
+    return done.stdout.splitlines()[-1]
+
+
+def test_loading_every_template_imports_no_sympy_mpmath_or_scipy_solvers():
+    # reducer-profile calls diff: its derivatives are found when first evaluated
+    body = "for name in workbook.list_templates():\n    workbook.load(name)"
+    assert _heavy_imports(body) == "-"
+
+
+def test_cold_start_of_concave_cam_imports_no_sympy_mpmath_or_scipy_solvers(tmp_path):
+    body = (
+        "from workbook.cli import main\n"
+        "assert main(['run', 'concave-cam', '--out', sys.argv[1]]) == 0"
+    )
+    assert _heavy_imports(body, str(tmp_path / "cc.xlsx")) == "-"
+
+
+def test_a_derivative_is_found_at_first_use(tmp_path):
+    path = tmp_path / "d.toml"
+    path.write_text(EXTREMA, encoding="utf-8")
+    body = (
+        f"s = workbook.load({str(path)!r})\n"
+        "assert s.typer.function('v').body.unit is not None\n"
+        "print(','.join(m for m in ('sympy',) if m in sys.modules) or '-')\n"
+        "print(s.evaluate('v', 0.0))"
+    )
+    import subprocess
+    import sys
+
+    code = HEAVY_CODE.format(body=body)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    before, value, after = out.stdout.splitlines()
+    assert before == "-" and "sympy" in after.split(",")
+    assert value == "1.0 meter / second"  # A*omega = 10 mm * 100/s
+
+
+DIFF = """
+[inputs]
+A = "10 mm"
+omega = "100 1/s"
+[arguments]
+x = {{ unit = "" }}
+y = {{ unit = "" }}
+t = {{ unit = "s" }}
+[definitions]
+"s(t)" = {{ expr = "A*sin(omega*t)", unit = "mm" }}
+{line}
+"""
+
+
+@pytest.mark.parametrize(
+    "line, message",
+    [
+        ('"d(t)" = "diff(s(t), t, 11)"', "the order N must be a whole number from 1 to 10"),
+        ('"d(t)" = "diff(s(t), t, 1.5)"', "the order N must be a whole number"),
+        ('d = "diff(x^2, x)"', "the derivative is a function of x, which is not an argument"),
+        ('"d(x)" = "diff(root(x*y - 1, y, 0.1, 10), x)"', "root() is solved numerically"),
+        ('"d(x)" = "diff(maximum(x*y, y, 0, 1), x)"', "maximum() is solved numerically"),
+        ('"d(x)" = "diff(x > 1, x)"', "a comparison cannot be used as a number"),
+        ('"d(t)" = "diff(s(t), omega)"', "already an input"),
+    ],
+)
+def test_diff_errors_without_sympy_come_at_load(tmp_path, line, message):
+    path = tmp_path / "d.toml"
+    path.write_text(DIFF.format(line=line), encoding="utf-8")
+    with pytest.raises(TemplateError, match=re.escape(message)) as err:
+        workbook.load(path)
+    assert err.value.line == 11 and err.value.definition == "d"
+    assert "d.toml" in str(err.value)
+
+
+def test_a_derivative_sympy_cannot_write_back_is_an_error_at_first_use(tmp_path):
+    from workbook.cli import main
+
+    path = tmp_path / "d.toml"
+    path.write_text(DIFF.format(line='"d(x)" = "diff(sign(x)*x^2, x, 2)"'), encoding="utf-8")
+    s = workbook.load(path)  # the second derivative holds DiracDelta: found when first used
+    with pytest.raises(TemplateError, match="the derivative contains DiracDelta") as err:
+        s.evaluate("d", 1.0)
+    assert (err.value.line, err.value.definition) == (11, "d")
+    assert str(err.value).startswith(f"{path}:11, in 'd'")
+    table = DIFF.format(line='"d(x)" = "diff(sign(x)*x^2, x, 2)"') + (
+        '[[tables]]\nname = "t"\nrange = "x := 1, 2 .. 3"\ncolumns = { d = "" }\n'
+    )
+    path.write_text(table, encoding="utf-8")
+    assert main(["run", str(path), "--out", str(tmp_path / "d.xlsx")]) == 2
+
+
+def test_a_derivative_inside_another_function_call(tmp_path):
+    # diff's variable is the enclosing one: z(u) = v(2*u) is s'(t) at t = 2*u
+    path = tmp_path / "d.toml"
+    lines = '"v(t)" = { expr = "diff(s(t), t)", unit = "m/s" }\n"z(t)" = "v(2*t)"'
+    path.write_text(DIFF.format(line=lines), encoding="utf-8")
+    s = workbook.load(path)
+    t = np.array([0.0, 0.003, 0.02])
+    want = 0.01 * 100 * np.cos(100 * 2 * t)
+    assert np.allclose(s.evaluate("z", t).to("m/s").magnitude, want, rtol=1e-13, atol=1e-16)

@@ -49,7 +49,8 @@ class ExcelPrinter(Visitor):
         self.ranges: dict[tuple[str, str], str] = {}
         # the writer's allocator of helper cells (a root's bisection steps), set while it
         # writes scalar definitions; a binding hook finds it as ``body.helpers`` (and EXPR's
-        # typed tree, the variable and the other arguments as body.typed, .var, .rest)
+        # typed tree, the variable and the other arguments as body.typed, .var, .rest;
+        # ``body.tree(t)`` prints another typed tree in the call's scope)
         self.helpers = None
         self._calls: dict[tuple, tuple[str, int]] = {}  # (function, argument texts) -> printed
 
@@ -143,6 +144,9 @@ class ExcelPrinter(Visitor):
 
         printed.helpers = self.helpers
         printed.typed, printed.var, printed.rest = body, var, rest
+        # another tree printed in the call's scope (diff's derivative) and the sheet's typer
+        printed.var_param, printed.typer = t.args[var_at], self.typer
+        printed.tree = lambda tree: self.visit(tree, s)
         return entry.excel(printed, [self.print(a, s) for a in rest], consts)
 
     def visit_TCall(self, t, s):

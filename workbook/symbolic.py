@@ -59,6 +59,73 @@ def exact_number(value: float):
     return sp.Rational(repr(v))
 
 
+class _Refusal(Visitor):
+    """Why a typed node itself has no symbolic form (a message), or None. Reads no SymPy, so
+    that ``diff()`` refuses such an EXPR when the sheet is loaded (:func:`refusal`) with the
+    message the converter gives when it meets the node."""
+
+    def _none(self, t, symbols, values) -> None:
+        return None
+
+    visit_TConst = visit_TText = visit_TParam = visit_TScale = visit_TUnary = _none
+    visit_TCompare = visit_TLogic = visit_TCall = visit_TPiecewise = _none
+
+    def visit_TRef(self, t, symbols, values):
+        if t.kind == "choice" and t.name not in symbols and t.name not in values:
+            # A choice is a word, not a number: with no value to compare (a derivative found
+            # once for every value of the input) a condition on it has no symbolic form, and
+            # comparing a symbol with the word would silently pick the last piece.
+            return (
+                f"a condition on the choice '{t.name}' has no symbolic form; "
+                "write one function per option and choose between their results"
+            )
+        return None
+
+    def visit_TBinary(self, t, symbols, values):
+        if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
+            return self.visit_TMatrix(t, symbols, values)
+        return None
+
+    def visit_TFunc(self, t, symbols, values):
+        return getattr(REGISTRY[t.func].sympy, "refusal", None)
+
+    def visit_TBlock(self, t, symbols, values):
+        return f"{t.name}() is a solver block ({t.ref}): it has no formula to differentiate"
+
+    def visit_TMatrix(self, t, symbols, values):
+        return "vectors and matrices are not differentiated symbolically"
+
+    visit_TIndex = visit_TMatrix
+
+    def visit_TProgram(self, t, symbols, values):
+        return f"the program of {t.name} is statements, not one formula"
+
+    def visit_TOde(self, t, symbols, values):
+        return f"{t.name}() is the solution of ode '{t.ode}', a numerical result"
+
+    def visit_TAggregate(self, t, symbols, values):
+        return f"{t.func}_over({t.table}, {t.column}) is a value of a table, not a formula"
+
+
+_REFUSAL = _Refusal()
+
+
+def refusal(typer, t: ty.T) -> str | None:
+    """Why ``t`` (with the sheet functions it calls) has no symbolic form, or None; inputs and
+    definitions it refers to count as symbols. No SymPy is imported."""
+    stack, seen = [t], set()
+    while stack:
+        n = stack.pop()
+        why = _REFUSAL.visit(n, {}, {})
+        if why:
+            return why
+        if isinstance(n, ty.TCall) and n.name not in seen:
+            seen.add(n.name)
+            stack.append(typer.function(n.name).body)
+        stack.extend(ty.children(n))
+    return None
+
+
 class SympyConverter(Visitor):
     """Converts typed nodes of one sheet to SymPy; one ``visit_<Node>`` method per node kind."""
 
@@ -71,6 +138,12 @@ class SympyConverter(Visitor):
         self._bodies: dict[str, tuple] = {}
 
     # -- entry points -------------------------------------------------------------------
+    def visit(self, node, *args):
+        why = _REFUSAL.visit(node, self.symbols, self.sheet.values)
+        if why:
+            raise NotSymbolic(why)
+        return super().visit(node, *args)
+
     def convert(self, t: ty.T, env: dict | None = None):
         """SymPy expression of ``t``; ``env`` maps parameters to SymPy expressions."""
         return self.visit(t, env or {})
@@ -104,15 +177,7 @@ class SympyConverter(Visitor):
         name, kind = t.name, t.kind
         if name in self.symbols:
             return self.symbols[name]
-        if kind == "choice":
-            # A choice is a word, not a number: with no value to compare (a derivative found
-            # once for every value of the input) a condition on it has no symbolic form, and
-            # comparing a symbol with the word would silently pick the last piece.
-            if name not in self.sheet.values:
-                raise NotSymbolic(
-                    f"a condition on the choice '{name}' has no symbolic form; "
-                    "write one function per option and choose between their results"
-                )
+        if kind == "choice":  # its word (a choice without a value is refused: _Refusal)
             return self.sheet.values[name]
         if name in self.keep:
             return sp.Symbol(name, real=True)
@@ -137,8 +202,6 @@ class SympyConverter(Visitor):
 
     def visit_TBinary(self, t, env):
         sp = _sympy()
-        if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
-            raise NotSymbolic("vectors and matrices are not differentiated symbolically")
         a, b = self.convert(t.left, env), self.convert(t.right, env)
         if t.op == "+":
             return a + b
@@ -175,33 +238,18 @@ class SympyConverter(Visitor):
         var = sp.Symbol(t.args[var_at].name, real=True)
         body = self.convert(t.args[expr_at], {**env, t.args[var_at].name: var})
         rest = [self.convert(a, env) for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
-        return entry.sympy(sp, body, var, *rest)
+        out = entry.sympy(sp, body, var, *rest)
+        # the variable left free in the result (diff's) is the one of the enclosing scope
+        name = t.args[var_at].name
+        outer = env.get(name, self.symbols.get(name))
+        if outer is not None and var in getattr(out, "free_symbols", ()):
+            out = out.xreplace({var: outer})
+        return out
 
     def visit_TCall(self, t, env):
         syms, body = self.function(t.name)
         args = [self.convert(a, env) for a in t.args]
         return body.xreplace(dict(zip(syms, args)))
-
-    def visit_TBlock(self, t, env):
-        raise NotSymbolic(
-            f"{t.name}() is a solver block ({t.ref}): it has no formula to differentiate"
-        )
-
-    def visit_TMatrix(self, t, env):
-        raise NotSymbolic("vectors and matrices are not differentiated symbolically")
-
-    visit_TIndex = visit_TMatrix
-
-    def visit_TProgram(self, t, env):
-        raise NotSymbolic(f"the program of {t.name} is statements, not one formula")
-
-    def visit_TOde(self, t, env):
-        raise NotSymbolic(f"{t.name}() is the solution of ode '{t.ode}', a numerical result")
-
-    def visit_TAggregate(self, t, env):
-        raise NotSymbolic(
-            f"{t.func}_over({t.table}, {t.column}) is a value of a table, not a formula"
-        )
 
     def visit_TPiecewise(self, t, env):
         sp = _sympy()

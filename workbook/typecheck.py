@@ -65,6 +65,12 @@ class Typer(ArrayTyping, Visitor):
         self.functions: dict[str, TypedFunction] = {}
         self._stack: list[str] = []
         self.dimensionless = un.registry().dimensionless
+        # diff() calls typed so far, by id of EXPR's typed tree: each finds its derivative
+        # (SymPy) the first time a back end needs it (workbook.numerics.derivative)
+        self.derivatives: dict[int, object] = {}
+        # the parameters in scope of the binding built-in being typed (diff's variable must
+        # be one of them: the derivative is a function of it)
+        self.scope: dict[str, pint.Unit] = {}
 
     # -- public -------------------------------------------------------------------
     def sympy_converter(self, keep: set[str]):
@@ -115,6 +121,12 @@ class Typer(ArrayTyping, Visitor):
         return self.function(name).unit if d.is_function else self.scalar(name).unit
 
     # -- internals ----------------------------------------------------------------
+    def where(self) -> dict:
+        """File, line and definition being typed (for an error found later, at first use)."""
+        name = self._stack[-1] if self._stack else None
+        d = self.spec.definitions.get(name) if name else None
+        return {"file": str(self.spec.path), "line": d.line if d else None, "definition": name}
+
     def _definition(self, name: str) -> Definition:
         d = self.spec.definitions.get(name)
         if d is None:
@@ -527,6 +539,7 @@ class Typer(ArrayTyping, Visitor):
                 args.append(self._number(body, f"argument {i + 1} of {name}()"))
             else:
                 args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
+        self.scope = scope
         return entry.unit_rule(self, name, tuple(args))
 
     def _data_call(self, node: ex.Call, scope) -> T:
@@ -546,6 +559,7 @@ class Typer(ArrayTyping, Visitor):
                 args.append(TRef(col.unit, name=a.id, kind="data"))
             else:
                 args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
+        self.scope = scope
         return entry.unit_rule(self, name, tuple(args))
 
     def _aggregate(self, node: ex.Call) -> T:

@@ -24,7 +24,7 @@ class Bound:
     def __init__(self, evaluator, body: ty.T, fn: Callable, var: ty.TParam, env: dict):
         self.evaluator = evaluator
         self.body, self.fn, self.env = body, fn, env
-        self.var = var.name
+        self.var, self.var_param = var.name, var
         self.unit_text = un.pretty(var.unit)
         used = ty.parameters(body) - {self.var}
         self.arrays = {k: np.asarray(env[k]) for k in used if k in env and np.ndim(env[k]) > 0}

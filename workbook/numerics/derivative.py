@@ -1,18 +1,23 @@
 """``diff(EXPR, X, N)``: the derivative as a typed tree, found by SymPy from EXPR's own tree.
 
-EXPR's typed tree is printed as SymPy (:class:`workbook.symbolic.SympyConverter`, inputs and
-definitions kept as symbols), differentiated, and read back into a typed tree whose leaves are
-EXPR's own parameters and references. Every back end then treats the derivative as any other
-formula: numpy evaluates it, Excel gets it as a live formula, SymPy sees it again.
-SymPy is imported only for sheets that call ``diff``.
+At load the typer gives ``diff`` its unit (EXPR's over X's to the N) and keeps a
+:class:`Pending` record of the call; nothing is differentiated yet, and SymPy is not imported.
+The first back end that needs the derivative (a value, a formula, a check) calls
+:func:`formula`: EXPR's typed tree is printed as SymPy
+(:class:`workbook.symbolic.SympyConverter`, inputs and definitions kept as symbols),
+differentiated, and read back into a typed tree whose leaves are EXPR's own parameters and
+references; it is kept for every later use. Every back end then treats the derivative as any
+other formula: numpy evaluates it, Excel gets it as a live formula.
 """
 
 from __future__ import annotations
 
 import math
+import weakref
+from dataclasses import dataclass, field
 
 from .. import typed as ty
-from ..errors import NotSymbolic, TemplateError
+from ..errors import NotSymbolic, TemplateError, WorkbookError
 from ..visitor import Visitor
 
 _FUNCS = {
@@ -36,6 +41,55 @@ _FUNCS = {
     "atan2": "atan2",
 }
 _REL = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "==", "!=": "!="}
+
+
+@dataclass(eq=False)
+class Pending:
+    """One diff() call: EXPR, the variable, the order, its unit and where it is written."""
+
+    body: ty.T
+    var: ty.TParam
+    order: int
+    unit: object
+    where: dict = field(default_factory=dict)  # file, line, definition
+    tree: ty.T | None = None
+    compiled: weakref.WeakKeyDictionary = field(default_factory=weakref.WeakKeyDictionary)
+
+
+def pending(typer, body: ty.T, var: ty.TParam, order: int, unit) -> Pending:
+    """Record a diff() call being typed (no SymPy): its derivative is found at first use."""
+    rec = Pending(body, var, order, unit, typer.where())
+    typer.derivatives[id(body)] = rec
+    return rec
+
+
+def formula(typer, body: ty.T, var: ty.TParam, order: int) -> ty.T:
+    """The typed tree of ``diff(body, var, order)`` (found once; later calls reuse it).
+
+    An error of SymPy's derivative (a function with no formula in the worksheet language)
+    names the file, line and definition of the diff() call."""
+    rec = typer.derivatives.get(id(body))
+    if rec is None or rec.body is not body or rec.order != order:
+        # a call not met at load (a tree rebuilt by an analysis): no location known
+        rec = Pending(body, var, order, body.unit / var.unit**order)
+    if rec.tree is None:
+        try:
+            rec.tree = derivative(typer, body, var, order, rec.unit)
+        except WorkbookError as err:
+            raise err.located(**rec.where) from None
+    return rec.tree
+
+
+def compiled(evaluator, body: ty.T, var: ty.TParam, order: int):
+    """The derivative compiled by ``evaluator`` (a numpy closure of an environment)."""
+    tree = formula(evaluator.typer, body, var, order)
+    rec = evaluator.typer.derivatives.get(id(body))
+    if rec is None or rec.tree is not tree:
+        return evaluator.compile(tree)
+    fn = rec.compiled.get(evaluator)
+    if fn is None:
+        fn = rec.compiled[evaluator] = evaluator.compile(tree)
+    return fn
 
 
 def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:

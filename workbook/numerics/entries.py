@@ -93,7 +93,11 @@ def _extremum_unit(ctx, name: str, args: tuple) -> ty.T:
 
 
 def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
-    from .derivative import derivative
+    """diff's unit, EXPR's over X's to the N: no SymPy at load. What can be refused without
+    SymPy is refused here (the order, a variable not in scope, EXPR with a part that has no
+    formula); the derivative itself is found at first use (workbook.numerics.derivative)."""
+    from ..symbolic import refusal
+    from .derivative import pending
 
     body, var, *rest = args
     _variable(name, body, var)
@@ -107,7 +111,17 @@ def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
                 "a number"
             )
         order = int(n.value)
-    return derivative(ctx, body, var, order, body.unit / var.unit**order)
+    if var.name not in ctx.scope:
+        raise TemplateError(
+            f"diff(): the derivative is a function of {var.name}, which is not an argument "
+            f'here: make {var.name} an argument of the definition ("NAME({var.name})")'
+        )
+    why = refusal(ctx, body)
+    if why:
+        raise TemplateError(f"diff(): {why}")
+    unit = body.unit / var.unit**order
+    pending(ctx, body, var, order, unit)
+    return ty.TFunc(unit, func=name, args=args)
 
 
 def _product_unit(ctx, name: str, args: tuple) -> ty.T:
@@ -264,6 +278,14 @@ def _extremum_numpy(name: str):
     return hook
 
 
+def _diff_numpy(of, order=1):
+    """The derivative's formula evaluated where diff() is (its variable is the enclosing
+    one's, in the environment)."""
+    from .derivative import compiled
+
+    return compiled(of.evaluator, of.body, of.var_param, int(order))(of.env)
+
+
 def _product_numpy(of, a, b):
     from . import series
 
@@ -375,8 +397,12 @@ def _product_excel(body, args, consts) -> tuple[str, int]:
     return "(" + ")*(".join(terms) + ")", PREC["*"]
 
 
-def _unreachable(*args):  # pragma: no cover - diff's unit rule returns the derivative itself
-    raise AssertionError("diff() is replaced by its derivative when the sheet is loaded")
+def _diff_excel(body, args, consts) -> tuple[str, int]:
+    """The derivative's formula, live like any other (found at first use)."""
+    from .derivative import formula
+
+    order = int(consts[0]) if consts else 1
+    return body.tree(formula(body.typer, body.typed, body.var_param, order))
 
 
 # -- sympy --------------------------------------------------------------------------------------
@@ -388,10 +414,17 @@ def _product_sympy(sp, body, var, a, b):
     return sp.Product(body, (var, a, b)).doit()
 
 
-def _no_sympy(name: str):
-    def convert(sp, body, var, *rest):
-        raise NotSymbolic(f"{name}() is solved numerically: it has no formula to differentiate")
+def _diff_sympy(sp, body, var, order=1):
+    return sp.diff(body, var, int(order))
 
+
+def _no_sympy(name: str):
+    why = f"{name}() is solved numerically: it has no formula to differentiate"
+
+    def convert(sp, body, var, *rest):
+        raise NotSymbolic(why)
+
+    convert.refusal = why  # read by workbook.symbolic.refusal, without SymPy
     return convert
 
 
@@ -449,11 +482,11 @@ register(
         "diff",
         (2, 3),
         _diff_unit,
-        _unreachable,
-        _unreachable,
-        _unreachable,
+        _diff_numpy,
+        _diff_excel,
+        _diff_sympy,
         doc="diff(EXPR, X) or diff(EXPR, X, N): the (N-th) derivative of EXPR in X, "
-        "found symbolically at load (a formula like any other)",
+        "found symbolically at first use (a formula like any other)",
         binds=(0, 1),
         mathml="<mfrac><mi mathvariant='normal'>d</mi><mrow><mi mathvariant='normal'>d</mi>{1}"
         "</mrow></mfrac>{0:group}",
