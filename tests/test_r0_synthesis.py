@@ -74,6 +74,31 @@ def reference_r0(H, phi_rise, alpha_max, e, delta_sigma, law, digits=40):
         return float(mpmath.sqrt(max(best, 0) ** 2 + e**2))
 
 
+def template_reference_r0(sheet, digits: int = 40) -> float:
+    """r0 in ``digits``-digit arithmetic from the template's own S0_req (through SymPy): its
+    largest value on each half of the rise from the ends and the roots of its derivative."""
+    import mpmath
+    import sympy as sp
+
+    from workbook import symbolic
+
+    x = symbolic.symbol("x")
+    expr = symbolic.to_sympy(sheet, "S0_req", {"x": x}, true_pi=True)
+    g = sp.lambdify(x, expr, "mpmath")
+    dg = sp.lambdify(x, sp.diff(expr, x), "mpmath")
+    e = mpmath.mpf(repr(mm(sheet.evaluate("e"))))
+    with mpmath.workdps(digits):
+        half = mpmath.mpf(1) / 2
+        best = max(g(mpmath.mpf(0)), g(half), g(mpmath.mpf(1)))
+        for lo, hi in ((0, half), (half, 1)):
+            pts = [lo + (hi - lo) * mpmath.mpf(i) / 200 for i in range(201)]
+            d = [dg(p) for p in pts[1:-1]]
+            for a, b, fa, fb in zip(pts[1:-2], pts[2:-1], d[:-1], d[1:]):
+                if fa > 0 > fb:  # a maximum between a and b
+                    best = max(best, g(mpmath.findroot(dg, (a, b), solver="anderson")))
+        return float(mpmath.sqrt(max(best, 0) ** 2 + e**2))
+
+
 @pytest.fixture(scope="module")
 def sheet():
     """With the optional part studies (left out by a plain load)."""
@@ -151,7 +176,7 @@ def test_direct_r0_is_scene_value(sheet):
     # and exact to floating point against a 40-digit evaluation
     ref = reference_r0(**SCENE)
     assert r0 == pytest.approx(ref, rel=1e-14)
-    assert R.reference_r0(sheet) == pytest.approx(ref, rel=1e-15)  # the block's, from S0_req
+    assert template_reference_r0(sheet) == pytest.approx(ref, rel=1e-15)  # from S0_req
 
 
 @pytest.mark.parametrize("dr, expected", [("1 mm", 39.0), ("0.1 mm", 38.3), ("0.01 mm", 38.25)])
@@ -237,7 +262,9 @@ def test_rise_laws(sheet, law):
     assert np.allclose(Sp, 16.0 * law_slope_exact(law, x) / phi_rise, rtol=0, atol=1e-12)
     assert Sp[0] == pytest.approx(0, abs=1e-12) and Sp[-1] == pytest.approx(0, abs=1e-12)
     # and the workbook r0 for this law is the direct answer
-    assert R.reference_r0(s) == pytest.approx(reference_r0(**dict(SCENE, law=law)), rel=1e-14)
+    assert template_reference_r0(s) == pytest.approx(
+        reference_r0(**dict(SCENE, law=law)), rel=1e-14
+    )
 
 
 def test_grid_maximum_aggregate(sheet):
@@ -368,6 +395,15 @@ def test_findings_all_pass(sheet):
     assert [f.value for f in listed[1:]] == pytest.approx([39.0, 38.3, 38.25], abs=1e-9)
     fig4 = [f for f in report.findings if f.topic == "Fig. 4"]
     assert all(abs(f.value) > 1 for f in fig4)  # alpha at phi_rise/2 and phi_rise does change
+    # the same from the paper's formula, written out here, at r0 and 2*r0
+    r0, phi_rise = mm(sheet.evaluate("r0")), math.radians(100)
+    for f, x in zip(fig4, (0.5, 1.0)):
+        sp_, s_ = 16.0 * law_slope_exact("stepped", x) / phi_rise, 16.0 * law_arrays("stepped", x)
+        alpha = [
+            math.degrees(math.atan((sp_ + 6.0) / (math.sqrt(r * r - 36) + s_)))
+            for r in (r0, 2 * r0)
+        ]
+        assert f.value == pytest.approx(alpha[1] - alpha[0], abs=1e-12)
 
 
 # -- the workbook ---------------------------------------------------------------------------

@@ -249,8 +249,11 @@ def test_rp_7_6_undercut(sheet):
 def test_packing_limit_verdict(sheet):
     s = sheet.with_inputs(e1="0.3 mm", rp="10.3 mm")  # convex; packing limit 10.275 mm
     f = [x for x in s.check().findings if x.topic == "undercut"]
-    bad = next(x for x in f if x.verdict == "fail")
+    bad = next(x for x in f if x.what.startswith("INVALID PROFILE"))
+    assert bad.verdict == "fail"
     assert "packing limit" in bad.what and "overlap" in bad.what
+    margin = next(x for x in f if x.what.startswith("rp = 10.3 mm: margin"))
+    assert margin.verdict == "fail" and margin.value == pytest.approx(10.275116 - 10.3, abs=1e-6)
 
 
 @pytest.mark.parametrize("factor,concave", [(0.98, False), (1.02, True)])
@@ -282,8 +285,9 @@ def test_e1_zero_gives_circles(sheet, sense):
 def test_e1_not_below_r2_is_refused_clearly(sheet, e1):
     s = sheet.with_inputs(e1=e1)
     f = s.check().findings
-    assert len(f) == 1 and f[0].verdict == "fail"
-    assert "not smaller than r2" in f[0].what and "cannot be assembled" in f[0].what
+    assert all(x.verdict == "fail" and x.value is None for x in f)  # no number for no mechanism
+    why = next(x for x in f if x.topic == "inputs")
+    assert "not smaller than r2" in why.what and "cannot be assembled" in why.what
     with pytest.raises(InputError, match="not smaller than r2"):
         s.table("rollers")
     with pytest.raises(WorkbookError, match="is not a finite number"):
@@ -292,7 +296,8 @@ def test_e1_not_below_r2_is_refused_clearly(sheet, e1):
 
 def test_fractional_roller_count_is_refused(sheet):
     f = sheet.with_inputs(n=12.5).check().findings
-    assert f[0].verdict == "fail" and "whole number" in f[0].what
+    assert all(x.verdict == "fail" and x.value is None for x in f)
+    assert "whole number" in next(x for x in f if x.topic == "inputs").what
 
 
 # -- the symbolic converter -------------------------------------------------------------------

@@ -3,15 +3,16 @@
 Scene r0-synthesis: Parkhomenko, Porotnikov, Kucher (DonNTU) describe a VBA macro that finds
 r0 by stepping r0 = e + dr, e + 2 dr, ... until the pressure angle stays within alpha_max at
 every angle of the rise. The rise laws, the required S0, its maximum over the continuous angle
-(``maximum``/``argmax``) and r0 are the template's (templates/r0-synthesis.toml). Here:
+(``maximum``/``argmax``), r0 and the checks are the template's (templates/r0-synthesis.toml).
+Here:
 
 * :func:`loop_r0` is the macro's loop (r0 = e + k*dr, not r0 += dr, so no drift): on the grid,
   |alpha| <= alpha_max at every angle exactly when S0 = sqrt(r0^2 - e^2) reaches the grid's
   largest required S0 (``S0_grid``), so the loop steps k until it does; it refuses the cases
   the macro got wrong silently;
-* the findings check r0 against brute force and the paper's Fig. 4 text, and the bench times
-  the loop against the direct solution, whose error is measured against 40 digits (the
-  template's own S0_req through SymPy and mpmath).
+* the listed example's lengths (the language has no length literal to compare with);
+* the study that times the loop against the direct solution, whose error is measured against
+  the same solution at the reference tolerance of ``workbook bench``.
 """
 
 from __future__ import annotations
@@ -74,81 +75,27 @@ def loop(e: float, dr: float, r0_grid: float, r0: float, cap: int = LOOP_CAP) ->
     return r, k
 
 
-# -- checks ---------------------------------------------------------------------------------
-def _example(sheet) -> bool:
-    """Are the sheet's inputs the template's (the listed example)?"""
-    names = ("H", "phi_rise", "alpha_max", "e", "delta_sigma", "law")
-    return all(sheet.evaluate(n) == sheet.spec.inputs[n].value for n in names)
-
-
+# -- the listed example ----------------------------------------------------------------------
 LISTED_R0 = 38.2405  # the example's direct r0 and the loop's r0 for each dr
 LISTED_LOOP = {"1 mm": 39.0, "0.1 mm": 38.3, "0.01 mm": 38.25}
 
 
 @findings_block
-def findings(sheet) -> list[Finding]:
-    """r0 checks: continuous maximum, brute force, the loop, the paper's Fig. 4 claim."""
-    out: list[Finding] = []
-    r0, e = _mm(sheet, "r0"), _mm(sheet, "e")
-    phi = float(sheet.evaluate("phi_of", x=float(sheet.evaluate("x_crit"))).to("deg").magnitude)
-    out.append(
-        Finding(
-            "direct r0", f"r0 over the continuous angle (critical phi = {phi:.6g} deg)", r0, "mm"
-        )
-    )
-    brute = _mm(sheet.with_inputs(n_grid=1_000_001), "r0_grid") - r0
-    out.append(
-        Finding(
-            "direct r0",
-            "brute force over 1,000,001 angles (r0_grid) minus direct r0",
-            brute,
-            "mm",
-            "ok" if -1e-6 <= brute <= 1e-12 else "fail",
-            "a dense grid can only fall short of the continuous maximum",
-        )
-    )
-    top = float((sheet.evaluate("alpha_top") - sheet.evaluate("alpha_max")).to("deg").magnitude)
-    ok = "ok" if abs(top) < 1e-9 else "fail"
-    out.append(Finding("direct r0", "largest |alpha| at r0 minus alpha_max", top, "deg", ok))
-    dr, n = _mm(sheet, "dr"), int(float(sheet.evaluate("n_grid").magnitude))
-    try:
-        r_loop = _mm(sheet, "r0_loop")
-        out.append(
-            Finding(
-                "VBA loop",
-                f"r0 by the loop (dr = {dr:g} mm, {n} angles, "
-                f"{round((r_loop - e) / dr):,} steps) minus direct r0",
-                r_loop - r0,
-                "mm",
-                "ok" if 0 <= r_loop - r0 <= dr + 1e-9 else "warning",
-                "the loop overshoots by up to dr",
-            )
-        )
-    except (InputError, LimitError) as err:
-        out.append(Finding("VBA loop", "the loop cannot give r0", None, "", "warning", err.message))
-    if _example(sheet):
-        ok = "ok" if abs(r0 - LISTED_R0) <= 5e-5 else "fail"
-        out.append(Finding("listed example", f"direct r0 (listed {LISTED_R0} mm)", r0, "mm", ok))
-        odd = {"n_grid": n if n % 2 else 101}
-        for dr_text, listed in LISTED_LOOP.items():
-            r = _mm(sheet.with_inputs(dr=dr_text, **odd), "r0_loop")
-            ok = "ok" if abs(r - listed) <= 1e-9 else "fail"
-            what = f"loop r0 with dr = {dr_text} (listed {listed:g} mm)"
-            out.append(Finding("listed example", what, r, "mm", ok))
-    # the paper's Fig. 4 text: alpha at phi_rise/2 and phi_rise "does not depend on r0"
-    x = np.array([0.0, 0.5, 1.0])
-    at = [sheet.evaluate("alpha_r", x=x, r=f"{r!r} mm").to("deg").magnitude for r in (r0, 2 * r0)]
-    for j, name in ((1, "phi_rise/2"), (2, "phi_rise")):
-        change = float(at[1][j] - at[0][j])
-        out.append(
-            Finding(
-                "Fig. 4",
-                f"alpha at {name}: at 2*r0 minus at r0 (the paper says it does not depend on r0)",
-                change,
-                "deg",
-                "info" if abs(change) > 1e-9 else "ok",
-            )
-        )
+def listed_example(sheet) -> list[Finding]:
+    """The paper's r0 and loop results, when the design inputs are the template's own (any
+    dr and grid: the loop runs at the listed dr on the grid, or on 101 angles if it is even)."""
+    names = ("H", "phi_rise", "alpha_max", "e", "delta_sigma", "law")
+    if not all(sheet.evaluate(n) == sheet.spec.inputs[n].value for n in names):
+        return []
+    r0, n = _mm(sheet, "r0"), int(float(sheet.evaluate("n_grid").magnitude))
+    odd = {"n_grid": n if n % 2 else 101}
+    ok = "ok" if abs(r0 - LISTED_R0) <= 5e-5 else "fail"
+    out = [Finding("listed example", f"direct r0 (listed {LISTED_R0} mm)", r0, "mm", ok)]
+    for dr_text, listed in LISTED_LOOP.items():
+        r = _mm(sheet.with_inputs(dr=dr_text, **odd), "r0_loop")
+        ok = "ok" if abs(r - listed) <= 1e-9 else "fail"
+        what = f"loop r0 with dr = {dr_text} (listed {listed:g} mm)"
+        out.append(Finding("listed example", what, r, "mm", ok))
     return out
 
 
@@ -237,42 +184,22 @@ def bench_chart(sheet):
 
 @table_block
 def direct_point(sheet):
-    """The direct method as one point: its run time, and its error against 40-digit mpmath."""
+    """The direct method as one point: its run time, and its error against the same solution at
+    the reference tolerance of ``workbook bench`` (1e-14)."""
     import pandas as pd
+
+    from ..numerics._common import current, sheet_tolerance, tolerance
+    from ..numerics.bench import REFERENCE_RTOL
 
     df = run_bench(sheet, grids=WORKBOOK_GRIDS)
     r0 = float(df["r0 direct [mm]"].iloc[0])
-    ref = reference_r0(sheet)
+    with tolerance(current(sheet_tolerance(sheet.spec.meta)).tighter(REFERENCE_RTOL)):
+        ref = _mm(sheet.with_inputs(), "r0")
     return pd.DataFrame(
         {
             "direct time [s]": [float(df["direct time [s]"].iloc[0])],
             "direct error [mm]": [max(abs(r0 - ref), 1e-15)],  # a log axis cannot show 0
             "r0 direct [mm]": [r0],
-            "r0 reference (mpmath, 40 digits) [mm]": [ref],
+            "r0 reference (tolerance 1e-14) [mm]": [ref],
         }
     )
-
-
-def reference_r0(sheet, digits: int = 40) -> float:
-    """r0 in ``digits``-digit arithmetic: the template's S0_req through SymPy, its largest value
-    on each half of the rise from the ends and the roots of its derivative (mpmath)."""
-    import mpmath
-    import sympy as sp
-
-    from .. import symbolic
-
-    x = symbolic.symbol("x")
-    expr = symbolic.to_sympy(sheet, "S0_req", {"x": x}, true_pi=True)
-    g = sp.lambdify(x, expr, "mpmath")
-    dg = sp.lambdify(x, sp.diff(expr, x), "mpmath")
-    e = mpmath.mpf(repr(_mm(sheet, "e")))
-    with mpmath.workdps(digits):
-        half = mpmath.mpf(1) / 2
-        best = max(g(mpmath.mpf(0)), g(half), g(mpmath.mpf(1)))
-        for lo, hi in ((0, half), (half, 1)):
-            pts = [lo + (hi - lo) * mpmath.mpf(i) / 200 for i in range(201)]
-            d = [dg(p) for p in pts[1:-1]]
-            for a, b, fa, fb in zip(pts[1:-2], pts[2:-1], d[:-1], d[1:]):
-                if fa > 0 > fb:  # a maximum between a and b
-                    best = max(best, g(mpmath.findroot(dg, (a, b), solver="anderson")))
-        return float(mpmath.sqrt(max(best, 0) ** 2 + e**2))

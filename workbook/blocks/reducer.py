@@ -359,7 +359,7 @@ def findings(sheet) -> list[Finding]:
                 )
             )
 
-    rp, packing = _mag(sheet, "rp", "mm"), _mag(sheet, "rp_packing", "mm")
+    rp = _mag(sheet, "rp", "mm")
     if _mag(sheet, "kappa_max", "1/mm") > 0:
         phi = _mag(sheet, "phi_valley", "deg")
         x, y = (float(_f(sheet, name, 0, phi)) for name in ("x_t", "y_t"))
@@ -385,23 +385,8 @@ def findings(sheet) -> list[Finding]:
                 "info",
             )
         )
-    what = "packing limit (r2 - e1)*sin(pi/n)"
-    note = "neighbouring rollers touch when rp reaches it"
-    out.append(Finding("undercut", what, packing, "mm", "info", note))
     regular = _mag(sheet, "regular") == 1
-    if regular:
-        out.append(
-            Finding(
-                "undercut",
-                f"rp = {rp:g} mm is below both limits: the practical "
-                "profile is regular (no cusps, no loops)",
-                _mag(sheet, "rp_margin", "mm"),
-                "mm",
-                "ok",
-                "margin to the nearer limit",
-            )
-        )
-    else:
+    if not regular:
         note = "the profile tables and the chart still show it"
         out.append(
             Finding("undercut", "INVALID PROFILE: " + _verdict_text(sheet), rp, "mm", "fail", note)
