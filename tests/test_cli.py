@@ -109,17 +109,17 @@ def test_a_bug_in_a_block_is_exit_3_in_one_line(tmp_path, monkeypatch, capsys):
     from workbook import blocks
     from workbook.cli import main
 
-    out = tmp_path / "cc.xlsx"
-    assert main(["run", "concave-cam", "--out", str(out)]) == 0
+    out = tmp_path / "valve.xlsx"
+    args = ["run", "cam-wear-valve", "--out", str(out)]
+    assert main(args) == 0
     before = out.read_bytes()
-    blocks.get("concave.stability_findings")  # registers the module's blocks
+    blocks.get("wear.measured_findings")  # registers the module's blocks
 
     def broken(sheet):
         return 1 / 0
 
-    monkeypatch.setattr(blocks._REGISTRY["concave.stability_findings"], "func", broken)
+    monkeypatch.setattr(blocks._REGISTRY["wear.measured_findings"], "func", broken)
     capsys.readouterr()
-    args = ["run", "concave-cam", "--part", "hand-checks", "--out", str(out)]
     assert main(args) == 3
     err = capsys.readouterr().err
     assert err.startswith("workbook: internal error (ZeroDivisionError: division by zero)")
