@@ -3,8 +3,9 @@
 References are not taken from the code under test where that is possible: the steady roots
 from mpmath.findroot on the equilibrium written out here from the paper, the values of the
 reference example, eigenfrequencies from scipy.linalg.eigh on (K, M), the exact
-solution (matrix exponential) checked against solve_ivp at rtol 1e-12, and the rigid-tooth
-limit from a 2-DOF ODE written out here and integrated with solve_ivp at rtol 1e-12.
+solution (matrix exponential) checked against solve_ivp at rtol 1e-12 on the template's ODE,
+and the rigid-tooth limit from a 2-DOF ODE written out here and integrated with solve_ivp at
+rtol 1e-12.
 """
 
 from __future__ import annotations
@@ -16,8 +17,8 @@ import numpy as np
 import pytest
 
 import workbook
+from workbook import ode
 from workbook.blocks import coupling as cp
-from workbook.blocks import solvers as sv
 from workbook.errors import WorkbookError
 
 # the reference example's dimensions (SI)
@@ -247,33 +248,33 @@ def _undamped_freqs(c2):
 
 @pytest.mark.parametrize("c2,tooth", [(1e6, 707.0), (1e8, 7070.0)])
 def test_eigenvalues(sheet, c2, tooth):
-    lam = cp.eigen(variant(sheet, c2))
-    assert len(lam) == 4  # rigid rotation mode excluded
+    s = variant(sheet, c2)
+    lam = s.evaluate("lam").to("1/s").magnitude  # rows (Re, Im)
+    assert lam.shape == (4, 2)  # rigid rotation mode excluded
     ref = _undamped_freqs(c2)
-    got = np.sort(np.abs(lam.imag))[::2]
+    got = np.sort(np.abs(lam[:, 1]))[::2]
     np.testing.assert_allclose(got, ref, rtol=2e-3)  # light damping shifts them a little
-    assert abs(lam[-1].imag) == pytest.approx(tooth, rel=0.01)  # reference example: ~707, ~7070
-    assert np.all(lam.real < 0)
-    assert np.all(cp.eigen(variant(sheet, c2), damping="as printed").real > 0)  # printed sign
+    assert abs(lam[-1, 1]) == pytest.approx(tooth, rel=0.01)  # reference example: ~707, ~7070
+    assert np.all(lam[:, 0] < 0)
+    assert np.all(s.evaluate("lam_printed").magnitude[:, 0] > 0)  # printed sign
 
 
 def test_stiffness_grows_with_c2(sheet):
-    idx = [cp.stiffness(variant(sheet, c2))["index"] for c2 in (1e6, 1e8, 1e10)]
+    idx = [float(variant(sheet, c2).evaluate("stiff_index")) for c2 in (1e6, 1e8, 1e10)]
     assert idx[1] / idx[0] == pytest.approx(10, rel=0.01)
     assert idx[2] / idx[1] == pytest.approx(10, rel=0.01)
-    assert cp.auto_method(variant(sheet, 1e6)) == "LSODA"
-    assert cp.auto_method(variant(sheet, 1e10)) == "Radau"
+    assert variant(sheet, 1e6).evaluate("method_used") == "LSODA"
+    assert variant(sheet, 1e10).evaluate("method_used") == "Radau"
 
 
 def test_exact_solution_matches_tight_solve_ivp(sheet):
     from scipy.integrate import solve_ivp
 
-    cs = cp.case(variant(sheet, 1e8, 0.1))
-    pr = cs.problem
-    sol = solve_ivp(
-        pr.fun, (0, pr.t_end), pr.y0, method="DOP853", rtol=1e-12, atol=1e-15, t_eval=pr.t_eval
-    )
-    err = np.max(np.abs(pr.model.outputs(sol.y) - cs.exact))
+    s = variant(sheet, 1e8, 0.1)
+    cs = cp.case(s)
+    fun, t0, t1, y0 = ode.problem(s.typer.ode("motion"), s.evaluator.compile)
+    sol = solve_ivp(fun, (t0, t1), y0, method="DOP853", rtol=1e-12, atol=1e-15, t_eval=cs.t)
+    err = np.max(np.abs(cp.outputs(sol.y) - cs.exact))
     assert err < 1e-10
 
 
@@ -319,10 +320,10 @@ def test_rigid_limit_and_default_solver_at_c2_1e10(sheet):
     assert cs.delta == pytest.approx(predicted, rel=0.2)
     assert d8 / d9 == pytest.approx(10, rel=0.2)
     tol = 2 * predicted
-    method = cp.auto_method(variant(sheet, 1e10))
-    run = cs.problem.run(method, 1e-5)
+    method = str(variant(sheet, 1e10).evaluate("method_used"))
+    run = cp.run(variant(sheet, 1e10), method, 1e-5, cs.t)
     assert run.ok
-    dev = np.max(np.abs(cs.problem.model.outputs(run.y) - ref))
+    dev = np.max(np.abs(cp.outputs(run.y) - ref))
     assert dev <= tol, (method, dev, tol)
 
 
@@ -332,23 +333,24 @@ def test_default_solver_within_2x_of_fastest(sheet):
     limit are then timed again side by side (best of 3)."""
     p = variant(sheet, t_end=0.1)
     df = cp.study(p, (1e10,), (1e-3, 1e-4, 1e-5, 1e-6, 1e-7), max_time=2.0, label=None)
-    cs = cp.case(variant(p, 1e10))
+    stiff = variant(p, 1e10)
+    cs = cp.case(stiff)
     tol = 2 * cs.delta
     ok = df[(df["stopped"] == "finished") & (df["deviation from rigid [rad]"] <= tol)]
     assert not ok.empty
     best = ok.loc[ok["run time [s]"].idxmin()]
-    method = cp.auto_method(variant(p, 1e10))
+    method = str(stiff.evaluate("method_used"))
     default_rows = ok[(ok["method"] == method) & (ok["rtol"] == 1e-5)]
     assert not default_rows.empty  # the default reaches the rigid limit
-    t_best = min(cs.problem.run(best["method"], best["rtol"]).elapsed for _ in range(3))
-    t_def = min(cs.problem.run(method, 1e-5).elapsed for _ in range(3))
+    t_best = min(cp.run(stiff, best["method"], best["rtol"], cs.t).elapsed for _ in range(3))
+    t_def = min(cp.run(stiff, method, 1e-5, cs.t).elapsed for _ in range(3))
     assert t_def <= 2 * t_best, (best["method"], best["rtol"], t_best, t_def)
 
 
 def test_errors_fall_with_rtol_at_moderate_c2(sheet):
     p = variant(sheet, t_end=0.1)
     df = cp.study(p, (1e6,), (1e-3, 1e-6, 1e-9), max_time=5.0, label=None)
-    for m in sv.METHODS:
+    for m in ode.SOLVERS:
         e = df[df["method"] == m].sort_values("rtol", ascending=False)["error [rad]"].to_numpy()
         assert e[-1] < e[0] / 100, (m, e)
 
@@ -368,26 +370,17 @@ def test_explicit_method_on_a_very_stiff_tooth_is_bounded(sheet):
 def test_weights_on_the_stop_dynamics(sheet):
     p = variant(sheet, t_end=0.05, omega_dyn="50 rad/s")
     assert float(p.evaluate("F0", omega1=50).magnitude) <= 0  # on the stop
-    mdl = cp.model(p)
-    assert mdl.n == 2  # phi2 held on the stop
-    cs = cp.case(p)
-    run = cs.problem.run("Radau", 1e-6)
+    assert float(p.evaluate("free")) == 0  # phi2 held on the stop
+    run = cp.run(p, "Radau", 1e-6, cp.times(p))
     assert run.ok
-    assert np.all(cs.problem.model.outputs(run.y)[0] == 0.0)
+    assert np.all(cp.outputs(run.y)[0] == 0.0)
+    assert np.all(p.evaluate("phi2_r", t=cp.times(p)).magnitude == 0.0)
 
 
 def test_run_ode_progress_goes_to_stderr(sheet, capsys):
-    pr = cp.case(variant(sheet, 1e8, 0.05)).problem
-    sv.run_ode(
-        pr.fun,
-        (0, pr.t_end),
-        pr.y0,
-        method="RK45",
-        rtol=1e-6,
-        label="probe",
-        progress_every=0.0,
-        t_eval=pr.t_eval,
-    )
+    s = variant(sheet, 1e8, 0.05)
+    fun, t0, t1, y0 = ode.problem(s.typer.ode("motion"), s.evaluator.compile)
+    ode.run_ode(fun, (t0, t1), y0, method="RK45", rtol=1e-6, label="probe", progress_every=0.0)
     err = capsys.readouterr().err
     assert "[probe] t = " in err and "finished" in err
 
@@ -395,15 +388,15 @@ def test_run_ode_progress_goes_to_stderr(sheet, capsys):
 def test_ctrl_c_leaves_no_partial_state(sheet, monkeypatch):
     p = variant(sheet, t_end=0.013)
     calls = {"n": 0}
-    real = cp.Problem.run
+    real = cp.run
 
-    def interrupted(self, *a, **k):
+    def interrupted(*a, **k):
         calls["n"] += 1
         if calls["n"] == 3:
             raise KeyboardInterrupt
-        return real(self, *a, **k)
+        return real(*a, **k)
 
-    monkeypatch.setattr(cp.Problem, "run", interrupted)
+    monkeypatch.setattr(cp, "run", interrupted)
     from workbook import blocks
 
     before = set(blocks._CACHE)
@@ -422,7 +415,7 @@ def test_ctrl_c_during_write_keeps_old_file(tmp_path, monkeypatch):
 
     from workbook import blocks
 
-    monkeypatch.setattr(blocks.get("coupling.histories", "table"), "func", boom)
+    monkeypatch.setattr(blocks.get("coupling.stiffness_table", "table"), "func", boom)
     with pytest.raises(KeyboardInterrupt):
         sheet.write_xlsx(out, force=True)
     assert out.read_bytes() == b"old"
@@ -434,7 +427,7 @@ def test_bench_quick_is_fast(sheet):
     t = time.perf_counter()
     df = cp.bench(sheet, quick=True)
     assert time.perf_counter() - t < 5.0
-    assert set(df["method"]) == set(sv.METHODS)
+    assert set(df["method"]) == set(ode.SOLVERS)
     assert {"error [rad]", "run time [s]", "stopped"} <= set(df.columns)
 
 

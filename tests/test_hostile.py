@@ -201,8 +201,8 @@ HOSTILE = {
         "no block module 'builtins'",
     ),
     "block_helper_not_registered": (
-        '[blocks]\nrun = "solvers.run_ode"\n\n' + define("run(1)"),
-        "has no registered block 'run_ode'",
+        '[blocks]\nrun = "coupling.linear_system"\n\n' + define("run(1)"),
+        "has no registered block 'linear_system'",
     ),
     "block_dotted": (
         '[blocks]\nrun = "os.path.join"\n\n' + define("run(1)"),
@@ -269,7 +269,7 @@ def test_solver_step_cap_stops_a_billion_steps():
     documented budget (wall clock, then the step cap) with a reason, not after hours."""
     import numpy as np
 
-    from workbook.blocks.solvers import run_ode
+    from workbook.ode import run_ode
 
     def stiff(t, y):  # y' = -1e6 (y - cos t): RK45 needs ~1e6 steps per unit of time
         return -1e6 * (y - np.cos(t))

@@ -150,6 +150,15 @@ def eigenvecs(m):
     return _first(vec)
 
 
+def eigenparts(m):
+    """Eigenvalues, complex ones included, as rows (Re, Im): by modulus, then by imaginary
+    part (a conjugate pair: the negative imaginary part first)."""
+    lam = np.linalg.eigvals(_last(m))
+    order = np.lexsort((lam.imag, np.abs(lam)), axis=-1)
+    lam = np.take_along_axis(lam, order, axis=-1)
+    return _first(np.stack([lam.real, lam.imag], axis=-1))
+
+
 def cross(a, b):
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     ra, rb = a.ndim - 2, b.ndim - 2
@@ -380,6 +389,19 @@ def register_entries() -> None:
         lambda m, shapes: eigenvals(m),
         not_live("eigenvalues have no spreadsheet formula"),
         "eigenvalues of a square matrix, ascending (real ones only)",
+    )
+
+    def r_eigenparts(ctx, name, args):
+        n = square(args, name)
+        return func(args[0].unit, name, args, (n, 2))
+
+    entry(
+        "eigenparts",
+        1,
+        r_eigenparts,
+        lambda m, shapes: eigenparts(m),
+        not_live("eigenvalues have no spreadsheet formula"),
+        "eigenvalues, complex ones included, as rows (Re, Im) by modulus",
     )
     entry(
         "eigenvecs",

@@ -2,8 +2,8 @@
 
 A section declares states (unit, initial value, derivative expression), the time range and the
 method; the engine types the expressions like any definition, integrates once with
-``workbook.blocks.solvers.run_ode`` (a wall-clock budget and a step cap, dense output) and
-each state becomes a function of time, ``x(t)``, usable in tables and charts::
+:func:`run_ode` (a wall-clock budget and a step cap, dense output) and each state becomes a
+function of time, ``x(t)``, usable in tables and charts::
 
     [[ode]]
     name = "fall"
@@ -16,15 +16,23 @@ each state becomes a function of time, ``x(t)``, usable in tables and charts::
       { name = "v", unit = "m/s", initial = "0 m/s", derivative = "-g - c/m*v" },
     ]
 
+``method``, ``rtol``, ``atol`` and ``max_time`` may also be expressions of the sheet (a text
+definition or choice input for the method), and a state may have its own ``atol``.
+
 This module holds the numerical side on plain magnitudes (states in their declared units,
-time in its unit): reading a section, choosing a method, running it and the bench rows.
-scipy is imported inside the functions.
+time in its unit): reading a section, choosing a method, the bounded runner
+(:func:`run_ode`, in the style of ``solve_ivp`` but stopped by a wall-clock budget or a step
+cap, saying why), a sheet's run with other settings (:func:`run_sheet`, for studies) and
+error against run time. scipy is imported inside the functions. Ctrl-C is not caught: a
+KeyboardInterrupt leaves a run at once and nothing half-made is kept.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+import sys
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,6 +52,9 @@ MAX_STEPS = 1_000_000
 MAX_STATES = 1000
 
 
+Setting = float | ex.Node  # a number, or an expression of the sheet
+
+
 @dataclass(frozen=True)
 class StateSpec:
     name: str
@@ -52,6 +63,7 @@ class StateSpec:
     derivative: ex.Node
     initial_text: str
     derivative_text: str
+    atol: ex.Node | None = None  # this state's absolute tolerance (in its unit)
 
 
 @dataclass(frozen=True)
@@ -62,17 +74,24 @@ class OdeSpec:
     last: ex.Node
     time_text: str
     states: tuple[StateSpec, ...]
-    method: str = "auto"
-    rtol: float = 1e-6
-    atol: float = 1e-9
-    max_time: float = MAX_TIME
+    method: str | ex.Node = "auto"  # one of METHODS, or an expression giving one
+    rtol: Setting = 1e-6
+    atol: Setting = 1e-9
+    max_time: Setting = MAX_TIME
     max_steps: int = MAX_STEPS
     note: str = ""
     line: int | None = None
 
+    def expressions(self) -> list[ex.Node]:
+        """Every expression of the section (what it depends on)."""
+        out = [self.first, self.last]
+        out += [x for s in self.states for x in (s.initial, s.derivative, s.atol) if x]
+        settings = (self.method, self.rtol, self.atol, self.max_time)
+        return out + [x for x in settings if isinstance(x, ex.Node)]
+
 
 _KEYS = {"name", "time", "states", "method", "rtol", "atol", "max_time", "max_steps", "note"}
-_STATE_KEYS = {"name", "unit", "initial", "derivative", "note"}
+_STATE_KEYS = {"name", "unit", "initial", "derivative", "atol", "note"}
 
 
 def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
@@ -98,14 +117,14 @@ def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
     if rng.second is not None:
         raise TemplateError(f"{where}: time is 'VAR := FIRST .. LAST' (no step)", line=line)
     method = raw.get("method", "auto")
+    if not isinstance(method, str):
+        raise TemplateError(f"{where}: method is one of {', '.join(METHODS)}", line=line)
     if method not in METHODS:
-        raise TemplateError(
-            f"{where}: method {method!r} is not one of {', '.join(METHODS)}", line=line
-        )
-    rtol, atol = _positive(raw, "rtol", 1e-6, where), _positive(raw, "atol", 1e-9, where)
-    if rtol < 1e-13:
+        method = ex.parse(method, what=f"{where}: method")
+    rtol, atol = _setting(raw, "rtol", 1e-6, where), _setting(raw, "atol", 1e-9, where)
+    if isinstance(rtol, float) and rtol < 1e-13:
         raise TemplateError(f"{where}: rtol {rtol:g} is below what doubles resolve (1e-13)")
-    max_time = _positive(raw, "max_time", MAX_TIME, where)
+    max_time = _setting(raw, "max_time", MAX_TIME, where)
     max_steps = int(_positive(raw, "max_steps", MAX_STEPS, where))
     states = raw.get("states")
     if not isinstance(states, list) or not states:
@@ -125,7 +144,7 @@ def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
         missing = {"name", "initial", "derivative"} - set(s)
         if extra or missing:
             raise TemplateError(
-                f"{sw}: keys are name, unit, initial, derivative (and note); "
+                f"{sw}: keys are name, unit, initial, derivative (and atol, note); "
                 + (f"unknown: {', '.join(sorted(extra))}" if extra else "")
                 + (f"missing: {', '.join(sorted(missing))}" if missing else ""),
                 line=line,
@@ -148,6 +167,7 @@ def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
                 ex.parse(der, what=f"{sw}: derivative"),
                 init,
                 der,
+                _expression(s["atol"], f"{sw}: atol") if "atol" in s else None,
             )
         )
     if rng.var in seen:
@@ -169,11 +189,293 @@ def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
     )
 
 
+def _expression(v, what: str) -> ex.Node:
+    """A setting given as a number or as an expression text."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+        raise TemplateError(f"{what}: a number or an expression, got {v!r}")
+    return ex.parse(v if isinstance(v, str) else repr(v), what=what)
+
+
+def _setting(raw: dict, key: str, default: float, where: str) -> Setting:
+    """A positive number, or an expression of the sheet (checked when it is evaluated)."""
+    if isinstance(raw.get(key), str):
+        return ex.parse(raw[key], what=f"{where}: {key}")
+    return _positive(raw, key, default, where)
+
+
 def _positive(raw: dict, key: str, default: float, where: str) -> float:
     v = raw.get(key, default)
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not (v > 0 and math.isfinite(v)):
         raise TemplateError(f"{where}: {key} must be a positive number, got {v!r}")
     return float(v)
+
+
+# -- bounded runs -----------------------------------------------------------------------------
+SOLVERS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+IMPLICIT = ("Radau", "BDF", "LSODA")  # methods that use a Jacobian
+
+
+@dataclass
+class OdeRun:
+    """One ODE run: the solution at t_eval (or at the steps), cost, and why it stopped."""
+
+    method: str
+    rtol: float
+    atol: float
+    t: np.ndarray
+    y: np.ndarray  # shape (n, len(t))
+    stop_reason: str  # "finished" | "time budget" | "step cap" | "failed: <message>"
+    elapsed: float  # wall-clock seconds (time.perf_counter)
+    nfev: int
+    njev: int
+    nlu: int
+    nsteps: int
+    t_reached: float
+    t_final: float
+    notes: list[str] = field(default_factory=list)
+    sol: object = None  # scipy OdeSolution over [t0, t_reached] when run with dense_output
+
+    @property
+    def ok(self) -> bool:
+        return self.stop_reason == "finished"
+
+    @property
+    def fraction(self) -> float:
+        """Fraction of the time span covered."""
+        span = self.t_final - self.t[0] if len(self.t) else 1.0
+        return 1.0 if span == 0 else min(1.0, max(0.0, (self.t_reached - self.t[0]) / span))
+
+    def summary(self) -> str:
+        head = f"{self.method} rtol={self.rtol:.0e}: {self.stop_reason}"
+        return (
+            f"{head} at t = {self.t_reached:.6g} of {self.t_final:.6g} "
+            f"({100 * self.fraction:.1f} %), {self.nsteps} steps, {self.nfev} f-evals, "
+            f"{self.elapsed:.3g} s"
+        )
+
+
+def _progress(label: str, solver, t0: float, t1: float, nsteps: int, start: float) -> None:
+    frac = (solver.t - t0) / (t1 - t0) if t1 != t0 else 1.0
+    print(
+        f"[{label}] t = {solver.t:.4g} of {t1:.4g} ({100 * frac:.1f} %), {nsteps} steps, "
+        f"{time.perf_counter() - start:.1f} s",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def run_ode(
+    fun: Callable,
+    t_span: Sequence[float],
+    y0,
+    *,
+    method: str = "RK45",
+    rtol: float = 1e-6,
+    atol: float | np.ndarray = 1e-9,
+    jac=None,
+    t_eval=None,
+    max_time: float = 30.0,
+    max_steps: int = 1_000_000,
+    first_step=None,
+    max_step: float = np.inf,
+    label: str | None = None,
+    progress_every: float = 2.0,
+    dense_output: bool = False,
+    blowup: float | None = None,
+) -> OdeRun:
+    """Integrate y' = fun(t, y) over t_span with scipy's solver ``method``, bounded in time.
+
+    Like ``solve_ivp`` (t_eval values are interpolated from each step's dense output) but the
+    run stops, with ``stop_reason`` saying why, after ``max_time`` wall-clock seconds or
+    ``max_steps`` steps. ``jac`` is passed to the implicit methods only. With
+    ``dense_output`` the run keeps every step's interpolant (``run.sol``, a scipy
+    OdeSolution); with ``blowup`` it stops ("blow-up") when a state leaves the finite numbers
+    or exceeds that magnitude.
+    """
+    from scipy import integrate
+
+    classes = {
+        "RK45": integrate.RK45,
+        "DOP853": integrate.DOP853,
+        "Radau": integrate.Radau,
+        "BDF": integrate.BDF,
+        "LSODA": integrate.LSODA,
+        "RK23": integrate.RK23,
+    }
+    if method not in classes:
+        raise ValueError(f"unknown ODE method {method!r} (known: {', '.join(classes)})")
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    y0 = np.asarray(y0, dtype=float)
+    options = dict(rtol=rtol, atol=atol, max_step=max_step)
+    if first_step is not None:
+        options["first_step"] = first_step
+    if jac is not None and method in IMPLICIT:
+        options["jac"] = jac
+    start = time.perf_counter()
+    solver = classes[method](fun, t0, y0, t1, **options)
+    if t_eval is None:
+        ts, ys = [t0], [y0.copy()]
+    else:
+        t_eval = np.asarray(t_eval, dtype=float)
+        ts, ys = [], []
+        if t_eval.size and t_eval[0] == t0:
+            ts.append(t_eval[:1])
+            ys.append(y0[:, None].copy())
+            t_eval_i = 1
+        else:
+            t_eval_i = 0
+    nsteps = 0
+    reason = None
+    last_report = start
+    notes: list[str] = []
+    pieces, knots = [], [t0]
+    while reason is None:
+        message = solver.step()
+        nsteps += 1
+        if solver.status == "failed":
+            reason = f"failed: {message}"
+            break
+        if blowup is not None and not np.all(np.abs(solver.y) <= blowup):
+            k = int(np.argmax(~(np.abs(solver.y) <= blowup)))
+            reason = "blow-up"
+            notes.append(
+                f"state {k} reached {solver.y[k]:.3g} at t = {solver.t:.6g} "
+                f"(beyond {blowup:.3g}: the solution blows up)"
+            )
+            break
+        if dense_output:
+            pieces.append(solver.dense_output())
+            knots.append(solver.t)
+        if t_eval is None:
+            ts.append(solver.t)
+            ys.append(solver.y.copy())
+        else:
+            hi = np.searchsorted(t_eval, solver.t, side="right")
+            if hi > t_eval_i:
+                sol = solver.dense_output()
+                chunk = t_eval[t_eval_i:hi]
+                ts.append(chunk)
+                ys.append(np.asarray(sol(chunk)).reshape(len(y0), -1))
+                t_eval_i = hi
+        if solver.status == "finished":
+            reason = "finished"
+            break
+        now = time.perf_counter()
+        if now - start > max_time:
+            reason = "time budget"
+            notes.append(f"stopped after the wall-clock budget of {max_time:g} s")
+        elif nsteps >= max_steps:
+            reason = "step cap"
+            notes.append(f"stopped after the step cap of {max_steps} steps")
+        elif label and now - last_report >= progress_every:
+            _progress(label, solver, t0, t1, nsteps, start)
+            last_report = now
+    elapsed = time.perf_counter() - start
+    if t_eval is None:
+        t_out = np.asarray(ts, dtype=float)
+        y_out = np.asarray(ys, dtype=float).T.reshape(len(y0), -1)
+    else:
+        t_out = np.concatenate(ts) if ts else np.empty(0)
+        y_out = np.hstack(ys) if ys else np.empty((len(y0), 0))
+    run = OdeRun(
+        method,
+        float(rtol),
+        float(np.max(atol)),
+        t_out,
+        y_out,
+        reason,
+        elapsed,
+        int(solver.nfev),
+        int(getattr(solver, "njev", 0)),
+        int(getattr(solver, "nlu", 0)),
+        nsteps,
+        float(solver.t),
+        t1,
+        notes,
+    )
+    if dense_output and pieces:
+        from scipy.integrate import OdeSolution
+
+        run.sol = OdeSolution(knots, pieces)
+    if label and (elapsed > progress_every or not run.ok):
+        print(f"[{label}] {run.summary()}", file=sys.stderr, flush=True)
+    return run
+
+
+@dataclass
+class StudyRow:
+    """One cell of a work-precision study."""
+
+    case: str
+    method: str
+    rtol: float
+    error: float
+    elapsed: float
+    nfev: int
+    nsteps: int
+    stop_reason: str
+    extra: dict = field(default_factory=dict)
+
+
+def work_precision(
+    run_case: Callable[[str, float], OdeRun],
+    error_of: Callable[[OdeRun], float],
+    methods: Sequence[str],
+    rtols: Sequence[float],
+    *,
+    case: str = "",
+    label: str | None = None,
+    skip_after_stall: bool = True,
+    extra_of: Callable[[OdeRun], dict] | None = None,
+) -> list[StudyRow]:
+    """Run every method at every rtol (tight last); errors from ``error_of(run)``.
+
+    When a method stops early (budget or step cap) at some rtol, its tighter rtols are not
+    run (they would stall too) and are recorded with stop_reason "skipped (stalled at ...)".
+    """
+    rows: list[StudyRow] = []
+    for method in methods:
+        stalled = None
+        for rtol in sorted(rtols, reverse=True):
+            if stalled is not None and skip_after_stall:
+                rows.append(
+                    StudyRow(
+                        case,
+                        method,
+                        rtol,
+                        math.nan,
+                        math.nan,
+                        0,
+                        0,
+                        f"skipped (stopped at rtol {stalled:.0e})",
+                    )
+                )
+                continue
+            run = run_case(method, rtol)
+            err = error_of(run) if run.ok else math.nan
+            rows.append(
+                StudyRow(
+                    case,
+                    method,
+                    rtol,
+                    err,
+                    run.elapsed,
+                    run.nfev,
+                    run.nsteps,
+                    run.stop_reason,
+                    extra_of(run) if extra_of else {},
+                )
+            )
+            if not run.ok:
+                stalled = rtol
+            if label:
+                print(
+                    f"[{label}] {case} {method} rtol={rtol:.0e}: error {err:.2e}, "
+                    f"{run.elapsed:.3f} s, {run.stop_reason}",
+                    file=sys.stderr,
+                    flush=True,
+                )
+    return rows
 
 
 # -- stiffness and the choice of method -------------------------------------------------------
@@ -255,11 +557,13 @@ class Solution:
     t1: float
     method: str
     choice: Choice | None
-    run: object  # solvers.OdeRun
+    run: OdeRun
     notes: list[str] = field(default_factory=list)
+    sizes: tuple = ()  # per state: None (a number) or n (a vector of n)
 
     def __call__(self, k: int, t) -> np.ndarray | float:
-        """State k at time(s) t (magnitudes in the time unit); outside the span is an error."""
+        """State k at time(s) t (magnitudes in the time unit); outside the span is an error.
+        A vector state of n elements gives shape (n, 1) + shape of t."""
         arr = np.asarray(t, dtype=float)
         lo, hi = min(self.t0, self.t1), max(self.t0, self.t1)
         tol = 1e-12 * max(1.0, abs(hi - lo))
@@ -271,7 +575,12 @@ class Solution:
                 f"[{self.t0:g}, {self.t1:g}]",
                 definition=self.states[k],
             )
-        out = self.run.sol(np.clip(arr, lo, hi))[k]
+        sizes = self.sizes or (None,) * len(self.states)
+        first = sum(1 if n is None else n for n in sizes[:k])
+        y = self.run.sol(np.clip(arr, lo, hi))
+        if sizes[k] is not None:
+            return y[first : first + sizes[k]].reshape((sizes[k], 1) + arr.shape)
+        out = y[first]
         return float(out) if arr.ndim == 0 else out
 
     def finding(self) -> str:
@@ -295,15 +604,14 @@ def solve(
     states: tuple[str, ...],
     method: str = "auto",
     rtol: float = 1e-6,
-    atol: float = 1e-9,
+    atol: float | np.ndarray = 1e-9,
     max_time: float = MAX_TIME,
     max_steps: int = MAX_STEPS,
     time_unit: str = "",
+    sizes: tuple = (),
 ) -> Solution:
     """Integrate y' = fun(t, y) from t0 to t1; a run that does not finish is a LimitError
     (budget, step cap) or a DomainError (blow-up, solver failure) that says where and why."""
-    from .blocks.solvers import run_ode
-
     y0 = np.asarray(y0, dtype=float)
     if not np.all(np.isfinite(y0)):
         raise DomainError(f"ode '{name}': an initial value is not a finite number")
@@ -329,8 +637,19 @@ def solve(
         blowup=BLOWUP,
     )
     if not run.ok:
-        _refuse(run, name, states, time_unit)
-    return Solution(name, tuple(states), float(t0), float(t1), method, choice, run)
+        _refuse(run, name, flat_names(states, sizes), time_unit)
+    return Solution(
+        name, tuple(states), float(t0), float(t1), method, choice, run, sizes=tuple(sizes)
+    )
+
+
+def flat_names(states, sizes) -> list[str]:
+    """A name per number of the state vector: x, or q[0], q[1], ... of a vector state."""
+    sizes = sizes or (None,) * len(states)
+    out = []
+    for s, n in zip(states, sizes):
+        out += [s] if n is None else [f"{s}[{i}]" for i in range(n)]
+    return out
 
 
 def _refuse(run, name: str, states, time_unit: str) -> None:
@@ -345,8 +664,8 @@ def _refuse(run, name: str, states, time_unit: str) -> None:
         )
     if run.stop_reason == "blow-up":
         note = run.notes[-1]
-        for k, s in enumerate(states):
-            note = note.replace(f"state {k} ", f"state '{s}' ", 1)
+        k = int(note.split()[1])
+        note = note.replace(f"state {k} ", f"state '{states[k]}' ", 1)
         raise DomainError(f"ode '{name}' stopped at {at}: {note}", definition=name)
     big = ""
     if run.y.size and np.max(np.abs(run.y[:, -1])) > 1e6:
@@ -373,8 +692,6 @@ def bench_rows(
     """Every method at every rtol against a tight reference (DOP853 or Radau at rtol 1e-12,
     the one "auto" would take): the largest error over ``points`` times, relative to the
     largest magnitude of each state, and the run time."""
-    from .blocks.solvers import run_ode, work_precision
-
     y0 = np.asarray(y0, dtype=float)
     ref_method = choose_method(fun, t0, t1, y0, 1e-12).method
     ts = np.linspace(t0, t1, points)
@@ -433,7 +750,8 @@ def bench_rows(
 @dataclass(frozen=True)
 class TypedOde:
     """The typed expressions of one section: derivatives in state unit per time unit,
-    initial values in the state's unit, the time bounds in the time variable's unit."""
+    initial values and tolerances in the state's unit, the time bounds in the time variable's
+    unit; settings given as expressions typed (None: the section's number)."""
 
     spec: OdeSpec
     time_unit: object  # pint.Unit
@@ -442,6 +760,15 @@ class TypedOde:
     initials: tuple
     first: object
     last: object
+    atols: tuple = ()  # typed node or None, per state
+    settings: dict = field(default_factory=dict)  # "method", "rtol", "atol", "max_time"
+    shapes: tuple = ()  # per state: None (a number) or (n, 1) (a vector)
+
+    @property
+    def sizes(self) -> tuple:
+        """Per state: None (a number) or its number of elements."""
+        shapes = self.shapes or (None,) * len(self.units)
+        return tuple(None if s is None else s[0] for s in shapes)
 
 
 def type_ode(typer, spec: OdeSpec) -> TypedOde:
@@ -457,38 +784,156 @@ def type_ode(typer, spec: OdeSpec) -> TypedOde:
             units.append(un.unit(s.unit, what=f"ode '{spec.name}', state '{s.name}'"))
         except WorkbookError as err:
             raise err.located(line=spec.line, definition=s.name) from None
-    scope = {spec.var: time_unit, **{s.name: u for s, u in zip(spec.states, units)}}
+    scope = {spec.var: time_unit}
 
     def in_unit(node, unit, what: str, plain_ok: bool):
         t = typer.expression(node, scope if not plain_ok else {}, what)
-        if plain_ok and t.unit == dimensionless and not t.boolean:
+        if plain_ok and t.unit == dimensionless and not t.boolean and not t.text:
             return t  # a plain number is taken in the declared unit (as range bounds)
         try:
             return typer.convert(t, unit, what)
         except WorkbookError as err:
             raise err.located(line=spec.line, definition=what) from None
 
-    ders, inits = [], []
-    for s, u in zip(spec.states, units):
-        ders.append(in_unit(s.derivative, u / time_unit, f"{s.name}' (ode '{spec.name}')", False))
-        inits.append(in_unit(s.initial, u, f"initial {s.name} (ode '{spec.name}')", True))
+    inits = [
+        in_unit(s.initial, u, f"initial {s.name} (ode '{spec.name}')", True)
+        for s, u in zip(spec.states, units)
+    ]
+    shapes = tuple(_state_shape(spec, s, t) for s, t in zip(spec.states, inits))
+    for s, u, shape in zip(spec.states, units, shapes):
+        scope[s.name] = u if shape is None else (u, shape)
+    ders, atols = [], []
+    for s, u, shape in zip(spec.states, units, shapes):
+        der = in_unit(s.derivative, u / time_unit, f"{s.name}' (ode '{spec.name}')", False)
+        if der.shape != shape:
+            raise TemplateError(
+                f"ode '{spec.name}': the derivative of '{s.name}' is {_shape_word(der.shape)}, "
+                f"its initial value {_shape_word(shape)}",
+                line=spec.line,
+                definition=s.name,
+            )
+        ders.append(der)
+        atols.append(
+            in_unit(s.atol, u, f"atol of {s.name} (ode '{spec.name}')", True) if s.atol else None
+        )
     first = in_unit(spec.first, time_unit, f"time range of ode '{spec.name}'", True)
     last = in_unit(spec.last, time_unit, f"time range of ode '{spec.name}'", True)
-    return TypedOde(spec, time_unit, tuple(units), tuple(ders), tuple(inits), first, last)
+    settings = {}
+    for key, unit in (("rtol", dimensionless), ("atol", dimensionless), ("max_time", "s")):
+        node = getattr(spec, key)
+        if isinstance(node, ex.Node):
+            unit = un.unit(unit) if isinstance(unit, str) else unit
+            settings[key] = in_unit(node, unit, f"{key} of ode '{spec.name}'", True)
+    if isinstance(spec.method, ex.Node):
+        settings["method"] = _typed_method(typer, spec)
+    return TypedOde(
+        spec,
+        time_unit,
+        tuple(units),
+        tuple(ders),
+        tuple(inits),
+        first,
+        last,
+        tuple(atols),
+        settings,
+        shapes,
+    )
+
+
+def _state_shape(spec: OdeSpec, s: StateSpec, initial) -> tuple | None:
+    """A state is a number or a vector (a column), as its initial value."""
+    if initial.shape is not None and initial.shape[1] != 1:
+        raise TemplateError(
+            f"ode '{spec.name}': the initial value of '{s.name}' is a "
+            f"{initial.shape[0]}x{initial.shape[1]} matrix; a state is a number or a vector",
+            line=spec.line,
+            definition=s.name,
+        )
+    return initial.shape
+
+
+def _shape_word(shape) -> str:
+    return "a number" if shape is None else f"a vector of {shape[0]}"
+
+
+def _typed_method(typer, spec: OdeSpec):
+    """The method as an expression: a text definition or a choice input."""
+    from .typed import TRef
+
+    node = spec.method
+    known = set(typer.spec.inputs) | set(typer.spec.definitions)
+    if isinstance(node, ex.Name) and node.id not in known:
+        raise TemplateError(
+            f"ode '{spec.name}': method {node.id!r} is not one of {', '.join(METHODS)}, nor a "
+            "text definition or choice input of the sheet",
+            line=spec.line,
+        )
+    t = typer.expression(node, {}, f"method of ode '{spec.name}'")
+    if not (t.text or (isinstance(t, TRef) and t.kind == "choice")):
+        raise TemplateError(
+            f"ode '{spec.name}': method must give text, one of {', '.join(METHODS)}",
+            line=spec.line,
+        )
+    return t
+
+
+@dataclass(frozen=True)
+class Settings:
+    """A section's method and tolerances, evaluated on its sheet."""
+
+    method: str
+    rtol: float
+    atol: np.ndarray  # per state, in the states' units
+    max_time: float
+    max_steps: int
+
+
+def settings(typed: TypedOde, compile_expr: Callable) -> Settings:
+    """Evaluate the method, rtol, atol (per state) and budget of a section."""
+    spec, done = typed.spec, typed.settings
+
+    def value(key: str):
+        return compile_expr(done[key])({}) if key in done else getattr(spec, key)
+
+    method, rtol, max_time = value("method"), float(value("rtol")), float(value("max_time"))
+    if method not in METHODS:
+        raise DomainError(
+            f"ode '{spec.name}': method {method!r} is not one of {', '.join(METHODS)}",
+            definition=spec.name,
+        )
+    for key, v, low in (("rtol", rtol, 1e-13), ("max_time", max_time, 0.0)):
+        if not (math.isfinite(v) and v > low):
+            raise DomainError(f"ode '{spec.name}': {key} = {v:g} is not above {low:g}")
+    atol = float(value("atol"))
+    per_state = [compile_expr(a)({}) if a is not None else atol for a in typed.atols]
+    per_state = per_state or [atol] * len(spec.states)
+    atols = np.concatenate(
+        [np.full(1 if n is None else n, float(v)) for v, n in zip(per_state, typed.sizes)]
+    )
+    if not np.all((atols > 0) & np.isfinite(atols)):
+        raise DomainError(f"ode '{spec.name}': an atol is not a positive number")
+    return Settings(method, rtol, atols, max_time, spec.max_steps)
 
 
 def problem(typed: TypedOde, compile_expr: Callable):
     """(fun, t0, t1, y0) of a section, compiled with the numpy back end."""
     spec = typed.spec
-    names = [s.name for s in spec.states]
     ders = [compile_expr(d) for d in typed.derivatives]
     var = spec.var
+    parts, first = [], 0  # (name, first index, size or None)
+    for s, n in zip(spec.states, typed.sizes):
+        parts.append((s.name, first, n))
+        first += 1 if n is None else n
 
     def fun(t, y):
-        env = {var: float(t), **{n: float(v) for n, v in zip(names, y)}}
-        return np.array([float(d(env)) for d in ders])
+        env = {var: float(t)}
+        for name, k, n in parts:
+            env[name] = float(y[k]) if n is None else y[k : k + n].reshape(n, 1)
+        return np.concatenate([np.asarray(d(env), dtype=float).reshape(-1) for d in ders])
 
-    y0 = [float(compile_expr(i)({})) for i in typed.initials]
+    y0 = np.concatenate(
+        [np.asarray(compile_expr(i)({}), dtype=float).reshape(-1) for i in typed.initials]
+    )
     t0, t1 = float(compile_expr(typed.first)({})), float(compile_expr(typed.last)({}))
     return fun, t0, t1, y0
 
@@ -499,6 +944,7 @@ def solve_typed(typed: TypedOde, compile_expr: Callable) -> Solution:
 
     spec = typed.spec
     fun, t0, t1, y0 = problem(typed, compile_expr)
+    st = settings(typed, compile_expr)
     return solve(
         fun,
         t0,
@@ -506,12 +952,50 @@ def solve_typed(typed: TypedOde, compile_expr: Callable) -> Solution:
         y0,
         name=spec.name,
         states=tuple(s.name for s in spec.states),
-        method=spec.method,
-        rtol=spec.rtol,
-        atol=spec.atol,
-        max_time=spec.max_time,
-        max_steps=spec.max_steps,
+        method=st.method,
+        rtol=st.rtol,
+        atol=st.atol,
+        max_time=st.max_time,
+        max_steps=st.max_steps,
         time_unit=un.pretty(typed.time_unit),
+        sizes=typed.sizes,
+    )
+
+
+def run_sheet(
+    sheet,
+    name: str,
+    *,
+    t_eval=None,
+    max_time: float | None = None,
+    max_steps: int | None = None,
+    label: str | None = None,
+    jac=None,
+) -> OdeRun:
+    """One bounded run of the sheet's ``[[ode]] name`` with its own method and tolerances
+    (give other ones with ``sheet.with_inputs``), timed: a run that stops early is returned,
+    not raised (a study records it). ``t_eval`` in the time unit (default: the steps);
+    ``jac(t, y)``: the Jacobian for the implicit methods, when the caller knows it (a linear
+    system's matrix), else they estimate it by differences."""
+    typed = sheet.typer.ode(name)
+    fun, t0, t1, y0 = problem(typed, sheet.evaluator.compile)
+    st = settings(typed, sheet.evaluator.compile)
+    method = st.method
+    if method == "auto":
+        method = choose_method(fun, t0, t1, y0, st.rtol).method
+    fun(t0, y0)  # what the derivatives share is computed before the clock starts
+    return run_ode(
+        fun,
+        (t0, t1),
+        y0,
+        method=method,
+        rtol=st.rtol,
+        atol=st.atol,
+        t_eval=t_eval,
+        max_time=st.max_time if max_time is None else max_time,
+        max_steps=st.max_steps if max_steps is None else max_steps,
+        label=label,
+        jac=jac,
     )
 
 

@@ -277,7 +277,8 @@ class ArrayTyping:
         typed = self.ode(name)
         (var,) = d.params
         t = TParam(scope[var], name=var)
-        return TOde(typed.units[k], ode=name, state=k, name=d.name, args=(t,))
+        shape = typed.shapes[k] if typed.shapes else None
+        return TOde(typed.units[k], ode=name, state=k, name=d.name, args=(t,), shape=shape)
 
     def ode(self, name: str):
         """The typed section ``[[ode]] name`` (units checked once)."""

@@ -666,7 +666,7 @@ def _with_unit(t: T, unit: pint.Unit) -> T:
     """Same node, relabelled with an equal unit (factor exactly 1)."""
     if isinstance(t, TConst):
         return TConst(unit, value=t.value)
-    return TScale(unit, child=t, factor=1.0)
+    return TScale(unit, child=t, factor=1.0, shape=t.shape)
 
 
 def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
@@ -691,7 +691,7 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         if d.ode is not None:
             o = spec.odes[d.ode[0]]
             local |= {o.var} | {s.name for s in o.states}
-            bodies = [o.first, o.last] + [x for s in o.states for x in (s.initial, s.derivative)]
+            bodies = o.expressions()
         for body in bodies:
             todo.extend(m for m in ex.names(body) if m not in local)
     return out

@@ -1,16 +1,11 @@
-"""Centrifugal injection-advance coupling (Braginets, Kabelkov, Meremkulov 2003).
+"""Centrifugal injection-advance coupling (Braginets, Kabelkov, Meremkulov 2003): the studies.
 
-Every formula of the scene is the template's (templates/advance-coupling.toml): the steady
-weight angle phi2(omega1), the closed forms, the lift-off speed, the entries of M, Phi and H
-and the weights' stiffness k_w. This module reads them through the sheet
-(``sheet.evaluate``, ``sheet.with_inputs`` for the families and the c2 variants) and does
-what is the scene's own: the families and trends of Fig. 3, the 3-DOF dynamics
-M q'' + Phi q' + H q = M0 + M(t) against its rigid-tooth limit (eigenvalues, the exact solution
-by the matrix exponential), and a work-precision study of five scipy ODE methods.
-
-q = (phi1, phi2, phi3); phi2 is the weight lever angle from phi20; the advance angle is
-psi = phi3 - phi1. The dynamics is written relative to the steady rotation omega1*t*(1, 0, 1),
-the rigid rotation mode of H, so the state stays bounded.
+The model is the template's (templates/advance-coupling.toml): the steady weight angle, the
+closed forms, the matrices M, Phi, H, the eigenvalues, the ODEs ``motion`` (3 DOF) and
+``rigid`` (the rigid-tooth limit) and the solver choice ``method_used``. This module re-reads
+it at changed inputs (``sheet.with_inputs``) for what is one scene's: the families and trends
+of Fig. 3, the stiffness over c2, a work-precision study of five methods on the template's
+ODE against its exact solution (matrix exponential of the linear system), prose findings.
 """
 
 from __future__ import annotations
@@ -22,9 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import expr as ex
+from .. import ode
 from .. import typecheck as tc
 from . import Finding, bench_block, cached, findings_block, table_block
-from .solvers import METHODS, OdeRun, run_ode, work_precision
 
 
 def _v(sheet, name: str, unit: str, **args):
@@ -33,21 +28,18 @@ def _v(sheet, name: str, unit: str, **args):
     return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
 
 
-def with_input(sheet, name: str, value: float, unit: str):
+def with_input(sheet, name: str, value: float, unit: str = ""):
     """The sheet with one input replaced by ``value`` in ``unit``."""
-    return sheet.with_inputs(**{name: f"{float(value)!r} {unit}"})
+    return sheet.with_inputs(**{name: f"{float(value)!r} {unit}".strip()})
 
 
-# ---------------------------------------------------------------------------------------------
-# families of Fig. 3
-# ---------------------------------------------------------------------------------------------
+# -- families of Fig. 3 ------------------------------------------------------------------------
 FAMILIES = {
-    "c1": ("spring stiffness c1", "N/m", (1500.0, 3000.0, 4000.0, 6000.0)),
-    "m": ("weight mass m", "kg", (0.65, 0.7, 0.75, 0.8)),
-    "phi20": ("initial angle phi20", "rad", (0.4363, 0.5235, 0.6108, 0.6981)),
+    "c1": ("N/m", (1500.0, 3000.0, 4000.0, 6000.0)),
+    "m": ("kg", (0.65, 0.7, 0.75, 0.8)),
+    "phi20": ("rad", (0.4363, 0.5235, 0.6108, 0.6981)),
 }
-# the printed trends: phi2 falls as c1 rises, rises with m and with phi20
-TRENDS = {"c1": -1, "m": +1, "phi20": +1}
+TRENDS = {"c1": -1, "m": +1, "phi20": +1}  # the printed trends: sign of d phi2 / d parameter
 TREND_TEXT = {
     "c1": "phi2 falls as c1 rises",
     "m": "phi2 rises with m",
@@ -57,34 +49,30 @@ TREND_TEXT = {
 
 def speeds(sheet) -> np.ndarray:
     """The speeds of the template's steady table (rad/s)."""
-    spec = sheet.table_spec("steady")
-    return sheet.range_values(spec.range, "table steady")
+    return sheet.range_values(sheet.table_spec("steady").range, "table steady")
 
 
 def closed_form(sheet, ws, form: str = "printed") -> tuple[np.ndarray, np.ndarray]:
-    """(value, denominator) of the template's closed form (phi2_lin or phi2_newton): NaN where
-    its denominator is not positive (the template gives no value there)."""
+    """(value, denominator) of phi2_lin (printed) or phi2_newton: NaN where the denominator
+    is not positive (the template gives no value there)."""
     suffix = "lin" if form == "printed" else "newton"
     den = np.atleast_1d(_v(sheet, f"D_{suffix}", "N*m", omega1=ws))
     value = np.full(den.shape, math.nan)
-    ok = den > 0
-    if ok.any():
-        value[ok] = _v(sheet, f"phi2_{suffix}", "rad", omega1=np.asarray(ws)[ok])
+    if (den > 0).any():
+        value[den > 0] = _v(sheet, f"phi2_{suffix}", "rad", omega1=np.asarray(ws)[den > 0])
     return value, den
 
 
 def family(sheet, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
-    """For each value of the family parameter: nonlinear root and both closed forms."""
+    """For each value of the family parameter: the root and both closed forms."""
 
     def build():
         out = {}
-        for value in FAMILIES[key][2]:
-            s = with_input(sheet, key, value, FAMILIES[key][1])
-            printed, den = closed_form(s, ws, "printed")
+        for value in FAMILIES[key][1]:
+            s = with_input(sheet, key, value, FAMILIES[key][0])
             out[value] = {
                 "root": np.atleast_1d(_v(s, "phi2", "rad", omega1=ws)),
-                "printed": printed,
-                "D": den,
+                "printed": closed_form(s, ws, "printed")[0],
                 "newton": closed_form(s, ws, "newton")[0],
             }
         return out
@@ -96,13 +84,10 @@ def _family_table(sheet, key: str):
     import pandas as pd
 
     ws = speeds(sheet)
-    fam = family(sheet, key, ws)
-    unit = FAMILIES[key][1]
+    fam, unit = family(sheet, key, ws), FAMILIES[key][0]
     cols = {"omega1 [rad/s]": ws}
-    for value, d in fam.items():
-        cols[f"phi2 {key}={value:g} {unit} [rad]"] = d["root"]
-    for value, d in fam.items():
-        cols[f"linear {key}={value:g} [rad]"] = d["printed"]
+    cols |= {f"phi2 {key}={v:g} {unit} [rad]": d["root"] for v, d in fam.items()}
+    cols |= {f"linear {key}={v:g} [rad]": d["printed"] for v, d in fam.items()}
     return pd.DataFrame(cols)
 
 
@@ -124,217 +109,92 @@ def family_phi20(sheet):
     return _family_table(sheet, "phi20")
 
 
-# ---------------------------------------------------------------------------------------------
-# dynamics: linear 3-DOF model and its rigid-tooth limit
-# ---------------------------------------------------------------------------------------------
-@dataclass
-class LinearModel:
-    """M x'' + Phi x' + K x = f0 + fp*sin(Omega t) in coordinates x = C p (C maps reduced to q)."""
-
-    M: np.ndarray
-    Phi: np.ndarray
-    K: np.ndarray
-    f0: np.ndarray
-    fp: np.ndarray
-    Omega: float
-    C: np.ndarray  # q = C x (3 x n)
-    x0: np.ndarray
-    name: str
-
-    @property
-    def n(self) -> int:
-        return self.M.shape[0]
-
-    def first_order(self):
-        """A, b, g of y' = A y + b + g sin(Omega t), y = (x, x')."""
-        n = self.n
-        Minv = np.linalg.inv(self.M)
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, n:] = np.eye(n)
-        A[n:, :n] = -Minv @ self.K
-        A[n:, n:] = -Minv @ self.Phi
-        b = np.concatenate([np.zeros(n), Minv @ self.f0])
-        g = np.concatenate([np.zeros(n), Minv @ self.fp])
-        return A, b, g
-
-    def y0(self) -> np.ndarray:
-        return np.concatenate([self.x0, np.zeros(self.n)])
-
-    def outputs(self, y: np.ndarray) -> np.ndarray:
-        """(phi2, psi) rows from states y (2n x k): psi = phi3 - phi1, the advance angle."""
-        q = self.C @ y[: self.n]
-        return np.vstack([q[1], q[2] - q[0]])
+# -- the template's ODE, its exact solution and the rigid limit --------------------------------
+def times(sheet, n_out: int = 401) -> np.ndarray:
+    return np.linspace(0.0, _v(sheet, "t_end", "s"), n_out)
 
 
-def _matrix(sheet, names, unit) -> np.ndarray:
-    """A symmetric 3x3 matrix from the template's entries (upper triangle, row by row)."""
-    vals = {n: _v(sheet, n, unit) for n in names if n}
-    out = np.zeros((3, 3))
-    for (i, j), n in zip(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), names):
-        if n:
-            out[i, j] = out[j, i] = vals[n]
+def outputs(y: np.ndarray) -> np.ndarray:
+    """(phi2, psi) rows from states y = (q, q') of ode motion: psi = phi3 - phi1."""
+    return np.vstack([y[1], y[2] - y[0]])
+
+
+def linear_system(sheet):
+    """A, b, g of the template's ode motion, y' = A y + b + g sin(Omega_pump t), read off its
+    derivatives (a linear function is its own difference quotient) and checked at a point."""
+    return cached(sheet, "linear system", lambda: _linear_system(sheet))
+
+
+def _linear_system(sheet):
+    fun, t0, t1, y0 = ode.problem(sheet.typer.ode("motion"), sheet.evaluator.compile)
+    om, n = _v(sheet, "Omega_pump", "rad/s"), len(y0)
+    b = fun(0.0, np.zeros(n))
+    A = np.column_stack([fun(0.0, e) - b for e in np.eye(n)])
+    g = fun(0.5 * math.pi / om, np.zeros(n)) - b
+    y, t = np.linspace(0.1, 0.3, n), 0.3 / om
+    want = A @ y + b + g * math.sin(om * t)
+    if not np.allclose(fun(t, y), want, rtol=1e-9, atol=1e-12 * np.max(np.abs(A))):
+        raise ValueError("ode motion is not linear with forcing sin(Omega_pump*t)")
+    return A, b, g, om, np.asarray(y0)
+
+
+def exact(sheet, ts: np.ndarray) -> np.ndarray:
+    """The states at ts by the matrix exponential of the system augmented with the forcing
+    (z = (y, 1, sin, cos)): independent of any ODE method."""
+    from scipy.linalg import expm
+
+    A, b, g, om, y0 = linear_system(sheet)
+    N = len(y0)
+    Z = np.zeros((N + 3, N + 3))
+    Z[:N, :N], Z[:N, N], Z[:N, N + 1] = A, b, g
+    Z[N + 1, N + 2], Z[N + 2, N + 1] = om, -om
+    z = np.concatenate([y0, [1.0, 0.0, 1.0]])
+    h = ts[1] - ts[0]  # a uniform grid; substeps keep |lambda h| small
+    sub = max(1, int(math.ceil(np.max(np.abs(np.linalg.eigvals(A))) * h / 0.5)))
+    E = np.linalg.matrix_power(expm(Z * (h / sub)), sub)
+    out = np.empty((N, len(ts)))
+    for k in range(len(ts)):
+        out[:, k] = z[:N]
+        z = E @ z
     return out
 
 
-def model(sheet, *, rigid: bool = False, damping: str = "corrected") -> LinearModel:
-    """The coupling about its steady state at omega_dyn, driven by the pump torque
-    pump_amp*sin(pump_order*omega_dyn*t) on the driven half (M_N0 = M_D0: balanced torques).
+@dataclass
+class Case:
+    """One sheet (one c2): the exact 3-DOF outputs, the rigid-tooth limit, their difference."""
 
-    rigid=True gives the rigid-tooth limit (2 DOF, phi3 = phi1 + k_gear*phi2). If the weights
-    sit on the stop, phi2 is held at 0 (one DOF fewer).
-    """
-    w = _v(sheet, "omega_dyn", "rad/s")
-    phi2 = _v(sheet, "phi2", "rad", omega1=w)
-    on_stop = _v(sheet, "F0", "N*m", omega1=w) <= 0
-    M3 = _matrix(sheet, ("a11", "a12", "", "a22", "", "a33"), "kg*m^2")
-    b22 = _v(sheet, "b22_printed" if damping == "as printed" else "b22", "N*m*s")
-    Phi3 = np.diag([0.0, b22, 0.0])
-    H3 = _matrix(sheet, ("c11", "c12", "c13", "c22", "c23", "c33"), "N*m")
-    kw = _v(sheet, "k_w", "N*m")
-    K3 = H3 + np.diag([0.0, 0.0 if on_stop else kw, 0.0])
-    M_D0 = _v(sheet, "M_D0", "N*m")
-    f0 = np.array([M_D0, _v(sheet, "Q2_dyn", "N*m"), -M_D0])  # M0 + the weights
-    fp = np.array([0.0, 0.0, -_v(sheet, "pump_amp", "N*m")])
-    k = _v(sheet, "k_gear", "")
-    if rigid:
-        C = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, k]])
-        x0 = np.array([0.0, phi2])
-        K3 = K3 - H3  # the tooth does no work on a rigid-tooth motion
-    else:
-        C = np.eye(3)
-        x0 = np.array([0.0, phi2, _v(sheet, "psi_dyn", "rad")])
-    if on_stop:  # weights held on the stop: drop phi2 (and its constant force)
-        f0[1] = 0.0
-        keep = [0] if rigid else [0, 2]
-        C, x0 = (
-            (np.array([[1.0], [0.0], [1.0]]), np.array([0.0])) if rigid else (C[:, keep], x0[keep])
-        )
-    return LinearModel(
-        C.T @ M3 @ C,
-        C.T @ Phi3 @ C,
-        C.T @ K3 @ C,
-        C.T @ f0,
-        C.T @ fp,
-        _v(sheet, "Omega_pump", "rad/s"),
-        C,
-        x0,
-        "rigid tooth" if rigid else "3 DOF",
-    )
+    sheet: object
+    t: np.ndarray
+    exact: np.ndarray
+    rigid: np.ndarray
+    delta: float
 
 
-def eigen(sheet, damping: str = "corrected"):
-    """Eigenvalues of the linear system without the rigid rotation mode, sorted by size.
+def case(sheet, n_out: int = 401) -> Case:
+    def build():
+        ts = times(sheet, n_out)
+        ex_ = outputs(exact(sheet, ts))
+        rig = np.vstack([_v(sheet, "phi2_r", "rad", t=ts), _v(sheet, "psi_r", "rad", t=ts)])
+        return Case(sheet, ts, ex_, rig, float(np.max(np.abs(ex_ - rig))))
 
-    The rigid rotation r0 (K r0 = 0, Phi r0 = 0) is condensed out: in coordinates (r0, rest)
-    its row says (M u)_r0 = 0 for every mode with lambda != 0, which leaves the Schur
-    complement of M on the rest; no near-zero eigenvalue has to be told from round-off.
-    """
-    mdl = model(sheet, damping=damping)
-    n = mdl.n
-    r0 = np.linalg.svd(mdl.K)[2][-1]
-    T = np.linalg.svd(np.column_stack([r0, np.eye(n)]))[0]  # r0 first, then its complement
-    T[:, 0] = r0
-    Mr, Pr, Kr = T.T @ mdl.M @ T, T.T @ mdl.Phi @ T, T.T @ mdl.K @ T
-    Mred = Mr[1:, 1:] - np.outer(Mr[1:, 0], Mr[0, 1:]) / Mr[0, 0]
-    m = n - 1
-    if m == 0:
-        return np.empty(0, dtype=complex)
-    Minv = np.linalg.inv(Mred)
-    A = np.zeros((2 * m, 2 * m))
-    A[:m, m:] = np.eye(m)
-    A[m:, :m] = -Minv @ Kr[1:, 1:]
-    A[m:, m:] = -Minv @ Pr[1:, 1:]
-    lam = np.linalg.eigvals(A)
-    return lam[np.argsort(np.abs(lam))]
+    return cached(sheet, ("case", n_out), build)
 
 
-def stiffness(sheet) -> dict:
-    """Stiffness measures: ratio max|lambda|/min|lambda| and max|lambda| * t_end (the number of
-    radians of the fastest mode over the run: about the steps an explicit method needs / 3)."""
-    lam = eigen(sheet)
-    big, small = float(np.max(np.abs(lam))), float(np.min(np.abs(lam)))
-    tooth = lam[np.argmax(np.abs(lam))]
-    return {
-        "lam": lam,
-        "ratio": big / small,
-        "index": big * _v(sheet, "t_end", "s"),
-        "tooth_damping": -tooth.real / abs(tooth),
-    }
+def run(sheet, method: str, rtol: float, t_eval=None, **bounds) -> ode.OdeRun:
+    """The template's ode motion with ``method`` and ``rtol`` (its atol follows rtol); the
+    implicit methods get its constant Jacobian."""
+    s = sheet.with_inputs(method=str(method), rtol=f"{float(rtol)!r}")
+    A = linear_system(sheet)[0]
+    return ode.run_sheet(s, "motion", t_eval=t_eval, jac=lambda t, y: A, **bounds)
 
 
-class Problem:
-    """The ODE of a LinearModel with its constant Jacobian, and its exact solution."""
-
-    def __init__(self, mdl: LinearModel, t_end: float, n_out: int = 401):
-        self.model = mdl
-        self.A, self.b, self.g = mdl.first_order()
-        self.Omega = mdl.Omega
-        self.y0 = mdl.y0()
-        self.t_end = t_end
-        self.t_eval = np.linspace(0.0, t_end, n_out)
-        A, b, g, Om = self.A, self.b, self.g, self.Omega
-        self.fun = lambda t, y: A @ y + b + g * math.sin(Om * t)
-        self.jac = lambda t, y: A
-
-    def atol(self, rtol: float) -> np.ndarray:
-        """Absolute tolerances scaled per state: angles 1e-3 rad, rates Omega*1e-3 rad/s."""
-        n = self.model.n
-        scale = np.concatenate([np.full(n, 1.0), np.full(n, max(self.Omega, 1.0))])
-        return rtol * 1e-3 * scale
-
-    def run(
-        self,
-        method: str,
-        rtol: float,
-        *,
-        max_time: float = 20.0,
-        max_steps: int = 2_000_000,
-        label: str | None = None,
-    ) -> OdeRun:
-        return run_ode(
-            self.fun,
-            (0.0, self.t_end),
-            self.y0,
-            method=method,
-            rtol=rtol,
-            atol=self.atol(rtol),
-            jac=self.jac,
-            t_eval=self.t_eval,
-            max_time=max_time,
-            max_steps=max_steps,
-            label=label,
-        )
-
-    def exact(self) -> np.ndarray:
-        """Exact solution at t_eval from the matrix exponential of the system augmented with
-        the forcing (z = (y, 1, sin, cos)): independent of any ODE method."""
-        from scipy.linalg import expm
-
-        t = self.t_eval
-        N = len(self.y0)
-        Z = np.zeros((N + 3, N + 3))
-        Z[:N, :N] = self.A
-        Z[:N, N] = self.b
-        Z[:N, N + 1] = self.g
-        Z[N + 1, N + 2] = self.Omega
-        Z[N + 2, N + 1] = -self.Omega
-        z = np.concatenate([self.y0, [1.0, 0.0, 1.0]])
-        out = np.empty((N, len(t)))
-        out[:, 0] = z[:N]
-        # one propagator for the uniform grid, refined by substeps so that |lambda h| stays small
-        h = t[1] - t[0]
-        sub = max(1, int(math.ceil(np.max(np.abs(np.linalg.eigvals(self.A))) * h / 0.5)))
-        E = np.linalg.matrix_power(expm(Z * (h / sub)), sub)
-        for k in range(1, len(t)):
-            z = E @ z
-            out[:, k] = z[:N]
-        return out
+def deviation(run_: ode.OdeRun, against: np.ndarray) -> float:
+    if not run_.ok or run_.y.shape[1] != against.shape[1]:
+        return math.nan
+    return float(np.max(np.abs(outputs(run_.y) - against)))
 
 
-# ---------------------------------------------------------------------------------------------
-# solver choice, study, cache
-# ---------------------------------------------------------------------------------------------
-AUTO_INDEX = 3000.0  # |lambda_max|*t_end above which "auto" takes Radau (from the study)
+# -- stiffness over c2, the work-precision study ----------------------------------------------
 STUDY_C2 = (1e6, 1e8, 1e10)
 STUDY_RTOLS = (1e-3, 1e-5, 1e-7)
 FULL_C2 = (1e6, 1e7, 1e8, 1e9, 1e10)
@@ -348,92 +208,72 @@ def at_c2(sheet, c2: float):
     return with_input(sheet, "c2", c2, "N/m")
 
 
-def auto_method(sheet) -> str:
-    """The default solver: Radau when the tooth mode makes the run stiff (stiffness index
-    |lambda_max|*t_end above AUTO_INDEX), LSODA otherwise. See docs/advance-coupling.md."""
-    return "Radau" if stiffness(sheet)["index"] > AUTO_INDEX else "LSODA"
+@table_block
+def stiffness_table(sheet):
+    """Eigenvalues (rigid rotation excluded) and stiffness measures for c2 = 1e6 .. 1e10 N/m."""
+    import pandas as pd
+
+    rows = []
+    for c2 in FULL_C2:
+        s2 = at_c2(sheet, c2)
+        cs = case(s2)
+        row = {"c2 [N/m]": c2}
+        for name, title, unit in (
+            ("weight_re", "weight mode Re [1/s]", "1/s"),
+            ("weight_im", "weight mode Im [rad/s]", "rad/s"),
+            ("tooth_re", "tooth mode Re [1/s]", "1/s"),
+            ("tooth_im", "tooth mode Im [rad/s]", "rad/s"),
+            ("tooth_damping", "tooth damping ratio", ""),
+            ("stiff_ratio", "stiffness ratio |lam|max/|lam|min", ""),
+            ("stiff_index", "stiffness index |lam|max*t_end", ""),
+        ):
+            row[title] = _v(s2, name, unit)
+        row["rigid-model difference [rad]"] = cs.delta
+        row["difference*c2 [N rad/m]"] = cs.delta * c2
+        row["auto method"] = str(
+            at_c2(sheet.with_inputs(method="auto"), c2).evaluate("method_used")
+        )
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
-def method_of(sheet) -> str:
-    return str(sheet.evaluate("method"))
-
-
-def chosen_method(sheet) -> str:
-    m = method_of(sheet)
-    return auto_method(sheet) if m == "auto" else m
-
-
-@dataclass
-class Case:
-    """One sheet (one c2): the 3-DOF problem, its exact solution and the rigid-tooth limit."""
-
-    c2: float
-    problem: Problem
-    exact: np.ndarray  # outputs (phi2, psi) of the exact 3-DOF solution
-    rigid: np.ndarray  # outputs of the exact rigid-tooth solution
-    delta: float  # max |3-DOF - rigid| (model difference)
-
-
-def case(sheet, n_out: int = 401) -> Case:
-    t_end = _v(sheet, "t_end", "s")
-
-    def build():
-        pr = Problem(model(sheet), t_end, n_out)
-        rg = Problem(model(sheet, rigid=True), t_end, n_out)
-        ex_, rr = pr.model.outputs(pr.exact()), rg.model.outputs(rg.exact())
-        return Case(_v(sheet, "c2", "N/m"), pr, ex_, rr, float(np.max(np.abs(ex_ - rr))))
-
-    return cached(sheet, ("case", n_out), build)
-
-
-def _dev(cs: Case, run: OdeRun, against: np.ndarray) -> float:
-    if not run.ok or run.y.shape[1] != against.shape[1]:
-        return math.nan
-    return float(np.max(np.abs(cs.problem.model.outputs(run.y) - against)))
-
-
-def study(
-    sheet,
-    c2s,
-    rtols,
-    methods=METHODS,
-    *,
-    max_time=5.0,
-    label: str | None = "advance-coupling study",
-):
+def study(sheet, c2s, rtols, methods=ode.SOLVERS, *, max_time=5.0, label="advance-coupling study"):
     """Work-precision rows: every method x rtol at every c2; error against the exact solution
-    and deviation from the exact rigid-tooth limit."""
+    and deviation from the rigid-tooth limit. A method that stops early at some rtol is not
+    run at tighter ones."""
     import pandas as pd
 
     def build():
-        rows = []
         if label:
             print(
-                f"[{label}] {len(c2s) * len(rtols) * len(methods)} runs: {len(methods)} methods"
-                f" x {len(rtols)} rtols x c2 = {', '.join(f'{c:.0e}' for c in c2s)} N/m "
-                f"(each run at most {max_time:g} s)",
+                f"[{label}] {len(c2s) * len(rtols) * len(methods)} runs at c2 = "
+                f"{', '.join(f'{c:.0e}' for c in c2s)} N/m (each at most {max_time:g} s)",
                 file=sys.stderr,
                 flush=True,
             )
+        rows = []
         for c2 in c2s:
-            cs = case(at_c2(sheet, c2))
-            runs = {}
+            cs, runs = case(at_c2(sheet, c2)), {}
 
-            def run_case(method, rtol, cs=cs, runs=runs):
-                runs[(method, rtol)] = cs.problem.run(method, rtol, max_time=max_time, label=label)
-                return runs[(method, rtol)]
+            def one(method, rtol, cs=cs, runs=runs):
+                runs[method, rtol] = run(
+                    cs.sheet, method, rtol, cs.t, max_time=max_time, label=label
+                )
+                return runs[method, rtol]
 
-            for r in work_precision(
-                run_case, lambda run, cs=cs: _dev(cs, run, cs.exact), methods, rtols, label=None
+            for r in ode.work_precision(
+                one, lambda x, cs=cs: deviation(x, cs.exact), methods, rtols
             ):
-                run = runs.get((r.method, r.rtol))
+                done = runs.get((r.method, r.rtol))
                 rows.append(
                     {
                         "c2 [N/m]": c2,
                         "method": r.method,
                         "rtol": r.rtol,
                         "error [rad]": r.error,
-                        "deviation from rigid [rad]": _dev(cs, run, cs.rigid) if run else math.nan,
+                        "deviation from rigid [rad]": deviation(done, cs.rigid)
+                        if done
+                        else math.nan,
                         "rigid-model difference [rad]": cs.delta,
                         "run time [s]": r.elapsed,
                         "f-evals": r.nfev,
@@ -441,8 +281,6 @@ def study(
                         "stopped": r.stop_reason,
                     }
                 )
-            if label:
-                print(f"[{label}] c2 = {c2:.0e} N/m done", file=sys.stderr, flush=True)
         return pd.DataFrame(rows)
 
     return cached(sheet, ("study", tuple(c2s), tuple(rtols), tuple(methods), max_time), build)
@@ -469,7 +307,7 @@ def _wide(df, c2: float):
 
     sub = df[df["c2 [N/m]"] == c2]
     cols = {"rtol": sorted(sub["rtol"].unique(), reverse=True)}
-    for m in METHODS:
+    for m in ode.SOLVERS:
         s = sub[sub["method"] == m].set_index("rtol")
         cols[f"time {m} [s]"] = [s["run time [s]"].get(r, math.nan) for r in cols["rtol"]]
         cols[f"error {m} [rad]"] = [s["error [rad]"].get(r, math.nan) for r in cols["rtol"]]
@@ -488,90 +326,20 @@ def wp_moderate(sheet):
     return _wide(_study_for_sheet(sheet)[1], 1e8)
 
 
-@table_block
-def stiffness_table(sheet):
-    """Eigenvalues (rigid rotation excluded) and stiffness measures for c2 = 1e6 .. 1e10 N/m."""
-    import pandas as pd
-
-    rows = []
-    for c2 in FULL_C2:
-        s2 = at_c2(sheet, c2)
-        s, cs = stiffness(s2), case(s2)
-        lam = s["lam"]
-        rows.append(
-            {
-                "c2 [N/m]": c2,
-                "weight mode Re [1/s]": float(lam[0].real),
-                "weight mode Im [rad/s]": abs(lam[0].imag),
-                "tooth mode Re [1/s]": float(lam[-1].real),
-                "tooth mode Im [rad/s]": abs(lam[-1].imag),
-                "tooth damping ratio": s["tooth_damping"],
-                "stiffness ratio |lam|max/|lam|min": s["ratio"],
-                "stiffness index |lam|max*t_end": s["index"],
-                "rigid-model difference [rad]": cs.delta,
-                "difference*c2 [N rad/m]": cs.delta * c2,
-                "auto method": auto_method(s2),
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def default_run(sheet):
-    """The sheet's own run (method, rtol, max_time): the case and the run, computed once."""
-    method, rtol = chosen_method(sheet), _v(sheet, "rtol", "")
-
-    def build():
-        cs = case(sheet)
-        run = cs.problem.run(
-            method, rtol, max_time=_v(sheet, "max_time", "s"), label="advance-coupling dynamics"
-        )
-        return cs, run
-
-    return cached(sheet, ("history", method), build)
-
-
-@table_block
-def histories(sheet):
-    """Time histories of phi2 and the advance angle psi = phi3 - phi1 (3 DOF and rigid tooth)."""
-    import pandas as pd
-
-    cs, run = default_run(sheet)
-    t = cs.problem.t_eval
-    out = np.full((2, len(t)), math.nan)
-    k = run.y.shape[1] if not run.ok else len(t)  # a partial run: keep what was reached
-    out[:, :k] = cs.problem.model.outputs(run.y)[:, :k]
-    return _blank(
-        pd.DataFrame(
-            {
-                "t [s]": t,
-                "phi2 [rad]": out[0],
-                "advance psi [deg]": np.degrees(out[1]),
-                "phi2 rigid tooth [rad]": cs.rigid[0],
-                "advance psi rigid tooth [deg]": np.degrees(cs.rigid[1]),
-                "phi2 - rigid [rad]": out[0] - cs.rigid[0],
-            }
-        )
-    )
-
-
-# ---------------------------------------------------------------------------------------------
-# extreme cases
-# ---------------------------------------------------------------------------------------------
-def stall_run(
-    sheet, method: str = "RK45", c2: float = STALL_C2, max_time: float = 0.5, max_steps=20_000
-) -> tuple[OdeRun, float]:
-    """An explicit method on a very stiff tooth: bounded by a budget and a step cap.
-    Returns the run and the steps it would need at its stability limit (about index/3)."""
+def stall_run(sheet, method="RK45", c2=STALL_C2, max_time=0.5, max_steps=20_000):
+    """An explicit method on a very stiff tooth, bounded by a budget and a step cap: the run
+    and the steps it would need at its stability limit (about stiff_index/3.3)."""
     s2 = at_c2(sheet, c2)
-    run = case(s2).problem.run(
-        method, 1e-5, max_time=max_time, max_steps=max_steps, label="advance-coupling stall"
+    r = run(
+        s2, method, 1e-5, max_time=max_time, max_steps=max_steps, label="advance-coupling stall"
     )
-    return run, stiffness(s2)["index"] / 3.3
+    return r, _v(s2, "stiff_index", "") / 3.3
 
 
+# -- closed forms at their limits --------------------------------------------------------------
 def soft_spring_limit(sheet, w: float, form: str = "printed") -> float:
-    """Spring stiffness c1 below which the closed form's denominator is <= 0 at speed w
-    (the template's denominator is linear in c1: one secant step is exact)."""
+    """Spring stiffness c1 below which the closed form's denominator is <= 0 at speed w (the
+    denominator is linear in c1: one secant step is exact)."""
     name = "D_lin" if form == "printed" else "D_newton"
     c1 = _v(sheet, "c1", "N/m")
     d1 = _v(sheet, name, "N*m", omega1=w)
@@ -580,17 +348,14 @@ def soft_spring_limit(sheet, w: float, form: str = "printed") -> float:
 
 
 def denominator_zero_speed(sheet, form: str = "printed") -> float:
-    """Speed at which the closed form's denominator passes through zero [rad/s] (the
-    template's denominator is k - c*omega1^2: its values at 0 and 1 rad/s give k and c)."""
+    """Speed where the closed form's denominator k - c*omega1^2 passes through zero [rad/s]."""
     name = "D_lin" if form == "printed" else "D_newton"
     k = _v(sheet, name, "N*m", omega1=0.0)
     c = k - _v(sheet, name, "N*m", omega1=1.0)
     return math.sqrt(k / c) if c > 0 else math.inf
 
 
-# ---------------------------------------------------------------------------------------------
-# findings
-# ---------------------------------------------------------------------------------------------
+# -- findings ----------------------------------------------------------------------------------
 SCENE_VALUES = ((50.0, 0.0), (80.0, 0.070), (110.0, 0.204))  # the reference example, base case
 
 
@@ -598,7 +363,7 @@ def trend_holds(sheet, key: str, ws) -> tuple[list[float], list[float], list[flo
     """Speeds where the printed trend holds strictly, where it fails, where it is vacuous
     (every member of the family on the stop)."""
     fam = family(sheet, key, ws)
-    vals = np.array([fam[v]["root"] for v in FAMILIES[key][2]])  # members x speeds
+    vals = np.array([fam[v]["root"] for v in FAMILIES[key][1]])  # members x speeds
     holds, fails, vacuous = [], [], []
     for j, w in enumerate(ws):
         col = vals[:, j]
@@ -633,8 +398,7 @@ def departures(sheet, key: str, ws, form: str = "printed", limit: float = 0.05):
     speeds where the denominator is <= 0)."""
     out = []
     for value, d in family(sheet, key, ws).items():
-        root = d["root"]
-        lin = d["printed"] if form == "printed" else d["newton"]
+        root, lin = d["root"], d["printed" if form == "printed" else "newton"]
         mask = root > 0
         rel = np.full(len(ws), np.nan)
         rel[mask] = np.abs(lin[mask] - root[mask]) / root[mask]
@@ -654,44 +418,23 @@ def _is_example(sheet) -> bool:
 @findings_block
 def findings(sheet):
     """Steady values, printed trends, closed-form departures, stiffness and the run."""
-    F = Finding
-    ws = speeds(sheet)
-    out: list[Finding] = []
+    F, ws, out = Finding, speeds(sheet), []
     example = _is_example(sheet)
     for w, ref in SCENE_VALUES:
         val = _v(sheet, "phi2", "rad", omega1=w)
         if example:
-            ok = "ok" if abs(val - ref) <= 1e-3 else "fail"
+            what = f"phi2 at omega1 = {w:g} rad/s (reference example: {ref:.3f})"
             out.append(
-                F(
-                    "steady state",
-                    f"phi2 at omega1 = {w:g} rad/s (reference example: {ref:.3f})",
-                    val,
-                    "rad",
-                    ok,
-                )
+                F("steady state", what, val, "rad", "ok" if abs(val - ref) <= 1e-3 else "fail")
             )
         else:
-            out.append(
-                F(
-                    "steady state",
-                    f"phi2 at omega1 = {w:g} rad/s",
-                    val,
-                    "rad",
-                    "info",
-                    "inputs differ from the reference example",
-                )
-            )
+            note = "inputs differ from the reference example"
+            out.append(F("steady state", f"phi2 at omega1 = {w:g} rad/s", val, "rad", "info", note))
     stop = [float(w) for w, f0 in zip(ws, _v(sheet, "F0", "N*m", omega1=ws)) if f0 <= 0]
+    note = f"on the stop at {_speeds_text(stop, ws)}: phi2 = 0 there, not a root"
+    lift = _v(sheet, "omega_lift", "rad/s")
     out.append(
-        F(
-            "steady state",
-            "lift-off speed (weights leave the stop)",
-            _v(sheet, "omega_lift", "rad/s"),
-            "rad/s",
-            "info",
-            f"on the stop at {_speeds_text(stop, ws)}: phi2 = 0 there, not a root",
-        )
+        F("steady state", "lift-off speed (weights leave the stop)", lift, "rad/s", "info", note)
     )
     for key in FAMILIES:
         holds, fails, vacuous = trend_holds(sheet, key, ws)
@@ -712,8 +455,8 @@ def findings(sheet):
     for form, title in (("printed", "printed linear form"), ("newton", "Newton-step linear form")):
         for key in FAMILIES:
             for value, where, worst, zero in departures(sheet, key, ws, form):
-                unit = FAMILIES[key][1]
-                what = f"{title}, {key} = {value:g} {unit}: largest departure from the root"
+                what = f"{title}, {key} = {value:g} {FAMILIES[key][0]}: largest departure"
+                what += " from the root"
                 note, verdict = "within 5 % at every speed off the stop", "ok"
                 if where:
                     note, verdict = f"more than 5 % at {_speeds_text(where, ws)}", "warning"
@@ -721,79 +464,59 @@ def findings(sheet):
                     note += (
                         f"; denominator <= 0 at {_speeds_text(zero, ws)}: reported, not divided by"
                     )
-                out.append(
-                    F(
-                        f"linear form vs nonlinear root ({form})",
-                        what,
-                        100 * worst,
-                        "%",
-                        verdict,
-                        note,
-                    )
-                )
+                topic = f"linear form vs nonlinear root ({form})"
+                out.append(F(topic, what, 100 * worst, "%", verdict, note))
     wmax, c1 = float(ws[-1]), _v(sheet, "c1", "N/m")
     for form in ("printed", "newton"):
+        what = f"{form} linear form: denominator passes through zero at {wmax:g} rad/s"
+        what += " for springs softer than"
+        note = f"with c1 = {c1:g} N/m it is zero at {denominator_zero_speed(sheet, form):.4g} rad/s"
         out.append(
-            F(
-                "extreme cases",
-                f"{form} linear form: denominator passes through zero at {wmax:g} rad/s "
-                "for springs softer than",
-                soft_spring_limit(sheet, wmax, form),
-                "N/m",
-                "info",
-                f"with c1 = {c1:g} N/m it is zero at "
-                f"{denominator_zero_speed(sheet, form):.4g} rad/s",
-            )
+            F("extreme cases", what, soft_spring_limit(sheet, wmax, form), "N/m", "info", note)
         )
     c2 = _v(sheet, "c2", "N/m")
-    lam = eigen(sheet)
-    out.append(
-        F(
-            "dynamics",
-            f"weight mode at c2 = {c2:.0e} N/m: Im lambda",
-            abs(lam[0].imag),
-            "rad/s",
-            "info",
-            f"Re lambda = {lam[0].real:.4g} 1/s",
-        )
-    )
+    re_w, re_t = _v(sheet, "weight_re", "1/s"), _v(sheet, "tooth_re", "1/s")
+    what = f"weight mode at c2 = {c2:.0e} N/m: Im lambda"
+    note = f"Re lambda = {re_w:.4g} 1/s"
+    out.append(F("dynamics", what, _v(sheet, "weight_im", "rad/s"), "rad/s", "info", note))
+    note = f"Re lambda = {re_t:.3g} 1/s (almost undamped)"
     out.append(
         F(
             "dynamics",
             "tooth mode: Im lambda",
-            abs(lam[-1].imag),
+            _v(sheet, "tooth_im", "rad/s"),
             "rad/s",
             "info",
-            f"Re lambda = {lam[-1].real:.3g} 1/s (almost undamped)",
-        )
-    )
-    out.append(
-        F(
-            "dynamics",
-            "with the printed damping sign (-beta OC^2 sin^2 phi20) the weight mode grows: "
-            "Re lambda",
-            float(eigen(sheet, damping="as printed")[0].real),
-            "1/s",
-            "warning",
-            "negative damping; the corrected sign is used",
-        )
-    )
-    cs, run = default_run(sheet)
-    note = run.summary()
-    if run.ok:
-        note += f"; error against the exact solution {_dev(cs, run, cs.exact):.3g} rad"
-    how = "auto" if method_of(sheet) == "auto" else "chosen"
-    out.append(
-        F(
-            "dynamics",
-            f"time histories: {run.method} rtol {run.rtol:.0e} at c2 = {c2:.0e} N/m ({how})",
-            run.elapsed,
-            "s",
-            "ok" if run.ok else "warning",
             note,
         )
     )
-    return out
+    what = "with the printed damping sign (-beta OC^2 sin^2 phi20) the weight mode grows: Re lambda"
+    note = "negative damping; the corrected sign is used"
+    out.append(F("dynamics", what, _v(sheet, "weight_re_printed", "1/s"), "1/s", "warning", note))
+    return out + [history_finding(sheet, c2)]
+
+
+def history_finding(sheet, c2: float) -> Finding:
+    """The sheet's own run of ode motion: its cost, and its error against the exact solution."""
+    from ..errors import WorkbookError
+
+    how = "auto" if str(sheet.evaluate("method")) == "auto" else "chosen"
+    try:
+        sol = sheet.evaluator.ode_solution("motion")
+    except WorkbookError as err:
+        return Finding(
+            "dynamics",
+            f"time histories at c2 = {c2:.0e} N/m ({how})",
+            None,
+            "",
+            "warning",
+            str(err),
+        )
+    cs, r = case(sheet), sol.run
+    err = float(np.max(np.abs(outputs(sol.run.sol(cs.t)) - cs.exact)))
+    what = f"time histories: {sol.method} rtol {r.rtol:.0e} at c2 = {c2:.0e} N/m ({how})"
+    note = f"{r.summary()}; error against the exact solution {err:.3g} rad"
+    return Finding("dynamics", what, r.elapsed, "s", "ok", note)
 
 
 @findings_block
@@ -802,16 +525,20 @@ def study_findings(sheet):
     optional part studies: 45 solver runs and a stalled RK45, a few seconds)."""
     short, df = _study_for_sheet(sheet)
     out = choice_findings(short, df)
-    run, need = stall_run(sheet)
+    r, need = stall_run(sheet)
+    what = f"RK45 at c2 = {STALL_C2:.0e} N/m stopped ({r.stop_reason})"
+    note = (
+        f"{r.nsteps} steps in {r.elapsed:.2f} s reached t = {r.t_reached:.3g} s; "
+        f"the stability limit needs about {need:.3g} steps"
+    )
     out.append(
         Finding(
             "extreme cases",
-            f"RK45 at c2 = {STALL_C2:.0e} N/m stopped ({run.stop_reason})",
-            run.fraction * 100,
+            what,
+            r.fraction * 100,
             "% of the run",
-            "ok" if not run.ok else "info",
-            f"{run.nsteps} steps in {run.elapsed:.2f} s reached t = {run.t_reached:.3g} s; "
-            f"the stability limit needs about {need:.3g} steps",
+            "ok" if not r.ok else "info",
+            note,
         )
     )
     return out
@@ -826,7 +553,8 @@ def choice_findings(sheet, df) -> list[Finding]:
     tol = 2 * float(sub["rigid-model difference [rad]"].iloc[0])
     ok = sub[(sub["stopped"] == "finished") & (sub["deviation from rigid [rad]"] <= tol)]
     stiff = at_c2(sheet, CHOICE_C2)
-    default, rtol = chosen_method(stiff), _v(sheet, "rtol", "")
+    default, rtol = str(stiff.evaluate("method_used")), _v(sheet, "rtol", "")
+    note = f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g} rad"
     out = [
         F(
             "solver choice",
@@ -834,7 +562,7 @@ def choice_findings(sheet, df) -> list[Finding]:
             tol / 2,
             "rad",
             "info",
-            f"a run 'reaches the rigid limit' when it deviates from it by <= {tol:.3g} rad",
+            note,
         )
     ]
     if ok.empty:
@@ -842,30 +570,24 @@ def choice_findings(sheet, df) -> list[Finding]:
             F("solver choice", "no run of the study reaches the rigid limit", None, "", "warning")
         ]
     best = ok.loc[ok["run time [s]"].idxmin()]
-    # time the best and the default again side by side (best of 3)
-    cs = case(stiff)
-    t_best = min(cs.problem.run(best["method"], best["rtol"]).elapsed for _ in range(3))
-    runs = [cs.problem.run(default, rtol) for _ in range(3)]
+    cs = case(stiff)  # time the best and the default again side by side (best of 3)
+    t_best = min(run(stiff, best["method"], best["rtol"], cs.t).elapsed for _ in range(3))
+    runs = [run(stiff, default, rtol, cs.t) for _ in range(3)]
     t_def = min(r.elapsed for r in runs)
-    dev, ratio = _dev(cs, runs[0], cs.rigid), t_def / t_best
-    out.append(
-        F(
-            "solver choice",
-            f"fastest run reaching the rigid limit: {best['method']} rtol {best['rtol']:.0e}",
-            t_best,
-            "s",
-            "info",
-            f"deviation {best['deviation from rigid [rad]']:.3g} rad",
-        )
-    )
+    dev, ratio = deviation(runs[0], cs.rigid), t_def / t_best
+    what = f"fastest run reaching the rigid limit: {best['method']} rtol {best['rtol']:.0e}"
+    note = f"deviation {best['deviation from rigid [rad]']:.3g} rad"
+    out.append(F("solver choice", what, t_best, "s", "info", note))
+    verdict = "ok" if ratio <= 2 and dev <= tol else "warning"
+    note = f"{t_def:.3g} s, deviation from the rigid limit {dev:.3g} rad (<= {tol:.3g})"
     out.append(
         F(
             "solver choice",
             f"default {default} rtol {rtol:.0e}: time / fastest",
             ratio,
             "",
-            "ok" if ratio <= 2 and dev <= tol else "warning",
-            f"{t_def:.3g} s, deviation from the rigid limit {dev:.3g} rad (<= {tol:.3g})",
+            verdict,
+            note,
         )
     )
     for c2 in sorted(df["c2 [N/m]"].unique()):
@@ -873,15 +595,13 @@ def choice_findings(sheet, df) -> list[Finding]:
         rows = at[(at["stopped"] == "finished") & (at["error [rad]"] <= 1e-6)]
         if rows.empty:
             continue
-        auto = chosen_method(at_c2(sheet, c2))
+        auto = str(at_c2(sheet, c2).evaluate("method_used"))
         mine = at[(at["method"] == auto) & (at["rtol"] == rtol)]
         fast = rows.loc[rows["run time [s]"].idxmin()]
         note = f"fastest with error <= 1e-6 rad: {fast['method']} rtol {fast['rtol']:.0e}"
         if not mine.empty:
-            note += (
-                f"; {auto} rtol {rtol:.0e}: error {mine['error [rad]'].iloc[0]:.2g} rad, "
-                f"{mine['run time [s]'].iloc[0]:.3g} s"
-            )
+            e, t = mine["error [rad]"].iloc[0], mine["run time [s]"].iloc[0]
+            note += f"; {auto} rtol {rtol:.0e}: error {e:.2g} rad, {t:.3g} s"
         out.append(
             F(
                 "solver choice",
@@ -892,22 +612,14 @@ def choice_findings(sheet, df) -> list[Finding]:
                 note,
             )
         )
-    out.append(
-        F(
-            "solver choice",
-            "why",
-            None,
-            "",
-            "info",
-            "the tooth mode is almost undamped and, for c2 >= 1e9 N/m, far faster than the "
-            "weights: explicit methods (RK45, DOP853) must follow it with about "
-            "|lambda|*t_end/3 steps, LSODA falls back to small steps, BDF of high order is "
-            "not stable near the imaginary axis; Radau (L-stable) steps over it. So 'auto' "
-            f"takes Radau when |lambda_max|*t_end > {AUTO_INDEX:g}, LSODA (cheapest in the "
-            "study at small c2) otherwise",
-        )
+    why = (
+        "the tooth mode is almost undamped and, for c2 >= 1e9 N/m, far faster than the weights: "
+        "explicit methods (RK45, DOP853) must follow it with about |lambda|*t_end/3 steps, LSODA "
+        "falls back to small steps, BDF of high order is not stable near the imaginary axis; "
+        "Radau (L-stable) steps over it. So 'auto' takes Radau when |lambda_max|*t_end > "
+        f"{_v(sheet, 'auto_index', ''):g}, LSODA (cheapest in the study at small c2) otherwise"
     )
-    return out
+    return out + [F("solver choice", "why", None, "", "info", why)]
 
 
 @bench_block
