@@ -236,3 +236,28 @@ def test_run_prints_matrices_and_texts(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "K = [[8., 2.], [4., 6.]] kN/m" in out
     assert 'verdict = "OK"' in out
+
+
+def test_eigenparts_against_scipy(tmp_path):
+    """Complex eigenvalues as rows (Re, Im), by modulus then imaginary part, against
+    scipy.linalg.eigvals of the same matrices (a real, a complex and a mixed spectrum)."""
+    from scipy.linalg import eigvals
+
+    cases = {
+        "A": [[0, 1], [-25, -6]],  # -3 +- 4i
+        "B": [[2, 1, 0], [1, 3, 1], [0, 1, 4]],  # real
+        "C": [[0, 1, 0, 0], [-400, -0.2, 5, 0], [0, 0, 0, 1], [3, 0, -9, -0.01]],
+    }
+    text = "[definitions]\n" + "".join(f'e{k} = "eigenparts({v})"\n' for k, v in cases.items())
+    path = tmp_path / "e.toml"
+    path.write_text(text, encoding="utf-8")
+    sheet = workbook.load(path)
+    for k, m in cases.items():
+        got = sheet.evaluate(f"e{k}").magnitude
+        lam = eigvals(np.array(m, dtype=float))
+        lam = lam[np.lexsort((lam.imag, np.abs(lam)))]
+        assert got.shape == (len(m), 2)
+        np.testing.assert_allclose(got[:, 0], lam.real, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(got[:, 1], lam.imag, rtol=1e-12, atol=1e-12)
+        moduli = np.hypot(got[:, 0], got[:, 1])
+        assert np.all(np.diff(moduli) >= -1e-12)

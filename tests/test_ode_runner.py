@@ -87,3 +87,31 @@ def test_bench_rows_cover_every_method_against_a_tight_reference():
     dop = {r["rtol"]: r["error"] for r in rows if r["method"] == "DOP853"}
     assert dop[1e-8] < dop[1e-4] and dop[1e-8] < 1e-6
     assert rows[-1]["method"].startswith("reference")
+
+
+def test_work_precision_skips_tighter_rtols_after_a_stall():
+    """A method stopped by its step cap at one rtol is recorded as skipped at tighter ones;
+    the others are run and their error falls with rtol (closed form of y' = -y)."""
+    ts = np.linspace(0.0, 2.0, 5)
+
+    def case(method, rtol):
+        cap = 3 if method == "RK45" and rtol < 1e-4 else 100_000
+        return ode.run_ode(
+            lambda t, y: -y,
+            (0.0, 2.0),
+            [1.0],
+            method=method,
+            rtol=rtol,
+            atol=1e-12,
+            t_eval=ts,
+            max_steps=cap,
+        )
+
+    def error(run):
+        return float(np.max(np.abs(run.y[0] - np.exp(-ts))))
+
+    rows = ode.work_precision(case, error, ("RK45", "Radau"), (1e-3, 1e-6, 1e-9))
+    got = {(r.method, r.rtol): r for r in rows}
+    assert got["RK45", 1e-6].stop_reason == "step cap"
+    assert got["RK45", 1e-9].stop_reason.startswith("skipped") and np.isnan(got["RK45", 1e-9].error)
+    assert got["Radau", 1e-9].error < got["Radau", 1e-3].error / 1000

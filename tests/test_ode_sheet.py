@@ -101,3 +101,83 @@ def test_time_outside_the_range_is_an_error(tmp_path):
     sheet = _sheet(tmp_path, ode("decay", [("y", "m", "y0", "-k*y")]))
     with pytest.raises(workbook.WorkbookError, match="outside the time range"):
         sheet.evaluate("y", [1, 5])
+
+
+MASS = """
+[inputs]
+m1 = "2 kg"
+m2 = "1 kg"
+k = "800 N/m"
+c = "4 N*s/m"
+x0 = "10 mm"
+scheme = { value = "Radau", options = ["RK45", "DOP853", "Radau"] }
+tol = "1e-10"
+
+[arguments]
+t = { unit = "s" }
+
+[definitions]
+M = "[[m1, 0], [0, m2]]"
+K = "[[2*k, -k], [-k, k]]"
+C = "[[c, 0], [0, c]]"
+"x2(t)" = { expr = "x(t)[1]", unit = "mm" }
+
+[[ode]]
+name = "two_masses"
+time = "t := 0 .. 0.5"
+method = "scheme"
+rtol = "tol"
+states = [
+  { name = "x", unit = "mm", initial = "[x0, 0]", derivative = "v", atol = "1e-9" },
+  { name = "v", unit = "mm/s", initial = "[0, 0]", derivative = "lsolve(M, -K*x - C*v)" },
+]
+"""
+
+
+def test_vector_states_against_the_matrix_exponential(tmp_path):
+    """M x'' + C x' + K x = 0 as two vector states, against expm of the first-order system
+    written out here; the method is a choice input and rtol an input."""
+    from scipy.linalg import expm
+
+    path = tmp_path / "m.toml"
+    path.write_text(MASS, encoding="utf-8")
+    sheet = Sheet(load_spec(path))
+    M, K, C = np.diag([2.0, 1.0]), np.array([[1600.0, -800.0], [-800.0, 800.0]]), 4 * np.eye(2)
+    A = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    ts = np.array([0.05, 0.2, 0.5])
+    ref = np.array([expm(A * t) @ [0.01, 0, 0, 0] for t in ts])  # m, m/s
+    got = sheet.evaluate("x", ts).to("m").magnitude  # (2, 1, 3)
+    assert got.shape == (2, 1, 3)
+    np.testing.assert_allclose(got[:, 0, :].T, ref[:, :2], atol=1e-11)
+    np.testing.assert_allclose(sheet.evaluate("x2", ts).to("m").magnitude, ref[:, 1], atol=1e-11)
+    sol = sheet.evaluator.ode_solution("two_masses")
+    assert sol.method == "Radau" and sol.run.rtol == 1e-10
+    other = sheet.with_inputs(scheme="DOP853")
+    assert other.evaluator.ode_solution("two_masses").method == "DOP853"
+
+
+def test_vector_state_shapes_and_method_names_are_checked_at_load(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text(MASS.replace('derivative = "v"', 'derivative = "v[0]"'), encoding="utf-8")
+    with pytest.raises(workbook.WorkbookError, match="derivative of 'x' is a number"):
+        Sheet(load_spec(path))
+    path.write_text(MASS.replace('method = "scheme"', 'method = "schema"'), encoding="utf-8")
+    with pytest.raises(workbook.WorkbookError, match="not one of auto"):
+        Sheet(load_spec(path))
+    path.write_text(MASS.replace('method = "scheme"', 'method = "tol"'), encoding="utf-8")
+    with pytest.raises(workbook.WorkbookError, match="must give text"):
+        Sheet(load_spec(path))
+
+
+def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
+    from workbook import ode as wo
+
+    path = tmp_path / "m.toml"
+    path.write_text(MASS, encoding="utf-8")
+    sheet = Sheet(load_spec(path)).with_inputs(scheme="RK45", tol="1e-9")
+    ts = np.linspace(0, 0.5, 11)
+    run = wo.run_sheet(sheet, "two_masses", t_eval=ts)
+    assert run.ok and run.method == "RK45" and run.y.shape == (4, 11)
+    np.testing.assert_allclose(run.y[:2, -1], sheet.evaluate("x", 0.5).magnitude[:, 0], atol=1e-5)
+    capped = wo.run_sheet(sheet, "two_masses", t_eval=ts, max_steps=5)
+    assert capped.stop_reason == "step cap" and not capped.ok
