@@ -406,10 +406,7 @@ class Translator:
         xt, yt = et.visit(x), et.visit(y)
         ranges = list(dict.fromkeys(et.ranges))
         if not ranges:
-            raise Untranslatable(
-                "no range variable (a vector against a vector, or a single point: "
-                "a chart draws over a range)"
-            )
+            return self.points(xt, yt)
         if len(ranges) > 1:
             names = ", ".join(r.mathcad for r in ranges)
             raise Untranslatable(f"over two range variables at once ({names})")
@@ -419,7 +416,44 @@ class Translator:
         )
         if item is None or ranges[0].broken:
             raise Untranslatable(f"the range variable {ranges[0].mathcad} is not translated")
-        return xt, yt, item
+        return xt, yt, item, False
+
+    def points(self, xt: ex.Node, yt: ex.Node) -> tuple:
+        """A trace without a range variable: a vector against a vector (Mathcad draws a point
+        for each element: a series over their index) or a single point (a marker)."""
+        lengths = [self._length(t) for t in (xt, yt)]
+        o = self.sheet_origin
+        index = self.index_sym()
+        if lengths == [None, None]:  # numbers: one point (the engine refuses a vector here)
+            n, xt_, yt_ = 1, xt, yt
+        elif None in lengths or lengths[0] != lengths[1]:
+            raise Untranslatable(
+                "a vector against a vector whose lengths are not both known at import"
+                if None in lengths
+                else f"a vector of {lengths[1]} against a vector of {lengths[0]}"
+            )
+        else:
+            n = lengths[0]
+            at = (ex.Name(index.token()),)
+            xt_, yt_ = ex.Index(xt, at), ex.Index(yt, at)
+        rng = Item("range", "", sym=index, range=(ex.Number(o), None, ex.Number(o + n - 1)))
+        return xt_, yt_, rng, True
+
+    def _length(self, tree: ex.Node) -> int | None:
+        """The length of a vector the worksheet defines by name (None: not a known vector)."""
+        seen = set()
+        while isinstance(tree, ex.Name) and tree.id not in seen:
+            seen.add(tree.id)
+            item = next(
+                (i for i in self.out.items if i.sym is not None and i.sym.token() == tree.id),
+                None,
+            )
+            if item is None or item.kind != "definition" or item.body is None:
+                return None
+            tree = item.body
+        if isinstance(tree, ex.Matrix) and all(len(r) == 1 for r in tree.rows):
+            return len(tree.rows)
+        return None
 
     def argument_units(self) -> None:
         """Mathcad's functions are untyped: an argument takes the unit of the values the

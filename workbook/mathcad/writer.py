@@ -325,28 +325,32 @@ def _solve(item: Item, mapping, out: Rendered) -> list[str]:
 
 def _chart(item: Item, mapping) -> list[str]:
     """A [[charts]] entry: Mathcad's X-Y plot, one series per trace over its range."""
-    series = [(x, y, rng) for x, y, rng in item.chart if not rng.sym.broken]
+    series = [t for t in item.chart if not t[2].sym.broken]
     if not series:
         return []
     tag = f"(region {item.region})"
     polar = item.value == "polar"
     kind = "Mathcad polar plot" if polar else "Mathcad plot"
     first = series[0][2]
+    first_text = first.sym.final + " := " + _range_text(first, mapping)
     lines = []
-    for x, y, rng in series:
+    for x, y, rng, points in series:
         parts = [f"x = {_q(_text(x, mapping))}", f"y = {_q(_text(y, mapping))}"]
-        if rng is not first:
-            parts.append(f"range = {_q(rng.sym.final + ' := ' + _range_text(rng, mapping))}")
+        text = rng.sym.final + " := " + _range_text(rng, mapping)
+        if text != first_text:
+            parts.append(f"range = {_q(text)}")
+        if points:  # Mathcad draws the points of vectors, or a single point
+            parts += ['line = "none"', "marker = true"]
         lines.append(f"  {{ {', '.join(parts)} }},")
-    x_title = ", ".join(dict.fromkeys(_text(x, mapping) for x, _, _ in series))
-    y_title = ", ".join(dict.fromkeys(_text(y, mapping) for _, y, _ in series))
+    x_title = ", ".join(dict.fromkeys(_text(t[0], mapping) for t in series))
+    y_title = ", ".join(dict.fromkeys(_text(t[1], mapping) for t in series))
     return [
         "",
         f"[[charts]]  # Mathcad's plot {tag}",
         f"name = {_q('plot_' + item.region)}  # {tag}",
         f"title = {_q(kind + ', region ' + item.region)}",
         *(["equal_axes = true"] if polar else []),
-        f"range = {_q(first.sym.final + ' := ' + _range_text(first, mapping))}",
+        f"range = {_q(first_text)}",
         f"x_title = {_q(x_title)}",
         f"y_title = {_q(y_title)}",
         "series = [",
