@@ -187,13 +187,17 @@ def test_a_plot_item_that_is_not_gzip_or_too_large_is_listed(tmp_path, capsys):
 
 def test_plot_of_vectors_is_a_series_over_their_index(tmp_path, capsys):
     """points-and-lines: Y against X (two vectors of six points) is a series of markers over
-    the index; a trace over a range variable beside it keeps its own range."""
+    the index; a trace over a range variable beside it keeps its own range; a quick plot (a
+    variable the worksheet does not define) is drawn over Mathcad's default -10 .. 10."""
     toml, _ = _import("points-and-lines.xmcd", tmp_path, capsys)
     text = toml.read_text(encoding="utf-8")
     chart = text[text.index('name = "plot_912"') :].split("\n\n")[0]
     assert 'range = "index := 0 .. 5"' in chart
     assert '{ x = "X[index]", y = "Y[index]", line = "none", marker = true }' in chart
     assert re.search(r'\{ x = "x_", y = "L34\(x_\)", range = "x_ := x3 \.\. x4" \}', chart)
+    # a quick plot: t is not defined, Mathcad draws x1(t, ...) against y1(t, ...) from -10 to 10
+    quick = text[text.index('name = "plot_919"') :].split("\n\n")[0]
+    assert 'range = "t := -10, -9.9 .. 10"' in quick
     out = tmp_path / "out.xlsx"
     assert main(["run", str(toml), "--out", str(out)]) == 0
     assert len(_charts(out)) == text.count("[[charts]]")

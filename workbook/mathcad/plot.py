@@ -55,6 +55,31 @@ def payload(encoded: str) -> bytes:
     return data
 
 
+def x_limits(data: bytes) -> tuple[float, float] | None:
+    """The x axis's limits (lower, upper) the user set, or None where Mathcad chooses them."""
+    root = _tree(data)
+    try:
+        upper, lower = root.right.left.left.left, root.right.left.left.right
+    except AttributeError:
+        return None
+    values = [_limit(r) for r in (lower, upper)]
+    if None in values or values[0] >= values[1]:
+        return None
+    return values[0], values[1]
+
+
+def _limit(rec: _Rec | None) -> float | None:
+    sign = 1.0
+    if rec is not None and rec.op == _NEG:
+        sign, rec = -1.0, rec.right
+    if rec is None or rec.op != _LEAF or not rec.side & 0x10 or (rec.side & 0x3F) == 0x36:
+        return None  # an expression, or a number Mathcad chose itself
+    try:
+        return sign * float(rec.value or "")
+    except ValueError:
+        return None
+
+
 def traces(data: bytes) -> tuple[list[tuple[MNode, MNode]], bool]:
     """(x, y) expressions of each trace of an X-Y or polar plot, as Mathcad's XML elements,
     and whether the plot is polar (its r(theta) traces become x = r cos(theta), y = r

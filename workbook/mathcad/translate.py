@@ -383,16 +383,18 @@ class Translator:
     def plot(self, region: Region) -> None:
         """An X-Y plot: a chart whose series are its traces, each over the range variable its
         expressions use (Mathcad plots a trace at every value of it)."""
-        from .plot import payload, traces
+        from .plot import payload, traces, x_limits
 
         if not region.binary:
             raise Untranslatable("a plot without its binary item (its definition)")
         self.forced_region(region)
         series, why = [], []
-        pairs, polar = traces(payload(region.binary))
+        data = payload(region.binary)
+        pairs, polar = traces(data)
+        limits = None if polar else x_limits(data)
         for n, (x, y) in enumerate(pairs, 1):
             try:
-                series.append(self.trace(x, y))
+                series.append(self.trace(x, y, limits))
             except Untranslatable as err:
                 why.append(f"trace {n}: {err}")
         if not series:
@@ -401,7 +403,10 @@ class Translator:
             self.skip(region.id, "a plot (traces left out)", "; ".join(why))
         self.out.items.append(Item("chart", region.id, chart=series, value="polar" * polar))
 
-    def trace(self, x: MNode, y: MNode) -> tuple:
+    def trace(self, x: MNode, y: MNode, limits=None) -> tuple:
+        free = self._free_names(x)
+        if len(free) == 1:
+            return self.quick_plot(free[0], x, y, limits if x.tag == "id" else None)
         et = ExprTranslator(self)
         xt, yt = et.visit(x), et.visit(y)
         ranges = list(dict.fromkeys(et.ranges))
@@ -417,6 +422,39 @@ class Translator:
         if item is None or ranges[0].broken:
             raise Untranslatable(f"the range variable {ranges[0].mathcad} is not translated")
         return xt, yt, item, False
+
+    def _free_names(self, node: MNode) -> list[tuple[str, str]]:
+        """Names in ``node`` that the worksheet has not defined (not units, not pi)."""
+        out: list[tuple[str, str]] = []
+
+        def walk(n: MNode, head: bool = False) -> None:
+            if n.tag == "id":
+                key = _key(n)
+                if not head and self.scope.get(key) is None and key[0] not in _KNOWN:
+                    out.append(key)
+                return
+            for i, c in enumerate(n.children):
+                walk(c, head=n.tag == "apply" and i == 0)
+
+        walk(node)
+        return list(dict.fromkeys(out))
+
+    def quick_plot(self, key, x: MNode, y: MNode, limits) -> tuple:
+        """Mathcad's quick plot: a name the x expression uses that the worksheet has not
+        defined is a variable from -10 to 10 (over the x axis's limits where the user set
+        them and x is that name), drawn at QUICK_PLOT_STEPS steps."""
+        lo, hi = limits or (-10.0, 10.0)
+        sym = self.new_sym("var", nm.identifier(*key), nm.mathcad_text(*key), unit="")
+        sym.is_range = True
+        step = (hi - lo) / QUICK_PLOT_STEPS
+        rng = Item(
+            "range",
+            "",
+            sym=sym,
+            range=(ex.Number(lo), ex.Number(lo + step), ex.Number(hi)),
+        )
+        et = ExprTranslator(self, {key: sym})
+        return et.visit(x), et.visit(y), rng, False
 
     def points(self, xt: ex.Node, yt: ex.Node) -> tuple:
         """A trace without a range variable: a vector against a vector (Mathcad draws a point
@@ -1088,6 +1126,10 @@ def _has_solve() -> bool:
 #: condition), the root nearest the guess that meets the conditions is the one it reports in
 #: the worksheets measured; the others (linear, quasi-Newton): the default method
 _METHODS = {"levenberg": "levenberg-marquardt", "conjugate": "nearest"}
+
+#: steps of the range of a quick plot (an x that the worksheet has not defined)
+QUICK_PLOT_STEPS = 200
+_KNOWN = {*FORMULA_UNITS, "π", "e"}
 
 _INEQUALITY = {"lessThan", "greaterThan", "lessOrEqual", "greaterOrEqual"}
 
