@@ -6,6 +6,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
+from recalc import cell_values, formula_values, recalculate, soffice
 from scipy.optimize import brentq
 
 import workbook
@@ -576,3 +577,114 @@ def test_a_derivative_inside_another_function_call(tmp_path):
     t = np.array([0.0, 0.003, 0.02])
     want = 0.01 * 100 * np.cos(100 * 2 * t)
     assert np.allclose(s.evaluate("z", t).to("m/s").magnitude, want, rtol=1e-13, atol=1e-16)
+
+
+# -- a root in a table column: live, one bisection chain per table row ---------------------------
+ROOT_TABLE = """
+[inputs]
+eps = "0.05 mm"
+D = "100 mm"
+[arguments]
+Re = { unit = "" }
+f = { unit = "" }
+[definitions]
+"colebrook(f, Re)" = "1/sqrt(f) + 2*log10(eps/(3.7*D) + 2.51/(Re*sqrt(f)))"
+"friction(Re)" = "root(colebrook(f, Re), f, 0.005, 0.1)"
+"friction_guess(Re)" = "root(colebrook(f, Re), f, 0.02)"
+[[tables]]
+name = "moody"
+range = "Re := 4000, 24000 .. 104000"
+columns = { friction = "", friction_guess = "" }
+"""
+
+
+def _root_table(tmp_path):
+    import openpyxl
+
+    s = sheet(tmp_path, ROOT_TABLE)
+    path = s.write_xlsx(tmp_path / "m.xlsx")
+    wb = openpyxl.load_workbook(path)
+    ws = next(w for w in wb.worksheets if w.title not in ("Inputs", "Definitions"))
+    return s, path, wb, ws
+
+
+def test_a_root_in_a_table_column_is_live_as_bisection_steps(tmp_path):
+    s, path, wb, ws = _root_table(tmp_path)
+    heads = [c.value for c in ws[2]]
+    live, guess = heads.index("friction") + 1, heads.index("friction_guess") + 1
+    re_values = [ws.cell(r, 1).value for r in range(3, 9)]
+    assert re_values == [4000 + 20000 * i for i in range(6)]
+    for r in range(3, 9):
+        formula = ws.cell(r, live).value
+        assert formula.startswith("=IF('Solver steps'!$H$" + str(r)), formula
+        assert isinstance(ws.cell(r, guess).value, float)  # from a guess: a number
+    assert "Solver steps" in wb.sheetnames
+    assert "from a guess" in ws.cell(2, guess).comment.text
+    stated = re.search(r"by ([0-9.e+-]+) ", ws.cell(2, live).comment.text)
+    assert stated and float(stated.group(1)) < 1e-10
+    # the cached value of every step cell is what the formulas compute (the same steps)
+    from workbook.numerics.entries import _bisection
+
+    steps = wb["Solver steps"]
+    f = lambda x, i: colebrook(x, np.array(re_values)[i.astype(int)])  # noqa: E731
+    want = _bisection(f, np.full(6, 0.005), np.full(6, 0.1), np.arange(6.0))
+    cached = openpyxl_values(path)["Solver steps"]
+    assert steps.cell(3, 8).value.startswith("=1/SQRT((0.005))")
+    for r in range(6):
+        assert cached[(r + 3, 8)] == pytest.approx(want["fa"][r], rel=1e-12)
+        assert cached[(r + 3, 8 + 2 + 3 * 60)] == pytest.approx(want["lo"][60][r], rel=1e-12)
+
+
+def openpyxl_values(path) -> dict:
+    import openpyxl
+
+    wb = openpyxl.load_workbook(path, data_only=True)
+    return {
+        ws.title: {(c.row, c.column): c.value for row in ws.iter_rows() for c in row}
+        for ws in wb.worksheets
+    }
+
+
+def test_a_root_in_a_long_table_column_is_a_number_with_the_limit(tmp_path):
+    import openpyxl
+
+    long = ROOT_TABLE.replace("Re := 4000, 24000 .. 104000", "Re := 4000, 4100 .. 104000")
+    s = sheet(tmp_path, long)
+    path = s.write_xlsx(tmp_path / "m.xlsx")
+    ws = next(w for w in openpyxl.load_workbook(path).worksheets if w.title != "Inputs")
+    heads = [c.value for c in ws[2]]
+    col = heads.index("friction") + 1
+    assert isinstance(ws.cell(3, col).value, float)
+    text = ws.cell(2, col).comment.text
+    assert "up to 100,000 cells" in text and "1,001 rows" in text
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed")
+def test_a_live_root_column_follows_an_input_change_in_libreoffice(tmp_path):
+    s, path, wb, ws = _root_table(tmp_path)
+    heads = [c.value for c in ws[2]]
+    col = heads.index("friction") + 1
+    stated = float(re.search(r"by ([0-9.e+-]+) ", ws.cell(2, col).comment.text).group(1))
+    # unchanged inputs: LibreOffice computes every formula cell to its cached value (f near
+    # the root is rounding noise, 1e-14 beside terms near 7, computed a little differently)
+    before = formula_values(path)
+    again = cell_values(recalculate(path, tmp_path / "lo0"))
+    bad = [
+        (k, v, again.get(k))
+        for k, (_, v) in before.items()
+        if isinstance(v, float) and again.get(k) != pytest.approx(v, rel=1e-12, abs=1e-12)
+    ]
+    assert not bad, bad[:5]
+    # eps 0.05 mm -> 0.5 mm: the column follows
+    row = next(r for r in wb["Inputs"].iter_rows() if r[0].value == "eps")
+    row[1].value = 0.5
+    wb.save(tmp_path / "edited.xlsx")
+    got = cell_values(recalculate(tmp_path / "edited.xlsx", tmp_path / "lo1"))
+    re_values = np.array([4000.0 + 20000 * i for i in range(6)])
+    want = s.with_inputs(eps="0.5 mm").evaluate("friction", re_values).magnitude
+    old = s.evaluate("friction", re_values).magnitude
+    for i, r in enumerate(range(3, 9)):
+        value = got[(ws.title, f"{ws.cell(r, col).column_letter}{r}")]
+        assert value == pytest.approx(want[i], rel=1e-9, abs=10 * stated)
+        assert value != pytest.approx(old[i], rel=1e-3)

@@ -29,6 +29,7 @@ from .uses import names_used
 from .version import __version__
 
 MAX_ROWS = 1_048_576
+MAX_COLS = 16_384
 ROW_TOKEN = "\x00"
 PROGRESS_CELLS = 200_000  # a table with more cells than this reports its progress on stderr
 
@@ -141,6 +142,8 @@ class WorkbookWriter:
         self.not_live: list[str] = []
         self.formula_cells = 0
         self.planned: dict[tuple[str, str], ColumnCells] = {}
+        # the next free column and the cells used of the row-wise blocks of 'Solver steps'
+        self.step_col, self.step_cells = RowSteps.FIRST_COL, 0
 
     def ws(self, name: str):
         if name not in self.sheets:
@@ -411,7 +414,8 @@ class WorkbookWriter:
         for j, col in enumerate(data.columns[1:], start=1):
             if report:
                 _progress(f"table {spec.name}: column {j} of {len(data.columns) - 1} ({n:,} rows)")
-            if self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n):
+            var_values = data.columns[0].values
+            if self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n, var_values):
                 env = {data.var: data.columns[0].values}
                 self._live_note(ws, first - 1, j, col.typed, env, col.values)
             cells = ColumnCells(spec.sheet, j, first, first + n - 1, col.title)
@@ -471,10 +475,12 @@ class WorkbookWriter:
         return texts[0], texts[1], texts[2]
 
     def _write_column(
-        self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n
+        self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n, var_values
     ) -> bool:
         """Write one column, live formulas if it can be; True if it is live."""
         fmt = self.fmt["value"]
+        steps = RowSteps(self, ws.name, first, n, var_ref, col.typed, {var: var_values})
+        self.printer.helpers = steps  # a root's bisection steps, one chain a row
         try:
             template = self.printer.formula(col.typed, {var: var_ref})
         except NotLive as why:
@@ -487,6 +493,9 @@ class WorkbookWriter:
             ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
             self.not_live.append(f"{table}.{col.text}")
             return False
+        finally:
+            self.printer.helpers = None
+        steps.write()
         pieces = template.split(ROW_TOKEN)
         write = ws.write_formula
         if self.printer.array:  # computes with vectors or matrices: one-cell array formulas
@@ -935,6 +944,109 @@ class HelperCells:
         write_labels(ws, start + 1, 1, headers, self.writer.fmt["header"])
         self.writer.rows[self.SHEET] = start + rows + 3
         return HelperBlock(ws, self.SHEET, start + 2)
+
+
+class RowSteps:
+    """Helper cells of the live roots of one table column: blocks of columns on the sheet
+    'Solver steps' whose row i is the table's row i, so that one formula a block column,
+    with the table's row number (``ROW_TOKEN``) filled in, serves every row.
+
+    ``chain(expr)`` is the engine's bisection chain of the root of EXPR in every row (the
+    cached values); ``block(title, headers)`` reserves a block (NotLive beyond
+    ``MAX_CELLS``); the blocks are written by :meth:`write` once the column's formula is
+    printed (a column that is not live leaves no helper cells)."""
+
+    per_row = True
+    SHEET = HelperCells.SHEET
+    FIRST_COL = 7  # H: columns B to F hold the scalar roots' steps
+    #: helper cells of all row-wise blocks of a workbook (543 table rows of one root)
+    MAX_CELLS = 100_000
+
+    def __init__(self, writer, table_sheet: str, first: int, n: int, var_ref, typed, env):
+        self.writer, self.first, self.n = writer, first, n
+        self.var_ref, self.typed, self.env = var_ref, typed, env
+        self.table_ref = f"'{table_sheet}'!{var_ref}"  # the variable seen from the steps sheet
+        self.blocks: list[RowBlock] = []
+        self._chains: dict | None = None
+
+    def chain(self, expr: tc.T) -> dict:
+        """The engine's bisection steps of the root of ``expr``, every row (or NotLive)."""
+        from .numerics._common import live_forms, recording_chains
+
+        if self._chains is None:
+            with live_forms(), recording_chains() as found:
+                try:
+                    self.writer.sheet.evaluator.compile(self.typed)(self.env)
+                except WorkbookError as err:
+                    raise NotLive(
+                        f"root(): the bisection steps leave the expression's domain ({err.message})"
+                    ) from None
+            self._chains = found
+        got = self._chains.get(id(expr), [])
+        arrays = [] if len(got) != 1 else _step_arrays(got[0][1])
+        if len(got) != 1 or any(np.shape(v) not in ((), (self.n,)) for v in arrays):
+            raise NotLive(
+                "root() is solved more than once for each row of this column (called twice, "
+                "or inside another built-in): its values are written as numbers"
+            )
+        if not all(np.isfinite(v).all() for v in arrays):
+            raise NotLive("root(): the bisection steps leave the expression's domain")
+        return got[0][1]
+
+    def block(self, title: str, headers: list[str]) -> RowBlock:
+        col = self.writer.step_col + sum(len(b.headers) for b in self.blocks)
+        cells = self.n * len(headers) + self.writer.step_cells
+        cells += sum(self.n * len(b.headers) for b in self.blocks)
+        if cells > self.MAX_CELLS or col + len(headers) > MAX_COLS:
+            rows = self.MAX_CELLS // len(headers)
+            raise NotLive(
+                f"root() in a table column is live as {len(headers)} helper cells a row on the "
+                f"sheet '{self.SHEET}', up to {self.MAX_CELLS:,} cells in a workbook ({rows} "
+                f"rows of one root); this table has {self.n:,} rows: its values are written "
+                "as numbers"
+            )
+        block = RowBlock(self, col, title, headers)
+        self.blocks.append(block)
+        return block
+
+    def write(self) -> None:
+        """Write the reserved blocks (the column's formula is printed: it is live)."""
+        if not self.blocks:
+            return
+        w = self.writer
+        ws = w.ws(self.SHEET)
+        for b in self.blocks:
+            ws.write_string(self.first - 2, b.col, b.title, w.fmt["title"])
+            write_labels(ws, self.first - 1, b.col, b.headers, w.fmt["header"])
+            for j, (formula, values) in enumerate(b.cells):
+                pieces = formula.replace(self.var_ref, self.table_ref).split(ROW_TOKEN)
+                values = np.broadcast_to(np.asarray(values, dtype=float), (self.n,)).tolist()
+                for i in range(self.n):
+                    row = self.first + i
+                    ws.write_formula(row, b.col + j, str(row + 1).join(pieces), None, values[i])
+            w.step_col = b.col + len(b.headers)
+            w.step_cells += self.n * len(b.headers)
+            w.formula_cells += self.n * len(b.headers)
+
+
+def _step_arrays(steps: dict) -> list:
+    return [steps["fa"], steps["fb"], *steps["lo"], *steps["hi"], *steps["fm"]]
+
+
+class RowBlock:
+    """Columns of 'Solver steps' for one root of a table column: ``ref(j)`` is column j's
+    cell in the current table row; ``write(j, formula, values)`` sets its formula (in the
+    row's terms) and the cached value of every row."""
+
+    def __init__(self, steps: RowSteps, col: int, title: str, headers: list[str]):
+        self.steps, self.col, self.title, self.headers = steps, col, title, headers
+        self.cells: list[tuple[str, object]] = [("", 0.0)] * len(headers)
+
+    def ref(self, j: int) -> str:
+        return f"'{self.steps.SHEET}'!${_col_letter(self.col + j)}${ROW_TOKEN}"
+
+    def write(self, j: int, formula: str, values) -> None:
+        self.cells[j] = (formula, values)
 
 
 class HelperBlock:

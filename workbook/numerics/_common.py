@@ -80,6 +80,28 @@ def live_forms() -> Iterator[None]:
         _live.reset(token)
 
 
+_chains: contextvars.ContextVar[dict | None] = contextvars.ContextVar(
+    "workbook_numerics_chains", default=None
+)
+
+
+def chains() -> dict | None:
+    """Inside :func:`recording_chains`: id of a root's EXPR -> the bisection chains found."""
+    return _chains.get()
+
+
+@contextlib.contextmanager
+def recording_chains() -> Iterator[dict]:
+    """Keep every bisection chain a live root computes (the cached values of the workbook's
+    step cells): ``{id(EXPR's typed tree): [chain, ...]}``, one chain per evaluation."""
+    found: dict = {}
+    token = _chains.set(found)
+    try:
+        yield found
+    finally:
+        _chains.reset(token)
+
+
 @contextlib.contextmanager
 def tolerance(tol: Tolerance) -> Iterator[None]:
     """Evaluate with ``tol`` instead of the sheet's tolerance (``workbook bench``'s reference)."""

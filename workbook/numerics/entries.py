@@ -19,7 +19,7 @@ from .. import units as un
 from ..entry import Builtin, register
 from ..errors import NotLive, NotSymbolic, TemplateError, UnitError, WorkbookError
 from ..expr import PREC
-from ._common import Result, live, sheet_tolerance
+from ._common import Result, chains, live, sheet_tolerance
 
 ATOM = PREC["atom"]
 #: rows solved at once (a bracket's samples take rows x samples memory)
@@ -171,16 +171,38 @@ def _solve(of, solve, *bounds) -> Result:
     )
 
 
-def _bisection(f, a, b, idx) -> np.ndarray:
-    """What the workbook's bisection steps compute (``_root_excel``), row by row."""
+def _bisection(f, a, b, idx) -> dict[str, np.ndarray]:
+    """What the workbook's bisection steps compute, row by row: f(A), f(B), then lo, hi and
+    f(mid) of every step (f(lo) keeps the sign of f(A), so only f(mid) is evaluated); the
+    root is the last (lo + hi)/2, NaN where f(A) and f(B) have the same sign (#N/A)."""
     lo, hi = a.copy(), b.copy()
-    flo = np.asarray(f(lo, idx), dtype=float)
+    fa = np.asarray(f(lo, idx), dtype=float)
+    fb = np.asarray(f(hi, idx), dtype=float)
+    out = {"fa": fa, "fb": fb, "lo": [lo], "hi": [hi], "fm": []}
     for _ in range(BISECTION_STEPS):
         mid = (lo + hi) / 2
-        left = flo * np.asarray(f(mid, idx), dtype=float) <= 0
+        fm = np.asarray(f(mid, idx), dtype=float)
+        left = fa * fm <= 0
         lo, hi = np.where(left, lo, mid), np.where(left, mid, hi)
-        flo = np.asarray(f(lo, idx), dtype=float)
-    return (lo + hi) / 2
+        out["lo"].append(lo)
+        out["hi"].append(hi)
+        out["fm"].append(fm)
+    out["root"] = np.where(fa * fb > 0, np.nan, (lo + hi) / 2)
+    return out
+
+
+def _live_root(of, a, b) -> np.ndarray:
+    """The live form's root of every row (and its chain kept, when the writer records)."""
+    shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
+    f = of.over(shape)
+    flat = [np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b)]
+    idx = np.arange(math.prod(shape), dtype=float)
+    with np.errstate(all="ignore"):
+        steps = _bisection(f, *flat, idx)
+    kept = chains()
+    if kept is not None:
+        kept.setdefault(id(of.body), []).append((of.body, steps))
+    return steps["root"].reshape(shape)
 
 
 def _root_numpy(of, a, b=None):
@@ -188,13 +210,7 @@ def _root_numpy(of, a, b=None):
 
     tol, var, unit = of.tolerance, of.var, of.unit_text
     if live() and b is not None:
-        res = _solve(
-            of,
-            lambda f, a, b, idx, label: Result(_bisection(f, a, b, idx), np.zeros(a.shape)),
-            a,
-            b,
-        )
-        return _out(res.value)
+        return _out(_live_root(of, a, b))
     if b is None:
         res = _solve(
             of,
@@ -317,8 +333,10 @@ def _not_live(name: str, primitive: str):
 def _root_excel(body, args, consts) -> tuple[str, int]:
     """A live root of a scalar definition: BISECTION_STEPS bisection steps in helper cells
     (lo, hi, mid, f(lo), f(mid) a row, each with its cached value); #N/A when f(A) and f(B)
-    have the same sign."""
+    have the same sign. In a table column: one chain a table row (:func:`_root_rows`)."""
     helpers = getattr(body, "helpers", None)
+    if getattr(helpers, "per_row", False):
+        return _root_rows(body, args, helpers)
     free = helpers is not None and len(args) == 2
     free = (
         free
@@ -366,6 +384,50 @@ def _root_excel(body, args, consts) -> tuple[str, int]:
         block.write(k, 4, "=" + body(r(k, 2)), fmid)
     same_sign = f"{r(0, 3)}*({body(r(0, 1))})>0"
     return f"IF({same_sign},NA(),{r(BISECTION_STEPS, 2)})", ATOM
+
+
+def _root_rows(body, args, helpers) -> tuple[str, int]:
+    """A live root in a table column: BISECTION_STEPS bisection steps for every table row, in
+    a block of the sheet 'Solver steps' whose row i is the table's row i (f(A), f(B), then
+    lo, hi and f(mid) of each step; f(lo) keeps the sign of f(A)). The cached values are the
+    engine's same steps (``_bisection``); #N/A when f(A) and f(B) have the same sign."""
+    if len(args) != 2:
+        raise NotLive(
+            "root() from a guess is computed by find_root (scipy.optimize.elementwise) to the "
+            "sheet's tolerance; its values are written as numbers (a bracketed root is live)"
+        )
+    a, b = args
+    if max(len(body(f"({a})")), len(body(f"({b})"))) > 2000:
+        raise NotLive("root(): the expression is too long for bisection steps in helper cells")
+    steps = helpers.chain(body.typed)
+    n = BISECTION_STEPS
+    headers = ["f(A)", "f(B)"]
+    for k in range(n + 1):
+        headers += [f"lo {k}", f"hi {k}"] + ([f"f(mid) {k}"] if k < n else [])
+    block = helpers.block("root() by bisection, one row per table row", headers)
+    r = block.ref
+    fa, fb = r(0), r(1)
+
+    def lo(k: int) -> str:
+        return r(2 + 3 * k)
+
+    def hi(k: int) -> str:
+        return r(3 + 3 * k)
+
+    block.write(0, "=" + body(f"({a})"), steps["fa"])
+    block.write(1, "=" + body(f"({b})"), steps["fb"])
+    for k in range(n + 1):
+        if k:
+            left = f"{fa}*{r(4 + 3 * (k - 1))}<=0"
+            mid = f"({lo(k - 1)}+{hi(k - 1)})/2"
+            block.write(2 + 3 * k, f"=IF({left},{lo(k - 1)},{mid})", steps["lo"][k])
+            block.write(3 + 3 * k, f"=IF({left},{mid},{hi(k - 1)})", steps["hi"][k])
+        else:
+            block.write(2, f"={a}", steps["lo"][0])
+            block.write(3, f"={b}", steps["hi"][0])
+        if k < n:
+            block.write(4 + 3 * k, "=" + body(f"(({lo(k)}+{hi(k)})/2)"), steps["fm"][k])
+    return f"IF({fa}*{fb}>0,NA(),({lo(n)}+{hi(n)})/2)", ATOM
 
 
 def _integral_excel(body, args, consts) -> tuple[str, int]:
