@@ -54,6 +54,14 @@ ok = "sigma <= f_y"
     assert (f.unit, f.verdict, f.topic) == ("N/mm^2", "ok", "bending")
 
 
+def test_a_choice_input_in_a_placeholder_is_its_text(tmp_path):
+    choice = '[inputs.mode]\nvalue = "simple"\noptions = ["simple", "fixed"]\n'
+    path = sheet_with(tmp_path, '[[checks]]\nwhat = "{mode} beam"\nvalue = "M"\n', choice)
+    assert list(findings(path)) == ["simple beam"]
+    with pytest.raises(workbook.errors.TemplateError, match="is a text, it has no unit"):
+        workbook.load(sheet_with(tmp_path, '[[checks]]\nwhat = "{mode:mm}"\nvalue = "M"\n', choice))
+
+
 def test_condition_false_gives_otherwise_and_inputs_change_only_that_line(tmp_path):
     path = sheet_with(
         tmp_path,

@@ -168,7 +168,7 @@ def _typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None
     t = sheet.typer.expression(ex.parse(expression, what=spec.label), {}, spec.label)
     if getattr(t, "boolean", False) or t.shape:
         raise TemplateError(f"{{{expression}}} must be one number or a text")
-    if getattr(t, "text", False):
+    if getattr(t, "text", False) or getattr(t, "kind", None) == "choice":  # a choice is text
         if unit is not None:
             raise TemplateError(f"{{{expression}}} is a text, it has no unit")
         return t, None, None
