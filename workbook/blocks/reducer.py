@@ -291,155 +291,106 @@ def _verdict_text(sheet) -> str:
 def findings(sheet) -> list[Finding]:
     """Closure of the n roller traces, the printed variants, and the undercut verdict."""
     out: list[Finding] = []
+
+    def add(topic, what, value=None, unit="", verdict="info", note=""):
+        out.append(Finding(topic, what, value, unit, verdict, note))
+
     try:
         validate(sheet)
     except InputError as err:
         return [Finding("inputs", err.message, None, "", "fail")]
-    variant = (sheet.evaluate("transform"), sheet.evaluate("ratio"))
-    corrected = variant == ("rotation", "lobes")
-    Z, n, e1 = _mag(sheet, "Z"), int(round(_mag(sheet, "n"))), _mag(sheet, "e1", "mm")
-    out.append(
-        Finding(
-            "profile",
-            f"Z = {Z:g} lobes; the cam turns by a = {_mag(sheet, 'i_a'):+.6g}*phi; transform "
-            f"(4): {variant[0]}; ratio: {variant[1]}",
-            Z,
-            "",
-            "info",
-            "" if corrected else "a printed variant, kept to show what the paper's formulas give",
-        )
-    )
-    if e1 == 0:
+    if _mag(sheet, "e1", "mm") == 0:
         r2 = _mag(sheet, "r2", "mm")
-        what = "e1 = 0: the theoretical profile is the circle of radius r2 (no teeth)"
-        out.append(Finding("profile", what, r2, "mm", "info"))
+        add(
+            "profile",
+            "e1 = 0: the theoretical profile is the circle of radius r2 (no teeth)",
+            r2,
+            "mm",
+        )
 
-    c = closure(sheet)
-    ok = c["max"] <= CLOSURE_TOL_MM
-    out.append(
-        Finding(
+    c, n = closure(sheet), int(round(_mag(sheet, "n")))
+    what = f"largest distance of the traces of rollers 1..{n - 1} from the trace of roller 0"
+    what += f" ({c['points']} points, one eccentric turn)"
+    if c["max"] <= CLOSURE_TOL_MM:
+        add("closure", what, c["max"], "mm", "ok", f"tolerance {CLOSURE_TOL_MM:g} mm")
+    else:
+        note = f"the traces do not coincide (worst: roller {c['k']} at phi = {c['phi']:g} deg): "
+        add(
             "closure",
-            f"largest distance of the traces of rollers 1..{n - 1} from the trace of "
-            f"roller 0 ({c['points']} points, one eccentric turn)",
+            what,
             c["max"],
             "mm",
-            "ok" if ok else "fail",
-            f"tolerance {CLOSURE_TOL_MM:g} mm"
-            if ok
-            else f"the traces do not coincide (worst: roller {c['k']} at phi = {c['phi']:g} deg): "
-            "the n rollers would cut n different cams",
+            "fail",
+            note + "the n rollers would cut n different cams",
         )
-    )
-    if corrected:
+    if (sheet.evaluate("transform"), sheet.evaluate("ratio")) == ("rotation", "lobes"):
         dev = closed_form_deviation(sheet)
-        out.append(
-            Finding(
-                "closure",
-                "largest deviation from the closed form "
-                "R(psi) = e1*cos(Z*psi) + sqrt(r2^2 - e1^2*sin(Z*psi)^2)",
-                dev,
-                "mm",
-                "ok" if dev < 1e-9 else "warning",
-            )
+        what = "largest deviation from the closed form R(psi) = e1*cos(Z*psi) + "
+        add(
+            "closure",
+            what + "sqrt(r2^2 - e1^2*sin(Z*psi)^2)",
+            dev,
+            "mm",
+            "ok" if dev < 1e-9 else "warning",
         )
         for label, changes in (
             ("the printed transform (4)", {"transform": "printed"}),
             ("the printed ratio a = phi/n", {"ratio": "printed"}),
             ("the printed (4) and ratio together", {"transform": "printed", "ratio": "printed"}),
         ):
-            other = closure(sheet.with_inputs(**changes))["max"]
-            out.append(
-                Finding(
-                    "closure",
-                    f"as printed, with {label}: largest distance between the roller traces",
-                    other,
-                    "mm",
-                    "info",
-                    "they do not coincide" if other > CLOSURE_TOL_MM else "",
-                )
+            d = closure(sheet.with_inputs(**changes))["max"]
+            what = f"as printed, with {label}: largest distance between the roller traces"
+            add(
+                "closure",
+                what,
+                d,
+                "mm",
+                "info",
+                "they do not coincide" if d > CLOSURE_TOL_MM else "",
             )
 
-    rp = _mag(sheet, "rp", "mm")
     if _mag(sheet, "kappa_max", "1/mm") > 0:
         phi = _mag(sheet, "phi_valley", "deg")
         x, y = (float(_f(sheet, name, 0, phi)) for name in ("x_t", "y_t"))
-        out.append(
-            Finding(
-                "undercut",
-                f"smallest radius of curvature of the concave parts of the theoretical "
-                f"profile (roller 0 at phi = {phi:.6g} deg, x_t = {x:.6g} mm, y_t = {y:.6g} mm)",
-                _mag(sheet, "rho_min", "mm"),
-                "mm",
-                "info",
-                "rp must stay below it",
-            )
-        )
+        what = "smallest radius of curvature of the concave parts of the theoretical profile "
+        what += f"(roller 0 at phi = {phi:.6g} deg, x_t = {x:.6g} mm, y_t = {y:.6g} mm)"
+        add("undercut", what, _mag(sheet, "rho_min", "mm"), "mm", "info", "rp must stay below it")
     else:
-        out.append(
-            Finding(
-                "undercut",
-                "the theoretical profile has no concave part (Z^2*e1/r2 = "
-                f"{_mag(sheet, 'concavity'):.6g} <= 1): no undercut whatever rp",
-                None,
-                "",
-                "info",
-            )
-        )
-    regular = _mag(sheet, "regular") == 1
+        what = "the theoretical profile has no concave part (Z^2*e1/r2 = "
+        add("undercut", what + f"{_mag(sheet, 'concavity'):.6g} <= 1): no undercut whatever rp")
+    rp, regular = _mag(sheet, "rp", "mm"), _mag(sheet, "regular") == 1
     if not regular:
         note = "the profile tables and the chart still show it"
-        out.append(
-            Finding("undercut", "INVALID PROFILE: " + _verdict_text(sheet), rp, "mm", "fail", note)
-        )
+        add("undercut", "INVALID PROFILE: " + _verdict_text(sheet), rp, "mm", "fail", note)
         uc = undercut(sheet)
-        for cusp in uc["cusps"][:2]:
-            out.append(
-                Finding(
-                    "undercut",
-                    f"tooth {cusp['tooth']}: cusp of the practical profile at phi = "
-                    f"{cusp['phi']:.6g} deg (polar angle {cusp['psi']:.6g} deg), "
-                    f"x_k = {cusp['x']:.6g} mm, y_k = {cusp['y']:.6g} mm",
-                    cusp["phi"],
-                    "deg",
-                    "fail",
-                )
+        for c in uc["cusps"][:2]:
+            what = f"tooth {c['tooth']}: cusp of the practical profile at phi = {c['phi']:.6g} deg"
+            what += (
+                f" (polar angle {c['psi']:.6g} deg), x_k = {c['x']:.6g} mm, y_k = {c['y']:.6g} mm"
             )
-        for loop in uc["loops"][:1]:
-            out.append(
-                Finding(
-                    "undercut",
-                    f"tooth {loop['tooth']}: the practical profile crosses itself "
-                    f"(loop) at x_k = {loop['x']:.6g} mm, y_k = {loop['y']:.6g} mm, polar angle "
-                    f"{loop['psi']:.6g} deg (phi = {loop['phi1']:.6g} and {loop['phi2']:.6g} deg)",
-                    loop["psi"],
-                    "deg",
-                    "fail",
-                )
-            )
+            add("undercut", what, c["phi"], "deg", "fail")
+        for c in uc["loops"][:1]:
+            what = f"tooth {c['tooth']}: the practical profile crosses itself (loop) at x_k = "
+            what += f"{c['x']:.6g} mm, y_k = {c['y']:.6g} mm, polar angle {c['psi']:.6g} deg "
+            what += f"(phi = {c['phi1']:.6g} and {c['phi2']:.6g} deg)"
+            add("undercut", what, c["psi"], "deg", "fail")
         if uc["cusps"]:
             what = f"{len(uc['cusps'])} cusps and {len(uc['loops'])} loops in all"
-            what += ": see the table 'undercut'"
-            out.append(Finding("undercut", what, len(uc["cusps"]), "", "fail"))
+            add("undercut", what + ": see the table 'undercut'", len(uc["cusps"]), "", "fail")
 
     # the practical profile must keep the distance rp from the theoretical one
     prof = _grid(sheet, _period(sheet))
     d, _ = distance_to_trace(sheet, _f(sheet, "x_k", 0, prof), _f(sheet, "y_k", 0, prof))
     gap = float(np.max(np.abs(d - rp)))
-    ok = gap < 1e-9 * max(1.0, rp)
-    out.append(
-        Finding(
-            "undercut",
-            "distance of the practical profile from the theoretical profile: largest "
-            "departure from rp",
-            gap,
-            "mm",
-            "ok" if ok else ("fail" if not regular else "warning"),
-            ""
-            if ok
-            else f"the practical profile comes as close as {float(np.min(d)):.6g} mm to "
-            "the theoretical one: the roller would cut into the neighbouring flank",
-        )
+    what = (
+        "distance of the practical profile from the theoretical profile: largest departure from rp"
     )
+    if gap < 1e-9 * max(1.0, rp):
+        add("undercut", what, gap, "mm", "ok")
+    else:
+        note = f"the practical profile comes as close as {float(np.min(d)):.6g} mm to the "
+        note += "theoretical one: the roller would cut into the neighbouring flank"
+        add("undercut", what, gap, "mm", "warning" if regular else "fail", note)
     return out
 
 
