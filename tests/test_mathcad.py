@@ -67,6 +67,12 @@ def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
     toml, _ = _import("frame/example.xmcd", tmp_path, capsys)
     text = toml.read_text(encoding="utf-8")
     assert "AddTrainInTable" in text  # a function of the referenced iSET_module.xmcd
+    # S is defined by a component (a data table): untranslated, never the unit S (siemens)
+    assert "#   region 11: a component defining S: not translated" in text
+    assert (
+        "#   region 40: L := ...: uses S, which is not translated: defined by a component" in text
+    )
+    assert "Mathcad's WRITEPRN() writes a file" in text
 
 
 @pytest.mark.parametrize(

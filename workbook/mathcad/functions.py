@@ -29,6 +29,18 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
 }  # fmt: skip
 
+#: Mathcad functions that are never translated, and why (a worksheet reads and writes no
+#: files but the data tables it declares)
+REFUSED: dict[str, str] = {
+    name: "writes a file (a worksheet of the language writes no files)"
+    for name in ("WRITEPRN", "APPENDPRN", "WRITE", "APPEND", "WRITEBMP", "WRITERGB",
+                 "WRITEWAV", "WRITECSV", "WRITEEXCEL", "WRITEFILE", "WRITEBIN")
+} | {
+    name: "reads a file (a worksheet reads measured data from a [data] table: see the language)"
+    for name in ("READPRN", "READ", "READFILE", "READEXCEL", "READCSV", "READBMP", "READRGB",
+                 "READWAV", "READBIN")
+}  # fmt: skip
+
 #: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
 OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpose": "transpose"}
 

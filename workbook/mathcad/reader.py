@@ -50,6 +50,7 @@ class Region:
     disabled: bool = False
     plot: MNode | None = None  # plot regions: the plot's data
     binary: str = ""  # plot regions: the binary item with the plot's definition (base64)
+    outputs: list[MNode] = field(default_factory=list)  # components: the names they define
 
 
 @dataclass
@@ -256,5 +257,11 @@ def _region(el, dy: float = 0.0, dx: float = 0.0) -> Region:
             return Region(kind="reference", href=href, **base)
         if tag == "picture":
             return Region(kind="picture", **base)
+        if tag == "component":  # a data table, spreadsheet...: the names it defines
+            outputs = next((x for x in c if _local(x.tag) == "outputs"), None)
+            names = [
+                _node(x) for x in (outputs if outputs is not None else ()) if _local(x.tag) == "id"
+            ]
+            return Region(kind="component", outputs=names, **base)
     tag = _local(kids[0].tag) if kids else "empty"
     return Region(kind=tag if tag in ("area",) else "other", text=tag, **base)

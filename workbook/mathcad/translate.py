@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from .. import expr as ex
 from ..visitor import Visitor
 from . import names as nm
-from .functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS, language_functions
+from .functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS, REFUSED, language_functions
 from .reader import MNode, Region, Worksheet
 from .symbols import Sym, Untranslatable
 from .symbols import key as _key
@@ -175,6 +175,8 @@ class ExprTranslator(Visitor):
             return self._call(op, args)
         if tag == "indexer" and len(args) == 2:
             return self._index(args)
+        if tag == "matcol" and len(args) == 2:
+            return self._column(args)
         if tag in _BINDERS:
             return self._binder(tag, args)
         if tag == "Find":
@@ -267,6 +269,21 @@ class ExprTranslator(Visitor):
             indices = [ex.Binary("+", i, ex.Number(float(shift))) for i in indices]
         return ex.Index(self.visit(target), tuple(indices))
 
+    def _column(self, args: list[MNode]) -> ex.Node:
+        """Mathcad's column M<j>: submatrix(M, first row, last row, j, j)."""
+        for name in ("submatrix", "rows"):
+            if name not in language_functions():
+                raise Untranslatable(f"a matrix column ({name}() is not in the language yet)")
+        m, j = self.visit(args[0]), self.visit(args[1])
+        shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
+        if shift:
+            j = ex.Binary("+", j, ex.Number(float(shift)))
+        o = self.tr.sheet_origin
+        last = ex.Call("rows", (m,))
+        if o != 1:
+            last = ex.Binary("+", last, ex.Number(float(o - 1)))
+        return ex.Call("submatrix", (m, ex.Number(float(o)), last, j, j))
+
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.visit(node.children[0])])
 
@@ -300,6 +317,8 @@ class ExprTranslator(Visitor):
                     raise Untranslatable(f"{text}() with {len(args)} arguments")
                 args = [args[i] for i in order]
             return self._builtin(name, text, [self.visit(a) for a in args])
+        if text in REFUSED and not key[1]:
+            raise Untranslatable(f"Mathcad's {text}() {REFUSED[text]}")
         raise Untranslatable(
             f"{nm.mathcad_text(*key)}() is neither defined before nor a known built-in"
         )
@@ -361,6 +380,9 @@ class Translator:
                 except Untranslatable as why:
                     self.skip(region.id, "a plot", str(why))
                 continue
+            if region.kind == "component":
+                self.component(region)
+                continue
             if region.kind != "math":
                 what = {"plot": "a plot", "picture": "a picture"}.get(region.kind, "a component")
                 if region.kind in ("reference", "area"):
@@ -379,6 +401,16 @@ class Translator:
         self.close_given("a solve block without Find")
         self.argument_units()
         return self.out
+
+    def component(self, region: Region) -> None:
+        """A component (a data table, a spreadsheet, ...): not translated; the names it
+        defines are untranslated names (never a unit of the same name, as S for siemens)."""
+        why = "not translated: the language has no such region"
+        names = ", ".join(nm.mathcad_text(*_key(n)) for n in region.outputs)
+        self.skip(region.id, "a component" + (f" defining {names}" if names else ""), why)
+        for node in region.outputs:
+            sym = self.define(_key(node), "var", region.id)
+            sym.broken = f"defined by a component (region {region.id}), {why}"
 
     def plot(self, region: Region) -> None:
         """An X-Y plot: a chart whose series are its traces, each over the range variable its
