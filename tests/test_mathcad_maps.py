@@ -250,3 +250,34 @@ def test_element_assignment_to_a_vector_the_program_has_not_given(tmp_path, caps
         assert "a vector the program has not given first" in text
     else:
         assert "region 1: g(...) := ...:" in text
+
+
+def test_matrix_column_is_a_submatrix(tmp_path, capsys):
+    """M := [[1, 2], [3, 4], [5, 6]] (stored column by column), max(M<1>) = 6 and the column
+    itself, at ORIGIN 0: Mathcad's stored values are reproduced."""
+    matrix = '<ml:matrix rows="3" cols="2">' + "".join(_real(v) for v in (1, 3, 5, 2, 4, 6))
+    src = tmp_path / "col.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("M") + matrix + "</ml:matrix>"),
+            _eval(2, _apply("matcol", _id("M"), _real(1)), _matrix_result(2, 4, 6)),
+            _eval(
+                3,
+                "<ml:apply>" + _id("max") + _apply("matcol", _id("M"), _real(1)) + "</ml:apply>",
+                _real(6),
+            ),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "col.toml").read_text(encoding="utf-8")
+    assert "max(submatrix(M, 0, rows(M) - 1, 1, 1))" in text
+    main(["check", str(tmp_path / "col.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (4, 4), result["failures"]
+
+
+def _matrix_result(*values) -> str:
+    cells = "".join(_real(v) for v in values)
+    return f'<ml:matrix rows="{len(values)}" cols="1">{cells}</ml:matrix>'

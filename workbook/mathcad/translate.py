@@ -281,7 +281,11 @@ class ExprTranslator(Visitor):
         o = self.tr.sheet_origin
         last = ex.Call("rows", (m,))
         if o != 1:
-            last = ex.Binary("+", last, ex.Number(float(o - 1)))
+            last = (
+                ex.Binary("-", last, ex.Number(float(1 - o)))
+                if o < 1
+                else ex.Binary("+", last, ex.Number(float(o - 1)))
+            )
         return ex.Call("submatrix", (m, ex.Number(float(o)), last, j, j))
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
