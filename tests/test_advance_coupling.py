@@ -19,6 +19,7 @@ import pytest
 import workbook
 from workbook import ode
 from workbook.blocks import coupling as cp
+from workbook.declared_checks import check_findings
 from workbook.errors import WorkbookError
 
 # the reference example's dimensions (SI)
@@ -163,7 +164,7 @@ def test_trend_findings_hold(sheet):
     for key in cp.FAMILIES:
         holds, fails, _ = cp.trend_holds(sheet, key, ws)
         assert not fails and len(holds) >= 10, key
-    found = {f.what: f for f in cp.findings(sheet)}
+    found = {f.what: f for f in cp.findings(sheet) + check_findings(sheet)}
     for text in cp.TREND_TEXT.values():
         assert found[text].verdict == "ok"
     assert found["phi2 at omega1 = 80 rad/s (reference example: 0.070)"].verdict == "ok"
@@ -213,7 +214,12 @@ def test_soft_spring_denominator_is_reported_not_divided(sheet):
     assert math.isnan(value[0]) and den[0] < 0
     # the root is still there
     assert float(soft.evaluate("phi2", omega1=110).magnitude) > 0
-    assert cp.soft_spring_limit(sheet, 110.0) == pytest.approx(990.95, abs=0.05)
+    c1_soft = float(sheet.evaluate("c1_soft_lin").to("N/m").magnitude)
+    assert c1_soft == pytest.approx(990.95, abs=0.05)
+    at = sheet.with_inputs(c1=f"{c1_soft!r} N/m")  # the denominator vanishes there
+    assert abs(float(at.evaluate("D_lin", omega1=110).magnitude)) < 1e-12
+    w0 = float(sheet.evaluate("omega_zero_newton").to("rad/s").magnitude)
+    assert abs(float(sheet.evaluate("D_newton", omega1=w0).magnitude)) < 1e-12
     # Newton form: c1 = 1500 N/m passes through zero inside 50..110 rad/s
     ws = np.arange(50, 111, 5.0)
     deps = {v: z for v, _, _, z in cp.departures(sheet, "c1", ws, "newton")}

@@ -478,6 +478,43 @@ def work_precision(
     return rows
 
 
+# -- linear systems with a harmonic forcing ---------------------------------------------------
+def linear_parts(fun: Callable, n: int, omega: float):
+    """A, b, g of y' = fun(t, y) = A y + b + g sin(omega t), read off fun (a linear function
+    is its own difference quotient) and checked at another point: a DomainError if fun is
+    not of that form."""
+    b = np.asarray(fun(0.0, np.zeros(n)), dtype=float)
+    A = np.column_stack([np.asarray(fun(0.0, e), dtype=float) - b for e in np.eye(n)])
+    g = np.asarray(fun(0.5 * math.pi / omega, np.zeros(n)), dtype=float) - b
+    y, t = np.linspace(0.1, 0.3, n), 0.3 / omega
+    want = A @ y + b + g * math.sin(omega * t)
+    scale = max(np.max(np.abs(A)), np.max(np.abs(b)), np.max(np.abs(g)), 1e-300)
+    if not np.allclose(fun(t, y), want, rtol=1e-9, atol=1e-12 * scale):
+        raise DomainError(f"the system is not linear with a forcing in sin({omega:g} t)")
+    return A, b, g
+
+
+def linear_solution(A, b, g, omega: float, y0, ts) -> np.ndarray:
+    """States (n x len(ts)) of y' = A y + b + g sin(omega t), y(ts[0]) = y0, on a uniform grid
+    ts starting at 0, by the matrix exponential of the system augmented with the forcing
+    (z = (y, 1, sin, cos)), with substeps so that |lambda h| <= 0.5: no ODE method."""
+    from scipy.linalg import expm
+
+    n, ts = len(y0), np.asarray(ts, dtype=float)
+    Z = np.zeros((n + 3, n + 3))
+    Z[:n, :n], Z[:n, n], Z[:n, n + 1] = A, b, g
+    Z[n + 1, n + 2], Z[n + 2, n + 1] = omega, -omega
+    z = np.concatenate([np.asarray(y0, dtype=float), [1.0, 0.0, 1.0]])
+    h = ts[1] - ts[0] if len(ts) > 1 else 0.0
+    sub = max(1, int(math.ceil(np.max(np.abs(np.linalg.eigvals(A))) * h / 0.5)))
+    E = np.linalg.matrix_power(expm(Z * (h / sub)), sub)
+    out = np.empty((n, len(ts)))
+    for k in range(len(ts)):
+        out[:, k] = z[:n]
+        z = E @ z
+    return out
+
+
 # -- stiffness and the choice of method -------------------------------------------------------
 def jacobian(fun: Callable, t: float, y: np.ndarray) -> np.ndarray:
     """Forward-difference Jacobian of fun(t, y) with respect to y."""
