@@ -2,8 +2,9 @@
 
 A piecewise condition comparing the variable with something free of it (``x <= L``), and
 ``abs``, ``min``, ``max`` of the variable against such a value (``abs(x - c)``,
-``min(x, c)``), give a break point: the integral is split there so that every piece is
-smooth. Inside a sheet function called with the variable as an argument, the same is
+``min(x, c)``), the points of the data ``linterp`` reads, and where ``min`` or ``max`` of such
+an interpolant and a value switches, give a break point: the integral is split there so that
+every piece is smooth. Inside a sheet function called with the variable as an argument, the same is
 found for the parameter it is bound to; the function's other parameters are replaced by
 the arguments of the call. Kinks this walker does not recognise are left to the adaptive
 rule.
@@ -77,7 +78,46 @@ class Kinks(Visitor):
             self._pair(t.args[0].left, t.args[0].right, aliases, subst)
         elif t.func in ("min", "max") and len(t.args) == 2:
             self._pair(t.args[0], t.args[1], aliases, subst)
+            for lin, other in ((t.args[0], t.args[1]), (t.args[1], t.args[0])):
+                self._crossings(lin, other, aliases, subst)
+        elif self._interpolant(t, aliases):  # linear between the points: a kink at each
+            xs, _, f = self._interpolant(t, aliases)
+            self.found += [ty.TConst(t.args[2].unit, value=float(x) / f) for x in xs]
         self._children(t, aliases, subst)
+
+    def _interpolant(self, t: ty.T, aliases):
+        """(X, Y, f) if ``t`` is linterp(X, Y, x) of the variable times f, else None."""
+        if not (isinstance(t, ty.TFunc) and t.func == "linterp"):
+            return None
+        f = self._linear(t.args[2], aliases)
+        if not f or not all(isinstance(a, ty.TRef) for a in t.args[:2]):
+            return None
+        data = self.typer.spec.data
+        return data[t.args[0].name].values, data[t.args[1].name].values, f
+
+    def _crossings(self, lin: ty.T, other: ty.T, aliases, subst) -> None:
+        """min/max(c, linterp(X, Y, x)): where each piece of the interpolant crosses c."""
+        g = 1.0
+        while isinstance(lin, ty.TScale):
+            g, lin = g * lin.factor, lin.child
+        found = self._interpolant(lin, aliases)
+        c = self._outer(other, aliases, subst)
+        if found is None or c is None:
+            return
+        xs, ys, f = found
+        unit = lin.args[2].unit
+        for x0, x1, y0, y1 in zip(xs[:-1], xs[1:], ys[:-1], ys[1:]):
+            if y1 != y0:  # x0 + (c/g - y0)*(x1 - x0)/(y1 - y0), in the variable's unit
+                shift = ty.TBinary(
+                    c.unit,
+                    op="-",
+                    left=ty.TScale(c.unit, child=c, factor=1 / g),
+                    right=ty.TConst(c.unit, value=float(y0)),
+                )
+                step = ty.TScale(unit, child=shift, factor=float((x1 - x0) / (y1 - y0)) / f)
+                self.found.append(
+                    ty.TBinary(unit, op="+", left=ty.TConst(unit, value=float(x0) / f), right=step)
+                )
 
     def visit_TCall(self, t: ty.TCall, aliases, subst):
         self._children(t, aliases, subst)

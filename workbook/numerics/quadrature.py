@@ -27,6 +27,8 @@ MAX_LEVELS = 5
 ROUGH = 1e-3
 #: an error this small relative to the integral of |f| is rounding: accepted (gk21's floor)
 ROUNDING = 51 * np.finfo(float).eps
+#: tanh-sinh: a piece's absolute error may be this share of the tolerance times the row's size
+ATOL_SHARE = 1e-3
 #: most intervals at once per row (on average) before the rest goes to tanh-sinh
 MAX_INTERVALS_PER_ROW = 64
 #: rows tried first in a table of at least 8 x PROBE rows (see the module's docstring)
@@ -150,7 +152,10 @@ def _tanhsinh(f, left, right, args, pending, tol, n, label, unit):
             right,
             args=(1.0 / scale[None], *args),
             rtol=max(tol.rtol, 1e-15),
-            atol=tol.atol or None,
+            # the integrand is divided by the row's size: a piece's error is allowed its share
+            # of the tolerance of the whole row, as in the Gauss-Kronrod pass (and a piece where
+            # f is 0 converges at once)
+            atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
         )
     status = np.asarray(res.status)
     if (status != 0).any():
