@@ -185,8 +185,6 @@ def test_measured_lift_noise_gain(valve, tmp_path):
     a_err = np.sqrt(np.mean((m["a"] - m["a_true"])[mid] ** 2))
     ac_err = np.sqrt(np.mean((m["ac"] - m["a_true"])[mid] ** 2))
     assert a_err < 0.02 * np.abs(m["a_true"]).max() and ac_err > 10 * a_err
-    ts_m = wear.measured_time_section(valve)
-    assert ts_m == pytest.approx(float(mag(valve.evaluate("TS2"), "mm^2*deg")), rel=2e-3)
     # the angles must increase in equal steps (the filter's condition): a clear error
     text = (valve.spec.path.parent / "cam-wear-valve.measured-lift.csv").read_text("utf-8")
     (tmp_path / "cam-wear-valve.measured-lift.csv").write_text(
@@ -196,6 +194,35 @@ def test_measured_lift_noise_gain(valve, tmp_path):
     (tmp_path / "valve.toml").write_text(toml, encoding="utf-8")
     with pytest.raises(InputError, match="equal steps"):
         wear.measured_points(workbook.load(tmp_path / "valve.toml"))
+
+
+def _ts_piecewise_linear(phi, h):
+    """Integral of f3 over a lift linear between the points (closed where negative): f3 is
+    quadratic in h, so Simpson's rule is exact on each piece, split where the lift is 0."""
+    total = 0.0
+    for x0, x1, y0, y1 in zip(phi[:-1], phi[1:], h[:-1], h[1:]):
+        if y0 <= 0 and y1 <= 0:
+            continue
+        if y0 < 0 or y1 < 0:
+            x = x0 + (0 - y0) * (x1 - x0) / (y1 - y0)
+            x0, y0, x1, y1 = (x, 0.0, x1, y1) if y0 < 0 else (x0, y0, x, 0.0)
+        total += (x1 - x0) / 6 * (f3(y0) + 4 * f3((y0 + y1) / 2) + f3(y1))
+    return total
+
+
+def test_measured_time_section(valve):
+    """TS_m integrates the [data] lift (linterp: split at every point, a piece where the valve
+    is closed is 0) to the sheet's tolerance."""
+    import csv
+
+    path = valve.spec.path.parent / "cam-wear-valve.measured-lift.csv"
+    rows = [r for r in csv.reader(x for x in path.open() if not x.startswith("#"))][1:]
+    phi, h = (np.array([float(r[i]) for r in rows]) for i in (0, 1))
+    ts_m = float(mag(valve.evaluate("TS_m"), "mm^2*deg"))
+    assert ts_m == pytest.approx(_ts_piecewise_linear(phi, h), rel=1e-10)
+    assert ts_m == pytest.approx(float(mag(valve.evaluate("TS2"), "mm^2*deg")), rel=2e-3)
+    f = [x for x in valve.check().findings if x.what.startswith("time-section of the measured")]
+    assert f[0].value == pytest.approx(ts_m) and f[0].verdict == "info"
 
 
 # -- pump ----------------------------------------------------------------------------------------
