@@ -28,7 +28,7 @@ from .symbols import Untranslatable
 MAX_PLOT_BYTES = 1_000_000
 
 _LEAF, _EMPTY, _ROOT, _PAIR, _COMMA = 0x0F02, 0x0F00, 0xC119, 0xC19F, 0xC30A
-_APPLY, _ARGS, _NEG, _INDEX = 0xCE12, 0x708E, 0x4B95, 0xFD04
+_APPLY, _ARGS, _NEG, _INDEX, _COLUMN = 0xCE12, 0x708E, 0x4B95, 0xFD04, 0xFD34
 #: binary operators -> the tag of Mathcad's XML
 _BINARY = {0xCA06: "mult", 0xCC05: "pow"}
 
@@ -197,6 +197,8 @@ def _node(rec: _Rec) -> MNode:
         return _apply("neg", [_node(kids[0])])
     if rec.op == _INDEX and len(kids) == 2:
         return _apply("indexer", [_node(k) for k in kids])
+    if rec.op == _COLUMN and len(kids) == 2:
+        return _apply("matcol", [_node(k) for k in kids])
     if rec.op in _BINARY and len(kids) == 2:
         return _apply(_BINARY[rec.op], [_node(k) for k in kids])
     if rec.op == _APPLY and rec.left is not None and rec.right is not None:
