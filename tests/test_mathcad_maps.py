@@ -281,3 +281,36 @@ def test_matrix_column_is_a_submatrix(tmp_path, capsys):
 def _matrix_result(*values) -> str:
     cells = "".join(_real(v) for v in values)
     return f'<ml:matrix rows="{len(values)}" cols="1">{cells}</ml:matrix>'
+
+
+def _extremum(op: str, f: str, x: str) -> str:
+    return (
+        f'<ml:apply><ml:{op} method="conjugate"/><ml:sequence>{_id(f)}{_id(x)}'
+        "</ml:sequence></ml:apply>"
+    )
+
+
+def test_maximize_and_minimize_from_a_guess(tmp_path, capsys):
+    """f(x) := x (10 - x) - 4 has its largest value at 5 (a root of its slope where it curves
+    down), g(x) := cos(x) from the guess 2 its smallest at pi (not 0 or 2 pi, maxima); the
+    stored results are Mathcad's values."""
+    f = _apply("minus", _apply("mult", _id("x"), _apply("minus", _real(10), _id("x"))), _real(4))
+    src = tmp_path / "extremum.xmcd"
+    src.write_text(
+        _worksheet(
+            _function(1, "f", ["x"], f),
+            _function(2, "g", ["x"], "<ml:apply>" + _id("cos") + _id("x") + "</ml:apply>"),
+            _region(3, _id("x") + _real(1)),
+            _eval(4, _extremum("Maximize", "f", "x"), _real(5)),
+            _region(5, _id("x") + _real(2)),
+            _eval(6, _extremum("Minimize", "g", "x"), _real(3.1415926535897931)),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "extremum.toml").read_text(encoding="utf-8")
+    assert 'conditions = ["f_curvature(x_2) < 0"]' in text
+    main(["check", str(tmp_path / "extremum.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]

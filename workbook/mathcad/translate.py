@@ -181,6 +181,8 @@ class ExprTranslator(Visitor):
             return self._binder(tag, args)
         if tag == "Find":
             return self.tr.find(self, args, op.attrs.get("method", ""))
+        if tag in ("Maximize", "Minimize") and _solve_methods():
+            return self.tr.extremum(self, args, tag == "Maximize")
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
 
     def _radians(self, node: ex.Node, other: ex.Node) -> ex.Node:
@@ -339,6 +341,7 @@ class Translator:
         self.note: list[str] = []
         self.calls: dict[Sym, list[tuple[ex.Node, ...]]] = {}  # call sites of each function
         self._index: Sym | None = None
+        self.region = ""  # the region being translated
         self.given: list[str] | None = None  # regions of the open solve block
         self.constraints: list[MNode] = []
         self.origin = 0  # Mathcad's ORIGIN where the translation is
@@ -573,6 +576,7 @@ class Translator:
 
     def math(self, region: Region) -> None:
         node = region.math
+        self.region = region.id
         if node.tag in ("define", "globalDefine"):
             self.definition(region, node)
         elif node.tag == "eval":
@@ -1043,6 +1047,74 @@ class Translator:
         if len(names) == 1:
             return names[0]
         return ex.Matrix(tuple((n,) for n in names))
+
+    def extremum(self, et: ExprTranslator, args: list[MNode], largest: bool) -> ex.Node:
+        """Maximize(f, x) / Minimize(f, x) from the guess x (and the inequalities of an open
+        Given block): the stationary point of f nearest the guess where f curves down (up),
+        a [[solve]] block of f's slope (a helper function of the derivative) == 0 by the
+        `nearest` method, with the curvature's sign a condition."""
+        what = "Maximize" if largest else "Minimize"
+        given, constraints = self.given, self.constraints
+        try:
+            if len(args) != 2 or any(a.tag != "id" for a in args):
+                raise Untranslatable(f"{what} of a function of {len(args) - 1} unknowns")
+            if any(c.children[0].tag not in _INEQUALITY for c in constraints):
+                raise Untranslatable(f"{what} with an equation in its Given block")
+            fsym = et.local.get(_key(args[0])) or self.scope.get(_key(args[0]))
+            if fsym is None or fsym.kind != "func" or fsym.broken:
+                raise Untranslatable(f"{what} of something that is not a function of the sheet")
+            if "diff" not in language_functions():
+                raise Untranslatable("diff() is not in the language yet")
+            key = _key(args[1])
+            try:
+                q = _Values(self).visit(et.visit(args[1]))  # the guess: the value before
+            except Untranslatable:
+                raise
+            except Exception:  # noqa: BLE001 - pint's errors alike
+                raise Untranslatable(f"the guess of {nm.mathcad_text(*key)} is not known") from None
+            guess = et.visit(args[1])
+            region = given[0] if given else self.region
+            slope = self._derivative(fsym, fsym, "slope", region, guess)
+            curve = self._derivative(slope, fsym, "curvature", region, guess)
+            sym = self.new_sym("var", nm.identifier(*key), nm.mathcad_text(*key), region)
+            inner = ExprTranslator(self, {**et.local, key: sym})
+            conditions = [inner.visit(c) for c in constraints]
+            u = ex.Name(sym.token())
+            conditions.append(
+                ex.Compare(
+                    ("<" if largest else ">",), (ex.Call(curve.token(), (u,)), ex.Number(0.0))
+                )
+            )
+            equation = ex.Compare(("==",), (ex.Call(slope.token(), (u,)), ex.Number(0.0)))
+            unit = "" if q.dimensionless else f" {q.units:~}"
+        except Untranslatable as why:
+            if given is not None:
+                self.close_given(str(why))
+            raise
+        if given is not None:
+            self.close_given(None)
+        self.out.items.append(
+            Item(
+                "solve",
+                region,
+                solve=([(sym, f"{float(q.magnitude)!r}{unit}")], [equation], [region], conditions),
+                value="nearest",
+            )
+        )
+        return u
+
+    def _derivative(self, fsym: Sym, of: Sym, word: str, region: str, guess: ex.Node) -> Sym:
+        """A helper function: the derivative of the function ``fsym`` of one argument (the
+        ``word`` of the function ``of``)."""
+        param = self.new_sym("param", "x", "x")
+        body = ex.Call(
+            "diff", (ex.Call(fsym.token(), (ex.Name(param.token()),)), ex.Name(param.token()))
+        )
+        out = self.new_sym("func", f"{of.base}_{word}", f"the {word} of {of.mathcad}", region)
+        self.out.items.append(Item("function", region, sym=out, params=[param], body=body))
+        self.calls.setdefault(out, []).append((guess,))
+        self.calls.setdefault(fsym, []).append((guess,))
+        return out
 
     def forced_region(self, region: Region) -> None:
         if region.id in self.forced:
