@@ -77,11 +77,6 @@ def _rollers(sheet):
     return np.repeat(np.arange(n), phi.size), np.tile(phi, n)
 
 
-# ----------------------------------------------------------------------------------------
-# nearest points and closure (a k-d tree over a dense trace, then Newton per point)
-# ----------------------------------------------------------------------------------------
-
-
 def distance_to_trace(sheet, px, py):
     """Distance of points (px, py) from the closed theoretical trace of roller 0.
 
@@ -131,11 +126,6 @@ def closed_form_deviation(sheet) -> float:
     x, y = _f(sheet, "x_t", K, PHI), _f(sheet, "y_t", K, PHI)
     R = sheet.evaluate("R_closed", psi=np.degrees(np.arctan2(y, x))).to("mm").magnitude
     return float(np.max(np.abs(np.hypot(x, y) - R)))
-
-
-# ----------------------------------------------------------------------------------------
-# undercut: cusps and loops of the practical profile
-# ----------------------------------------------------------------------------------------
 
 
 def undercut(sheet) -> dict:
@@ -190,19 +180,10 @@ def _loop_crossing(sheet, c1: float, c2: float, L: float):
     mid = 0.5 * (c1 + c2)
     left = np.linspace(mid - half, c1, 721)
     right = np.linspace(c2, mid + half, 721)
-    ax, ay, *_ = _offset(sheet, left)
-    bx, by, *_ = _offset(sheet, right)
-    p, r = (
-        np.column_stack([ax[:-1], ay[:-1]]),
-        np.column_stack([ax[1:] - ax[:-1], ay[1:] - ay[:-1]]),
-    )
-    q, u = (
-        np.column_stack([bx[:-1], by[:-1]]),
-        np.column_stack([bx[1:] - bx[:-1], by[1:] - by[:-1]]),
-    )
-    # segments p + t r and q + w u: solve for t, w in [0, 1]
-    P, R = p[:, None, :], r[:, None, :]
-    Q, U = q[None, :, :], u[None, :, :]
+    A, B = (np.column_stack(_offset(sheet, side)[:2]) for side in (left, right))
+    # segments P + t R of the left branch and Q + w U of the right one: t, w in [0, 1]
+    P, R = A[:-1, None, :], np.diff(A, axis=0)[:, None, :]
+    Q, U = B[None, :-1, :], np.diff(B, axis=0)[None, :, :]
     cross = R[..., 0] * U[..., 1] - R[..., 1] * U[..., 0]
     qp = Q - P
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -229,11 +210,6 @@ def _loop_crossing(sheet, c1: float, c2: float, L: float):
     x, y, *_ = (float(v) for v in _offset(sheet, s1))
     psi = math.degrees(math.atan2(y, x))
     return {"phi1": s1 % L, "phi2": s2 % L, "psi": psi, "x": x, "y": y}
-
-
-# ----------------------------------------------------------------------------------------
-# blocks
-# ----------------------------------------------------------------------------------------
 
 
 @table_block
@@ -394,11 +370,6 @@ def findings(sheet) -> list[Finding]:
     return out
 
 
-# ----------------------------------------------------------------------------------------
-# CAD export (workbook run reducer-profile --export PATH)
-# ----------------------------------------------------------------------------------------
-
-
 @export_block
 def export_profile_csv(sheet, path, *, allow_invalid: bool = False, header: bool = True):
     """Write the closed practical profile as CSV points ``x,y,z`` in mm for CAD; returns the path.
@@ -413,16 +384,15 @@ def export_profile_csv(sheet, path, *, allow_invalid: bool = False, header: bool
 
     profile = sheet.table("profile").iloc[:-1]
     if _mag(sheet, "regular") != 1 and not allow_invalid:
+        why = _verdict_text(sheet)
         raise InputError(
-            "the practical profile is invalid: "
-            + _verdict_text(sheet)
-            + "; reduce rp (or export anyway with allow_invalid=True)"
+            f"the practical profile is invalid: {why}; reduce rp (or export anyway "
+            "with allow_invalid=True)"
         )
-    xk, yk = profile["x_k [mm]"], profile["y_k [mm]"]
     path = Path(path)
     check_target(path, kind="csv")
     lines = ["x_mm,y_mm,z_mm"] if header else []
-    lines += [f"{x:.10f},{y:.10f},0" for x, y in zip(xk, yk)]
+    lines += [f"{x:.10f},{y:.10f},0" for x, y in zip(profile["x_k [mm]"], profile["y_k [mm]"])]
     with replacing(path) as tmp:
         tmp.write_text("\n".join(lines) + "\n", encoding="ascii")
     return path
