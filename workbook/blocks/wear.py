@@ -1,12 +1,11 @@
-"""Blocks of the cam-wear sheets (Ivashko, Buikus, Osuchukwu 2006).
+"""The cam-wear valve sheet's own analysis (Ivashko, Buikus, Osuchukwu 2006): the derivatives
+of a measured lift by a Savitzky-Golay filter. Every formula, check and time-section is the
+template's (templates/cam-wear-valve.toml); the wear formula is read through the sheet.
 
-Every formula is the template's, read through the sheet; the time-sections are the template's
-integrals, split where the integrand has a kink. Valve (templates/cam-wear-valve.toml):
-
-* ``measured_lift`` (table): a worn lift given as measured points (CSV with units in the
-  header); velocity and acceleration by a Savitzky-Golay filter whose noise gain is reported.
-* ``measured_findings``: the noise and the noise gains of the measured lift (its time-section
-  and the valve's other checks are the template's ``[[checks]]``).
+* ``measured_lift`` (table): the worn lift given as measured points (``[data.measured_lift]``);
+  velocity and acceleration by a Savitzky-Golay filter, beside central differences and the
+  formula.
+* ``measured_findings``: the noise, the filter's noise gains and its errors against the formula.
 
 scipy is imported inside the functions.
 """
@@ -19,9 +18,6 @@ import numpy as np
 
 from . import Finding, cached, findings_block, input_magnitude, table_block
 
-# ---------------------------------------------------------------------------------------------
-# Valve: measured lift
-# ---------------------------------------------------------------------------------------------
 SG_WINDOW = 15  # points (30 deg at a 2 deg spacing); cubic Savitzky-Golay
 SG_ORDER = 3
 
@@ -107,9 +103,6 @@ def measured_lift(sheet):
     )
 
 
-# ---------------------------------------------------------------------------------------------
-# Valve: findings
-# ---------------------------------------------------------------------------------------------
 @findings_block
 def measured_findings(sheet):
     """The measured lift: the noise, the filter's noise gains and errors."""
