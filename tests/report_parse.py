@@ -78,6 +78,9 @@ def to_text(el) -> str:
         if _tag(base) == "mi" and base.text_content() in ("sin", "cos", "tan", "sinh", "cosh"):
             return f"{base.text_content()}^{{{to_text(exp)}}}"  # sin²(x): fixed up below
         return f"({to_text(base)})^({to_text(exp)})"
+    if tag == "msub" and el.get("class") == "index":  # M[i, j]
+        base, sub = kids
+        return f"{to_text(base)}[{to_text(sub)}]"
     if tag == "msub":
         base, sub = kids
         parts = (
@@ -91,6 +94,9 @@ def to_text(el) -> str:
         return head + "".join("_" + p for p in parts)
     if tag == "munder":
         return "".join(to_text(k) for k in kids)
+    if tag == "mtable":  # inside its brackets: [a, b], [c, d] -> [[a, b], [c, d]]
+        rows = [", ".join(to_text(cell) for cell in row if _tag(cell)) for row in kids]
+        return ", ".join(f"[{r}]" for r in rows)
     raise AssertionError(f"unexpected MathML element <{tag}>")
 
 

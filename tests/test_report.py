@@ -54,6 +54,7 @@ def _shown(text: str) -> str:
         "a - (b - c)",
         "a - (-b)",
         "(a + b)^2",
+        "1 if F0(omega) > 0*G otherwise 0",
         "x^(3/2)",
         "-2*a*omega^2*cos((Theta - phi)*deg)",
         "1/k*sqrt(1 - k^2*sin(phi*deg)^2)",
@@ -119,6 +120,8 @@ def test_every_template_formula_reads_back(concave):
     for name in workbook.list_templates():
         sheet = concave if name == "concave-cam" else workbook.load(name)
         for d in sheet.spec.definitions.values():
+            if d.body is None and d.branches is None:
+                continue  # a program or a state of an ODE: not one formula
             bodies = [d.body] if d.body is not None else [b.value for b in d.branches]
             bodies += [b.condition for b in d.branches or () if b.condition is not None]
             for node in bodies:

@@ -135,7 +135,8 @@ def parse(text: str, *, what: str = "expression") -> Node:
 
 
 def _otherwise_as_else(source: str) -> str:
-    """The word ``otherwise`` (outside strings) as Python's ``else``."""
+    """The word ``otherwise`` (outside strings) as Python's ``else``; a comma before it is
+    read as Mathcad writes it (``1 if x > 0, otherwise 0``)."""
     import io
     import tokenize
 
@@ -147,10 +148,16 @@ def _otherwise_as_else(source: str) -> str:
     for line in source.splitlines(keepends=True):
         starts.append(starts[-1] + len(line))
     out = source
-    for tok in reversed(tokens):
+    for i in reversed(range(len(tokens))):
+        tok = tokens[i]
         if tok.type == tokenize.NAME and tok.string == "otherwise":
             at = starts[tok.start[0] - 1] + tok.start[1]
             out = out[:at] + "else" + out[at + len("otherwise") :]
+            before = tokens[i - 1] if i else None
+            if before is not None and before.type == tokenize.OP and before.string == ",":
+                # "1 if x > 0, otherwise 0", as the report prints a condition
+                comma = starts[before.start[0] - 1] + before.start[1]
+                out = out[:comma] + " " + out[comma + 1 :]
     return out
 
 

@@ -359,7 +359,9 @@ class MathML(Visitor):
         inner = _join(
             *[x for k, b in enumerate(idx) for x in ((_mo(",", 0.3),) if k else ()) + (b,)]
         )
-        return Box(f"<msub>{target.row()}{inner.row()}</msub>", target.width + 0.7 * inner.width)
+        # class 'index': an element of a vector or matrix, not a name with a subscript
+        xml = f"<msub class='index'>{target.row()}{inner.row()}</msub>"
+        return Box(xml, target.width + 0.7 * inner.width)
 
     def visit_IfElse(self, node: ex.IfElse) -> Box:
         p = PREC["or"] - 1
