@@ -236,20 +236,35 @@ def test_program_with_a_loop(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 
 
-def test_element_assignment_to_a_vector_the_program_has_not_given(tmp_path, capsys):
-    """Mathcad grows v by v[i] <- ...; the language's locals keep their shape: listed."""
-    body = (
-        f"<ml:program><ml:localDefine><ml:apply><ml:indexer/>{_id('v')}{_real(0)}</ml:apply>"
-        f"{_id('n')}</ml:localDefine>{_id('v')}</ml:program>"
-    )
+def test_element_assignment_makes_and_grows_a_vector(tmp_path, capsys):
+    """Mathcad makes v by v[2] <- n (the gap filled with 0): g(5) = [0, 0, 5] as Mathcad
+    stored it; v[n] <- 1 (a length known only when the program runs) is listed with why."""
+
+    def grow(index: str) -> str:
+        return (
+            f"<ml:program><ml:localDefine><ml:apply><ml:indexer/>{_id('v')}{index}</ml:apply>"
+            f"{_id('n')}</ml:localDefine>{_id('v')}</ml:program>"
+        )
+
+    call = "<ml:apply>" + _id("g") + _real(5) + "</ml:apply>"
     src = tmp_path / "grow.xmcd"
-    src.write_text(_worksheet(_function(1, "g", ["n"], body)), encoding="utf-8")
+    src.write_text(
+        _worksheet(
+            _function(1, "g", ["n"], grow(_real(2))),
+            _function(2, "h", ["n"], grow(_id("n"))),
+            _eval(3, call, _matrix_result(0, 0, 5)),
+        ),
+        encoding="utf-8",
+    )
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
     text = (tmp_path / "grow.toml").read_text(encoding="utf-8")
-    if _has_programs():
-        assert "a vector the program has not given first" in text
-    else:
-        assert "region 1: g(...) := ...:" in text
+    assert "v[2] := n" in text
+    assert "region 2: h(...) := ...: the engine refuses it" in text
+    assert "its index n is known only when the program runs" in text
+    main(["check", str(tmp_path / "grow.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
 
 
 def test_matrix_column_is_a_submatrix(tmp_path, capsys):

@@ -4,6 +4,7 @@ the live nested IF they become in the workbook (recalculated by the formulas pac
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -193,10 +194,44 @@ def test_programs_build_vectors_and_matrices_element_by_element(tmp_path):
     np.testing.assert_allclose(sheet.evaluate("grid", 1).to("m").magnitude, (i + 10 * j + 1) * 2.0)
     np.testing.assert_allclose(sheet.evaluate("table").magnitude[:, 0], [1, 3, 9, 27])
     for body, message in [
-        ("w[0] := 1\nw", "not a local vector or matrix"),
         ("v := [1, 2]\nv := 3\nv", "was a vector of 2, here it is given a number"),
-        ("v := [1, 2]\nv[2] := 1\nv", "element index 2 is out of range"),
+        ("v := [1, 2]\nv[-1] := 1\nv", "element index -1 is out of range"),
         ("v := [1, 2]\nif x > 0\n    return v\n0 otherwise", "gives a number here"),
     ]:
         with pytest.raises(workbook.WorkbookError, match=message):
+            _sheet(tmp_path, '[arguments]\nx = { unit = "" }\n[definitions]\n' + prog("f(x)", body))
+
+
+def test_a_vector_is_made_and_grown_by_its_elements(tmp_path):
+    """Mathcad's v[i] <- ... on a vector not given, or beyond its length: the vector is made
+    or grown, the gap filled with 0; its length is known at load (indices are numbers or the
+    variables of loops over numbers, set on every pass), else it is refused with why."""
+    sheet = _sheet(
+        tmp_path,
+        '[arguments]\nx = { unit = "" }\n[definitions]\n'
+        + prog("squares(x)", "for k in 0 .. 3\n    w[k] := x*k^2\nw")
+        + prog("gap(x)", "w[3] := x\nw")
+        + prog("longer(x)", "v := [x, 2*x]\nv[4] := 5\nv")
+        + prog(
+            "grid(x)", "for i in 0 .. 1\n    for j in 0 .. 2\n        M[i, j] := i + 10*j + x\nM"
+        )
+        + prog(
+            "fib(x)", "f[0] := 0\nf[1] := 1\nfor k in 2 .. 9\n    f[k] := f[k-1] + f[k-2]\nf[9]*x"
+        )
+        + prog("count(x)", "for k in 0 .. 4\n    w[k] := k\nrows(w)*x"),
+    )
+    np.testing.assert_allclose(sheet.evaluate("squares", 2).magnitude[:, 0], [0, 2, 8, 18])
+    np.testing.assert_allclose(sheet.evaluate("gap", 7).magnitude[:, 0], [0, 0, 0, 7])
+    np.testing.assert_allclose(sheet.evaluate("longer", 3).magnitude[:, 0], [3, 6, 0, 0, 5])
+    i, j = np.mgrid[0:2, 0:3]
+    np.testing.assert_allclose(sheet.evaluate("grid", 1).magnitude, i + 10 * j + 1)
+    assert sheet.evaluate("fib", 1).magnitude == 34
+    assert sheet.evaluate("count", 2).magnitude == 10
+    for body, message in [
+        ("for k in 0 .. x\n    w[k] := 1\nw", "its index k is known only when the program runs"),
+        ("w[0] := 1\nif x > 0\n    w[3] := 2\nw", "it is set under an if"),
+        ("for k in 0 .. 3\n    w[k] := 1\n    break if k > x\nw", "loop with break"),
+        ("w := [0]\nfor k in 0 .. 3\n    w[k] := rows(w)\nw", "'w' is used whole where the"),
+    ]:
+        with pytest.raises(workbook.WorkbookError, match=re.escape(message)):
             _sheet(tmp_path, '[arguments]\nx = { unit = "" }\n[definitions]\n' + prog("f(x)", body))

@@ -6,6 +6,7 @@ The text is split into statements here and every expression goes through
 
     a := x^2                      # a local (Mathcad's a <- x^2; '←' is read too)
     v := [0, 0, 0]                # a local vector; v[i] := ... sets an element
+    w[i] := i^2                   # w not given: it is made, and grown, by its elements
     for i in 1 .. n               # Mathcad's range form: first[, second] .. last
         a := a + i
         break if a > 100          # any simple statement may end in 'if CONDITION'
@@ -68,6 +69,7 @@ class SetItem(Stmt):
     indices: tuple
     value: Any
     origin: int = 0
+    grow: Any = None  # (rows, columns) the local is made or grown to (zeros), if it is
 
 
 @dataclass(frozen=True)
@@ -427,12 +429,14 @@ def type_program(
     the next); every value the program can give must agree (numbers in one dimension, or text).
     """
     pending: dict[str, Any] = {}
+    grown = growth(program, typing.origin)
     for _ in range(4):
-        state = _TypeState(dict(scope), dict(pending), typing, reserved)
-        body = state.block(program.body)
+        state = _TypeState(dict(scope), dict(pending), typing, reserved, grown)
+        body = state.block(program.body, top=True)
         if state.local_units == pending:
             break
         pending = dict(state.local_units)
+    _grown_used_whole(program, grown, state.growing)
     if state.value_unit is None and not state.value_text:
         raise TemplateError("the program gives no value (no return and no value line)")
     unit = state.value_unit if not state.value_text else typing.unit_of(state.first_value)
@@ -443,7 +447,10 @@ def type_program(
 
 
 class _TypeState:
-    def __init__(self, scope, hints, typing: ExprTyping, reserved):
+    def __init__(self, scope, hints, typing: ExprTyping, reserved, grown=None):
+        self.grown: dict[str, _Growth] = grown or {}
+        self.growing: set[str] = set()  # locals made or grown by their elements
+        self.top = 0  # the top-level statement being typed
         self.scope = scope
         self.hints = hints  # units learned for locals in an earlier pass
         self.local_units: dict[str, Any] = {}
@@ -534,11 +541,25 @@ class _TypeState:
 
     def set_item(self, s: SetItem):
         shape = self.local_shapes.get(s.name)
-        if shape is None:
-            raise TemplateError(
-                f"{self.where(s)}: '{s.name}' is not a local vector or matrix of the program "
-                f"(give it one first, e.g. {s.name} := [0, 0, 0])"
-            )
+        g = self.grown.get(s.name)
+        reach = None
+        if g is not None and not g.why and min(g.extent) >= 0:
+            reach = (g.extent[0] + 1, g.extent[1] + 1 if len(g.extent) == 2 else 1)
+        if shape is None or (reach is not None and (reach[0] > shape[0] or reach[1] > shape[1])):
+            if s.name in self.reserved:
+                raise TemplateError(
+                    f"{self.where(s)}: '{s.name}' is a name of the sheet; give the local "
+                    "another name"
+                )
+            if reach is None:
+                why = g.why if g is not None and g.why else "its length is not known at load"
+                raise TemplateError(
+                    f"{self.where(s)}: '{s.name}' is made or grown by its elements, but {why}; "
+                    f"give it its full length first (e.g. {s.name} := [0, 0, 0])"
+                )
+            shape = reach if shape is None else (max(shape[0], reach[0]), max(shape[1], reach[1]))
+            self.local_shapes[s.name] = shape
+            self.growing.add(s.name)
         if len(s.indices) == 1 and shape[1] != 1:
             raise TemplateError(f"{self.where(s)}: '{s.name}' is a matrix: write {s.name}[i, j]")
         words = ("row", "column") if len(s.indices) == 2 else ("element",)
@@ -546,13 +567,19 @@ class _TypeState:
         t = self.number(s.value, s, f"an element of '{s.name}'")
         if self.t.shape_of(t) is not None:
             raise TemplateError(f"{self.where(s)}: an element is a number, not a matrix")
-        unit = self.local_units.get(s.name) or self.t.unit_of(t)
+        unit = self.local_units.get(s.name) or self.hints.get(s.name) or self.t.unit_of(t)
         value = self.t.convert(t, unit, f"{self.where(s)}: an element of '{s.name}'")
+        if s.name in self.growing:
+            self.local_units[s.name] = unit
+            self.scope[s.name] = self.t.scope_entry(unit, shape)
+            return SetItem(s.line, s.name, idx, value, self.t.origin, shape)
         return SetItem(s.line, s.name, idx, value, self.t.origin)
 
-    def block(self, block):
+    def block(self, block, top: bool = False):
         out = []
-        for s in block:
+        for k, s in enumerate(block):
+            if top:
+                self.top = k
             out.append(self.stmt(s))
         return tuple(out)
 
@@ -596,6 +623,129 @@ def _shape_words(shape) -> str:
         return "a number"
     r, c = shape
     return f"a {r}x{c} matrix" if c != 1 else f"a vector of {r}"
+
+
+# -- vectors made and grown by their elements (Mathcad's v[i] <- ...) ------------------------
+@dataclass
+class _Growth:
+    """What the element assignments of one local reach, found before typing."""
+
+    extent: list[int]  # the largest row (and column) index, origin 0 (-1: none known)
+    why: str = ""  # why the extent is not known at load ('' : it is)
+    first: int = -1  # the top-level statement of the first element assignment
+    last: int = -1  # ... and of the last
+    last_line: int = 0  # the program line of the last
+
+
+def growth(program: Program, origin: int) -> dict[str, _Growth]:
+    """For each name assigned by element (``v[i] := ...``): the largest index its element
+    assignments reach, known at load when every index is a number or the variable of a
+    ``for`` over numbers, and every such assignment runs on every pass (not under ``if`` or
+    ``while``, in no loop with ``break``, ``continue`` or ``return``); else why not."""
+    out: dict[str, _Growth] = {}
+
+    def index_values(node, loops: dict):
+        if isinstance(node, ex.Name) and node.id in loops:
+            return loops[node.id]
+        v = _number(node)
+        return None if v is None else [v]
+
+    def visit(block, loops: dict, why: str, top: int | None) -> None:
+        for k, st in enumerate(block):
+            at = k if top is None else top
+            if isinstance(st, SetItem):
+                g = out.setdefault(st.name, _Growth([-1] * len(st.indices), first=at))
+                g.last = max(g.last, at)
+                g.last_line = max(g.last_line, st.line)
+                if len(g.extent) != len(st.indices):
+                    g.why = g.why or "it is set with one index and with two"
+                    continue
+                for d, node in enumerate(st.indices):
+                    values = index_values(node, loops)
+                    if values is None:
+                        g.why = g.why or (
+                            f"line {st.line}: its index {ex.to_text(node)} is known only when "
+                            "the program runs (a number, or the variable of a for over numbers)"
+                        )
+                    elif any(v != int(v) or v < origin for v in values):
+                        g.why = g.why or f"line {st.line}: an index below the origin or not whole"
+                    else:
+                        g.extent[d] = max(g.extent[d], int(max(values)) - origin)
+                if why:
+                    g.why = g.why or f"line {st.line}: {why}"
+            elif isinstance(st, If):
+                for _, b in st.branches:
+                    visit(b, loops, why or "it is set under an if", at)
+                if st.otherwise is not None:
+                    visit(st.otherwise, loops, why or "it is set under an if", at)
+            elif isinstance(st, While):
+                visit(st.body, loops, why or "it is set in a while loop", at)
+            elif isinstance(st, For):
+                bounds = [_number(b) if b is not None else 0.0 for b in (st.first, st.last)]
+                second = _number(st.second) if st.second is not None else None
+                values = None
+                if None not in bounds and (st.second is None or second is not None):
+                    try:
+                        values = [float(v) for v in _range_values(bounds[0], second, bounds[1])]
+                    except TemplateError:
+                        values = None
+                stop = any(isinstance(x, (Break, Continue, Return)) for x in walk(st.body))
+                inner = why or (
+                    "it is set in a loop with break, continue or return" if stop else ""
+                )
+                visit(st.body, {**loops, st.var: values}, inner, at)
+
+    visit(program.body, {}, "", None)
+    return out
+
+
+def _number(node) -> float | None:
+    """A number written in the program (``3``, ``-1``), else None."""
+    if isinstance(node, ex.Number):
+        return float(node.value)
+    if isinstance(node, ex.Unary) and node.op == "-" and isinstance(node.operand, ex.Number):
+        return -float(node.operand.value)
+    return None
+
+
+def _range_values(first, second, last):
+    from .ranges import range_values
+
+    return range_values(first, second, last, what="loop")
+
+
+def _grown_used_whole(program: Program, grown: dict, growing: set[str]) -> None:
+    """A vector made or grown by its elements is used whole (rows(v), v itself) only after
+    the statement that sets its last element: before, Mathcad's length is still growing."""
+    for k, top in enumerate(program.body):
+        for name in sorted(growing):
+            g = grown[name]
+            if not g.first <= k <= g.last:
+                continue
+            for st in walk((top,)):
+                exprs = list(expressions((st,))) if not isinstance(st, (If, For, While)) else []
+                if isinstance(st, If):
+                    exprs = [c for c, _ in st.branches]
+                elif isinstance(st, For):
+                    exprs = [e for e in (st.first, st.second, st.last) if e is not None]
+                elif isinstance(st, While):
+                    exprs = [st.condition]
+                if any(_whole_uses(e, {name}) for e in exprs):
+                    raise TemplateError(
+                        f"program line {st.line}: '{name}' is used whole where the program is "
+                        f"still setting its elements (its length grows until line "
+                        f"{g.last_line}); use it after, or its elements {name}[i]"
+                    )
+
+
+def _whole_uses(node, names: set[str]) -> set[str]:
+    """Names of ``names`` that ``node`` uses as a whole (not as v[...])."""
+    found = set()
+    skip = {id(n.target) for n in ex.walk(node) if isinstance(n, ex.Index)}
+    for n in ex.walk(node):
+        if isinstance(n, ex.Name) and n.id in names and id(n) not in skip:
+            found.add(n.id)
+    return found
 
 
 # -- running ----------------------------------------------------------------------------------
@@ -660,11 +810,19 @@ def compile_program(
         if isinstance(s, SetItem):
             from .matrix import element_index
 
-            f, n, origin = compile_expr(s.value), s.name, s.origin
+            f, n, origin, grow = compile_expr(s.value), s.name, s.origin, s.grow
             idx = [compile_expr(i) for i in s.indices]
 
             def set_item(env, last):
                 tick(s)
+                if grow is not None:  # made, or grown with zeros, to its length at load
+                    old = env.get(n)
+                    if old is None or np.shape(old)[:2] != tuple(grow):
+                        target = np.zeros(grow)
+                        if old is not None:
+                            old = np.asarray(old, dtype=float).reshape(np.shape(old)[0], -1)
+                            target[: old.shape[0], : old.shape[1]] = old
+                        env[n] = target
                 target = env[n]
                 at = element_index(target.shape, [i(env) for i in idx], origin, f"{n}[...]")
                 target[at] = f(env)

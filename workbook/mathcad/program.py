@@ -3,8 +3,8 @@
 A program becomes lines of statements (``a := ...``, ``for i in 1 .. n``, ``while ...``,
 ``if ...`` blocks, ``value if condition``, ``value otherwise``, ``return``, ``break``,
 ``continue``), one block indented under its header. Locals are names of their own (never a
-name of the sheet). What the language's programs cannot hold (an element assignment
-``v[i] <- ...``, a loop over a vector, try/catch) is untranslatable.
+name of the sheet). What the language's programs cannot hold (a loop over a vector,
+try/catch) is untranslatable.
 """
 
 from __future__ import annotations
@@ -143,16 +143,22 @@ class ProgramTranslator:
         return [self._local(lhs), " := ", value]
 
     def _element(self, lhs: MNode, rhs: MNode) -> list:
-        """v[i] <- value: an element of a local vector the program has given already (Mathcad
-        also grows a vector that way; the language keeps a local's shape)."""
+        """v[i] <- value: an element of a local vector; one the program has not given, or
+        an index beyond its length, makes or grows it (the language does where the length
+        is known at load, and says why not where it is not)."""
         target = lhs.children[1]
-        if target.tag != "id" or name_key(target) not in self.locals:
-            raise Untranslatable(
-                "an element assignment to a vector the program has not given first (Mathcad "
-                "grows it; the language's locals keep their shape)"
-            )
+        if target.tag != "id":
+            raise Untranslatable("an element assignment to something that is not a name")
+        value = self._expr(rhs)  # the right side sees the vector before the assignment
+        if name_key(target) not in self.locals:
+            if name_key(target) in self.scope:  # a parameter or a name of the sheet
+                raise Untranslatable(
+                    "an element assignment to a vector the program has not given (Mathcad "
+                    "copies the argument or the sheet's vector into a local)"
+                )
+            self._local(target)
         index = self._expr(lhs)  # v[i] as an expression: the index tree, shifted by ORIGIN
-        return [index, " := ", self._expr(rhs)]
+        return [index, " := ", value]
 
     def _local(self, node: MNode) -> ex.Node:
         if node.tag != "id":
