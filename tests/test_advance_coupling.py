@@ -280,7 +280,7 @@ def test_exact_solution_matches_tight_solve_ivp(sheet):
     cs = cp.case(s)
     fun, t0, t1, y0 = ode.problem(s.typer.ode("motion"), s.evaluator.compile)
     sol = solve_ivp(fun, (t0, t1), y0, method="DOP853", rtol=1e-12, atol=1e-15, t_eval=cs.t)
-    err = np.max(np.abs(cp.outputs(sol.y) - cs.exact))
+    err = np.max(np.abs(cp.outputs(s, sol.y) - cs.exact))
     assert err < 1e-10
 
 
@@ -329,7 +329,7 @@ def test_rigid_limit_and_default_solver_at_c2_1e10(sheet):
     method = str(variant(sheet, 1e10).evaluate("method_used"))
     run = cp.run(variant(sheet, 1e10), method, 1e-5, cs.t)
     assert run.ok
-    dev = np.max(np.abs(cp.outputs(run.y) - ref))
+    dev = np.max(np.abs(cp.outputs(sheet, run.y) - ref))
     assert dev <= tol, (method, dev, tol)
 
 
@@ -379,7 +379,7 @@ def test_weights_on_the_stop_dynamics(sheet):
     assert float(p.evaluate("free")) == 0  # phi2 held on the stop
     run = cp.run(p, "Radau", 1e-6, cp.times(p))
     assert run.ok
-    assert np.all(cp.outputs(run.y)[0] == 0.0)
+    assert np.all(cp.outputs(p, run.y)[0] == 0.0)
     assert np.all(p.evaluate("phi2_r", t=cp.times(p)).magnitude == 0.0)
 
 

@@ -181,3 +181,16 @@ def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
     np.testing.assert_allclose(run.y[:2, -1], sheet.evaluate("x", 0.5).magnitude[:, 0], atol=1e-5)
     capped = wo.run_sheet(sheet, "two_masses", t_eval=ts, max_steps=5)
     assert capped.stop_reason == "step cap" and not capped.ok
+
+
+def test_a_method_given_by_a_text_definition_is_checked_when_it_is_evaluated(tmp_path):
+    text = MASS.replace('method = "scheme"', 'method = "pick"').replace(
+        "[definitions]\n",
+        '[definitions]\npick = "\\"Radau\\" if tol < 1e-6 otherwise \\"Euler\\""\n',
+    )
+    path = tmp_path / "m.toml"
+    path.write_text(text, encoding="utf-8")
+    sheet = Sheet(load_spec(path))
+    assert sheet.evaluator.ode_solution("two_masses").method == "Radau"
+    with pytest.raises(workbook.WorkbookError, match="'Euler' is not one of auto"):
+        sheet.with_inputs(tol="1e-3").evaluate("x", 0.1)

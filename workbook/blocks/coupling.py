@@ -105,13 +105,14 @@ def family_phi20(sheet):
 
 
 # -- the template's ODE, its exact solution and the rigid limit --------------------------------
-def times(sheet, n_out: int = 401) -> np.ndarray:
-    return np.linspace(0.0, _v(sheet, "t_end", "s"), n_out)
+def times(sheet) -> np.ndarray:
+    """The times of the template's histories table (s)."""
+    return sheet.range_values(sheet.table_spec("histories").range, "table histories")
 
 
-def outputs(y: np.ndarray) -> np.ndarray:
-    """(phi2, psi) rows from states y = (q, q') of ode motion: psi = phi3 - phi1."""
-    return np.vstack([y[1], y[2] - y[0]])
+def outputs(sheet, y: np.ndarray) -> np.ndarray:
+    """(phi2, psi) rows from states y = (q, q') of ode motion: the template's P_out*q."""
+    return _v(sheet, "P_out", "") @ y[:3]
 
 
 def linear_system(sheet):
@@ -130,14 +131,14 @@ def linear_system(sheet):
 Case = namedtuple("Case", "sheet t exact rigid delta")
 
 
-def case(sheet, n_out: int = 401) -> Case:
+def case(sheet) -> Case:
     def build():
-        ts = times(sheet, n_out)
-        ex_ = outputs(ode.linear_solution(*linear_system(sheet), ts))
+        ts = times(sheet)
+        ex_ = outputs(sheet, ode.linear_solution(*linear_system(sheet), ts))
         rig = np.vstack([_v(sheet, "phi2_r", "rad", t=ts), _v(sheet, "psi_r", "rad", t=ts)])
         return Case(sheet, ts, ex_, rig, float(np.max(np.abs(ex_ - rig))))
 
-    return cached(sheet, ("case", n_out), build)
+    return cached(sheet, "case", build)
 
 
 def run(sheet, method: str, rtol: float, t_eval=None, **bounds) -> ode.OdeRun:
@@ -148,10 +149,10 @@ def run(sheet, method: str, rtol: float, t_eval=None, **bounds) -> ode.OdeRun:
     return ode.run_sheet(s, "motion", t_eval=t_eval, jac=lambda t, y: A, **bounds)
 
 
-def deviation(run_: ode.OdeRun, against: np.ndarray) -> float:
+def deviation(cs: Case, run_: ode.OdeRun, against: np.ndarray) -> float:
     if not run_.ok or run_.y.shape[1] != against.shape[1]:
         return math.nan
-    return float(np.max(np.abs(outputs(run_.y) - against)))
+    return float(np.max(np.abs(outputs(cs.sheet, run_.y) - against)))
 
 
 # -- stiffness over c2, the work-precision study ----------------------------------------------
@@ -220,10 +221,10 @@ def _study_rows(cs: Case, c2: float, methods, rtols, max_time: float, label) -> 
 
     done = ode.work_precision(
         one,
-        lambda x: deviation(x, cs.exact),
+        lambda x: deviation(cs, x, cs.exact),
         methods,
         rtols,
-        extra_of=lambda x: {rigid: deviation(x, cs.rigid)},
+        extra_of=lambda x: {rigid: deviation(cs, x, cs.rigid)},
     )
     return [
         {"c2 [N/m]": c2, "method": r.method, "rtol": r.rtol, "error [rad]": r.error}
@@ -370,7 +371,7 @@ def history_finding(sheet) -> Finding:
         what = f"time histories at c2 = {c2:.0e} N/m ({how})"
         return Finding("dynamics", what, None, "", "warning", str(err))
     cs, r = case(sheet), sol.run
-    err = float(np.max(np.abs(outputs(r.sol(cs.t)) - cs.exact)))
+    err = float(np.max(np.abs(outputs(sheet, r.sol(cs.t)) - cs.exact)))
     what = f"time histories: {sol.method} rtol {r.rtol:.0e} at c2 = {c2:.0e} N/m ({how})"
     note = f"{r.summary()}; error against the exact solution {err:.3g} rad"
     return Finding("dynamics", what, r.elapsed, "s", "ok", note)
@@ -411,7 +412,7 @@ def choice_findings(sheet, df) -> list[Finding]:
     t_best = min(run(stiff, best["method"], best["rtol"], cs.t).elapsed for _ in range(3))
     runs = [run(stiff, default, rtol, cs.t) for _ in range(3)]
     t_def = min(r.elapsed for r in runs)
-    dev, ratio = deviation(runs[0], cs.rigid), t_def / t_best
+    dev, ratio = deviation(cs, runs[0], cs.rigid), t_def / t_best
     what = f"fastest run reaching the rigid limit: {best['method']} rtol {best['rtol']:.0e}"
     note = f"deviation {best['deviation from rigid [rad]']:.3g} rad"
     out.append(Finding(topic, what, t_best, "s", "info", note))
