@@ -207,3 +207,22 @@ def test_plot_of_vectors_is_a_series_over_their_index(tmp_path, capsys):
     out = tmp_path / "out.xlsx"
     assert main(["run", str(toml), "--out", str(out)]) == 0
     assert len(_charts(out)) == text.count("[[charts]]")
+
+
+def test_a_trace_the_engine_cannot_draw_leaves_the_others(tmp_path, capsys):
+    """parabola-ellipse, region 406: f(x) = x^3 + 4 sqrt(x^3) over a quick plot's -10 .. 10
+    has no value below 0 (Mathcad leaves a gap): that trace is listed with the engine's
+    reason, the plot keeps the tangent and the normal, and the workbook runs."""
+    toml, _ = _import("parabola-ellipse.xmcd", tmp_path, capsys)
+    text = toml.read_text(encoding="utf-8")
+    assert re.search(
+        r"^#   region 406: a plot \(traces left out\): trace 1: the engine cannot draw it: "
+        r"f is not a finite number",
+        text,
+        re.M,
+    )
+    chart = text[text.index('name = "plot_406"') :].split("\n\n")[0]
+    assert "trace 1)" not in chart and "trace 2)" in chart and "trace 3)" in chart
+    out = tmp_path / "out.xlsx"
+    assert main(["run", str(toml), "--out", str(out)]) == 0
+    assert len(_charts(out)) == text.count("[[charts]]")

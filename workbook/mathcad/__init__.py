@@ -95,7 +95,7 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
     name = sheet_name(src)
     out_dir = Path(out_dir)
     forced: dict[str, str] = {}
-    for _ in range(len(regions) + 1):
+    for _ in range(2 * len(regions) + 10):  # a region, or a trace of a plot, at a time
         tr = Translator(forced).run(ws, regions)
         rendered = writer.render(tr, name, src)
         problem = writer.engine_problem(rendered, out_dir)

@@ -39,7 +39,7 @@ class Item:
     range_values: list[float] | None = None
     program: list | None = None  # lines of a program: (indent, [text or tree, ...])
     solve: tuple | None = None  # a solve block: ([(unknown, guess text)], equations, regions)
-    chart: list | None = None  # a plot: its traces, [(x tree, y tree, range item)]
+    chart: list | None = None  # a plot: its traces, [(x, y, range item, points?, number)]
 
 
 @dataclass
@@ -432,8 +432,11 @@ class Translator:
         pairs, polar = traces(data)
         limits = None if polar else x_limits(data)
         for n, (x, y) in enumerate(pairs, 1):
+            forced = self.forced.get(f"{region.id}/trace {n}")
             try:
-                series.append(self.trace(x, y, limits))
+                if forced is not None:  # the engine could not draw it
+                    raise Untranslatable(forced)
+                series.append((*self.trace(x, y, limits), n))
             except Untranslatable as err:
                 why.append(f"trace {n}: {err}")
         if not series:

@@ -334,14 +334,14 @@ def _chart(item: Item, mapping) -> list[str]:
     first = series[0][2]
     first_text = first.sym.final + " := " + _range_text(first, mapping)
     lines = []
-    for x, y, rng, points in series:
+    for x, y, rng, points, n in series:
         parts = [f"x = {_q(_text(x, mapping))}", f"y = {_q(_text(y, mapping))}"]
         text = rng.sym.final + " := " + _range_text(rng, mapping)
         if text != first_text:
             parts.append(f"range = {_q(text)}")
         if points:  # Mathcad draws the points of vectors, or a single point
             parts += ['line = "none"', "marker = true"]
-        lines.append(f"  {{ {', '.join(parts)} }},")
+        lines.append(f"  {{ {', '.join(parts)} }},  # (region {item.region}, trace {n})")
     x_title = ", ".join(dict.fromkeys(_text(t[0], mapping) for t in series))
     y_title = ", ".join(dict.fromkeys(_text(t[1], mapping) for t in series))
     return [
@@ -403,6 +403,9 @@ def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
             sheet = workbook.load(str(path))
             _draw_charts(sheet)
         except WorkbookError as err:
+            trace = _trace_of(err, rendered)
+            if trace is not None:  # one trace of a plot: the plot keeps the others
+                return trace, f"the engine cannot draw it: {err.message}"
             region = _region_of(err, rendered)
             if region is None:
                 raise WorkbookError(
@@ -426,7 +429,23 @@ def _draw_charts(sheet) -> None:
                         sheet.column(col, rng.var, values, what)
             except WorkbookError as err:  # the chart's region, not the definition's
                 err.line, err.definition = chart.line, None
+                err.series = chart.series.index(s)
                 raise
+
+
+def _trace_of(err: WorkbookError, rendered: Rendered) -> str | None:
+    """'REGION/trace N' of the chart series that failed (its line's comment), or None."""
+    k = getattr(err, "series", None)
+    if k is None or not err.line:
+        return None
+    lines = rendered.toml.splitlines()[err.line :]
+    series = [
+        ln for ln in lines[: lines.index("]") if "]" in lines else None] if ln.startswith("  {")
+    ]
+    if k >= len(series):
+        return None
+    m = re.search(r"# \(region ([^,]+), trace (\d+)\)$", series[k])
+    return f"{m.group(1)}/trace {m.group(2)}" if m else None
 
 
 def _region_of(err: WorkbookError, rendered: Rendered) -> str | None:
