@@ -47,15 +47,16 @@ def speeds(sheet) -> np.ndarray:
     return sheet.range_values(sheet.table_spec("steady").range, "table steady")
 
 
-def closed_form(sheet, ws, form: str = "printed") -> tuple[np.ndarray, np.ndarray]:
-    """(value, denominator) of phi2_lin (printed) or phi2_newton: NaN where the denominator
-    is not positive (the template gives no value there)."""
+def closed_form(sheet, ws, form: str = "printed") -> tuple[np.ndarray, ...]:
+    """(value, denominator, departure from the root) of phi2_lin (printed) or phi2_newton, and
+    dev_lin or dev_newton: NaN where the denominator is not positive (no value there)."""
     suffix = "lin" if form == "printed" else "newton"
     den = np.atleast_1d(_v(sheet, f"D_{suffix}", "N*m", omega1=ws))
-    value = np.full(den.shape, math.nan)
-    if (den > 0).any():
-        value[den > 0] = _v(sheet, f"phi2_{suffix}", "rad", omega1=np.asarray(ws)[den > 0])
-    return value, den
+    value, dev, ok = np.full(den.shape, math.nan), np.full(den.shape, math.nan), den > 0
+    if ok.any():
+        value[ok] = _v(sheet, f"phi2_{suffix}", "rad", omega1=np.asarray(ws)[ok])
+        dev[ok] = _v(sheet, f"dev_{suffix}", "", omega1=np.asarray(ws)[ok])
+    return value, den, dev
 
 
 def family(sheet, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
@@ -65,11 +66,10 @@ def family(sheet, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
         out = {}
         for value in FAMILIES[key][1]:
             s = with_input(sheet, key, value, FAMILIES[key][0])
-            out[value] = {
-                "root": np.atleast_1d(_v(s, "phi2", "rad", omega1=ws)),
-                "printed": closed_form(s, ws, "printed")[0],
-                "newton": closed_form(s, ws, "newton")[0],
-            }
+            out[value] = {"root": np.atleast_1d(_v(s, "phi2", "rad", omega1=ws))}
+            for form in ("printed", "newton"):
+                value_, _, out[value][f"dev {form}"] = closed_form(s, ws, form)
+                out[value][form] = value_
         return out
 
     return cached(sheet, ("family", key, tuple(ws)), build)
@@ -317,14 +317,12 @@ def _speeds_text(xs, ws) -> str:
 
 
 def departures(sheet, key: str, ws, form: str = "printed", limit: float = 0.05):
-    """Per family member: (value, speeds with |lin - root| > limit*root, max rel. departure,
-    speeds where the denominator is <= 0)."""
+    """Per family member: (value, speeds where the template's departure dev_lin (dev_newton)
+    exceeds limit, the largest, speeds where the denominator is <= 0)."""
     out = []
     for value, d in family(sheet, key, ws).items():
-        root, lin = d["root"], d["printed" if form == "printed" else "newton"]
-        mask = root > 0
-        rel = np.full(len(ws), np.nan)
-        rel[mask] = np.abs(lin[mask] - root[mask]) / root[mask]
+        mask, lin = d["root"] > 0, d[form]
+        rel = np.where(mask, np.abs(d[f"dev {form}"]), np.nan)
         bad = mask & ((rel > limit) | np.isnan(lin))
         zero = [float(w) for w, v in zip(ws, lin) if np.isnan(v)]
         worst = float(np.nanmax(rel)) if mask.any() else 0.0
