@@ -204,6 +204,13 @@ def check_findings(sheet) -> list[Finding]:
 
 
 def _finding(sheet, spec: CheckSpec) -> Finding:
+    # a value that is not finite is an error with its reason (the evaluator says which
+    # formula left its domain), so numpy's own warnings would only repeat it
+    with np.errstate(all="ignore"):
+        return _computed(sheet, spec)
+
+
+def _computed(sheet, spec: CheckSpec) -> Finding:
     try:
         at = sheet.with_inputs(**spec.inputs) if spec.inputs else sheet
         what = _fill(at, spec, spec.what)
