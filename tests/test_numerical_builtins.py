@@ -616,23 +616,23 @@ def test_a_root_in_a_table_column_is_live_as_bisection_steps(tmp_path):
     assert re_values == [4000 + 20000 * i for i in range(6)]
     for r in range(3, 9):
         formula = ws.cell(r, live).value
-        assert formula.startswith("=IF('Solver steps'!$H$" + str(r)), formula
+        assert formula.startswith("=IF('Solver rows'!$B$" + str(r)), formula
         assert isinstance(ws.cell(r, guess).value, float)  # from a guess: a number
-    assert "Solver steps" in wb.sheetnames
+    assert "Solver rows" in wb.sheetnames
     assert "from a guess" in ws.cell(2, guess).comment.text
     stated = re.search(r"by ([0-9.e+-]+) ", ws.cell(2, live).comment.text)
     assert stated and float(stated.group(1)) < 1e-10
     # the cached value of every step cell is what the formulas compute (the same steps)
     from workbook.numerics.entries import _bisection
 
-    steps = wb["Solver steps"]
+    steps = wb["Solver rows"]
     f = lambda x, i: colebrook(x, np.array(re_values)[i.astype(int)])  # noqa: E731
     want = _bisection(f, np.full(6, 0.005), np.full(6, 0.1), np.arange(6.0))
-    cached = openpyxl_values(path)["Solver steps"]
-    assert steps.cell(3, 8).value.startswith("=1/SQRT((0.005))")
+    cached = openpyxl_values(path)["Solver rows"]
+    assert steps.cell(3, 2).value.startswith("=1/SQRT((0.005))")
     for r in range(6):
-        assert cached[(r + 3, 8)] == pytest.approx(want["fa"][r], rel=1e-12)
-        assert cached[(r + 3, 8 + 2 + 3 * 60)] == pytest.approx(want["lo"][60][r], rel=1e-12)
+        assert cached[(r + 3, 2)] == pytest.approx(want["fa"][r], rel=1e-12)
+        assert cached[(r + 3, 2 + 2 + 3 * 60)] == pytest.approx(want["lo"][60][r], rel=1e-12)
 
 
 def openpyxl_values(path) -> dict:

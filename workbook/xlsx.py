@@ -142,7 +142,7 @@ class WorkbookWriter:
         self.not_live: list[str] = []
         self.formula_cells = 0
         self.planned: dict[tuple[str, str], ColumnCells] = {}
-        # the next free column and the cells used of the row-wise blocks of 'Solver steps'
+        # the next free column and the cells used of the row-wise blocks of 'Solver rows'
         self.step_col, self.step_cells = RowSteps.FIRST_COL, 0
 
     def ws(self, name: str):
@@ -948,7 +948,7 @@ class HelperCells:
 
 class RowSteps:
     """Helper cells of the live roots of one table column: blocks of columns on the sheet
-    'Solver steps' whose row i is the table's row i, so that one formula a block column,
+    'Solver rows' whose row i is the table's row i, so that one formula a column,
     with the table's row number (``ROW_TOKEN``) filled in, serves every row.
 
     ``chain(expr)`` is the engine's bisection chain of the root of EXPR in every row (the
@@ -957,8 +957,8 @@ class RowSteps:
     printed (a column that is not live leaves no helper cells)."""
 
     per_row = True
-    SHEET = HelperCells.SHEET
-    FIRST_COL = 7  # H: columns B to F hold the scalar roots' steps
+    SHEET = "Solver rows"
+    FIRST_COL = 1  # B
     #: helper cells of all row-wise blocks of a workbook (543 table rows of one root)
     MAX_CELLS = 100_000
 
@@ -971,27 +971,9 @@ class RowSteps:
 
     def chain(self, expr: tc.T) -> dict:
         """The engine's bisection steps of the root of ``expr``, every row (or NotLive)."""
-        from .numerics._common import live_forms, recording_chains
-
         if self._chains is None:
-            with live_forms(), recording_chains() as found:
-                try:
-                    self.writer.sheet.evaluator.compile(self.typed)(self.env)
-                except WorkbookError as err:
-                    raise NotLive(
-                        f"root(): the bisection steps leave the expression's domain ({err.message})"
-                    ) from None
-            self._chains = found
-        got = self._chains.get(id(expr), [])
-        arrays = [] if len(got) != 1 else _step_arrays(got[0][1])
-        if len(got) != 1 or any(np.shape(v) not in ((), (self.n,)) for v in arrays):
-            raise NotLive(
-                "root() is solved more than once for each row of this column (called twice, "
-                "or inside another built-in): its values are written as numbers"
-            )
-        if not all(np.isfinite(v).all() for v in arrays):
-            raise NotLive("root(): the bisection steps leave the expression's domain")
-        return got[0][1]
+            self._chains = _recorded_chains(self.writer, self.typed, self.env)
+        return _one_chain(self._chains, expr, (self.n,))
 
     def block(self, title: str, headers: list[str]) -> RowBlock:
         col = self.writer.step_col + sum(len(b.headers) for b in self.blocks)
@@ -1029,12 +1011,39 @@ class RowSteps:
             w.formula_cells += self.n * len(b.headers)
 
 
-def _step_arrays(steps: dict) -> list:
-    return [steps["fa"], steps["fb"], *steps["lo"], *steps["hi"], *steps["fm"]]
+def _recorded_chains(writer, typed: tc.T, env: dict) -> dict:
+    """The steps of every live root met evaluating ``typed`` in ``env`` with the live forms
+    (workbook.numerics), by id of its EXPR."""
+    from .numerics._common import live_forms, recording_chains
+
+    with live_forms(), recording_chains() as found:
+        try:
+            writer.sheet.evaluator.compile(typed)(env)
+        except WorkbookError as err:
+            why = f"the live form's steps leave the expression's domain ({err.message})"
+            raise NotLive(why) from None
+    return found
+
+
+def _one_chain(found: dict, expr: tc.T, shape: tuple) -> dict:
+    """The one chain of ``expr`` in ``found``, each array of ``shape`` or one value."""
+    got = found.get(id(expr), [])
+    arrays = []
+    if len(got) == 1:
+        for v in got[0][1].values():
+            arrays.extend(v if isinstance(v, list) else [v])
+    if len(got) != 1 or any(np.shape(v) not in ((), (1,), shape) for v in arrays):
+        raise NotLive(
+            "root() is solved more than once for each row of this column (called twice, or "
+            "inside another built-in): its values are written as numbers"
+        )
+    if not all(np.isfinite(v).all() for v in arrays):
+        raise NotLive("the live form's steps leave the expression's domain")
+    return got[0][1]
 
 
 class RowBlock:
-    """Columns of 'Solver steps' for one root of a table column: ``ref(j)`` is column j's
+    """Columns of 'Solver rows' for one root of a table column: ``ref(j)`` is column j's
     cell in the current table row; ``write(j, formula, values)`` sets its formula (in the
     row's terms) and the cached value of every row."""
 

@@ -388,7 +388,7 @@ def _root_excel(body, args, consts) -> tuple[str, int]:
 
 def _root_rows(body, args, helpers) -> tuple[str, int]:
     """A live root in a table column: BISECTION_STEPS bisection steps for every table row, in
-    a block of the sheet 'Solver steps' whose row i is the table's row i (f(A), f(B), then
+    a block of the sheet 'Solver rows' whose row i is the table's row i (f(A), f(B), then
     lo, hi and f(mid) of each step; f(lo) keeps the sign of f(A)). The cached values are the
     engine's same steps (``_bisection``); #N/A when f(A) and f(B) have the same sign."""
     if len(args) != 2:

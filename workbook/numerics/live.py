@@ -10,9 +10,9 @@ from ._common import live_forms
 #: built-ins whose Excel form is live but approximate
 APPROXIMATE = {
     "integral": "a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)",
-    "root": "60 bisection steps on the sheet 'Solver steps', a chain per table row in a "
-    "table (#N/A when f(A) and f(B) have the same sign; with more than one root in [A, B] it "
-    "may find another one than the engine)",
+    "root": "60 bisection steps on the sheet 'Solver steps' (in a table, a chain per table "
+    "row on 'Solver rows'; #N/A when f(A) and f(B) have the same sign; with more than one "
+    "root in [A, B] it may find another one than the engine)",
 }
 
 
