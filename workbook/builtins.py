@@ -133,7 +133,7 @@ def _log_domain(name: str) -> tuple[Domain, ...]:
 
 def _simple(name, numpy, excel, sympy, doc, rule=plain_in, domain=(), arity=1, **display):
     xl = excel if callable(excel) else excel_call(excel)
-    uses = (excel,) if isinstance(excel, str) else ()
+    uses = (excel,) if isinstance(excel, str) else display.pop("excel_functions", ())
     register(
         Builtin(name, arity, rule, numpy, xl, sympy, domain, doc, excel_functions=uses, **display)
     )
@@ -182,6 +182,7 @@ _simple(
     "angle of the point (x, y): atan2(y, x)",
     rule=_atan2_unit,
     arity=2,
+    excel_functions=("ATAN2",),
 )
 _simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine", **_TRIG)
 _simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine", **_TRIG)

@@ -120,14 +120,6 @@ def closure(sheet) -> dict:
     return {"max": float(d[i]), "k": int(K[i]), "phi": float(PHI[i]), "points": int(d.size)}
 
 
-def closed_form_deviation(sheet) -> float:
-    """Largest |radius - R_closed(psi)| over all rollers and one turn (psi: polar angle)."""
-    K, PHI = _rollers(sheet)
-    x, y = _f(sheet, "x_t", K, PHI), _f(sheet, "y_t", K, PHI)
-    R = sheet.evaluate("R_closed", psi=np.degrees(np.arctan2(y, x))).to("mm").magnitude
-    return float(np.max(np.abs(np.hypot(x, y) - R)))
-
-
 def undercut(sheet) -> dict:
     """Cusps (where rp*kappa_n = 1) and loop crossings of the practical profile, per tooth.
 
@@ -300,15 +292,6 @@ def findings(sheet) -> list[Finding]:
             note + "the n rollers would cut n different cams",
         )
     if (sheet.evaluate("transform"), sheet.evaluate("ratio")) == ("rotation", "lobes"):
-        dev = closed_form_deviation(sheet)
-        what = "largest deviation from the closed form R(psi) = e1*cos(Z*psi) + "
-        add(
-            "closure",
-            what + "sqrt(r2^2 - e1^2*sin(Z*psi)^2)",
-            dev,
-            "mm",
-            "ok" if dev < 1e-9 else "warning",
-        )
         for label, changes in (
             ("the printed transform (4)", {"transform": "printed"}),
             ("the printed ratio a = phi/n", {"ratio": "printed"}),
