@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook import ode
+from workbook import ode, oderun
 from workbook.blocks import coupling as cp
 from workbook.declared_checks import check_findings
 from workbook.errors import WorkbookError
@@ -356,7 +356,7 @@ def test_default_solver_within_2x_of_fastest(sheet):
 def test_errors_fall_with_rtol_at_moderate_c2(sheet):
     p = variant(sheet, t_end=0.1)
     df = cp.study(p, (1e6,), (1e-3, 1e-6, 1e-9), max_time=5.0, label=None)
-    for m in ode.SOLVERS:
+    for m in oderun.SOLVERS:
         e = df[df["method"] == m].sort_values("rtol", ascending=False)["error [rad]"].to_numpy()
         assert e[-1] < e[0] / 100, (m, e)
 
@@ -386,7 +386,7 @@ def test_weights_on_the_stop_dynamics(sheet):
 def test_run_ode_progress_goes_to_stderr(sheet, capsys):
     s = variant(sheet, 1e8, 0.05)
     fun, t0, t1, y0 = ode.problem(s.typer.ode("motion"), s.evaluator.compile)
-    ode.run_ode(fun, (t0, t1), y0, method="RK45", rtol=1e-6, label="probe", progress_every=0.0)
+    oderun.run_ode(fun, (t0, t1), y0, method="RK45", rtol=1e-6, label="probe", progress_every=0.0)
     err = capsys.readouterr().err
     assert "[probe] t = " in err and "finished" in err
 
@@ -433,7 +433,7 @@ def test_bench_quick_is_fast(sheet):
     t = time.perf_counter()
     df = cp.bench(sheet, quick=True)
     assert time.perf_counter() - t < 5.0
-    assert set(df["method"]) == set(ode.SOLVERS)
+    assert set(df["method"]) == set(oderun.SOLVERS)
     assert {"error [rad]", "run time [s]", "stopped"} <= set(df.columns)
 
 

@@ -269,7 +269,7 @@ def test_solver_step_cap_stops_a_billion_steps():
     documented budget (wall clock, then the step cap) with a reason, not after hours."""
     import numpy as np
 
-    from workbook.ode import run_ode
+    from workbook.oderun import run_ode
 
     def stiff(t, y):  # y' = -1e6 (y - cos t): RK45 needs ~1e6 steps per unit of time
         return -1e6 * (y - np.cos(t))

@@ -1,4 +1,5 @@
-"""The ODE runner of [[ode]] sections (workbook.ode) against closed forms and scipy."""
+"""The ODE runner (workbook.oderun) and the solving of [[ode]] sections (workbook.ode) against
+closed forms and scipy."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from workbook import ode
+from workbook import ode, oderun
 from workbook.errors import DomainError, LimitError
 
 
@@ -96,7 +97,7 @@ def test_work_precision_skips_tighter_rtols_after_a_stall():
 
     def case(method, rtol):
         cap = 3 if method == "RK45" and rtol < 1e-4 else 100_000
-        return ode.run_ode(
+        return oderun.run_ode(
             lambda t, y: -y,
             (0.0, 2.0),
             [1.0],
@@ -110,7 +111,7 @@ def test_work_precision_skips_tighter_rtols_after_a_stall():
     def error(run):
         return float(np.max(np.abs(run.y[0] - np.exp(-ts))))
 
-    rows = ode.work_precision(case, error, ("RK45", "Radau"), (1e-3, 1e-6, 1e-9))
+    rows = oderun.work_precision(case, error, ("RK45", "Radau"), (1e-3, 1e-6, 1e-9))
     got = {(r.method, r.rtol): r for r in rows}
     assert got["RK45", 1e-6].stop_reason == "step cap"
     assert got["RK45", 1e-9].stop_reason.startswith("skipped") and np.isnan(got["RK45", 1e-9].error)
@@ -128,14 +129,14 @@ def test_linear_parts_and_the_matrix_exponential_against_solve_ivp():
     def f(t, y):
         return A @ y + b + g * np.sin(om * t)
 
-    A2, b2, g2 = ode.linear_parts(f, 4, om)
+    A2, b2, g2 = oderun.linear_parts(f, 4, om)
     np.testing.assert_allclose(A2, A, atol=1e-9)
     np.testing.assert_allclose(b2, b, atol=1e-12)
     np.testing.assert_allclose(g2, g, atol=1e-12)
     ts = np.linspace(0, 0.5, 51)
     y0 = [0.01, 0, -0.02, 0]
-    got = ode.linear_solution(A2, b2, g2, om, y0, ts)
+    got = oderun.linear_solution(A2, b2, g2, om, y0, ts)
     ref = solve_ivp(f, (0, 0.5), y0, method="DOP853", rtol=1e-12, atol=1e-14, t_eval=ts)
     np.testing.assert_allclose(got, ref.y, atol=1e-9 * np.max(np.abs(ref.y)))
     with pytest.raises(DomainError, match="not linear"):
-        ode.linear_parts(lambda t, y: -(y**3), 2, om)
+        oderun.linear_parts(lambda t, y: -(y**3), 2, om)

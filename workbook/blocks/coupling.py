@@ -16,7 +16,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from .. import ode
+from .. import ode, oderun
 from . import Finding, bench_block, cached, findings_block, table_block
 
 
@@ -121,7 +121,7 @@ def linear_system(sheet):
     def build():
         fun, t0, t1, y0 = ode.problem(sheet.typer.ode("motion"), sheet.evaluator.compile)
         om = _v(sheet, "Omega_pump", "rad/s")
-        return (*ode.linear_parts(fun, len(y0), om), om, y0)
+        return (*oderun.linear_parts(fun, len(y0), om), om, y0)
 
     return cached(sheet, "linear system", build)
 
@@ -134,14 +134,14 @@ Case = namedtuple("Case", "sheet t exact rigid delta")
 def case(sheet) -> Case:
     def build():
         ts = times(sheet)
-        ex_ = outputs(sheet, ode.linear_solution(*linear_system(sheet), ts))
+        ex_ = outputs(sheet, oderun.linear_solution(*linear_system(sheet), ts))
         rig = np.vstack([_v(sheet, "phi2_r", "rad", t=ts), _v(sheet, "psi_r", "rad", t=ts)])
         return Case(sheet, ts, ex_, rig, float(np.max(np.abs(ex_ - rig))))
 
     return cached(sheet, "case", build)
 
 
-def run(sheet, method: str, rtol: float, t_eval=None, **bounds) -> ode.OdeRun:
+def run(sheet, method: str, rtol: float, t_eval=None, **bounds) -> oderun.OdeRun:
     """The template's ode motion with ``method`` and ``rtol`` (its atol follows rtol); the
     implicit methods get its constant Jacobian."""
     s = sheet.with_inputs(method=str(method), rtol=f"{float(rtol)!r}")
@@ -149,7 +149,7 @@ def run(sheet, method: str, rtol: float, t_eval=None, **bounds) -> ode.OdeRun:
     return ode.run_sheet(s, "motion", t_eval=t_eval, jac=lambda t, y: A, **bounds)
 
 
-def deviation(cs: Case, run_: ode.OdeRun, against: np.ndarray) -> float:
+def deviation(cs: Case, run_: oderun.OdeRun, against: np.ndarray) -> float:
     if not run_.ok or run_.y.shape[1] != against.shape[1]:
         return math.nan
     return float(np.max(np.abs(outputs(cs.sheet, run_.y) - against)))
@@ -195,7 +195,9 @@ def stiffness_table(sheet):
     return pd.DataFrame(rows)
 
 
-def study(sheet, c2s, rtols, methods=ode.SOLVERS, *, max_time=5.0, label="advance-coupling study"):
+def study(
+    sheet, c2s, rtols, methods=oderun.SOLVERS, *, max_time=5.0, label="advance-coupling study"
+):
     """Work-precision rows: every method x rtol at every c2; error against the exact solution
     and deviation from the rigid-tooth limit. A method that stops early at some rtol is not
     run at tighter ones."""
@@ -219,7 +221,7 @@ def _study_rows(cs: Case, c2: float, methods, rtols, max_time: float, label) -> 
     def one(method, rtol):
         return run(cs.sheet, method, rtol, cs.t, max_time=max_time, label=label)
 
-    done = ode.work_precision(
+    done = oderun.work_precision(
         one,
         lambda x: deviation(cs, x, cs.exact),
         methods,
@@ -256,7 +258,7 @@ def _wide(df, c2: float):
 
     sub = df[df["c2 [N/m]"] == c2]
     cols = {"rtol": sorted(sub["rtol"].unique(), reverse=True)}
-    for m in ode.SOLVERS:
+    for m in oderun.SOLVERS:
         s = sub[sub["method"] == m].set_index("rtol")
         cols[f"time {m} [s]"] = [s["run time [s]"].get(r, math.nan) for r in cols["rtol"]]
         cols[f"error {m} [rad]"] = [s["error [rad]"].get(r, math.nan) for r in cols["rtol"]]
