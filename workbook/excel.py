@@ -155,6 +155,11 @@ class ExcelPrinter(Visitor):
         # once (NotLive: the writer writes the values as numbers), so nested calls such as
         # f_i(x) = (f_{i-1}(x) + f_{i-1}(x))/2 cost the limit, not 2^depth.
         f = self.typer.function(t.name)
+        if any(f.shapes):
+            raise NotLive(
+                f"{t.name.split('@')[0]}() is called with a vector or matrix; "
+                "its values are written as numbers"
+            )
         inner = {p: self._wrap(a, s, ATOM - 1) for p, a in zip(f.params, t.args)}
         key = (t.name, tuple(inner.values()))
         if key not in self._calls:

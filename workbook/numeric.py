@@ -270,10 +270,11 @@ class Evaluator(Visitor):
 
     def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
         conds = [None if k is None else self.compile(k) for k in t.conditions]
-        split = _partition(conds, t.texts)
+        matrices = _matrix_names(t)
+        split = _partition(conds, t.texts, matrices)
         keys = tuple(None if k is None else self.plan.keys.key(k) for k in t.conditions)
         split = self._kept(self.plan.keys.signature("pieces", keys), split)
-        return _piecewise(t, conds, [self.compile(v) for v in t.values], split)
+        return _piecewise(t, conds, [self.compile(v) for v in t.values], split, matrices)
 
     def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
         from .matrix import build
@@ -307,19 +308,22 @@ class Evaluator(Visitor):
         params, is_text, name = t.params, t.text, t.name
         matrix = tuple(t.shape or ())
 
+        matrices = t.matrices
+
         def program(env):
-            arrays = {p: env[p] for p in params if p in env and np.ndim(env[p]) > 0}
+            arrays = {
+                p: np.asarray(env[p])
+                for p in params
+                if p in env and np.ndim(env[p]) > (2 if p in matrices else 0)
+            }
             try:
                 if not arrays:
                     return run(env)
-                keys = list(arrays)
-                shaped = np.broadcast_arrays(*[np.asarray(arrays[k]) for k in keys])
-                grid = shaped[0].shape
+                grid, at = _range_points(arrays, matrices)
                 out = np.empty(matrix + grid, dtype=object if is_text else float)
                 lead = (slice(None),) * len(matrix)  # a matrix value: its axes come first
                 for ix in np.ndindex(grid):
-                    one = {**env, **{k: float(a[ix]) for k, a in zip(keys, shaped)}}
-                    out[lead + ix] = run(one)
+                    out[lead + ix] = run({**env, **at(ix)})
                 return out
             except NoValue:
                 raise InputError(
@@ -384,11 +388,36 @@ def _constant(t: tc.T) -> bool:
     return all(_constant(c) for c in children(t))
 
 
-def _partition(conds: list, texts: tuple) -> Fn:
+def _matrix_names(t: tc.T) -> frozenset:
+    """The parameters and program locals that are vectors or matrices, read in ``t``."""
+    out, todo = set(), [t]
+    while todo:
+        n = todo.pop()
+        if isinstance(n, tc.TParam) and n.shape is not None:
+            out.add(n.name)
+        todo.extend(ty.children(n))
+    return frozenset(out)
+
+
+def _points(env: dict, matrices: frozenset) -> list:
+    """The names in ``env`` whose values vary over a range (a vector or matrix is one value,
+    refused in a condition when it varies over a range)."""
+    for k in matrices:
+        if np.ndim(env.get(k)) > 2:
+            raise InputError(
+                f"a condition reads the vector or matrix '{k}', which varies over a range "
+                "here; write the function as a program (evaluated point by point)"
+            )
+    return [
+        k for k, v in env.items() if isinstance(v, np.ndarray) and v.ndim > 0 and k not in matrices
+    ]
+
+
+def _partition(conds: list, texts: tuple, matrices: frozenset = frozenset()) -> Fn:
     """env with arrays -> (shape, [(piece, mask, env of the piece's points)]): first true wins."""
 
     def split(env):
-        keys = [k for k, v in env.items() if isinstance(v, np.ndarray) and v.ndim > 0]
+        keys = _points(env, matrices)
         shaped = np.broadcast_arrays(*[env[k] for k in keys])
         shape = shaped[0].shape
         full = {**env, **dict(zip(keys, shaped))}
@@ -409,11 +438,15 @@ def _partition(conds: list, texts: tuple) -> Fn:
     return split
 
 
-def _piecewise(t: tc.TPiecewise, conds: list, values: list, split: Fn) -> Fn:
+def _piecewise(
+    t: tc.TPiecewise, conds: list, values: list, split: Fn, matrices: frozenset = frozenset()
+) -> Fn:
     texts = t.texts
 
     def evaluate(env):
-        if not any(isinstance(v, np.ndarray) and v.ndim > 0 for v in env.values()):
+        if not any(
+            isinstance(v, np.ndarray) and v.ndim > 0 and k not in matrices for k, v in env.items()
+        ) and not any(np.ndim(env.get(k)) > 2 for k in matrices):
             for cond, val in zip(conds, values):
                 if cond is None or bool(cond(env)):
                     return val(env)
@@ -439,6 +472,28 @@ def _matrix_binary(t: tc.TBinary, left: Fn, right: Fn) -> Fn:
     op = {**_ARITH, "^": np.power}[t.op]
     lm, rm = t.left.shape is not None, t.right.shape is not None
     return lambda env: mx.elementwise(op, left(env), right(env), lm, rm)
+
+
+def _range_points(arrays: dict, matrices: tuple):
+    """The grid of range points of a program's arguments that vary over a range, and the
+    arguments at one point (a matrix argument's range axes follow its two matrix axes)."""
+    from . import matrix as mx
+
+    depth = max(a.ndim - 2 if k in matrices else a.ndim for k, a in arrays.items())
+    padded = {k: mx.pad(a, depth - (a.ndim - 2)) if k in matrices else a for k, a in arrays.items()}
+    grid = np.broadcast_shapes(
+        *[a.shape[2:] if k in matrices else a.shape for k, a in padded.items()]
+    )
+    full = {
+        k: np.broadcast_to(a, a.shape[:2] + grid if k in matrices else grid)
+        for k, a in padded.items()
+    }
+    lead = (slice(None), slice(None))
+
+    def at(ix) -> dict:
+        return {k: a[lead + ix] if k in matrices else float(a[ix]) for k, a in full.items()}
+
+    return grid, at
 
 
 class _NoPiece(InputError):

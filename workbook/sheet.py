@@ -94,11 +94,14 @@ class Sheet:
                 typed_equations(self.typer, block)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=block.line, definition=block.what) from None
+        later = []  # functions whose body needs vectors: typed by the calls of the sheet
         for name, d in self.spec.definitions.items():
             try:
                 self.typer.function(name) if d.is_function else self.typer.scalar(name)
             except WorkbookError as err:
-                raise err.located(file=self.file, line=d.line, definition=d.name) from None
+                if not d.is_function:
+                    raise err.located(file=self.file, line=d.line, definition=d.name) from None
+                later.append(d)
             except RecursionError:
                 raise LimitError(
                     "definitions and expressions nested too deeply for the engine",
@@ -124,6 +127,11 @@ class Sheet:
             from .declared_checks import type_checks
 
             type_checks(self)
+        for d in later:  # typed at numbers, or by a call with vectors or matrices
+            try:
+                self.typer.function(d.name)
+            except WorkbookError as err:
+                raise err.located(file=self.file, line=d.line, definition=d.name) from None
 
     def at_template_inputs(self) -> bool:
         """Are the inputs the template's own (the worked example it lists)?"""

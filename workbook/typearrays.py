@@ -268,6 +268,7 @@ class ArrayTyping:
             name=d.name,
             program=typed,
             params=tuple(d.params),
+            matrices=tuple(p for p in d.params if isinstance(scope[p], tuple)),
             text=typed.text,
             shape=typed.shape,
         )

@@ -44,6 +44,7 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TypedFunction,
     children,
     is_zero,
+    shape_text,
 )
 from .visitor import Visitor
 
@@ -95,14 +96,34 @@ class Typer(ArrayTyping, Visitor):
         return self.scalars[name]
 
     def function(self, name: str) -> TypedFunction:
-        if name not in self.functions:
+        """Typed function ``name`` (or one of its specializations, by its key): its body with
+        each parameter a number of its unit. A function whose body needs vectors or matrices
+        (``P[0]``) has no such typing: then its first specialization typed (by a call with
+        vectors or matrices) stands for it, or the error of its typing at numbers is raised."""
+        if name in self.functions:
+            return self.functions[name]
+        try:
+            return self.specialized(name, ())
+        except WorkbookError:
+            found = next((f for k, f in self.functions.items() if _key_of(k) == name), None)
+            if found is None:
+                raise
+            return found
+
+    def specialized(self, name: str, shapes: tuple) -> TypedFunction:
+        """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for
+        all numbers), each in the unit declared in [arguments]; typed once per shapes."""
+        key = specialization_key(name, shapes)
+        if key not in self.functions:
             d = self._definition(name)
-            scope = {p: self.spec.arguments[p].binding_unit for p in d.params}
+            shapes = tuple(shapes) or (None,) * len(d.params)
+            units = tuple(self.spec.arguments[p].binding_unit for p in d.params)
+            scope = {p: u if sh is None else (u, sh) for p, u, sh in zip(d.params, units, shapes)}
             body = self._typed_body(d, scope)
             if d.unit is not None:
                 body = self.declared(body, d.unit, _declared(name, d.unit))
-            self.functions[name] = TypedFunction(name, d.params, tuple(scope.values()), body)
-        return self.functions[name]
+            self.functions[key] = TypedFunction(key, d.params, units, body, shapes)
+        return self.functions[key]
 
     def expression(self, node: ex.Node, scope: dict[str, pint.Unit], what: str) -> T:
         """Type a free expression (a table column, a chart series) in a scope of parameters."""
@@ -469,13 +490,13 @@ class Typer(ArrayTyping, Visitor):
                     f"{name}() takes {len(d.params)} argument(s) "
                     f"({', '.join(d.params)}), got {len(args)}"
                 )
-            self._scalar_args(name, args)
-            f = self.function(name)
+            shapes = tuple(a.shape for a in args)
+            f = self._called(node, shapes) if any(shapes) else self.specialized(name, ())
             conv = tuple(
                 self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
                 for i, (a, u) in enumerate(zip(args, f.param_units))
             )
-            return TCall(f.unit, name=name, args=conv, shape=f.body.shape, text=f.body.text)
+            return TCall(f.unit, name=f.name, args=conv, shape=f.body.shape, text=f.body.text)
         if name in self.spec.blocks:
             from . import blocks
 
@@ -504,6 +525,31 @@ class Typer(ArrayTyping, Visitor):
         entry.check_arity(len(args))
         typed = entry.unit_rule(self, name, tuple(args))
         return typed if entry.arrays else self.elementwise_call(name, entry, tuple(args), typed)
+
+    def _called(self, node: ex.Call, shapes: tuple) -> TypedFunction:
+        """The specialization of a function called with vectors or matrices; an error in its
+        body for these shapes names the call as well as the definition."""
+        name = node.func
+        d = self.spec.definitions[name]
+        if d.ode is not None or d.branches is not None:
+            what = "the solution of an ode" if d.ode is not None else "defined by pieces"
+            raise TemplateError(
+                f"{ex.to_text(node)}: {name}() is {what}; its arguments are numbers "
+                "(pass elements, v[i])"
+            )
+        try:
+            return self.specialized(name, shapes)
+        except WorkbookError as err:
+            given = ", ".join(
+                f"{p} a {shape_text(sh)}" for p, sh in zip(d.params, shapes) if sh is not None
+            )
+            err.message = f"{ex.to_text(node)} (with {given}): {err.message}"
+            err.args = (err.message,)
+            caller = self._stack[-1] if self._stack else None
+            if caller is not None and caller != err.definition:
+                err.message += f" (called in '{caller}')"
+                err.args = (err.message,)
+            raise
 
     def _scalar_args(self, name: str, args) -> None:
         for a in args:
@@ -586,6 +632,19 @@ class Typer(ArrayTyping, Visitor):
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}
+
+
+def specialization_key(name: str, shapes: tuple) -> str:
+    """The name of function ``name`` typed for arguments of ``shapes`` (``dist@2x1,2x1``;
+    ``1`` for a number); ``name`` itself for numbers only."""
+    if not any(shapes):
+        return name
+    return name + "@" + ",".join("1" if s is None else f"{s[0]}x{s[1]}" for s in shapes)
+
+
+def _key_of(key: str) -> str:
+    """The function a specialization key belongs to."""
+    return key.split("@", 1)[0]
 
 
 def column_node(spec: SheetSpec, col, var: str) -> ex.Node:

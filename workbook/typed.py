@@ -149,6 +149,7 @@ class TProgram(T):
     name: str = ""
     program: object = None  # workbook.program.TypedProgram
     params: tuple = ()
+    matrices: tuple = ()  # the parameters that are vectors or matrices
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,6 +168,9 @@ class TypedFunction:
     params: tuple[str, ...]
     param_units: tuple[pint.Unit, ...]
     body: T
+    # the parameters' shapes, (rows, columns) or None for a number (() for numbers only):
+    # a function called with vectors or matrices is typed once per tuple of shapes
+    shapes: tuple = ()
 
     @property
     def unit(self) -> pint.Unit:

@@ -1,0 +1,144 @@
+"""Functions called with vectors and matrices against numpy: the body is typed once per
+tuple of argument shapes; shape and unit mistakes are errors at load naming the call."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbook.errors import TemplateError, UnitError
+from workbook.sheet import Sheet
+from workbook.template import load_spec
+
+DATA = Path(__file__).parent / "data" / "matrix_functions.toml"
+L, TH = 0.25, math.radians(35)
+A = np.array([1.5, -2, 0.25]) * L
+B = np.array([4, 6, -1]) * L
+C = np.array([[1.5, -2], [3, 0.5]])
+
+
+def _rot(a: float) -> np.ndarray:
+    return np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+
+
+@pytest.fixture(scope="module")
+def sheet() -> Sheet:
+    return Sheet(load_spec(DATA))
+
+
+def _mm(q) -> np.ndarray:
+    return np.asarray(q.to("mm").magnitude, dtype=float)
+
+
+def test_distance_between_two_points(sheet):
+    assert _mm(sheet.evaluate("d")) == pytest.approx(1e3 * np.linalg.norm(A - B), rel=1e-13)
+    assert _mm(sheet.evaluate("d2")) == pytest.approx(1e3 * np.linalg.norm(A - B), rel=1e-13)
+    # one typed body per tuple of shapes, shared by both calls
+    assert [k for k in sheet.typer.functions if k.startswith("dist")] == ["dist@3x1,3x1"]
+
+
+def test_matrix_functions_return_vectors(sheet):
+    np.testing.assert_allclose(_mm(sheet.evaluate("r"))[:, 0], 1e3 * _rot(TH) @ A[:2], rtol=1e-13)
+    np.testing.assert_allclose(_mm(sheet.evaluate("m"))[:, 0], 1e3 * C @ B[:2], rtol=1e-13)
+    assert _mm(sheet.evaluate("t")) == pytest.approx(1e3 * B.sum(), rel=1e-13)
+
+
+def test_a_condition_on_a_vector_argument_is_one_number(sheet):
+    assert float(sheet.evaluate("sd").magnitude) == (1 if A[1] > 0 else -1)
+
+
+def test_table_columns_over_a_range_with_vector_arguments(sheet):
+    cols = {c.text: c.values for c in sheet.table_data("walk").columns}
+    i = np.arange(5.0)
+    want = [np.linalg.norm(A - np.array([k, 1, 0]) * L) for k in i]
+    np.testing.assert_allclose(cols["dist(A, [i, 1, 0]*L)"], 1e3 * np.array(want), rtol=1e-13)
+    np.testing.assert_allclose(cols["total([i, 1]*L)"], 1e3 * (i + 1) * L, rtol=1e-13)
+    want = [(_rot(k * TH) @ np.array([L, 0]))[1] for k in i]
+    np.testing.assert_allclose(cols["rot(i*th, [1, 0]*L)[1]"], 1e3 * np.array(want), atol=1e-12)
+
+
+def test_workbook_writes_the_values_with_a_comment(sheet, tmp_path):
+    import openpyxl
+
+    path = sheet.write_xlsx(tmp_path / "mf.xlsx")
+    ws = openpyxl.load_workbook(path)["Definitions"]
+    row = next(r for r in ws.iter_rows() if r[0].value == "d")
+    assert row[1].value == pytest.approx(1e3 * np.linalg.norm(A - B), rel=1e-12)
+    assert "called with a vector or matrix" in row[1].comment.text
+
+
+def _load(tmp_path, definitions: str, inputs: str = 'L = "2 m"\nT = "3 s"\n') -> Sheet:
+    path = tmp_path / "bad.toml"
+    path.write_text(
+        f'[inputs]\n{inputs}\n[arguments]\nP = {{ unit = "m" }}\nQ = {{ unit = "m" }}\n'
+        f"\n[definitions]\n{definitions}",
+        encoding="utf-8",
+    )
+    return Sheet(load_spec(path))
+
+
+def test_index_out_of_range_names_the_call_and_the_definition(tmp_path):
+    with pytest.raises(TemplateError) as err:
+        _load(tmp_path, '"third(P)" = "P[2]"\ny = "third([1, 2]*L)"\n')
+    text = str(err.value)
+    assert "in 'third'" in text and "third([1, 2] * L)" in text and "P a vector of 2" in text
+    assert "index 2 is out of range" in text and "called in 'y'" in text
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        ('"f(P, Q)" = "P + Q"\ny = "f([1, 2]*L, [1, 2, 3]*L)"', "cannot add a vector of 3"),
+        ('"f(P)" = "det(P)"\ny = "f([1, 2]*L)"', "square"),
+        ('"f(P)" = "P[0]"\ny = "f(L)"', "P is not a vector or matrix"),
+        ('"f(P)" = "P[0]"', "P is not a vector or matrix"),
+    ],
+)
+def test_shape_mistakes_are_refused_at_load(tmp_path, body, message):
+    with pytest.raises(TemplateError, match=message):
+        _load(tmp_path, body + "\n")
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        ('"f(P)" = "norm(P)"\ny = "f([1, 2]*T)"', r"\[time\] \(s\) cannot be converted"),
+        ('"f(P)" = "P + 1"\ny = "f([1, 2]*L)"', "cannot add dimensionless"),
+        ('"f(P)" = "sin(P)"\ny = "f([1, 2]*L)"', "dimensionless argument"),
+    ],
+)
+def test_unit_mistakes_are_refused_at_load(tmp_path, body, message):
+    with pytest.raises(UnitError, match=message):
+        _load(tmp_path, body + "\n")
+
+
+def test_a_condition_in_a_program_on_a_local_vector_is_one_number(tmp_path):
+    sheet = _load(
+        tmp_path,
+        '"loc(P)" = { program = """\nv := [1, -2]*P\nw := 1 if v[1] > 0 otherwise -1\nw\n""" }\n'
+        'y = "loc(L)"\n',
+    )
+    assert np.ndim(sheet.evaluate("y").magnitude) == 0
+    assert float(sheet.evaluate("y").magnitude) == -1
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculation_reproduces_the_engine(sheet, tmp_path):
+    from recalc import cell_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    path = sheet.write_xlsx(tmp_path / "mf.xlsx")
+    written = cell_values(path)
+    again = cell_values(recalculate(path, tmp_path / "out"))
+    compared = 0
+    for key, value in written.items():
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            assert again.get(key) == pytest.approx(value, rel=1e-9, abs=1e-12), key
+            compared += 1
+    assert compared >= 30
+    twice = sheet.evaluate("twice").to("mm").magnitude
+    assert twice == pytest.approx(2e3 * np.linalg.norm(A - B), rel=1e-13)
