@@ -393,6 +393,9 @@ def test_findings_all_pass(sheet):
     listed = [f for f in report.findings if f.topic == "listed example"]
     assert [f.verdict for f in listed] == ["ok"] * 4
     assert [f.value for f in listed[1:]] == pytest.approx([39.0, 38.3, 38.25], abs=1e-9)
+    # the listed lengths hold at the template's own inputs only
+    changed = sheet.with_inputs(H="17 mm").check().findings
+    assert not [f for f in changed if f.topic == "listed example"]
     fig4 = [f for f in report.findings if f.topic == "Fig. 4"]
     assert all(abs(f.value) > 1 for f in fig4)  # alpha at phi_rise/2 and phi_rise does change
     # the same from the paper's formula, written out here, at r0 and 2*r0
