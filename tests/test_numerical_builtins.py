@@ -688,3 +688,12 @@ def test_a_live_root_column_follows_an_input_change_in_libreoffice(tmp_path):
         value = got[(ws.title, f"{ws.cell(r, col).column_letter}{r}")]
         assert value == pytest.approx(want[i], rel=1e-9, abs=10 * stated)
         assert value != pytest.approx(old[i], rel=1e-3)
+
+
+def test_a_loaded_sheet_with_diff_pickles():
+    # as one without diff does (before evaluating: compiled closures do not pickle)
+    import pickle
+
+    s = workbook.load("reducer-profile")
+    again = pickle.loads(pickle.dumps(s))
+    assert again.evaluate("dx_t", 1, 10.0) == s.evaluate("dx_t", 1, 10.0)

@@ -55,6 +55,12 @@ class Pending:
     tree: ty.T | None = None
     compiled: weakref.WeakKeyDictionary = field(default_factory=weakref.WeakKeyDictionary)
 
+    def __getstate__(self) -> dict:  # a Sheet pickles: the compiled closures are left out
+        return {**self.__dict__, "compiled": None}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state, compiled=weakref.WeakKeyDictionary())
+
 
 def pending(typer, body: ty.T, var: ty.TParam, order: int, unit) -> Pending:
     """Record a diff() call being typed (no SymPy): its derivative is found at first use."""
