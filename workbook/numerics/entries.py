@@ -399,12 +399,12 @@ def _root_rows(body, args, helpers) -> tuple[str, int]:
     a, b = args
     if max(len(body(f"({a})")), len(body(f"({b})"))) > 2000:
         raise NotLive("root(): the expression is too long for bisection steps in helper cells")
-    steps = helpers.chain(body.typed)
     n = BISECTION_STEPS
     headers = ["f(A)", "f(B)"]
     for k in range(n + 1):
         headers += [f"lo {k}", f"hi {k}"] + ([f"f(mid) {k}"] if k < n else [])
-    block = helpers.block("root() by bisection, one row per table row", headers)
+    block = helpers.block("root() by bisection, one row per table row", headers)  # the limit
+    steps = helpers.chain(body.typed)
     r = block.ref
     fa, fb = r(0), r(1)
 
