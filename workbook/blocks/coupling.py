@@ -380,7 +380,7 @@ def history_finding(sheet) -> Finding:
 @findings_block
 def study_findings(sheet):
     """Solver choice from the work-precision study, and the explicit solver's stall (the
-    optional part studies: 45 solver runs and a stalled RK45, a few seconds)."""
+    optional part studies: 45 solver runs and a stalled RK45, about 12 s of CPU)."""
     short, df = _study_for_sheet(sheet)
     r, need = stall_run(sheet)
     what = f"RK45 at c2 = {STALL_C2:.0e} N/m stopped ({r.stop_reason})"
