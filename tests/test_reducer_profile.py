@@ -300,8 +300,11 @@ def test_e1_not_below_r2_is_refused_clearly(sheet, e1):
 
 
 def test_fractional_roller_count_is_refused(sheet):
-    f = sheet.with_inputs(n=12.5).check().findings
-    assert all(x.verdict != "ok" and x.value is None for x in f if x.topic != "profile")
+    s = sheet.with_inputs(n=12.5)
+    f = s.check().findings
+    assert all(x.verdict != "ok" and x.value is None for x in f)  # Z = 11.5 is no number
+    with pytest.raises(InputError, match="no piece applies.* n == floor\\(n\\)"):
+        s.evaluate("Z")
     assert "whole number" in next(x for x in f if x.topic == "inputs").what
 
 
