@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -329,3 +330,45 @@ def test_maximize_and_minimize_from_a_guess(tmp_path, capsys):
     main(["check", str(tmp_path / "extremum.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]
+
+
+def _metres(inner: str) -> str:
+    return (
+        f'<ml:unitedValue>{inner}<u:unitMonomial xmlns:u="http://schemas.mathsoft.com/units10">'
+        '<u:unitReference unit="meter"/></u:unitMonomial></ml:unitedValue>'
+    )
+
+
+def test_functions_of_vectors_translate(tmp_path, capsys):
+    """P := (3, 4) m, Q := (0, 1) m, dist(a, b) := |a - b|, y(v) := v[1], twice(v) := 2 v:
+    Mathcad's |x| of a vector is its length; the stored results are reproduced."""
+
+    def vec(*values) -> str:
+        cells = "".join(_real(v) for v in values)
+        return f'<ml:matrix rows="{len(values)}" cols="1">{cells}</ml:matrix>'
+
+    def call(f, *args) -> str:
+        return f"<ml:apply>{_id(f)}{''.join(args)}</ml:apply>"
+
+    src = tmp_path / "points.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("P") + _apply("mult", vec(3, 4), _id("m"))),
+            _region(2, _id("Q") + _apply("mult", vec(0, 1), _id("m"))),
+            _function(3, "dist", ["a", "b"], _apply("absval", _apply("minus", _id("a"), _id("b")))),
+            _function(4, "y", ["v"], _apply("indexer", _id("v"), _real(1))),
+            _function(5, "twice", ["v"], _apply("mult", _real(2), _id("v"))),
+            _eval(6, call("dist", _id("P"), _id("Q")), _metres(_real(math.sqrt(18)))),
+            _eval(7, call("y", _id("P")), _metres(_real(4))),
+            _eval(8, call("twice", _id("P")), _metres(vec(6, 8))),
+            _eval(9, _apply("absval", _real(-2)), _real(2)),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "points.toml").read_text(encoding="utf-8")
+    assert "mag(a - b)" in text and "abs(-2)" in text
+    main(["check", str(tmp_path / "points.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (5, 5), result["failures"]

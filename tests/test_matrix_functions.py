@@ -37,13 +37,20 @@ def test_distance_between_two_points(sheet):
     assert _mm(sheet.evaluate("d")) == pytest.approx(1e3 * np.linalg.norm(A - B), rel=1e-13)
     assert _mm(sheet.evaluate("d2")) == pytest.approx(1e3 * np.linalg.norm(A - B), rel=1e-13)
     # one typed body per tuple of shapes, shared by both calls
-    assert [k for k in sheet.typer.functions if k.startswith("dist")] == ["dist@3x1,3x1"]
+    assert [k for k in sheet.typer.functions if k.startswith("dist@")] == ["dist@3x1,3x1"]
 
 
 def test_matrix_functions_return_vectors(sheet):
     np.testing.assert_allclose(_mm(sheet.evaluate("r"))[:, 0], 1e3 * _rot(TH) @ A[:2], rtol=1e-13)
     np.testing.assert_allclose(_mm(sheet.evaluate("m"))[:, 0], 1e3 * C @ B[:2], rtol=1e-13)
     assert _mm(sheet.evaluate("t")) == pytest.approx(1e3 * B.sum(), rel=1e-13)
+
+
+def test_mag_is_mathcads_absolute_value(sheet):
+    assert _mm(sheet.evaluate("mag_number")) == pytest.approx(1e3 * L, rel=1e-15)
+    assert _mm(sheet.evaluate("mag_vector")) == pytest.approx(1e3 * np.linalg.norm(A), rel=1e-14)
+    got = float(sheet.evaluate("mag_matrix").magnitude)
+    assert got == pytest.approx(np.linalg.det(C), rel=1e-14)
 
 
 def test_a_condition_on_a_vector_argument_is_one_number(sheet):

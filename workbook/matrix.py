@@ -465,6 +465,39 @@ def register_entries() -> None:
         ("SQRT", "SUMSQ"),
     )
 
+    # Mathcad's |x|: one operator whose meaning follows the shape (known at load)
+    def r_mag(ctx, name, args):
+        (a,) = args
+        if a.shape is None or a.shape[1] == 1:
+            return func(a.unit, name, args, None)
+        return func(a.unit ** square(args, name), name, args, None)
+
+    def numpy_mag(v, shapes):
+        if shapes[0] is None:
+            return np.abs(v)
+        return norm(v) if shapes[0][1] == 1 else det(v)
+
+    def excel_mag(args, shapes=None):
+        shape = shapes[0] if shapes else None
+        if shape is None:
+            return f"ABS({args[0]})", atom
+        return (f"SQRT(SUMSQ({args[0]}))" if shape[1] == 1 else f"MDETERM({args[0]})"), atom
+
+    register(
+        Builtin(
+            "mag",
+            1,
+            r_mag,
+            numpy_mag,
+            excel_mag,
+            lambda sp, a: sp.Abs(a),
+            doc="Mathcad's |x|: abs of a number, length of a vector, determinant of a "
+            "square matrix",
+            excel_functions=("ABS", "SQRT", "SUMSQ", "MDETERM"),
+            arrays=True,
+        )
+    )
+
     # joining and cutting
     def r_join(axis: int):
         def rule(ctx, name, args):

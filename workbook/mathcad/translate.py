@@ -166,6 +166,8 @@ class ExprTranslator(Visitor):
         if tag == "nthRoot" and len(args) == 2:
             n, x = self.visit(args[0]), self.visit(args[1])
             return ex.Binary("^", x, ex.Binary("/", ex.Number(1.0), n))
+        if tag == "absval" and len(args) == 1:
+            return self._absval(self.visit(args[0]))
         if tag in OPERATOR_FUNCTIONS and len(args) == 1:
             return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.visit(args[0])])
         if tag == "id":
@@ -292,6 +294,18 @@ class ExprTranslator(Visitor):
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.visit(node.children[0])])
+
+    def _absval(self, x: ex.Node) -> ex.Node:
+        """Mathcad's |x|: abs of a number, but the length of a vector and the determinant of
+        a square matrix: ``mag`` (the shape decides at load) where x may be a vector (it
+        reads a function's parameter, a program's local, a matrix or a vector the sheet
+        defines), else ``abs``."""
+        local = {s.token() for s in self.local.values()}
+        names = ex.names(x)
+        vectors = any(self.tr.is_array(n) for n in names)
+        if names & local or vectors or _has_matrix(x):
+            return self._builtin("mag", "absval", [x])
+        return self._builtin("abs", "absval", [x])
 
     def _builtin(self, name: str, mathcad: str, args: list[ex.Node]) -> ex.Node:
         if name not in language_functions():
@@ -518,6 +532,20 @@ class Translator:
             xt_, yt_ = ex.Index(xt, at), ex.Index(yt, at)
         rng = Item("range", "", sym=index, range=(ex.Number(o), None, ex.Number(o + n - 1)))
         return xt_, yt_, rng, True
+
+    def is_array(self, token: str) -> bool:
+        """Does the definition ``token`` (a name of the worksheet) hold a vector or matrix
+        as far as the import sees (a matrix written in it, or a name that does)?"""
+        memo = self.__dict__.setdefault("_arrays", {})
+        if token not in memo:
+            memo[token] = False  # a cycle is not an array
+            item = next(
+                (i for i in self.out.items if i.sym is not None and i.sym.token() == token), None
+            )
+            if item is not None and item.kind == "definition" and item.body is not None:
+                body = item.body
+                memo[token] = _has_matrix(body) or any(self.is_array(n) for n in ex.names(body))
+        return memo[token]
 
     def _length(self, tree: ex.Node) -> int | None:
         """The length of a vector the worksheet defines by name (None: not a known vector)."""
@@ -1379,8 +1407,19 @@ class _Units(Visitor):
             return a**n.right.value
         raise _Unknown
 
+    def visit_Matrix(self, n):
+        """A matrix has one unit: that of its first element whose unit is known."""
+        for row in n.rows:
+            for e in row:
+                if not (isinstance(e, ex.Number) and e.value == 0):
+                    return self.visit(e)
+        return self._reg().dimensionless
+
+    def visit_Index(self, n):
+        return self.visit(n.target)
+
     def visit_Call(self, n):
-        if n.func in ("abs", "min", "max", "floor", "ceil"):
+        if n.func in ("abs", "mag", "min", "max", "floor", "ceil"):
             return self.visit(n.args[0])
         if n.func == "sqrt":
             return self.visit(n.args[0]) ** 0.5
@@ -1391,6 +1430,11 @@ class _Units(Visitor):
 
 class _Unknown(Exception):
     pass
+
+
+def _has_matrix(tree: ex.Node) -> bool:
+    """Is a vector or matrix written inside ``tree``?"""
+    return any(isinstance(n, ex.Matrix) for n in ex.walk(tree))
 
 
 # -- stored values, units, literals ----------------------------------------------
