@@ -697,3 +697,87 @@ def test_a_loaded_sheet_with_diff_pickles():
     s = workbook.load("reducer-profile")
     again = pickle.loads(pickle.dumps(s))
     assert again.evaluate("dx_t", 1, 10.0) == s.evaluate("dx_t", 1, 10.0)
+
+
+# -- extrema: live as samples and golden-section steps ---------------------------------------
+EXTREMA_LIVE = """
+[inputs]
+c = "0.1"
+[arguments]
+x = { unit = "" }
+k = { unit = "" }
+[definitions]
+peak = "maximum(sin(x) + c*x, x, 0, 10)"
+at = "argmax(sin(x) + c*x, x, 0, 10)"
+low = "minimum(sin(x) + c*x, x, 0, 10)"
+at_low = "argmin(sin(x) + c*x, x, 0, 10)"
+"top(k)" = "maximum(sin(x) + (k + c)*x, x, 0, 10)"
+"where(k)" = "argmax(sin(x) + (k + c)*x, x, 0, 10)"
+[[tables]]
+name = "t"
+range = "k := 0, 0.05 .. 0.3"
+columns = { top = "", where = "" }
+"""
+STATED = r"differs from the engine's value by ([0-9.e+-]+) "
+
+
+def _extrema_book(tmp_path):
+    import openpyxl
+
+    s = sheet(tmp_path, EXTREMA_LIVE)
+    path = s.write_xlsx(tmp_path / "e.xlsx")
+    wb = openpyxl.load_workbook(path)
+    return s, path, wb
+
+
+def _cells(wb):
+    """{name: (sheet, cell, stated difference)} of the scalar results and the table rows."""
+    out = {}
+    res = wb["Results"]
+    for row in res.iter_rows(min_row=2, max_row=5):
+        out[row[0].value] = ("Results", row[1].coordinate, row[1].comment.text)
+    ws = wb["Listing"]
+    heads = {c.value: c for c in ws[2]}
+    for name in ("top", "where"):
+        head = heads[name]
+        for r in range(3, 10):
+            cell = ws.cell(r, head.column)
+            out[(name, r - 3)] = ("Listing", cell.coordinate, head.comment.text)
+    return out
+
+
+def test_extrema_are_live_where_close_to_the_engine(tmp_path):
+    s, path, wb = _extrema_book(tmp_path)
+    for key, (sheet_name, ref, comment) in _cells(wb).items():
+        cell = wb[sheet_name][ref].value
+        name = key if isinstance(key, str) else key[0]
+        if name in ("at", "at_low", "where"):  # flat there: found to 1e-6 only, a number
+            assert isinstance(cell, float), (key, cell)
+            assert "more than 1e-09" in comment, comment
+            continue
+        steps = "'Solver steps'" if sheet_name == "Results" else "'Solver rows'"
+        assert cell.startswith("=IF(") and steps + "!" in cell, (key, cell)
+        assert float(re.search(STATED, comment).group(1)) < 1e-9 * 2, (key, comment)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed")
+def test_live_extrema_follow_an_input_change_in_libreoffice(tmp_path):
+    s, path, wb = _extrema_book(tmp_path)
+    cells = {
+        k: v for k, v in _cells(wb).items() if isinstance(wb[v[0]][v[1]].value, str)
+    }  # the live ones
+    assert {"peak", "low", ("top", 0)} <= set(cells)
+    row = next(r for r in wb["Inputs"].iter_rows() if r[0].value == "c")
+    row[1].value = -0.05  # the global maximum moves to the first peak
+    wb.save(tmp_path / "edited.xlsx")
+    got = cell_values(recalculate(tmp_path / "edited.xlsx", tmp_path / "lo"))
+    new, k = s.with_inputs(c="-0.05"), 0.05 * np.arange(7)
+    want = {name: new.evaluate(name).magnitude for name in ("peak", "low")}
+    want.update({("top", i): v for i, v in enumerate(new.evaluate("top", k).magnitude)})
+    for key, (sheet_name, ref, comment) in cells.items():
+        stated = float(re.search(STATED, comment).group(1))
+        value = got[(sheet_name, ref)]
+        assert value == pytest.approx(want[key], rel=1e-9, abs=10 * stated), key
+    old = s.evaluate("peak").magnitude
+    assert got[cells["peak"][:2]] != pytest.approx(old, rel=1e-2)  # it followed the edit

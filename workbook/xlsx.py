@@ -210,7 +210,7 @@ class WorkbookWriter:
             q = self.sheet.scalar_quantity(d.name)
             ws.write_string(row, 0, d.name)
             value = q if t.text else float(q.magnitude)
-            self.printer.helpers = HelperCells(self, d.name)
+            self.printer.helpers = HelperCells(self, d.name, t)
             try:
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             finally:
@@ -275,7 +275,7 @@ class WorkbookWriter:
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
                 self.formula_cells += 1
                 continue
-            self.printer.helpers = HelperCells(self, d.name)
+            self.printer.helpers = HelperCells(self, d.name, t)
             try:
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             finally:
@@ -930,8 +930,17 @@ class HelperCells:
 
     SHEET = "Solver steps"
 
-    def __init__(self, writer, what: str):
-        self.writer, self.what = writer, what
+    def __init__(self, writer, what: str, typed: tc.T | None = None):
+        self.writer, self.what, self.typed = writer, what, typed
+        self._chains: dict | None = None
+
+    def chain(self, expr: tc.T) -> dict:
+        """The engine's steps of the live form of ``expr`` in this definition (or NotLive)."""
+        if self.typed is None:
+            raise NotLive("no helper cells here")
+        if self._chains is None:
+            self._chains = _recorded_chains(self.writer, self.typed, {})
+        return _one_chain(self._chains, expr, ())
 
     def value(self, t: tc.T, env: dict) -> float:
         """The engine's value of a typed tree (for a helper cell's cached value)."""
@@ -947,8 +956,8 @@ class HelperCells:
 
 
 class RowSteps:
-    """Helper cells of the live roots of one table column: blocks of columns on the sheet
-    'Solver rows' whose row i is the table's row i, so that one formula a column,
+    """Helper cells of the live roots and extrema of one table column: blocks of columns on
+    the sheet 'Solver rows' whose row i is the table's row i, so that one formula a column,
     with the table's row number (``ROW_TOKEN``) filled in, serves every row.
 
     ``chain(expr)`` is the engine's bisection chain of the root of EXPR in every row (the
@@ -959,7 +968,8 @@ class RowSteps:
     per_row = True
     SHEET = "Solver rows"
     FIRST_COL = 1  # B
-    #: helper cells of all row-wise blocks of a workbook (543 table rows of one root)
+    #: helper cells of all row-wise blocks of a workbook (543 table rows of one root, 361 of
+    #: one extremum)
     MAX_CELLS = 100_000
 
     def __init__(self, writer, table_sheet: str, first: int, n: int, var_ref, typed, env):
@@ -970,7 +980,8 @@ class RowSteps:
         self._chains: dict | None = None
 
     def chain(self, expr: tc.T) -> dict:
-        """The engine's bisection steps of the root of ``expr``, every row (or NotLive)."""
+        """The engine's steps of the live form of ``expr`` (a root's, an extremum's), every
+        row (or NotLive)."""
         if self._chains is None:
             self._chains = _recorded_chains(self.writer, self.typed, self.env)
         return _one_chain(self._chains, expr, (self.n,))
@@ -982,7 +993,8 @@ class RowSteps:
         if cells > self.MAX_CELLS or col + len(headers) > MAX_COLS:
             rows = self.MAX_CELLS // len(headers)
             raise NotLive(
-                f"root() in a table column is live as {len(headers)} helper cells a row on the "
+                f"a root or extremum in a table column is live as {len(headers)} helper cells a "
+                f"row on the "
                 f"sheet '{self.SHEET}', up to {self.MAX_CELLS:,} cells in a workbook ({rows} "
                 f"rows of one root); this table has {self.n:,} rows: its values are written "
                 "as numbers"
@@ -1012,13 +1024,16 @@ class RowSteps:
 
 
 def _recorded_chains(writer, typed: tc.T, env: dict) -> dict:
-    """The steps of every live root met evaluating ``typed`` in ``env`` with the live forms
-    (workbook.numerics), by id of its EXPR."""
+    """The steps of every live root and extremum met evaluating ``typed`` in ``env`` with
+    the live forms (workbook.numerics), by id of their EXPR."""
     from .numerics._common import live_forms, recording_chains
 
-    with live_forms(), recording_chains() as found:
+    with recording_chains() as found:
         try:
-            writer.sheet.evaluator.compile(typed)(env)
+            fn = writer.sheet.evaluator.compile(typed)
+            fn(env)  # the engine's values of extrema, to compare with their live forms
+            with live_forms():
+                fn(env)
         except WorkbookError as err:
             why = f"the live form's steps leave the expression's domain ({err.message})"
             raise NotLive(why) from None
@@ -1034,16 +1049,17 @@ def _one_chain(found: dict, expr: tc.T, shape: tuple) -> dict:
             arrays.extend(v if isinstance(v, list) else [v])
     if len(got) != 1 or any(np.shape(v) not in ((), (1,), shape) for v in arrays):
         raise NotLive(
-            "root() is solved more than once for each row of this column (called twice, or "
-            "inside another built-in): its values are written as numbers"
+            "a root or extremum solved more than once for each value of this formula (called "
+            "twice, or inside another built-in): its values are written as numbers"
         )
     if not all(np.isfinite(v).all() for v in arrays):
         raise NotLive("the live form's steps leave the expression's domain")
-    return got[0][1]
+    engine = found.get(("engine", id(expr)))
+    return {**got[0][1], "engine": engine[0] if engine and len(engine) == 1 else None}
 
 
 class RowBlock:
-    """Columns of 'Solver rows' for one root of a table column: ``ref(j)`` is column j's
+    """Columns of 'Solver rows' for one root or extremum of a table column: ``ref(j)`` is column j's
     cell in the current table row; ``write(j, formula, values)`` sets its formula (in the
     row's terms) and the cached value of every row."""
 

@@ -26,6 +26,15 @@ ATOM = PREC["atom"]
 CHUNK = 20_000
 #: bisection steps of a root's live Excel form (a bracket halves 60 times: full precision)
 BISECTION_STEPS = 60
+#: golden-section steps of an extremum's live Excel form (after sampling, around the best sample)
+GOLDEN_STEPS = 60
+#: an extremum is live only where its live form is this close (relative) to the engine's value
+LIVE_EXTREMUM = 1e-9
+#: two values of EXPR this close (relative) count as equal in the live extremum's comparisons,
+#: so that rounding (which LibreOffice or Excel may do differently) does not choose the side
+SAME = 1e-12
+#: the golden ratio's inverse, as the workbook's formulas write it
+GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 #: nodes of the Gauss-Legendre rule of an integral's live Excel form
 EXCEL_NODES = 20
 #: highest order of diff(EXPR, X, N)
@@ -191,18 +200,55 @@ def _bisection(f, a, b, idx) -> dict[str, np.ndarray]:
     return out
 
 
-def _live_root(of, a, b) -> np.ndarray:
-    """The live form's root of every row (and its chain kept, when the writer records)."""
+def _live_chain(of, a, b, steps_of) -> dict[str, np.ndarray]:
+    """``steps_of(f, a, b, idx)`` (the cells of a live form) over every row, in the call's
+    shape; the chain is kept when the writer records (the cached values of the cells)."""
     shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
     f = of.over(shape)
     flat = [np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b)]
     idx = np.arange(math.prod(shape), dtype=float)
     with np.errstate(all="ignore"):
-        steps = _bisection(f, *flat, idx)
+        steps = steps_of(f, *flat, idx)
     kept = chains()
     if kept is not None:
         kept.setdefault(id(of.body), []).append((of.body, steps))
-    return steps["root"].reshape(shape)
+    return {k: v.reshape(shape) if k in ("root", "value", "where") else v for k, v in steps.items()}
+
+
+def _golden(f, a, b, idx, kind: str, of) -> dict:
+    """What the workbook's live extremum computes, row by row: EXPR at the 4 x samples + 1
+    points A + (B-A)*j/m, the first best sample k, then GOLDEN_STEPS golden-section steps on
+    [x(k-1), x(k+1)] (c = hi - (hi-lo)*g, d = lo + (hi-lo)*g, the side of the better of f(c),
+    f(d) kept, the left one when they are within SAME of each other); the result is f at the
+    middle of the last bracket, or the best sample where that is better by more than SAME."""
+    m = 4 * of.tolerance.samples
+    sign = 1.0 if kind == "max" else -1.0
+    width = b - a
+    xs = [a + width * j / m for j in range(m + 1)]
+    fs = [np.broadcast_to(np.asarray(f(x, idx), dtype=float), a.shape) for x in xs]
+    stack = sign * np.vstack(fs)
+    k = np.argmax(stack, axis=0)  # the first best sample
+    best = np.take_along_axis(np.vstack(fs), k[None], axis=0)[0]
+    lo = a + width * np.maximum(k - 1, 0) / m
+    hi = a + width * np.minimum(k + 1, m) / m
+    out = {"samples": fs, "k": k.astype(float), "lo": [lo], "hi": [hi], "fc": [], "fd": []}
+    for _ in range(GOLDEN_STEPS):
+        c, d = hi - (hi - lo) * GOLDEN, lo + (hi - lo) * GOLDEN
+        fc = np.asarray(f(c, idx), dtype=float)
+        fd = np.asarray(f(d, idx), dtype=float)
+        left = sign * (fc - fd) >= -SAME * (np.abs(fc) + np.abs(fd))
+        lo, hi = np.where(left, lo, c), np.where(left, d, hi)
+        out["lo"].append(lo)
+        out["hi"].append(hi)
+        out["fc"].append(fc)
+        out["fd"].append(fd)
+    x = (lo + hi) / 2
+    fx = np.asarray(f(x, idx), dtype=float)
+    better = sign * (fx - best) >= -SAME * (np.abs(fx) + np.abs(best))
+    out["fx"] = fx
+    out["value"] = np.where(better, fx, best)
+    out["where"] = np.where(better, x, a + width * k / m)
+    return out
 
 
 def _root_numpy(of, a, b=None):
@@ -210,7 +256,7 @@ def _root_numpy(of, a, b=None):
 
     tol, var, unit = of.tolerance, of.var, of.unit_text
     if live() and b is not None:
-        return _out(_live_root(of, a, b))
+        return _out(_live_chain(of, a, b, _bisection)["root"])
     if b is None:
         res = _solve(
             of,
@@ -268,6 +314,9 @@ def _extremum_numpy(name: str):
     def hook(of, a, b):
         from . import extrema
 
+        if live():  # what the workbook's samples and golden-section steps compute
+            steps = _live_chain(of, a, b, lambda f, a, b, idx: _golden(f, a, b, idx, kind, of))
+            return _out(steps["where" if where else "value"])
         tol, var, unit = of.tolerance, of.var, of.unit_text
         res = _solve(
             of,
@@ -289,6 +338,9 @@ def _extremum_numpy(name: str):
         if where:
             res = Result(res.where, res.where_error, evaluations=res.evaluations)
         of.record(name, res)
+        kept = chains()
+        if kept is not None:  # the writer compares the live form with it
+            kept.setdefault(("engine", id(of.body)), []).append(np.ravel(res.value))
         return _out(res.value)
 
     return hook
@@ -320,16 +372,6 @@ def _out(v: np.ndarray):
 
 
 # -- Excel --------------------------------------------------------------------------------------
-def _not_live(name: str, primitive: str):
-    def excel(body, args, consts):
-        raise NotLive(
-            f"{name}() is computed by {primitive} (error estimate below the sheet's tolerance); "
-            "its value is written as a number"
-        )
-
-    return excel
-
-
 def _root_excel(body, args, consts) -> tuple[str, int]:
     """A live root of a scalar definition: BISECTION_STEPS bisection steps in helper cells
     (lo, hi, mid, f(lo), f(mid) a row, each with its cached value); #N/A when f(A) and f(B)
@@ -428,6 +470,103 @@ def _root_rows(body, args, helpers) -> tuple[str, int]:
         if k < n:
             block.write(4 + 3 * k, "=" + body(f"(({lo(k)}+{hi(k)})/2)"), steps["fm"][k])
     return f"IF({fa}*{fb}>0,NA(),({lo(n)}+{hi(n)})/2)", ATOM
+
+
+def _cells(helpers, title: str, headers: list[str]):
+    """One row of helper cells, in a scalar definition's block or a table row's block:
+    (ref(j), write(j, formula, value or values))."""
+    if getattr(helpers, "per_row", False):
+        block = helpers.block(title, headers)
+        return block.ref, block.write
+    block = helpers(title, 1, headers)
+    return (lambda j: block.ref(0, j)), (
+        lambda j, f, v: block.write(0, j, f, float(np.ravel(v)[0]))
+    )
+
+
+def _close_to_engine(name: str, steps: dict) -> None:
+    """NotLive unless the live form is within LIVE_EXTREMUM of the engine's value in every
+    row (a peak at a kink, or the position of a flat one, is not)."""
+    live = np.ravel(steps["where" if name.startswith("arg") else "value"])
+    engine = steps.get("engine")
+    if engine is None or np.shape(engine) not in ((1,), live.shape):
+        raise NotLive(f"{name}(): the engine's value to compare the live form with is unknown")
+    diff = float(np.max(np.abs(live - engine)))
+    scale = float(np.max(np.abs(engine))) or 1.0
+    if diff > LIVE_EXTREMUM * scale:
+        raise NotLive(
+            f"{name}() is computed by sampling and find_minimum (scipy.optimize.elementwise); "
+            f"its live form (samples and golden-section steps) would differ from the engine's "
+            f"value by {diff:.2g} ({diff / scale:.1g} relative, more than {LIVE_EXTREMUM:g}), "
+            "so the value is written as a number"
+        )
+
+
+def _not_worse(kind: str, p: str, q: str) -> str:
+    """Excel's test that EXPR at p is at least as good as at q, to SAME (as ``_golden``)."""
+    diff = f"{p}-{q}" if kind == "max" else f"{q}-{p}"
+    return f"{diff}>=-{SAME!r}*(ABS({p})+ABS({q}))".replace("e-", "E-")
+
+
+def _extremum_excel(name: str):
+    kind = "max" if name.endswith("max") or name == "maximum" else "min"
+
+    def excel(body, args, consts) -> tuple[str, int]:
+        """A live extremum: EXPR at 4 x samples + 1 points of [A, B], the first best one
+        (MATCH), then GOLDEN_STEPS golden-section steps around it, in helper cells (a row of
+        the sheet 'Solver steps'; in a table, one row per table row on 'Solver rows')."""
+        helpers = getattr(body, "helpers", None)
+        if helpers is None or not hasattr(helpers, "chain"):
+            raise NotLive(
+                f"{name}() is computed by sampling and find_minimum (scipy.optimize."
+                "elementwise); its value is written as a number (live as samples and "
+                "golden-section steps in a scalar definition or a table column)"
+            )
+        a, b = args
+        steps = helpers.chain(body.typed)
+        _close_to_engine(name, steps)
+        m, n = len(steps["samples"]) - 1, GOLDEN_STEPS
+        headers = [f"f(x{j})" for j in range(m + 1)] + ["best"]
+        for s in range(n + 1):
+            headers += [f"lo {s}", f"hi {s}"] + ([f"f(c) {s}", f"f(d) {s}"] if s < n else [])
+        headers.append("f(x)")
+        ref, write = _cells(helpers, f"{name}() by samples and golden section", headers)
+
+        def x(j: str) -> str:
+            return f"(({a})+(({b})-({a}))*{j}/{m})"
+
+        for j in range(m + 1):
+            write(j, "=" + body(x(str(j))), steps["samples"][j])
+        samples = f"{ref(0)}:{ref(m).split('!')[1]}"
+        best, k = f"{kind.upper()}({samples})", ref(m + 1)
+        write(m + 1, f"=MATCH({best},{samples},0)-1", steps["k"])
+        g = repr(GOLDEN)
+        col = m + 2
+        for s in range(n + 1):
+            lo, hi = ref(col), ref(col + 1)
+            if s:
+                plo, phi, fc, fd = (ref(col - 4 + i) for i in range(4))
+                c, d = f"({phi}-({phi}-{plo})*{g})", f"({plo}+({phi}-{plo})*{g})"
+                keep = _not_worse(kind, fc, fd)
+                write(col, f"=IF({keep},{plo},{c})", steps["lo"][s])
+                write(col + 1, f"=IF({keep},{d},{phi})", steps["hi"][s])
+            else:
+                write(col, f"={x(f'MAX({k}-1,0)')}", steps["lo"][0])
+                write(col + 1, f"={x(f'MIN({k}+1,{m})')}", steps["hi"][0])
+            if s < n:
+                c, d = f"({hi}-({hi}-{lo})*{g})", f"({lo}+({hi}-{lo})*{g})"
+                write(col + 2, "=" + body(c), steps["fc"][s])
+                write(col + 3, "=" + body(d), steps["fd"][s])
+                col += 4
+        mid = f"(({ref(col)}+{ref(col + 1)})/2)"
+        fx = ref(col + 2)
+        write(col + 2, "=" + body(mid), steps["fx"])
+        better = _not_worse(kind, fx, best)
+        if name.startswith("arg"):
+            return f"IF({better},{mid},{x(k)})", ATOM
+        return f"IF({better},{fx},{best})", ATOM
+
+    return excel
 
 
 def _integral_excel(body, args, consts) -> tuple[str, int]:
@@ -531,10 +670,11 @@ for _name, _text, _shown in (
             4,
             _extremum_unit,
             _extremum_numpy(_name),
-            _not_live(_name, "sampling and find_minimum (scipy.optimize.elementwise)"),
+            _extremum_excel(_name),
             _no_sympy(_name),
             doc=f"{_name}(EXPR, X, A, B): {_text} (the global one among all local ones)",
             binds=(0, 1),
+            excel_functions=("ABS", "IF", "MATCH", "MAX", "MIN"),
             mathml=f"<munder><mi>{_shown}</mi><mrow>{{1}}<mo>\u2208</mo><mrow><mo>[</mo>{{2}}"
             "<mo separator='true'>,</mo>{3}<mo>]</mo></mrow></mrow></munder>{0:group}",
         )

@@ -13,6 +13,20 @@ APPROXIMATE = {
     "root": "60 bisection steps on the sheet 'Solver steps' (in a table, a chain per table "
     "row on 'Solver rows'; #N/A when f(A) and f(B) have the same sign; with more than one "
     "root in [A, B] it may find another one than the engine)",
+    **{
+        name: "samples at 4 x samples + 1 points and 60 golden-section steps around the best "
+        "one, on the sheet 'Solver steps' or, in a table, 'Solver rows' (with two peaks "
+        "nearly as high it may find another one than the engine)"
+        + (
+            "; where the extremum is, the workbook finds to about 1e-6 relative (values of "
+            "EXPR within 1e-12 count as equal in its steps, so that another spreadsheet's "
+            "rounding takes the same steps; the function is flat there), the engine to "
+            "about 1e-8"
+            if name.startswith("arg")
+            else ""
+        )
+        for name in ("maximum", "minimum", "argmax", "argmin")
+    },
 }
 
 
