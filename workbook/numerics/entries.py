@@ -505,7 +505,8 @@ def _close_to_engine(name: str, steps: dict) -> None:
 def _not_worse(kind: str, p: str, q: str) -> str:
     """Excel's test that EXPR at p is at least as good as at q, to SAME (as ``_golden``)."""
     diff = f"{p}-{q}" if kind == "max" else f"{q}-{p}"
-    return f"{diff}>=-{SAME!r}*(ABS({p})+ABS({q}))".replace("e-", "E-")
+    same = repr(SAME).replace("e", "E")
+    return f"{diff}>=-{same}*(ABS({p})+ABS({q}))"
 
 
 def _extremum_excel(name: str):
