@@ -139,3 +139,54 @@ def test_workbook_run(tmp_path):
     assert done.returncode == 2
     assert "bad.toml" in done.stderr and "Traceback" not in done.stderr
     assert "divided by the plain number 90" in done.stderr and "plain = true" in done.stderr
+
+
+# -- a bare number in a slot typed as an angle in degrees --------------------------------------
+
+SLOTS = """
+[arguments]
+phi = { unit = "deg" }
+
+[data.table]
+file = "angles.csv"
+columns = { A = "deg", Y = "mm" }
+
+[definitions]
+"f(phi)" = "sin(phi)"
+"g(phi)" = "cos(phi)"
+call = "f(90)"
+call_pi = "f(pi/2)"
+top = { expr = "argmax(f(phi), phi, 0, 180)", unit = "deg" }
+low = { expr = "argmin(g(phi), phi, 90, 270)", unit = "deg" }
+half = { expr = "root(g(phi), phi, 0, 120)", unit = "deg" }
+near = { expr = "root(g(phi), phi, 80)", unit = "deg" }
+area = { expr = "integral(f(phi), phi, 0, 180)", unit = "rad" }
+area_pi = { expr = "integral(f(phi), phi, 0, pi)", unit = "rad" }
+peak = "maximum(f(phi), phi, 0, 180)"
+at45 = { expr = "linterp(A, Y, 45)", unit = "mm" }
+"""
+
+
+@pytest.mark.parametrize(
+    ("name", "expected"),
+    [
+        ("call", 1.0),
+        ("call_pi", 1.0),
+        ("top", 90.0),
+        ("low", 180.0),
+        ("half", 90.0),
+        ("near", 90.0),
+        ("area", 2.0),
+        ("area_pi", 2.0),
+        ("peak", 1.0),
+        ("at45", 45.0),
+    ],
+)
+def test_a_bare_number_where_an_angle_in_degrees_is_wanted_is_in_degrees(tmp_path, name, expected):
+    """A bound, a guess, a function's argument, the x of linterp: 180 is 180 deg (it was read
+    as 180 rad: argmax of sin over [0, 180] gave 5490 deg); pi/2 stays radians."""
+    (tmp_path / "angles.csv").write_text("A,Y\n0,0\n90,90\n", encoding="utf-8")
+    path = tmp_path / "slots.toml"
+    path.write_text(SLOTS, encoding="utf-8")
+    sheet = Sheet(load_spec(path))
+    assert sheet.evaluate(name).magnitude == pytest.approx(expected, rel=1e-8, abs=1e-9)

@@ -177,6 +177,8 @@ def test_bad_tolerance_is_refused_at_load(tmp_path):
         ("root(x^2 + 1, x, 1)", "no sign change found searching from the guess"),
         ("integral(1/x, x, 0, 1)", "divergent"),
         ("argmax(0*x + 1, x, 0, 1)", "flat"),
+        ("argmax(min(x, 0.5), x, 0, 1)", r"maximum 0.5 is reached all along x = 0.5 \.\. 1"),
+        ("argmin(max(x, 0.5), x, 0, 1)", r"minimum 0.5 is reached all along x = 0 \.\. 0.5"),
     ],
 )
 def test_hard_cases_are_errors_naming_file_line_definition(tmp_path, expr, message):

@@ -508,7 +508,7 @@ class Typer(ArrayTyping, Visitor):
                     f"({', '.join(blk.args)}), got {len(args)}"
                 )
             conv = tuple(
-                self.convert(a, un.unit(u), f"argument '{p}' of {name}()")
+                self.declared(a, un.unit(u), f"argument '{p}' of {name}()")
                 for a, (p, u) in zip(args, blk.args.items())
             )
             return TBlock(un.unit(blk.returns), name=name, ref=blk.ref, args=conv)
@@ -628,7 +628,7 @@ class Typer(ArrayTyping, Visitor):
 
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
-        return self.convert(a, unit, where)
+        return self.declared(a, unit, where)  # f(90) of an argument in deg is 90 deg
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}

@@ -96,10 +96,30 @@ def extremum(
         best_x[take] = where[first][better]
         best_ve[take] = verr[first][better]
         best_xe[take] = werr[first][better]
+    if need_where:
+        _no_plateau(kind, xs, fs, best_v, tol, var, unit, label)
     return Result(
         (sgn * best_v).reshape(shape),
         best_ve.reshape(shape),
         best_x.reshape(shape),
         best_xe.reshape(shape),
         evaluations=evaluations,
+    )
+
+
+def _no_plateau(kind, xs, fs, best, tol: Tolerance, var: str, unit: str, label) -> None:
+    """An extremum reached on a stretch of samples (a piece ``R otherwise`` at the top) has no
+    one place: arg{kind} would silently pick an end of the stretch."""
+    near = fs <= (best + np.maximum(tol.rtol * np.abs(best), tol.atol))[:, None]
+    run = near[:, :-2] & near[:, 1:-1] & near[:, 2:]  # three samples in a row at the extremum
+    if not run.any():
+        return
+    i, j = np.argwhere(run)[0]
+    end = j + 2
+    while end + 1 < near.shape[1] and near[i, end + 1]:
+        end += 1
+    raise NumericsError(
+        f"arg{kind}(): the {kind}imum {num(-best[i] if kind == 'max' else best[i])} is reached "
+        f"all along {var} = {num(xs[i, j])} .. {num(xs[i, end])}{_u(unit)}"
+        f"{row_text(label, i, xs.shape[0])}: it has no one arg{kind} (narrow the interval)"
     )
