@@ -44,6 +44,9 @@ def test_matrix_functions_return_vectors(sheet):
     np.testing.assert_allclose(_mm(sheet.evaluate("r"))[:, 0], 1e3 * _rot(TH) @ A[:2], rtol=1e-13)
     np.testing.assert_allclose(_mm(sheet.evaluate("m"))[:, 0], 1e3 * C @ B[:2], rtol=1e-13)
     assert _mm(sheet.evaluate("t")) == pytest.approx(1e3 * B.sum(), rel=1e-13)
+    np.testing.assert_allclose(_mm(sheet.evaluate("m2"))[:, 0], 1e3 * C @ B[:2], rtol=1e-13)
+    want = 1e3 * ((C @ B[:2])[1] + B[0])
+    assert _mm(sheet.evaluate("last_y")) == pytest.approx(want, rel=1e-13)
 
 
 def test_mag_is_mathcads_absolute_value(sheet):
@@ -67,14 +70,22 @@ def test_table_columns_over_a_range_with_vector_arguments(sheet):
     np.testing.assert_allclose(cols["rot(i*th, [1, 0]*L)[1]"], 1e3 * np.array(want), atol=1e-12)
 
 
-def test_workbook_writes_the_values_with_a_comment(sheet, tmp_path):
+def test_workbook_inlines_a_call_and_writes_a_program_as_values(sheet, tmp_path):
+    """A call with a matrix argument is inlined as for numbers (an array formula over the
+    named blocks); a program called with one is written as its values, with a comment."""
     import openpyxl
 
-    path = sheet.write_xlsx(tmp_path / "mf.xlsx")
-    ws = openpyxl.load_workbook(path)["Definitions"]
-    row = next(r for r in ws.iter_rows() if r[0].value == "d")
-    assert row[1].value == pytest.approx(1e3 * np.linalg.norm(A - B), rel=1e-12)
-    assert "called with a vector or matrix" in row[1].comment.text
+    wb = openpyxl.load_workbook(sheet.write_xlsx(tmp_path / "mf.xlsx"))
+
+    def cell(name: str):
+        key = name if name in wb.defined_names else name + "_"  # d_: d reads as a column
+        ((title, ref),) = wb.defined_names[key].destinations
+        return wb[title][ref.replace("$", "")]
+
+    assert "SQRT(SUMSQ(" in cell("d").value.text
+    assert "MMULT(C_" in cell("last_y").value.text
+    assert cell("t").value == pytest.approx(1e3 * B.sum(), rel=1e-12)
+    assert "called with a vector or matrix" in cell("t").comment.text
 
 
 def _load(tmp_path, definitions: str, inputs: str = 'L = "2 m"\nT = "3 s"\n') -> Sheet:
