@@ -783,3 +783,13 @@ def test_live_extrema_follow_an_input_change_in_libreoffice(tmp_path):
         assert value == pytest.approx(want[key], rel=1e-9, abs=10 * stated), key
     old = s.evaluate("peak").magnitude
     assert got[cells["peak"][:2]] != pytest.approx(old, rel=1e-2)  # it followed the edit
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", workbook.list_templates())
+def test_bench_of_every_template_is_an_answer_not_a_crash(name, capsys):
+    """`workbook bench` on each installed template: a table (0) or "nothing to time" (2),
+    never an internal error (a text definition among the targets was one)."""
+    from workbook.cli import main
+
+    assert main(["bench", name, "--quick"]) in (0, 2)

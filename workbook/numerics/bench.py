@@ -73,8 +73,8 @@ def targets(sheet) -> list[tuple[str, set[str], object]]:
     """(what, built-ins, compute(fresh sheet) -> values) for each place the built-ins are used."""
     out = []
     for name, d in sheet.spec.definitions.items():
-        if d.is_function:
-            continue
+        if d.is_function or sheet.typer.scalar(name).text:
+            continue  # a text (a verdict, a method's name) has no error to measure
         found = uses(sheet, sheet.typer.scalar(name))
         if found:
             out.append((name, found, lambda s, name=name: s.evaluate(name).magnitude))
