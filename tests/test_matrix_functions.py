@@ -68,6 +68,8 @@ def test_table_columns_over_a_range_with_vector_arguments(sheet):
     np.testing.assert_allclose(cols["total([i, 1]*L)"], 1e3 * (i + 1) * L, rtol=1e-13)
     want = [(_rot(k * TH) @ np.array([L, 0]))[1] for k in i]
     np.testing.assert_allclose(cols["rot(i*th, [1, 0]*L)[1]"], 1e3 * np.array(want), atol=1e-12)
+    # a condition on a vector that varies over the range: row by row
+    assert list(cols["side([i, i - 2, 0]*L)"]) == [1 if k - 2 > 0 else -1 for k in i]
 
 
 def test_workbook_inlines_a_call_and_writes_a_program_as_values(sheet, tmp_path):
@@ -160,3 +162,14 @@ def test_libreoffice_recalculation_reproduces_the_engine(sheet, tmp_path):
     assert compared >= 30
     twice = sheet.evaluate("twice").to("mm").magnitude
     assert twice == pytest.approx(2e3 * np.linalg.norm(A - B), rel=1e-13)
+
+
+def test_a_function_of_vectors_only_is_not_evaluated_with_numbers(tmp_path):
+    """x0(P) = P[0] is typed for the vectors it is called with: evaluated by name with a
+    list (the points of a range, for a function of numbers) it is refused, never indexed."""
+    from workbook.errors import InputError
+
+    sheet = _load(tmp_path, '"x0(P)" = "P[0]"\ny = "x0([3, 4]*L)"\n')
+    assert float(sheet.evaluate("y").to("m").magnitude) == 6
+    with pytest.raises(InputError, match="takes vectors or matrices"):
+        sheet.evaluate("x0", [1.0, 2.0, 3.0])

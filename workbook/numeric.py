@@ -399,28 +399,40 @@ def _matrix_names(t: tc.T) -> frozenset:
     return frozenset(out)
 
 
-def _points(env: dict, matrices: frozenset) -> list:
-    """The names in ``env`` whose values vary over a range (a vector or matrix is one value,
-    refused in a condition when it varies over a range)."""
-    for k in matrices:
-        if np.ndim(env.get(k)) > 2:
-            raise InputError(
-                f"a condition reads the vector or matrix '{k}', which varies over a range "
-                "here; write the function as a program (evaluated point by point)"
-            )
-    return [
-        k for k, v in env.items() if isinstance(v, np.ndarray) and v.ndim > 0 and k not in matrices
-    ]
+def _points(env: dict, matrices: frozenset) -> tuple[tuple, dict]:
+    """The grid of points of ``env`` (the shape its values vary over) and those values
+    broadcast to it: a number varying over a range, or a vector or matrix (``matrices``)
+    whose axes after its two matrix axes are a range's."""
+    from . import matrix as mx
+
+    keys = [k for k, v in env.items() if isinstance(v, np.ndarray) and v.ndim > 0]
+    scalars = [k for k in keys if k not in matrices]
+    mats = [k for k in keys if k in matrices and env[k].ndim > 2]
+    if not mats:
+        shaped = np.broadcast_arrays(*[env[k] for k in scalars])
+        return shaped[0].shape, dict(zip(scalars, shaped))
+    depth = max([env[k].ndim for k in scalars] + [env[k].ndim - 2 for k in mats])
+    padded = {k: mx.pad(env[k], depth - (env[k].ndim - 2)) for k in mats}
+    shape = np.broadcast_shapes(
+        *[env[k].shape for k in scalars], *[m.shape[2:] for m in padded.values()]
+    )
+    full = {k: np.broadcast_to(env[k], shape) for k in scalars}
+    full.update({k: np.broadcast_to(m, m.shape[:2] + shape) for k, m in padded.items()})
+    return shape, full
+
+
+def _at(full: dict, matrices: frozenset, take) -> dict:
+    """The values of ``full`` at the points ``take`` (a mask over the grid)."""
+    lead = (slice(None), slice(None))
+    return {k: v[lead + (take,)] if k in matrices else v[take] for k, v in full.items()}
 
 
 def _partition(conds: list, texts: tuple, matrices: frozenset = frozenset()) -> Fn:
     """env with arrays -> (shape, [(piece, mask, env of the piece's points)]): first true wins."""
 
     def split(env):
-        keys = _points(env, matrices)
-        shaped = np.broadcast_arrays(*[env[k] for k in keys])
-        shape = shaped[0].shape
-        full = {**env, **dict(zip(keys, shaped))}
+        shape, points = _points(env, matrices)
+        full = {**env, **points}
         todo = np.ones(shape, dtype=bool)
         pieces = []
         for i, cond in enumerate(conds):
@@ -429,11 +441,12 @@ def _partition(conds: list, texts: tuple, matrices: frozenset = frozenset()) -> 
             else:
                 take = todo & np.broadcast_to(np.asarray(cond(full), dtype=bool), shape)
             if take.any():
-                pieces.append((i, take, {**env, **{k: full[k][take] for k in keys}}))
+                pieces.append((i, take, {**env, **_at(points, matrices, take)}))
                 todo = todo & ~take
             if not todo.any():
                 return shape, pieces
-        raise _NoPiece({k: full[k][todo] for k in keys}, texts)
+        missed = {k: v for k, v in _at(points, matrices, todo).items() if k not in matrices}
+        raise _NoPiece(missed, texts)
 
     return split
 

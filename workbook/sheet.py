@@ -215,6 +215,11 @@ class Sheet:
                     raise InputError(f"'{name}' takes no arguments")
                 return self.scalar_quantity(name)
             f = self.typer.function(name)
+            if any(f.shapes):
+                raise InputError(
+                    f"{name}() takes vectors or matrices (its body is typed for the shapes of "
+                    "its calls in the sheet); evaluate a definition that calls it"
+                )
             env = self._bind(name, d.params, args, kwargs)
             out = self.evaluator.function(name)(env)
             if f.body.text:
