@@ -72,6 +72,8 @@ class Typer(ArrayTyping, Visitor):
         # the parameters in scope of the binding built-in being typed (diff's variable must
         # be one of them: the derivative is a function of it)
         self.scope: dict[str, pint.Unit] = {}
+        # functions typed only for the vectors and matrices they are called with
+        self._at_numbers_fails: set[str] = set()
 
     # -- public -------------------------------------------------------------------
     def sympy_converter(self, keep: set[str]):
@@ -102,13 +104,14 @@ class Typer(ArrayTyping, Visitor):
         vectors or matrices) stands for it, or the error of its typing at numbers is raised."""
         if name in self.functions:
             return self.functions[name]
-        try:
-            return self.specialized(name, ())
-        except WorkbookError:
-            found = next((f for k, f in self.functions.items() if _key_of(k) == name), None)
-            if found is None:
-                raise
-            return found
+        if name not in self._at_numbers_fails:
+            try:
+                return self.specialized(name, ())
+            except WorkbookError:
+                if not any(_key_of(k) == name for k in self.functions):
+                    raise
+                self._at_numbers_fails.add(name)
+        return next(f for k, f in self.functions.items() if _key_of(k) == name)
 
     def specialized(self, name: str, shapes: tuple) -> TypedFunction:
         """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for
