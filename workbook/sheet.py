@@ -113,6 +113,8 @@ class Sheet:
             if t.range is not None:
                 for col in t.columns:
                     self.typed_column(col, t.range.var, f"table {t.name}")
+            for name, values in t.vary.items():
+                self._check_vary(t, name, values)
         for c in self.full_spec.charts:
             for s in c.series:
                 if s.table is None:
@@ -138,6 +140,18 @@ class Sheet:
                     )
                     err.args = (err.message,)
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
+
+    def _check_vary(self, t, name: str, values) -> None:
+        where = dict(file=self.file, line=t.line, definition=f"table {t.name}")
+        if name not in self.spec.inputs:
+            raise InputError(
+                f"vary: '{name}' is not an input{nearest(name, self.spec.inputs)}", **where
+            )
+        for v in values:
+            try:
+                coerce_input(self.spec.inputs[name], v, file=self.file)
+            except WorkbookError as err:
+                raise type(err)(f"vary.{name}: {err.message}", **where) from None
 
     def at_template_inputs(self) -> bool:
         """Are the inputs the template's own (the worked example it lists)?"""
@@ -501,6 +515,8 @@ class Sheet:
         spec = self.table_spec(name)
         if spec.block:
             return self.block_table(spec.block)
+        if spec.vary:
+            return self.family_table(spec)
         data = self.table_data(name)
         return pd.DataFrame({un.header(c.title, c.unit): c.values for c in data.columns})
 
@@ -509,15 +525,40 @@ class Sheet:
 
         return blocks.get(ref, "table").func(self)
 
-    def block_table_cached(self, name: str):
-        """The DataFrame of the block table named ``name``, computed once per Sheet
-        (the xlsx writer's equal-axes charts read block-table series through it)."""
-        key = ("block table", name)
+    def family_table(self, spec):
+        """A table with ``vary = { NAME = [values] }``: its range, then each column at each
+        value of the input NAME (headers ``"phi2 c1=1500 N/m [rad]"``), the other inputs as
+        they are. The range is this sheet's, the same for every curve."""
+        import pandas as pd
+
+        (name, values), what = next(iter(spec.vary.items())), f"table {spec.name}"
+        xs = self.range_values(spec.range, what)
+        var = spec.range.var
+        arg = self.spec.arguments.get(var)
+        out = {un.header(var, arg.unit if arg else un.registry().dimensionless): xs}
+        curves = [self.with_inputs(**{name: v}) for v in values]
+        columns = {}
+        for v, s in zip(values, curves):
+            with s.evaluator.sharing():
+                columns[v] = [s.column(c, var, xs, f"{what} at {name} = {v}") for c in spec.columns]
+            self.reads |= s.reads
+        for j, c in enumerate(spec.columns):
+            for v in values:
+                col = columns[v][j]
+                out[un.header(f"{c.title} {name}={v}", col.unit)] = col.values
+        return pd.DataFrame(out)
+
+    def computed_table(self, name: str):
+        """The DataFrame of a computed table (a solver block's, or a family over an input's
+        values), computed once per Sheet: the writer, its charts and the report read it."""
+        key = ("computed table", name)
         if key not in self._memo:
-            spec = next((t for t in self.spec.tables if t.name == name and t.block), None)
+            spec = next((t for t in self.spec.tables if t.name == name and t.computed), None)
             if spec is None:
-                raise InputError(f"no block table '{name}' in {self.name}")
-            self._memo[key] = self.block_table(spec.block)
+                raise InputError(f"no block or family table '{name}' in {self.name}")
+            self._memo[key] = (
+                self.block_table(spec.block) if spec.block else self.family_table(spec)
+            )
         return self._memo[key]
 
     def write_xlsx(self, path, **options) -> Path:

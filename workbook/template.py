@@ -47,6 +47,7 @@ SECTIONS = {
     "ode",
 }
 ALL_PARTS = "all"
+MAX_VARY = 50  # curves of one family table
 
 # The keys each table of a template may hold (anything else is a misspelling: refused).
 SHEET_KEYS = (
@@ -66,7 +67,7 @@ INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "lab
 ARGUMENT_KEYS = ("unit", "note", "plain")
 DEFINITION_KEYS = ("expr", "pieces", "program", "unit", "note")
 PART_KEYS = ("title", "note")
-TABLE_KEYS = ("name", "title", "range", "columns", "sheet", "block", "part")
+TABLE_KEYS = ("name", "title", "range", "columns", "sheet", "block", "part", "vary")
 COLUMN_KEYS = ("expr", "unit", "title")
 CHART_KEYS = (
     "name",
@@ -200,6 +201,14 @@ class TableSpec:
     block: str | None = None
     line: int | None = None
     part: str | None = None
+    # a family of curves: input name -> the values (texts) the columns are computed at
+    vary: dict[str, tuple[str, ...]] = field(default_factory=dict)
+
+    @property
+    def computed(self) -> bool:
+        """Values computed by the engine and written as numbers (a solver block's table, or
+        a family over input values), not a live formula per cell."""
+        return bool(self.block or self.vary)
 
 
 @dataclass
@@ -964,6 +973,9 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
         block = f.text("block", None)
         if not block and rng is None:
             raise TemplateError(f"table {name} needs a range (or a block)")
+        vary = _vary(f, name)
+        if vary and (block or not cols):
+            raise TemplateError(f"table {name}: vary needs a range and columns (not a block)")
         return TableSpec(
             name,
             f.text("title", name),
@@ -972,9 +984,36 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
             sheet_name(f.text("sheet", "Listing"), f"table {name}"),
             block,
             line,
+            vary=vary,
         )
     except WorkbookError as err:
         raise err.located(line=line, definition=f"table {name}") from None
+
+
+def _vary(f: Fields, name: str) -> dict[str, tuple[str, ...]]:
+    """``vary = { c1 = ["1500 N/m", "3000 N/m"] }``: one input and its values (checked
+    against the input when the sheet loads)."""
+    raw = f.table("vary")
+    if len(raw) > 1:
+        raise TemplateError(
+            f"table {name}: vary takes one input (a family of curves), got {len(raw)}"
+        )
+    out = {}
+    for key, values in raw.items():
+        if (
+            not isinstance(values, list)
+            or not values
+            or not all(isinstance(v, (str, int, float)) and not isinstance(v, bool) for v in values)
+        ):
+            raise TemplateError(
+                f'table {name}: vary.{key} must be a list of values like ["1500 N/m", "3000 N/m"]'
+            )
+        if len(values) > MAX_VARY:
+            raise LimitError(
+                f"table {name}: vary.{key} has {len(values)} values (limit {MAX_VARY})"
+            )
+        out[str(key)] = tuple(str(v) for v in values)
+    return out
 
 
 def _name_line(text: str, name: str) -> int | None:

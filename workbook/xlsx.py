@@ -381,7 +381,7 @@ class WorkbookWriter:
             if t.sheet in ("Inputs", "Definitions"):
                 continue
             start = rows.get(t.sheet, 0)
-            if t.block or start is None:
+            if t.computed or start is None:
                 rows[t.sheet] = None
                 continue
             n = len(self.sheet.range_values(t.range, f"table {t.name}"))
@@ -511,8 +511,8 @@ class WorkbookWriter:
         return True
 
     # -- block tables --------------------------------------------------------------------
-    def write_block_table(self, spec) -> None:
-        df = self.sheet.block_table(spec.block)
+    def write_computed_table(self, spec) -> None:
+        df = self.sheet.computed_table(spec.name)
         ws = self.ws(spec.sheet)
         start = self.rows[spec.sheet]
         n = len(df)
@@ -520,11 +520,15 @@ class WorkbookWriter:
             raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}")
         ws.write_string(start, 0, spec.title, self.fmt["title"])
         write_labels(ws, start + 1, 0, [str(c) for c in df.columns], self.fmt["header"])
+        how = (
+            f"the solver block {spec.block}"
+            if spec.block
+            else "the engine at each value of "
+            + "; ".join(f"{k} ({', '.join(v)})" for k, v in spec.vary.items())
+            + ", the other inputs as on the Inputs sheet"
+        )
         ws.write_comment(
-            start + 1,
-            0,
-            f"Values computed by the solver block {spec.block}; "
-            "not live formulas (rerun workbook to update).",
+            start + 1, 0, f"Values computed by {how}; not live formulas (rerun workbook to update)."
         )
         first = start + 2
         for j, name in enumerate(df.columns):
@@ -669,8 +673,8 @@ class WorkbookWriter:
         for s in chart.series:
             if s.table is not None:
                 df = (
-                    self.sheet.block_table_cached(s.table)
-                    if hasattr(self.sheet, "block_table_cached")
+                    self.sheet.computed_table(s.table)
+                    if hasattr(self.sheet, "computed_table")
                     else None
                 )
                 if df is not None:
@@ -899,8 +903,8 @@ def write_workbook(
         w.write_inputs(needed)
         w.write_definitions(needed)
         for t in sheet.spec.tables:
-            if t.block:
-                w.write_block_table(t)
+            if t.computed:
+                w.write_computed_table(t)
             else:
                 w.write_range_table(t)
         w.write_charts()

@@ -32,11 +32,7 @@ def with_input(sheet, name: str, value: float, unit: str = ""):
 
 
 # -- families of Fig. 3 ------------------------------------------------------------------------
-FAMILIES = {
-    "c1": ("N/m", (1500.0, 3000.0, 4000.0, 6000.0)),
-    "m": ("kg", (0.65, 0.7, 0.75, 0.8)),
-    "phi20": ("rad", (0.4363, 0.5235, 0.6108, 0.6981)),
-}
+FAMILY_TABLES = {"c1": "fig3a", "m": "fig3b", "phi20": "fig3c"}  # the vary tables
 TRENDS = {"c1": -1, "m": +1, "phi20": +1}  # the printed trends: sign of d phi2 / d parameter
 TREND_TEXT = {"c1": "phi2 falls as c1 rises", "m": "phi2 rises with m"}
 TREND_TEXT["phi20"] = "phi2 rises with phi20"
@@ -59,49 +55,28 @@ def closed_form(sheet, ws, form: str = "printed") -> tuple[np.ndarray, ...]:
     return value, den, dev
 
 
-def family(sheet, key: str, ws) -> dict[float, dict[str, np.ndarray]]:
-    """For each value of the family parameter: the root and both closed forms."""
+def family(sheet, key: str, ws) -> dict[str, dict[str, np.ndarray]]:
+    """For each value of the family input ``key`` (the template's vary table of Fig. 3): the
+    root from the table, and both closed forms with their departures."""
 
     def build():
+        name = FAMILY_TABLES[key]
+        df, (values,) = sheet.computed_table(name), sheet.table_spec(name).vary.values()
         out = {}
-        for value in FAMILIES[key][1]:
-            s = with_input(sheet, key, value, FAMILIES[key][0])
-            out[value] = {"root": np.atleast_1d(_v(s, "phi2", "rad", omega1=ws))}
+        table_speeds = np.array_equal(np.asarray(ws, dtype=float), df.iloc[:, 0].to_numpy())
+        for text in values:
+            s = sheet.with_inputs(**{key: text})
+            root = (
+                df[f"phi2 {key}={text} [rad]"].to_numpy()
+                if table_speeds
+                else np.atleast_1d(_v(s, "phi2", "rad", omega1=ws))
+            )
+            member = out[text] = {"root": root}
             for form in ("printed", "newton"):
-                value_, _, out[value][f"dev {form}"] = closed_form(s, ws, form)
-                out[value][form] = value_
+                member[form], _, member[f"dev {form}"] = closed_form(s, ws, form)
         return out
 
     return cached(sheet, ("family", key, tuple(ws)), build)
-
-
-def _family_table(sheet, key: str):
-    import pandas as pd
-
-    ws = speeds(sheet)
-    fam, unit = family(sheet, key, ws), FAMILIES[key][0]
-    cols = {"omega1 [rad/s]": ws}
-    cols |= {f"phi2 {key}={v:g} {unit} [rad]": d["root"] for v, d in fam.items()}
-    cols |= {f"linear {key}={v:g} [rad]": d["printed"] for v, d in fam.items()}
-    return pd.DataFrame(cols)
-
-
-@table_block
-def family_c1(sheet):
-    """Fig. 3a: phi2(omega1) for c1 = 1500, 3000, 4000, 6000 N/m (root, printed closed form)."""
-    return _family_table(sheet, "c1")
-
-
-@table_block
-def family_m(sheet):
-    """Fig. 3b: phi2(omega1) for m = 0.65 .. 0.8 kg."""
-    return _family_table(sheet, "m")
-
-
-@table_block
-def family_phi20(sheet):
-    """Fig. 3c: phi2(omega1) for phi20 = 0.4363 .. 0.6981 rad."""
-    return _family_table(sheet, "phi20")
 
 
 # -- the template's ODE, its exact solution and the rigid limit --------------------------------
@@ -292,7 +267,7 @@ def trend_holds(sheet, key: str, ws) -> tuple[list[float], list[float], list[flo
     """Speeds where the printed trend holds strictly, where it fails, where it is vacuous
     (every member of the family on the stop)."""
     fam = family(sheet, key, ws)
-    vals = np.array([fam[v]["root"] for v in FAMILIES[key][1]])  # members x speeds
+    vals = np.array([member["root"] for member in fam.values()])  # members x speeds
     holds, fails, vacuous = [], [], []
     for j, w in enumerate(ws):
         col = vals[:, j]
@@ -337,7 +312,7 @@ def findings(sheet):
     """Printed trends, closed-form departures and the run (the steady values, the limits of
     the closed forms and the eigenvalues are the template's [[checks]])."""
     ws, out = speeds(sheet), []
-    for key in FAMILIES:
+    for key in FAMILY_TABLES:
         holds, fails, vacuous = trend_holds(sheet, key, ws)
         verdict = "ok" if holds and not fails else ("warning" if holds else "fail")
         note = f"holds at {_speeds_text(holds, ws)}; fails at {_speeds_text(fails, ws)}"
@@ -347,9 +322,9 @@ def findings(sheet):
         out.append(Finding(topic, TREND_TEXT[key], n, "speeds", verdict, note))
     for form, title in (("printed", "printed linear form"), ("newton", "Newton-step linear form")):
         topic = f"linear form vs nonlinear root ({form})"
-        for key in FAMILIES:
+        for key in FAMILY_TABLES:
             for value, where, worst, zero in departures(sheet, key, ws, form):
-                what = f"{title}, {key} = {value:g} {FAMILIES[key][0]}: largest departure"
+                what = f"{title}, {key} = {value}: largest departure"
                 note, verdict = "within 5 % at every speed off the stop", "ok"
                 if where:
                     note, verdict = f"more than 5 % at {_speeds_text(where, ws)}", "warning"

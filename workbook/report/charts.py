@@ -20,7 +20,7 @@ WIDTH_IN, HEIGHT_IN = 6.6, 3.7  # fits the A4 text width
 def series_data(sheet, chart, s) -> tuple[np.ndarray, np.ndarray]:
     """x and y of one series, as the engine computes them."""
     if s.table is not None:
-        df = sheet.block_table_cached(s.table)
+        df = sheet.computed_table(s.table)
         return (
             np.asarray(df[s.x_column], dtype=float),
             np.asarray(df[s.y_column], dtype=float),

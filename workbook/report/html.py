@@ -343,7 +343,7 @@ class Document:
         for t in self.spec.tables:
             head = f"<h3>Table {escape(t.name)}: {escape(t.title)}</h3>"
             try:
-                body = self.block_table(t) if t.block else self.range_table(t)
+                body = self.computed_table(t) if t.computed else self.range_table(t)
             except Exception as err:
                 body = f"<p class='error'>not computed: {escape(_error_text(err))}</p>"
             out.append(f"<div class='table' id='table-{escape(t.name)}'>{head}{body}</div>")
@@ -378,8 +378,8 @@ class Document:
         rows = f"{n:,} row{'s' if n != 1 else ''}"
         return f"<p class='range'>{range_math}: {rows}</p>" + self._grid(heads, columns, n)
 
-    def block_table(self, t) -> str:
-        df = self.sheet.block_table_cached(t.name)
+    def computed_table(self, t) -> str:
+        df = self.sheet.computed_table(t.name)
         heads = []
         for name in df.columns:
             m = re.match(r"^(.*?)\s*\[(.*)\]$", str(name))
@@ -387,9 +387,13 @@ class Document:
             unit_html = f"<br><span class='unit'>{escape(unit)}</span>" if unit else ""
             heads.append(f"{escape(label)}{unit_html}")
         columns = [df[c].to_numpy(dtype=object) for c in df.columns]
+        how = (
+            f"computed by the solver block <code>{escape(t.block)}</code>"
+            if t.block
+            else f"the columns at each value of {escape(_varied(t))}"
+        )
         return (
-            f"<p class='range'>computed by the solver block <code>{escape(t.block)}</code>: "
-            f"{len(df):,} row{'s' if len(df) != 1 else ''}</p>"
+            f"<p class='range'>{how}: {len(df):,} row{'s' if len(df) != 1 else ''}</p>"
             + self._grid(heads, columns, len(df))
         )
 
@@ -717,3 +721,9 @@ def fragment(sheet, *, full_tables: bool = False) -> str:
     with np.errstate(all="ignore"):
         body = doc.body()
     return f"<div class='workbook-report'><style>{CSS}</style>\n{body}\n</div>"
+
+
+def _varied(t) -> str:
+    """``c1 = 1500 N/m, 3000 N/m``: the input a family table varies, and its values."""
+    ((name, values),) = t.vary.items()
+    return f"{name} = {', '.join(values)}"
