@@ -175,3 +175,35 @@ def test_mistakes_are_refused_at_load_with_file_and_line(tmp_path, capsys, check
     assert message in err and str(path) in err
     header = path.read_text().splitlines().index("[[checks]]") + 1
     assert f"{path}:{header}:" in err or f"{path}:{header}, in 'check " in err
+
+
+def test_example_only_names_the_inputs_of_the_example(tmp_path):
+    path = sheet_with(
+        tmp_path,
+        """
+[[checks]]
+what = "listed for this load"
+value = "M"
+example_only = ["F", "L"]
+
+[[checks]]
+what = "listed at 24 kN"
+value = "M"
+inputs = { F = "24 kN" }
+example_only = true
+""",
+    )
+    sheet = workbook.load(path)
+    both = ["listed for this load", "listed at 24 kN"]
+    assert [f.what for f in sheet.check().findings] == both
+    assert [f.what for f in sheet.with_inputs(W="1 cm^3").check().findings] == [
+        "listed for this load"
+    ]
+    # the second check sets F itself: another F leaves it
+    assert [f.what for f in sheet.with_inputs(F="1 kN").check().findings] == ["listed at 24 kN"]
+
+
+def test_example_only_with_an_unknown_input_is_refused(tmp_path, capsys):
+    path = sheet_with(tmp_path, '\n[[checks]]\nwhat = "x"\nvalue = "M"\nexample_only = ["FF"]\n')
+    assert main(["check", str(path)]) == 2
+    assert "'FF' is not an input (did you mean F?)" in capsys.readouterr().err

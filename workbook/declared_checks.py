@@ -27,7 +27,7 @@ import numpy as np
 from . import expr as ex
 from . import units as un
 from .errors import InputError, TemplateError, WorkbookError
-from .fields import Fields
+from .fields import Fields, nearest
 from .findings import Finding
 from .verdicts import FINDING_VERDICTS
 
@@ -60,7 +60,9 @@ class CheckSpec:
     otherwise: str
     note: str
     inputs: dict[str, str] = field(default_factory=dict)
-    example_only: bool = False
+    # the check is for the template's own inputs (a listed worked example): all of them but
+    # those the check sets itself (True), or the ones named
+    example_only: bool | tuple[str, ...] = False
     part: str | None = None
     line: int | None = None
 
@@ -94,7 +96,7 @@ def read_check(raw: dict, line: int | None) -> CheckSpec:
             otherwise=otherwise,
             note=f.text("note", ""),
             inputs=inputs,
-            example_only=f.flag("example_only"),
+            example_only=_example_only(f, text),
             part=f.text("part", None),
             line=line,
         )
@@ -106,6 +108,16 @@ def read_check(raw: dict, line: int | None) -> CheckSpec:
     except WorkbookError as err:
         raise err.located(line=line) from None
     return spec
+
+
+def _example_only(f: Fields, what: str) -> bool | tuple[str, ...]:
+    value = f.raw.get("example_only", False)
+    if isinstance(value, bool):
+        return value
+    names = f.texts("example_only")
+    if not names:
+        raise TemplateError(f"check {what!r}: example_only is true, false or a list of inputs")
+    return names
 
 
 def _input_text(what: str, name, value) -> str:
@@ -131,6 +143,13 @@ def type_checks(sheet) -> None:
     """Type every check of the sheet (all parts), so that a mistake is an error at load."""
     for spec in sheet.full_spec.checks:
         try:
+            if not isinstance(spec.example_only, bool):
+                for name in spec.example_only:
+                    if name not in sheet.spec.inputs:
+                        known = sheet.spec.inputs
+                        raise InputError(
+                            f"example_only: '{name}' is not an input{nearest(name, known)}"
+                        )
             for name, text in spec.inputs.items():
                 try:
                     sheet.with_inputs(**{name: text})
@@ -195,12 +214,17 @@ def _factor(src, dst, label: str, dst_text: str | None) -> float:
 def check_findings(sheet) -> list[Finding]:
     """The findings of the sheet's ``[[checks]]`` (those of its chosen parts)."""
     out = []
-    example = sheet.at_template_inputs()
     for spec in sheet.spec.checks:
-        if spec.example_only and not example:
+        if spec.example_only and not sheet.at_template_inputs(_example_inputs(sheet, spec)):
             continue
         out.append(_finding(sheet, spec))
     return out
+
+
+def _example_inputs(sheet, spec: CheckSpec) -> list[str]:
+    if spec.example_only is True:
+        return [n for n in sheet.spec.inputs if n not in spec.inputs]
+    return list(spec.example_only)
 
 
 def _finding(sheet, spec: CheckSpec) -> Finding:

@@ -153,9 +153,11 @@ class Sheet:
             except WorkbookError as err:
                 raise type(err)(f"vary.{name}: {err.message}", **where) from None
 
-    def at_template_inputs(self) -> bool:
-        """Are the inputs the template's own (the worked example it lists)?"""
-        return all(bool(self.values[n] == i.value) for n, i in self.spec.inputs.items())
+    def at_template_inputs(self, names=None) -> bool:
+        """Are the inputs ``names`` (default: all) the template's own (the worked example it
+        lists)?"""
+        inputs = self.spec.inputs
+        return all(bool(self.values[n] == inputs[n].value) for n in names or inputs)
 
     def with_inputs(self, **changes) -> Sheet:
         """A new Sheet with some inputs replaced (``"40 mm"``, a pint Quantity, or a number)."""
