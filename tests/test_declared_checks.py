@@ -207,3 +207,17 @@ def test_example_only_with_an_unknown_input_is_refused(tmp_path, capsys):
     path = sheet_with(tmp_path, '\n[[checks]]\nwhat = "x"\nvalue = "M"\nexample_only = ["FF"]\n')
     assert main(["check", str(path)]) == 2
     assert "'FF' is not an input (did you mean F?)" in capsys.readouterr().err
+
+
+def test_an_input_a_check_or_a_result_uses_is_not_reported_unused(tmp_path):
+    path = sheet_with(
+        tmp_path,
+        """
+[[checks]]
+what = "stress at {F:kN}"
+ok = "sigma <= f_y"
+""",
+        extra='[inputs.spare]\nvalue = "1 mm"\n',
+    )
+    # f_y only in the check, F W L through sigma (a result on the Results sheet); spare nowhere
+    assert workbook.load(path).unused_inputs() == ["spare"]

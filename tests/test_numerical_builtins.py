@@ -793,3 +793,44 @@ def test_bench_of_every_template_is_an_answer_not_a_crash(name, capsys):
     from workbook.cli import main
 
     assert main(["bench", name, "--quick"]) in (0, 2)
+
+
+LIVE_FORMS = """
+[inputs]
+R = "50 mm"
+u_max = "2 m/s"
+eps = "0.05 mm"
+D = "100 mm"
+[arguments]
+r = { unit = "mm" }
+Re = { unit = "" }
+f = { unit = "" }
+[definitions]
+"u(r)" = { expr = "u_max*(1 - r/R)^(1/7)", unit = "m/s" }
+Q = { expr = "integral(2*pi*r*u(r), r, 0, R)", unit = "L/s" }
+"colebrook(f, Re)" = "1/sqrt(f) + 2*log10(eps/(3.7*D) + 2.51/(Re*sqrt(f)))"
+"friction(Re)" = "root(colebrook(f, Re), f, 0.005, 0.1)"
+[[tables]]
+name = "moody"
+range = "Re := 4000, 104000 .. 1004000"
+columns = { friction = "" }
+"""
+
+
+def test_the_checks_sheet_lists_each_live_form_and_its_difference(tmp_path):
+    """An integral's Gauss-Legendre sum and a column of bisection chains: on the Checks sheet,
+    where each is, the engine's value, the live cell and their difference."""
+    import openpyxl
+
+    s = sheet(tmp_path, LIVE_FORMS)
+    out = s.write_xlsx(tmp_path / "pipe.xlsx")
+    ws = openpyxl.load_workbook(out)["Checks"]
+    rows = [[c.value for c in row] for row in ws.iter_rows()]
+    start = next(i for i, r in enumerate(rows) if r[0] == "Live forms of numerical built-ins")
+    lines = {r[1]: r for r in rows[start + 2 :] if r[0] and r[0].startswith("'")}
+    q = lines["Q"]
+    assert q[2] == "integral()" and q[5] == f"={q[0]}"
+    assert q[4] == pytest.approx(s.evaluate("Q").to("L/s").magnitude, rel=1e-12)
+    column = next(r for what, r in lines.items() if what.startswith("table moody: friction"))
+    assert column[2] == "root()" and ":" in column[0]
+    assert 0 <= column[6] < 1e-9

@@ -583,10 +583,12 @@ class Sheet:
         return run_checks(self)
 
     def unused_inputs(self) -> list[str]:
-        """Inputs that no table, chart, printed value or definition in use needs (in any part),
-        nor anything evaluated through this sheet so far (``reads``: what the findings and block
-        tables read; a check runs the findings first)."""
-        used = names_used(self.full_spec, hand_checks=True, reads=self.reads)
+        """Inputs that no table, chart, printed value, check or scalar definition (each is on
+        the workbook's Results sheet) needs (in any part), nor anything evaluated through this
+        sheet so far (``reads``: what the findings and block tables read; a check runs the
+        findings first)."""
+        shown = {n for n, d in self.full_spec.definitions.items() if not d.is_function}
+        used = names_used(self.full_spec, hand_checks=True, reads=self.reads | shown)
         return [n for n in self.full_spec.inputs if n not in used]
 
     def _repr_html_(self) -> str:

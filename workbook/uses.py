@@ -1,6 +1,6 @@
 """What a sheet's outputs use: the one place that lists the expressions a sheet shows.
 
-Tables, charts, printed values (and, for the hand checks, relations and findings) are the
+Tables, charts, printed values (and, for the hand checks, relations, findings and checks) are the
 outputs; :func:`names_used` follows their expressions through the definitions to the inputs
 and blocks they need. The writer writes only those (``xlsx.needed_names``), ``Sheet``
 reports the inputs nothing uses, and the analysis finds the ranges that show a function.
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from . import expr as ex
 from . import typecheck as tc
+from .declared_checks import placeholders
 from .errors import WorkbookError
 from .printed import read_printed
 from .ranges import RangeSpec
@@ -51,6 +52,11 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
     if hand_checks:
         for r in spec.relations:
             roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
+        for c in spec.checks:
+            roots += [n for n in (c.value, c.ok) if n is not None]
+            roots += [ex.Name(n) for n in c.inputs]
+            for piece in (c.what, c.note):
+                roots += [ex.parse(text) for text, _ in placeholders(piece)]
     return roots
 
 

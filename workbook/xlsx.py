@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from xlsxwriter.utility import xl_rowcol_to_cell
 
 from . import expr as ex
 from . import style
@@ -140,6 +141,8 @@ class WorkbookWriter:
         self.sheets: dict[str, object] = {}
         self.rows: dict[str, int] = {}
         self.not_live: list[str] = []
+        # live approximate forms (integral, root, extrema): where, what, how far from the engine
+        self.live_forms: list[tuple[str, str, object, float | None]] = []
         self.formula_cells = 0
         self.planned: dict[tuple[str, str], ColumnCells] = {}
         # the next free column and the cells used of the row-wise blocks of 'Solver rows'
@@ -358,16 +361,25 @@ class WorkbookWriter:
             ws.write_formula(row, col, formula, fmt, value)
         self.formula_cells += 1
         if not subst:
-            self._live_note(ws, row, col, t, {}, value)
+            self._live_note(ws, row, col, t, {}, value, what)
         return True
 
-    def _live_note(self, ws, row, col, t: tc.T, env: dict, values) -> None:
-        """A comment on a live formula that holds an approximate live form (an integral)."""
-        from .numerics.live import note
+    def _live_note(self, ws, row, col, t: tc.T, env: dict, values, what: str, rows=0) -> None:
+        """A comment on a live formula that holds an approximate live form (an integral), and
+        a line of the Checks sheet's list of live forms."""
+        from .numerics.live import difference
 
-        text = note(self.sheet, t, env, values)
-        if text:
-            ws.write_comment(row, col, text)
+        diff = difference(self.sheet, t, env, values)
+        if diff is None:
+            return
+        ws.write_comment(row, col, diff.note)
+        cells = xl_rowcol_to_cell(row, col, row_abs=True, col_abs=True)
+        if rows:  # a table column: its cells below the header
+            first = xl_rowcol_to_cell(row + 1, col, row_abs=True, col_abs=True)
+            cells = f"{first}:{xl_rowcol_to_cell(row + rows, col, row_abs=True, col_abs=True)}"
+        where = f"'{ws.name}'!{cells}"
+        engine = float(values) if np.ndim(values) == 0 else None  # a column: its header
+        self.live_forms.append((where, what, diff, engine))
 
     # -- range tables -------------------------------------------------------------------
     def plan_range_tables(self) -> None:
@@ -417,7 +429,8 @@ class WorkbookWriter:
             var_values = data.columns[0].values
             if self._write_column(ws, spec.name, first, j, col, data.var, var_ref, n, var_values):
                 env = {data.var: data.columns[0].values}
-                self._live_note(ws, first - 1, j, col.typed, env, col.values)
+                what = f"table {spec.name}: {col.title} ({n:,} rows)"
+                self._live_note(ws, first - 1, j, col.typed, env, col.values, what, n)
             cells = ColumnCells(spec.sheet, j, first, first + n - 1, col.title)
             planned = self.planned.get((spec.name, col.text))
             is_first = next(c for c in data.columns[1:] if c.text == col.text) is col
@@ -786,6 +799,8 @@ class WorkbookWriter:
                 ws.write_string(row, 9, f.verdict, fmt)
                 ws.write_string(row, 10, f.note, self.fmt["wrap"])
                 row += 1
+        if self.live_forms:
+            row = self._write_live_forms(ws, row + 1)
         if report.unused_inputs:
             row += 1
             ws.write_string(
@@ -795,6 +810,34 @@ class WorkbookWriter:
                 self.fmt["note"],
             )
         ws.freeze_panes(1, 0)
+
+    def _write_live_forms(self, ws, row: int) -> int:
+        """Each live approximate form (an integral's Gauss-Legendre sum, a root's bisection
+        chain, an extremum's golden-section steps) and its difference from the engine's value
+        at the written inputs; for a scalar the live value and the difference are formulas."""
+        ws.write_string(row, 0, "Live forms of numerical built-ins", self.fmt["title"])
+        heads = ["Where", "What", "Form", "", "Engine", "Live", "Difference", "Relative"]
+        write_labels(ws, row + 1, 0, heads + ["", "", "Note"], self.fmt["header"])
+        row += 2
+        for where, what, diff, engine in self.live_forms:
+            ws.write_string(row, 0, where)
+            ws.write_string(row, 1, what, self.fmt["wrap"])
+            ws.write_string(row, 2, ", ".join(f"{f}()" for f in diff.forms))
+            if engine is not None:
+                ws.write_number(row, 4, engine, self.fmt["number"])
+                ws.write_formula(row, 5, f"={where}", self.fmt["number"], diff.value)
+                ws.write_formula(
+                    row, 6, f"=ABS(F{row + 1}-E{row + 1})", self.fmt["sci"], diff.largest
+                )
+                note = "engine: its value at the inputs written here; live: the cell as it is now"
+            else:
+                ws.write_number(row, 6, diff.largest, self.fmt["sci"])
+                note = "largest over the column at the inputs written here"
+            ws.write_number(row, 7, diff.relative, self.fmt["sci"])
+            ws.write_string(row, 10, note, self.fmt["wrap"])
+            self.formula_cells += 2 if engine is not None else 0
+            row += 1
+        return row
 
     def _write_checked_value(self, ws, row, r) -> bool:
         """Computed value as a live formula: the function at the printed argument, in its unit."""

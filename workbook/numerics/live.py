@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .. import typed as ty
@@ -43,9 +45,29 @@ def _approximate(sheet, t: ty.T) -> set[str]:
     return found
 
 
-def note(sheet, t: ty.T, env: dict, values) -> str | None:
-    """A cell comment for a live formula that holds an approximate live form: which form,
-    and its largest difference from the engine's ``values`` at the written inputs."""
+@dataclass(frozen=True)
+class Difference:
+    """How far the live form of a cell (or a column) is from the engine at the written inputs."""
+
+    forms: tuple[str, ...]  # the approximate built-ins in it: integral, root, ...
+    largest: float  # largest absolute difference
+    relative: float
+    value: float | None = None  # the live form's value, for one cell
+
+    @property
+    def note(self) -> str:
+        """The cell comment: which form, and how far it is from the engine."""
+        forms = "; ".join(f"{name}() is {APPROXIMATE[name]}" for name in self.forms)
+        return (
+            f"Live formula: {forms}. At the inputs written here it differs from the engine's "
+            f"value by {self.largest:.2g} ({self.relative:.1g} relative); the engine's value "
+            "has an error below the sheet's tolerance."
+        )
+
+
+def difference(sheet, t: ty.T, env: dict, values) -> Difference | None:
+    """The live form's largest difference from the engine's ``values`` at the written inputs
+    (None when the formula holds no approximate live form)."""
     found = _approximate(sheet, t)
     if not found:
         return None
@@ -54,9 +76,5 @@ def note(sheet, t: ty.T, env: dict, values) -> str | None:
     values = np.asarray(values, dtype=float)
     diff = float(np.max(np.abs(approx - values)))
     scale = float(np.max(np.abs(values))) or 1.0
-    forms = "; ".join(f"{name}() is {APPROXIMATE[name]}" for name in sorted(found))
-    return (
-        f"Live formula: {forms}. At the inputs written here it differs from the engine's "
-        f"value by {diff:.2g} ({diff / scale:.1g} relative); the engine's value has an error "
-        "below the sheet's tolerance."
-    )
+    value = float(approx) if approx.ndim == 0 else None
+    return Difference(tuple(sorted(found)), diff, diff / scale, value)
