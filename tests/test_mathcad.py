@@ -72,7 +72,9 @@ def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
     assert (
         "#   region 40: L := ...: uses S, which is not translated: defined by a component" in text
     )
-    assert "Mathcad's WRITEPRN() writes a file" in text
+    # the value WRITEPRN wrote is a definition of its own, its stored result compared
+    assert 'written_1 = { expr = "[[0, 0]]"' in text
+    assert 'WRITEPRN wrote this value to the file "last_EH.txt"' in text
 
 
 @pytest.mark.parametrize(

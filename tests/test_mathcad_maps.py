@@ -372,3 +372,50 @@ def test_functions_of_vectors_translate(tmp_path, capsys):
     main(["check", str(tmp_path / "points.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["reproduced"]) == (5, 5), result["failures"]
+
+
+def test_writeprn_is_the_value_written(tmp_path, capsys):
+    """WRITEPRN("a.prn", M) = M (Mathcad 15's form) and WRITEPRN("b.prn") := v (older
+    worksheets): each value written is a definition of its own with a note naming the file,
+    and Mathcad's stored result of the first is compared; no file is written."""
+    matrix = '<ml:matrix rows="2" cols="2">' + "".join(_real(v) for v in (1, 3, 2, 4))
+    matrix += "</ml:matrix>"
+    call = (
+        f"<ml:apply>{_id('WRITEPRN')}<ml:sequence><ml:str>a.prn</ml:str>"
+        f"{_id('M')}</ml:sequence></ml:apply>"
+    )
+    old = f"<ml:apply>{_id('WRITECSV')}<ml:str>b.csv</ml:str></ml:apply>"
+    src = tmp_path / "write.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("M") + matrix),
+            _eval(2, call, matrix),
+            _region(3, old + _apply("mult", _real(2), _id("M"))),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "0 regions not translated" in capsys.readouterr().out
+    text = (tmp_path / "write.toml").read_text(encoding="utf-8")
+    assert 'written_1 = { expr = "M"' in text and 'written_2 = { expr = "2 * M"' in text
+    assert 'WRITEPRN wrote this value to the file "a.prn"' in text
+    assert 'WRITECSV wrote this value to the file "b.csv"' in text
+    main(["check", str(tmp_path / "write.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (4, 4), result["failures"]
+    assert not (tmp_path / "a.prn").exists() and not (tmp_path / "b.csv").exists()
+
+
+def test_writeprn_of_another_value_fails_the_check(tmp_path, capsys):
+    """A stored result that is not the value written is reported as failed, not passed."""
+    call = (
+        f"<ml:apply>{_id('WRITEPRN')}<ml:sequence><ml:str>a.prn</ml:str>"
+        f"{_real(2)}</ml:sequence></ml:apply>"
+    )
+    src = tmp_path / "wrong.xmcd"
+    src.write_text(_worksheet(_eval(1, call, _real(3))), encoding="utf-8")
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    main(["check", str(tmp_path / "wrong.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["failed"]) == (1, 1), result

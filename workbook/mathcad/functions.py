@@ -41,6 +41,11 @@ REFUSED: dict[str, str] = {
                  "READWAV", "READBIN")
 }  # fmt: skip
 
+#: Mathcad functions that write a value to a file (``WRITEPRN("f", M)``, or
+#: ``WRITEPRN("f") := M`` in older worksheets): the value written is translated, as Mathcad
+#: shows it, but no file is written.
+WRITERS: frozenset[str] = frozenset({"WRITEPRN", "APPENDPRN", "WRITECSV", "WRITE", "APPEND"})
+
 #: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
 OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpose": "transpose"}
 

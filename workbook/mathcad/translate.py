@@ -15,7 +15,13 @@ from dataclasses import dataclass, field
 from .. import expr as ex
 from ..visitor import Visitor
 from . import names as nm
-from .functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS, REFUSED, language_functions
+from .functions import (
+    MATHCAD_FUNCTIONS,
+    OPERATOR_FUNCTIONS,
+    REFUSED,
+    WRITERS,
+    language_functions,
+)
 from .reader import MNode, Region, Worksheet
 from .symbols import Sym, Untranslatable
 from .symbols import key as _key
@@ -360,6 +366,7 @@ class Translator:
         self.constraints: list[MNode] = []
         self.origin = 0  # Mathcad's ORIGIN where the translation is
         self.sheet_origin = 0  # the worksheet's [sheet] origin
+        self.writes = 0  # values written to a file (WRITEPRN and friends) so far
 
     # -- symbols --------------------------------------------------------------
     def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
@@ -683,6 +690,10 @@ class Translator:
         evaluation = rhs if rhs.tag == "eval" else None
         if evaluation is not None:
             rhs = evaluation.children[0]
+        writer = _writer(lhs, 1)  # WRITEPRN("file") := M
+        if writer is not None:
+            self.written(region, *writer[:2], rhs, evaluation)
+            return
         if lhs.tag == "function":
             fname, bound = lhs.children[0], lhs.children[1]
             self.function(region, fname, [c for c in bound.children if c.tag == "id"], rhs)
@@ -732,6 +743,33 @@ class Translator:
             if evaluation is not None:
                 self.evaluation(region, evaluation, sym)
             raise
+        self.out.items.append(item)
+        if evaluation is not None:
+            self.evaluation(region, evaluation, sym)
+
+    def written(self, region: Region, func: str, file: str, value: MNode, evaluation):
+        """The value Mathcad's WRITEPRN (and friends) wrote to a file: a definition of its
+        own (``written_1``, ...) with a note naming the file, so that its stored result is
+        compared; the worksheet writes no file."""
+        self.writes += 1
+        sym = self.new_sym("var", f"written_{self.writes}", f'{func}("{file}")', region.id)
+        self.out.items.append(
+            Item(
+                "note",
+                region.id,
+                value=f'Mathcad\'s {func} wrote this value to the file "{file}" (the '
+                "worksheet writes no files)",
+            )
+        )
+        try:
+            self._forced(region, sym)
+            item = self.value_item(region, value, "")
+        except Untranslatable as why:
+            sym.broken = sym.broken or str(why)
+            if evaluation is not None:
+                self.evaluation(region, evaluation, sym)
+            raise
+        item.sym = sym
         self.out.items.append(item)
         if evaluation is not None:
             self.evaluation(region, evaluation, sym)
@@ -961,6 +999,10 @@ class Translator:
         except Untranslatable as why:
             self.out.results.append(Result(region.id, None, mathcad, "", []))
             self.skip(region.id, f"the result of {mathcad}", str(why))
+            return
+        writer = _writer(expr, 2) if target is None else None  # WRITEPRN("file", M) =
+        if writer is not None:
+            self.written(region, *writer[:2], writer[2], node)
             return
         shape = _shape(result.children[0])
         if target is not None:  # a definition with its value shown: x := ... = value
@@ -1246,6 +1288,22 @@ class _Renamer(Visitor):
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
     return _Renamer(mapping).visit(node)
+
+
+def _writer(node: MNode, arity: int) -> tuple[str, str, MNode | None] | None:
+    """(function, file, value) of a call of a Mathcad function that writes a file with a
+    literal file name: ``WRITEPRN("f")`` (arity 1, the value is the right side of ``:=``)
+    or ``WRITEPRN("f", M)`` (arity 2); None for anything else."""
+    if node.tag != "apply" or len(node.children) != 2 or node.children[0].tag != "id":
+        return None
+    func = _key(node.children[0])
+    if func[1] or func[0] not in WRITERS:
+        return None
+    args = node.children[1]
+    args = args.children if args.tag == "sequence" else [args]
+    if len(args) != arity or args[0].tag != "str":
+        return None
+    return func[0], args[0].text, args[1] if arity == 2 else None
 
 
 def _is_indexer(node: MNode) -> bool:
