@@ -85,13 +85,14 @@ def evaluations(toml: Path, failures: list[dict]) -> tuple[int, int]:
 def _short(reason: str) -> str:
     reason = re.sub(r"uses \S+, which is not translated: ", "uses an untranslated name: ", reason)
     reason = re.sub(r"piece '.*?': ", "", reason)
-    return reason[:110]
+    return reason[:150]
 
 
 def main() -> int:
     folder = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "tests" / "data" / "mathcad"
     skip = referenced(folder)
     rows = []
+    sums = Counter()
     with tempfile.TemporaryDirectory() as tmp:
         for path in sorted(folder.rglob("*.xmcd")):
             if path.resolve() in skip:
@@ -108,6 +109,9 @@ def main() -> int:
             pct = f"{100 * ok / n:.0f} %" if n else "-"
             why = "; ".join(f"{c} × {r}" for r, c in reasons(toml, res["failures"]).most_common())
             good, total = evaluations(toml, res["failures"])
+            sums.update(
+                good=good, total=total, n=n, ok=ok, failed=res["failed"], nc=res["not_computable"]
+            )
             rows.append(
                 f"| {name} | {good} of {total} | {n} | {ok} | {res['failed']} | "
                 f"{res['not_computable']} | {pct} | {why or '-'} |"
@@ -118,6 +122,11 @@ def main() -> int:
     )
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
     print("\n".join(rows))
+    pct = f"{100 * sums['ok'] / sums['n']:.0f} %" if sums["n"] else "-"
+    print(
+        f"| all | {sums['good']} of {sums['total']} | {sums['n']} | {sums['ok']} | "
+        f"{sums['failed']} | {sums['nc']} | {pct} | |"
+    )
     return 0
 
 

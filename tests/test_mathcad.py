@@ -67,11 +67,10 @@ def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
     toml, _ = _import("frame/example.xmcd", tmp_path, capsys)
     text = toml.read_text(encoding="utf-8")
     assert "AddTrainInTable" in text  # a function of the referenced iSET_module.xmcd
-    # S is defined by a component (a data table): untranslated, never the unit S (siemens)
-    assert "#   region 11: a component defining S: not translated" in text
-    assert (
-        "#   region 40: L := ...: uses S, which is not translated: defined by a component" in text
-    )
+    # S is a data table (a component): a matrix of the worksheet, never the unit S (siemens),
+    # and L := max(S^T<1>) reads it (Mathcad's stored L is checked in the table's test)
+    assert 'S = { expr = "[[0, 5, 10, 15, 20, 25, 30, 35, 40, 45, 50, 55, 60], ' in text
+    assert 'L = { expr = "max(submatrix(transpose(S), 1, rows(transpose(S)), 1, 1))"' in text
     # the value WRITEPRN wrote is a definition of its own, its stored result compared
     assert 'written_1 = { expr = "[[0, 0]]"' in text
     assert 'WRITEPRN wrote this value to the file "last_EH.txt"' in text

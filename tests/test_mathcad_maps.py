@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import base64
+import gzip
 import json
 import math
+import struct
 
 import pytest
 
@@ -419,3 +422,104 @@ def test_writeprn_of_another_value_fails_the_check(tmp_path, capsys):
     main(["check", str(tmp_path / "wrong.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["failed"]) == (1, 1), result
+
+
+def _compound_file(contents: bytes) -> bytes:
+    """A minimal OLE compound file (version 3) whose stream Contents lies in the mini
+    stream in pieces stored in reverse order (read by its mini FAT chain, not in place)."""
+    end, free = 0xFFFFFFFE, 0xFFFFFFFF
+    pieces = [contents[i : i + 64].ljust(64, b"\0") for i in range(0, len(contents), 64)]
+    n = len(pieces)
+    slots = list(reversed(range(n)))  # piece k is stored in mini sector slots[k]
+    ministream = bytearray(64 * n)
+    minifat = [free] * 128
+    for k, slot in enumerate(slots):
+        ministream[slot * 64 : (slot + 1) * 64] = pieces[k]
+        minifat[slot] = slots[k + 1] if k + 1 < n else end
+    ministream = bytes(ministream).ljust(-(-len(ministream) // 512) * 512, b"\0")
+    n_mini_sectors = len(ministream) // 512
+    fat = [0xFFFFFFFD, end, end] + [4 + i for i in range(n_mini_sectors - 1)] + [end]
+    fat += [free] * (128 - len(fat))
+
+    def entry(name: str, kind: int, start: int, size: int) -> bytes:
+        raw = (name + "\0").encode("utf-16-le")
+        e = raw.ljust(64, b"\0") + struct.pack("<HBB", len(raw), kind, 1)
+        e += struct.pack("<III", free, free, 1 if kind == 5 else free)
+        return e.ljust(116, b"\0") + struct.pack("<III", start, size, 0)
+
+    directory = entry("Root Entry", 5, 3, 64 * n) + entry("Contents", 2, slots[0], len(contents))
+    header = b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + bytes(16)
+    header += struct.pack("<HHHHH6sIIII", 0x3E, 3, 0xFFFE, 9, 6, bytes(6), 0, 1, 1, 0)
+    header += struct.pack("<IIIII", 4096, 2, 1, end, 0)
+    header += struct.pack("<109I", 0, *[free] * 108)
+    sectors = [struct.pack("<128I", *fat), directory.ljust(512, b"\0")]
+    sectors += [struct.pack("<128I", *minifat), ministream]
+    return header + b"".join(sectors)
+
+
+def _table_item(rows: list[list[float]], count: int | None = None) -> str:
+    """A data table's binary item (base64 of gzip), its cells stored column by column."""
+    values = [rows[r][c] for c in range(len(rows[0])) for r in range(len(rows))]
+    count = len(values) if count is None else count
+    block = bytes.fromhex("00548cc93163d011a68d00a024cf05d1")
+    block += struct.pack("<9I", 1, 1, 8, 2, 0, 0, len(rows[0]) - 1, len(rows) - 1, count)
+    block += struct.pack(f"<{len(values)}d", *values)
+    contents = b"formatting" + struct.pack("<I", len(block)) + block + b"end"
+    cfb = _compound_file(contents)
+    return base64.b64encode(gzip.compress(b"record" + struct.pack("<I", len(cfb)) + cfb)).decode()
+
+
+TABLE = "01350081-1122-11DB-9380-000D56C6051A"
+
+
+def _component(rid: int, item: int, name: str, clsid: str = TABLE) -> str:
+    return (
+        f'<region region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}">'
+        f'<component clsid-buddy="{clsid}" item-idref="{item}" disable-calc="false"><inputs/>'
+        f'<outputs><ml:id xmlns:ml="{ML}">{name}</ml:id></outputs></component></region>'
+    )
+
+
+def _with_items(sheet: str, items: dict[int, str]) -> str:
+    body = "".join(
+        f'<item item-id="{k}" content-encoding="gzip">{v}</item>' for k, v in items.items()
+    )
+    return sheet.replace("</worksheet>", f"<binaryContent>{body}</binaryContent></worksheet>")
+
+
+def test_data_table_is_a_matrix(tmp_path, capsys):
+    """S, a data table of 2 x 3 numbers (a negative one, fractions), and v, one of a single
+    column: S becomes a matrix by rows, v a column vector; Mathcad's stored S = and v[1] =
+    are reproduced; a component of another kind and a table whose cell count does not
+    match its grid stay untranslated, with their reason."""
+    s_rows = [[1.5, -2.0, 3.0], [4.0, 0.25, 6e-3]]
+    v_rows = [[10.0], [20.0], [30.0]]
+    stored = '<ml:matrix rows="2" cols="3">' + "".join(
+        _real(s_rows[r][c]) for c in range(3) for r in range(2)
+    )
+    src = tmp_path / "table.xmcd"
+    sheet = _worksheet(
+        _component(1, 1, "S"),
+        _component(2, 2, "v"),
+        _component(3, 3, "X", clsid="00000000-0000-0000-0000-000000000000"),
+        _component(4, 4, "B"),
+        _eval(5, _id("S"), stored + "</ml:matrix>"),
+        _eval(6, _apply("indexer", _id("v"), _real(1)), _real(20)),
+    )
+    items = {
+        1: _table_item(s_rows),
+        2: _table_item(v_rows),
+        3: _table_item(v_rows),
+        4: _table_item(v_rows, count=2),
+    }
+    src.write_text(_with_items(sheet, items), encoding="utf-8")
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "2 regions not translated" in capsys.readouterr().out
+    text = (tmp_path / "table.toml").read_text(encoding="utf-8")
+    assert 'S = { expr = "[[1.5, -2, 3], [4, 0.25, 0.006]]"' in text
+    assert 'v = { expr = "[10, 20, 30]"' in text
+    assert "region 3: a component defining X: not translated" in text
+    assert "region 4: a component defining B: a data table whose binary item" in text
+    main(["check", str(tmp_path / "table.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (7, 7), result["failures"]

@@ -49,8 +49,9 @@ class Region:
     href: str = ""  # reference regions: the referenced file
     disabled: bool = False
     plot: MNode | None = None  # plot regions: the plot's data
-    binary: str = ""  # plot regions: the binary item with the plot's definition (base64)
+    binary: str = ""  # plots, components: the binary item with their definition (base64)
     outputs: list[MNode] = field(default_factory=list)  # components: the names they define
+    component: dict[str, str] = field(default_factory=dict)  # components: their attributes
 
 
 @dataclass
@@ -200,6 +201,8 @@ def _worksheet(root, path: Path) -> Worksheet:
     for region in ws.regions:  # a plot's definition is a binary item (decoded when translated)
         if region.kind == "plot" and region.plot is not None:
             region.binary = items.get(region.plot.attrs.get("item-idref", ""), "")
+        if region.kind == "component":
+            region.binary = items.get(region.component.get("item-idref", ""), "")
     ws.regions.sort(key=lambda r: (r.top, r.left))  # Mathcad's order: top down, left to right
     return ws
 
@@ -262,6 +265,7 @@ def _region(el, dy: float = 0.0, dx: float = 0.0) -> Region:
             names = [
                 _node(x) for x in (outputs if outputs is not None else ()) if _local(x.tag) == "id"
             ]
-            return Region(kind="component", outputs=names, **base)
+            attrs = {k: v for k, v in c.attrib.items() if isinstance(k, str)}
+            return Region(kind="component", outputs=names, component=attrs, **base)
     tag = _local(kids[0].tag) if kids else "empty"
     return Region(kind=tag if tag in ("area",) else "other", text=tag, **base)

@@ -431,14 +431,48 @@ class Translator:
         return self.out
 
     def component(self, region: Region) -> None:
-        """A component (a data table, a spreadsheet, ...): not translated; the names it
-        defines are untranslated names (never a unit of the same name, as S for siemens)."""
-        why = "not translated: the language has no such region"
+        """A data table of numbers: a matrix definition of its name. Any other component (a
+        spreadsheet, ...): not translated; the names it defines are untranslated names
+        (never a unit of the same name, as S for siemens)."""
         names = ", ".join(nm.mathcad_text(*_key(n)) for n in region.outputs)
+        try:
+            self.data_table(region)
+            return
+        except Untranslatable as error:
+            why = str(error)
         self.skip(region.id, "a component" + (f" defining {names}" if names else ""), why)
         for node in region.outputs:
             sym = self.define(_key(node), "var", region.id)
             sym.broken = f"defined by a component (region {region.id}), {why}"
+
+    def data_table(self, region: Region) -> None:
+        """A data table (Insert > Data > Table) whose cells are numbers: ``S := [[...]]``
+        by rows, or a column vector ``[a, b, ...]`` for a single column."""
+        from .table import TABLE_CLSID, grid
+
+        if region.component.get("clsid-buddy", "").upper() != TABLE_CLSID:
+            raise Untranslatable("not translated: the language has no such region")
+        if len(region.outputs) != 1 or region.outputs[0].tag != "id":
+            raise Untranslatable("a data table that defines more than one name")
+        if not region.binary:
+            raise Untranslatable("a data table without its binary item (its cells)")
+        if region.component.get("disable-calc") == "true":
+            raise Untranslatable("disabled in Mathcad")
+        cells = grid(region.binary)
+        if not all(math.isfinite(v) for row in cells for v in row):
+            raise Untranslatable("a data table with an empty cell or a value that is not a number")
+
+        def number(v: float) -> ex.Node:
+            return ex.Unary("-", ex.Number(-v)) if v < 0 else ex.Number(v)
+
+        body = ex.Matrix(tuple(tuple(number(v) for v in row) for row in cells))
+        self._forced(region, None)
+        sym = self.define(_key(region.outputs[0]), "var", region.id)
+        rows, cols = len(cells), len(cells[0])
+        self.out.items.append(
+            Item("note", region.id, value=f"a data table of Mathcad ({rows} x {cols})")
+        )
+        self.out.items.append(Item("definition", region.id, sym=sym, body=body))
 
     def plot(self, region: Region) -> None:
         """An X-Y plot: a chart whose series are its traces, each over the range variable its
