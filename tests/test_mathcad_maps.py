@@ -523,3 +523,38 @@ def test_data_table_is_a_matrix(tmp_path, capsys):
     main(["check", str(tmp_path / "table.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["reproduced"]) == (7, 7), result["failures"]
+
+
+@pytest.mark.parametrize(
+    "data, reason",
+    [
+        (b"not gzip at all", "a data table whose binary item is not gzip"),
+        (gzip.compress(b"a record and no compound file"), "no OLE compound file"),
+        (gzip.compress(b"rec\x00\x10\x00\x00\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1"), "cut short"),
+    ],
+)
+def test_broken_data_table_is_listed_with_why(data, reason):
+    """A table item that is not gzip, holds no compound file, or is cut short: refused with
+    the reason, never a guessed grid."""
+    from workbook.mathcad.symbols import Untranslatable
+    from workbook.mathcad.table import grid
+
+    encoded = base64.b64encode(data).decode()
+    with pytest.raises(Untranslatable, match=reason):
+        grid(encoded)
+
+
+def test_data_table_with_a_cyclic_sector_chain_is_refused():
+    """A mini FAT chain that loops back on itself ends with a clear reason, in bounded time."""
+    from workbook.mathcad.symbols import Untranslatable
+    from workbook.mathcad.table import grid
+
+    raw = base64.b64decode(_table_item([[1.0, 2.0], [3.0, 4.0]]))
+    data = gzip.decompress(raw)
+    at = data.index(b"\xd0\xcf\x11\xe0")
+    minifat = at + 512 + 2 * 512  # the third sector: the mini FAT
+    # two pieces, stored in mini sectors 1 then 0: 0 ends the chain; make it point to 1
+    assert struct.unpack_from("<2I", data, minifat) == (0xFFFFFFFE, 0)
+    looped = data[:minifat] + struct.pack("<I", 1) + data[minifat + 4 :]
+    with pytest.raises(Untranslatable, match="broken sector chain"):
+        grid(base64.b64encode(gzip.compress(looped)).decode())

@@ -42,16 +42,16 @@ class _Rec:
         self.right: _Rec | None = None
 
 
-def payload(encoded: str) -> bytes:
-    """The bytes of a binary item (base64 of gzip), at most MAX_PLOT_BYTES."""
+def payload(encoded: str, what: str = "a plot") -> bytes:
+    """The bytes of a binary item (base64 of gzip) of ``what``, at most MAX_PLOT_BYTES."""
     try:
         raw = base64.b64decode(encoded, validate=False)
         d = zlib.decompressobj(16 + zlib.MAX_WBITS)
         data = d.decompress(raw, MAX_PLOT_BYTES)
     except (ValueError, zlib.error):
-        raise Untranslatable("a plot whose binary item is not gzip (not decoded)") from None
+        raise Untranslatable(f"{what} whose binary item is not gzip (not decoded)") from None
     if d.unconsumed_tail:
-        raise Untranslatable(f"a plot whose binary item is larger than {MAX_PLOT_BYTES} bytes")
+        raise Untranslatable(f"{what} whose binary item is larger than {MAX_PLOT_BYTES} bytes")
     return data
 
 

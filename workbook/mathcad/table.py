@@ -36,7 +36,7 @@ def _bad(what: str) -> Untranslatable:
 
 def grid(encoded: str) -> list[list[float]]:
     """The table's numbers by rows, from its binary item (base64 of gzip)."""
-    data = payload(encoded)
+    data = payload(encoded, "a data table")
     at = data.find(_SIGNATURE)
     if at < 4:
         raise _bad("no OLE compound file")
