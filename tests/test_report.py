@@ -173,6 +173,8 @@ def check_numbers(sheet, text: str | None = None) -> int:
         count += 1
     # every scalar definition: its result and unit, or its error
     shown = {el.get("data-name"): el for el in doc.xpath("//mrow[@class='result']")}
+    texts = {el.get("data-name"): el for el in doc.xpath("//mrow[@class='result-text']")}
+    arrays = {el.get("data-name"): el for el in doc.xpath("//mrow[@class='result-matrix']")}
     for name, d in sheet.spec.definitions.items():
         if d.is_function:
             continue
@@ -182,6 +184,18 @@ def check_numbers(sheet, text: str | None = None) -> int:
             div = doc.get_element_by_id(f"def-{name}")
             assert "not computed" in div.text_content(), name
             continue
+        if isinstance(q, str):  # a text: shown in quotes
+            assert texts[name].text_content() == f"\u201c{q}\u201d", name
+            count += 1
+            continue
+        if np.ndim(q.magnitude):  # a vector or matrix: every element, by rows
+            want = q.to(d.unit) if d.unit is not None else q
+            cells = [rp.number(td.text_content()) for td in arrays[name].xpath(".//mtd")]
+            assert len(cells) == want.magnitude.size, name
+            for got, engine in zip(cells, np.asarray(want.magnitude, dtype=float).ravel()):
+                assert _same(got, float(engine)), (name, got, engine)
+            count += len(cells)
+            continue
         value, unit = rp.value_and_unit(shown[name])
         want = q.to(d.unit) if d.unit is not None else q
         assert un.unit(unit) == un.unit(un.pretty(want.units)), (name, unit, want.units)
@@ -190,7 +204,7 @@ def check_numbers(sheet, text: str | None = None) -> int:
     # tables: each shown cell against the engine's column
     for t in sheet.spec.tables:
         div = doc.get_element_by_id(f"table-{t.name}")
-        if t.block:
+        if t.computed:  # a block's table or a family over an input's values
             df = sheet.table(t.name)
             columns = [df[c].to_numpy() for c in df.columns]
             units = [None] * len(columns)

@@ -292,9 +292,11 @@ class Document:
                 error = f"<p class='error'>not computed: {escape(_error_text(r))}</p>"
                 result = mm.text_box("not computed", "error")
             elif isinstance(r, str):
-                result = mm.text_box(f"\u201c{r}\u201d")
+                text = mm.text_box(f"\u201c{r}\u201d")
+                result = Box(_named("result-text", d.name, text.xml), text.width)
             elif np.ndim(r[0]):
-                result = mm.matrix_box(r[0], r[1])
+                box = mm.matrix_box(r[0], r[1])
+                result = Box(_named("result-matrix", d.name, box.xml), box.width)
             else:
                 attrs = f"class='result' data-name='{escape(d.name)}'"
                 result = mm.quantity_box(r[0], r[1], attrs=attrs)
@@ -727,3 +729,8 @@ def _varied(t) -> str:
     """``c1 = 1500 N/m, 3000 N/m``: the input a family table varies, and its values."""
     ((name, values),) = t.vary.items()
     return f"{name} = {', '.join(values)}"
+
+
+def _named(cls: str, name: str, xml: str) -> str:
+    """A result that is a text or a matrix, marked with the definition it is the value of."""
+    return f"<mrow class='{cls}' data-name='{escape(name)}'>{xml}</mrow>"
