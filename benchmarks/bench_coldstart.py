@@ -14,7 +14,15 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _timing import Result, median, ms, report, run_seconds, workbook_command  # noqa: E402
+from _timing import (  # noqa: E402
+    INSTALLED_ENV,
+    Result,
+    median,
+    ms,
+    report,
+    run_seconds,
+    workbook_command,
+)
 
 TARGET = 2.0
 BARE = [sys.executable, "-c", "import numpy, pint, xlsxwriter"]
@@ -57,6 +65,7 @@ def stages(template: str = "concave-cam", parts: tuple[str, ...] = ()) -> str:
                 check=True,
                 capture_output=True,
                 text=True,
+                env=INSTALLED_ENV,
             )
             .stdout.splitlines()[-1]
             .split()

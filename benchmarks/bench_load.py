@@ -15,7 +15,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _timing import Result, median, ms, report, run_seconds  # noqa: E402
+from _timing import INSTALLED_ENV, Result, median, ms, report, run_seconds  # noqa: E402
 from bench_coldstart import engine_command  # noqa: E402
 
 TARGET = 1.0
@@ -38,7 +38,13 @@ print(time.perf_counter() - t0, ",".join(loaded) or "-", ",".join(failed) or "-"
 def load_all_seconds() -> tuple[float, list[str], list[str]]:
     """Seconds, templates loaded, templates that failed to load (a template error)."""
     out = (
-        subprocess.run([sys.executable, "-c", LOAD_ALL], check=True, capture_output=True, text=True)
+        subprocess.run(
+            [sys.executable, "-c", LOAD_ALL],
+            check=True,
+            capture_output=True,
+            text=True,
+            env=INSTALLED_ENV,
+        )
         .stdout.splitlines()[-1]
         .split()
     )
