@@ -28,6 +28,10 @@ class UnitContext(Protocol):
 
     def meeting(self, values) -> list[ty.T]: ...
 
+    def declared(self, t: ty.T, unit: pint.Unit, where: str) -> ty.T: ...
+
+    def symbolic_refusal(self, t: ty.T) -> str | None: ...
+
 
 @dataclass(frozen=True)
 class Domain:

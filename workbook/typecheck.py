@@ -267,6 +267,12 @@ class Typer(ArrayTyping, Visitor):
             return TConst(unit, value=t.value)
         return self.convert(t, unit, where)
 
+    def symbolic_refusal(self, t: T) -> str | None:
+        """Why ``t`` has no symbolic form (``diff`` refuses it at load), or None; no SymPy."""
+        from .symbolic import refusal
+
+        return refusal(self, t)
+
     def plain(self, t: T, where: str) -> T:
         """Convert to a plain number (radians for angles); refuse dimensioned values."""
         if t.boolean:

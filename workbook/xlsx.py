@@ -1073,7 +1073,7 @@ class RowSteps:
 def _recorded_chains(writer, typed: tc.T, env: dict) -> dict:
     """The steps of every live root and extremum met evaluating ``typed`` in ``env`` with
     the live forms (workbook.numerics), by id of their EXPR."""
-    from .numerics._common import live_forms, recording_chains
+    from .numerics import live_forms, recording_chains
 
     with recording_chains() as found:
         try:

@@ -21,6 +21,24 @@ engine wraps it. SciPy is imported inside the functions, so importing this packa
 
 from __future__ import annotations
 
-from ._common import NumericsError, Result, Tolerance, current, sheet_tolerance, tolerance
+from ._common import (
+    NumericsError,
+    Result,
+    Tolerance,
+    current,
+    live_forms,
+    recording_chains,
+    sheet_tolerance,
+    tolerance,
+)
 
-__all__ = ["NumericsError", "Result", "Tolerance", "current", "sheet_tolerance", "tolerance"]
+__all__ = [
+    "NumericsError",
+    "Result",
+    "Tolerance",
+    "current",
+    "live_forms",
+    "recording_chains",
+    "sheet_tolerance",
+    "tolerance",
+]
