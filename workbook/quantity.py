@@ -161,6 +161,12 @@ def _exponent(tokens: list[str], i: int, shown: str, what: str) -> None:
     if j >= len(tokens) or not tokens[j][0].isdigit():
         raise InputError(f"{what}: {shown!r}: a power needs a number (m^2, s^-1)")
     value = sign * float(tokens[j])
+    if j + 1 < len(tokens) and tokens[j + 1] in ("**", "^"):
+        # kg^9**9**9 is kg to the power 9**(9**9): each power alone is small, pint would
+        # compute the tower (minutes of CPU and unbounded memory)
+        raise LimitError(
+            f"{what}: {shown!r} raises a power to a power (write one power: m^2, s^-1)"
+        )
     if abs(value) > MAX_UNIT_POWER:
         raise LimitError(
             f"{what}: power {value:g} in {shown!r} (a unit's power is at most "

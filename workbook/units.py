@@ -7,9 +7,9 @@ import math
 
 import pint
 
-from .errors import InputError
+from .errors import InputError, LimitError
 from .fields import nearest
-from .quantity import check_unit_text, split_quantity
+from .quantity import MAX_UNIT_POWER, check_unit_text, split_quantity
 
 
 @functools.cache
@@ -118,7 +118,7 @@ def _unit_names() -> tuple[str, ...]:
 def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
     """pint's unit for a text the quantity reader accepted (a clear error for unknown names)."""
     try:
-        return _unit_of(text)
+        u = _unit_of(text)
     except pint.UndefinedUnitError as exc:
         names = [str(n) for n in (getattr(exc, "unit_names", ()) or ())]
         bad = ", ".join(repr(n) for n in names) or "a name"
@@ -126,6 +126,14 @@ def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
         raise InputError(f"{what}: cannot read {shown!r}: {bad} is not a unit{near}") from None
     except Exception as exc:  # noqa: BLE001 - pint raises many kinds for malformed text
         raise InputError(f"{what}: cannot read {shown!r} as a unit ({exc})") from None
+    big = [(n, p) for n, p in u.dimensionality.items() if abs(p) > MAX_UNIT_POWER]
+    if big:  # ((kg^12)^12)^12: each power is allowed, the product of them is not
+        name, power = big[0]
+        raise LimitError(
+            f"{what}: {shown!r} is {name} to the power {power:g} (a unit's power is at most "
+            f"{MAX_UNIT_POWER} in magnitude)"
+        )
+    return u
 
 
 def factor(src: pint.Unit, dst: pint.Unit) -> float:
