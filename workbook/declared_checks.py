@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import expr as ex
+from . import typed as ty
 from . import units as un
 from .errors import InputError, TemplateError, WorkbookError
 from .fields import Fields, nearest
@@ -171,7 +172,7 @@ def _typed_value(sheet, spec: CheckSpec):
     if getattr(t, "text", False) or getattr(t, "boolean", False) or t.shape:
         raise TemplateError("value must be one number")
     shown = un.unit(spec.unit, what=spec.label) if spec.unit is not None else t.unit
-    return t, _factor(t.unit, shown, spec.label, spec.unit)
+    return t, _factor(t, shown, spec.unit)
 
 
 def _typed_condition(sheet, spec: CheckSpec):
@@ -192,16 +193,21 @@ def _typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None
             raise TemplateError(f"{{{expression}}} is a text, it has no unit")
         return t, None, None
     if unit == _PERCENT:
-        return t, 100 * _factor(t.unit, un.registry().dimensionless, spec.label, ""), "%"
+        return t, 100 * _factor(t, un.registry().dimensionless, ""), "%"
     shown = un.unit(unit, what=spec.label) if unit is not None else _shown_unit(t.unit)
-    return t, _factor(t.unit, shown, spec.label, unit), shown
+    return t, _factor(t, shown, unit), shown
 
 
 def _shown_unit(u):
     return un.registry().dimensionless if un.is_compound_ratio(u) else u
 
 
-def _factor(src, dst, label: str, dst_text: str | None) -> float:
+def _factor(t, dst, dst_text: str | None) -> float:
+    """The factor that shows ``t`` in ``dst`` (a bare number shown in degrees is in degrees,
+    as the typer reads it)."""
+    if ty.is_bare(t) and un.is_angle(dst):
+        return 1.0
+    src = t.unit
     try:
         return un.factor(src, dst)
     except Exception:

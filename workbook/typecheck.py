@@ -43,6 +43,7 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TUnary,
     TypedFunction,
     children,
+    is_bare,
     is_zero,
     shape_text,
 )
@@ -93,7 +94,7 @@ class Typer(ArrayTyping, Visitor):
                 raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
             body = self._typed_body(d, {})
             if d.unit is not None:
-                body = self.declared(body, d.unit, _declared(name, d.unit))
+                body = self.convert(body, d.unit, _declared(name, d.unit))
             self.scalars[name] = body
         return self.scalars[name]
 
@@ -124,7 +125,7 @@ class Typer(ArrayTyping, Visitor):
             scope = {p: u if sh is None else (u, sh) for p, u, sh in zip(d.params, units, shapes)}
             body = self._typed_body(d, scope)
             if d.unit is not None:
-                body = self.declared(body, d.unit, _declared(name, d.unit))
+                body = self.convert(body, d.unit, _declared(name, d.unit))
             self.functions[key] = TypedFunction(key, d.params, units, body, shapes)
         return self.functions[key]
 
@@ -238,9 +239,13 @@ class Typer(ArrayTyping, Visitor):
     def convert(self, t: T, target: pint.Unit, where: str, *, angle: bool = False) -> T:
         """``t`` in the unit ``target`` (an explicit factor), or a UnitError naming ``where``.
 
-        ``angle``: ``t`` is used as an angle (the argument of sin, cos...)."""
+        ``angle``: ``t`` is used as an angle (the argument of sin, cos...). A bare number
+        wanted as an angle in degrees (any angle unit) is in that unit: a bound 180, ``f(90)``,
+        a shown ``90`` are 180, 90 and 90 degrees, not radians."""
         if t.unit == target:
             return t
+        if is_bare(t) and is_angle(target):
+            return TConst(target, value=t.value)
         if not angle:
             self._no_bare_ratio(t, target, where)
         if t.text:
@@ -260,12 +265,6 @@ class Typer(ArrayTyping, Visitor):
     def meeting(self, values) -> list[T]:
         """Bare numbers among ``values`` next to an angle in degrees take its unit."""
         return meeting(values)
-
-    def declared(self, t: T, unit: pint.Unit, where: str) -> T:
-        """``t`` shown in a declared unit: a bare number is in it when it is an angle unit."""
-        if is_bare(t) and is_angle(unit):
-            return TConst(unit, value=t.value)
-        return self.convert(t, unit, where)
 
     def symbolic_refusal(self, t: T) -> str | None:
         """Why ``t`` has no symbolic form (``diff`` refuses it at load), or None; no SymPy."""
@@ -517,7 +516,7 @@ class Typer(ArrayTyping, Visitor):
                     f"({', '.join(blk.args)}), got {len(args)}"
                 )
             conv = tuple(
-                self.declared(a, un.unit(u), f"argument '{p}' of {name}()")
+                self.convert(a, un.unit(u), f"argument '{p}' of {name}()")
                 for a, (p, u) in zip(args, blk.args.items())
             )
             return TBlock(un.unit(blk.returns), name=name, ref=blk.ref, args=conv)
@@ -637,7 +636,7 @@ class Typer(ArrayTyping, Visitor):
 
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
-        return self.declared(a, unit, where)  # f(90) of an argument in deg is 90 deg
+        return self.convert(a, unit, where)  # f(90) of an argument in deg is 90 deg
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}
@@ -672,7 +671,7 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     scope = {var: arg.binding_unit if arg else typer.dimensionless}
     t = typer.expression(column_node(typer.spec, col, var), scope, what)
     if col.unit is not None:
-        t = typer.declared(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
+        t = typer.convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
 
 
@@ -715,11 +714,6 @@ def _bare_ratio(t: T) -> float | None:
         if found is not None:
             return found
     return None
-
-
-def is_bare(t: T) -> bool:
-    """A plain number written in the expression (a literal, or literals folded)."""
-    return isinstance(t, TConst) and t.unit == un.registry().dimensionless
 
 
 def meeting(values) -> list[T]:

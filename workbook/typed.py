@@ -223,6 +223,11 @@ class _Children(Visitor):
 _CHILDREN = _Children()
 
 
+def is_bare(t: T) -> bool:
+    """A plain number written in the expression (a literal, or literals folded)."""
+    return isinstance(t, TConst) and t.unit == un.registry().dimensionless
+
+
 def is_zero(t: T) -> bool:
     """A dimensionless literal zero, which agrees with any unit."""
     return (

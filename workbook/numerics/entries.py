@@ -68,7 +68,7 @@ def _in_var_unit(ctx, t: ty.T, var: ty.TParam, name: str, what: str) -> ty.T:
         )
     # a bare number bounding an angle in degrees is in degrees, as range bounds are
     # (180 for phi in deg was 180 rad); an expression with pi (pi/2) stays in radians
-    return ctx.declared(t, var.unit, f"{name}(): {what}")
+    return ctx.convert(t, var.unit, f"{name}(): {what}")
 
 
 def _zero(t: ty.T) -> bool:
@@ -728,7 +728,7 @@ def _interp_unit(ctx, name: str, args: tuple) -> ty.T:
             f"{name}(): x is {un.dims(x.unit)} ({un.pretty(x.unit) or '1'}), but the data "
             f"column {xs.name} is {un.dims(xs.unit)} ({un.pretty(xs.unit) or '1'})"
         )
-    x = ctx.declared(x, xs.unit, f"{name}(): x")  # a bare 45 in data in deg is 45 deg
+    x = ctx.convert(x, xs.unit, f"{name}(): x")  # a bare 45 in data in deg is 45 deg
     return ty.TFunc(ys.unit, func=name, args=(xs, ys, x))
 
 
