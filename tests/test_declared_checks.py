@@ -221,3 +221,11 @@ ok = "sigma <= f_y"
     )
     # f_y only in the check, F W L through sigma (a result on the Results sheet); spare nowhere
     assert workbook.load(path).unused_inputs() == ["spare"]
+
+
+def test_a_bare_number_shown_in_degrees_is_degrees(tmp_path):
+    path = sheet_with(
+        tmp_path, '\n[[checks]]\nwhat = "a right angle: {90:deg}"\nvalue = "90"\nunit = "deg"\n'
+    )
+    (f,) = findings(path).values()
+    assert f.what == "a right angle: 90 deg" and f.value == 90.0
