@@ -27,6 +27,8 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "stack": ("stack", None), "augment": ("augment", None), "submatrix": ("submatrix", None),
     "identity": ("identity", None), "mean": ("mean", None), "stdev": ("stdev", None),
     "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
+    "csort": ("csort", None), "rsort": ("rsort", None), "sort": ("sort", None),
+    "reverse": ("reverse", None),
 }  # fmt: skip
 
 #: Mathcad functions that are never translated, and why (a worksheet reads and writes no

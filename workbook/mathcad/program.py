@@ -41,16 +41,111 @@ class ProgramTranslator:
             raise Untranslatable("a program (programs are not in the language yet)")
         self.tr = tr
         self.expressions = expressions
+        self.params = dict(local)
         self.scope = dict(local)  # parameters, then locals as they are assigned
         self.locals: dict[tuple[str, str], Sym] = {}
+        self.loops = 0  # loops around the statement being translated
+        self.taken: set[str] = set()  # identifiers of the program's names
 
     def lines(self, program: MNode) -> list[Line]:
+        body = program.children if program.tag == "program" else [program]
+        self.taken = {nm.identifier(*name_key(n)) for n in _walk(program) if n.tag == "id"}
         out: list[Line] = []
-        self._block(program.children if program.tag == "program" else [program], 0, out)
+        self._copies(body, out)
+        self._zero_starts(body, out)
+        self._block(body, 0, out, tail=True)
         return out
 
+    # -- what Mathcad gives every program before its first line ---------------------------------
+    def _copies(self, body: list[MNode], out: list[Line]) -> None:
+        """Mathcad's parameters are the program's own copies: one whose elements the program
+        sets, or that it sets inside a block (so that a later line reads it on every path),
+        becomes a local copy on the first line (``A_local := A``)."""
+        whole, elements = _targets(body)
+        for key, sym in self.params.items():
+            if key in elements or whole.get(key):
+                copy = self._fresh(f"{sym.base}_local")
+                self.locals[key] = copy
+                self.scope[key] = copy
+                out.append((0, [ex.Name(copy.token()), " := ", ex.Name(sym.token())]))
+
+    def _zero_starts(self, body: list[MNode], out: list[Line]) -> None:
+        """Mathcad starts every local at 0: a local the program reads before it has given it
+        on some path (``s := s + x``, or set in one branch only) starts at 0 on the first
+        line (``s := 0``). A vector made by its elements (``l[rows(l) + 1] := x``) starts
+        empty in the language; it starts at 0 only where the program reads it whole first
+        (``if res != 0``)."""
+        whole, elements = _targets(body)
+        assigned = set(whole) | elements
+        given = set(self.params) | set(self.locals)
+        given |= {k for k, s in self.tr.scope.items() if s.kind != "func"}
+        flagged: list[tuple[str, str]] = []
+
+        def read(node: MNode, have: set, own=None) -> None:
+            for key, indexed in _reads(node):
+                if key not in assigned or key in have or key in flagged or key == own:
+                    continue
+                if indexed and key in elements:
+                    continue
+                flagged.append(key)
+
+        def run(stmts: list[MNode], have: set | None) -> set | None:
+            i = 0
+            while i < len(stmts) and have is not None:
+                s = stmts[i]
+                nxt = stmts[i + 1] if i + 1 < len(stmts) else None
+                if s.tag == "ifThen":
+                    cond, then = s.children
+                    read(cond, have)
+                    a = run(_statements(then), set(have))
+                    if nxt is not None and nxt.tag == "otherwise":
+                        b = run(_statements(nxt.children[0]), set(have))
+                        have = b if a is None else a if b is None else a & b
+                        i += 2
+                        continue
+                elif s.tag == "otherwise":
+                    run(_statements(s.children[0]), set(have))
+                elif s.tag == "for":
+                    var, over, loop = s.children
+                    read(over, have)
+                    have = have | {name_key(var)} if var.tag == "id" else have
+                    run(_statements(loop), set(have))
+                elif s.tag == "while":
+                    read(s.children[0], have)
+                    run(_statements(s.children[1]), set(have))
+                elif s.tag == "localDefine":
+                    lhs, rhs = s.children
+                    read(rhs, have)
+                    if lhs.tag == "id":
+                        have = have | {name_key(lhs)}
+                    elif lhs.tag == "matrix":
+                        have = have | {name_key(c) for c in lhs.children if c.tag == "id"}
+                    elif lhs.tag == "apply" and len(lhs.children) == 3:
+                        target = lhs.children[1]
+                        own = name_key(target) if target.tag == "id" else None
+                        read(lhs.children[2], have, own)
+                        if own is not None:
+                            have = have | {own}
+                elif s.tag in ("return", "break", "continue"):
+                    for c in s.children:
+                        read(c, have)
+                    have = None
+                elif s.tag == "program":
+                    have = run(s.children, have)
+                elif not (s.tag == "id" and name_key(s) in elements):  # a value line
+                    read(s, have)
+                i += 1
+            return have
+
+        run(body, given)
+        for key in flagged:
+            sym = self._local_key(key)
+            out.append((0, [ex.Name(sym.token()), " := ", ex.Number(0.0)]))
+
     # -- statements ---------------------------------------------------------------------------
-    def _block(self, stmts: list[MNode], indent: int, out: list[Line]) -> None:
+    def _block(self, stmts: list[MNode], indent: int, out: list[Line], tail: bool) -> None:
+        """``tail``: nothing runs after this block in the program (a ``break`` outside any
+        loop there ends the program without a value, as in Mathcad)."""
         if not stmts:
             raise Untranslatable("an empty program block")
         i = 0
@@ -58,49 +153,87 @@ class ProgramTranslator:
             s = stmts[i]
             nxt = stmts[i + 1] if i + 1 < len(stmts) else None
             if s.tag == "ifThen" and nxt is not None and nxt.tag == "otherwise":
+                last = tail and i + 2 >= len(stmts)
                 other = nxt.children[0]
-                if (
+                if self.loops == 0 and (_is_break(s.children[1]) or _is_break(other)):
+                    self._stopping_if(s, other, indent, out, last)
+                elif (
                     self._one_line(s.children[1])
                     and self._one_line(other)
                     and other.tag not in _SIMPLE
                 ):
-                    self._stmt(s, indent, out)
-                    self._stmt(nxt, indent, out)
+                    self._stmt(s, indent, out, last)
+                    self._stmt(nxt, indent, out, last)
                 else:  # block form: if ... / otherwise
-                    self._if_block(s, indent, out)
+                    self._if_block(s, indent, out, last)
                     out.append((indent, ["otherwise"]))
-                    self._body(nxt.children[0], indent + 4, out)
+                    self._body(other, indent + 4, out, last)
                 i += 2
                 continue
-            self._stmt(s, indent, out)
+            self._stmt(s, indent, out, tail and i == len(stmts) - 1)
             i += 1
 
+    def _stopping_if(self, s: MNode, other: MNode, indent: int, out: list[Line], last: bool):
+        """``if C: break`` / ``otherwise: X`` (or the other way round) outside any loop: the
+        branch that breaks ends the program without a value; the other is kept (``X if not
+        C``)."""
+        if not last:
+            raise Untranslatable(_BREAK_WHY)
+        cond, then = s.children
+        if _is_break(then) and _is_break(other):
+            return
+        if _is_break(other):
+            self._stmt(s, indent, out, last)
+            return
+        negated = _negate(self._cond(cond))
+        if self._one_line(other) and other.tag not in ("break", "continue"):
+            out.append((indent, [*self._simple(other), " if ", negated]))
+        else:
+            out.append((indent, ["if ", negated]))
+            self._body(other, indent + 4, out, last)
+
     def _one_line(self, body: MNode) -> bool:
+        if body.tag == "localDefine" and body.children[0].tag == "matrix":
+            return False  # destructuring: several lines
+        if body.tag == "localDefine" and _is_column(body.children[0]):
+            return False  # a column: a loop
         return body.tag != "program" and body.tag not in ("for", "while", "ifThen")
 
-    def _body(self, body: MNode, indent: int, out: list[Line]) -> None:
-        self._block(body.children if body.tag == "program" else [body], indent, out)
+    def _body(self, body: MNode, indent: int, out: list[Line], tail: bool = False) -> None:
+        start = len(out)
+        self._block(body.children if body.tag == "program" else [body], indent, out, tail)
+        if len(out) == start:
+            raise Untranslatable("a block that only stops the program (break outside a loop)")
 
-    def _if_block(self, s: MNode, indent: int, out: list[Line]) -> None:
+    def _if_block(self, s: MNode, indent: int, out: list[Line], tail: bool = False) -> None:
         cond, body = s.children
-        out.append((indent, ["if ", self._expr(cond)]))
-        self._body(body, indent + 4, out)
+        out.append((indent, ["if ", self._cond(cond)]))
+        self._body(body, indent + 4, out, tail)
 
-    def _stmt(self, s: MNode, indent: int, out: list[Line]) -> None:
+    def _stmt(self, s: MNode, indent: int, out: list[Line], tail: bool = False) -> None:
         tag = s.tag
         if tag == "localDefine":
-            out.append((indent, self._assign(s)))
+            for extra, parts in self._assign(s):
+                out.append((indent + extra, parts))
         elif tag == "return":
             out.append((indent, ["return ", self._expr(s.children[0])]))
         elif tag in ("break", "continue"):
+            if self.loops == 0:
+                if tag == "continue" or not tail:
+                    raise Untranslatable(_BREAK_WHY if tag == "break" else _CONTINUE_WHY)
+                return  # the program ends here without a value, as Mathcad's stops
             out.append((indent, [tag]))
         elif tag == "ifThen":
             cond, body = s.children
+            if self.loops == 0 and _is_break(body):
+                if not tail:
+                    raise Untranslatable(_BREAK_WHY)
+                return  # it ends the program either way: without a value
             if body.tag in _SIMPLE or self._one_line(body):
                 parts = self._simple(body)
-                out.append((indent, [*parts, " if ", self._expr(cond)]))
+                out.append((indent, [*parts, " if ", self._cond(cond)]))
             else:
-                self._if_block(s, indent, out)
+                self._if_block(s, indent, out, tail)
         elif tag == "otherwise":
             body = s.children[0]
             if not self._one_line(body) or body.tag in _SIMPLE:
@@ -112,35 +245,50 @@ class ProgramTranslator:
                 raise Untranslatable("a for loop over the elements of a vector")
             head = self._range(over)
             out.append((indent, ["for ", self._local(var), " in ", *head]))
-            self._body(body, indent + 4, out)
+            self._loop_body(body, indent + 4, out)
         elif tag == "while":
             cond, body = s.children
-            out.append((indent, ["while ", self._expr(cond)]))
-            self._body(body, indent + 4, out)
+            out.append((indent, ["while ", self._cond(cond)]))
+            self._loop_body(body, indent + 4, out)
         elif tag == "program":
-            self._block(s.children, indent, out)
+            self._block(s.children, indent, out, tail)
         elif tag in ("tryCatch", "onError"):
             raise Untranslatable(f"{what(tag)} in a program")
         else:
             out.append((indent, [self._expr(s)]))
 
+    def _loop_body(self, body: MNode, indent: int, out: list[Line]) -> None:
+        self.loops += 1
+        try:
+            self._body(body, indent, out)
+        finally:
+            self.loops -= 1
+
     def _simple(self, body: MNode) -> list:
         if body.tag == "localDefine":
-            return self._assign(body)
+            lines = self._assign(body)
+            if len(lines) != 1:
+                raise Untranslatable("an assignment of several lines on an 'if' line")
+            return lines[0][1]
         if body.tag == "return":
             return ["return ", self._expr(body.children[0])]
         if body.tag in ("break", "continue"):
             return [body.tag]
         return [self._expr(body)]
 
-    def _assign(self, s: MNode) -> list:
+    def _assign(self, s: MNode) -> list[tuple[int, list]]:
+        """The lines of one assignment: (indent under the statement's, parts)."""
         lhs, rhs = s.children
         if lhs.tag == "apply" and len(lhs.children) == 3 and lhs.children[0].tag == "indexer":
-            return self._element(lhs, rhs)
+            return [(0, self._element(lhs, rhs))]
+        if _is_column(lhs):
+            return self._column(lhs, rhs)
+        if lhs.tag == "matrix":
+            return self._destructure(lhs, rhs)
         if lhs.tag != "id":
             raise Untranslatable("an assignment to something that is not a name in a program")
         value = self._expr(rhs)  # the right side sees the local's previous value
-        return [self._local(lhs), " := ", value]
+        return [(0, [self._local(lhs), " := ", value])]
 
     def _element(self, lhs: MNode, rhs: MNode) -> list:
         """v[i] <- value: an element of a local vector; one the program has not given, or
@@ -150,26 +298,86 @@ class ProgramTranslator:
         if target.tag != "id":
             raise Untranslatable("an element assignment to something that is not a name")
         value = self._expr(rhs)  # the right side sees the vector before the assignment
-        if name_key(target) not in self.locals:
-            if name_key(target) in self.scope:  # a parameter or a name of the sheet
-                raise Untranslatable(
-                    "an element assignment to a vector the program has not given (Mathcad "
-                    "copies the argument or the sheet's vector into a local)"
-                )
-            self._local(target)
+        self._target(target)
         index = self._expr(lhs)  # v[i] as an expression: the index tree, shifted by ORIGIN
         return [index, " := ", value]
+
+    def _target(self, target: MNode) -> ex.Node:
+        """The local whose elements an assignment sets (made if the program has not)."""
+        if name_key(target) not in self.locals and name_key(target) in self.scope:
+            raise Untranslatable(
+                "an element assignment to a vector the program has not given (Mathcad "
+                "copies the argument or the sheet's vector into a local)"
+            )
+        return self._local(target)
+
+    def _column(self, lhs: MNode, rhs: MNode) -> list[tuple[int, list]]:
+        """M<j> <- v: column j of a local matrix, element by element (a loop over v)."""
+        target, j = lhs.children[1], lhs.children[2]
+        if target.tag != "id":
+            raise Untranslatable("a column assignment to something that is not a name")
+        value = self._expr(rhs)  # the right side sees the matrix before the assignment
+        lines: list[tuple[int, list]] = []
+        if not isinstance(value, ex.Name):
+            tmp = self._fresh("column")
+            lines.append((0, [ex.Name(tmp.token()), " := ", value]))
+            value = ex.Name(tmp.token())
+        column = self._shifted(self._expr(j))
+        m = self._target(target)
+        k = ex.Name(self._fresh("k").token())
+        o = self.tr.sheet_origin
+        last: ex.Node = ex.Call("rows", (value,))
+        if o != 1:
+            last = ex.Binary("+" if o > 1 else "-", last, ex.Number(float(abs(o - 1))))
+        lines.append((0, ["for ", k, " in ", ex.Number(float(o)), " .. ", last]))
+        lines.append((4, [ex.Index(m, (k, column)), " := ", ex.Index(value, (k,))]))
+        return lines
+
+    def _destructure(self, lhs: MNode, rhs: MNode) -> list[tuple[int, list]]:
+        """[a; b; c] <- value: each name an element of the value (a local of its own first),
+        at Mathcad's ORIGIN."""
+        rows, cols = int(lhs.attrs.get("rows", 0)), int(lhs.attrs.get("cols", 0))
+        names = lhs.children
+        if rows * cols != len(names) or not names:
+            raise Untranslatable("a matrix of names whose size does not match its elements")
+        if any(n.tag != "id" for n in names):
+            raise Untranslatable("an assignment to a matrix of something that is not names")
+        value = self._expr(rhs)
+        tmp = ex.Name(self._fresh("parts").token())
+        lines: list[tuple[int, list]] = [(0, [tmp, " := ", value])]
+        o = self.tr.sheet_origin
+        for c in range(cols):
+            for r in range(rows):
+                at = (r,) if cols == 1 else (r, c)
+                index = tuple(ex.Number(float(o + a)) for a in at)
+                name = self._local(names[c * rows + r])
+                lines.append((0, [name, " := ", ex.Index(tmp, index)]))
+        return lines
+
+    def _shifted(self, index: ex.Node) -> ex.Node:
+        shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
+        return ex.Binary("+", index, ex.Number(float(shift))) if shift else index
 
     def _local(self, node: MNode) -> ex.Node:
         if node.tag != "id":
             raise Untranslatable("a program local that is not a name")
-        key = name_key(node)
+        return ex.Name(self._local_key(name_key(node)).token())
+
+    def _local_key(self, key: tuple[str, str]) -> Sym:
         sym = self.locals.get(key)
         if sym is None:
             sym = self.tr.new_sym("local", nm.identifier(*key), nm.mathcad_text(*key))
             self.locals[key] = sym
             self.scope[key] = sym
-        return ex.Name(sym.token())
+        return sym
+
+    def _fresh(self, base: str) -> Sym:
+        """A local of the translation's own, named unlike every name of the program."""
+        name, n = base, 2
+        while name in self.taken:
+            name, n = f"{base}_{n}", n + 1
+        self.taken.add(name)
+        return self.tr.new_sym("local", name, name)
 
     def _range(self, rng: MNode) -> list:
         first = rng.children[0]
@@ -180,9 +388,112 @@ class ProgramTranslator:
             head = [self._expr(first)]
         return [*head, " .. ", self._expr(rng.children[1])]
 
+    def _translator(self):
+        return self.expressions(self.tr, self.scope)
+
     def _expr(self, node: MNode) -> ex.Node:
-        et = self.expressions(self.tr, self.scope)
-        tree = et.visit(node)
+        et = self._translator()
+        tree = et.value(node)
         if et.ranges:
             raise Untranslatable("a program over a range variable")
         return tree
+
+    def _cond(self, node: MNode) -> ex.Node:
+        et = self._translator()
+        tree = et.condition(node)
+        if et.ranges:
+            raise Untranslatable("a program over a range variable")
+        return tree
+
+
+_BREAK_WHY = "a break outside any loop (Mathcad stops the program there) before the program's end"
+_CONTINUE_WHY = "a continue outside any loop"
+
+_NEGATED = {"==": "!=", "!=": "==", "<": ">=", ">=": "<", ">": "<=", "<=": ">"}
+
+
+def _negate(cond: ex.Node) -> ex.Node:
+    if isinstance(cond, ex.Compare) and len(cond.ops) == 1:
+        return ex.Compare((_NEGATED[cond.ops[0]],), cond.operands)
+    return ex.Unary("not", cond)
+
+
+def _is_break(body: MNode) -> bool:
+    while body.tag == "program" and len(body.children) == 1:
+        body = body.children[0]
+    return body.tag == "break"
+
+
+def _is_column(lhs: MNode) -> bool:
+    return lhs.tag == "apply" and len(lhs.children) == 3 and lhs.children[0].tag == "matcol"
+
+
+def _walk(node: MNode):
+    yield node
+    for c in node.children:
+        yield from _walk(c)
+
+
+def _statements(body: MNode) -> list[MNode]:
+    return body.children if body.tag == "program" else [body]
+
+
+def _targets(body: list[MNode]) -> tuple[dict, set]:
+    """Names a program assigns: {name: set inside a block?} for whole assignments (and loop
+    variables), and the names whose elements or columns it sets."""
+    whole: dict[tuple[str, str], bool] = {}
+    elements: set[tuple[str, str]] = set()
+
+    def visit(stmts: list[MNode], inner: bool) -> None:
+        for s in stmts:
+            if s.tag == "localDefine":
+                lhs = s.children[0]
+                if lhs.tag == "id":
+                    whole[name_key(lhs)] = whole.get(name_key(lhs), False) or inner
+                elif lhs.tag == "matrix":
+                    for c in lhs.children:
+                        if c.tag == "id":
+                            whole[name_key(c)] = whole.get(name_key(c), False) or inner
+                elif lhs.tag == "apply" and len(lhs.children) == 3 and lhs.children[1].tag == "id":
+                    elements.add(name_key(lhs.children[1]))
+            elif s.tag == "for":
+                var = s.children[0]
+                if var.tag == "id":
+                    whole[name_key(var)] = True
+                visit(_statements(s.children[2]), True)
+            elif s.tag in ("ifThen", "while"):
+                visit(_statements(s.children[1]), True)
+            elif s.tag == "otherwise":
+                visit(_statements(s.children[0]), True)
+            elif s.tag == "program":
+                visit(s.children, inner)
+
+    visit(body, False)
+    return whole, elements
+
+
+def _reads(node: MNode):
+    """(name, read as an array whose element or column is taken?) of each name ``node``
+    reads (not the names of the functions it calls)."""
+    if node.tag == "id":
+        yield name_key(node), False
+        return
+    children = node.children
+    if node.tag == "apply" and children:
+        head = children[0]
+        if head.tag in ("indexer", "matcol") and len(children) == 3:
+            target = children[1]
+            while target.tag == "parens" and target.children:
+                target = target.children[0]
+            if target.tag == "id":
+                yield name_key(target), True
+            else:
+                yield from _reads(target)
+            yield from _reads(children[2])
+            return
+        if head.tag == "id":
+            children = children[1:]
+    if node.tag in ("lambda", "boundVars"):
+        return
+    for c in children:
+        yield from _reads(c)

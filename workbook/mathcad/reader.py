@@ -52,6 +52,12 @@ class Region:
     binary: str = ""  # plots, components: the binary item with their definition (base64)
     outputs: list[MNode] = field(default_factory=list)  # components: the names they define
     component: dict[str, str] = field(default_factory=dict)  # components: their attributes
+    areas: tuple = ()  # (top, left) of each area the region is inside, outermost first
+
+    def order(self) -> tuple:
+        """Mathcad's reading order: an area's regions come together, at the area's place
+        (a collapsed area's regions may lie below the regions after it)."""
+        return (*self.areas, (self.top, self.left))
 
 
 @dataclass
@@ -203,7 +209,7 @@ def _worksheet(root, path: Path) -> Worksheet:
             region.binary = items.get(region.plot.attrs.get("item-idref", ""), "")
         if region.kind == "component":
             region.binary = items.get(region.component.get("item-idref", ""), "")
-    ws.regions.sort(key=lambda r: (r.top, r.left))  # Mathcad's order: top down, left to right
+    ws.regions.sort(key=Region.order)  # Mathcad's order: top down, left to right
     return ws
 
 
@@ -212,18 +218,21 @@ def dy_of(el, top: float) -> float:
     return top + _float(el.get("top"))
 
 
-def _collect(parent, top: float, left: float, out: list[Region]) -> None:
-    """Regions in order; those inside a collapsible area are placed relative to it."""
+def _collect(parent, top: float, left: float, out: list[Region], areas: tuple = ()) -> None:
+    """Regions in order; those inside a collapsible area are placed relative to it, and
+    read with it (``areas``: where the areas around them are)."""
     for el in parent.iterchildren(f"{{{WS}}}region"):
         region = _region(el, top, left)
+        region.areas = areas
         out.append(region)
         text = el.find(f"{{{WS}}}text")
         if text is not None:  # math regions placed inside a paragraph of text
             for p in text.iter(f"{{{WS}}}p"):
-                _collect(p, top, left, out)
+                _collect(p, top, left, out, areas)
         area = el.find(f"{{{WS}}}area")
         if area is not None:
-            _collect(area, dy_of(el, top), left + _float(el.get("left")), out)
+            inner = (*areas, (region.top, region.left))
+            _collect(area, dy_of(el, top), left + _float(el.get("left")), out, inner)
 
 
 def _float(text, default=0.0) -> float:

@@ -157,29 +157,29 @@ class ExprTranslator(Visitor):
             args = args[0].children
         tag = op.tag
         if tag in _BINARY and len(args) == 2:
-            left, right = self.visit(args[0]), self.visit(args[1])
+            left, right = self.value(args[0]), self.value(args[1])
             if tag == "div":
                 left, right = self._radians(left, right), self._radians(right, left)
             return ex.Binary(_BINARY[tag], left, right)
         if tag in _COMPARE and len(args) == 2:
-            return ex.Compare((_COMPARE[tag],), (self.visit(args[0]), self.visit(args[1])))
+            return self._compare(tag, args)
         if tag == "neg" and len(args) == 1:
-            return ex.Unary("-", self.visit(args[0]))
+            return ex.Unary("-", self.value(args[0]))
         if tag in ("and", "or") and len(args) == 2:
-            return ex.Logic(tag, (self.visit(args[0]), self.visit(args[1])))
+            return _logic(tag, [self.condition(a) for a in args])
         if tag == "not" and len(args) == 1:
-            return ex.Unary("not", self.visit(args[0]))
+            return ex.Unary("not", self.condition(args[0]))
         if tag == "nthRoot" and len(args) == 2:
-            n, x = self.visit(args[0]), self.visit(args[1])
+            n, x = self.value(args[0]), self.value(args[1])
             return ex.Binary("^", x, ex.Binary("/", ex.Number(1.0), n))
         if tag == "absval" and len(args) == 1:
-            return self._absval(self.visit(args[0]))
+            return self._absval(self.value(args[0]))
         if tag in OPERATOR_FUNCTIONS and len(args) == 1:
-            return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.visit(args[0])])
+            return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.value(args[0])])
         if tag == "id":
             if _is_if(node) and hasattr(ex, "IfElse"):
                 cond, a, b = _if_args(node)
-                return ex.IfElse(self.visit(a), self.visit(cond), self.visit(b))
+                return ex.IfElse(self.value(a), self.condition(cond), self.value(b))
             return self._call(op, args)
         if tag == "indexer" and len(args) == 2:
             return self._index(args)
@@ -192,6 +192,43 @@ class ExprTranslator(Visitor):
         if tag in ("Maximize", "Minimize") and _solve_methods():
             return self.tr.extremum(self, args, tag == "Maximize")
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
+
+    def value(self, node: MNode) -> ex.Node:
+        """``node`` where Mathcad uses a number: a comparison (Mathcad's 1 or 0) is
+        ``(1 if C otherwise 0)``."""
+        return _as_number(self.visit(node))
+
+    def condition(self, node: MNode) -> ex.Node:
+        """``node`` where Mathcad tests it (if, while, if()): a product of comparisons is
+        ``C1 and C2`` (Mathcad's idiom for and), a sum of them ``C1 or C2``, a comparison
+        itself; any other value is true where it is not 0 (``X != 0``)."""
+        inner = _unparen(node)
+        if inner.tag == "apply" and len(inner.children) == 3:
+            op = inner.children[0].tag
+            if op in ("mult", "plus") and all(_is_condition(a) for a in inner.children[1:]):
+                word = "and" if op == "mult" else "or"
+                return _logic(word, [self.condition(a) for a in inner.children[1:]])
+        tree = self.visit(node)
+        if _is_boolean(tree):
+            return tree
+        return ex.Compare(("!=",), (tree, ex.Number(0.0)))
+
+    def _compare(self, tag: str, args: list[MNode]) -> ex.Node:
+        """A comparison; Mathcad's ranged inequality ``a <= t <= b`` (stored as a comparison
+        whose left side is an inequality, without brackets) is the chain ``a <= t <= b``."""
+        left = args[0]
+        if (
+            tag in _INEQUALITY
+            and left.tag == "apply"
+            and len(left.children) == 3
+            and left.children[0].tag in _INEQUALITY
+        ):
+            chain = self._compare(left.children[0].tag, left.children[1:])
+            if isinstance(chain, ex.Compare):
+                return ex.Compare(
+                    (*chain.ops, _COMPARE[tag]), (*chain.operands, self.value(args[1]))
+                )
+        return ex.Compare((_COMPARE[tag],), (self.value(args[0]), self.value(args[1])))
 
     def _radians(self, node: ex.Node, other: ex.Node) -> ex.Node:
         """``node / rad`` where ``node`` is an angle in degrees (or another angle unit) and
@@ -264,7 +301,7 @@ class ExprTranslator(Visitor):
         rows, cols = int(node.attrs.get("rows", 0)), int(node.attrs.get("cols", 0))
         if rows * cols != len(node.children) or rows * cols == 0:
             raise Untranslatable("a matrix whose size does not match its elements")
-        cells = [self.visit(c) for c in node.children]
+        cells = [self.value(c) for c in node.children]
         return ex.Matrix(
             tuple(tuple(cells[c * rows + r] for c in range(cols)) for r in range(rows))
         )
@@ -273,18 +310,18 @@ class ExprTranslator(Visitor):
         if not hasattr(ex, "Index"):
             raise Untranslatable("an array index (arrays are not in the language yet)")
         target, index = args[0], args[1]
-        indices = [self.visit(i) for i in (index.children if index.tag == "sequence" else [index])]
+        indices = [self.value(i) for i in (index.children if index.tag == "sequence" else [index])]
         shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
         if shift:
             indices = [ex.Binary("+", i, ex.Number(float(shift))) for i in indices]
-        return ex.Index(self.visit(target), tuple(indices))
+        return ex.Index(self.value(target), tuple(indices))
 
     def _column(self, args: list[MNode]) -> ex.Node:
         """Mathcad's column M<j>: submatrix(M, first row, last row, j, j)."""
         for name in ("submatrix", "rows"):
             if name not in language_functions():
                 raise Untranslatable(f"a matrix column ({name}() is not in the language yet)")
-        m, j = self.visit(args[0]), self.visit(args[1])
+        m, j = self.value(args[0]), self.value(args[1])
         shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
         if shift:
             j = ex.Binary("+", j, ex.Number(float(shift)))
@@ -299,7 +336,7 @@ class ExprTranslator(Visitor):
         return ex.Call("submatrix", (m, ex.Number(float(o)), last, j, j))
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
-        return self._builtin("sqrt", "sqrt", [self.visit(node.children[0])])
+        return self._builtin("sqrt", "sqrt", [self.value(node.children[0])])
 
     def _absval(self, x: ex.Node) -> ex.Node:
         """Mathcad's |x|: abs of a number, but the length of a vector and the determinant of
@@ -328,7 +365,7 @@ class ExprTranslator(Visitor):
                 raise Untranslatable(
                     f"{sym.mathcad}(...) multiplies or indexes a value (not a function call)"
                 )
-            call = ex.Call(sym.token(), tuple(self.visit(a) for a in args))
+            call = ex.Call(sym.token(), tuple(self.value(a) for a in args))
             self.tr.calls.setdefault(sym, []).append(call.args)
             return call
         text = key[0]
@@ -342,7 +379,7 @@ class ExprTranslator(Visitor):
                 if len(args) != len(order):
                     raise Untranslatable(f"{text}() with {len(args)} arguments")
                 args = [args[i] for i in order]
-            return self._builtin(name, text, [self.visit(a) for a in args])
+            return self._builtin(name, text, [self.value(a) for a in args])
         if text in REFUSED and not key[1]:
             raise Untranslatable(f"Mathcad's {text}() {REFUSED[text]}")
         raise Untranslatable(
@@ -824,7 +861,7 @@ class Translator:
         if _is_if(rhs):
             return Item("definition", region.id, pieces=self.if_pieces(rhs, {}), unit=display)
         et = ExprTranslator(self)
-        body = et.visit(rhs)
+        body = et.value(rhs)
         if et.ranges:
             raise Untranslatable(
                 f"uses the range variable {et.ranges[0].mathcad} outside a function "
@@ -856,9 +893,9 @@ class Translator:
                 cond, value = line.children
                 if value.tag in ("program", "localDefine"):
                     raise Untranslatable("a program with local definitions or blocks")
-                out.append((et.visit(value), et.visit(cond)))
+                out.append((et.value(value), et.condition(cond)))
             elif line.tag == "otherwise" and len(line.children) == 1:
-                out.append((et.visit(line.children[0]), None))
+                out.append((et.value(line.children[0]), None))
             else:
                 raise Untranslatable(
                     f"a program with {_what(line.tag)} lines (only 'if' and 'otherwise' "
@@ -879,12 +916,12 @@ class Translator:
         while _is_if(node):
             cond, a, b = _if_args(node)
             et = ExprTranslator(self, local)
-            out.append((et.visit(a), et.visit(cond)))
+            out.append((et.value(a), et.condition(cond)))
             if et.ranges:
                 raise Untranslatable("an if() over a range variable")
             node = b
         et = ExprTranslator(self, local)
-        out.append((et.visit(node), None))
+        out.append((et.value(node), None))
         if et.ranges:
             raise Untranslatable("an if() over a range variable")
         return out
@@ -917,13 +954,16 @@ class Translator:
         if target.tag != "id":
             raise Untranslatable("an element assignment to something that is not a name")
         key = _key(target)
+        nodes = index.children if index.tag == "sequence" else [index]
+        ranges = [self._range_of(n) if n.tag == "id" else None for n in nodes]
+        if all(r is None for r in ranges) and available_programs():
+            self.element(region, key, lhs, rhs)
+            return
         sym = self.define(key, "var", region.id)
         try:
             self._forced(region, sym)
             if not hasattr(ex, "Matrix"):
                 raise Untranslatable("an element assignment (vectors are not in the language yet)")
-            nodes = index.children if index.tag == "sequence" else [index]
-            ranges = [self._range_of(n) if n.tag == "id" else None for n in nodes]
             if any(r is None for r in ranges) or len(ranges) > 2:
                 raise Untranslatable(
                     "an element assignment v[k] := ... at a single index (the language "
@@ -943,7 +983,7 @@ class Translator:
                 local[_key(n)] = p
                 params.append(p)
             et = ExprTranslator(self, local)
-            body = et.visit(rhs)
+            body = et.value(rhs)
             if et.ranges:
                 raise Untranslatable("an element assignment over another range variable")
         except Untranslatable as why:
@@ -963,6 +1003,37 @@ class Translator:
         else:
             rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
         self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
+
+    def element(self, region: Region, key, lhs: MNode, rhs: MNode) -> None:
+        """v[k] := value at an index that is not a range variable (Mathcad sets one element
+        of v, making or growing it): a new definition of v, a program that copies the
+        previous definition of v (if there is one), sets the element and gives it."""
+        from .program import ProgramTranslator
+
+        previous = self.scope.get(key)
+        sym = self.define(key, "var", region.id)
+        try:
+            self._forced(region, sym)
+            if previous is not None and previous.broken:
+                raise Untranslatable(_uses(previous))
+            if previous is not None and (previous.kind == "func" or previous.is_range):
+                raise Untranslatable(
+                    f"an element of {previous.mathcad}, which is a "
+                    + ("function" if previous.kind == "func" else "range variable")
+                )
+            program = ProgramTranslator(self, {}, ExprTranslator)
+            value = program._expr(rhs)  # the right side sees the previous definition
+            local = self.new_sym("local", sym.base, sym.mathcad)
+            lines = []
+            if previous is not None:
+                lines.append((0, [ex.Name(local.token()), " := ", ex.Name(previous.token())]))
+            program.locals[key] = program.scope[key] = local
+            index = program._expr(lhs)  # v[k], its index shifted by ORIGIN
+            lines += [(0, [index, " := ", value]), (0, [ex.Name(local.token())])]
+        except Untranslatable as why:
+            sym.broken = str(why)
+            raise
+        self.out.items.append(Item("definition", region.id, sym=sym, program=lines))
 
     def range_variable(self, region: Region, key, rng: MNode) -> None:
         sym = self.define(key, "var", region.id)
@@ -1006,7 +1077,7 @@ class Translator:
                 item = Item("function", region.id, params=psyms, pieces=self.if_pieces(body, local))
             else:
                 et = ExprTranslator(self, local)
-                item = Item("function", region.id, params=psyms, body=et.visit(body))
+                item = Item("function", region.id, params=psyms, body=et.value(body))
                 if et.ranges:
                     raise Untranslatable(
                         f"uses the range variable {et.ranges[0].mathcad} inside a function"
@@ -1028,6 +1099,9 @@ class Translator:
             return  # Mathcad stored nothing (not calculated, or an error)
         expr = node.children[0]
         mathcad = self.describe_expr(expr)
+        if _is_nested(result.children[0]):
+            self.nested(region, expr, target, result.children[0], mathcad)
+            return
         try:
             unit, values = _stored(result.children[0])
         except Untranslatable as why:
@@ -1103,6 +1177,70 @@ class Translator:
         self.out.items.append(Item("function", region.id, sym=sym, params=[k], body=body))
         self.out.results.append(Result(region.id, sym, mathcad, unit, at, k))
 
+    def nested(self, region: Region, expr: MNode, target: Sym | None, stored: MNode, mathcad):
+        """A nested array Mathcad shows (a vector of vectors...): each leaf a printed value,
+        read by chained indices; the leaves at one place inside the outer elements
+        (``TT[i][2][1]`` for every i) are a function of the outer index, as an array
+        result's elements are."""
+        try:
+            leaves = list(_leaves(stored))
+        except Untranslatable as why:
+            self.out.results.append(Result(region.id, None, mathcad, "", []))
+            self.skip(region.id, f"the result of {mathcad}", str(why))
+            return
+        try:
+            if target is not None:
+                if target.broken:
+                    raise Untranslatable(target.broken)
+                base = ex.Name(target.token())
+            else:
+                self.forced_region(region)
+                et = ExprTranslator(self)
+                base = et.value(expr)
+                if et.ranges:
+                    raise Untranslatable("an evaluation of a nested array over a range variable")
+            self.nested_result(region, base, leaves, mathcad)
+        except Untranslatable as why:
+            unit = next((u for _, u, _ in leaves if u), "")
+            self.broken_result(region, mathcad, unit, [v for _, _, v in leaves], str(why))
+            if target is None or not target.broken:
+                self.skip(region.id, f"the result of {mathcad}", str(why))
+
+    def nested_result(self, region: Region, base: ex.Node, leaves, mathcad: str) -> None:
+        if not isinstance(base, ex.Name):
+            whole = self.new_sym("helper", f"result_{region.id}_value", mathcad, region.id)
+            self.out.items.append(Item("definition", region.id, sym=whole, body=base))
+            base = ex.Name(whole.token())
+        o = self.sheet_origin
+        k = self.index_sym()
+        kn = ex.Name(k.token())
+        groups: dict[tuple, list] = {}
+        for path, unit, value in leaves:
+            row, col, _, cols = path[0]
+            groups.setdefault(path[1:], []).append((float(row * cols + col), unit, value))
+        _, _, _, cols = leaves[0][0][0]
+        if cols == 1:  # the index of the element itself
+            outer: tuple = (kn,)
+        else:  # the element's number row by row from 0
+            row = ex.Call("floor", (ex.Binary("/", kn, ex.Number(float(cols))),))
+            col = ex.Binary("-", kn, ex.Binary("*", ex.Number(float(cols)), row))
+            first = ex.Number(float(o))
+            outer = (ex.Binary("+", first, row), ex.Binary("+", first, col))
+        for tail, rows in groups.items():
+            body: ex.Node = ex.Index(base, outer)
+            text = suffix = ""
+            for r, c, _, ncols in tail:
+                at = [o + a for a in ((r,) if ncols == 1 else (r, c))]
+                body = ex.Index(body, tuple(ex.Number(float(a)) for a in at))
+                text += "[" + ", ".join(map(str, at)) + "]"
+                suffix += "_" + "_".join(map(str, at))
+            what = f"{mathcad}[...]{text}"
+            sym = self.new_sym("helper", f"result_{region.id}{suffix}", what, region.id)
+            self.out.items.append(Item("function", region.id, sym=sym, params=[k], body=body))
+            at = [(a + o if cols == 1 else a, v) for a, _, v in rows]
+            unit = next((u for _, u, _ in rows if u), "")
+            self.out.results.append(Result(region.id, sym, what, unit, at, k))
+
     def solve_block(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         if self.given[0] in self.forced:
             raise Untranslatable(self.forced[self.given[0]])
@@ -1137,7 +1275,7 @@ class Translator:
         inner = ExprTranslator(self, {**et.local, **local})
         equations = []
         for c in eqs:
-            left, right = inner.visit(c.children[1]), inner.visit(c.children[2])
+            left, right = inner.value(c.children[1]), inner.value(c.children[2])
             equations.append(ex.Compare(("==",), (left, right)))
         conditions = [inner.visit(c) for c in ineqs]  # checked at the root found
         if inner.ranges:
@@ -1229,7 +1367,7 @@ class Translator:
 
     def standalone(self, region: Region, expr: MNode, unit: str, values, mathcad: str, shape):
         et = ExprTranslator(self)
-        body = et.visit(expr)
+        body = et.value(expr)
         ranges = list(dict.fromkeys(et.ranges))
         if not ranges:
             if len(values) != 1:
@@ -1342,6 +1480,12 @@ def _writer(node: MNode, arity: int) -> tuple[str, str, MNode | None] | None:
 
 def _is_indexer(node: MNode) -> bool:
     return node.tag == "apply" and len(node.children) == 3 and node.children[0].tag == "indexer"
+
+
+def available_programs() -> bool:
+    from .program import available
+
+    return available()
 
 
 def _has_solve() -> bool:
@@ -1547,6 +1691,29 @@ def _unit_monomial(node: MNode) -> str:
     return " * ".join(parts)
 
 
+def _is_nested(node: MNode) -> bool:
+    """Is ``node`` a stored array whose elements are arrays (Mathcad's nested array)?"""
+    return node.tag == "matrix" and any(c.tag == "matrix" for c in node.children)
+
+
+def _leaves(node: MNode, path: tuple = ()):
+    """(path, unit, value) of every number or text of a stored nested array; the path has
+    (row, column, rows, columns) of each array it passes, outermost first (Mathcad stores a
+    matrix column by column)."""
+    if node.tag != "matrix":
+        unit, values = _stored(node)
+        if len(values) != 1:
+            raise Untranslatable("a nested array result with a matrix that has units")
+        yield path, unit, values[0]
+        return
+    rows, cols = int(node.attrs.get("rows", 0)), int(node.attrs.get("cols", 0))
+    if rows * cols != len(node.children):
+        raise Untranslatable("an array result whose size does not match its values")
+    for n, child in enumerate(node.children):
+        col, row = divmod(n, rows)
+        yield from _leaves(child, (*path, (row, col, rows, cols)))
+
+
 def _shape(node: MNode) -> tuple[int, int]:
     """(rows, cols) of a stored result: (1, 1) for a scalar."""
     inner = node.children[0] if node.tag == "unitedValue" and node.children else node
@@ -1733,3 +1900,48 @@ class _Values(Visitor):
             n.func, n.func
         )
         return self.ureg.Quantity(float(getattr(np, name)(v.to("").magnitude)))
+
+
+# -- Mathcad's comparisons are numbers (1 or 0), its numbers conditions (true where not 0) --
+def _is_boolean(tree: ex.Node) -> bool:
+    """Is ``tree`` a condition of the language (a comparison, and/or, not)?"""
+    return isinstance(tree, (ex.Compare, ex.Logic)) or (
+        isinstance(tree, ex.Unary) and tree.op == "not"
+    )
+
+
+def _as_number(tree: ex.Node) -> ex.Node:
+    """A condition where Mathcad uses its value: ``(1 if C otherwise 0)``."""
+    if _is_boolean(tree) and hasattr(ex, "IfElse"):
+        return ex.IfElse(ex.Number(1.0), tree, ex.Number(0.0))
+    return tree
+
+
+def _logic(op: str, values: list[ex.Node]) -> ex.Node:
+    """``a and b and c`` (nested ands flattened)."""
+    flat: list[ex.Node] = []
+    for v in values:
+        flat += list(v.values) if isinstance(v, ex.Logic) and v.op == op else [v]
+    return ex.Logic(op, tuple(flat))
+
+
+def _unparen(node: MNode) -> MNode:
+    while node.tag == "parens" and node.children:
+        node = node.children[0]
+    return node
+
+
+def _is_condition(node: MNode) -> bool:
+    """Is ``node`` a comparison, and/or/not, or a product or sum of such (Mathcad's idioms
+    for and, or)?"""
+    node = _unparen(node)
+    if node.tag != "apply" or not node.children:
+        return False
+    op = node.children[0].tag
+    if op in _COMPARE or op in ("and", "or", "not"):
+        return True
+    return (
+        op in ("mult", "plus")
+        and len(node.children) == 3
+        and all(_is_condition(a) for a in node.children[1:])
+    )

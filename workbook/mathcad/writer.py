@@ -77,9 +77,11 @@ def _assign(tr: Translation) -> None:
     for sym in tr.syms:
         if sym.kind in ("var", "func", "helper") and not sym.is_range:
             claim(sym)
-    for sym in tr.syms:  # locals: never a name of the sheet; programs may share them
-        if sym.kind == "local":
-            claim(sym, share=lambda o: o.kind == "local", alt=False)
+    for sym in tr.syms:  # locals: never a name of the sheet; programs share a local's name
+        if sym.kind == "local":  # (two locals of one program are two Mathcad names: x.LN, x.LN_)
+            claim(
+                sym, share=lambda o, s=sym: o.kind == "local" and o.mathcad == s.mathcad, alt=False
+            )
     for sym in arguments:
         claim(sym, share=lambda o, s=sym: (o.kind == "param" or o.is_range) and o.unit == s.unit)
     for sym in tr.syms:
