@@ -354,3 +354,22 @@ def test_two_locals_whose_identifiers_meet_stay_two(tmp_path, capsys):
     assert "x_LN := 1\nx_LN_2 := 2\nx_LN - x_LN_2" in text
     result = _check(tmp_path, capsys, "two")
     assert result["reproduced"] == 1, result["failures"]
+
+
+def test_top_level_destructuring(tmp_path, capsys):
+    """[a; b] := pair(3) (ORIGIN 1): the value a definition of its own, each name an element;
+    b = 6 as stored."""
+    pair = _matrix(_id("x"), _apply("mult", _real(2), _id("x")))
+    text = _import(
+        tmp_path,
+        capsys,
+        "top",
+        _function(1, "pair", ["x"], pair),
+        _define(2, _matrix(_id("a"), _id("b")), _call("pair", _real(3))),
+        _eval(3, _id("b"), _real(6)),
+        origin=1,
+    )
+    assert 'parts = { expr = "pair(3)"' in text and 'b = { expr = "parts[2]"' in text
+    assert "->" not in text.split("[sheet]")[0]  # parts is no Mathcad name that changed
+    result = _check(tmp_path, capsys, "top")
+    assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]

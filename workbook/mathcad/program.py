@@ -377,7 +377,7 @@ class ProgramTranslator:
         while name in self.taken:
             name, n = f"{base}_{n}", n + 1
         self.taken.add(name)
-        return self.tr.new_sym("local", name, name)
+        return self.tr.new_sym("local", name, name, generated=True)
 
     def _range(self, rng: MNode) -> list:
         first = rng.children[0]

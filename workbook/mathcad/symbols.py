@@ -30,6 +30,7 @@ class Sym:
     final: str = ""
     hint: ex.Node | None = None  # a bound variable: an expression in its unit
     hint_sym: Sym | None = None  # a bound variable: the parameter it stands for
+    generated: bool = False  # a name of the translation's own (no Mathcad name)
 
     def token(self) -> str:
         return f"\x00{id(self)}"

@@ -772,6 +772,9 @@ class Translator:
         if _is_indexer(lhs) and evaluation is None:
             self.elements(region, lhs, rhs)
             return
+        if lhs.tag == "matrix" and evaluation is None and hasattr(ex, "Index"):
+            self.destructure(region, lhs, rhs)
+            return
         if lhs.tag != "id":
             if evaluation is not None:
                 self.stored_but_broken(region, evaluation, f"{_what(lhs.tag)} := ...")
@@ -1003,6 +1006,37 @@ class Translator:
         else:
             rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
         self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
+
+    def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> None:
+        """[a; b] := value: the value a definition of its own (``parts``), then each name
+        its element at ORIGIN."""
+        rows, cols = int(lhs.attrs.get("rows", 0)), int(lhs.attrs.get("cols", 0))
+        names = lhs.children
+        if rows * cols != len(names) or not names or any(n.tag != "id" for n in names):
+            raise Untranslatable("a definition of a matrix of something that is not names")
+        whole = self.new_sym("var", "parts", f"[...] := (region {region.id})", region.id)
+        whole.generated = True
+        try:
+            self._forced(region, whole)
+            et = ExprTranslator(self)
+            body = et.value(rhs)
+            if et.ranges:
+                raise Untranslatable(
+                    f"uses the range variable {et.ranges[0].mathcad} outside a function"
+                )
+        except Untranslatable as why:
+            for n in names:
+                self.define(_key(n), "var", region.id).broken = str(why)
+            raise
+        self.out.items.append(Item("definition", region.id, sym=whole, body=body))
+        o = self.sheet_origin
+        for c in range(cols):
+            for r in range(rows):
+                at = (r,) if cols == 1 else (r, c)
+                index = tuple(ex.Number(float(o + a)) for a in at)
+                sym = self.define(_key(names[c * rows + r]), "var", region.id)
+                item = ex.Index(ex.Name(whole.token()), index)
+                self.out.items.append(Item("definition", region.id, sym=sym, body=item))
 
     def element(self, region: Region, key, lhs: MNode, rhs: MNode) -> None:
         """v[k] := value at an index that is not a range variable (Mathcad sets one element

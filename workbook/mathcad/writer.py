@@ -133,7 +133,11 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             ":= or =), left out: " + ", ".join(tr.ignored)
         )
     renamed = sorted(
-        {(s.mathcad, s.final) for s in tr.syms if s.mathcad != s.final and s.kind != "helper"}
+        {
+            (s.mathcad, s.final)
+            for s in tr.syms
+            if s.mathcad != s.final and s.kind != "helper" and not s.generated
+        }
     )
     if renamed:
         head.append("#")
