@@ -32,6 +32,12 @@ def _sign(x):
     return mpmath.sign(x)
 
 
+def _remainder(u, v):
+    """u - v*trunc(u/v): the sign of u, as Mathcad's mod (mpmath.fmod takes that of v)."""
+    q = u / v
+    return u - v * (mpmath.floor(q) if q >= 0 else mpmath.ceil(q))
+
+
 # built-in name -> (worksheet expression of u[, v], mpmath reference, domain of u[, v])
 FUNCTIONS = {
     "sin": ("sin(u)", mpmath.sin, (-20, 20)),
@@ -54,6 +60,7 @@ FUNCTIONS = {
     "ceil": ("ceil(u)", mpmath.ceil, (-5, 5)),
     "min": ("min(u, v, 0.5)", lambda u, v: min(u, v, mpmath.mpf(0.5)), (-3, 3), (-3, 3)),
     "max": ("max(u, v)", max, (-3, 3), (-3, 3)),
+    "mod": ("mod(u, v)", lambda u, v: _remainder(u, v), (-20, 20), (0.3, 7)),
 }
 
 # operator -> (worksheet expression, mpmath reference, domains, exact: correctly rounded)

@@ -227,10 +227,19 @@ def test_a_vector_is_made_and_grown_by_its_elements(tmp_path):
     np.testing.assert_allclose(sheet.evaluate("grid", 1).magnitude, i + 10 * j + 1)
     assert sheet.evaluate("fib", 1).magnitude == 34
     assert sheet.evaluate("count", 2).magnitude == 10
+    # a length known only when the program runs: a run-time array (workbook.runtime)
+    late = _sheet(
+        tmp_path,
+        '[arguments]\nx = { unit = "" }\n[definitions]\n'
+        + prog("upto(x)", "for k in 0 .. x\n    w[k] := 1\nw")
+        + prog("maybe(x)", "w[0] := 1\nif x > 0\n    w[3] := 2\nw")
+        + prog("stopped(x)", "for k in 0 .. 3\n    w[k] := 1\n    break if k > x\nw"),
+    )
+    np.testing.assert_allclose(late.evaluate("upto", 2).magnitude[:, 0], [1, 1, 1])
+    np.testing.assert_allclose(late.evaluate("maybe", 1).magnitude[:, 0], [1, 0, 0, 2])
+    np.testing.assert_allclose(late.evaluate("maybe", -1).magnitude[:, 0], [1])
+    np.testing.assert_allclose(late.evaluate("stopped", 1).magnitude[:, 0], [1, 1, 1])
     for body, message in [
-        ("for k in 0 .. x\n    w[k] := 1\nw", "its index k is known only when the program runs"),
-        ("w[0] := 1\nif x > 0\n    w[3] := 2\nw", "it is set under an if"),
-        ("for k in 0 .. 3\n    w[k] := 1\n    break if k > x\nw", "loop with break"),
         ("w := [0]\nfor k in 0 .. 3\n    w[k] := rows(w)\nw", "'w' is used whole where the"),
     ]:
         with pytest.raises(workbook.WorkbookError, match=re.escape(message)):

@@ -246,6 +246,30 @@ register(
 )
 
 
+def _mod_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    x, y = args
+    y = ctx.convert(y, x.unit, "mod(x, y): x and y")
+    return ty.TFunc(x.unit, func=name, args=(x, y))
+
+
+def _excel_mod(args: list[str]) -> tuple[str, int]:
+    x, y = args  # Excel's MOD takes the sign of y; Mathcad's mod that of x
+    return f"({x})-({y})*TRUNC(({x})/({y}))", PREC["+"]
+
+
+_simple(
+    "mod",
+    np.fmod,
+    _excel_mod,
+    lambda sp, x, y: x - y * sp.sign(x / y) * sp.floor(sp.Abs(x / y)),
+    "remainder of x / y, with the sign of x (Mathcad's mod)",
+    rule=_mod_unit,
+    domain=(Domain("mod by zero", lambda v: v == 0, "mod(x, {})", arg=1),),
+    arity=2,
+    excel_functions=("TRUNC",),
+)
+
+
 # -- sum(EXPR, I, A, B): a built-in that binds a variable ------------------------------------
 #: Most terms of sum(); Excel gets the terms written out up to MAX_EXCEL_TERMS.
 MAX_TERMS = 1_000_000

@@ -59,6 +59,8 @@ class Builtin:
     mathml: str = ""
     mathml_powered: bool = False
     arrays: bool = False  # takes vectors/matrices: the hooks get ``shapes=`` (workbook.matrix)
+    # the unit rule when an argument is a run-time array (workbook.runtime); None: refused
+    runtime: Callable[..., ty.T] | None = None
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""

@@ -54,6 +54,11 @@ class ExcelPrinter(Visitor):
         self.helpers = None
         self._calls: dict[tuple, tuple[str, int]] = {}  # (function, argument texts) -> printed
 
+    def visit(self, t, *args):
+        if tc.is_runtime(getattr(t, "shape", None)):
+            raise NotLive("an array whose size is known only when its program runs")
+        return super().visit(t, *args)
+
     def formula(self, t: tc.T, subst: dict[str, str]) -> str:
         self.array = False  # set when the formula computes with arrays (an array formula)
         text = "=" + self.print(t, subst)

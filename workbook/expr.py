@@ -255,16 +255,13 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
 
 
 def _matrix(node: ast.List, text: str, what: str, depth: int) -> Matrix:
-    """``[a, b]`` is a column; ``[[a, b], [c, d]]`` a matrix by rows (``[[a, b]]`` a row)."""
+    """``[a, b]`` is a column; ``[[a, b], [c, d]]`` a matrix by rows (``[[a, b]]`` a row);
+    a column with some bracketed elements, ``[n, [0, 30]]``, holds those arrays as elements
+    (a nested array)."""
     if not node.elts:
         raise TemplateError(f"{what}: an empty vector [] in {text!r}")
     nested = [isinstance(e, ast.List) for e in node.elts]
-    if any(nested) and not all(nested):
-        raise TemplateError(
-            f"{what}: write a vector [a, b, c] or a matrix by rows [[a, b], [c, d]], "
-            f"not a mix, in {text!r}"
-        )
-    if not any(nested):
+    if not all(nested):
         return Matrix(tuple((_convert(e, text, what, depth),) for e in node.elts))
     rows = []
     for r in node.elts:

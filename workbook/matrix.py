@@ -298,7 +298,7 @@ def register_entries() -> None:
 
         return printed
 
-    def entry(name, arity, rule, numpy, excel, doc, uses=()):
+    def entry(name, arity, rule, numpy, excel, doc, uses=(), runtime=None):
         register(
             Builtin(
                 name,
@@ -310,8 +310,28 @@ def register_entries() -> None:
                 doc=doc,
                 excel_functions=uses,
                 arrays=True,
+                runtime=runtime,
             )
         )
+
+    # the unit rules when an argument is a run-time array (workbook.runtime): units are
+    # checked here, shapes when the program runs
+    def origin_arg(ctx):
+        return ty.TConst(ctx.dimensionless, value=float(ctx.spec.origin))
+
+    def rt_same_unit(ctx, name, args):
+        unit = args[0].unit
+        conv = [ctx.convert(a, unit, f"{name}(): argument {k + 1}") for k, a in enumerate(args)]
+        return func(unit, name, conv, ty.RUNTIME)
+
+    def rt_with_origin(result_unit):
+        def rule(ctx, name, args):
+            rest = [ctx.plain(a, f"{name}(): argument {k}") for k, a in enumerate(args[1:], 2)]
+            shape = None if result_unit == "plain" else ty.RUNTIME
+            unit = ctx.dimensionless if result_unit == "plain" else args[0].unit
+            return func(unit, name, [args[0], *rest, origin_arg(ctx)], shape)
+
+        return rule
 
     def func(unit, name, args, shape):
         return ty.TFunc(unit, func=name, args=tuple(args), shape=shape)
@@ -320,6 +340,9 @@ def register_entries() -> None:
     def r_transpose(ctx, name, args):
         r, c = need(args, 0, name)
         return func(args[0].unit, name, args, (c, r))
+
+    def rt_transpose(ctx, name, args):
+        return func(args[0].unit, name, args, ty.RUNTIME)
 
     def r_det(ctx, name, args):
         n = square(args, name)
@@ -521,17 +544,19 @@ def register_entries() -> None:
         "augment",
         (2, None),
         r_join(1),
-        lambda *m, shapes: augment(*m),
+        lambda *m, shapes: augment(*_numbers_as_1x1(m, shapes)),
         not_live("augment() is written as values"),
         "matrices side by side (same rows)",
+        runtime=rt_same_unit,
     )
     entry(
         "stack",
         (2, None),
         r_join(0),
-        lambda *m, shapes: stack(*m),
+        lambda *m, shapes: stack(*_numbers_as_1x1(m, shapes)),
         not_live("stack() is written as values"),
         "matrices one above the other (same columns)",
+        runtime=rt_same_unit,
     )
 
     def r_submatrix(ctx, name, args):
@@ -556,9 +581,30 @@ def register_entries() -> None:
         "submatrix",
         5,
         r_submatrix,
-        lambda m, ir, jr, ic, jc, shapes: submatrix(m, int(ir), int(jr), int(ic), int(jc)),
+        numpy_submatrix,
         not_live("submatrix() is written as values"),
         "submatrix(M, first row, last row, first column, last column)",
+        runtime=rt_with_origin("same"),
+    )
+
+    def r_csort(ctx, name, args):
+        r, c = need(args, 0, name)
+        j = ctx.plain(args[1], "csort(): the column")
+        if isinstance(j, ty.TConst) and not ctx.spec.origin <= j.value < ctx.spec.origin + c:
+            raise TemplateError(
+                f"csort(): column {j.value:g} is outside the {shape_text((r, c))} "
+                f"(origin {ctx.spec.origin})"
+            )
+        return func(args[0].unit, name, [args[0], j, origin_arg(ctx)], (r, c))
+
+    entry(
+        "csort",
+        2,
+        r_csort,
+        lambda m, j, origin, shapes: csort(m, j, int(origin)),
+        not_live("csort() is written as values"),
+        "csort(M, j): the rows of M sorted by column j, smallest first (Mathcad's csort)",
+        runtime=rt_with_origin("same"),
     )
 
     # sizes (constants at load)
@@ -572,13 +618,29 @@ def register_entries() -> None:
 
         return rule
 
+    def numpy_size(kind: str):
+        def hook(v, origin=0.0, *, shapes):  # a run-time array: its size when it runs
+            from .runtime import size
+
+            return size(kind, v, int(origin))
+
+        return hook
+
     for kind, doc in (
         ("rows", "number of rows"),
         ("cols", "number of columns"),
         ("length", "number of elements of a vector"),
         ("last", "index of the last element of a vector (with the sheet's origin)"),
     ):
-        entry(kind, 1, r_size(kind), _typed_as_constant, not_live(kind), doc)
+        entry(
+            kind,
+            1,
+            r_size(kind),
+            numpy_size(kind),
+            not_live(kind),
+            doc,
+            runtime=rt_with_origin("plain"),
+        )
 
     # reductions: max and min of numbers and of the elements of matrices; mean
     def r_reduce(ctx, name, args):
@@ -621,6 +683,7 @@ def register_entries() -> None:
                 doc=doc,
                 excel_functions=(excel_name,),
                 arrays=True,
+                runtime=r_reduce,
             )
         )
     entry(
@@ -631,12 +694,42 @@ def register_entries() -> None:
         _excel_list("AVERAGE"),
         "mean of the arguments (or of the elements of vectors and matrices)",
         ("AVERAGE",),
+        runtime=r_reduce,
     )
 
 
-def _typed_as_constant(*values, shapes):
-    """rows, cols, length and last are constants of the typed tree, never evaluated."""
-    raise TypeError("a size of a matrix is a constant at load")  # pragma: no cover
+def _numbers_as_1x1(values, shapes):
+    """stack and augment take a number as a 1x1 matrix (as Mathcad's)."""
+    return [np.reshape(v, (1, 1)) if s is None else v for v, s in zip(values, shapes)]
+
+
+def numpy_submatrix(m, ir, jr, ic, jc, origin=0.0, *, shapes):
+    """submatrix(M, ir, jr, ic, jc): bounds made origin 0 at load, or (a run-time array)
+    checked here against the shape M has."""
+    origin = int(origin)
+    bounds = [int(round(float(b))) - origin for b in (ir, jr, ic, jc)]
+    if origin or shapes[0] is not None and np.ndim(m) == 2:
+        r, c = np.shape(m)
+        ir, jr, ic, jc = bounds
+        if not (0 <= ir <= jr < r and 0 <= ic <= jc < c):
+            raise InputError(
+                f"submatrix(M, {ir + origin}, {jr + origin}, {ic + origin}, {jc + origin}) is "
+                f"outside the {r}x{c} matrix (origin {origin})"
+            )
+    return submatrix(m, *bounds)
+
+
+def csort(m, j, origin: int):
+    """The rows of ``m`` sorted by column ``j`` (stable, smallest first)."""
+    m = np.asarray(m, dtype=float)
+    k = int(round(float(j))) - origin
+    if m.ndim != 2:
+        raise InputError("csort(): the matrix varies over a range; sort a fixed matrix")
+    if not 0 <= k < m.shape[1]:
+        raise InputError(
+            f"csort(): column {k + origin} is outside the {m.shape[0]}x{m.shape[1]} matrix"
+        )
+    return m[np.argsort(m[:, k], kind="stable")]
 
 
 def _excel_list(function: str):

@@ -19,6 +19,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from . import runtime as rt
 from . import typecheck as tc
 from . import typed as ty
 from .errors import DomainError, InputError
@@ -156,6 +157,9 @@ class Evaluator(Visitor):
 
     def visit_TBinary(self, t: tc.TBinary) -> Fn:
         left, right = self.compile(t.left), self.compile(t.right)
+        if ty.is_runtime(t.shape):
+            op, what = t.op, _text(t)
+            return lambda env: rt.binary(op, left(env), right(env), what)
         if t.left.shape is not None or t.right.shape is not None:
             return _matrix_binary(t, left, right)
         if t.op == "^":
@@ -186,6 +190,14 @@ class Evaluator(Visitor):
 
     def visit_TCompare(self, t: tc.TCompare) -> Fn:
         parts = [self.compile(o) for o in t.operands]
+        if any(ty.is_runtime(o.shape) for o in t.operands):
+            ops_text, what = t.ops, _text(t)
+
+            def runtime_chain(env):
+                vals = [p(env) for p in parts]
+                return all(rt.compare(op, x, y, what) for op, x, y in zip(ops_text, vals, vals[1:]))
+
+            return runtime_chain
         ops = [_CMP[o] for o in t.ops]
         if len(parts) == 2:
             a, b, op = parts[0], parts[1], ops[0]
@@ -217,6 +229,17 @@ class Evaluator(Visitor):
         f = entry.numpy
         if entry.binds and len(t.args) > max(entry.binds):
             return self._binding(t, entry)
+        if entry.arrays and any(ty.is_runtime(a.shape) for a in t.args):
+            args, hook, what = [self.compile(a) for a in t.args], f, _text(t)
+
+            def runtime_call(env):
+                values = [rt.value(a(env)) for a in args]
+                try:
+                    return rt.value(hook(*values, shapes=rt.shapes(values)))
+                except (TypeError, ValueError) as err:  # numpy refusing a nested array
+                    raise InputError(f"{what}: {err}") from None
+
+            return runtime_call
         if entry.arrays:
             f = functools.partial(f, shapes=tuple(a.shape for a in t.args))
         args = [self.compile(a) for a in t.args]
@@ -280,6 +303,8 @@ class Evaluator(Visitor):
         from .matrix import build
 
         rows = [[self.compile(e) for e in row] for row in t.rows]
+        if ty.is_runtime(t.shape):  # an array of arrays
+            return lambda env: rt.build([[e(env) for e in row] for row in rows])
         if all(isinstance(e, tc.TConst) for row in t.rows for e in row):
             value = np.array([[e.value for e in row] for row in t.rows])
             return lambda env: value
@@ -293,6 +318,10 @@ class Evaluator(Visitor):
         idx = [self.compile(i) for i in t.indices]
         shape, origin = t.target.shape, t.origin
         what = typed_text(t)
+        if ty.is_runtime(shape):
+            return lambda env: rt.index(
+                target(env), [i(env) for i in idx], origin=origin, what=what
+            )
         if len(idx) == 1:
             i0 = idx[0]
             return lambda env: index(target(env), i0(env), origin=origin, shape=shape, what=what)
@@ -306,9 +335,16 @@ class Evaluator(Visitor):
 
         run = compile_program(t.program, self.compile, t.name)
         params, is_text, name = t.params, t.text, t.name
-        matrix = tuple(t.shape or ())
+        runtime = ty.is_runtime(t.shape)
+        matrix = () if runtime else tuple(t.shape or ())
 
         matrices = t.matrices
+
+        def each(point):
+            out = run(point)
+            if runtime:  # over a range, each point's value must be a number
+                return rt.number(out, f"'{name}' over a range")
+            return out
 
         def program(env):
             arrays = {
@@ -323,7 +359,7 @@ class Evaluator(Visitor):
                 out = np.empty(matrix + grid, dtype=object if is_text else float)
                 lead = (slice(None),) * len(matrix)  # a matrix value: its axes come first
                 for ix in np.ndindex(grid):
-                    out[lead + ix] = run({**env, **at(ix)})
+                    out[lead + ix] = each({**env, **at(ix)})
                 return out
             except NoValue:
                 raise InputError(
@@ -379,6 +415,13 @@ class Evaluator(Visitor):
             return out
 
         return looped
+
+
+def _text(t: tc.T) -> str:
+    """The source text of a typed node, for run-time errors."""
+    from .analysis import typed_text
+
+    return typed_text(t)
 
 
 def _constant(t: tc.T) -> bool:

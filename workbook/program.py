@@ -40,7 +40,9 @@ from typing import Any
 import numpy as np
 
 from . import expr as ex
+from . import runtime as rt
 from .errors import LimitError, TemplateError
+from .typed import RUNTIME, is_runtime
 
 #: Statements one call of a program may execute (a `while` that never ends stops here).
 MAX_STEPS = 1_000_000
@@ -429,14 +431,16 @@ def type_program(
     the next); every value the program can give must agree (numbers in one dimension, or text).
     """
     pending: dict[str, Any] = {}
+    runtime: set[str] = set()
     grown = growth(program, typing.origin)
     for _ in range(4):
-        state = _TypeState(dict(scope), dict(pending), typing, reserved, grown)
+        state = _TypeState(dict(scope), dict(pending), typing, reserved, grown, set(runtime))
         body = state.block(program.body, top=True)
-        if state.local_units == pending:
+        if state.local_units == pending and state.runtime == runtime:
             break
         pending = dict(state.local_units)
-    _grown_used_whole(program, grown, state.growing)
+        runtime = set(state.runtime)
+    _grown_used_whole(program, grown, state.growing - state.runtime)
     if state.value_unit is None and not state.value_text:
         raise TemplateError("the program gives no value (no return and no value line)")
     unit = state.value_unit if not state.value_text else typing.unit_of(state.first_value)
@@ -447,8 +451,12 @@ def type_program(
 
 
 class _TypeState:
-    def __init__(self, scope, hints, typing: ExprTyping, reserved, grown=None):
+    def __init__(self, scope, hints, typing: ExprTyping, reserved, grown=None, runtime=()):
         self.grown: dict[str, _Growth] = grown or {}
+        # locals whose shape is known only when the program runs (workbook.runtime): grown
+        # at indices not known at load, given arrays as elements, or given values of
+        # different shapes where one is such an array
+        self.runtime: set[str] = set(runtime)
         self.growing: set[str] = set()  # locals made or grown by their elements
         self.top = 0  # the top-level statement being typed
         self.scope = scope
@@ -493,6 +501,8 @@ class _TypeState:
         shape = self.t.shape_of(t)
         if self.value_shape is _UNSET:
             self.value_shape = shape
+        elif is_runtime(shape) or is_runtime(self.value_shape):
+            self.value_shape = RUNTIME
         elif shape != self.value_shape:
             raise TemplateError(
                 f"{self.where(s)}: the program gives {_shape_words(shape)} here and "
@@ -521,6 +531,11 @@ class _TypeState:
             )
         t = self.number(s.value, s, f"the value of '{s.name}'")
         shape = self.t.shape_of(t)
+        if is_runtime(shape) or s.name in self.runtime:
+            self.runtime.add(s.name)
+            shape = RUNTIME
+        elif s.name in self.local_shapes and is_runtime(self.local_shapes[s.name]):
+            shape = RUNTIME
         if s.name in self.local_shapes and self.local_shapes[s.name] != shape:
             raise TemplateError(
                 f"{self.where(s)}: '{s.name}' was {_shape_words(self.local_shapes[s.name])}, "
@@ -541,10 +556,19 @@ class _TypeState:
 
     def set_item(self, s: SetItem):
         shape = self.local_shapes.get(s.name)
+        given = self.scope.get(s.name)
+        if shape is None and isinstance(given, tuple) and s.name not in self.reserved:
+            # an argument's vector: the program sets elements of its own copy (as Mathcad)
+            shape = self.local_shapes[s.name] = given[1]
+            self.local_units.setdefault(s.name, given[0])
         g = self.grown.get(s.name)
         reach = None
         if g is not None and not g.why and min(g.extent) >= 0:
             reach = (g.extent[0] + 1, g.extent[1] + 1 if len(g.extent) == 2 else 1)
+        if s.name in self.runtime or is_runtime(shape):
+            return self.runtime_item(s)
+        if shape is None and reach is None and s.name not in self.reserved:
+            return self.runtime_item(s)  # grown at indices known only when it runs
         if shape is None or (reach is not None and (reach[0] > shape[0] or reach[1] > shape[1])):
             if s.name in self.reserved:
                 raise TemplateError(
@@ -565,8 +589,8 @@ class _TypeState:
         words = ("row", "column") if len(s.indices) == 2 else ("element",)
         idx = tuple(self.t.index(i, self.scope, n, w) for i, n, w in zip(s.indices, shape, words))
         t = self.number(s.value, s, f"an element of '{s.name}'")
-        if self.t.shape_of(t) is not None:
-            raise TemplateError(f"{self.where(s)}: an element is a number, not a matrix")
+        if self.t.shape_of(t) is not None:  # an array as an element: a nested array
+            return self.runtime_item(s)
         unit = self.local_units.get(s.name) or self.hints.get(s.name) or self.t.unit_of(t)
         value = self.t.convert(t, unit, f"{self.where(s)}: an element of '{s.name}'")
         if s.name in self.growing:
@@ -574,6 +598,31 @@ class _TypeState:
             self.scope[s.name] = self.t.scope_entry(unit, shape)
             return SetItem(s.line, s.name, idx, value, self.t.origin, shape)
         return SetItem(s.line, s.name, idx, value, self.t.origin)
+
+    def runtime_item(self, s: SetItem):
+        """``v[i] := x`` on a local whose shape is known only when the program runs: made,
+        grown (with zeros) or nested as in Mathcad, checked when it runs."""
+        if s.name in self.reserved:
+            raise TemplateError(
+                f"{self.where(s)}: '{s.name}' is a name of the sheet; give the local another name"
+            )
+        if len(s.indices) > 2:
+            raise TemplateError(f"{self.where(s)}: at most two indices, {s.name}[i, j]")
+        self.runtime.add(s.name)
+        t = self.number(s.value, s, f"an element of '{s.name}'")
+        unit = self.local_units.get(s.name) or self.hints.get(s.name)
+        if unit is None and not self.t.is_zero(t):
+            unit = self.t.unit_of(t)
+        if unit is not None:
+            self.local_units[s.name] = unit
+            value = self.t.convert(t, unit, f"{self.where(s)}: an element of '{s.name}'")
+        else:  # only zeros so far: the unit comes from another element
+            value = t
+        self.local_shapes[s.name] = RUNTIME
+        self.scope[s.name] = self.t.scope_entry(unit or self.t.unit_of(t), RUNTIME)
+        words = ("row", "column") if len(s.indices) == 2 else ("element",)
+        idx = tuple(self.t.index(i, self.scope, None, w) for i, w in zip(s.indices, words))
+        return SetItem(s.line, s.name, idx, value, self.t.origin, RUNTIME)
 
     def block(self, block, top: bool = False):
         out = []
@@ -621,6 +670,8 @@ _UNSET = object()
 def _shape_words(shape) -> str:
     if shape is None:
         return "a number"
+    if is_runtime(shape):
+        return "an array of a size known when it runs"
     r, c = shape
     return f"a {r}x{c} matrix" if c != 1 else f"a vector of {r}"
 
@@ -803,7 +854,11 @@ def compile_program(
             def assign(env, last):
                 tick(s)
                 value = f(env)  # a matrix is copied: its elements may be set later
-                env[n] = np.array(value, dtype=float) if np.ndim(value) else value
+                if isinstance(value, np.ndarray) and value.dtype == object:
+                    env[n] = value.copy()
+                else:
+                    env[n] = np.array(value, dtype=float) if np.ndim(value) else value
+                env.setdefault(_OWNED, set()).add(n)
                 return last
 
             return assign
@@ -812,9 +867,28 @@ def compile_program(
 
             f, n, origin, grow = compile_expr(s.value), s.name, s.origin, s.grow
             idx = [compile_expr(i) for i in s.indices]
+            if is_runtime(grow):
+                what = f"program of '{name}', line {s.line}: {n}[...]"
+
+                def set_runtime(env, last):
+                    tick(s)
+                    owned = env.setdefault(_OWNED, set())
+                    old = env.get(n)
+                    if n not in owned and isinstance(old, np.ndarray):
+                        old = old.copy()  # an argument's array is the caller's
+                    owned.add(n)
+                    at = [i(env) for i in idx]
+                    env[n] = rt.set_item(old, at, f(env), origin=origin, what=what)
+                    return last
+
+                return set_runtime
 
             def set_item(env, last):
                 tick(s)
+                owned = env.setdefault(_OWNED, set())
+                if n not in owned and isinstance(env.get(n), np.ndarray):
+                    env[n] = env[n].copy()  # an argument's array is the caller's
+                owned.add(n)
                 if grow is not None:  # made, or grown with zeros, to its length at load
                     old = env.get(n)
                     if old is None or np.shape(old)[:2] != tuple(grow):
@@ -875,11 +949,12 @@ def compile_program(
             body, var = block(s.body), s.var
 
             def for_(env, last):
+                where = f"program of '{name}', line {s.line}"
                 values = range_values(
-                    float(first(env)),
-                    float(second(env)) if second is not None else None,
-                    float(last_(env)),
-                    what=f"program of '{name}', line {s.line}",
+                    rt.number(first(env), where),
+                    rt.number(second(env), where) if second is not None else None,
+                    rt.number(last_(env), where),
+                    what=where,
                 )
                 for v in values:
                     tick(s)
@@ -912,21 +987,38 @@ def compile_program(
         raise TypeError(s)  # pragma: no cover
 
     main = block(typed.body)
+    # a local made by its elements when the program runs is the number 0 until its first
+    # element is set (Mathcad's start of a local): rows(v) is 0, so v[rows(v) + 1] appends
+    made = {s.name for s in walk(typed.body) if isinstance(s, SetItem) and is_runtime(s.grow)}
 
     def run(env: dict):
         steps[0] = 0
         local = dict(env)
+        for n in made:
+            local.setdefault(n, 0.0)
         try:
             out = main(local, _NONE)
         except _Return as r:
-            return np.array(r.value) if np.ndim(r.value) else r.value
+            return _result(r.value)
         except (_Break, _Continue):
             raise TemplateError(f"'break'/'continue' outside a loop in '{name}'") from None
         if out is _NONE:
             raise NoValue(name)
-        return np.array(out) if np.ndim(out) else out
+        return _result(out)
 
     return run
+
+
+def _result(value):
+    """A program's value: an array is the program's own copy."""
+    if isinstance(value, np.ndarray):
+        return value.copy() if value.dtype == object else np.array(value)
+    return value
+
+
+#: Where a program run keeps the names of the locals it made (an argument's array is copied
+#: before its first element is set); not a valid name, so no local can meet it.
+_OWNED = "#owned"
 
 
 # -- a live spreadsheet formula ---------------------------------------------------------------

@@ -11,6 +11,7 @@ import numpy as np
 import pint
 
 from . import expr as ex
+from . import runtime as rt
 from . import typecheck as tc
 from . import units as un
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
@@ -328,7 +329,7 @@ class Sheet:
                         line=d.line,
                         definition=name,
                     )
-            elif not np.all(np.isfinite(value)):
+            elif not rt.all_finite(value):
                 raise DomainError(
                     f"{name} has elements that are not finite numbers; its formula is {d.text}",
                     file=self.file,

@@ -23,6 +23,7 @@ from . import expr as ex
 from . import units as un
 from .errors import TemplateError, UnitError
 from .typed import (
+    RUNTIME,
     T,
     TBinary,
     TConst,
@@ -33,6 +34,7 @@ from .typed import (
     TParam,
     TPiecewise,
     TProgram,
+    is_runtime,
     is_zero,
     shape_text,
 )
@@ -53,11 +55,12 @@ class ArrayTyping:
             raise TemplateError(f"a matrix of {r * c} elements (limit {MAX_ELEMENTS})")
         typed = [[self.visit(e, scope) for e in row] for row in node.rows]
         first = None
+        nested = any(e.shape is not None for row in typed for e in row)
         for i, row in enumerate(typed):
             for j, e in enumerate(row):
                 where = f"element [{i}, {j}] of the matrix"
-                if e.boolean or e.text or e.shape is not None:
-                    what = "a comparison" if e.boolean else "text" if e.text else "a matrix"
+                if e.boolean or e.text:
+                    what = "a comparison" if e.boolean else "text"
                     raise TemplateError(f"{where} is {what}; elements are numbers")
                 self._number(e, where)
                 if first is None and not is_zero(e):
@@ -77,7 +80,8 @@ class ArrayTyping:
                     )
                 out.append(self.convert(e, unit, f"element [{i}, {j}] of the matrix"))
             rows.append(tuple(out))
-        return TMatrix(unit, rows=tuple(rows), shape=(r, c))
+        # an array of arrays (Mathcad's nested array): its shape is looked at when it runs
+        return TMatrix(unit, rows=tuple(rows), shape=RUNTIME if nested else (r, c))
 
     def visit_Index(self, node: ex.Index, scope) -> T:
         target = self.visit(node.target, scope)
@@ -85,8 +89,19 @@ class ArrayTyping:
             raise TemplateError(
                 f"{ex.to_text(node.target)} is not a vector or matrix; it cannot be indexed"
             )
-        r, c = target.shape
         n = len(node.indices)
+        if is_runtime(target.shape):  # its shape, and the element's, are known when it runs
+            if n > 2:
+                raise TemplateError(f"{ex.to_text(node)}: at most two indices, M[i, j]")
+            words = ("row", "column") if n == 2 else ("element",)
+            idx = tuple(
+                self.typed_index(i, scope, None, w, ex.to_text(node))
+                for i, w in zip(node.indices, words)
+            )
+            return TIndex(
+                target.unit, target=target, indices=idx, origin=self.spec.origin, shape=RUNTIME
+            )
+        r, c = target.shape
         if n == 1 and c != 1:
             raise TemplateError(
                 f"{ex.to_text(node.target)} is a {shape_text(target.shape)}: "
@@ -98,13 +113,14 @@ class ArrayTyping:
             idx.append(self.typed_index(i, scope, size, word, ex.to_text(node)))
         return TIndex(target.unit, target=target, indices=tuple(idx), origin=self.spec.origin)
 
-    def typed_index(self, i: ex.Node, scope, size: int, word: str, what: str) -> T:
-        """An index: a plain number; a constant one is checked against ``size`` here."""
+    def typed_index(self, i: ex.Node, scope, size: int | None, word: str, what: str) -> T:
+        """An index: a plain number; a constant one is checked against ``size`` here (None:
+        a run-time array, checked when it runs)."""
         origin = self.spec.origin
         t = self.plain(self._number(self.visit(i, scope), "an index"), f"the {word} index")
-        if t.shape is not None:
+        if t.shape is not None and not is_runtime(t.shape):
             raise TemplateError(f"the {word} index is a matrix; an index is a number")
-        if isinstance(t, TConst):
+        if isinstance(t, TConst) and size is not None:
             v = t.value
             if v != int(v) or not origin <= v < origin + size:
                 raise TemplateError(
@@ -148,6 +164,8 @@ class ArrayTyping:
     def matrix_binary(self, op: str, left: T, right: T) -> T:
         """``left op right`` where at least one side is a vector or matrix."""
         ls, rs = left.shape, right.shape
+        if is_runtime(ls) or is_runtime(rs):
+            return self.runtime_binary(op, left, right)
         if op in "+-":
             if ls is not None and rs is not None and ls != rs:
                 raise TemplateError(
@@ -209,6 +227,34 @@ class ArrayTyping:
             raise UnitError(f"matrix power {n} is out of range (at most 1000)")
         return TBinary(left.unit**n, op="@^", left=left, right=right, shape=ls)
 
+    def runtime_binary(self, op: str, left: T, right: T) -> T:
+        """``left op right`` with a run-time array on one side: units as for numbers, the
+        shapes by Mathcad's rules when it runs (:func:`workbook.runtime.binary`)."""
+        if self._elementwise:
+            raise TemplateError(
+                "vectorize(...) of an array whose size is known only when it runs; write a "
+                "loop over its elements"
+            )
+        if op in "+-":
+            if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
+                if is_zero(left):
+                    left = self.convert(left, right.unit, "sum")
+                else:
+                    self._mismatch(op, left, right)
+            right = self.convert(right, left.unit, "sum")
+            return TBinary(left.unit, op=op, left=left, right=right, shape=RUNTIME)
+        if op == "*":
+            return TBinary(left.unit * right.unit, op="*", left=left, right=right, shape=RUNTIME)
+        if op == "/":
+            return TBinary(left.unit / right.unit, op="/", left=left, right=right, shape=RUNTIME)
+        if not right.unit.dimensionless or right.unit.dimensionality:
+            raise UnitError(f"an exponent must be dimensionless, got {un.dims(right.unit)}")
+        right = self.convert(right, self.dimensionless, "exponent")
+        if left.unit.dimensionality and not isinstance(right, TConst):
+            raise UnitError(f"{un.dims(left.unit)} raised to a variable power has no unit")
+        unit = left.unit**right.value if isinstance(right, TConst) else left.unit
+        return TBinary(unit, op="^", left=left, right=right, shape=RUNTIME)
+
     def _same_shape(self, verb: str, ls, rs) -> None:
         if ls != rs:
             raise TemplateError(
@@ -230,6 +276,8 @@ class ArrayTyping:
         shaped = [a.shape for a in args if a.shape is not None]
         if not shaped:
             return typed
+        if any(is_runtime(s) for s in shaped):  # numbers, or arrays element by element
+            return replace(typed, shape=RUNTIME)
         if len(args) != 1:
             raise TemplateError(
                 f"{name}() takes numbers, not a vector or matrix; index the elements, or "

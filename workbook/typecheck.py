@@ -44,6 +44,7 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TypedFunction,
     children,
     is_bare,
+    is_runtime,
     is_zero,
     shape_text,
 )
@@ -443,7 +444,7 @@ class Typer(ArrayTyping, Visitor):
     def visit_Compare(self, node: ex.Compare, scope) -> T:
         ops = list(node.operands)
         typed = [self.visit(o, scope) for o in ops]
-        if any(t.shape is not None for t in typed):
+        if any(t.shape is not None and not is_runtime(t.shape) for t in typed):
             raise TemplateError("cannot compare a vector or matrix; compare its elements, v[i]")
         texts = [t.text or (isinstance(t, TRef) and t.kind == "choice") for t in typed]
         if any(texts):
@@ -531,6 +532,13 @@ class Typer(ArrayTyping, Visitor):
             raise self._unknown("function", name, scope)
         entry = REGISTRY[name]
         entry.check_arity(len(args))
+        if entry.arrays and any(is_runtime(a.shape) for a in args):
+            if entry.runtime is None:
+                raise TemplateError(
+                    f"{name}() of an array whose size is known only when the program runs is "
+                    "not supported"
+                )
+            return entry.runtime(self, name, tuple(args))
         typed = entry.unit_rule(self, name, tuple(args))
         return typed if entry.arrays else self.elementwise_call(name, entry, tuple(args), typed)
 
@@ -604,6 +612,11 @@ class Typer(ArrayTyping, Visitor):
         for i, a in enumerate(node.args):
             if i in entry.data_args:
                 col = self.spec.data.get(a.id) if isinstance(a, ex.Name) else None
+                if col is None and not (isinstance(a, ex.Name) and a.id not in scope):
+                    typed = self._number(self.visit(a, scope), f"argument {i + 1} of {name}()")
+                    if typed.shape is not None:  # a vector of the sheet or of a program
+                        args.append(typed)
+                        continue
                 if col is None:
                     known = ", ".join(self.spec.data) or "none: add a [data] table"
                     raise TemplateError(
@@ -647,7 +660,13 @@ def specialization_key(name: str, shapes: tuple) -> str:
     ``1`` for a number); ``name`` itself for numbers only."""
     if not any(shapes):
         return name
-    return name + "@" + ",".join("1" if s is None else f"{s[0]}x{s[1]}" for s in shapes)
+    return name + "@" + ",".join(_shape_key(s) for s in shapes)
+
+
+def _shape_key(shape) -> str:
+    if shape is None:
+        return "1"
+    return "?" if is_runtime(shape) else f"{shape[0]}x{shape[1]}"
 
 
 def _key_of(key: str) -> str:

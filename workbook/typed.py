@@ -238,8 +238,45 @@ def is_zero(t: T) -> bool:
     )
 
 
+class RuntimeShape:
+    """The shape of a value known only when a program runs (a vector grown element by
+    element, a nested array): one object, :data:`RUNTIME`. It cannot be unpacked or indexed,
+    so code that needs rows and columns at load fails loudly instead of guessing."""
+
+    _instance = None
+
+    def __new__(cls):
+        if cls._instance is None:
+            cls._instance = super().__new__(cls)
+        return cls._instance
+
+    def __iter__(self):
+        raise TypeError("the shape of a run-time array is not known at load")
+
+    __getitem__ = __len__ = __iter__
+
+    def __bool__(self) -> bool:  # a shape: "an array", as a (rows, columns) tuple is
+        return True
+
+    def __repr__(self) -> str:
+        return "RUNTIME"
+
+    def __reduce__(self):
+        return (RuntimeShape, ())
+
+
+RUNTIME = RuntimeShape()
+
+
+def is_runtime(shape) -> bool:
+    """True for the shape of a value known only when its program runs."""
+    return shape is RUNTIME
+
+
 def shape_text(shape) -> str:
     """``3x2 matrix`` or ``vector of 3``, for messages."""
+    if shape is RUNTIME:
+        return "array of a size known when it runs"
     r, c = shape
     return f"{r}x{c} matrix" if c != 1 else f"vector of {r}"
 

@@ -236,6 +236,10 @@ class WorkbookWriter:
         that cannot be computed shows the error as text in its cell."""
         defs = [d for d in self.sheet.spec.definitions.values() if not d.is_function]
         matrices = [d for d in defs if self._shape(d.name) is not None]
+        runtime = [d for d in matrices if tc.is_runtime(self._shape(d.name))]
+        arrays = [d for d in runtime if self._runtime_value(d.name) is not None]
+        # an array known only when it runs that is a number when it runs is a scalar result
+        matrices = [d for d in matrices if d not in runtime or d in arrays]
         written = getattr(self, "on_matrices", set())
         if [d for d in matrices if d.name not in written]:
             self.write_matrices([d for d in matrices if d.name not in written])
@@ -296,6 +300,9 @@ class WorkbookWriter:
         self.on_matrices = getattr(self, "on_matrices", set()) | {d.name for d in defs}
         for d in defs:
             t = self.sheet.typer.scalar(d.name)
+            if tc.is_runtime(t.shape):
+                row = self._write_runtime(ws, row, d, t)
+                continue
             value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
             r, c = t.shape
             ws.write_string(row, 0, d.name, self.fmt["header"])
@@ -306,6 +313,43 @@ class WorkbookWriter:
             self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
             row = top + r + 1
         self.rows["Matrices"] = row
+
+    def _runtime_value(self, name: str):
+        """The array a definition whose size is known only when it runs has (None when it is
+        a number, or cannot be computed: then it is written with the scalar results)."""
+        from .runtime import is_array, value
+
+        try:
+            v = value(self.sheet.scalar_value(name, "definition"))
+        except WorkbookError:
+            return None
+        return v if is_array(v) else None
+
+    def _write_runtime(self, ws, row: int, d, t: tc.T) -> int:
+        """An array whose size is known only when its program ran: its values (a nested
+        array, whose elements are arrays, as a line of text), with a comment."""
+        value = self._runtime_value(d.name)
+        r, c = value.shape
+        ws.write_string(row, 0, d.name, self.fmt["header"])
+        ws.write_string(row, 1, f"{un.pretty(t.unit) or '1'}   {d.text}   {d.note}".strip())
+        top = row + 1
+        if value.dtype == object:
+            ws.write_string(top, 1, _nested_text(value))
+            ws.write_comment(
+                top, 1, "A nested array (its elements are arrays): shown as text, not cells"
+            )
+            self.not_live.append(d.name)
+            return top + 2
+        for i in range(r):
+            for j in range(c):
+                ws.write_number(top + i, 1 + j, float(value[i, j]), self.fmt["number"])
+        ws.write_comment(
+            top, 1, "Values, not formulas: an array whose size is known only when its program runs"
+        )
+        self.not_live.append(d.name)
+        last = f"{_col_letter(c)}${top + r}"
+        self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
+        return top + r + 1
 
     def _shape(self, name: str):
         """(rows, columns) of a definition's value, None for a number (or one in error)."""
@@ -1132,3 +1176,18 @@ class HelperBlock:
 
     def write(self, i: int, j: int, formula: str, value: float) -> None:
         self.ws.write_formula(self.first + i, j + 1, formula, None, value)
+
+
+def _nested_text(value) -> str:
+    """A nested array as text, in the language's literals: a column [a, b], a matrix by rows
+    [[a, b], [c, d]], an array element in its place ([1, [0, 30]])."""
+    from .runtime import is_array
+
+    def text(v) -> str:
+        if not is_array(v):
+            return f"{float(v):.10g}"
+        if v.shape[1] == 1:
+            return "[" + ", ".join(text(e) for e in v[:, 0]) + "]"
+        return "[" + ", ".join("[" + ", ".join(text(e) for e in row) + "]" for row in v) + "]"
+
+    return text(value)

@@ -19,7 +19,7 @@ from .. import units as un
 from ..entry import Builtin, register
 from ..errors import NotLive, NotSymbolic, TemplateError, UnitError, WorkbookError
 from ..expr import PREC
-from ._common import Result, chains, live, sheet_tolerance
+from ._common import NumericsError, Result, chains, live, sheet_tolerance
 
 ATOM = PREC["atom"]
 #: rows solved at once (a bracket's samples take rows x samples memory)
@@ -716,6 +716,10 @@ def _interp_unit(ctx, name: str, args: tuple) -> ty.T:
     from .interpolate import check_data
 
     xs, ys, x = args
+    if not (isinstance(xs, ty.TRef) and xs.kind == "data") or not (
+        isinstance(ys, ty.TRef) and ys.kind == "data"
+    ):
+        return _interp_vectors(ctx, name, args)
     cx, cy = ctx.spec.data[xs.name], ctx.spec.data[ys.name]
     if cx.table != cy.table:
         raise TemplateError(
@@ -732,13 +736,46 @@ def _interp_unit(ctx, name: str, args: tuple) -> ty.T:
     return ty.TFunc(ys.unit, func=name, args=(xs, ys, x))
 
 
+def _interp_vectors(ctx, name: str, args: tuple) -> ty.T:
+    """linterp(vx, vy, x) of two vectors (of the sheet, or of a program): their lengths are
+    checked at load when known, else when they run."""
+    xs, ys, x = args
+    for k, v in ((1, xs), (2, ys)):
+        if v.shape is None:
+            raise TemplateError(f"{name}(): argument {k} must be a vector or a [data] column")
+        if not ty.is_runtime(v.shape) and v.shape[1] != 1:
+            shown = ty.shape_text(v.shape)
+            raise TemplateError(f"{name}(): argument {k} is a {shown}, not a vector")
+    if not ty.is_runtime(xs.shape) and not ty.is_runtime(ys.shape) and xs.shape != ys.shape:
+        raise TemplateError(
+            f"{name}(): x and y need the same number of values ({ty.shape_text(xs.shape)} and "
+            f"{ty.shape_text(ys.shape)})"
+        )
+    if x.shape is not None:
+        raise TemplateError(f"{name}(): x is a vector or matrix; give a number")
+    x = ctx.convert(x, xs.unit, f"{name}(): x")
+    return ty.TFunc(ys.unit, func=name, args=(xs, ys, x))
+
+
 def _interp_numpy(kind: str):
     def hook(xs, ys, x):
-        from .interpolate import interpolate
+        from .interpolate import check_data, interpolate
 
-        return _out(interpolate(xs, ys, x, kind=kind, what=f"{_KINDS[kind]}()"))
+        what = f"{_KINDS[kind]}()"
+        if np.ndim(xs) == 2:  # vectors (columns), not [data] columns: checked as they run
+            xs = _data_vector(xs, what)
+            ys = _data_vector(ys, what)
+            check_data(xs, ys, what)
+        return _out(interpolate(xs, ys, x, kind=kind, what=what))
 
     return hook
+
+
+def _data_vector(v, what: str) -> np.ndarray:
+    v = np.asarray(v)
+    if v.ndim != 2 or v.shape[1] != 1 or v.dtype == object:
+        raise NumericsError(f"{what}: the data must be vectors of numbers")
+    return v[:, 0].astype(float)
 
 
 _KINDS = {"linear": "linterp", "cubic": "cspline"}

@@ -1,0 +1,245 @@
+"""Run-time arrays: values whose shape is known only when a program runs, as in Mathcad.
+
+A vector grown element by element (``l[rows(l) + 1] := x``), an array whose elements are
+arrays (``[num, vt, vx]`` with vectors inside) or a local that is a number and later a
+vector has no shape at load: the typer gives it the shape :data:`workbook.typed.RUNTIME`
+and still checks its unit (one unit for all its elements, as every matrix). Its shape is
+checked here, when it runs, by Mathcad's rules; every mistake is an error naming the
+expression, never a guess.
+
+A run-time value is a number (a float) or a matrix: a 2-D numpy array (rows, columns) of
+floats, or of objects when an element is itself an array (a nested array). Run-time values
+never carry the range axes of a table (:mod:`workbook.matrix`): a program runs once per
+point.
+"""
+
+from __future__ import annotations
+
+import operator
+
+import numpy as np
+
+from .errors import InputError
+
+
+def value(v):
+    """``v`` as a run-time value: a float, or a 2-D array (a vector is a column)."""
+    if isinstance(v, np.ndarray):
+        if v.ndim == 0:
+            return v.item() if v.dtype == object else float(v)
+        if v.ndim == 1:
+            return v.reshape(-1, 1)
+        return v
+    if isinstance(v, (bool, np.bool_)):
+        return float(v)
+    if isinstance(v, (int, float, np.number)):
+        return float(v)
+    return v
+
+
+def is_array(v) -> bool:
+    return isinstance(v, np.ndarray) and v.ndim == 2
+
+
+def shape_of(v) -> tuple[int, int] | None:
+    """(rows, columns) of a run-time array, None for a number."""
+    return v.shape if is_array(v) else None
+
+
+def all_finite(v) -> bool:
+    """Every number of ``v`` (of its elements' elements, for a nested array) is finite."""
+    if isinstance(v, np.ndarray) and v.dtype == object:
+        return all(all_finite(value(e)) for e in v.ravel())
+    return bool(np.all(np.isfinite(v)))
+
+
+def describe(v) -> str:
+    if is_array(v):
+        r, c = v.shape
+        nested = " (nested)" if v.dtype == object else ""
+        return (f"a vector of {r}" if c == 1 else f"a {r}x{c} matrix") + nested
+    if isinstance(v, str):
+        return "text"
+    return "a number"
+
+
+def size(kind: str, v, origin: int = 0) -> float:
+    """rows, cols, length or last of a run-time value; a number has 0 rows and columns (as
+    Mathcad's rows of a scalar), so a vector grown from nothing starts at rows 0."""
+    v = value(v)
+    if not is_array(v):
+        r, c = 0, 0
+    else:
+        r, c = v.shape
+    if kind in ("length", "last") and c > 1:
+        raise InputError(f"{kind}() takes a vector, got {describe(v)}")
+    return float({"rows": r, "cols": c, "length": r, "last": r - 1 + origin}[kind])
+
+
+# -- indexing and setting elements ------------------------------------------------------------
+def _position(i, origin: int, n: int | None, word: str, what: str) -> int:
+    x = float(np.asarray(i, dtype=float)) if np.ndim(i) == 0 else None
+    if x is None:
+        raise InputError(f"{what}: the {word} index is an array; an index is a number")
+    k = round(x)
+    if not np.isfinite(x) or abs(x - k) > 1e-9:
+        raise InputError(f"{what}: {word} index {x:g} is not an integer")
+    k -= origin
+    if k < 0 or (n is not None and k >= n):
+        shown = f"{n} {word}s: {origin} .. {origin + n - 1}" if n else f"no {word}s"
+        raise InputError(
+            f"{what}: {word} index {k + origin} is out of range ({shown} with origin {origin})"
+        )
+    return k
+
+
+def index(target, indices: list, *, origin: int, what: str):
+    """``v[i]`` or ``M[i, j]`` of a run-time value (an element may be an array)."""
+    target = value(target)
+    if not is_array(target):
+        raise InputError(f"{what}: the value is {describe(target)}; it cannot be indexed")
+    r, c = target.shape
+    if len(indices) == 1:
+        if c != 1:
+            raise InputError(
+                f"{what}: the value is {describe(target)}; write M[i, j] (one index is for "
+                "a vector)"
+            )
+        at = (_position(indices[0], origin, r, "element", what), 0)
+    else:
+        at = (
+            _position(indices[0], origin, r, "row", what),
+            _position(indices[1], origin, c, "column", what),
+        )
+    return value(target[at])
+
+
+def set_item(target, indices: list, x, *, origin: int, what: str):
+    """``target`` with element ``[i]`` or ``[i, j]`` set to ``x``: a number or a missing local
+    becomes a vector, and an array grows with zeros to reach the index (as Mathcad); an array
+    element makes the array nested. Returns the new array (a copy only when it grows)."""
+    x = value(x)
+    target = value(target) if target is not None else None
+    if len(indices) == 1:
+        if is_array(target) and target.shape[1] != 1:
+            raise InputError(
+                f"{what}: the value is {describe(target)}; set M[i, j] (one index is for a vector)"
+            )
+        at = (_position(indices[0], origin, None, "element", what), 0)
+    else:
+        at = (
+            _position(indices[0], origin, None, "row", what),
+            _position(indices[1], origin, None, "column", what),
+        )
+    if not is_array(target):
+        target = np.zeros((0, 1 if len(indices) == 1 else 0))
+    r, c = target.shape
+    nested = target.dtype == object or is_array(x)
+    if at[0] >= r or at[1] >= c or nested != (target.dtype == object):
+        grown = np.zeros((max(r, at[0] + 1), max(c, at[1] + 1)), dtype=object if nested else float)
+        if nested:
+            grown.fill(0.0)
+        grown[:r, :c] = target
+        target = grown
+    target[at] = x
+    return target
+
+
+def build(rows: list[list]):
+    """A matrix literal with run-time elements: nested when an element is an array."""
+    values = [[value(e) for e in row] for row in rows]
+    if not any(is_array(e) for row in values for e in row):
+        return np.array(values, dtype=float)
+    out = np.empty((len(values), len(values[0])), dtype=object)
+    for i, row in enumerate(values):
+        for j, e in enumerate(row):
+            out[i, j] = e
+    return out
+
+
+# -- operators --------------------------------------------------------------------------------
+_ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}
+
+
+def binary(op: str, a, b, what: str):
+    """``a op b`` by Mathcad's rules on the shapes the values have when they run: ``+ -``
+    element by element (same shape, or an array and a number); ``*`` a number times an
+    array, the dot product of two vectors of one length, else the matrix product; ``/`` by a
+    number; ``^`` a power of a number, or a matrix power (``M^-1`` the inverse)."""
+    a, b = value(a), value(b)
+    sa, sb = shape_of(a), shape_of(b)
+    if sa is None and sb is None:
+        if op == "^":
+            return float(np.power(a, b))
+        return float(_ARITH[op](a, b))
+    for v in (a, b):
+        if is_array(v) and v.dtype == object:
+            raise InputError(f"{what}: arithmetic on a nested array; use its elements")
+    if op in "+-":
+        if sa is not None and sb is not None and sa != sb:
+            raise InputError(f"{what}: cannot add or subtract {describe(a)} and {describe(b)}")
+        return _ARITH[op](a, b)
+    if op == "*":
+        if sa is None or sb is None:
+            return a * b
+        if sa[1] == 1 and sb[1] == 1 and sa[0] == sb[0]:
+            return float(np.sum(a * b))  # Mathcad's v*w of two vectors
+        if sa[1] != sb[0]:
+            raise InputError(f"{what}: cannot multiply {describe(a)} by {describe(b)}")
+        return a @ b
+    if op == "/":
+        if sb is not None:
+            raise InputError(f"{what}: cannot divide by {describe(b)}")
+        return a / b
+    if sb is not None:
+        raise InputError(f"{what}: an exponent must be a number, got {describe(b)}")
+    n = float(b)
+    if sa[0] != sa[1] or n != int(n):
+        raise InputError(f"{what}: a power of {describe(a)} needs a square matrix and an integer")
+    from .matrix import power
+
+    return power(a, int(n))
+
+
+_COMPARE = {
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "==": operator.eq,
+    "!=": operator.ne,
+}
+
+
+def compare(op: str, a, b, what: str) -> bool:
+    """``a op b`` of numbers; ``==`` and ``!=`` of arrays compare whole values (same shape
+    and elements), as Mathcad's; ``<`` of an array is an error."""
+    a, b = value(a), value(b)
+    if is_array(a) or is_array(b):
+        if op not in ("==", "!="):
+            raise InputError(f"{what}: cannot order {describe(a)} and {describe(b)}")
+        same = _same(a, b)
+        return same if op == "==" else not same
+    return bool(_COMPARE[op](a, b))
+
+
+def _same(a, b) -> bool:
+    if not (is_array(a) and is_array(b)) or a.shape != b.shape:
+        return False
+    return all(
+        _same(x, y) if is_array(x) or is_array(y) else bool(x == y)
+        for x, y in zip(a.ravel(), b.ravel())
+    )
+
+
+def shapes(values) -> tuple:
+    """The shapes a matrix built-in's hook gets (``shapes=``) for run-time values."""
+    return tuple(shape_of(value(v)) for v in values)
+
+
+def number(v, what: str) -> float:
+    """A run-time value that must be a number here (a loop bound, a table cell)."""
+    v = value(v)
+    if is_array(v):
+        raise InputError(f"{what}: {describe(v)} where a number is wanted")
+    return v
