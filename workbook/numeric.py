@@ -294,10 +294,12 @@ class Evaluator(Visitor):
     def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
         conds = [None if k is None else self.compile(k) for k in t.conditions]
         matrices = _matrix_names(t)
-        split = _partition(conds, t.texts, matrices)
+        split = _partition(conds, t.texts, matrices, frozenset(ty.parameters(t)))
         keys = tuple(None if k is None else self.plan.keys.key(k) for k in t.conditions)
         split = self._kept(self.plan.keys.signature("pieces", keys), split)
-        return _piecewise(t, conds, [self.compile(v) for v in t.values], split, matrices)
+        return _piecewise(
+            t, conds, [self.compile(v) for v in t.values], split, matrices, ty.parameters(t)
+        )
 
     def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
         from .matrix import build
@@ -470,11 +472,15 @@ def _at(full: dict, matrices: frozenset, take) -> dict:
     return {k: v[lead + (take,)] if k in matrices else v[take] for k, v in full.items()}
 
 
-def _partition(conds: list, texts: tuple, matrices: frozenset = frozenset()) -> Fn:
-    """env with arrays -> (shape, [(piece, mask, env of the piece's points)]): first true wins."""
+def _partition(
+    conds: list, texts: tuple, matrices: frozenset = frozenset(), used: frozenset | None = None
+) -> Fn:
+    """env with arrays -> (shape, [(piece, mask, env of the piece's points)]): first true wins.
+    Only the names the pieces use (``used``) span the grid: a program's other locals do not."""
 
     def split(env):
-        shape, points = _points(env, matrices)
+        seen = env if used is None else {k: v for k, v in env.items() if k in used}
+        shape, points = _points(seen, matrices)
         full = {**env, **points}
         todo = np.ones(shape, dtype=bool)
         pieces = []
@@ -495,13 +501,20 @@ def _partition(conds: list, texts: tuple, matrices: frozenset = frozenset()) -> 
 
 
 def _piecewise(
-    t: tc.TPiecewise, conds: list, values: list, split: Fn, matrices: frozenset = frozenset()
+    t: tc.TPiecewise,
+    conds: list,
+    values: list,
+    split: Fn,
+    matrices: frozenset = frozenset(),
+    used=None,
 ) -> Fn:
     texts = t.texts
+    used = frozenset(used) if used is not None else None
 
     def evaluate(env):
+        seen = env.items() if used is None else ((k, env[k]) for k in used if k in env)
         if not any(
-            isinstance(v, np.ndarray) and v.ndim > 0 and k not in matrices for k, v in env.items()
+            isinstance(v, np.ndarray) and v.ndim > 0 and k not in matrices for k, v in seen
         ) and not any(np.ndim(env.get(k)) > 2 for k in matrices):
             for cond, val in zip(conds, values):
                 if cond is None or bool(cond(env)):

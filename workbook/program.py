@@ -532,8 +532,9 @@ class _TypeState:
         t = self.number(s.value, s, f"the value of '{s.name}'")
         shape = self.t.shape_of(t)
         if is_runtime(shape) or s.name in self.runtime:
+            # given a run-time array here, or elsewhere: it is one everywhere (next pass)
             self.runtime.add(s.name)
-            shape = RUNTIME
+            shape = self.local_shapes[s.name] = RUNTIME
         elif s.name in self.local_shapes and is_runtime(self.local_shapes[s.name]):
             shape = RUNTIME
         if s.name in self.local_shapes and self.local_shapes[s.name] != shape:

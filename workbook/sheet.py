@@ -134,12 +134,6 @@ class Sheet:
             try:
                 self.typer.function(d.name)
             except WorkbookError as err:
-                if "vector or matrix" in err.message:
-                    err.message = (  # typed for the shapes of its calls: there are none
-                        f"no formula calls {d.name}() with a vector or matrix, and with "
-                        f"numbers: {err.message}"
-                    )
-                    err.args = (err.message,)
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
 
     def _check_vary(self, t, name: str, values) -> None:

@@ -22,6 +22,7 @@ from .registry import REGISTRY
 from .template import Definition, SheetSpec
 from .typearrays import ArrayTyping
 from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
+    RUNTIME,
     T,
     TAggregate,
     TBinary,
@@ -109,11 +110,28 @@ class Typer(ArrayTyping, Visitor):
         if name not in self._at_numbers_fails:
             try:
                 return self.specialized(name, ())
-            except WorkbookError:
+            except WorkbookError as at_numbers:
                 if not any(_key_of(k) == name for k in self.functions):
-                    raise
+                    return self._unspecialized(name, at_numbers)
                 self._at_numbers_fails.add(name)
         return next(f for k, f in self.functions.items() if _key_of(k) == name)
+
+    def _unspecialized(self, name: str, at_numbers: WorkbookError) -> TypedFunction:
+        """A function no formula calls with vectors or matrices, whose body fails at numbers:
+        checked with each argument an array of a size known when it is called (its units are
+        checked all the same); an error there is the function's own."""
+        d = self._definition(name)
+        try:
+            return self.specialized(name, (RUNTIME,) * len(d.params))
+        except WorkbookError as err:
+            if err.message == at_numbers.message:
+                raise at_numbers from None
+            err.message = (
+                f"no formula calls {name}() with a vector or matrix; with numbers: "
+                f"{at_numbers.message}; with arrays: {err.message}"
+            )
+            err.args = (err.message,)
+            raise
 
     def specialized(self, name: str, shapes: tuple) -> TypedFunction:
         """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for

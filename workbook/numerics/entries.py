@@ -751,7 +751,7 @@ def _interp_vectors(ctx, name: str, args: tuple) -> ty.T:
             f"{name}(): x and y need the same number of values ({ty.shape_text(xs.shape)} and "
             f"{ty.shape_text(ys.shape)})"
         )
-    if x.shape is not None:
+    if x.shape is not None and not ty.is_runtime(x.shape):
         raise TemplateError(f"{name}(): x is a vector or matrix; give a number")
     x = ctx.convert(x, xs.unit, f"{name}(): x")
     return ty.TFunc(ys.unit, func=name, args=(xs, ys, x))
