@@ -114,7 +114,7 @@ def test_index_out_of_range_names_the_call_and_the_definition(tmp_path):
         ('"f(P, Q)" = "P + Q"\ny = "f([1, 2]*L, [1, 2, 3]*L)"', "cannot add a vector of 3"),
         ('"f(P)" = "det(P)"\ny = "f([1, 2]*L)"', "square"),
         ('"f(P)" = "P[0]"\ny = "f(L)"', "P is not a vector or matrix"),
-        ('"f(P)" = "P[0]"', "P is not a vector or matrix"),
+        ('"f(P)" = "P[0]*nosuch"', "with numbers: P is not a vector or matrix.*with arrays:"),
     ],
 )
 def test_shape_mistakes_are_refused_at_load(tmp_path, body, message):
@@ -173,3 +173,10 @@ def test_a_function_of_vectors_only_is_not_evaluated_with_numbers(tmp_path):
     assert float(sheet.evaluate("y").to("m").magnitude) == 6
     with pytest.raises(InputError, match="takes vectors or matrices"):
         sheet.evaluate("x0", [1.0, 2.0, 3.0])
+
+
+def test_a_function_of_vectors_no_formula_calls_is_checked_with_run_time_arrays(tmp_path):
+    """A library function of vectors that the sheet does not call loads (its units are
+    checked with its argument as an array of a size known when called)."""
+    sheet = _load(tmp_path, '"first(P)" = "P[0]*2"\n')
+    assert sheet.typer.function("first").body.unit == sheet.typer.spec.arguments["P"].unit

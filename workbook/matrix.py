@@ -206,7 +206,8 @@ def reduce(kind: str, *values, matrix: tuple[bool, ...]):
 def index(m, i, j=None, *, origin: int, shape: tuple[int, int], what: str):
     """Element [i] of a vector or [i, j] of a matrix, with the sheet's origin; an index out of
     range or not an integer is an error naming it."""
-    m = np.asarray(m, dtype=float)
+    if type(m) is not np.ndarray or m.dtype != float:
+        m = np.asarray(m, dtype=float)
     ii = _index_values(i, origin, shape[0], "row" if j is not None else "element", what)
     jj = _index_values(j, origin, shape[1], "column", what) if j is not None else 0
     if m.ndim > 2 and (np.ndim(ii) or np.ndim(jj)):
@@ -218,6 +219,10 @@ def index(m, i, j=None, *, origin: int, shape: tuple[int, int], what: str):
 
 
 def _index_values(i, origin: int, n: int, word: str, what: str):
+    if isinstance(i, (int, float)):  # one index (in a program's loop): no array work
+        k = round(i)
+        if abs(i - k) <= 1e-9 and 0 <= k - origin < n:
+            return k - origin
     arr = np.asarray(i, dtype=float)
     k = np.rint(arr)
     if not np.all(np.isfinite(arr)) or np.any(np.abs(arr - k) > 1e-9):

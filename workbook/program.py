@@ -672,7 +672,7 @@ def _shape_words(shape) -> str:
     if shape is None:
         return "a number"
     if is_runtime(shape):
-        return "an array of a size known when it runs"
+        return "a run-time array"
     r, c = shape
     return f"a {r}x{c} matrix" if c != 1 else f"a vector of {r}"
 

@@ -119,12 +119,12 @@ class Typer(ArrayTyping, Visitor):
     def _unspecialized(self, name: str, at_numbers: WorkbookError) -> TypedFunction:
         """A function no formula calls with vectors or matrices, whose body fails at numbers:
         checked with each argument an array of a size known when it is called (its units are
-        checked all the same); an error there is the function's own."""
+        checked all the same); if that fails too, the error says what failed each way."""
         d = self._definition(name)
         try:
             return self.specialized(name, (RUNTIME,) * len(d.params))
         except WorkbookError as err:
-            if err.message == at_numbers.message:
+            if at_numbers.message in err.message:  # the same mistake either way
                 raise at_numbers from None
             err.message = (
                 f"no formula calls {name}() with a vector or matrix; with numbers: "

@@ -276,7 +276,7 @@ def is_runtime(shape) -> bool:
 def shape_text(shape) -> str:
     """``3x2 matrix`` or ``vector of 3``, for messages."""
     if shape is RUNTIME:
-        return "array of a size known when it runs"
+        return "run-time array"
     r, c = shape
     return f"{r}x{c} matrix" if c != 1 else f"vector of {r}"
 
