@@ -227,3 +227,23 @@ def test_a_trace_the_engine_cannot_draw_leaves_the_others(tmp_path, capsys):
     out = tmp_path / "out.xlsx"
     assert main(["run", str(toml), "--out", str(out)]) == 0
     assert len(_charts(out)) == text.count("[[charts]]")
+
+
+def _has_runtime_arrays() -> bool:
+    from workbook.registry import REGISTRY
+
+    return "csort" in REGISTRY
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not _has_runtime_arrays(), reason="the language has no run-time arrays yet")
+def test_frame_library_programs_reproduce_every_stored_value(tmp_path, capsys):
+    """frame/example.xmcd with its library: the train table TT (a nested array: one printed
+    value per number of it), x.e(TT, 1, 3), I.Н := Uk(1, 0)/2 and E.Н(1) (through r_EH, a
+    while loop over Uk) as Mathcad stored them."""
+    toml, _ = _import("frame/example.xmcd", tmp_path, capsys)
+    result = _check(toml, capsys)
+    assert result["failed"] == 0, result["failures"]
+    assert (result["printed"], result["reproduced"]) == (48, 48), result["failures"]
+    text = toml.read_text(encoding="utf-8")
+    assert '"result_875_2_1(index)" = { expr = "TT_7[index][2][1]"' in text
