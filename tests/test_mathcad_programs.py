@@ -196,9 +196,15 @@ def test_column_assignment_is_a_loop(tmp_path, capsys):
         _local(col.format(_id("M"), _real(0)), _apply("mult", _real(2), _id("v"))),
         _id("M"),
     )
-    text = _translated(tmp_path, "col", _function(1, "cols2", ["v"], body)).toml
+    call = _call("cols2", _matrix(_real(1), _real(2)))
+    stored = _matrix(_real(2), _real(4), _real(1), _real(2), cols=2)  # column by column
+    text = _import(
+        tmp_path, capsys, "col", _function(1, "cols2", ["v"], body), _eval(2, call, stored)
+    )
     assert "for k in 0 .. rows(v) - 1\n    M[k, 1] := v[k]" in text
     assert "column := 2 * v\nfor k_2 in 0 .. rows(column) - 1\n    M[k_2, 0] := column[k_2]" in text
+    result = _check(tmp_path, capsys, "col")
+    assert (result["printed"], result["reproduced"]) == (4, 4), result["failures"]
 
 
 def test_locals_start_at_zero_where_read_first(tmp_path, capsys):
@@ -310,16 +316,35 @@ def test_elements_defined_one_by_one(tmp_path, capsys):
 
 
 def test_nested_array_result_is_one_value_per_leaf(tmp_path, capsys):
-    """A stored vector of [number; vector] pairs: one printed value per number, read by
-    chained indices, a function of the outer index for each place inside."""
-    inner = [_matrix(_real(n), _matrix(_real(10 * n), _real(10 * n + 1))) for n in (1, 2)]
-    stored = _matrix(*inner)
-    value = _matrix(*[_matrix(_real(n), _matrix(_real(10 * n), _real(10 * n + 1))) for n in (1, 2)])
-    out = _translated(tmp_path, "nest", _define(1, _id("T"), value), _eval(2, _id("T"), stored))
-    csv = out.csv["nest.mathcad.index.csv"]
-    assert "result_2_0,1.0,2.0," in csv and "result_2_1_1,1.0,21.0," in csv
-    assert len([line for line in csv.splitlines() if line.startswith("result_2")]) == 6
-    assert '"result_2_1_1(index)" = { expr = "T[index][1][1]"' in out.toml
+    """T := [pair(1); pair(2)] with pair(n) := [n; [10 n; 10 n + 1]]: Mathcad stores T as a
+    vector of [number; vector] pairs; one printed value per number, read by chained indices,
+    a function of the outer index for each place inside."""
+    pair = _matrix(
+        _id("n"),
+        _matrix(_apply("mult", _real(10), _id("n")),
+                _apply("plus", _apply("mult", _real(10), _id("n")), _real(1))),
+    )  # fmt: skip
+    stored = _matrix(
+        *[_matrix(_real(n), _matrix(_real(10 * n), _real(10 * n + 1))) for n in (1, 2)]
+    )
+    table = _matrix(_call("pair", _real(1)), _call("pair", _real(2)))
+    literal = _matrix(_matrix(_real(1), _real(2)), _matrix(_real(3), _real(4)))
+    text = _import(
+        tmp_path,
+        capsys,
+        "nest",
+        _function(1, "pair", ["n"], pair),
+        _define(2, _id("T"), table),
+        _eval(3, _id("T"), stored),
+        _define(4, _id("U"), literal),  # a column of literal vectors: [[1, 2], [3, 4]] is a
+    )  # matrix by rows in the language, so it is listed
+    csv = (tmp_path / "nest.mathcad.index.csv").read_text(encoding="utf-8")
+    assert "result_3_0,1.0,2.0," in csv and "result_3_1_1,1.0,21.0," in csv
+    assert len([line for line in csv.splitlines() if line.startswith("result_3")]) == 6
+    assert '"result_3_1_1(index)" = { expr = "T[index][1][1]"' in text
+    assert "region 4: U := ...: a column whose every element is a vector written out" in text
+    result = _check(tmp_path, capsys, "nest")
+    assert (result["printed"], result["reproduced"]) == (6, 6), result["failures"]
 
 
 def test_collapsed_area_is_read_at_its_place(tmp_path, capsys):

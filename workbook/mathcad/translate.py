@@ -302,6 +302,11 @@ class ExprTranslator(Visitor):
         if rows * cols != len(node.children) or rows * cols == 0:
             raise Untranslatable("a matrix whose size does not match its elements")
         cells = [self.value(c) for c in node.children]
+        if cols == 1 and all(isinstance(c, ex.Matrix) for c in cells):
+            raise Untranslatable(
+                "a column whose every element is a vector written out (the language reads "
+                "[[a, b], [c, d]] as a matrix by rows)"
+            )
         return ex.Matrix(
             tuple(tuple(cells[c * rows + r] for c in range(cols)) for r in range(rows))
         )
