@@ -72,9 +72,9 @@ class ProgramTranslator:
     def _zero_starts(self, body: list[MNode], out: list[Line]) -> None:
         """Mathcad starts every local at 0: a local the program reads before it has given it
         on some path (``s := s + x``, or set in one branch only) starts at 0 on the first
-        line (``s := 0``). A vector made by its elements (``l[rows(l) + 1] := x``) starts
-        empty in the language; it starts at 0 only where the program reads it whole first
-        (``if res != 0``)."""
+        line (``s := 0``). A vector made by its elements (``l[rows(l) + 1] := x``) is 0
+        until its first element is set in the language too; it gets the line only where the
+        program reads it whole first (``if res != 0``), so that the program says so."""
         whole, elements = _targets(body)
         assigned = set(whole) | elements
         given = set(self.params) | set(self.locals)
