@@ -25,6 +25,9 @@ pytestmark = [
         "circle-area-and-plots.xmcd",
         "lagrange-polynomial.xmcd",
         "points-and-lines.xmcd",
+        "fermat-spiral.xmcd",
+        "parabola-ellipse.xmcd",
+        "frame/example.xmcd",
     ],
 )
 def test_imported_workbook_recalculates_to_engine_values(name, tmp_path, capsys):

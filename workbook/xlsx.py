@@ -194,8 +194,7 @@ class WorkbookWriter:
         defs = [
             d for n, d in self.sheet.spec.definitions.items() if not d.is_function and n in needed
         ]
-        matrices = [d for d in defs if self.sheet.typer.scalar(d.name).shape is not None]
-        defs = [d for d in defs if d not in matrices]
+        matrices, defs = self._arrays_and_numbers(defs)
         if matrices:
             self.write_matrices(matrices)
         if not defs:
@@ -235,15 +234,10 @@ class WorkbookWriter:
         Definitions sheet), a live formula where possible, its unit and note. A definition
         that cannot be computed shows the error as text in its cell."""
         defs = [d for d in self.sheet.spec.definitions.values() if not d.is_function]
-        matrices = [d for d in defs if self._shape(d.name) is not None]
-        runtime = [d for d in matrices if tc.is_runtime(self._shape(d.name))]
-        arrays = [d for d in runtime if self._runtime_value(d.name) is not None]
-        # an array known only when it runs that is a number when it runs is a scalar result
-        matrices = [d for d in matrices if d not in runtime or d in arrays]
+        matrices, defs = self._arrays_and_numbers(defs)
         written = getattr(self, "on_matrices", set())
         if [d for d in matrices if d.name not in written]:
             self.write_matrices([d for d in matrices if d.name not in written])
-        defs = [d for d in defs if d not in matrices]
         if not defs:
             return
         done = getattr(self, "on_definitions", set())
@@ -313,6 +307,18 @@ class WorkbookWriter:
             self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
             row = top + r + 1
         self.rows["Matrices"] = row
+
+    def _arrays_and_numbers(self, defs: list) -> tuple[list, list]:
+        """Definitions that are vectors or matrices (written as blocks) and those that are
+        numbers; a run-time array is one or the other by the value it has when it runs."""
+        arrays = []
+        for d in defs:
+            shape = self._shape(d.name)
+            if shape is not None and (
+                not tc.is_runtime(shape) or self._runtime_value(d.name) is not None
+            ):
+                arrays.append(d)
+        return arrays, [d for d in defs if d not in arrays]
 
     def _runtime_value(self, name: str):
         """The array a definition whose size is known only when it runs has (None when it is
