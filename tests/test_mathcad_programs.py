@@ -398,3 +398,36 @@ def test_top_level_destructuring(tmp_path, capsys):
     assert "->" not in text.split("[sheet]")[0]  # parts is no Mathcad name that changed
     result = _check(tmp_path, capsys, "top")
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
+
+
+def test_break_inside_a_loop_stays_and_continue_outside_is_listed(tmp_path, capsys):
+    """A break inside a while loop is the loop's; a continue outside any loop is listed; an
+    element assignment at i + 1 over a range variable i is listed with why."""
+    loop = (
+        f"<ml:while>{_apply('lessThan', _id('s'), _real(100))}"
+        + _program(
+            _local(_id("s"), _apply("plus", _id("s"), _id("x"))),
+            _if(_apply("greaterThan", _id("s"), _real(10)), "<ml:break/>"),
+        )
+        + "</ml:while>"
+    )
+    found = _program(_local(_id("s"), _real(0)), loop, _id("s"))
+    skip = _program(_local(_id("s"), _id("x")), "<ml:continue/>", _id("s"))
+    rng = f"<ml:range>{_real(0)}{_real(2)}</ml:range>"
+    text = _import(
+        tmp_path,
+        capsys,
+        "loops",
+        _function(1, "first", ["x"], found),
+        _function(2, "skip", ["x"], skip),
+        _define(3, _id("i"), rng),
+        _define(4, _index(_id("v"), _apply("plus", _id("i"), _real(1))), _id("i")),
+        _eval(5, _call("first", _real(4)), _real(12)),
+    )
+    assert "while s < 100\n    s := s + x\n    break if s > 10\ns\n" in text
+    assert "region 2: skip(...) := ...: a continue outside any loop" in text
+    assert (
+        "region 4: v[...] := ...: an element assignment whose index or value uses a range" in text
+    )
+    result = _check(tmp_path, capsys, "loops")
+    assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]

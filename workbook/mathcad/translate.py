@@ -1047,8 +1047,6 @@ class Translator:
         """v[k] := value at an index that is not a range variable (Mathcad sets one element
         of v, making or growing it): a new definition of v, a program that copies the
         previous definition of v (if there is one), sets the element and gives it."""
-        from .program import ProgramTranslator
-
         previous = self.scope.get(key)
         sym = self.define(key, "var", region.id)
         try:
@@ -1060,14 +1058,19 @@ class Translator:
                     f"an element of {previous.mathcad}, which is a "
                     + ("function" if previous.kind == "func" else "range variable")
                 )
-            program = ProgramTranslator(self, {}, ExprTranslator)
-            value = program._expr(rhs)  # the right side sees the previous definition
+            et = ExprTranslator(self)
+            value = et.value(rhs)  # the right side sees the previous definition
             local = self.new_sym("local", sym.base, sym.mathcad)
             lines = []
             if previous is not None:
                 lines.append((0, [ex.Name(local.token()), " := ", ex.Name(previous.token())]))
-            program.locals[key] = program.scope[key] = local
-            index = program._expr(lhs)  # v[k], its index shifted by ORIGIN
+            inner = ExprTranslator(self, {key: local})
+            index = inner.value(lhs)  # v[k], its index shifted by ORIGIN
+            if et.ranges or inner.ranges:
+                raise Untranslatable(
+                    "an element assignment whose index or value uses a range variable (other "
+                    "than as the index itself)"
+                )
             lines += [(0, [index, " := ", value]), (0, [ex.Name(local.token())])]
         except Untranslatable as why:
             sym.broken = str(why)
