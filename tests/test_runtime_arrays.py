@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import openpyxl
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import workbook
 from workbook import runtime as rt
@@ -124,10 +126,7 @@ def test_a_nested_array_of_trains(sheet):
 
 
 def test_linterp_in_a_nested_element(tmp_path):
-    text = SHEET.replace('where = "at(trains, 2, 15)"', 'where = "at(trains, 2, 35)"')
-    path = tmp_path / "grow.toml"
-    path.write_text(text, encoding="utf-8")
-    s = workbook.load(path)
+    s = _changed(tmp_path, 'where = "at(trains, 2, 15)"', 'where = "at(trains, 2, 35)"')
     assert rt.value(s.scalar_value("where", "definition")) == pytest.approx(30.0, rel=1e-15)
 
 
@@ -160,20 +159,20 @@ def test_csort_sorts_rows_by_a_column(sheet):
     assert value(sheet, "ordered").tolist() == [[1.0, 10.0], [3.0, 30.0]]
 
 
-def test_units_are_still_checked_at_load(tmp_path):
-    text = SHEET.replace('three = "appended(3)"', 'three = "appended(3) + L"')
+def _changed(tmp_path, old: str, new: str):
     path = tmp_path / "grow.toml"
-    path.write_text(text, encoding="utf-8")
+    path.write_text(SHEET.replace(old, new), encoding="utf-8")
+    return workbook.load(path)
+
+
+def test_units_are_still_checked_at_load(tmp_path):
     with pytest.raises(WorkbookError, match="cannot add"):
-        workbook.load(path)
+        _changed(tmp_path, 'three = "appended(3)"', 'three = "appended(3) + L"')
 
 
 def test_static_shapes_keep_their_load_errors(tmp_path):
-    text = SHEET.replace('three = "appended(3)"', 'three = "[1, 2] + [1, 2, 3]"')
-    path = tmp_path / "grow.toml"
-    path.write_text(text, encoding="utf-8")
     with pytest.raises(WorkbookError, match="cannot add a vector of 3 to a vector of 2"):
-        workbook.load(path)
+        _changed(tmp_path, 'three = "appended(3)"', 'three = "[1, 2] + [1, 2, 3]"')
 
 
 def test_the_workbook_shows_values_and_nested_arrays_as_text(sheet, tmp_path):
@@ -225,3 +224,28 @@ def test_matrix_rules_when_running():
     assert rt.binary("*", a, np.array([[1.0], [1.0]]), "a*v").ravel().tolist() == [3.0, 7.0]
     with pytest.raises(InputError, match="cannot divide"):
         rt.binary("/", 1.0, a, "1/a")
+
+
+# -- a model: a run-time vector against a Python list -------------------------------------------
+@given(
+    st.lists(
+        st.tuples(st.integers(min_value=1, max_value=12), st.floats(-1e6, 1e6)),
+        min_size=1,
+        max_size=30,
+    )
+)
+@settings(max_examples=200, deadline=None)
+def test_set_item_matches_a_list_model(steps):
+    """v[i] := x in any order (origin 1) is a list that grows with zeros to reach i."""
+    model: list[float] = []
+    v = 0.0  # Mathcad's start of a local
+    for i, x in steps:
+        v = rt.set_item(v, [i], x, origin=1, what="v")
+        model += [0.0] * (i - len(model))
+        model[i - 1] = x
+        assert rt.size("rows", v) == len(model)
+    assert v.ravel().tolist() == model
+    for i, x in enumerate(model, start=1):
+        assert rt.index(v, [i], origin=1, what="v") == x
+    with pytest.raises(InputError, match="out of range"):
+        rt.index(v, [len(model) + 1], origin=1, what="v")

@@ -32,14 +32,7 @@ from .visitor import Visitor
 Env = dict[str, object]
 Fn = Callable[[Env], object]
 
-_CMP = {
-    "<": operator.lt,
-    "<=": operator.le,
-    ">": operator.gt,
-    ">=": operator.ge,
-    "==": operator.eq,
-    "!=": operator.ne,
-}
+_CMP = rt.COMPARE
 # Powers by products and square roots (x^1.5, x^3 and x^4 in Evaluator._power_by_parts):
 # several times faster than np.power, within 2 ulp (tests/test_numeric_golden.py, mpmath).
 _POWERS = {

@@ -201,7 +201,8 @@ def binary(op: str, a, b, what: str):
     return power(a, int(n))
 
 
-_COMPARE = {
+#: The comparison operators by their worksheet symbol (the numpy back end uses them too).
+COMPARE = {
     "<": operator.lt,
     "<=": operator.le,
     ">": operator.gt,
@@ -220,7 +221,7 @@ def compare(op: str, a, b, what: str) -> bool:
             raise InputError(f"{what}: cannot order {describe(a)} and {describe(b)}")
         same = _same(a, b)
         return same if op == "==" else not same
-    return bool(_COMPARE[op](a, b))
+    return bool(COMPARE[op](a, b))
 
 
 def _same(a, b) -> bool:
