@@ -557,3 +557,30 @@ def test_data_table_with_a_cyclic_sector_chain_is_refused():
     looped = data[:minifat] + struct.pack("<I", 1) + data[minifat + 4 :]
     with pytest.raises(Untranslatable, match="broken sector chain"):
         grid(base64.b64encode(gzip.compress(looped)).decode())
+
+
+def test_a_function_that_calls_itself_is_a_recursion(tmp_path, capsys):
+    """fact(n) := 1 if n <= 1, n*fact(n - 1) otherwise; fact(6) = 720 as Mathcad stored."""
+    program = (
+        "<ml:program><ml:ifThen>"
+        + _apply("lessOrEqual", _id("n"), _real(1))
+        + _real(1)
+        + "</ml:ifThen><ml:otherwise>"
+        + _apply(
+            "mult",
+            _id("n"),
+            "<ml:apply>" + _id("fact") + _apply("minus", _id("n"), _real(1)) + "</ml:apply>",
+        )
+        + "</ml:otherwise></ml:program>"
+    )
+    src = tmp_path / "fact.xmcd"
+    call = "<ml:apply>" + _id("fact") + _real(6) + "</ml:apply>"
+    src.write_text(
+        _worksheet(_function(1, "fact", ["n"], program), _eval(2, call, _real(720))),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "0 regions not translated" in capsys.readouterr().out
+    main(["check", str(tmp_path / "fact.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]

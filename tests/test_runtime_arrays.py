@@ -249,3 +249,45 @@ def test_set_item_matches_a_list_model(steps):
         assert rt.index(v, [i], origin=1, what="v") == x
     with pytest.raises(InputError, match="out of range"):
         rt.index(v, [len(model) + 1], origin=1, what="v")
+
+
+def test_a_table_column_of_run_time_values_is_a_number_a_row(tmp_path):
+    text = '''
+[sheet]
+name = "col"
+origin = 1
+
+[arguments]
+n = { unit = "" }
+
+[definitions]
+"grown(n)" = { program = """
+for i in 1 .. n
+    v[rows(v) + 1] := i
+v
+""" }
+"total(n)" = { program = """
+g := grown(n)
+s := 0
+for i in 1 .. rows(g)
+    s := s + g[i]
+s + 0*g[1]
+""" }
+"whole(n)" = "grown(n)"
+
+[[tables]]
+name = "sums"
+range = "n := 1 .. 5"
+columns = { "total(n)" = "" }
+
+[[tables]]
+name = "arrays"
+range = "n := 1 .. 3"
+columns = { "whole(n)" = "" }
+'''
+    path = tmp_path / "col.toml"
+    path.write_text(text, encoding="utf-8")
+    sheet = workbook.load(path)
+    assert sheet.table("sums")["total(n)"].tolist() == [1.0, 3.0, 6.0, 10.0, 15.0]
+    with pytest.raises(WorkbookError, match="whole.*a vector of 1 where a number is wanted"):
+        sheet.table("arrays")

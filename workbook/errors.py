@@ -51,6 +51,11 @@ class TemplateError(WorkbookError):
     kind = "template error"
 
 
+class ShapeError(TemplateError):
+    """A number where a vector or matrix is needed (indexed, or given to rows()): a function
+    whose body is typed at numbers says so when nothing calls it with arrays."""
+
+
 class UnitError(WorkbookError):
     """Dimensions do not agree."""
 

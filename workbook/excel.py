@@ -160,6 +160,8 @@ class ExcelPrinter(Visitor):
         # once (NotLive: the writer writes the values as numbers), so nested calls such as
         # f_i(x) = (f_{i-1}(x) + f_{i-1}(x))/2 cost the limit, not 2^depth.
         f = self.typer.function(t.name)
+        if t.name in self.typer.recursive:  # Excel has no recursion
+            raise NotLive(f"{t.name.split('@')[0]}() calls itself; its values are numbers")
         if any(f.shapes) and isinstance(f.body, tc.TProgram):  # loops over a matrix: no formula
             raise NotLive(
                 f"{t.name.split('@')[0]}() is called with a vector or matrix; "

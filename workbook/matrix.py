@@ -259,7 +259,7 @@ def register_entries() -> None:
     """Register the matrix built-ins (called once, by workbook.registry)."""
     from . import typed as ty
     from .entry import Builtin, register
-    from .errors import NotLive, NotSymbolic, TemplateError
+    from .errors import NotLive, NotSymbolic, ShapeError, TemplateError
     from .expr import PREC
     from .typed import shape_text
 
@@ -268,7 +268,7 @@ def register_entries() -> None:
     def need(args, k: int, name: str, what: str = "a vector or matrix"):
         a = args[k]
         if a.shape is None:
-            raise TemplateError(f"{name}(): argument {k + 1} must be {what}, got a number")
+            raise ShapeError(f"{name}(): argument {k + 1} must be {what}, got a number")
         return a.shape
 
     def vector(args, k: int, name: str) -> int:

@@ -22,7 +22,7 @@ import numpy as np
 from . import runtime as rt
 from . import typecheck as tc
 from . import typed as ty
-from .errors import DomainError, InputError
+from .errors import DomainError, InputError, LimitError
 from .numerics.bound import Bound
 from .registry import REGISTRY
 from .subtrees import plan
@@ -100,10 +100,19 @@ class Evaluator(Visitor):
         if name not in self._functions:
             f = self.typer.function(name)
             self.plan.update(self.typer)
-            self._functions[name] = _checked(
-                name, f.params, self.compile(f.body), self.describe_args
-            )
-            self._functions[name].explain = lambda env, f=f: _explain(self, f, env)
+            compiled: list[Fn] = []
+            # a call inside its own body (recursion) reaches the function once it is compiled
+            self._functions[name] = lambda env: compiled[0](env)
+            try:
+                fn = _checked(name, f.params, self.compile(f.body), self.describe_args)
+            except BaseException:
+                del self._functions[name]
+                raise
+            fn.explain = lambda env, f=f: _explain(self, f, env)
+            if name in self.typer.recursive:
+                fn = _recursion_bounded(name, fn)
+            compiled.append(fn)
+            self._functions[name] = fn
         return self._functions[name]
 
     def compile(self, t: tc.T) -> Fn:
@@ -410,6 +419,44 @@ class Evaluator(Visitor):
             return out
 
         return looped
+
+
+#: How deep a function may call itself (Mathcad's recursion), and the Python frames that
+#: takes: each level runs through a few closures, so the interpreter's limit is raised while
+#: such a function runs (Python 3.11 calls Python closures without growing the C stack).
+MAX_RECURSION = 1000
+_FRAMES_PER_LEVEL = 40
+
+
+def _recursion_bounded(name: str, fn: Fn) -> Fn:
+    """``fn`` (a function that calls itself) with its depth counted: deeper than
+    MAX_RECURSION is a LimitError naming it, never Python's RecursionError."""
+    import sys
+
+    depth = [0]
+
+    def run(env):
+        if depth[0] >= MAX_RECURSION:
+            raise LimitError(
+                f"{name}() called itself more than {MAX_RECURSION} deep (a recursion that does "
+                "not end?)",
+                definition=name,
+            )
+        before = sys.getrecursionlimit()
+        need = sys.getrecursionlimit() + 0
+        need = max(before, 1000 + _FRAMES_PER_LEVEL * (depth[0] + 1))
+        if need > before:
+            sys.setrecursionlimit(need)
+        depth[0] += 1
+        try:
+            return fn(env)
+        finally:
+            depth[0] -= 1
+            if depth[0] == 0 and sys.getrecursionlimit() != before:
+                sys.setrecursionlimit(before)
+
+    run.explain = getattr(fn, "explain", None)
+    return run
 
 
 def _text(t: tc.T) -> str:

@@ -446,7 +446,13 @@ class Sheet:
     def column(self, col: ColumnSpec, var: str, values: np.ndarray, what: str) -> Column:
         t = self.typed_column(col, var, what)
         fn = self.evaluator.compile(t)
-        if t.shape is not None:
+        if tc.is_runtime(t.shape):  # a run-time value: each row's must be a number
+            run = fn
+            where = f"column '{col.text}'"
+            fn = lambda env: np.array(  # noqa: E731
+                [rt.number(run({var: float(v)}), where) for v in np.ravel(env[var])]
+            ).reshape(np.shape(env[var]))
+        elif t.shape is not None:
             raise self._locate(
                 TemplateError(
                     f"column '{col.text}' is a vector or matrix; a column is one value a row "

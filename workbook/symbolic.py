@@ -119,6 +119,8 @@ def refusal(typer, t: ty.T) -> str | None:
         why = _REFUSAL.visit(n, {}, {})
         if why:
             return why
+        if isinstance(n, ty.TCall) and n.name in typer.recursive:
+            return f"{n.name.split('@')[0]}() calls itself"
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
             stack.append(typer.function(n.name).body)
@@ -151,6 +153,8 @@ class SympyConverter(Visitor):
     def function(self, name: str):
         """(parameter symbols, body expression) of a sheet function."""
         if name not in self._bodies:
+            if name in self.sheet.typer.recursive:
+                raise NotSymbolic(f"{name.split('@')[0]}() calls itself")
             sp = _sympy()
             f = self.sheet.typer.function(name)
             syms = tuple(self.symbols.get(p, sp.Symbol(p, real=True)) for p in f.params)

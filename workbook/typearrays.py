@@ -21,7 +21,7 @@ import pint
 
 from . import expr as ex
 from . import units as un
-from .errors import TemplateError, UnitError
+from .errors import ShapeError, TemplateError, UnitError
 from .typed import (
     RUNTIME,
     T,
@@ -86,7 +86,7 @@ class ArrayTyping:
     def visit_Index(self, node: ex.Index, scope) -> T:
         target = self.visit(node.target, scope)
         if target.shape is None:
-            raise TemplateError(
+            raise ShapeError(
                 f"{ex.to_text(node.target)} is not a vector or matrix; it cannot be indexed"
             )
         n = len(node.indices)

@@ -16,7 +16,7 @@ import pint
 
 from . import expr as ex
 from . import units as un
-from .errors import LimitError, TemplateError, UnitError, WorkbookError
+from .errors import LimitError, ShapeError, TemplateError, UnitError, WorkbookError
 from .fields import nearest
 from .registry import REGISTRY
 from .template import Definition, SheetSpec
@@ -77,6 +77,11 @@ class Typer(ArrayTyping, Visitor):
         self.scope: dict[str, pint.Unit] = {}
         # functions typed only for the vectors and matrices they are called with
         self._at_numbers_fails: set[str] = set()
+        # functions being typed, by specialization key: a call of one inside its own body
+        # (recursion) reads the unit and shape assumed for it (see specialized)
+        self._assumed: dict[str, TypedFunction] = {}
+        self._recursive: set[str] = set()
+        self.recursive: set[str] = set()  # specialization keys of functions that call themselves
 
     # -- public -------------------------------------------------------------------
     def sympy_converter(self, keep: set[str]):
@@ -112,6 +117,8 @@ class Typer(ArrayTyping, Visitor):
                 return self.specialized(name, ())
             except WorkbookError as at_numbers:
                 if not any(_key_of(k) == name for k in self.functions):
+                    if not isinstance(at_numbers, ShapeError):
+                        raise
                     return self._unspecialized(name, at_numbers)
                 self._at_numbers_fails.add(name)
         return next(f for k, f in self.functions.items() if _key_of(k) == name)
@@ -137,16 +144,69 @@ class Typer(ArrayTyping, Visitor):
         """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for
         all numbers), each in the unit declared in [arguments]; typed once per shapes."""
         key = specialization_key(name, shapes)
+        if key in self._assumed:  # a call inside its own body: recursion
+            d = self._definition(name)
+            if d.program is None and d.branches is None:  # nothing can end it
+                cycle = " -> ".join(self._stack[self._stack.index(name) :] + [name])
+                raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=name)
+            self._recursive.add(key)
+            return self._assumed[key]
         if key not in self.functions:
             d = self._definition(name)
             shapes = tuple(shapes) or (None,) * len(d.params)
             units = tuple(self.spec.arguments[p].binding_unit for p in d.params)
             scope = {p: u if sh is None else (u, sh) for p, u, sh in zip(d.params, units, shapes)}
-            body = self._typed_body(d, scope)
-            if d.unit is not None:
-                body = self.convert(body, d.unit, _declared(name, d.unit))
-            self.functions[key] = TypedFunction(key, d.params, units, body, shapes)
+            self.functions[key] = self._settled(d, key, units, scope, shapes)
         return self.functions[key]
+
+    def _settled(self, d: Definition, key: str, units, scope, shapes) -> TypedFunction:
+        """Function ``d`` typed for one specialization. A function that calls itself (Mathcad
+        allows it, ending the recursion under an ``if``) is typed with its own calls in an
+        assumed unit: the unit it declares, else dimensionless, else the unit of one of its
+        arguments (``halve(x)``); the first assumption the body's value agrees with is its
+        unit. None agreeing is an error that asks for the unit to be declared."""
+        candidates = [d.unit] if d.unit is not None else [self.dimensionless, *units]
+        first_error = None
+        for unit in dict.fromkeys(candidates):
+            assumed = T(unit)
+            self._assumed[key] = TypedFunction(key, d.params, units, assumed, shapes)
+            self._recursive.discard(key)
+            # what this attempt types (a function f calls, that calls f) rests on the
+            # assumption: it is forgotten unless the assumption holds
+            functions, scalars = set(self.functions), set(self.scalars)
+            try:
+                body = self._typed_body(d, scope)
+                if d.unit is not None:
+                    body = self.convert(body, d.unit, _declared(d.name, d.unit))
+            except WorkbookError as err:
+                if key not in self._recursive:
+                    raise
+                first_error = first_error or err
+                self._forget(functions, scalars)
+                continue
+            finally:
+                del self._assumed[key]
+            if key not in self._recursive:
+                return TypedFunction(key, d.params, units, body, shapes)
+            if body.unit == unit and body.shape is None and not body.text:
+                self.recursive.add(key)
+                return TypedFunction(key, d.params, units, body, shapes)
+            self._forget(functions, scalars)
+        why = f": {first_error.message}" if first_error is not None else ""
+        raise TemplateError(
+            f"{d.name}() calls itself, and no unit of its value agrees with its own calls "
+            f"(tried {', '.join(un.pretty(u) or '1' for u in dict.fromkeys(candidates))}); "
+            f'declare its unit ({{ program = ..., unit = "..." }}){why}',
+            line=d.line,
+            definition=d.name,
+        )
+
+    def _forget(self, functions: set, scalars: set) -> None:
+        """Drop the typings made since ``functions`` and ``scalars`` were the keys."""
+        for k in set(self.functions) - functions:
+            del self.functions[k]
+        for k in set(self.scalars) - scalars:
+            del self.scalars[k]
 
     def expression(self, node: ex.Node, scope: dict[str, pint.Unit], what: str) -> T:
         """Type a free expression (a table column, a chart series) in a scope of parameters."""

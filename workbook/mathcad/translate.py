@@ -1112,6 +1112,8 @@ class Translator:
             ps = self.new_sym("param", nm.identifier(*pkey), nm.mathcad_text(*pkey), unit=unit)
             local[pkey] = ps
             psyms.append(ps)
+        # defined before its body is read: a call of f inside f is Mathcad's recursion
+        sym = self.define(key, "func", region.id)
         try:
             if body.tag == "program":
                 item = Item("function", region.id, params=psyms, **self.program(body, local))
@@ -1125,10 +1127,8 @@ class Translator:
                         f"uses the range variable {et.ranges[0].mathcad} inside a function"
                     )
         except Untranslatable as why:
-            sym = self.define(key, "func", region.id)
             sym.broken = str(why)
             raise
-        sym = self.define(key, "func", region.id)
         item.sym = sym
         self._forced(region, sym)
         self.out.items.append(item)
