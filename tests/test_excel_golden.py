@@ -51,6 +51,7 @@ CASES = [
     ("inline_diff", "sq(a - b) + cube(-a)", None),
     ("inline_nested", "sq(sq(a) - x)", None),
     ("floor_ceil", "floor(-x/2) + 10*ceil(-x/2)", None),
+    ("round_trunc", "round(-x/4, 1) + 10*round(x/2) + 100*trunc(-x/2)", None),  # halves
     ("mod_signs", "mod(-x, a) + 10*mod(x, -a)", None),  # Excel's MOD takes the sign of y
     ("sign_abs", "sign(a - x) + abs(a - x)", None),
     ("exp_ln", "exp(-a) + ln(b) + log10(c)", None),

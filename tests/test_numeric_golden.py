@@ -38,6 +38,12 @@ def _remainder(u, v):
     return u - v * (mpmath.floor(q) if q >= 0 else mpmath.ceil(q))
 
 
+def _round(u, n: int):
+    """Half away from zero to n decimals, of the exact value of u (not numpy's half to even)."""
+    scale = mpmath.mpf(10) ** n
+    return _sign(u) * mpmath.floor(abs(u) * scale + mpmath.mpf(0.5)) / scale
+
+
 # built-in name -> (worksheet expression of u[, v], mpmath reference, domain of u[, v])
 FUNCTIONS = {
     "sin": ("sin(u)", mpmath.sin, (-20, 20)),
@@ -61,6 +67,8 @@ FUNCTIONS = {
     "min": ("min(u, v, 0.5)", lambda u, v: min(u, v, mpmath.mpf(0.5)), (-3, 3), (-3, 3)),
     "max": ("max(u, v)", max, (-3, 3), (-3, 3)),
     "mod": ("mod(u, v)", lambda u, v: _remainder(u, v), (-20, 20), (0.3, 7)),
+    "round": ("round(u, 2)", lambda u: _round(u, 2), (-50, 50)),
+    "trunc": ("trunc(u)", lambda u: _sign(u) * mpmath.floor(abs(u)), (-5, 5)),
 }
 
 # operator -> (worksheet expression, mpmath reference, domains, exact: correctly rounded)

@@ -70,6 +70,7 @@ from .entry import (  # noqa: F401 - the entry record is part of this module's i
 )
 from .errors import InputError, LimitError, NotLive, TemplateError, UnitError
 from .expr import PREC
+from .units import pretty
 
 
 # -- unit rules ------------------------------------------------------------------------------
@@ -269,6 +270,78 @@ _simple(
     excel_functions=("TRUNC",),
 )
 
+
+# -- round and trunc: of plain numbers only ------------------------------------------------------
+def _integer_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    """round and trunc take a plain number: rounding 1.5 m gives 2 m in metres but 1.5 m in
+    millimetres (Mathcad rounds the value in SI units), so a value with a unit, or in a unit
+    that is not the plain number itself (deg, %, mm/m), is refused."""
+    x = args[0]
+    factor = None if x.unit.dimensionality else (1 * x.unit).to(ctx.dimensionless).magnitude
+    if factor != 1:
+        raise UnitError(
+            f"{name}() needs a plain number, got a value in {pretty(x.unit)}: the result would "
+            f"depend on the unit it is rounded in; round a ratio, {name}(x/step)*step"
+        )
+    rest = tuple(ctx.plain(a, f"{name}(): the number of decimals") for a in args[1:])
+    return ty.TFunc(ctx.dimensionless, func=name, args=(ctx.plain(x, f"{name}()"), *rest))
+
+
+def _round_numpy(x, n=0.0):
+    """Round half away from zero to ``n`` decimals (Mathcad's round, Excel's ROUND). A value
+    within 4 units in the last place below a half is taken as the half it was written as
+    (2.675 to 2 decimals is 2.68, as in Excel and LibreOffice, though the double nearest to
+    2.675 is below it); numpy's round goes half to even and is not used."""
+    x, n = np.asarray(x, dtype=float), np.asarray(n, dtype=float)
+    with np.errstate(all="ignore"):
+        k = np.clip(n, -308, 308)
+        scale = 10.0 ** np.abs(k)
+        y = np.where(k >= 0, np.abs(x) * scale, np.abs(x) / scale)
+        r = np.floor(y)
+        r = r + (y - r >= 0.5 - np.where(y < 2.0**40, 4 * np.spacing(y), 0.0))
+        out = np.where(k >= 0, r / scale, r * scale) * np.sign(x) + 0.0
+        out = np.where(y >= 2.0**52, x, out)  # no fraction left at this scale
+        out = np.where(n < -308, 0.0, out)
+        out = np.where(n == np.floor(n), out, np.nan)
+    return out if out.ndim else float(out)
+
+
+def _excel_round(args: list[str]) -> tuple[str, int]:
+    return f"ROUND({args[0]}, {args[1] if len(args) > 1 else 0})", PREC["atom"]
+
+
+def _round_sympy(sp, x, n=0):
+    scale = sp.Integer(10) ** n
+    return sp.sign(x) * sp.floor(sp.Abs(x) * scale + sp.Rational(1, 2)) / scale
+
+
+_simple(
+    "round",
+    _round_numpy,
+    _excel_round,
+    _round_sympy,
+    "round(x): nearest integer, a half away from zero; round(x, n): to n decimals "
+    "(x a plain number)",
+    rule=_integer_unit,
+    domain=(
+        Domain(
+            "round to a number of decimals that is not an integer",
+            lambda v: v != np.floor(v),
+            "round(x, {})",
+            arg=1,
+        ),
+    ),
+    arity=(1, 2),
+    excel_functions=("ROUND",),
+)
+_simple(
+    "trunc",
+    np.trunc,
+    "TRUNC",
+    lambda sp, x: sp.sign(x) * sp.floor(sp.Abs(x)),
+    "integer part, toward zero (x a plain number)",
+    rule=_integer_unit,
+)
 
 # -- sum(EXPR, I, A, B): a built-in that binds a variable ------------------------------------
 #: Most terms of sum(); Excel gets the terms written out up to MAX_EXCEL_TERMS.

@@ -1,0 +1,125 @@
+"""round, trunc (numbers) against mpmath, at the halves where numpy's half-to-even round
+differs, and their refusal of values with units; the Excel formulas recalculated by
+LibreOffice (slow)."""
+
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import pytest
+from conftest import write_template
+
+import workbook
+from workbook.builtins import _round_numpy
+from workbook.errors import WorkbookError
+
+SHEET = """
+[inputs]
+L = "17 mm"
+step = "5 mm"
+phi = "30 deg"
+
+[arguments]
+u = { unit = "" }
+n = { unit = "" }
+
+[definitions]
+"r0(u)" = "round(u)"
+"rn(u, n)" = "round(u, n)"
+"t(u)" = "trunc(u)"
+Lr = { expr = "round(L/step)*step", unit = "mm" }
+"""
+
+
+@pytest.fixture(scope="module")
+def sheet(tmp_path_factory):
+    return workbook.load(write_template(tmp_path_factory.mktemp("more"), SHEET))
+
+
+def _away(u: float, n: int = 0) -> float:
+    """Half away from zero, of the exact value of the double u."""
+    with mpmath.workdps(60):
+        x, scale = mpmath.mpf(u), mpmath.mpf(10) ** n
+        return float(mpmath.sign(x) * mpmath.floor(abs(x) * scale + mpmath.mpf(0.5)) / scale)
+
+
+def test_round_goes_half_away_from_zero(sheet):
+    halves = np.arange(-20, 21) + 0.5
+    rng = np.random.default_rng(1)
+    u = np.concatenate([halves, rng.uniform(-1e6, 1e6, 500), rng.uniform(-3, 3, 500)])
+    got = sheet.evaluate("r0", u).magnitude
+    assert got.tolist() == [_away(x) for x in u]
+    assert np.any(got[:41] != np.round(halves))  # numpy's round would differ here
+
+
+@pytest.mark.parametrize("n", [-3, -1, 1, 2, 5])
+def test_round_to_decimals(sheet, n):
+    rng = np.random.default_rng(n + 10)
+    u = np.concatenate([rng.uniform(-1e4, 1e4, 400), np.array([0.125, -0.125, 2.5, 1250.0])])
+    got = sheet.evaluate("rn", u, n).magnitude
+    assert got.tolist() == [_away(x, n) for x in u]
+
+
+def test_round_keeps_a_decimal_half_as_written():
+    # the doubles of 2.675 and 1.005 are just below the half; Excel and LibreOffice round up
+    assert _round_numpy(2.675, 2) == 2.68
+    assert _round_numpy(1.005, 2) == 1.01
+    assert _round_numpy(-2.675, 2) == -2.68
+    assert _round_numpy(0.49999999999999, 0) == 0.0  # far from the half (many ulps): down
+    assert _round_numpy(2.0**50 + 0.25, 0) == 2.0**50  # no tolerance for large values
+
+
+def test_round_edges():
+    assert _round_numpy(1e300, 2) == 1e300
+    assert _round_numpy(123.0, -400) == 0.0
+    assert np.isnan(_round_numpy(1.5, 0.5))
+    assert str(_round_numpy(-0.3)) == "0.0"  # not -0.0
+
+
+def test_trunc_goes_toward_zero(sheet):
+    u = np.array([-2.7, -2.0, -0.5, 0.0, 0.5, 2.7, 1e17 + 2])
+    assert sheet.evaluate("t", u).magnitude.tolist() == [-2.0, -2.0, 0.0, 0.0, 0.0, 2.0, 1e17 + 2]
+
+
+def test_round_of_a_ratio_times_a_step(sheet):
+    assert sheet.evaluate("Lr").to("mm").magnitude == pytest.approx(15.0, rel=1e-15)
+
+
+@pytest.mark.parametrize(
+    "expr,message",
+    [
+        ("round(L)", "round() needs a plain number, got a value in mm"),
+        ("trunc(phi)", "trunc() needs a plain number, got a value in deg"),
+        ("round(2.5, L)", "the number of decimals needs a dimensionless argument"),
+    ],
+)
+def test_a_value_with_a_unit_is_refused(tmp_path, expr, message):
+    with pytest.raises(WorkbookError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        workbook.load(write_template(tmp_path, SHEET + f'bad = "{expr}"\n'))
+
+
+LIVE = """
+[inputs]
+x = "2.675"
+
+[definitions]
+a = "round(x, 2)"
+b = "round(-2.5) + 10*round(0.125, 2)"
+c = "trunc(-x) + round(1234.5, -2)"
+d = "round(1.005, 2)"
+"""
+
+
+@pytest.mark.slow
+def test_libreoffice_agrees(tmp_path):
+    from recalc import cell_values, formula_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    sheet = workbook.load(write_template(tmp_path, LIVE))
+    path = sheet.write_xlsx(tmp_path / "live.xlsx")
+    cells = formula_values(path)
+    lo = cell_values(recalculate(path, tmp_path / "lo"))
+    assert len(cells) >= 4
+    for key, (formula, value) in cells.items():
+        assert lo[key] == pytest.approx(value, rel=1e-15, abs=1e-15), (formula, lo[key])
