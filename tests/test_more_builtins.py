@@ -123,3 +123,124 @@ def test_libreoffice_agrees(tmp_path):
     assert len(cells) >= 4
     for key, (formula, value) in cells.items():
         assert lo[key] == pytest.approx(value, rel=1e-15, abs=1e-15), (formula, lo[key])
+
+
+# -- sort, reverse, rsort ------------------------------------------------------------------------
+ARRAYS = '''
+[sheet]
+origin = 1
+
+[inputs]
+a = "2 m"
+
+[arguments]
+u = { unit = "" }
+n = { unit = "" }
+
+[definitions]
+v = { expr = "[3, 1, 2, 1]*a", unit = "mm" }
+s = { expr = "sort(v)", unit = "m" }
+r = "reverse([[1, 2], [3, 4], [5, 6]])"
+rv = "reverse(v)"
+rs = "rsort([[3, 1, 2, 1], [30, 10, 20, 11]], 1)"
+rs2 = "rsort([[3, 1, 2], [30, 10, 20]], 2)"
+"f(u)" = "sort([u, 1 - u, 0.5])"
+"g(u)" = "reverse([u, 2*u])"
+"grown(n)" = { program = """
+for i in 1 .. n
+    w[i] := mod(7*i, 5)
+sort(w)
+""" }
+"backwards(n)" = { program = """
+for i in 1 .. n
+    w[i] := [i, 2*i]
+reverse(w)
+""" }
+"by_row(n)" = { program = """
+M[1, 1] := n
+M[1, 2] := 1
+M[2, 1] := 10*n
+M[2, 2] := 10
+rsort(M, 1)
+""" }
+"maybe(n)" = { program = """
+for i in 1 .. n
+    w[i] := i if i > 3
+sort(w)
+""" }
+"rowsort(n)" = { program = """
+for i in 1 .. n
+    w[i] := i
+rsort(w, n + 1)
+""" }
+back = "backwards(3)"
+'''
+
+
+@pytest.fixture(scope="module")
+def arrays(tmp_path_factory):
+    return workbook.load(write_template(tmp_path_factory.mktemp("sorts"), ARRAYS))
+
+
+def test_sort_reverse_rsort_of_fixed_arrays(arrays):
+    assert arrays.evaluate("s").to("m").magnitude.ravel().tolist() == [2.0, 2.0, 4.0, 6.0]
+    assert arrays.evaluate("r").magnitude.tolist() == [[5, 6], [3, 4], [1, 2]]
+    assert arrays.evaluate("rv").to("m").magnitude.ravel().tolist() == [2.0, 4.0, 2.0, 6.0]
+    # stable: the two columns with 1 in row 1 keep their order
+    assert arrays.evaluate("rs").magnitude.tolist() == [[1, 1, 2, 3], [10, 11, 20, 30]]
+    assert arrays.evaluate("rs2").magnitude.tolist() == [[1, 2, 3], [10, 20, 30]]
+
+
+def test_sort_over_a_range_sorts_each_point(arrays):
+    u = np.linspace(-1, 2, 31)
+    got = arrays.evaluate("f", u).magnitude
+    want = np.sort(np.stack([u, 1 - u, np.full_like(u, 0.5)]), axis=0)
+    assert got.shape == (3, 1, 31) and np.array_equal(got[:, 0, :], want)
+    assert np.array_equal(arrays.evaluate("g", u).magnitude[:, 0, :], np.stack([2 * u, u]))
+
+
+def test_run_time_arrays(arrays):
+    from workbook import runtime as rt
+
+    grown = rt.value(arrays.evaluate("grown", 6.0).magnitude)
+    assert grown.ravel().tolist() == sorted(float(7 * i % 5) for i in range(1, 7))
+    back = rt.value(arrays.scalar_value("back", "definition"))  # a nested array reversed
+    assert [rt.value(e).ravel().tolist() for e in back.ravel()] == [[3, 6], [2, 4], [1, 2]]
+    assert rt.value(arrays.evaluate("by_row", 5.0).magnitude).tolist() == [[1, 5], [10, 50]]
+
+
+@pytest.mark.parametrize(
+    "call,message",
+    [
+        ("maybe(2)", r"sort\(\) takes a vector, got a number"),
+        ("rowsort(2)", r"rsort\(\): row 3 is outside the 2x1 matrix"),
+    ],
+)
+def test_run_time_mistakes_are_errors(arrays, call, message):
+    name, _, n = call.partition("(")
+    with pytest.raises(WorkbookError, match=message):
+        arrays.evaluate(name, float(n.rstrip(")")))
+
+
+@pytest.mark.parametrize(
+    "expr,message",
+    [
+        ("sort([[1, 2], [3, 4]])", r"sort\(\): argument 1 must be a vector, got a 2x2"),
+        ("sort(a)", r"sort\(\): argument 1 must be a vector, got a number"),
+        ("reverse(a)", r"reverse\(\): argument 1 must be a vector or matrix, got a number"),
+        ("rsort([[1, 2], [3, 4]], 3)", r"rsort\(\): row 3 is outside the 2x2"),
+        ("rsort([[1, 2], [3, 4]], a)", r"rsort\(\): the row needs a dimensionless"),
+    ],
+)
+def test_load_mistakes_are_errors(tmp_path, expr, message):
+    with pytest.raises(WorkbookError, match=message):
+        workbook.load(write_template(tmp_path, ARRAYS + f'bad = "{expr}"\n'))
+
+
+def test_sorted_arrays_are_written_as_values(arrays, tmp_path):
+    import openpyxl
+
+    wb = openpyxl.load_workbook(arrays.write_xlsx(tmp_path / "sorts.xlsx"))
+    comments = [c.comment.text for ws in wb for row in ws.iter_rows() for c in row if c.comment]
+    for name in ("sort", "reverse", "rsort"):
+        assert any(f"{name}() is written as values" in t for t in comments), name

@@ -702,6 +702,51 @@ def register_entries() -> None:
         runtime=r_reduce,
     )
 
+    # sort, reverse, rsort: the shape of the argument, in its unit
+    def r_sort(ctx, name, args):
+        return func(args[0].unit, name, args, (vector(args, 0, name), 1))
+
+    def r_reverse(ctx, name, args):
+        return func(args[0].unit, name, args, need(args, 0, name))
+
+    def r_rsort(ctx, name, args):
+        r, c = need(args, 0, name, "a matrix")
+        i = ctx.plain(args[1], "rsort(): the row")
+        if isinstance(i, ty.TConst) and not ctx.spec.origin <= i.value < ctx.spec.origin + r:
+            raise TemplateError(
+                f"rsort(): row {i.value:g} is outside the {shape_text((r, c))} "
+                f"(origin {ctx.spec.origin})"
+            )
+        return func(args[0].unit, name, [args[0], i, origin_arg(ctx)], (r, c))
+
+    entry(
+        "sort",
+        1,
+        r_sort,
+        numpy_sort,
+        not_live("sort() is written as values"),
+        "the elements of a vector, smallest first",
+        runtime=rt_same_unit,
+    )
+    entry(
+        "reverse",
+        1,
+        r_reverse,
+        numpy_reverse,
+        not_live("reverse() is written as values"),
+        "the elements of a vector, or the rows of a matrix, in reverse order",
+        runtime=rt_same_unit,
+    )
+    entry(
+        "rsort",
+        2,
+        r_rsort,
+        lambda m, i, origin, shapes: rsort(m, i, int(origin), shapes[0]),
+        not_live("rsort() is written as values"),
+        "rsort(M, i): the columns of M sorted by row i, smallest first (Mathcad's rsort)",
+        runtime=rt_with_origin("same"),
+    )
+
 
 def _numbers_as_1x1(values, shapes):
     """stack and augment take a number as a 1x1 matrix (as Mathcad's)."""
@@ -735,6 +780,47 @@ def csort(m, j, origin: int):
             f"csort(): column {k + origin} is outside the {m.shape[0]}x{m.shape[1]} matrix"
         )
     return m[np.argsort(m[:, k], kind="stable")]
+
+
+def _array_arg(v, shape, what: str, vector: bool = False):
+    """The array a sort gets; a run-time value is checked here (a number, a matrix where a
+    vector is wanted, a nested array are errors)."""
+    if shape is None:
+        raise InputError(
+            f"{what} takes a {'vector' if vector else 'vector or matrix'}, got a number"
+        )
+    if vector and shape[1] != 1:
+        raise InputError(f"{what} takes a vector, got a {shape[0]}x{shape[1]} matrix")
+    m = np.asarray(v)
+    if m.dtype == object:
+        raise InputError(f"{what}: a nested array (an element that is an array) is not sorted")
+    return m.astype(float)
+
+
+def numpy_sort(v, *, shapes):
+    """sort(v): ascending (each point of a range on its own)."""
+    return np.sort(_array_arg(v, shapes[0], "sort()", vector=True), axis=0)
+
+
+def numpy_reverse(v, *, shapes):
+    """reverse(v): the elements (the rows of a matrix) last first; a nested array too."""
+    if shapes[0] is None:
+        raise InputError("reverse() takes a vector or matrix, got a number")
+    return np.flip(np.asarray(v), axis=0).copy()
+
+
+def rsort(m, i, origin: int, shape):
+    """The columns of ``m`` (of ``shape``; None: a number) sorted by row ``i`` (stable,
+    smallest first)."""
+    m = _array_arg(m, shape, "rsort()")
+    k = int(round(float(i))) - origin
+    if m.ndim != 2:
+        raise InputError("rsort(): the matrix varies over a range; sort a fixed matrix")
+    if not 0 <= k < m.shape[0]:
+        raise InputError(
+            f"rsort(): row {k + origin} is outside the {m.shape[0]}x{m.shape[1]} matrix"
+        )
+    return m[:, np.argsort(m[k, :], kind="stable")]
 
 
 def _excel_list(function: str):
