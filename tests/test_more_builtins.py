@@ -4,6 +4,8 @@ LibreOffice (slow)."""
 
 from __future__ import annotations
 
+import re
+
 import mpmath
 import numpy as np
 import pytest
@@ -107,22 +109,38 @@ a = "round(x, 2)"
 b = "round(-2.5) + 10*round(0.125, 2)"
 c = "trunc(-x) + round(1234.5, -2)"
 d = "round(1.005, 2)"
+v = "[1, 2, 3, 4, 10]"
+e = "stdev(v) + 10*var(v) + 100*median(v, 7)"
+f = "det(identity(3)*2) + sum(identity(2))"
 """
 
 
 @pytest.mark.slow
 def test_libreoffice_agrees(tmp_path):
-    from recalc import cell_values, formula_values, recalculate, soffice
+    import openpyxl
+    from recalc import recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
     sheet = workbook.load(write_template(tmp_path, LIVE))
     path = sheet.write_xlsx(tmp_path / "live.xlsx")
-    cells = formula_values(path)
-    lo = cell_values(recalculate(path, tmp_path / "lo"))
-    assert len(cells) >= 4
-    for key, (formula, value) in cells.items():
-        assert lo[key] == pytest.approx(value, rel=1e-15, abs=1e-15), (formula, lo[key])
+    written = openpyxl.load_workbook(path)
+    cached = openpyxl.load_workbook(path, data_only=True)
+    lo = openpyxl.load_workbook(recalculate(path, tmp_path / "lo"), data_only=True)
+    checked = []
+    for ws in written.worksheets:
+        for row in ws.iter_rows():
+            for c in row:
+                formula = getattr(c.value, "text", c.value)  # array formulas: their text
+                if not (isinstance(formula, str) and formula.startswith("=")):
+                    continue
+                want = cached[ws.title][c.coordinate].value
+                got = lo[ws.title][c.coordinate].value
+                assert got == pytest.approx(want, rel=1e-15, abs=1e-15), (formula, got, want)
+                checked.append(formula)
+    called = " ".join(checked)
+    for function in ("ROUND(", "TRUNC(", "_xlfn.STDEV.P(", "_xlfn.VAR.P(", "MEDIAN(", "({1,0"):
+        assert function in called, function
 
 
 # -- sort, reverse, rsort ------------------------------------------------------------------------
@@ -244,3 +262,124 @@ def test_sorted_arrays_are_written_as_values(arrays, tmp_path):
     comments = [c.comment.text for ws in wb for row in ws.iter_rows() for c in row if c.comment]
     for name in ("sort", "reverse", "rsort"):
         assert any(f"{name}() is written as values" in t for t in comments), name
+
+
+# -- identity, stdev, var, median ----------------------------------------------------------------
+STATS = '''
+[inputs]
+a = "2 kN/m"
+N = "3"
+
+[arguments]
+u = { unit = "" }
+n = { unit = "" }
+
+[definitions]
+K = "[[4, 1], [2, 3]]*a"
+I3 = "identity(3)"
+A = "K - a*identity(rows(K))"
+x = { expr = "[1, 2, 3, 4, 10]*a", unit = "N/mm" }
+sd = { expr = "stdev(x)", unit = "N/mm" }
+vr = { expr = "var(x)", unit = "N^2/mm^2" }
+md = { expr = "median(x)", unit = "N/mm" }
+md_even = "median([4, 1, 3, 2])"
+mixed = { expr = "stdev(x, a, [[1, 2], [3, 4]]*a)", unit = "N/mm" }
+"sdu(u)" = "stdev([u, 2*u^2, 3], 1)"
+"vru(u)" = "var([u, 2*u^2, 3], 1)"
+"mdu(u)" = "median([u, 2*u^2, 3], 1)"
+"grown(n)" = { program = """
+for i in 1 .. n
+    w[i] := i^2
+stdev(w) + 1000*median(w)
+""" }
+'''
+
+
+@pytest.fixture(scope="module")
+def stats(tmp_path_factory):
+    return workbook.load(write_template(tmp_path_factory.mktemp("stats"), STATS))
+
+
+def _population(values):
+    """mpmath at 50 digits: (stdev, var, median), divided by N."""
+    with mpmath.workdps(50):
+        xs = [mpmath.mpf(float(v)) for v in values]
+        mean = mpmath.fsum(xs) / len(xs)
+        var = mpmath.fsum((x - mean) ** 2 for x in xs) / len(xs)
+        s = sorted(xs)
+        k = len(s) // 2
+        median = s[k] if len(s) % 2 else (s[k - 1] + s[k]) / 2
+        return float(mpmath.sqrt(var)), float(var), float(median)
+
+
+def test_identity(stats):
+    assert stats.evaluate("I3").magnitude.tolist() == np.eye(3).tolist()
+    assert stats.evaluate("A").to("kN/m").magnitude.tolist() == [[6, 2], [4, 4]]
+
+
+@pytest.mark.parametrize(
+    "expr,message",
+    [
+        ("identity(N)", "n must be a positive integer known at load"),
+        ("identity(0)", "n must be a positive integer known at load"),
+        ("identity(2.5)", "n must be a positive integer known at load"),
+        ("identity(a)", "needs a dimensionless argument"),
+        ("identity(5000)", "more than 2000 rows"),
+    ],
+)
+def test_identity_needs_a_size_known_at_load(tmp_path, expr, message):
+    with pytest.raises(WorkbookError, match=re.escape(message)):
+        workbook.load(write_template(tmp_path, STATS + f'bad = "{expr}"\n'))
+
+
+def test_statistics_against_mpmath(stats):
+    sd, var, med = _population([2, 4, 6, 8, 20])  # x in N/mm
+    assert stats.evaluate("sd").to("N/mm").magnitude == pytest.approx(sd, rel=1e-15)
+    assert stats.evaluate("vr").to("N^2/mm^2").magnitude == pytest.approx(var, rel=1e-15)
+    assert stats.evaluate("md").to("N/mm").magnitude == med == 6.0
+    assert stats.evaluate("md_even").magnitude == 2.5
+    sd, _, _ = _population([2, 4, 6, 8, 20, 2, 2, 4, 6, 8])
+    assert stats.evaluate("mixed").to("N/mm").magnitude == pytest.approx(sd, rel=1e-15)
+
+
+@pytest.mark.parametrize("name,which", [("sdu", 0), ("vru", 1), ("mdu", 2)])
+def test_statistics_over_a_range_against_mpmath(stats, name, which):
+    u = np.concatenate([np.linspace(-3, 3, 61), np.random.default_rng(7).uniform(-1e3, 1e3, 100)])
+    got = stats.evaluate(name, u).magnitude
+    want = np.array([_population([x, 2 * x * x, 3.0, 1.0])[which] for x in u])
+    assert np.allclose(got, want, rtol=4e-16 * 8, atol=0)
+
+
+def test_statistics_of_a_run_time_array(stats):
+    sd, _, med = _population([0, 1, 4, 9, 16])  # origin 0: w[0] is 0
+    assert stats.evaluate("grown", 4.0).magnitude == pytest.approx(sd + 1000 * med, rel=1e-15)
+
+
+def test_statistics_are_live_and_formulas_agrees(stats, tmp_path):
+    import formulas
+    import openpyxl
+
+    path = stats.write_xlsx(tmp_path / "stats.xlsx")
+    ws = openpyxl.load_workbook(path)["Definitions"]
+    rows = {
+        r[0].value: getattr(r[1].value, "text", r[1].value)  # array formulas: their text
+        for r in ws.iter_rows(min_row=2)
+        if r[0].value
+    }
+    assert rows["sd"] == "=_xlfn.STDEV.P(x_)"
+    assert rows["vr"] == "=_xlfn.VAR.P(x_)"
+    assert rows["md"] == "=MEDIAN(x_)"
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    got = {}
+    for key, value in solution.items():
+        book_sheet, _, cell = key.rpartition("!")
+        if book_sheet.upper().endswith("DEFINITIONS'") and ":" not in cell:
+            got[cell.upper()] = value.value[0, 0]
+    checked = 0
+    for r in ws.iter_rows(min_row=2):
+        if r[0].value in ("sd", "vr", "md", "md_even", "mixed"):
+            checked += 1
+            unit = r[2].value or ""
+            want = stats.evaluate(r[0].value).to(unit).magnitude
+            assert float(got[r[1].coordinate]) == pytest.approx(want, rel=1e-13), r[0].value
+    assert checked == 5

@@ -747,6 +747,57 @@ def register_entries() -> None:
         runtime=rt_with_origin("same"),
     )
 
+    # identity(n): the size a constant
+    def r_identity(ctx, name, args):
+        n = ctx.plain(args[0], "identity(): the size")
+        if not isinstance(n, ty.TConst) or n.value != int(n.value) or n.value < 1:
+            raise TemplateError(
+                "identity(n): n must be a positive integer known at load (a number, or "
+                "rows(M) of a matrix M), as the shape of every matrix is"
+            )
+        if n.value > MAX_IDENTITY:
+            raise TemplateError(f"identity({n.value:g}): more than {MAX_IDENTITY} rows")
+        return func(ctx.dimensionless, name, [n], (int(n.value), int(n.value)))
+
+    def x_identity(args, shapes=None):
+        n = int(float(args[0]))
+        if n > MAX_EXCEL_IDENTITY:
+            raise NotLive(f"identity({n}) is written as values (a constant of {n}x{n})")
+        rows = (",".join("1" if i == j else "0" for j in range(n)) for i in range(n))
+        # bracketed: a formula that ends with "}" loses it (read as an array formula's brace)
+        return "({" + ";".join(rows) + "})", atom
+
+    entry(
+        "identity",
+        1,
+        r_identity,
+        lambda n, shapes: np.eye(int(n)),
+        x_identity,
+        "identity(n): the n x n identity matrix (n known at load)",
+    )
+
+    # statistics of the elements (and numbers): Mathcad's stdev and var are the population
+    # ones (divided by N), as Excel's STDEV.P and VAR.P
+    def r_var(ctx, name, args):
+        t = r_reduce(ctx, name, args)
+        return func(t.unit**2, name, t.args, None)
+
+    for kind, rule, excel_name, doc in (
+        ("stdev", r_reduce, "_xlfn.STDEV.P", "population standard deviation (divided by N)"),
+        ("var", r_var, "_xlfn.VAR.P", "population variance (divided by N)"),
+        ("median", r_reduce, "MEDIAN", "median"),
+    ):
+        entry(
+            kind,
+            None,
+            rule,
+            numpy_statistic(kind),
+            _excel_list(excel_name),
+            f"{doc} of the arguments (or of the elements of vectors and matrices)",
+            ("MEDIAN",) if kind == "median" else (),
+            runtime=rule,
+        )
+
 
 def _numbers_as_1x1(values, shapes):
     """stack and augment take a number as a 1x1 matrix (as Mathcad's)."""
@@ -780,6 +831,27 @@ def csort(m, j, origin: int):
             f"csort(): column {k + origin} is outside the {m.shape[0]}x{m.shape[1]} matrix"
         )
     return m[np.argsort(m[:, k], kind="stable")]
+
+
+#: The largest identity(n); Excel gets it as an array constant up to MAX_EXCEL_IDENTITY.
+MAX_IDENTITY = 2000
+MAX_EXCEL_IDENTITY = 30
+
+
+def numpy_statistic(kind: str):
+    """stdev, var or median of every element of the matrices (and the numbers) given."""
+    fn = {"stdev": np.std, "var": np.var, "median": np.median}[kind]
+
+    def hook(*values, shapes):
+        parts = []
+        for v, shape in zip(values, shapes):
+            v = np.asarray(v, dtype=float)
+            parts.append(v[None, ...] if shape is None else v.reshape((-1,) + v.shape[2:]))
+        shape = np.broadcast_shapes(*[p.shape[1:] for p in parts])
+        flat = np.concatenate([np.broadcast_to(p, p.shape[:1] + shape) for p in parts], axis=0)
+        return _scalar(fn(flat, axis=0))
+
+    return hook
 
 
 def _array_arg(v, shape, what: str, vector: bool = False):

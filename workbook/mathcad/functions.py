@@ -26,6 +26,7 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "last": ("last", None), "transpose": ("transpose", None), "det": ("det", None),
     "stack": ("stack", None), "augment": ("augment", None), "submatrix": ("submatrix", None),
     "identity": ("identity", None), "mean": ("mean", None), "stdev": ("stdev", None),
+    "var": ("var", None), "median": ("median", None),
     "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
     "csort": ("csort", None), "rsort": ("rsort", None), "sort": ("sort", None),
     "reverse": ("reverse", None),
