@@ -261,3 +261,23 @@ def test_eigenparts_against_scipy(tmp_path):
         np.testing.assert_allclose(got[:, 1], lam.imag, rtol=1e-12, atol=1e-12)
         moduli = np.hypot(got[:, 0], got[:, 1])
         assert np.all(np.diff(moduli) >= -1e-12)
+
+
+def test_a_formula_ending_in_an_array_constant_keeps_its_brace(tmp_path):
+    """xlsxwriter takes a last '}' for the brace of {=...}: a matrix literal at the end of a
+    formula would lose it (=a_*{1,0;0,1); the formula is bracketed instead."""
+    import openpyxl
+
+    sheet = _sheet(tmp_path, '[inputs]\na = "2"\n[definitions]\nM = "a*[[1, 2], [3, 4]]"\n')
+    out = tmp_path / "m.xlsx"
+    sheet.write_xlsx(out)
+    ws = openpyxl.load_workbook(out)["Matrices"]
+    formulas = [
+        c.value.text if hasattr(c.value, "text") else c.value
+        for row in ws.iter_rows()
+        for c in row
+        if c.data_type == "f" or hasattr(c.value, "text")
+    ]
+    assert formulas, "no formula written"
+    for f in formulas:
+        assert f.count("{") == f.count("}"), f

@@ -62,6 +62,8 @@ class ExcelPrinter(Visitor):
     def formula(self, t: tc.T, subst: dict[str, str]) -> str:
         self.array = False  # set when the formula computes with arrays (an array formula)
         text = "=" + self.print(t, subst)
+        if text.endswith("}"):  # xlsxwriter drops a last "}" (it reads {=...} array braces)
+            text = f"=({text[1:]})"
         if len(text) > MAX_FORMULA:
             raise NotLive(f"formula is {len(text)} characters long (Excel's limit {MAX_FORMULA})")
         return text

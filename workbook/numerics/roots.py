@@ -41,18 +41,21 @@ def root_in(
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     xs = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, k + 1)
     fs = call(f, xs, [g[:, None] for g in args])
-    bad = ~np.isfinite(fs)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
+    if not np.isfinite(fs).all():
+        i, j = np.argwhere(~np.isfinite(fs))[0]
         raise NumericsError(
             f"root(): the function is not a finite number at {var} = {num(xs[i, j])}{_u(unit)}"
             f"{row_text(label, i, n)}, inside the bracket [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
         )
-    s = np.sign(fs)
-    change = s[:, :-1] * s[:, 1:] < 0
-    zero = s == 0
-    # a sampled exact zero counts once, even where it touches two intervals
-    count = change.sum(axis=1) + zero.sum(axis=1)
+    # signs as booleans (a byte each, not a float): the sampling is a fair share of the time
+    positive = fs > 0
+    zero = fs == 0
+    change = positive[:, :-1] != positive[:, 1:]
+    if zero.any():  # a sampled exact zero counts once, even where it touches two intervals
+        change &= ~(zero[:, :-1] | zero[:, 1:])
+        count = change.sum(axis=1) + zero.sum(axis=1)
+    else:
+        count = change.sum(axis=1)
     none = np.flatnonzero(count == 0)
     if none.size:
         i = none[0]
@@ -60,7 +63,7 @@ def root_in(
             f"root(): no sign change of the function in [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
             f"{row_text(label, i, n)}: sampled at {var} = "
             + ", ".join(num(x) for x in xs[i])
-            + f" with signs {''.join('+' if v > 0 else '-' for v in s[i])}"
+            + f" with signs {''.join('+' if v > 0 else '-' for v in fs[i])}"
             + (f" ({none.size} of {n} rows)" if n > 1 else "")
             + "; choose bounds on either side of the root"
         )
@@ -77,14 +80,18 @@ def root_in(
         )
     value = np.empty(n)
     error = np.zeros(n)
-    at_zero = zero.any(axis=1)
-    value[at_zero] = xs[at_zero][zero[at_zero]]
-    todo = np.flatnonzero(~at_zero)
     evaluations = k + 1
+    if zero.any():
+        at_zero = zero.any(axis=1)
+        value[at_zero] = xs[at_zero][zero[at_zero]]
+        todo = np.flatnonzero(~at_zero)
+        todo_args = tuple(g[todo] for g in args)
+    else:  # every row is refined (no copy of the arguments)
+        todo, todo_args = np.arange(n), tuple(args)
     if todo.size:
         j = np.argmax(change[todo], axis=1)
         xl, xr = xs[todo, j], xs[todo, j + 1]
-        res = find_root(f, (xl, xr), args=tuple(g[todo] for g in args), tolerances=_tolerances(tol))
+        res = find_root(f, (xl, xr), args=todo_args, tolerances=_tolerances(tol))
         _check_status(res, todo, lo, hi, label, n, unit)
         value[todo] = res.x
         error[todo] = _error(res, tol)
