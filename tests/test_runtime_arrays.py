@@ -291,3 +291,12 @@ columns = { "whole(n)" = "" }
     assert sheet.table("sums")["total(n)"].tolist() == [1.0, 3.0, 6.0, 10.0, 15.0]
     with pytest.raises(WorkbookError, match="whole.*a vector of 1 where a number is wanted"):
         sheet.table("arrays")
+
+
+def test_the_report_shows_a_nested_array_in_brackets(sheet, tmp_path):
+    html = sheet.report(tmp_path / "grow.html").read_text(encoding="utf-8")
+    assert "<p class='error'>error:" not in html  # no section failed
+    assert "not computed: " in html  # 'where' reads outside its data
+    start = html.index("data-name='trains'")
+    # the column of 3 trains, and in each train its column and its two vectors
+    assert html.count("<mtable>", start, html.index("</div>", start)) == 1 + 3 * 3

@@ -15,6 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from html import escape
 
+import numpy as np
+
 from .. import expr as ex
 from .. import registry as bi
 from ..visitor import Visitor
@@ -209,8 +211,15 @@ def quantity_box(value: float, unit: str, digits: int = PRECISION, attrs: str = 
 
 
 def matrix_box(values, unit: str, digits: int = PRECISION) -> Box:
-    """A vector or matrix of numbers in brackets, with its unit after."""
-    rows = [[number_box(float(v), digits) for v in row] for row in values]
+    """A vector or matrix of numbers in brackets, with its unit after; an element that is
+    itself an array (a nested array) is a bracketed matrix in its place."""
+
+    def element(v) -> Box:
+        if np.ndim(v) == 2:
+            return matrix_box(v, "", digits)
+        return number_box(float(v), digits)
+
+    rows = [[element(v) for v in row] for row in values]
     widths = [max(r[j].width for r in rows) for j in range(len(rows[0]))]
     xml = "".join("<mtr>" + "".join(f"<mtd>{b.xml}</mtd>" for b in r) + "</mtr>" for r in rows)
     box = _parens(Box(f"<mtable>{xml}</mtable>", sum(widths) + 0.6 * len(widths)), "[", "]")
