@@ -592,20 +592,26 @@ def register_entries() -> None:
         runtime=rt_with_origin("same"),
     )
 
-    def r_csort(ctx, name, args):
-        r, c = need(args, 0, name)
-        j = ctx.plain(args[1], "csort(): the column")
-        if isinstance(j, ty.TConst) and not ctx.spec.origin <= j.value < ctx.spec.origin + c:
-            raise TemplateError(
-                f"csort(): column {j.value:g} is outside the {shape_text((r, c))} "
-                f"(origin {ctx.spec.origin})"
-            )
-        return func(args[0].unit, name, [args[0], j, origin_arg(ctx)], (r, c))
+    def r_sort_by(word: str, axis: int, what: str = "a vector or matrix"):
+        """csort(M, j) / rsort(M, i): the column (row) to sort by, checked if constant."""
+
+        def rule(ctx, name, args):
+            r, c = need(args, 0, name, what)
+            k = ctx.plain(args[1], f"{name}(): the {word}")
+            size, origin = (r, c)[axis], ctx.spec.origin
+            if isinstance(k, ty.TConst) and not origin <= k.value < origin + size:
+                raise TemplateError(
+                    f"{name}(): {word} {k.value:g} is outside the {shape_text((r, c))} "
+                    f"(origin {origin})"
+                )
+            return func(args[0].unit, name, [args[0], k, origin_arg(ctx)], (r, c))
+
+        return rule
 
     entry(
         "csort",
         2,
-        r_csort,
+        r_sort_by("column", 1),
         lambda m, j, origin, shapes: csort(m, j, int(origin)),
         not_live("csort() is written as values"),
         "csort(M, j): the rows of M sorted by column j, smallest first (Mathcad's csort)",
@@ -625,8 +631,6 @@ def register_entries() -> None:
 
     def numpy_size(kind: str):
         def hook(v, origin=0.0, *, shapes):  # a run-time array: its size when it runs
-            from .runtime import size
-
             return size(kind, v, int(origin))
 
         return hook
@@ -709,16 +713,6 @@ def register_entries() -> None:
     def r_reverse(ctx, name, args):
         return func(args[0].unit, name, args, need(args, 0, name))
 
-    def r_rsort(ctx, name, args):
-        r, c = need(args, 0, name, "a matrix")
-        i = ctx.plain(args[1], "rsort(): the row")
-        if isinstance(i, ty.TConst) and not ctx.spec.origin <= i.value < ctx.spec.origin + r:
-            raise TemplateError(
-                f"rsort(): row {i.value:g} is outside the {shape_text((r, c))} "
-                f"(origin {ctx.spec.origin})"
-            )
-        return func(args[0].unit, name, [args[0], i, origin_arg(ctx)], (r, c))
-
     entry(
         "sort",
         1,
@@ -740,7 +734,7 @@ def register_entries() -> None:
     entry(
         "rsort",
         2,
-        r_rsort,
+        r_sort_by("row", 0, "a matrix"),
         lambda m, i, origin, shapes: rsort(m, i, int(origin), shapes[0]),
         not_live("rsort() is written as values"),
         "rsort(M, i): the columns of M sorted by row i, smallest first (Mathcad's rsort)",
@@ -797,6 +791,15 @@ def register_entries() -> None:
             ("MEDIAN",) if kind == "median" else (),
             runtime=rule,
         )
+
+
+def size(kind: str, v, origin: int = 0) -> float:
+    """rows, cols, length or last of a run-time value (workbook.runtime); a number has 0 rows
+    and columns (as Mathcad's rows of a scalar), so a vector grown from nothing starts at 0."""
+    r, c = np.shape(v) if np.ndim(v) == 2 else (0, 0)
+    if kind in ("length", "last") and c > 1:
+        raise InputError(f"{kind}() takes a vector, got a {r}x{c} matrix")
+    return float({"rows": r, "cols": c, "length": r, "last": r - 1 + origin}[kind])
 
 
 def _numbers_as_1x1(values, shapes):

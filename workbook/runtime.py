@@ -20,6 +20,7 @@ import operator
 import numpy as np
 
 from .errors import InputError
+from .matrix import size  # noqa: F401 - rows/cols/length/last of a run-time value
 
 
 def value(v):
@@ -61,19 +62,6 @@ def describe(v) -> str:
     if isinstance(v, str):
         return "text"
     return "a number"
-
-
-def size(kind: str, v, origin: int = 0) -> float:
-    """rows, cols, length or last of a run-time value; a number has 0 rows and columns (as
-    Mathcad's rows of a scalar), so a vector grown from nothing starts at rows 0."""
-    v = value(v)
-    if not is_array(v):
-        r, c = 0, 0
-    else:
-        r, c = v.shape
-    if kind in ("length", "last") and c > 1:
-        raise InputError(f"{kind}() takes a vector, got {describe(v)}")
-    return float({"rows": r, "cols": c, "length": r, "last": r - 1 + origin}[kind])
 
 
 # -- indexing and setting elements ------------------------------------------------------------
