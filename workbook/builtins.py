@@ -219,11 +219,29 @@ _simple(
     mathml=mathml_fence("|", "|"),
 )
 _simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
+
+
+# -- floor, ceil, round and trunc: of plain numbers only ----------------------------------------
+def _integer_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    """floor, ceil, round and trunc take a plain number: rounding 1.5 m gives 2 m in metres
+    but 1.5 m in millimetres (Mathcad rounds the value in SI units), so a value with a unit,
+    or in a unit that is not the plain number itself (deg, %, mm/m), is refused."""
+    x = args[0]
+    factor = None if x.unit.dimensionality else (1 * x.unit).to(ctx.dimensionless).magnitude
+    if factor != 1:
+        raise UnitError(
+            f"{name}() needs a plain number, got a value in {pretty(x.unit)}: the result would "
+            f"depend on the unit it is rounded in; round a ratio, {name}(x/step)*step"
+        )
+    rest = tuple(ctx.plain(a, f"{name}(): the number of decimals") for a in args[1:])
+    return ty.TFunc(ctx.dimensionless, func=name, args=(ctx.plain(x, f"{name}()"), *rest))
+
+
 register(
     Builtin(
         "floor",
         1,
-        same_unit,
+        _integer_unit,
         np.floor,
         lambda args: (f"INT({args[0]})", PREC["atom"]),
         lambda sp, x: sp.floor(x),
@@ -236,7 +254,7 @@ register(
     Builtin(
         "ceil",
         1,
-        same_unit,
+        _integer_unit,
         np.ceil,
         _excel_ceil,
         lambda sp, x: sp.ceiling(x),
@@ -269,22 +287,6 @@ _simple(
     arity=2,
     excel_functions=("TRUNC",),
 )
-
-
-# -- round and trunc: of plain numbers only ------------------------------------------------------
-def _integer_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
-    """round and trunc take a plain number: rounding 1.5 m gives 2 m in metres but 1.5 m in
-    millimetres (Mathcad rounds the value in SI units), so a value with a unit, or in a unit
-    that is not the plain number itself (deg, %, mm/m), is refused."""
-    x = args[0]
-    factor = None if x.unit.dimensionality else (1 * x.unit).to(ctx.dimensionless).magnitude
-    if factor != 1:
-        raise UnitError(
-            f"{name}() needs a plain number, got a value in {pretty(x.unit)}: the result would "
-            f"depend on the unit it is rounded in; round a ratio, {name}(x/step)*step"
-        )
-    rest = tuple(ctx.plain(a, f"{name}(): the number of decimals") for a in args[1:])
-    return ty.TFunc(ctx.dimensionless, func=name, args=(ctx.plain(x, f"{name}()"), *rest))
 
 
 def _round_numpy(x, n=0.0):
