@@ -1697,11 +1697,12 @@ class _Units(Visitor):
         return self.visit(n.target)
 
     def visit_Call(self, n):
-        if n.func in ("abs", "mag", "min", "max", "floor", "ceil"):
+        if n.func in ("abs", "mag", "min", "max", "mod"):
             return self.visit(n.args[0])
         if n.func == "sqrt":
             return self.visit(n.args[0]) ** 0.5
-        if n.func in ("sin", "cos", "tan", "exp", "ln", "log10", "asin", "acos", "atan"):
+        plain = ("sin", "cos", "tan", "exp", "ln", "log10", "asin", "acos", "atan")
+        if n.func in plain + ("floor", "ceil", "round", "trunc"):
             return self._reg().dimensionless
         raise _Unknown
 
