@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import operator
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
@@ -295,13 +296,11 @@ class Evaluator(Visitor):
 
     def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
         conds = [None if k is None else self.compile(k) for k in t.conditions]
-        matrices = _matrix_names(t)
-        split = _partition(conds, t.texts, matrices, frozenset(ty.parameters(t)))
+        matrices, used = _matrix_names(t), frozenset(ty.parameters(t))
+        split = _partition(conds, t.texts, matrices, used)
         keys = tuple(None if k is None else self.plan.keys.key(k) for k in t.conditions)
         split = self._kept(self.plan.keys.signature("pieces", keys), split)
-        return _piecewise(
-            t, conds, [self.compile(v) for v in t.values], split, matrices, ty.parameters(t)
-        )
+        return _piecewise(t, conds, [self.compile(v) for v in t.values], split, matrices, used)
 
     def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
         from .matrix import build
@@ -431,8 +430,6 @@ _FRAMES_PER_LEVEL = 40
 def _recursion_bounded(name: str, fn: Fn) -> Fn:
     """``fn`` (a function that calls itself) with its depth counted: deeper than
     MAX_RECURSION is a LimitError naming it, never Python's RecursionError."""
-    import sys
-
     depth = [0]
 
     def run(env):
@@ -443,7 +440,6 @@ def _recursion_bounded(name: str, fn: Fn) -> Fn:
                 definition=name,
             )
         before = sys.getrecursionlimit()
-        need = sys.getrecursionlimit() + 0
         need = max(before, 1000 + _FRAMES_PER_LEVEL * (depth[0] + 1))
         if need > before:
             sys.setrecursionlimit(need)
@@ -546,10 +542,9 @@ def _piecewise(
     values: list,
     split: Fn,
     matrices: frozenset = frozenset(),
-    used=None,
+    used: frozenset | None = None,
 ) -> Fn:
     texts = t.texts
-    used = frozenset(used) if used is not None else None
 
     def evaluate(env):
         seen = env.items() if used is None else ((k, env[k]) for k in used if k in env)

@@ -873,23 +873,16 @@ def compile_program(
 
                 def set_runtime(env, last):
                     tick(s)
-                    owned = env.setdefault(_OWNED, set())
-                    old = env.get(n)
-                    if n not in owned and isinstance(old, np.ndarray):
-                        old = old.copy()  # an argument's array is the caller's
-                    owned.add(n)
+                    _own(env, n)
                     at = [i(env) for i in idx]
-                    env[n] = rt.set_item(old, at, f(env), origin=origin, what=what)
+                    env[n] = rt.set_item(env.get(n), at, f(env), origin=origin, what=what)
                     return last
 
                 return set_runtime
 
             def set_item(env, last):
                 tick(s)
-                owned = env.setdefault(_OWNED, set())
-                if n not in owned and isinstance(env.get(n), np.ndarray):
-                    env[n] = env[n].copy()  # an argument's array is the caller's
-                owned.add(n)
+                _own(env, n)
                 if grow is not None:  # made, or grown with zeros, to its length at load
                     old = env.get(n)
                     if old is None or np.shape(old)[:2] != tuple(grow):
@@ -1020,6 +1013,15 @@ def _result(value):
 #: Where a program run keeps the names of the locals it made (an argument's array is copied
 #: before its first element is set); not a valid name, so no local can meet it.
 _OWNED = "#owned"
+
+
+def _own(env: dict, name: str) -> None:
+    """Before the first element of ``name`` is set in this run: an array the run did not
+    make (an argument's, the caller's) is replaced by a copy of it."""
+    owned = env.setdefault(_OWNED, set())
+    if name not in owned and isinstance(env.get(name), np.ndarray):
+        env[name] = env[name].copy()
+    owned.add(name)
 
 
 # -- a live spreadsheet formula ---------------------------------------------------------------

@@ -20,7 +20,10 @@ import operator
 import numpy as np
 
 from .errors import InputError
-from .matrix import size  # noqa: F401 - rows/cols/length/last of a run-time value
+from .matrix import (
+    power,
+    size,  # noqa: F401 - rows/cols/length/last of a run-time value
+)
 
 
 def value(v):
@@ -184,8 +187,6 @@ def binary(op: str, a, b, what: str):
     n = float(b)
     if sa[0] != sa[1] or n != int(n):
         raise InputError(f"{what}: a power of {describe(a)} needs a square matrix and an integer")
-    from .matrix import power
-
     return power(a, int(n))
 
 

@@ -228,32 +228,15 @@ class ArrayTyping:
         return TBinary(left.unit**n, op="@^", left=left, right=right, shape=ls)
 
     def runtime_binary(self, op: str, left: T, right: T) -> T:
-        """``left op right`` with a run-time array on one side: units as for numbers, the
-        shapes by Mathcad's rules when it runs (:func:`workbook.runtime.binary`)."""
+        """``left op right`` with a run-time array on one side: the units as for numbers
+        (:meth:`scalar_binary`), the shapes by Mathcad's rules when it runs
+        (:func:`workbook.runtime.binary`)."""
         if self._elementwise:
             raise TemplateError(
                 "vectorize(...) of an array whose size is known only when it runs; write a "
                 "loop over its elements"
             )
-        if op in "+-":
-            if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
-                if is_zero(left):
-                    left = self.convert(left, right.unit, "sum")
-                else:
-                    self._mismatch(op, left, right)
-            right = self.convert(right, left.unit, "sum")
-            return TBinary(left.unit, op=op, left=left, right=right, shape=RUNTIME)
-        if op == "*":
-            return TBinary(left.unit * right.unit, op="*", left=left, right=right, shape=RUNTIME)
-        if op == "/":
-            return TBinary(left.unit / right.unit, op="/", left=left, right=right, shape=RUNTIME)
-        if not right.unit.dimensionless or right.unit.dimensionality:
-            raise UnitError(f"an exponent must be dimensionless, got {un.dims(right.unit)}")
-        right = self.convert(right, self.dimensionless, "exponent")
-        if left.unit.dimensionality and not isinstance(right, TConst):
-            raise UnitError(f"{un.dims(left.unit)} raised to a variable power has no unit")
-        unit = left.unit**right.value if isinstance(right, TConst) else left.unit
-        return TBinary(unit, op="^", left=left, right=right, shape=RUNTIME)
+        return replace(self.scalar_binary(op, left, right), shape=RUNTIME)
 
     def _same_shape(self, verb: str, ls, rs) -> None:
         if ls != rs:

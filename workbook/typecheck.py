@@ -452,6 +452,10 @@ class Typer(ArrayTyping, Visitor):
         op = node.op
         if left.shape is not None or right.shape is not None:
             return self.matrix_binary(op, left, right)
+        return self.scalar_binary(op, left, right)
+
+    def scalar_binary(self, op: str, left: T, right: T) -> T:
+        """``left op right`` of numbers: the unit rules of the operators (constants folded)."""
         if op in "+-":
             left, right = meeting((left, right))
             if is_zero(left) and not is_zero(right):

@@ -16,6 +16,7 @@ import numpy as np
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from . import expr as ex
+from . import runtime as rt
 from . import style
 from . import typecheck as tc
 from . import units as un
@@ -323,13 +324,11 @@ class WorkbookWriter:
     def _runtime_value(self, name: str):
         """The array a definition whose size is known only when it runs has (None when it is
         a number, or cannot be computed: then it is written with the scalar results)."""
-        from .runtime import is_array, value
-
         try:
-            v = value(self.sheet.scalar_value(name, "definition"))
+            v = rt.value(self.sheet.scalar_value(name, "definition"))
         except WorkbookError:
             return None
-        return v if is_array(v) else None
+        return v if rt.is_array(v) else None
 
     def _write_runtime(self, ws, row: int, d, t: tc.T) -> int:
         """An array whose size is known only when its program ran: its values (a nested
@@ -1187,10 +1186,9 @@ class HelperBlock:
 def _nested_text(value) -> str:
     """A nested array as text, in the language's literals: a column [a, b], a matrix by rows
     [[a, b], [c, d]], an array element in its place ([1, [0, 30]])."""
-    from .runtime import is_array
 
     def text(v) -> str:
-        if not is_array(v):
+        if not rt.is_array(v):
             return f"{float(v):.10g}"
         if v.shape[1] == 1:
             return "[" + ", ".join(text(e) for e in v[:, 0]) + "]"
