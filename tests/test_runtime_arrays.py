@@ -75,6 +75,11 @@ a + [1, 2]
 a[rows(a) + 1] := n
 1 if a < 2 otherwise 0
 """ }
+"flipped(n)" = { program = """
+v[rows(v) + 1] := n
+v[rows(v) + 1] := 2*n
+transpose(v)
+""" }
 "sorted(n)" = { program = """
 M[1, 1] := 3
 M[1, 2] := 30
@@ -94,6 +99,7 @@ dotted = "selfdot(3)"
 sum_error = "bad_sum(1)"
 order_error = "bad_order(1)"
 ordered = "sorted(1)"
+row = "flipped(3)"
 '''
 
 
@@ -300,3 +306,7 @@ def test_the_report_shows_a_nested_array_in_brackets(sheet, tmp_path):
     start = html.index("data-name='trains'")
     # the column of 3 trains, and in each train its column and its two vectors
     assert html.count("<mtable>", start, html.index("</div>", start)) == 1 + 3 * 3
+
+
+def test_transpose_of_a_run_time_vector_is_a_row(sheet):
+    assert value(sheet, "row").tolist() == [[3.0, 6.0]]

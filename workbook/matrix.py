@@ -372,6 +372,7 @@ def register_entries() -> None:
         call("TRANSPOSE"),
         "rows and columns swapped",
         ("TRANSPOSE",),
+        runtime=rt_transpose,
     )
     entry(
         "det",
