@@ -1,7 +1,7 @@
 """The table of docs/mathcad.md: each Mathcad worksheet imported, then checked.
 
-For every .xmcd file under the folder (default tests/data/mathcad; a file that is only
-referenced by another one is skipped), runs ``workbook import`` and ``workbook check --json``
+For every .xmcd file under the folder (default ../shared/mathcad beside the repository; a
+file that is only referenced by another one is skipped), runs ``workbook import`` and ``workbook check --json``
 and prints a Markdown table: results Mathcad stored, reproduced, failed, not computable,
 and the reasons for those not reproduced (from the untranslated list of the worksheet).
 
@@ -89,7 +89,7 @@ def _short(reason: str) -> str:
 
 
 def main() -> int:
-    folder = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "tests" / "data" / "mathcad"
+    folder = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT.parent / "shared" / "mathcad"
     skip = referenced(folder)
     rows = []
     sums = Counter()

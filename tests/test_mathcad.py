@@ -10,7 +10,9 @@ import pytest
 
 from workbook.cli import main
 
-DATA = Path(__file__).parent / "data" / "mathcad"
+# Mathcad's own files are third-party: read from the shared folder beside the repository
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "mathcad"
+pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason=f"{DATA} is absent")
 
 
 def _import(name: str, out: Path, capsys) -> tuple[Path, str]:
@@ -114,7 +116,7 @@ def test_vectors_over_ranges_reproduce_every_stored_value(name, tmp_path, capsys
     "name",
     sorted(
         p.relative_to(DATA).as_posix()
-        for p in DATA.rglob("*.xmcd")
+        for p in (DATA.rglob("*.xmcd") if DATA.is_dir() else [])
         if p.name != "iSET_module.xmcd"  # a library that frame/example.xmcd references
     ),
 )

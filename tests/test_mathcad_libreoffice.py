@@ -10,8 +10,9 @@ from test_libreoffice import assert_same
 
 from workbook.cli import main
 
-DATA = Path(__file__).parent / "data" / "mathcad"
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "mathcad"
 pytestmark = [
+    pytest.mark.skipif(not DATA.is_dir(), reason=f"{DATA} is absent"),
     pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed"),
     pytest.mark.slow,
 ]
