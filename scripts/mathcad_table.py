@@ -1,9 +1,10 @@
 """The table of docs/mathcad.md: each Mathcad worksheet imported, then checked.
 
 For every .xmcd file under the folder (default ../shared/mathcad beside the repository; a
-file that is only referenced by another one is skipped), runs ``workbook import`` and ``workbook check --json``
-and prints a Markdown table: results Mathcad stored, reproduced, failed, not computable,
-and the reasons for those not reproduced (from the untranslated list of the worksheet).
+file that is only referenced by another one is skipped), runs ``workbook import`` and
+``workbook check --json`` and prints a Markdown table: results Mathcad stored, reproduced,
+failed, not computable, and the reasons for those not reproduced (from the untranslated list
+of the worksheet).
 
     python scripts/mathcad_table.py [FOLDER]
 """
