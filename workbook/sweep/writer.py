@@ -34,7 +34,7 @@ def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
     import xlsxwriter
 
     from ..version import __version__
-    from ..xlsx import write_labels
+    from ..xlsx import chart_label, write_labels
 
     df = result.table
     wb = xlsxwriter.Workbook(
@@ -64,6 +64,13 @@ def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
     x = result.varies[-1]
     xcol = nv - 1
     row = 0
+    label_row = 0
+
+    def literal(text: str):
+        nonlocal label_row
+        label, label_row = chart_label(charts, "Charts", text, label_row, head)
+        return label
+
     if x.unit or all(isinstance(v, (int, float)) for v in x.values):
         groups = _series_groups(result)
         for k, out in enumerate(result.outputs):
@@ -72,16 +79,16 @@ def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
             for label, first, last in groups:
                 c.add_series(
                     {
-                        "name": label or out.name,
+                        "name": literal(label or out.name),
                         "categories": ["Sweep", first, xcol, last, xcol],
                         "values": ["Sweep", first, col, last, col],
                         "marker": style.MARKER,
                     }
                 )
             unit = result.output_units[out.name]
-            c.set_title({"name": f"{out.name} over {x.name} ({result.sheet_name})"})
-            c.set_x_axis(style.axis(df.columns[xcol]))
-            c.set_y_axis(style.axis(f"{out.name}, {unit}" if unit else out.name))
+            c.set_title({"name": literal(f"{out.name} over {x.name} ({result.sheet_name})")})
+            c.set_x_axis(style.axis(literal(str(df.columns[xcol]))))
+            c.set_y_axis(style.axis(literal(f"{out.name}, {unit}" if unit else out.name)))
             row = style.place_chart(charts, row, c, legend=len(groups) > 1)
     about = wb.add_worksheet("About")
     about.set_column(0, 0, 20)
