@@ -360,7 +360,9 @@ class TextPrinter(Visitor):
         return f"({s})" if p < parent else s
 
     def visit_Number(self, node: Number) -> tuple[str, int]:
-        return number_text(node.value), PREC["atom"]
+        # a negative number reads back as a unary minus: bracketed as one (under a power)
+        level = PREC["neg"] if math.copysign(1.0, node.value) < 0 else PREC["atom"]
+        return number_text(node.value), level
 
     def visit_Text(self, node: Text) -> tuple[str, int]:
         return '"' + node.value.replace('"', "") + '"', PREC["atom"]

@@ -121,6 +121,12 @@ class ExprTranslator(Visitor):
             value = float(node.text.strip())
         except ValueError:
             raise Untranslatable(f"the number {node.text.strip()!r}") from None
+        if not math.isfinite(value):
+            raise Untranslatable(f"the number {node.text.strip()!r} is not finite")
+        # Mathcad writes (-1)^2 as a literal -1 under the power: the language's tree has the
+        # minus as an operator, so that printing brackets it where the precedence needs
+        if math.copysign(1.0, value) < 0:
+            return ex.Unary("-", ex.Number(-value))
         return ex.Number(value)
 
     def visit_parens(self, node: MNode) -> ex.Node:
