@@ -1,11 +1,22 @@
+import os
 import sys
 from pathlib import Path
 
 import pytest
 
+import workbook
+
 TESTS = Path(__file__).parent
 DATA = TESTS / "data"
 sys.path.insert(0, str(TESTS))
+
+# Run from a source checkout without installing (python -m pytest): the tests' subprocesses
+# start in temporary folders, so they find the package through PYTHONPATH.
+_SOURCE = TESTS.parent
+if Path(workbook.__file__).resolve().parent.parent == _SOURCE.resolve():
+    os.environ["PYTHONPATH"] = os.pathsep.join(
+        filter(None, [str(_SOURCE), os.environ.get("PYTHONPATH", "")])
+    )
 
 
 @pytest.fixture(scope="session")
