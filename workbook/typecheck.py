@@ -336,10 +336,46 @@ class Typer(ArrayTyping, Visitor):
                 f"{where}: {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}) cannot be converted "
                 f"to {un.dims(target)} ({un.pretty(target) or '1'})"
             )
+        kinds = (un.temperature_kind(t.unit), un.temperature_kind(target))
+        if "absolute" in kinds:
+            return self._temperature(t, target, kinds, where)
         f = un.factor(t.unit, target)
         if f == 1.0:
             return _with_unit(t, target)
         return TScale(target, child=t, factor=f, shape=t.shape)
+
+    def _temperature(self, t: T, target: pint.Unit, kinds, where: str) -> T:
+        """An absolute temperature in another scale: ``t*factor + offset`` (20 degC is
+        293.15 K); a difference is never shown as an absolute temperature, nor the reverse."""
+        if "difference" in kinds:
+            shown = (un.pretty(t.unit), un.pretty(target))
+            if kinds[0] == "difference":
+                raise UnitError(
+                    f"{where}: a temperature difference ({shown[0]}) cannot be shown as an "
+                    f"absolute temperature ({shown[1]}); show it in "
+                    f"{un.pretty(un.difference_unit(target))} or K"
+                )
+            raise UnitError(
+                f"{where}: an absolute temperature ({shown[0]}) cannot be shown as a "
+                f"difference ({shown[1]}); a difference is written T - T0, or show it in K"
+            )
+        f, offset = un.affine(t.unit, target)
+        if isinstance(t, TConst):
+            return TConst(target, value=t.value * f + offset)
+        scaled = _with_unit(t, target) if f == 1.0 else TScale(target, child=t, factor=f)
+        if offset == 0.0:
+            return scaled
+        op = "+" if offset > 0 else "-"
+        const = TConst(target, value=abs(offset))
+        return TBinary(target, op=op, left=scaled, right=const, shape=t.shape)
+
+    def kelvin(self, t: T) -> T:
+        """An absolute temperature with an offset (degC, degF) in kelvin, as a product, a
+        quotient, a power or a built-in takes it (Mathcad's rule: 2*T is 2*293.15 K at
+        20 degC); any other value as it is."""
+        if un.temperature_kind(t.unit) != "absolute":
+            return t
+        return self.convert(t, un.registry().kelvin, "an absolute temperature in kelvin")
 
     def meeting(self, values) -> list[T]:
         """Bare numbers among ``values`` next to an angle in degrees take its unit."""
@@ -462,11 +498,16 @@ class Typer(ArrayTyping, Visitor):
                 left = TConst(right.unit, value=0.0)
             if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
                 self._mismatch(op, left, right)
+            if not is_zero(left) and not is_zero(right):
+                left, right, unit = self._temperature_sum(op, left, right)
+                if unit is not None:
+                    return TBinary(unit, op=op, left=left, right=right)
             right = self.convert(right, left.unit, "sum")
             if isinstance(left, TConst) and isinstance(right, TConst):
                 v = left.value + right.value if op == "+" else left.value - right.value
                 return TConst(left.unit, value=v)
             return TBinary(left.unit, op=op, left=left, right=right)
+        left, right = self.kelvin(left), self.kelvin(right)
         if op == "*":
             if isinstance(left, TConst) and isinstance(right, TConst):
                 return TConst(left.unit * right.unit, value=left.value * right.value)
@@ -499,6 +540,37 @@ class Typer(ArrayTyping, Visitor):
                 ) from None
             return TConst(self.dimensionless, value=v)
         return TBinary(self.dimensionless, op="^", left=left, right=right)
+
+    def _temperature_sum(self, op: str, left: T, right: T) -> tuple[T, T, pint.Unit | None]:
+        """Sums and differences of temperatures as pint and Mathcad Prime read them: absolute
+        minus absolute is a difference (delta_degC), absolute plus or minus a difference is
+        absolute, two absolute temperatures are not added. Returns the operands converted
+        and the unit of the result, or the operands and None when no temperature rule applies
+        (K and degR alone are both absolute and difference, as in pint)."""
+        kinds = (un.temperature_kind(left.unit), un.temperature_kind(right.unit))
+        if "absolute" not in kinds and kinds not in (
+            ("difference", "kelvin"),
+            ("kelvin", "difference"),
+        ):
+            return left, right, None
+        shown = f"{un.pretty(left.unit)} {op} {un.pretty(right.unit)}"
+        if kinds == ("difference", "absolute") and op == "-":
+            raise UnitError(
+                f"{shown}: a temperature difference minus an absolute temperature is not a "
+                "temperature; write the absolute one first (T - dT)"
+            )
+        if kinds[1] == "difference":  # T + dT, T - dT: in the scale of T
+            return left, self.convert(right, un.difference_unit(left.unit), "sum"), left.unit
+        if kinds[0] == "difference":  # dT + T: in the scale of T
+            return self.convert(left, un.difference_unit(right.unit), "sum"), right, right.unit
+        if op == "+":
+            raise UnitError(
+                f"{shown}: two absolute temperatures cannot be added (20 degC + 20 degC is "
+                "not 40 degC); add a difference (T1 + (T2 - T1)/2 is their mean), or convert "
+                "both to K"
+            )
+        # absolute - absolute: a difference, in the scale of the left one
+        return left, self.convert(right, left.unit, "difference"), un.difference_unit(left.unit)
 
     def _no_bare_ratio(self, t: T, target: pint.Unit, where: str) -> None:
         """An angle in degrees divided by a plain number (theta/90) is a plain number of
@@ -614,6 +686,7 @@ class Typer(ArrayTyping, Visitor):
             raise self._unknown("function", name, scope)
         entry = REGISTRY[name]
         entry.check_arity(len(args))
+        args = [self.kelvin(a) for a in args]  # abs(T), max(T1, T2): as Mathcad, in kelvin
         if entry.arrays and any(is_runtime(a.shape) for a in args):
             if entry.runtime is None:
                 raise TemplateError(

@@ -7,7 +7,7 @@ import math
 
 import pint
 
-from .errors import InputError, LimitError
+from .errors import InputError, LimitError, UnitError
 from .fields import nearest
 from .quantity import MAX_UNIT_POWER, check_unit_text, split_quantity
 
@@ -137,10 +137,71 @@ def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
 
 
 def factor(src: pint.Unit, dst: pint.Unit) -> float:
-    """Multiplier that converts a magnitude in ``src`` into ``dst`` (raises on mismatch)."""
+    """Multiplier that converts a magnitude in ``src`` into ``dst`` (raises on mismatch).
+
+    A conversion from or to an absolute temperature with an offset (degC, degF) is not a
+    multiplier: it raises a UnitError (:func:`affine` gives its factor and offset)."""
     if src == dst:
         return 1.0
+    if temperature_kind(src) == "absolute" or temperature_kind(dst) == "absolute":
+        raise UnitError(
+            f"{pretty(src)} to {pretty(dst)} is not a scale factor (an absolute temperature "
+            "with an offset)"
+        )
     return float(registry().Quantity(1.0, src).to(dst).magnitude)
+
+
+def affine(src: pint.Unit, dst: pint.Unit) -> tuple[float, float]:
+    """``(factor, offset)`` with ``value in dst = value in src * factor + offset``, pint's
+    conversion (offset 0 for a multiplicative one). Between temperature units the two are
+    exact where the scales are (degC to degF is 1.8 and 32, not 31.999999999999936)."""
+    if temperature_kind(src) and temperature_kind(dst):
+        s1, o1 = _kelvin_scale(src)
+        s2, o2 = _kelvin_scale(dst)
+        return float(s1 / s2), float((o1 - o2) / s2)
+    q = registry().Quantity
+    zero = float(q(0.0, src).to(dst).magnitude)
+    return float(q(1.0, src).to(dst).magnitude) - zero, zero
+
+
+@functools.lru_cache(maxsize=64)
+def _kelvin_scale(u: pint.Unit):
+    """``(scale, offset)`` of a temperature unit as fractions: kelvin = value*scale + offset."""
+    from fractions import Fraction
+
+    q = registry().Quantity
+    zero = float(q(0.0, u).to("kelvin").magnitude)
+    scale = float(q(1.0, u).to("kelvin").magnitude) - zero
+    out = []
+    for x in (scale, zero):
+        f = Fraction(x).limit_denominator(10**6)
+        out.append(f if abs(float(f) - x) <= 1e-12 * max(abs(x), 1.0) else Fraction(x))
+    return tuple(out)
+
+
+def temperature_kind(u: pint.Unit) -> str | None:
+    """What a temperature unit can mean, as pint and Mathcad Prime read it: ``"absolute"``
+    (degC, degF: a temperature on a scale with an offset), ``"difference"`` (delta_degC,
+    delta_degF), ``"kelvin"`` (K, degR: either); None for any other unit, compound ones
+    included (W/(m*degC) is per degree of difference)."""
+    items = list(u._units.items())
+    if len(items) != 1 or items[0][1] != 1:
+        return None
+    name = items[0][0]
+    definition = registry()._units.get(name)
+    if definition is None or u.dimensionality != registry().kelvin.dimensionality:
+        return None
+    if not definition.converter.is_multiplicative:
+        return "absolute"
+    return "difference" if name.startswith("delta_") else "kelvin"
+
+
+def difference_unit(u: pint.Unit) -> pint.Unit:
+    """The unit of a difference of two temperatures in ``u``: delta_degC for degC, else ``u``."""
+    if temperature_kind(u) != "absolute":
+        return u
+    (name,) = u._units
+    return registry().Unit("delta_" + name)
 
 
 def dims(u: pint.Unit) -> str:

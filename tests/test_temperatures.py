@@ -1,0 +1,239 @@
+"""Absolute temperatures and temperature differences, against pint's own arithmetic.
+
+Every sum, difference, product and quotient of two temperatures in K, degC, degF, degR,
+delta_degC and delta_degF, and every conversion between them, is computed by the engine
+(numpy), printed as an Excel formula and recalculated by the `formulas` package (an
+independent Excel evaluator), and compared with pint (the registry the engine uses, with
+its offset units converted to kelvin in products, as the engine does).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import operator
+
+import formulas
+import pint
+import pytest
+from conftest import write_template
+from recalc import formula_values
+
+import workbook
+from workbook import units as un
+from workbook.errors import UnitError
+
+UNITS = ["K", "degC", "degF", "degR", "delta_degC", "delta_degF"]
+LEFT, RIGHT = 300.0, 20.0  # magnitudes of the two operands
+
+
+def _pint(op: str, a: str, b: str):
+    """pint's answer (None when pint refuses), with degC and degF in kelvin in products."""
+    q = un.registry().Quantity
+    left, right = q(LEFT, a), q(RIGHT, b)
+    if op in "*/":  # pint keeps 2*T in degC; products with a temperature use kelvin here
+        left, right = (
+            x.to("kelvin") if un.temperature_kind(x.units) == "absolute" else x
+            for x in (left, right)
+        )
+    try:
+        return {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}[op](
+            left, right
+        )
+    except (pint.errors.OffsetUnitCalculusError, pint.DimensionalityError):
+        return None
+
+
+def _sheet(tmp_path, a: str, b: str, definitions: str):
+    text = f"""
+[sheet]
+title = "temperatures"
+
+[inputs]
+A = {{ value = "{LEFT} {a}" }}
+B = {{ value = "{RIGHT} {b}" }}
+
+[definitions]
+{definitions}
+"""
+    return workbook.load(write_template(tmp_path, text))
+
+
+COMBINATIONS = list(itertools.product("+-*/", UNITS, UNITS))
+
+
+@pytest.mark.parametrize("op,a,b", COMBINATIONS, ids=[f"{a}{o}{b}" for o, a, b in COMBINATIONS])
+def test_arithmetic_of_two_temperatures_is_pints(tmp_path, op, a, b):
+    expected = _pint(op, a, b)
+    kinds = (un.temperature_kind(un.unit(a)), un.temperature_kind(un.unit(b)))
+    refused_here = op == "-" and kinds == ("difference", "absolute")  # pint: meaningless
+    if expected is None or refused_here:
+        with pytest.raises(UnitError, match="temperature"):
+            _sheet(tmp_path, a, b, f'r = "A {op} B"')
+        return
+    got = _sheet(tmp_path, a, b, f'r = "A {op} B"').evaluate("r")
+    if op in "+-":  # an absolute temperature or a difference, as pint says
+        assert un.temperature_kind(got.units) == un.temperature_kind(expected.units)
+    assert math.isclose(got.magnitude, expected.to(got.units).magnitude, rel_tol=1e-13)
+
+
+@pytest.mark.parametrize("a,b", list(itertools.product(UNITS, UNITS)))
+def test_a_temperature_shown_in_another_unit_is_pints_conversion(tmp_path, a, b):
+    q = un.registry().Quantity(LEFT, a)
+    try:
+        expected = q.to(b).magnitude
+    except pint.DimensionalityError:
+        with pytest.raises(UnitError, match="temperature"):
+            _sheet(tmp_path, a, a, f'r = {{ expr = "A", unit = "{b}" }}')
+        return
+    got = _sheet(tmp_path, a, a, f'r = {{ expr = "A", unit = "{b}" }}').evaluate("r")
+    assert str(got.units) == str(un.unit(b))
+    assert math.isclose(got.magnitude, expected, rel_tol=1e-13)
+
+
+SHEET = """
+[sheet]
+title = "a heated rod"
+
+[inputs]
+T1 = { value = "20 degC", note = "before" }
+T2 = { value = "85 degC", note = "after" }
+T3 = { value = "358.15 K" }
+Tf = { value = "98.6 degF" }
+alpha = { value = "1.2e-5 1/K", note = "expansion coefficient" }
+L = { value = "2 m" }
+
+[definitions]
+dT = { expr = "T2 - T1", unit = "K" }
+dT_plain = "T2 - T1"
+dT_F = { expr = "T2 - T1", unit = "delta_degF" }
+T2_K = { expr = "T2", unit = "K" }
+T3_C = { expr = "T3", unit = "degC" }
+Tf_C = { expr = "Tf", unit = "degC" }
+T1_F = { expr = "T1", unit = "degF" }
+dL = { expr = "alpha*L*(T2 - T1)", unit = "mm" }
+T_mid = "T1 + (T2 - T1)/2"
+T_mid_F = { expr = "T1 + (T2 - T1)/2", unit = "degF" }
+ratio = "T2/T1"
+warm = "1 if T2 > T3 otherwise 0"
+"""
+
+# (name, pint's value in the definition's unit)
+_Q = None
+
+
+def _expected():
+    q = un.registry().Quantity
+    t1, t2, t3, tf = q(20, "degC"), q(85, "degC"), q(358.15, "K"), q(98.6, "degF")
+    alpha, length = q(1.2e-5, "1/K"), q(2, "m")
+    return {
+        "dT": (t2 - t1).to("K"),
+        "dT_plain": (t2 - t1).to("delta_degC"),
+        "dT_F": (t2 - t1).to("delta_degF"),
+        "T2_K": t2.to("K"),
+        "T3_C": t3.to("degC"),
+        "Tf_C": tf.to("degC"),
+        "T1_F": t1.to("degF"),
+        "dL": (alpha * length * (t2 - t1)).to("mm"),
+        "T_mid": (t1 + (t2 - t1) / 2).to("degC"),
+        "T_mid_F": (t1 + (t2 - t1) / 2).to("degF"),
+        "ratio": (t2.to("K") / t1.to("K")).to(""),
+        "warm": q(1 if t2.to("K") > t3 else 0, ""),
+    }
+
+
+@pytest.fixture(scope="module")
+def rod(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("rod")
+    sheet = workbook.load(write_template(tmp, SHEET))
+    path = sheet.write_xlsx(tmp / "rod.xlsx")
+    return sheet, path
+
+
+@pytest.mark.parametrize("name", list(_expected()))
+def test_the_engine_agrees_with_pint(rod, name):
+    sheet, _ = rod
+    expected = _expected()[name]
+    got = sheet.evaluate(name)
+    assert str(got.units) == str(expected.units)
+    assert math.isclose(got.magnitude, expected.magnitude, rel_tol=1e-13, abs_tol=1e-12)
+
+
+def test_excel_formulas_are_affine_and_recalculate_to_pint(rod):
+    """The workbook's formulas add the offset (never a scale factor of 274.15), and the
+    `formulas` package recalculates them to pint's values."""
+    import openpyxl
+
+    sheet, path = rod
+    cells = formula_values(path)
+    results = openpyxl.load_workbook(path)["Results"]
+    rows = {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
+    text = {name: cells[("Results", f"B{rows[name]}")][0] for name in ("T2_K", "T3_C", "dT")}
+    assert text == {"T2_K": "=T2_+273.15", "T3_C": "=T3_-273.15", "dT": "=T2_-T1_"}
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    values = {}
+    for key, ranges in solution.items():
+        book_sheet, _, cell = key.rpartition("!")
+        if book_sheet.split("]", 1)[-1].strip("'").upper() == "RESULTS" and ":" not in cell:
+            values[cell.upper()] = ranges.value[0, 0]
+    for name, expected in _expected().items():
+        got = values[f"B{rows[name]}"]
+        assert math.isclose(float(got), expected.magnitude, rel_tol=1e-12, abs_tol=1e-12), name
+
+
+@pytest.mark.parametrize(
+    "expr,message",
+    [
+        ('"T1 + T2"', "two absolute temperatures cannot be added"),
+        ('{ expr = "T2 - T1", unit = "degC" }', "difference .* cannot be shown as an absolute"),
+        ('{ expr = "T1", unit = "delta_degC" }', "cannot be shown as a\\s+difference"),
+        ('"(T2 - T1) - T1"', "difference minus an absolute"),
+        ('"1 if T1 > T2 - T1 otherwise 0"', "difference"),
+    ],
+)
+def test_temperature_mistakes_are_refused_with_what_to_write(tmp_path, expr, message):
+    text = SHEET.split("[definitions]")[0] + f"[definitions]\nbad = {expr}\n"
+    with pytest.raises(UnitError, match=message) as err:
+        workbook.load(write_template(tmp_path, text))
+    assert "bad" in str(err.value)
+
+
+def test_set_and_a_table_column_shown_in_degf(tmp_path):
+    text = (
+        SHEET
+        + """
+[arguments]
+x = { unit = "" }
+
+[[tables]]
+name = "heating"
+range = "x := 0, 0.25 .. 1"
+columns = { "T1 + x*(T2 - T1)" = "degF" }
+"""
+    )
+    sheet = workbook.load(write_template(tmp_path, text)).with_inputs(T1="293.15 K")
+    table = sheet.table("heating")
+    q = un.registry().Quantity
+    t1, t2 = q(20, "degC"), q(85, "degC")
+    for x, got in zip((0, 0.25, 0.5, 0.75, 1), table.iloc[:, 1]):
+        assert math.isclose(got, (t1 + x * (t2 - t1)).to("degF").magnitude, rel_tol=1e-13)
+    assert math.isclose(sheet.evaluate("dT").magnitude, 65.0, rel_tol=1e-13)
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculates_the_temperature_sheet(rod, tmp_path):
+    import openpyxl
+    from recalc import cell_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    _, path = rod
+    rows = {
+        r[0].value: r[0].row
+        for r in openpyxl.load_workbook(path)["Results"].iter_rows(min_row=2)
+        if r[0].value
+    }
+    values = cell_values(recalculate(path, tmp_path))
+    for name, expected in _expected().items():
+        got = values[("Results", f"B{rows[name]}")]
+        assert math.isclose(float(got), expected.magnitude, rel_tol=1e-12, abs_tol=1e-12), name
