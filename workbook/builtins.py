@@ -11,13 +11,12 @@ An entry says everything the engine needs to know about one function:
 * ``numpy(*values)``: the function on numpy arrays (magnitudes in the units the rule chose);
 * ``excel(args) -> (text, level)``: the Excel formula from the printed arguments, with the
   precedence level of the result (:data:`workbook.expr.PREC`); it raises
-  :class:`workbook.errors.NotLive` when there is no live formula;
+  :class:`workbook.errors.NotLive` when there is no live formula.
+  A newer Excel function is printed with its stored prefix (``_xlfn.NORM.DIST``:
+  :func:`workbook.excel_functions.stored`); nothing else lists the functions a formula calls;
 * ``sympy(sp, *exprs)``: the SymPy expression (``sp`` is the sympy module, imported lazily);
 * ``domain``: the arguments' restricted domains (:class:`Domain`), explained by
   :mod:`workbook.analysis` when a value is not finite;
-* ``excel_functions``: the classic (Excel 2007) functions the printed formula calls; the writer
-  skips xlsxwriter's "_xlfn." rewriting for formulas that call only classic functions, so a
-  built-in that prints a newer function must not list it;
 * ``doc``: one line for the documentation;
 * ``mathml``: how a report writes a call (:mod:`workbook.report.mathml`): MathML in which
   ``{0}``, ``{1}``... are the arguments, ``{0:group}`` the argument bracketed unless it is a
@@ -134,10 +133,7 @@ def _log_domain(name: str) -> tuple[Domain, ...]:
 
 def _simple(name, numpy, excel, sympy, doc, rule=plain_in, domain=(), arity=1, **display):
     xl = excel if callable(excel) else excel_call(excel)
-    uses = (excel,) if isinstance(excel, str) else display.pop("excel_functions", ())
-    register(
-        Builtin(name, arity, rule, numpy, xl, sympy, domain, doc, excel_functions=uses, **display)
-    )
+    register(Builtin(name, arity, rule, numpy, xl, sympy, domain, doc, **display))
 
 
 def mathml_call(label: str) -> str:
@@ -183,7 +179,6 @@ _simple(
     "angle of the point (x, y): atan2(y, x)",
     rule=_atan2_unit,
     arity=2,
-    excel_functions=("ATAN2",),
 )
 _simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine", **_TRIG)
 _simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine", **_TRIG)
@@ -246,7 +241,6 @@ register(
         lambda args: (f"INT({args[0]})", PREC["atom"]),
         lambda sp, x: sp.floor(x),
         doc="largest integer not above",
-        excel_functions=("INT",),
         mathml=mathml_fence("\u230a", "\u230b"),
     )
 )
@@ -259,7 +253,6 @@ register(
         _excel_ceil,
         lambda sp, x: sp.ceiling(x),
         doc="smallest integer not below",
-        excel_functions=("INT",),
         mathml=mathml_fence("\u2308", "\u2309"),
     )
 )
@@ -285,7 +278,6 @@ _simple(
     rule=_mod_unit,
     domain=(Domain("mod by zero", lambda v: v == 0, "mod(x, {})", arg=1),),
     arity=2,
-    excel_functions=("TRUNC",),
 )
 
 
@@ -334,7 +326,6 @@ _simple(
         ),
     ),
     arity=(1, 2),
-    excel_functions=("ROUND",),
 )
 _simple(
     "trunc",
@@ -433,7 +424,6 @@ register(
         "sum(v): the sum of the elements of a vector or matrix",
         binds=(0, 1),
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
-        excel_functions=("SUM",),
         arrays=True,
     )
 )

@@ -55,7 +55,6 @@ class Builtin:
     doc: str = ""
     binds: tuple[int, int] | None = None
     data_args: tuple[int, ...] = ()  # arguments that name columns of [data] tables
-    excel_functions: tuple[str, ...] = ()
     mathml: str = ""
     mathml_powered: bool = False
     arrays: bool = False  # takes vectors/matrices: the hooks get ``shapes=`` (workbook.matrix)

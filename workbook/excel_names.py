@@ -2,7 +2,8 @@
 
 Excel reads a defined name case-insensitively (``d`` and ``D`` are one name: after the first
 recalculation ``=D/d`` is 1), allows at most 255 characters, and reads names like ``A1``,
-``XFD1``, ``R1C1``, ``R``, ``C`` as cell references and some as functions. :class:`ExcelNames`
+``XFD1``, ``R1C1``, ``R``, ``C`` as cell references, and a name spelt as a function
+(``rate``) or as one of its built-in names (``Print_Area``) as that one. :class:`ExcelNames`
 gives every worksheet name a defined name that is valid and unique among all of them; a
 name that had to change is listed in :attr:`ExcelNames.renamed` so that the writer can say so
 (a comment on the cell, and a list on the About sheet).
@@ -13,16 +14,22 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 
+from .excel_functions import FUNCTIONS
+
 MAX_NAME = 255  # Excel's limit on the length of a defined name
 
 _CELL = re.compile(r"^[A-Za-z]{1,3}[0-9]+$")  # A1 .. XFD1048576 (and beyond: refused too)
 _R1C1 = re.compile(r"^([Rr][0-9]*)?([Cc][0-9]*)?$")  # R, C, R1, C1, R1C1, RC
-# Excel function names a defined name must not shadow (LibreOffice reads some of them without
-# brackets), and the boolean literals.
+# Excel's built-in names (a workbook's print area, autostart macros, filters...): a defined
+# name spelt so would be read as the built-in one.
+BUILTIN_NAMES = frozenset(
+    "Auto_Open Auto_Close Auto_Activate Auto_Deactivate Consolidate_Area Criteria Data_Form "
+    "Database Extract Print_Area Print_Titles Recorder Sheet_Title _FilterDatabase".split()
+)
+# Names a defined name must not take (case-insensitively): every Excel function (LibreOffice
+# reads some of them without brackets; TRUE and FALSE are among them) and the built-in names.
 RESERVED = frozenset(
-    "pi e true false sin cos tan asin acos atan atan2 sinh cosh tanh sqrt exp ln log log10 abs "
-    "sign int min max if and or not na sum rand row column index degrees radians power mod "
-    "floor ceiling round trunc value text date time now today rows columns count average".split()
+    [name.lower() for name in FUNCTIONS] + [name.lower() for name in BUILTIN_NAMES]
 )
 
 
@@ -91,7 +98,7 @@ class ExcelNames:
         if len(name) > MAX_NAME:
             reason = f"Excel's names have at most {MAX_NAME} characters"
         elif needs_change(name):
-            reason = f"Excel reads '{name}' as a cell reference or function"
+            reason = f"Excel reads '{name}' as a cell reference, a function or a built-in name"
         else:
             reason = "Excel's names ignore case, and another name of this sheet is spelt alike"
         clash = [k for k, v in self.mapping.items() if k != name and k.lower() == name.lower()]

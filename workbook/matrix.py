@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from .errors import DomainError, InputError
+from .excel_functions import stored
 
 #: A matrix whose condition number exceeds this is singular for inverse and lsolve.
 SINGULAR_COND = 1e14
@@ -303,7 +304,7 @@ def register_entries() -> None:
 
         return printed
 
-    def entry(name, arity, rule, numpy, excel, doc, uses=(), runtime=None):
+    def entry(name, arity, rule, numpy, excel, doc, runtime=None):
         register(
             Builtin(
                 name,
@@ -313,7 +314,6 @@ def register_entries() -> None:
                 excel,
                 not_symbolic(name),
                 doc=doc,
-                excel_functions=uses,
                 arrays=True,
                 runtime=runtime,
             )
@@ -371,7 +371,6 @@ def register_entries() -> None:
         lambda m, shapes: transpose(m),
         call("TRANSPOSE"),
         "rows and columns swapped",
-        ("TRANSPOSE",),
         runtime=rt_transpose,
     )
     entry(
@@ -381,7 +380,6 @@ def register_entries() -> None:
         lambda m, shapes: det(m),
         call("MDETERM"),
         "determinant of a square matrix",
-        ("MDETERM",),
     )
     entry(
         "inverse",
@@ -390,7 +388,6 @@ def register_entries() -> None:
         lambda m, shapes: inverse(m),
         call("MINVERSE"),
         "inverse of a square matrix (a singular one is an error)",
-        ("MINVERSE",),
     )
     entry(
         "lsolve",
@@ -399,7 +396,6 @@ def register_entries() -> None:
         lambda m, v, shapes: lsolve(m, v),
         call("MMULT", "MINVERSE({}), {}"),
         "solution x of M x = v",
-        ("MMULT", "MINVERSE"),
     )
 
     # eigenvalues and eigenvectors
@@ -473,7 +469,6 @@ def register_entries() -> None:
         lambda a, b, shapes: cross(a, b),
         x_cross,
         "cross product of two vectors of 3",
-        ("CHOOSE", "INDEX"),
     )
     entry(
         "dot",
@@ -482,7 +477,6 @@ def register_entries() -> None:
         lambda a, b, shapes: dot(a, b),
         call("SUMPRODUCT", "{}, {}"),
         "dot product of two vectors",
-        ("SUMPRODUCT",),
     )
     entry(
         "norm",
@@ -491,7 +485,6 @@ def register_entries() -> None:
         lambda v, shapes: norm(v),
         call("SQRT", "SUMSQ({})"),
         "length (Euclidean norm) of a vector",
-        ("SQRT", "SUMSQ"),
     )
 
     # Mathcad's |x|: one operator whose meaning follows the shape (known at load)
@@ -522,7 +515,6 @@ def register_entries() -> None:
             lambda sp, a: sp.Abs(a),
             doc="Mathcad's |x|: abs of a number, length of a vector, determinant of a "
             "square matrix",
-            excel_functions=("ABS", "SQRT", "SUMSQ", "MDETERM"),
             arrays=True,
         )
     )
@@ -691,7 +683,6 @@ def register_entries() -> None:
                 _excel_list(excel_name),
                 sympy_reduce(kind),
                 doc=doc,
-                excel_functions=(excel_name,),
                 arrays=True,
                 runtime=r_reduce,
             )
@@ -703,7 +694,6 @@ def register_entries() -> None:
         numpy_reduce("mean"),
         _excel_list("AVERAGE"),
         "mean of the arguments (or of the elements of vectors and matrices)",
-        ("AVERAGE",),
         runtime=r_reduce,
     )
 
@@ -778,8 +768,8 @@ def register_entries() -> None:
         return func(t.unit**2, name, t.args, None)
 
     for kind, rule, excel_name, doc in (
-        ("stdev", r_reduce, "_xlfn.STDEV.P", "population standard deviation (divided by N)"),
-        ("var", r_var, "_xlfn.VAR.P", "population variance (divided by N)"),
+        ("stdev", r_reduce, stored("STDEV.P"), "population standard deviation (divided by N)"),
+        ("var", r_var, stored("VAR.P"), "population variance (divided by N)"),
         ("median", r_reduce, "MEDIAN", "median"),
     ):
         entry(
@@ -789,7 +779,6 @@ def register_entries() -> None:
             numpy_statistic(kind),
             _excel_list(excel_name),
             f"{doc} of the arguments (or of the elements of vectors and matrices)",
-            ("MEDIAN",) if kind == "median" else (),
             runtime=rule,
         )
 

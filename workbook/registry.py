@@ -14,9 +14,4 @@ matrix.register_entries()  # min, max, mean and the vector and matrix built-ins
 #: Every built-in function by name.
 REGISTRY = ENTRIES
 
-__all__ = ["REGISTRY", "excel_functions"]
-
-
-def excel_functions() -> frozenset[str]:
-    """Excel functions that the printed formulas of built-ins call."""
-    return frozenset(f for b in REGISTRY.values() for f in b.excel_functions)
+__all__ = ["REGISTRY"]

@@ -25,8 +25,8 @@ from .atomic import check_target, replacing
 from .checks import tolerances
 from .errors import InputError, LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
+from .excel_functions import CLASSIC
 from .excel_names import ExcelNames
-from .registry import excel_functions
 from .uses import names_used
 from .version import __version__
 
@@ -71,9 +71,6 @@ class ColumnCells:
     title: str
 
 
-# Functions of Excel 2007 that need no "_xlfn." prefix that the printer writes for operators,
-# conditions and aggregates; the built-ins add theirs (workbook.registry.excel_functions()).
-_CLASSIC = frozenset("AND IF INT MAX MIN NA NOT OR PI POWER SUM".split())
 _CALLED = re.compile(r"([A-Za-z_][A-Za-z0-9._]*)\(")
 
 
@@ -82,18 +79,18 @@ def _classic_formulas_as_they_are(ws) -> None:
 
     xlsxwriter rewrites every formula to prefix Excel 365 functions (FILTER, XLOOKUP...) with
     "_xlfn."; that costs ~70 % of the time of writing a table of formulas. A formula that
-    calls only classic functions is written as it is; any other goes through xlsxwriter's own
+    calls only classic functions (:data:`workbook.excel_functions.CLASSIC`) is written as it
+    is; any other goes through xlsxwriter's own
     rewriting, as before. tests/test_formula_shortcut.py proves every template's worksheets
     identical with and without this; pyproject.toml bounds xlsxwriter to the versions checked.
     """
     original = getattr(ws, "_prepare_formula", None)
     if original is None or getattr(ws, "use_future_functions", False):
         return
-    classic = _CLASSIC | excel_functions()
 
     def prepare(formula, expand_future_functions=False):
         if expand_future_functions or not all(
-            name.upper() in classic for name in _CALLED.findall(formula)
+            name.upper() in CLASSIC for name in _CALLED.findall(formula)
         ):
             return original(formula, expand_future_functions)
         if formula.startswith("{"):

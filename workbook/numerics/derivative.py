@@ -12,6 +12,7 @@ other formula: numpy evaluates it, Excel gets it as a live formula.
 
 from __future__ import annotations
 
+import functools
 import math
 import weakref
 from dataclasses import dataclass, field
@@ -20,26 +21,46 @@ from .. import typed as ty
 from ..errors import NotSymbolic, TemplateError, WorkbookError
 from ..visitor import Visitor
 
-_FUNCS = {
-    "sin": "sin",
-    "cos": "cos",
-    "tan": "tan",
-    "asin": "asin",
-    "acos": "acos",
-    "atan": "atan",
-    "sinh": "sinh",
-    "cosh": "cosh",
-    "tanh": "tanh",
-    "exp": "exp",
-    "log": "ln",
-    "Abs": "abs",
-    "sign": "sign",
-    "floor": "floor",
-    "ceiling": "ceil",
-    "Min": "min",
-    "Max": "max",
-    "atan2": "atan2",
-}
+
+def sympy_functions() -> dict[str, str]:
+    """SymPy's function -> the built-in written so (``log`` -> ``ln``, ``ceiling`` -> ``ceil``),
+    read from the registry: an entry whose SymPy form, given symbols, is one SymPy function of
+    exactly those symbols (``Abs(x)``, ``atan2(y, x)``). Plain built-ins come before those of
+    vectors (``abs`` before ``mag``, whose SymPy form is ``Abs`` too)."""
+    from ..registry import REGISTRY
+
+    return _sympy_functions(tuple(REGISTRY.values()))  # read again when an entry is added
+
+
+@functools.lru_cache(maxsize=4)
+def _sympy_functions(entries: tuple) -> dict[str, str]:
+    import sympy as sp
+
+    out: dict[str, str] = {}
+    for entry in sorted(entries, key=lambda b: b.arrays):  # a stable sort
+        if entry.binds or entry.data_args:
+            continue
+        for n in _argument_counts(entry.arity):
+            symbols = sp.symbols(f"a0:{n}", real=True)
+            try:
+                e = entry.sympy(sp, *symbols)
+            except Exception:  # noqa: BLE001 - a hook that refuses symbols names no function
+                continue
+            simple = isinstance(e, sp.Basic) and not isinstance(e, (sp.Add, sp.Mul, sp.Pow))
+            if simple and not e.is_Atom and e.args == tuple(symbols):
+                out.setdefault(type(e).__name__, entry.name)
+    return out
+
+
+def _argument_counts(arity) -> range:
+    if arity is None:
+        return range(1, 3)
+    if isinstance(arity, int):
+        return range(arity, arity + 1)
+    lo, hi = arity
+    return range(lo, min(hi if hi is not None else lo + 1, lo + 2) + 1)
+
+
 _REL = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "==", "!=": "!="}
 
 
@@ -151,7 +172,7 @@ class _Back(Visitor):
         return method(e)
 
     def _function(self, e):
-        name = _FUNCS.get(type(e).__name__)
+        name = sympy_functions().get(type(e).__name__)
         if name is None:
             raise TemplateError(
                 f"diff(): the derivative contains {type(e).__name__} ({e}), which has no "

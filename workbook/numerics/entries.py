@@ -642,7 +642,6 @@ register(
         doc="root(EXPR, X, A, B): the X in [A, B] where EXPR changes sign; "
         "root(EXPR, X, GUESS): a root near GUESS",
         binds=(0, 1),
-        excel_functions=("IF", "NA"),
     )
 )
 register(
@@ -657,7 +656,6 @@ register(
         binds=(0, 1),
         mathml="<msubsup><mo>\u222b</mo>{2}{3}</msubsup>{0:group}<mo>\u2062</mo>"
         "<mi mathvariant='normal'>d</mi>{1}",
-        excel_functions=("SUMPRODUCT",),
     )
 )
 for _name, _text, _shown in (
@@ -676,7 +674,6 @@ for _name, _text, _shown in (
             _no_sympy(_name),
             doc=f"{_name}(EXPR, X, A, B): {_text} (the global one among all local ones)",
             binds=(0, 1),
-            excel_functions=("ABS", "IF", "MATCH", "MAX", "MIN"),
             mathml=f"<munder><mi>{_shown}</mi><mrow>{{1}}<mo>\u2208</mo><mrow><mo>[</mo>{{2}}"
             "<mo separator='true'>,</mo>{3}<mo>]</mo></mrow></mrow></munder>{0:group}",
         )
