@@ -73,8 +73,13 @@ def _parser() -> argparse.ArgumentParser:
     chk.add_argument(
         "--json", action="store_true", help="print one JSON object (counts and failures)"
     )
-    imp = sub.add_parser("import", help="translate a Mathcad 11-15 worksheet (.xmcd)")
-    imp.add_argument("file", help="the .xmcd file")
+    imp = sub.add_parser(
+        "import", help="translate a Mathcad 11-15 worksheet (.xmcd) or an Excel workbook"
+    )
+    imp.add_argument("file", help="the .xmcd file, or the .xlsm/.xlsx/.xls workbook")
+    imp.add_argument(
+        "--vba", action="append", default=[], help="VBA from an add-in or a .bas/.cls module"
+    )
     imp.add_argument("--out", default=".", help="folder to write NAME.toml into (default: .)")
     imp.add_argument("--force", action="store_true", help="replace existing files")
     bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
@@ -318,6 +323,11 @@ def cmd_check(args) -> int:
 
 
 def cmd_import(args) -> int:
+    if Path(args.file).suffix.lower() in (".xlsm", ".xlsx", ".xls", ".xlam", ".xla"):
+        from .excelimport import import_file as excel_import
+
+        print(excel_import(args.file, args.out, vba=args.vba, force=args.force).line())
+        return EXIT_OK
     from .mathcad import import_file
 
     print(import_file(args.file, args.out, force=args.force).line())

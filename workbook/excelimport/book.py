@@ -1,0 +1,478 @@
+"""What the worksheet of an Excel workbook holds: names of cells, inputs, definitions from
+formula cells, functions from VBA, and what is listed as not translated (with why)."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .cells import FormulaProblem, FormulaTranslator, parse_formula
+from .reader import Book, Cell, read_book
+from .vba import Module, Procedure, is_event, read_modules
+from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
+
+#: formula cells translated at most (those that call VBA functions and what they read first)
+MAX_DEFINITIONS = 4000
+_UNIT_IN_LABEL = re.compile(r"[\(\[]\s*([^\)\]]{1,16}?)\s*[\)\]]")
+_UNIT_IN_FORMAT = re.compile(r'"\s*([^"]{1,12}?)\s*"\s*$')
+
+
+@dataclass
+class Definition:
+    name: str
+    cell: Cell
+    text: str | None = None  # the expression
+    problem: str | None = None
+    element: tuple[str, int] | None = None  # (array formula's name, index) of a block cell
+
+
+@dataclass
+class Translation:
+    path: Path
+    book: Book
+    modules: list[Module]
+    functions: dict[str, FunctionInfo] = field(default_factory=dict)
+    inputs: dict[str, tuple[Cell | None, str, str]] = field(default_factory=dict)  # value, note
+    texts: dict[str, tuple[Cell, str]] = field(default_factory=dict)
+    definitions: list[Definition] = field(default_factory=list)
+    listed: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
+    cell_names: dict[tuple[str, int, int], str] = field(default_factory=dict)
+
+
+def language_reserved() -> set[str]:
+    from ..registry import REGISTRY
+
+    return {n.lower() for n in REGISTRY} | KEYWORDS
+
+
+def translate_book(path: Path, vba_files: list[Path]) -> Translation:
+    book = read_book(path)
+    modules = (
+        read_modules(path)
+        if path.suffix.lower() in (".xlsm", ".xls", ".xlam", ".xla", ".xlsb")
+        else []
+    )
+    for extra in vba_files:
+        modules += read_modules(extra)
+    tr = Translation(path, book, modules)
+    tr.listed += book.skipped
+    reserved = language_reserved()
+    _collect_functions(tr, reserved)
+    cells = _formula_cells(tr)
+    parsed = {}
+    for cell in cells:
+        try:
+            parsed[_key(cell)] = parse_formula(cell.formula)
+        except FormulaProblem as exc:
+            tr.listed.append((cell.ref, str(exc)))
+    # which cells formulas read (names are given after, in reading order)
+    read: list[tuple[str, int, int]] = []
+
+    def record(sheet, row, col):
+        read.append((sheet, row, col))
+        return "x"
+
+    for cell in cells:
+        if _key(cell) in parsed and cell.array_master in (None, (cell.row, cell.col)):
+            try:
+                FormulaTranslator(book, cell.sheet, record, tr.functions, book.names).translate(
+                    parsed[_key(cell)].tree
+                )
+            except FormulaProblem:
+                pass
+    _name_cells(tr, cells, read, reserved)
+    _name_params(tr, reserved)
+    _translate_functions(tr, reserved)
+    _translate_cells(tr, cells, parsed)
+    return tr
+
+
+def _key(cell: Cell) -> tuple[str, int, int]:
+    return (cell.sheet, cell.row, cell.col)
+
+
+def _collect_functions(tr: Translation, reserved: set[str]) -> None:
+    taken = set(reserved)
+    for mod in tr.modules:
+        option_base = any(
+            re.match(r"^Option\s+Base\s+1", line, re.I) for _, line in mod.declarations
+        )
+        for _, line in mod.declarations:
+            low = line.lower()
+            if re.match(r"^(public\s+|private\s+)?declare\b", low):
+                tr.listed.append(
+                    (f"VBA module {mod.name}", f"declares a DLL function: {line[:80]}")
+                )
+            if "solver" in low:
+                tr.listed.append((f"VBA module {mod.name}", f"Solver: {line[:80]}"))
+        for proc in mod.procedures:
+            where = f"VBA {proc.kind} {proc.name} (module {mod.name})"
+            body = "\n".join(t for _, t in proc.lines)
+            if re.search(r"\bSolver\w*\b", body):
+                tr.listed.append((where, "runs Solver (a Solver model is not translated)"))
+            if proc.kind != "Function" or mod.document or is_event(proc):
+                why = (
+                    "an event procedure"
+                    if is_event(proc)
+                    else "a Sub (it writes cells or runs commands)"
+                    if proc.kind == "Sub"
+                    else "in a sheet, workbook, class or form module"
+                    if mod.document
+                    else "a Property"
+                )
+                if re.search(
+                    r"\b(Open|Print #|Write #|Kill|Dir\(|FileCopy|UserForm|\.Show)\b", body
+                ):
+                    why += "; reads or writes files or shows a form"
+                tr.listed.append((where, why))
+                continue
+            key = proc.name.lower()
+            if key in tr.functions:
+                continue  # the first definition wins, as Excel finds it first
+            final = re.sub(r"\W", "_", proc.name)
+            while final.lower() in taken:
+                final += "_"
+            taken.add(final.lower())
+            info = FunctionInfo(proc, final, [])
+            info.option_base = 1 if option_base else 0  # type: ignore[attr-defined]
+            info.consts = _module_consts(mod)  # type: ignore[attr-defined]
+            info.module_vars = _module_vars(mod)  # type: ignore[attr-defined]
+            tr.functions[key] = info
+    tr.reserved_functions = {i.final.lower() for i in tr.functions.values()}  # type: ignore[attr-defined]
+
+
+def _module_consts(mod: Module) -> list[str]:
+    return [
+        line
+        for _, line in mod.declarations
+        if re.match(r"^(public\s+|private\s+)?const\b", line, re.I)
+    ]
+
+
+def _module_vars(mod: Module) -> set[str]:
+    out = set()
+    for _, line in mod.declarations:
+        m = re.match(
+            r"^(?:dim|public|private|global)\s+(?!const\b|declare\b|function\b|sub\b|type\b|enum\b)(\w+)",
+            line,
+            re.I,
+        )
+        if m:
+            out.add(m.group(1).lower())
+    return out
+
+
+def _const_name(line: str) -> str | None:
+    m = re.search(r"(?i)\bconst\s+(\w+)", line)
+    return m.group(1) if m else None
+
+
+def _mentions(body: str, name: str) -> bool:
+    return re.search(rf"\b{re.escape(name)}\b", body, re.I) is not None
+
+
+def _formula_cells(tr: Translation) -> list[Cell]:
+    """Formula cells to translate, in reading order: those that call a VBA function and the
+    formula cells they read first, then the others, at most MAX_DEFINITIONS."""
+    out = []
+    for cells in tr.book.sheets.values():
+        for r, c in sorted(cells):
+            cell = cells[(r, c)]
+            if cell.formula is not None:
+                out.append(cell)
+    if len(out) <= MAX_DEFINITIONS:
+        return out
+    names = set(tr.functions)
+    calls = [
+        c for c in out if any(re.search(rf"\b{re.escape(n)}\s*\(", c.formula, re.I) for n in names)
+    ]
+    chosen = {id(c) for c in calls[:MAX_DEFINITIONS]}
+    for c in out:
+        if len(chosen) >= MAX_DEFINITIONS:
+            break
+        chosen.add(id(c))
+    kept = [c for c in out if id(c) in chosen]
+    left = len(out) - len(kept)
+    tr.listed.append(
+        (
+            f"{left:,} formula cells",
+            f"beyond the {MAX_DEFINITIONS:,} formula cells translated (those that call VBA "
+            "functions first)",
+        )
+    )
+    return kept
+
+
+def _ident(text: str) -> str | None:
+    text = _UNIT_IN_LABEL.sub("", str(text))
+    text = re.split(r"[:=]", text)[0]
+    words = re.findall(r"[A-Za-z0-9]+", text)[:4]
+    if not words:
+        return None
+    name = "_".join(words)[:32]
+    if name[0].isdigit():
+        name = "c_" + name
+    return name
+
+
+def _label(book: Book, sheet: str, row: int, col: int) -> str | None:
+    for dc in (1, 2):
+        cell = book.cell(sheet, row, col - dc)
+        if cell is None:
+            continue
+        if cell.formula is None and isinstance(cell.value, str) and cell.value.strip():
+            return cell.value.strip()
+        break
+    above = book.cell(sheet, row - 1, col)
+    if above is not None and above.formula is None and isinstance(above.value, str):
+        return above.value.strip() or None
+    return None
+
+
+def proposed_unit(label: str | None, number_format: str) -> str | None:
+    """A unit named by the label (``Span (mm)``) or the number format (``0.0 "kN"``) that
+    pint reads; proposed in a note, never applied."""
+    from .. import units as un
+
+    found = []
+    if label:
+        found += _UNIT_IN_LABEL.findall(label)
+    m = _UNIT_IN_FORMAT.search(number_format or "")
+    if m:
+        found.append(m.group(1))
+    for text in found:
+        text = text.strip().replace("°C", "degC").replace("°F", "degF").replace("°", "deg")
+        if not text or text.isdigit():
+            continue
+        try:
+            unit = un.unit(text, what="a unit")
+        except Exception:  # noqa: BLE001 - not a unit: nothing proposed
+            continue
+        if str(unit) != "dimensionless":
+            return text
+    return None
+
+
+def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) -> None:
+    book = tr.book
+    taken = set(reserved) | {i.final.lower() for i in tr.functions.values()}
+    many = len({s for s, _, _ in read} | {c.sheet for c in cells}) > 1
+    by_cell = {}
+    for name, (sheet, ref) in book.names.items():
+        if ":" not in ref:
+            from openpyxl.utils.cell import column_index_from_string, coordinate_from_string
+
+            try:
+                letters, row = coordinate_from_string(ref)
+            except ValueError:
+                continue
+            by_cell.setdefault((sheet, row, column_index_from_string(letters)), name)
+    wanted = sorted(
+        set(read) | {_key(c) for c in cells},
+        key=lambda k: (list(book.sheets).index(k[0]) if k[0] in book.sheets else 0, k[1], k[2]),
+    )
+    for key in wanted:
+        sheet, row, col = key
+        base = by_cell.get(key)
+        if base is not None:
+            base = re.sub(r"\W", "_", base)
+        else:
+            base = _ident(_label(book, sheet, row, col) or "")
+        if base is None:
+            from openpyxl.utils import get_column_letter
+
+            base = f"{get_column_letter(col)}{row}"
+            if many:
+                base = f"{re.sub(r'[^A-Za-z0-9]', '', sheet)[:12] or 'S'}_{base}"
+        name, n = base, 2
+        while name.lower() in taken:
+            name = f"{base}_{n}"
+            n += 1
+        taken.add(name.lower())
+        tr.cell_names[key] = name
+
+
+def _name_params(tr: Translation, reserved: set[str]) -> None:
+    taken = set(reserved) | {n.lower() for n in tr.cell_names.values()}
+    taken |= {i.final.lower() for i in tr.functions.values()}
+    for info in tr.functions.values():
+        used: set[str] = set()
+        body = "\n".join(t for _, t in info.proc.lines)
+        for p in info.proc.params:
+            name = re.sub(r"\W", "_", p.name)
+            while name.lower() in taken or name.lower() in used:
+                name += "_"
+            used.add(name.lower())
+            info.params.append(name)
+        for p, final in zip(info.proc.params, info.params):
+            if p.optional and re.search(
+                rf"\bIsMissing\s*\(\s*{re.escape(p.name)}\s*\)", body, re.I
+            ):
+                flag = f"{final}_given"
+                while flag.lower() in taken or flag.lower() in used:
+                    flag += "_"
+                used.add(flag.lower())
+                info.given[final] = flag
+
+
+def _translate_functions(tr: Translation, reserved: set[str]) -> None:
+    sheet_names = {n.lower() for n in tr.cell_names.values()}
+    all_params = {
+        p.lower() for i in tr.functions.values() for p in list(i.params) + list(i.given.values())
+    }
+    for info in tr.functions.values():
+        own = {p.lower() for p in list(info.params) + list(info.given.values())}
+        block = (
+            reserved
+            | sheet_names
+            | (all_params - own)
+            | {i.final.lower() for i in tr.functions.values()}
+        )
+        t = Translator(info, tr.functions, block)
+        t.option_base = info.option_base  # type: ignore[attr-defined]
+        body = "\n".join(x for _, x in info.proc.lines)
+        try:
+            for name in info.module_vars:  # type: ignore[attr-defined]
+                if re.search(rf"\b{re.escape(name)}\b", body, re.I):
+                    raise NotTranslated(
+                        f"uses the module variable {name} (state kept between calls)"
+                    )
+            consts = [c for c in info.consts if _const_name(c) and _mentions(body, _const_name(c))]  # type: ignore[attr-defined]
+            if consts:
+                info.proc.lines[:0] = [
+                    (0, re.sub(r"^(public|private)\s+", "", c, flags=re.I)) for c in consts
+                ]
+            info.program = t.translate()
+        except NotTranslated as exc:
+            info.problem = str(exc)
+        except Exception as exc:  # noqa: BLE001 - a construct the reader did not foresee
+            info.problem = f"not translated ({type(exc).__name__}: {exc})"
+    changed = True
+    while changed:  # a function that calls one not translated is not translated either
+        changed = False
+        for info in tr.functions.values():
+            if info.problem:
+                continue
+            for callee in info.calls:
+                other = tr.functions.get(callee)
+                if other is not None and other.problem:
+                    info.problem = f"calls {other.proc.name}, not translated"
+                    changed = True
+                    break
+    for info in tr.functions.values():
+        if info.problem:
+            tr.listed.append(
+                (f"VBA Function {info.proc.name} (module {info.proc.module})", info.problem)
+            )
+
+
+def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
+    book = tr.book
+    used: dict[tuple[str, int, int], None] = {}
+
+    def name_of(sheet, row, col):
+        used[(sheet, row, col)] = None
+        return tr.cell_names.get((sheet, row, col)) or f"missing_{row}_{col}"
+
+    formula_keys = {_key(c) for c in cells}
+    by_key: dict[tuple[str, int, int], Definition] = {}
+    for cell in cells:
+        key = _key(cell)
+        d = Definition(tr.cell_names[key], cell)
+        by_key[key] = d
+        if key not in parsed:
+            d.problem = "cannot parse the formula"
+            continue
+        if cell.array is not None and cell.array_master != (cell.row, cell.col):
+            master = by_key.get((cell.sheet, *cell.array_master))
+            if master is None:
+                d.problem = "part of an array formula whose first cell is not translated"
+            else:
+                from openpyxl.utils.cell import range_boundaries
+
+                c1, r1, c2, r2 = range_boundaries(cell.array)
+                if r1 != r2:
+                    d.problem = "part of a block array formula of several rows (not translated)"
+                else:
+                    d.element = (master.name, cell.col - c1)
+            tr.definitions.append(d)
+            continue
+        try:
+            ft = FormulaTranslator(book, cell.sheet, name_of, tr.functions, book.names)
+            d.text = ft.translate(parsed[key].tree).text
+            if parsed[key].linked:
+                d.note_link = True  # type: ignore[attr-defined]
+            d.reads = [  # type: ignore[attr-defined]
+                (ref.sheet, r, c)
+                for ref in ft.out.refs
+                for r in range(ref.r1, ref.r2 + 1)
+                for c in range(ref.c1, ref.c2 + 1)
+            ]
+        except FormulaProblem as exc:
+            d.problem = str(exc)
+        tr.definitions.append(d)
+    # a formula reading a formula cell that is not translated is not translated either
+    changed = True
+    while changed:
+        changed = False
+        for d in tr.definitions:
+            if d.problem:
+                continue
+            if d.element is not None:
+                master = next((x for x in tr.definitions if x.name == d.element[0]), None)
+                if master is not None and master.problem:
+                    d.problem = f"part of the array formula {master.name}, not translated"
+                    changed = True
+                continue
+            for k in getattr(d, "reads", []):
+                other = by_key.get(k)
+                if other is not None and other.problem:
+                    d.problem = f"reads {other.name} ({other.cell.ref}), not translated"
+                    changed = True
+                    break
+    for d in tr.definitions:
+        if d.problem:
+            tr.listed.append((f"{d.cell.ref} ={d.cell.formula[:60]}", d.problem))
+    # inputs: the constant cells translated formulas read
+    for d in tr.definitions:
+        if d.problem:
+            continue
+        for k in getattr(d, "reads", []):
+            if k in formula_keys:
+                continue
+            name = tr.cell_names.get(k)
+            if name is None or name in tr.inputs or name in tr.texts:
+                continue
+            cell = book.cell(*k)
+            label = _label(book, *k)
+            where = f"{k[0]}!{_addr(k[1], k[2])}" + (f": {label}" if label else "")
+            if cell is None or cell.value is None:
+                tr.inputs[name] = (cell, "0", f"{where} (an empty cell, 0 in Excel)")
+            elif isinstance(cell.value, bool):
+                tr.inputs[name] = (cell, "1" if cell.value else "0", f"{where} (TRUE/FALSE)")
+            elif isinstance(cell.value, (int, float)):
+                unit = proposed_unit(label, cell.number_format)
+                note = where + (f"; unit proposed: {unit}" if unit else "")
+                tr.inputs[name] = (
+                    cell,
+                    repr(float(cell.value)) if isinstance(cell.value, float) else str(cell.value),
+                    note,
+                )
+            elif isinstance(cell.value, str):
+                tr.texts[name] = (cell, cell.value)
+            else:
+                tr.inputs[name] = (
+                    cell,
+                    "0",
+                    f"{where} (a {type(cell.value).__name__}: not a number)",
+                )
+
+
+def _addr(row: int, col: int) -> str:
+    from openpyxl.utils import get_column_letter
+
+    return f"{get_column_letter(col)}{row}"
+
+
+__all__ = ["Translation", "translate_book", "Procedure"]

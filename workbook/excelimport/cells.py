@@ -1,0 +1,320 @@
+"""Cell formulas to expressions of the language.
+
+Formulas are parsed by the ``formulas`` package (its tokenizer and its operator precedence,
+which are Excel's); the tree it builds is walked here. A reference becomes the name of the
+cell (or a vector/matrix of names for a range), a call of a VBA function the call of its
+translation, Excel's functions their mapped forms (``functions.EXCEL``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from .functions import EXCEL, EXCEL_VARIADIC, VOLATILE
+
+#: a prefix that calls into an add-in or another workbook: [1]!f( or 'Book.xlam'!f(
+_LINK = re.compile(
+    r"(?:\[\d+\]|'[^']*\.xla[m]?'|[A-Za-z0-9_.\- ]+\.xla[m]?)!(?=[A-Za-z_][\w.]*\()", re.I
+)
+MAX_RANGE_CELLS = 100_000
+
+
+class FormulaProblem(Exception):
+    """A formula this translation does not take (the reason is the message)."""
+
+
+@dataclass
+class Parsed:
+    tree: tuple
+    linked: bool = False  # called a function through an external link (not followed)
+
+
+def parse_formula(text: str) -> Parsed:
+    """The tree of an Excel formula (the text after '=')."""
+    import formulas
+    from formulas.errors import FormulaError
+    from formulas.tokens.function import Function
+    from formulas.tokens.operator import Operator
+
+    linked = bool(_LINK.search(text))
+    text = _LINK.sub("", text)
+
+    class TreeBuilder:
+        def __init__(self, match=None, **_):
+            self.stack: list = []
+
+        def append(self, token):
+            if isinstance(token, (Operator, Function)):
+                n = token.get_n_args
+                if n > len(self.stack):
+                    raise FormulaError()
+                args = self.stack[len(self.stack) - n :] if n else []
+                del self.stack[len(self.stack) - n :]
+                kind = "fn" if isinstance(token, Function) else "op"
+                self.stack.append((kind, token.name, args))
+            else:
+                self.stack.append(("leaf", type(token).__name__, token))
+
+        def pop(self):
+            return self.stack.pop()
+
+        def __len__(self):
+            return len(self.stack)
+
+        def finish(self):
+            pass
+
+    parser = formulas.Parser()
+    parser.ast_builder = TreeBuilder
+    try:
+        _, builder = parser.ast("=" + text)
+    except Exception as exc:  # noqa: BLE001 - the parser's own errors
+        raise FormulaProblem(f"cannot parse the formula ({type(exc).__name__})") from None
+    return Parsed(builder.stack[0], linked)
+
+
+@dataclass
+class Ref:
+    sheet: str
+    r1: int
+    c1: int
+    r2: int
+    c2: int
+
+    @property
+    def single(self) -> bool:
+        return self.r1 == self.r2 and self.c1 == self.c2
+
+
+@dataclass
+class FormulaText:
+    text: str
+    refs: list[Ref] = field(default_factory=list)
+    udfs: set[str] = field(default_factory=set)  # lower-case VBA names called
+
+
+class FormulaTranslator:
+    """Walks a formula tree; ``name_of(sheet, row, col)`` gives a cell's name."""
+
+    def __init__(self, book, sheet: str, name_of, functions: dict, names: dict):
+        self.book = book
+        self.sheet = sheet
+        self.name_of = name_of
+        self.functions = functions
+        self.defined = {k.lower(): v for k, v in names.items()}
+        self.out = FormulaText("")
+
+    def translate(self, tree) -> FormulaText:
+        self.out.text = self.value(tree)
+        return self.out
+
+    # Excel precedence levels for brackets: 1 comparison, 2 &, 3 + -, 4 * /, 5 ^, 6 unary, 7 %
+    def value(self, node, ctx: int = 0) -> str:
+        kind, name, payload = node
+        if kind == "leaf":
+            return self.leaf(name, payload)
+        if kind == "op":
+            return self.operator(name, payload, ctx)
+        return self.function(name, payload)
+
+    def leaf(self, kind: str, token) -> str:
+        if kind == "Number":
+            text = token.name
+            if text.upper() in ("TRUE", "FALSE"):
+                return "1" if text.upper() == "TRUE" else "0"
+            return text
+        if kind == "String":
+            value = token.attr.get("expr", token.name)
+            value = token.name
+            if '"' in value or "\\" in value:
+                raise FormulaProblem("a text with a quote or a backslash")
+            return f'"{value}"'
+        if kind == "Range":
+            return self.reference(token)
+        if kind == "Error":
+            raise FormulaProblem(f"the error value {token.name} written in the formula")
+        raise FormulaProblem(f"a {kind} in the formula")
+
+    def ref_of(self, token) -> Ref:
+        attr = token.attr
+        if "r1" not in attr:  # a defined name
+            key = str(attr.get("ref", token.name)).lower()
+            if key not in self.defined:
+                raise FormulaProblem(f"the name {attr.get('ref', token.name)} (not a cell range)")
+            sheet, ref = self.defined[key]
+            return _parse_ref(sheet, ref)
+        sheet = self.sheet
+        if attr.get("sheet_id"):
+            if "[" in str(attr.get("sheet_id")):
+                raise FormulaProblem("a reference into another workbook (an external link)")
+            found = self.book.sheet_named(str(attr.get("sheet") or attr["sheet_id"]))
+            if found is None:
+                raise FormulaProblem(f"a reference to the sheet {attr.get('sheet')}")
+            sheet = found
+        r1, r2 = int(attr["r1"]), int(attr["r2"])
+        c1, c2 = _col(attr["c1"]), _col(attr["c2"])
+        if r1 < 1 or (r2 - r1 + 1) * (c2 - c1 + 1) > MAX_RANGE_CELLS:
+            raise FormulaProblem(f"a reference to whole rows or columns ({token.name})")
+        return Ref(sheet, min(r1, r2), min(c1, c2), max(r1, r2), max(c1, c2))
+
+    def reference(self, token) -> str:
+        ref = self.ref_of(token)
+        self.out.refs.append(ref)
+        if ref.single:
+            return self.name_of(ref.sheet, ref.r1, ref.c1)
+        rows = [
+            [self.name_of(ref.sheet, r, c) for c in range(ref.c1, ref.c2 + 1)]
+            for r in range(ref.r1, ref.r2 + 1)
+        ]
+        return "[" + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]"
+
+    def cells_of(self, node) -> list[str] | None:
+        """The names of a range argument, in reading order (None if not a range)."""
+        if node[0] == "leaf" and node[1] == "Range":
+            ref = self.ref_of(node[2])
+            self.out.refs.append(ref)
+            return [
+                self.name_of(ref.sheet, r, c)
+                for r in range(ref.r1, ref.r2 + 1)
+                for c in range(ref.c1, ref.c2 + 1)
+            ]
+        return None
+
+    def operator(self, op: str, args, ctx: int) -> str:
+        levels = {"+": 3, "-": 3, "*": 4, "/": 4, "^": 5}
+        if op in ("u-", "u+"):
+            inner = self.value(args[0], 6)
+            text = f"-{inner}" if op == "u-" else inner
+            return f"({text})" if ctx >= 5 or ctx > 0 else text
+        if op == "%":
+            return f"{self.value(args[0], 7)}/100"
+        if op in levels:
+            level = levels[op]
+            if op == "^":  # Excel's ^ is left-associative
+                return _br(f"{self.value(args[0], 6)}^{self.value(args[1], 6)}", level, ctx)
+            right_ctx = level + 1 if op in ("-", "/") else level
+            sep = f" {op} " if level == 3 else op
+            return _br(
+                f"{self.value(args[0], level)}{sep}{self.value(args[1], right_ctx)}", level, ctx
+            )
+        if op in ("=", "<>", "<", ">", "<=", ">="):
+            return f"(1 if {self.condition(('op', op, args))} otherwise 0)"
+        if op == "&":
+            raise FormulaProblem("joins texts (&)")
+        raise FormulaProblem(f"the operator {op}")
+
+    def condition(self, node) -> str:
+        kind, name, args = node
+        ops = {"=": "==", "<>": "!=", "<": "<", ">": ">", "<=": "<=", ">=": ">="}
+        if kind == "op" and name in ops:
+            return f"{self.value(args[0], 3)} {ops[name]} {self.value(args[1], 3)}"
+        if kind == "fn" and name.upper() in ("AND", "OR"):
+            joined = f" {name.lower()} ".join(f"({self.condition(a)})" for a in args)
+            return joined
+        if kind == "fn" and name.upper() == "NOT":
+            return f"not ({self.condition(args[0])})"
+        if kind == "leaf" and name == "Number" and args.name.upper() in ("TRUE", "FALSE"):
+            return "1 == 1" if args.name.upper() == "TRUE" else "1 == 0"
+        return f"{self.value(node, 3)} != 0"
+
+    def function(self, name: str, args) -> str:
+        upper = name.upper()
+        short = name.split(".")[-1]
+        if short.lower() in self.functions:
+            return self.udf(short.lower(), args)
+        if upper in VOLATILE:
+            raise FormulaProblem(
+                f"the volatile function {upper} (its value changes at every recalculation)"
+            )
+        if upper == "IF":
+            if len(args) != 3:
+                raise FormulaProblem("IF without a value for FALSE")
+            cond = self.condition(args[0])
+            return f"({self.value(args[1], 1)} if {cond} otherwise {self.value(args[2], 1)})"
+        if upper in ("AND", "OR", "NOT"):
+            return f"(1 if {self.condition(('fn', name, args))} otherwise 0)"
+        if upper in EXCEL_VARIADIC:
+            items: list[str] = []
+            for a in args:
+                cells = self.cells_of(a)
+                items += cells if cells is not None else [self.value(a, 1)]
+            how = EXCEL_VARIADIC[upper]
+            if how == "+":
+                return "(" + " + ".join(items) + ")" if len(items) > 1 else items[0]
+            if how == "mean":
+                return f"mean([{', '.join(items)}])"
+            return f"{how}({', '.join(items)})" if len(items) > 1 else items[0]
+        if upper in EXCEL:
+            text, arities = EXCEL[upper]
+            if len(args) not in arities:
+                raise FormulaProblem(f"{upper} with {len(args)} arguments")
+            return "(" + text.format(*[self.value(a, 0) for a in args]) + ")"
+        if upper == "ARRAY":
+            raise FormulaProblem("an array constant")
+        raise FormulaProblem(f"the Excel function {upper} (not mapped)")
+
+    def udf(self, key: str, args) -> str:
+        info = self.functions[key]
+        if info.problem:
+            raise FormulaProblem(f"calls {info.proc.name}, not translated: {info.problem}")
+        self.out.udfs.add(key)
+        params = info.proc.params
+        if len(args) > len(params):
+            raise FormulaProblem(f"{info.proc.name} called with {len(args)} arguments")
+        texts, flags = [], []
+        from .vbaprogram import NotTranslated, default_text
+
+        for k, p in enumerate(params):
+            a = args[k] if k < len(args) else None
+            given = a is not None and not (a[0] == "leaf" and a[1] == "Empty")
+            if not given:
+                if not p.optional:
+                    raise FormulaProblem(f"{info.proc.name} called without {p.name}")
+                if p.default is None and not (
+                    k < len(info.params) and info.params[k] in info.given
+                ):
+                    raise FormulaProblem(f"{info.proc.name} called without the Optional {p.name}")
+                try:
+                    texts.append(default_text(p))
+                except NotTranslated as exc:
+                    raise FormulaProblem(str(exc)) from None
+            elif a[0] == "leaf" and a[1] == "Range" and p.type.lower() in ("range", "variant"):
+                ref = self.ref_of(a[2])
+                if p.type.lower() == "range" or not ref.single:
+                    self.out.refs.append(ref)
+                    rows = [
+                        "["
+                        + ", ".join(
+                            self.name_of(ref.sheet, r, c) for c in range(ref.c1, ref.c2 + 1)
+                        )
+                        + "]"
+                        for r in range(ref.r1, ref.r2 + 1)
+                    ]
+                    texts.append("[" + ", ".join(rows) + "]")  # a range is a matrix
+                else:
+                    texts.append(self.value(a))
+            else:
+                texts.append(self.value(a))
+            if k < len(info.params) and info.params[k] in info.given:
+                flags.append("1" if given else "0")
+        return f"{info.final}({', '.join(texts + flags)})"
+
+
+def _br(text: str, level: int, ctx: int) -> str:
+    return f"({text})" if level < ctx else text
+
+
+def _col(letters: str) -> int:
+    from openpyxl.utils import column_index_from_string
+
+    return column_index_from_string(str(letters).replace("$", ""))
+
+
+def _parse_ref(sheet: str, ref: str) -> Ref:
+    from openpyxl.utils.cell import range_boundaries
+
+    c1, r1, c2, r2 = range_boundaries(ref.replace("$", ""))
+    if None in (c1, r1, c2, r2):
+        raise FormulaProblem(f"the name for {ref} (whole rows or columns)")
+    return Ref(sheet, r1, c1, r2, c2)

@@ -1,0 +1,149 @@
+"""Reading an Excel workbook safely: its cells (formula, cached value, number format), its
+defined names and its array formulas; never a macro run, never an external link followed."""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError, LimitError
+from ..limits import MAX_XLSX_MEMBER_BYTES, MAX_XLSX_MEMBERS, regular_file
+
+#: Largest workbook read (compressed), and cells of all sheets together.
+MAX_BOOK_BYTES = 200_000_000
+MAX_CELLS = 2_000_000
+
+
+@dataclass
+class Cell:
+    sheet: str
+    row: int
+    col: int
+    formula: str | None  # the text after "=", or None for a constant
+    value: object  # Excel's cached value (a constant's own value); None when empty
+    number_format: str = "General"
+    array: str | None = None  # "B10:E10" for every cell of a multi-cell array formula
+    array_master: tuple[int, int] | None = None
+
+    @property
+    def address(self) -> str:
+        from openpyxl.utils import get_column_letter
+
+        return f"{get_column_letter(self.col)}{self.row}"
+
+    @property
+    def ref(self) -> str:
+        return f"{self.sheet}!{self.address}"
+
+
+@dataclass
+class Book:
+    path: Path
+    sheets: dict[str, dict[tuple[int, int], Cell]] = field(default_factory=dict)
+    names: dict[str, tuple[str, str]] = field(default_factory=dict)  # name -> (sheet, A1 ref)
+    skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
+
+    def cell(self, sheet: str, row: int, col: int) -> Cell | None:
+        return self.sheets.get(sheet, {}).get((row, col))
+
+    def sheet_named(self, name: str) -> str | None:
+        """The sheet's own name for a name written in a formula (case-insensitive)."""
+        low = name.strip("'").lower()
+        return next((s for s in self.sheets if s.lower() == low), None)
+
+
+def check_archive(path: Path) -> None:
+    """Refuse a workbook whose zip members would inflate beyond the limits of ``--inputs``,
+    before any parser decompresses one."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            infos = z.infolist()
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+        raise InputError(f"{path}: cannot read it as an Excel workbook ({exc})") from None
+    if len(infos) > MAX_XLSX_MEMBERS:
+        raise LimitError(f"{path} has {len(infos):,} members (limit {MAX_XLSX_MEMBERS:,})")
+    for info in infos:
+        if info.file_size > MAX_XLSX_MEMBER_BYTES:
+            raise LimitError(
+                f"{path}: member {info.filename} inflates to {info.file_size:,} bytes "
+                f"(limit {MAX_XLSX_MEMBER_BYTES:,})"
+            )
+
+
+def read_book(path: Path) -> Book:
+    """The cells of every worksheet of an .xlsx/.xlsm/.xlam (formulas and cached values)."""
+    regular_file(path, what="workbook", max_bytes=MAX_BOOK_BYTES)
+    book = Book(path)
+    if path.suffix.lower() == ".xls":
+        book.skipped.append(
+            (
+                "the cells of the workbook",
+                "an Excel 97-2003 (.xls) file: its cell formulas are BIFF8 records, which "
+                "this import does not decode; its VBA is read",
+            )
+        )
+        return book
+    check_archive(path)
+    import warnings
+
+    import openpyxl
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            wb = openpyxl.load_workbook(path, data_only=False, keep_links=False)
+            cached = openpyxl.load_workbook(path, data_only=True, keep_links=False)
+    except Exception as exc:  # noqa: BLE001 - zip, XML: the file is not a readable workbook
+        raise InputError(f"{path}: cannot read it as an Excel workbook ({exc})") from None
+    total = 0
+    for ws in wb.worksheets:
+        cells: dict[tuple[int, int], Cell] = {}
+        values = cached[ws.title]
+        arrays: dict[tuple[int, int], tuple[str, tuple[int, int]]] = {}
+        for row in ws.iter_rows():
+            for c in row:
+                if c.value is None:
+                    continue
+                total += 1
+                if total > MAX_CELLS:
+                    raise LimitError(f"{path} has more than {MAX_CELLS:,} cells")
+                formula = None
+                v = c.value
+                if hasattr(v, "text") and hasattr(v, "ref"):  # an ArrayFormula
+                    formula = str(v.text or "").lstrip("=")
+                    ref = str(v.ref)
+                    if ":" in ref:
+                        for cells_row in ws[ref]:
+                            for part in cells_row:
+                                arrays[(part.row, part.column)] = (ref, (c.row, c.column))
+                elif isinstance(v, str) and v.startswith("="):
+                    formula = v[1:]
+                value = values.cell(c.row, c.column).value if formula is not None else v
+                cells[(c.row, c.column)] = Cell(
+                    ws.title, c.row, c.column, formula, value, c.number_format or "General"
+                )
+        for (r, col), (ref, master) in arrays.items():
+            cell = cells.get((r, col))
+            value = values.cell(r, col).value
+            if cell is None:
+                cell = cells[(r, col)] = Cell(ws.title, r, col, None, value)
+            cell.array, cell.array_master = ref, master
+            if (r, col) != master:
+                cell.formula = cells[master].formula
+                cell.value = value
+        book.sheets[ws.title] = cells
+    for name, dn in _defined_names(wb):
+        dests = list(getattr(dn, "destinations", []) or [])
+        if len(dests) == 1 and book.sheet_named(dests[0][0]):
+            book.names[name] = (book.sheet_named(dests[0][0]), dests[0][1].replace("$", ""))
+    return book
+
+
+def _defined_names(wb):
+    names = getattr(wb, "defined_names", {})
+    items = list(names.items()) if hasattr(names, "items") else []
+    for ws in wb.worksheets:  # names local to a sheet
+        local = getattr(ws, "defined_names", {})
+        items += list(local.items()) if hasattr(local, "items") else []
+    return items

@@ -1,0 +1,251 @@
+"""Writing the translation: NAME.toml (by tomli-w) and NAME.excel.csv, Excel's cached values
+as printed values. Definitions the engine refuses at load are listed and left out."""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+import tempfile
+from pathlib import Path
+
+from ..errors import WorkbookError
+from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE, _comment
+from ..mathcad.writer import write as write_files
+from .book import Translation
+
+MAX_LOAD_ROUNDS = 60  # loads of the worksheet while refused definitions are left out
+
+
+def _sheet_name(path: Path) -> str:
+    name = re.sub(r"[^A-Za-z0-9_-]+", "-", path.stem).strip("-").lower()
+    return name or "imported"
+
+
+def _cached(value) -> tuple[str, str] | None:
+    """(kind, CSV text) of a cached value: a number, a text, an error; None if empty."""
+    if value is None or isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return ("number", repr(float(value)))
+    if isinstance(value, str):
+        if value.startswith("#") and value.upper().rstrip("!?") in (
+            "#DIV/0", "#N/A", "#NAME", "#NULL", "#NUM", "#REF", "#VALUE", "#GETTING_DATA",
+        ):  # fmt: skip
+            return ("error", value)
+        if value == "":
+            return None
+        return ("text", value)
+    return None
+
+
+def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
+    """(TOML text, CSV text, counts) of the translation without the names in ``skip``."""
+    import tomli_w
+
+    name = _sheet_name(tr.path)
+    doc: dict = {
+        "sheet": {
+            "name": name,
+            "title": f"Imported from the Excel workbook {tr.path.name}",
+            "source": f"Excel workbook {tr.path.name}",
+            "origin": 0,
+        }
+    }
+    inputs = {
+        n: {"value": v, "note": note} for n, (_, v, note) in tr.inputs.items() if n not in skip
+    }
+    arguments: dict = {}
+    definitions: dict = {}
+    for n, (cell, text) in tr.texts.items():
+        if n not in skip:
+            definitions[n] = {
+                "expr": f'"{text}"' if '"' not in text and "\\" not in text else '""',
+                "note": f"{cell.ref} (text)",
+            }
+    for info in tr.functions.values():
+        if info.problem or info.final in skip:
+            continue
+        params = list(info.params) + list(info.given.values())
+        for p in params:
+            arguments.setdefault(p, {"unit": ""})
+        key = f"{info.final}({', '.join(params)})" if params else info.final
+        definitions[key] = {
+            "program": info.program + "\n",
+            "note": f"VBA Function {info.proc.name} (module {info.proc.module})",
+        }
+    rows = []
+    elements: list = []
+    for d in tr.definitions:
+        if d.problem or d.name in skip:
+            continue
+        cached = _cached(d.cell.value)
+        note = f"{d.cell.ref}: ={d.cell.formula}"[:300]
+        if d.element is not None:
+            if d.element[0] in skip:
+                continue
+            elements.append((d, cached))
+            continue
+        definitions[d.name] = {"expr": d.text, "note": note}
+        if cached is not None:
+            rows.append((d.name, "", cached, d.cell.ref))
+    # cells of an array formula: the function NAME_at(k) gives element k of NAME
+    at_rows = []
+    made = set()
+    for d, cached in elements:
+        fn = f"{d.element[0]}_at"
+        if fn not in made:
+            made.add(fn)
+            definitions[f"{fn}(k_at)"] = {
+                "expr": f"{d.element[0]}[k_at]",
+                "note": f"the cells of the array formula {d.element[0]}, one by one",
+            }
+            arguments["k_at"] = {"unit": "", "note": "the position of a cell in its array formula"}
+        if cached is not None:
+            at_rows.append((fn, str(d.element[1]), cached, d.cell.ref))
+    if inputs:
+        doc["inputs"] = inputs
+    if arguments:
+        doc["arguments"] = arguments
+    if definitions:
+        doc["definitions"] = definitions
+    counts = {"numbers": 0, "texts": 0, "errors": 0}
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    out.write("# Excel's cached values of the translated cells (imported by `workbook import`)\n")
+    w.writerow(["name", "argument", "value", "unit"])
+    printed = []
+    files = {}
+    for label, group, arg in (("", rows, None), (".at", at_rows, "k_at")):
+        if not group:
+            continue
+        out = io.StringIO()
+        w = csv.writer(out, lineterminator="\n")
+        out.write(
+            "# Excel's cached values of the translated cells (imported by `workbook import`)\n"
+        )
+        w.writerow(["name", "argument", "value", "unit"])
+        for n, at, (kind, text), ref in group:
+            counts[kind + "s"] += 1
+            if kind == "error":
+                out.write(f"# {ref}: Excel shows {text} (an error value: not compared)\n")
+                continue
+            out.write(f"# {ref}\n")
+            w.writerow([n, at, text, ""])
+        fname = f"{name}.excel{label}.csv"
+        files[fname] = out.getvalue()
+        entry = {
+            "file": fname,
+            "title": "Excel's cached values" + (" of the cells of array formulas" if arg else ""),
+            "rel_tolerance": REL_TOLERANCE,
+            "tolerance": ABS_TOLERANCE,
+        }
+        if arg:
+            entry["argument"] = arg
+        printed.append(entry)
+    if printed:
+        doc["printed"] = printed
+    head = [
+        f"# Imported from {tr.path.name} by `workbook import`: inputs from the constant cells",
+        "# that formulas read, definitions from formula cells, functions from VBA Functions,",
+        "# and Excel's cached values as printed values (`workbook check` compares them).",
+        "# Excel has no units: the numbers are plain; a unit a label names is proposed in a note.",
+    ]
+    listed = list(tr.listed) + [(k, v) for k, v in skip.items()]
+    if listed:
+        head.append("#")
+        head.append(f"# Not translated ({len(listed)}; their cells count as not reproduced):")
+        for what, why in listed[:400]:
+            head += _comment(f"  {what}: {why}")
+        if len(listed) > 400:
+            head.append(f"#   ... and {len(listed) - 400} more")
+    toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
+    return toml, files, counts
+
+
+def _load_problem(toml: str, files: dict, name: str) -> tuple[str, str] | None:
+    """(definition, why) the engine refuses, or None when the worksheet loads."""
+    import workbook
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"{name}.toml"
+        path.write_text(toml, encoding="utf-8")
+        for fname, text in files.items():
+            (Path(tmp) / fname).write_text(text, encoding="utf-8")
+        try:
+            workbook.load(str(path))
+        except WorkbookError as err:
+            what = err.definition
+            if what is None and err.line:
+                line = toml.splitlines()[err.line - 1] if err.line <= len(toml.splitlines()) else ""
+                m = re.match(r'^"?([A-Za-z_]\w*)', line)
+                what = m.group(1) if m else None
+            if what is None:
+                raise WorkbookError(
+                    f"the translated worksheet does not load: {err.message}"
+                ) from None
+            return what.split("(")[0], f"the engine refuses it: {err.message}"
+    return None
+
+
+def write(tr: Translation, out_dir: Path, *, force: bool):
+    """Write NAME.toml and its CSV files (existing ones need --force)."""
+    from ..mathcad.writer import Rendered
+    from . import ImportResult
+
+    name = _sheet_name(tr.path)
+    skip: dict[str, str] = {}
+    for _ in range(MAX_LOAD_ROUNDS):
+        toml, files, counts = render(tr, skip)
+        problem = _load_problem(toml, files, name)
+        if problem is None:
+            break
+        what, why = problem
+        if what in skip:
+            raise WorkbookError(f"the translated worksheet does not load: {why}")
+        skip[what] = why
+        _drop_dependents(tr, what, skip)
+    else:
+        raise WorkbookError(
+            f"the translated worksheet still does not load after leaving out {len(skip)} "
+            "definitions"
+        )
+    rendered = Rendered(name, toml, files)
+    paths = write_files(rendered, out_dir, force=force)
+    n_fn = sum(1 for i in tr.functions.values() if not i.problem and i.final not in skip)
+    n_def = len(tr.inputs) + sum(1 for d in tr.definitions if not d.problem and d.name not in skip)
+    return ImportResult(
+        paths[0],
+        paths,
+        n_def,
+        n_fn,
+        counts["numbers"] + counts["texts"],
+        list(tr.listed) + list(skip.items()),
+    )
+
+
+def _drop_dependents(tr: Translation, name: str, skip: dict[str, str]) -> None:
+    """Leave out the definitions that use ``name`` (they would be refused next)."""
+    pattern = re.compile(rf"\b{re.escape(name)}\b")
+    changed = True
+    names = {name}
+    while changed:
+        changed = False
+        for d in tr.definitions:
+            if d.problem or d.name in skip:
+                continue
+            uses = d.text or ""
+            if (d.element and d.element[0] in names) or any(
+                re.search(rf"\b{re.escape(n)}\b", uses) for n in names
+            ):
+                skip[d.name] = f"uses {name}, left out"
+                names.add(d.name)
+                changed = True
+        for info in tr.functions.values():
+            if info.problem or info.final in skip:
+                continue
+            if any(re.search(rf"\b{re.escape(n)}\s*\(", info.program) for n in names):
+                skip[info.final] = f"calls {name}, left out"
+                names.add(info.final)
+                changed = True
+    del pattern
