@@ -29,7 +29,13 @@ PACKAGE = Path(__file__).resolve().parents[1] / "workbook"
 
 # The modules of registry entries; and the Mathcad importer's map from Mathcad's names to the
 # language's (data about Mathcad, checked against the registry below).
-HOMES = {"builtins.py", "matrix.py", "numerics/entries.py", "mathcad/functions.py"}
+HOMES = {
+    "builtins.py",
+    "distributions.py",
+    "matrix.py",
+    "numerics/entries.py",
+    "mathcad/functions.py",
+}
 
 # Lists of built-in names that are still kept elsewhere, each exactly as it is now, so that a
 # new list, or a built-in added to one of these, fails: (module, the built-ins listed).

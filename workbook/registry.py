@@ -1,10 +1,12 @@
 """The complete registry of built-in functions: the plain ones of :mod:`workbook.builtins`, the
-numerical ones of :mod:`workbook.numerics.entries` and the vector and matrix ones of
-:mod:`workbook.matrix`. Every back end reads built-ins from here."""
+distributions of :mod:`workbook.distributions`, the numerical ones of
+:mod:`workbook.numerics.entries` and the vector and matrix ones of :mod:`workbook.matrix`.
+Every back end reads built-ins from here."""
 
 from __future__ import annotations
 
 from . import builtins as _plain  # noqa: F401 - registers the plain built-ins on import
+from . import distributions as _distributions  # noqa: F401 - pnorm, qt, pchisq, ...
 from . import matrix
 from .entry import ENTRIES
 from .numerics import entries as _numerical  # noqa: F401 - root, integral, ..., diff register

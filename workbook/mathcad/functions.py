@@ -30,6 +30,12 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
     "csort": ("csort", None), "rsort": ("rsort", None), "sort": ("sort", None),
     "reverse": ("reverse", None),
+    # probability distributions (workbook.distributions)
+    "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),
+    "dt": ("dt", None), "pt": ("pt", None), "qt": ("qt", None),
+    "dchisq": ("dchisq", None), "pchisq": ("pchisq", None), "qchisq": ("qchisq", None),
+    "pF": ("pF", None), "qF": ("qF", None), "pexp": ("pexp", None), "qexp": ("qexp", None),
+    "punif": ("punif", None),
 }  # fmt: skip
 
 #: Mathcad functions that are never translated, and why (a worksheet reads and writes no

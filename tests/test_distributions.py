@@ -1,0 +1,261 @@
+"""The distribution built-ins (dnorm, pnorm, qnorm, dt, ..., qunif) against mpmath at 50 digits,
+their Excel forms against the `formulas` package, their unit rules and domains."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import mpmath
+import numpy as np
+import pytest
+from conftest import write_template
+
+import workbook
+from workbook import WorkbookError
+from workbook.distributions import NAMES
+from workbook.registry import REGISTRY
+
+mp = mpmath.mp
+
+
+def _t_cdf(x, d):
+    tail = mpmath.betainc(d / 2, mpmath.mpf(1) / 2, 0, d / (d + x * x), regularized=True) / 2
+    return 1 - tail if x >= 0 else tail
+
+
+def _t_pdf(x, d):
+    c = mpmath.gamma((d + 1) / 2) / (mpmath.sqrt(d * mpmath.pi) * mpmath.gamma(d / 2))
+    return c * (1 + x * x / d) ** (-(d + 1) / 2)
+
+
+def _chisq_cdf(x, d):
+    return mpmath.gammainc(d / 2, 0, x / 2, regularized=True) if x > 0 else mpmath.mpf(0)
+
+
+def _chisq_pdf(x, d):
+    if x < 0:
+        return mpmath.mpf(0)
+    return x ** (d / 2 - 1) * mpmath.exp(-x / 2) / (2 ** (d / 2) * mpmath.gamma(d / 2))
+
+
+def _f_cdf(x, d1, d2):
+    if x <= 0:
+        return mpmath.mpf(0)
+    return mpmath.betainc(d1 / 2, d2 / 2, 0, d1 * x / (d1 * x + d2), regularized=True)
+
+
+def _quantile(cdf):
+    """The inverse of ``cdf`` by mpmath's root finder from the engine's value."""
+
+    def q(p, *params, start):
+        return mpmath.findroot(lambda x: cdf(x, *params) - p, mpmath.mpf(start), tol=1e-40)
+
+    return q
+
+
+# name -> (mpmath reference, points: (x or p, parameters...), relative tolerance)
+_X = [-3.5, -1.2, -0.3, 0.0, 0.4, 1.7, 4.2]
+_POS = [0.05, 0.4, 1.0, 2.3, 6.5, 15.0]
+_P = [1e-6, 0.01, 0.2, 0.45, 0.7, 0.93, 0.999]
+CASES = {
+    "dnorm": (lambda x, m, s: mpmath.npdf(x, m, s), [(x, 0.3, 1.7) for x in _X], 1e-14),
+    "pnorm": (lambda x, m, s: mpmath.ncdf(x, m, s), [(x, 0.3, 1.7) for x in _X], 1e-14),
+    "qnorm": (
+        lambda p, m, s: m + s * mpmath.sqrt(2) * mpmath.erfinv(2 * p - 1),
+        [(p, 0.3, 1.7) for p in _P],
+        1e-14,
+    ),
+    "dt": (_t_pdf, [(x, d) for x in _X for d in (1, 2.5, 7)], 1e-14),
+    "pt": (_t_cdf, [(x, d) for x in _X for d in (1, 2.5, 7)], 1e-14),
+    "qt": (_quantile(_t_cdf), [(p, d) for p in _P for d in (1, 2.5, 7)], 5e-14),
+    "dchisq": (_chisq_pdf, [(x, d) for x in [-1.0, *_POS] for d in (1, 3, 4.5)], 1e-14),
+    "pchisq": (_chisq_cdf, [(x, d) for x in [-1.0, *_POS] for d in (1, 3, 4.5)], 1e-14),
+    "qchisq": (_quantile(_chisq_cdf), [(p, d) for p in _P for d in (1, 3, 4.5)], 1e-14),
+    "pF": (_f_cdf, [(x, a, b) for x in [-1.0, *_POS] for a, b in ((1, 3), (4, 7.5))], 1e-14),
+    "qF": (
+        _quantile(_f_cdf),
+        [(p, a, b) for p in _P for a, b in ((1, 3), (4, 7.5))],
+        1e-14,
+    ),
+    "pexp": (
+        lambda x, r: -mpmath.expm1(-r * x) if x >= 0 else mpmath.mpf(0),
+        [(x, r) for x in [-1.0, *_POS] for r in (0.2, 3)],
+        1e-14,
+    ),
+    "qexp": (lambda p, r: -mpmath.log1p(-p) / r, [(p, r) for p in _P for r in (0.2, 3)], 1e-14),
+    "punif": (
+        lambda x, a, b: min(max((x - a) / (b - a), 0), 1),
+        [(x, -1, 2.5) for x in _X],
+        1e-15,
+    ),
+}
+
+
+def test_every_distribution_is_tested_here():
+    assert set(CASES) == NAMES and NAMES <= set(REGISTRY)
+
+
+@pytest.fixture(scope="module")
+def sheet(tmp_path_factory):
+    lines = ["[arguments]", *(f'{v} = {{ unit = "" }}' for v in "uvw"), "", "[definitions]"]
+    for name in CASES:
+        params = ("u", "v", "w")[: REGISTRY[name].arity]
+        lines.append(f'"f_{name}({", ".join(params)})" = "{name}({", ".join(params)})"')
+    return workbook.load(write_template(tmp_path_factory.mktemp("dist"), "\n".join(lines) + "\n"))
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_distribution_agrees_with_mpmath(sheet, name):
+    reference, points, rel = CASES[name]
+    worst = 0.0
+    with mp.workdps(50):
+        for point in points:
+            got = float(sheet.evaluate(f"f_{name}", *point).magnitude)
+            args = [mpmath.mpf(a) for a in point]
+            if name[0] == "q" and name not in ("qnorm", "qexp", "qunif"):
+                want = reference(*args, start=got)
+            else:
+                want = reference(*args)
+            err = abs(mpmath.mpf(got) - want) / max(abs(want), mpmath.mpf(1e-300))
+            if want == 0:
+                err = abs(got)
+            worst = max(worst, float(err))
+    print(f"{name}: largest relative difference from mpmath {worst:.2e}")
+    assert worst <= rel, f"{name}: {worst:.2e}"
+
+
+TEMPLATE = """
+[inputs]
+x = "0.7"
+p = "0.3"
+mu = "0.3"
+sigma = "1.7"
+d = "3"
+d2 = "5"
+r = "2.5"
+a = "-1"
+b = "2.5"
+half = "2.5"
+
+[definitions]
+"""
+
+EXCEL_CASES = {
+    "c_dnorm": "dnorm(x, mu, sigma)",
+    "c_pnorm": "pnorm(x, mu, sigma)",
+    "c_qnorm": "qnorm(p, mu, sigma)",
+    "c_dt": "dt(-x, d)",
+    "c_pt": "pt(-x, d)",
+    "c_qt": "qt(p, d)",
+    "c_dchisq": "dchisq(x, d)",
+    "c_pchisq": "pchisq(x, d)",
+    "c_qchisq": "qchisq(p, d)",
+    "c_pF": "pF(x, d, d2)",
+    "c_qF": "qF(p, d, d2)",
+    "c_pexp": "pexp(x, r)",
+    "c_qexp": "qexp(p, r)",
+    "c_punif": "punif(x, a, b)",
+    # below zero: 0, as mpmath above (Excel's own functions give #NUM!)
+    "c_below": "dchisq(-x, d) + 10*pchisq(-x, d) + 100*pF(-x, d, d2) + 1000*pexp(-x, r)",
+    "c_constants": "pt(0.4, 4) + qchisq(0.6, 2)",
+}
+
+
+@pytest.fixture(scope="module")
+def golden(tmp_path_factory):
+    formulas = pytest.importorskip("formulas")
+    from recalc import formula_values
+
+    tmp = tmp_path_factory.mktemp("dist_xl")
+    text = TEMPLATE + "".join(f'{k} = "{v}"\n' for k, v in EXCEL_CASES.items())
+    text += 'fractional = "pt(x, half)"\nconst_fraction = "qt(p, 2.5)"\n'
+    sheet = workbook.load(write_template(tmp, text, "dist.toml"))
+    path = sheet.write_xlsx(tmp / "dist.xlsx")
+    cells = formula_values(path)
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    recalculated = {}
+    for key, ranges in solution.items():
+        book_sheet, _, cell = key.rpartition("!")
+        if ":" in cell or "]" not in book_sheet:
+            continue
+        recalculated[(book_sheet.split("]", 1)[1].strip("'").upper(), cell)] = ranges.value[0, 0]
+    import openpyxl
+
+    written = {
+        (ws.title, c.coordinate): c.value
+        for ws in openpyxl.load_workbook(path).worksheets
+        for row in ws.iter_rows()
+        for c in row
+    }
+    return sheet, cells, recalculated, written
+
+
+def _cell(cells, formula_part: str):
+    found = [(k, f) for k, (f, _) in cells.items() if formula_part in f]
+    assert len(found) == 1, (formula_part, found)
+    return found[0]
+
+
+def test_excel_forms_agree_with_the_formulas_package(golden):
+    sheet, cells, recalculated, _ = golden
+    for name, text in EXCEL_CASES.items():
+        engine = float(sheet.evaluate(name).magnitude)
+        row = [k for k, (f, v) in cells.items() if v == pytest.approx(engine, rel=1e-15)]
+        assert row, f"{name}: no live formula cell holds {engine}"
+        key = row[0]
+        got = recalculated[(key[0].upper(), key[1])]
+        print(f"{text:40} {cells[key][0]}")
+        assert float(got) == pytest.approx(engine, rel=1e-14), (name, cells[key][0])
+    formulas_text = " ".join(f for f, _ in cells.values())
+    for function in ("NORM.DIST", "NORM.INV", "T.DIST", "T.INV", "CHISQ.DIST", "CHISQ.INV"):
+        assert f"_xlfn.{function}(" in formulas_text
+    for function in ("F.DIST", "F.INV", "EXPON.DIST"):  # all newer functions: prefixed
+        assert f"_xlfn.{function}(" in formulas_text
+
+
+def test_degrees_of_freedom_excel_would_truncate(golden):
+    """Excel truncates degrees of freedom: from a cell, a fraction gives #N/A (never the value
+    of another distribution); a constant fraction is written as the value."""
+    sheet, cells, recalculated, written = golden
+    key, formula = _cell(cells, "T.DIST(x_, half")
+    assert formula.startswith("=IF(INT(half)=half, ")
+    assert str(recalculated[(key[0].upper(), key[1])]) == "#N/A"
+    assert not any("T.INV(p_, 2.5" in f for f, _ in cells.values())
+    with mp.workdps(50):
+        want = float(_quantile(_t_cdf)(mpmath.mpf(0.3), mpmath.mpf(2.5), start=-0.6))
+    assert float(sheet.evaluate("const_fraction").magnitude) == pytest.approx(want, rel=1e-12)
+    assert any(v == float(sheet.evaluate("const_fraction").magnitude) for v in written.values())
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("pnorm(L, 0, 1)", "needs a dimensionless argument"),
+        ("qt(0.3, t)", "needs a dimensionless argument"),
+        ("pchisq(1)", "takes 2 argument(s), got 1"),
+    ],
+)
+def test_arguments_are_plain_numbers(tmp_path, text, message):
+    text = f'[inputs]\nL = "1 m"\nt = "4 s"\n\n[definitions]\nbad = "{text}"\n'
+    with pytest.raises(WorkbookError, match=re.escape(message)):
+        workbook.load(write_template(tmp_path, text))
+
+
+@pytest.mark.parametrize(
+    "text", ["qnorm(1.3, 0, 1)", "pnorm(0.5, 0, -1)", "pt(0.5, 0)", "qexp(0.5, -2)"]
+)
+def test_outside_the_domain_is_an_error_not_a_number(tmp_path, text):
+    path = write_template(tmp_path, f'[definitions]\nbad = "{text}"\n')
+    with pytest.raises(WorkbookError, match="not a finite number"):
+        workbook.load(path).evaluate("bad")
+
+
+def test_the_normal_density_is_the_derivative_of_its_probability(tmp_path):
+    text = '[arguments]\nu = { unit = "" }\n\n[definitions]\n'
+    text += '"slope(u)" = "diff(pnorm(u, 0.3, 1.7), u)"\n"dens(u)" = "dnorm(u, 0.3, 1.7)"\n'
+    sheet = workbook.load(write_template(tmp_path, text))
+    u = np.array([-2.0, 0.1, 1.3])
+    slope = sheet.evaluate("slope", u).magnitude
+    assert slope == pytest.approx(sheet.evaluate("dens", u).magnitude, rel=1e-14)
+    assert math.isclose(slope[1], float(mpmath.npdf(0.1, 0.3, 1.7)), rel_tol=1e-14)
