@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import openpyxl
 import pytest
 
@@ -663,3 +664,53 @@ def test_sweep_choice_values_and_chart_labels_stay_text(tmp_path):
     assert out.returncode == 0, out.stderr
     refs = _chart_references(tmp_path / "s.xlsx")
     assert all(r.startswith("Sweep!") for r in refs), refs
+
+
+# -- run-time arrays are values ------------------------------------------------------------
+
+ARRAYS_ARE_VALUES = r'''
+[arguments]
+n = { unit = "" }
+
+[definitions]
+"kept(n)" = { program = """
+w := 0
+k := 0
+while k < 3
+    w[k] := k + 1
+    k := k + 1
+T := [w, 1]
+w[0] := n
+T[0][0]
+""" }
+"shown(n)" = { program = """
+w := 0
+k := 0
+while k < 2
+    w[k] := k + 1
+    k := k + 1
+w
+w[0] := n
+""" }
+"appended(n)" = { program = """
+w := 0
+for k in 1 .. n
+    w[rows(w)] := k
+    a := w
+a[rows(a)] := 99
+w[rows(w)] := 7
+[a[n], w[n], rows(a), rows(w), sum(w[i], i, 0, n - 1)]
+""" }
+'''
+
+
+def test_an_array_stays_what_it_was_when_a_local_changes_later(tmp_path):
+    # an array stored in another kept a reference to the local: T[0][0] became 99; the last
+    # value line gave the local as it was at the end, not as that line saw it
+    sheet = workbook.load(write(tmp_path / "v.toml", ARRAYS_ARE_VALUES))
+    assert float(sheet.evaluate("kept", n=99).magnitude) == 1.0
+    assert list(np.ravel(sheet.evaluate("shown", n=99).magnitude)) == [1.0, 2.0]
+    # appends grow into spare room of the array; a copy of it is its own
+    n = 1000
+    got = list(np.ravel(sheet.evaluate("appended", n=n).magnitude))
+    assert got == [99.0, 7.0, n + 1, n + 1, n * (n + 1) / 2]

@@ -18,7 +18,7 @@ import time
 
 import pytest
 
-from workbook import expr, ranges, template, typecheck
+from workbook import expr, numeric, ranges, runtime, template, typecheck, xlsx
 
 MEMORY = 1536 * 2**20  # bytes of address space for one run
 CPU_SECONDS = 60
@@ -260,6 +260,10 @@ def test_limits_are_documented():
         ranges.MAX_RANGE_POINTS,
         template.MAX_TEMPLATE_BYTES,
         typecheck.MAX_CHAIN,
+        numeric.MAX_RECURSIVE_CALLS,
+        runtime.MAX_NESTING,
+        runtime.MAX_RUNTIME_ELEMENTS,
+        xlsx.MAX_ARRAY_CELLS,
     ):
         assert f"{value:,}" in limits or str(value) in limits, value
 
@@ -296,3 +300,59 @@ def test_solver_loop_asked_for_billions_of_steps(tmp_path):
     temporary = [e for e in out.events if e.endswith(".partial None") and str(tmp_path) in e]
     cleanup = ("os.remove", "os.rmdir")
     assert [e for e in out.events if e not in temporary and e not in cleanup] == [], out.events
+
+
+# -- programs and run-time arrays at their bounds ------------------------------------------
+
+
+def program(body: str, value: str) -> str:
+    """A sheet with a one-argument program ``p(n)`` and the definition ``s = value``."""
+    return (
+        '[arguments]\nn = { unit = "" }\n\n[definitions]\n"p(n)" = { program = """\n'
+        + body.strip("\n")
+        + '\n""" }\ns = '
+        + json.dumps(value)
+        + "\n"
+    )
+
+
+NEST_IN_ITSELF = program("T := [1, 2]\nfor k in 1 .. n\n    T := [T, 1]\nT", "p(8000)")
+GROW_BY_MILLIONS = program("w := 0\nfor k in 1 .. n\n    w[rows(w) + 1e6] := k\nrows(w)", "p(1e3)")
+RUNTIME_HOSTILE = {
+    # freeing or printing 8,000 nested arrays overflowed the C stack (SIGSEGV)
+    "nested_in_itself": (NEST_IN_ITSELF, 0, f"arrays nested more than {runtime.MAX_NESTING} deep"),
+    "grown_by_millions": (GROW_BY_MILLIONS, 0, f"limit {runtime.MAX_RUNTIME_ELEMENTS:,} elements"),
+    # xlsxwriter drops cells past the grid: the defined name pointed outside it, exit 0
+    "past_the_last_column": (
+        program("for k in 1 .. n\n    w[k] := k\ntranspose(w)", "p(20001)"),
+        2,
+        "1 x 20,002 (20,002 elements)",
+    ),
+    "past_the_last_row": (
+        program("w[n] := 1\nw", "p(2000000)"),
+        2,
+        "2,000,001 x 1 (2,000,001 elements)",
+    ),
+    "too_many_cells_to_write": (
+        '[definitions]\nI = "identity(2000)"\n',
+        2,
+        f"at most {xlsx.MAX_ARRAY_CELLS:,} cells",
+    ),
+    "branching_recursion": (
+        program("return n if n < 2\np(n - 1) + p(n - 2)", "p(30)"),
+        0,
+        f"more than {numeric.MAX_RECURSIVE_CALLS:,} times in one call",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(RUNTIME_HOSTILE))
+def test_a_program_at_its_bounds_is_stopped_with_a_message(tmp_path, name):
+    text, status, expected = RUNTIME_HOSTILE[name]
+    out = guarded(tmp_path, text)
+    assert out.returncode == status, (out.returncode, out.stderr[-2000:])
+    shown = out.stdout if status == 0 else out.stderr  # run lists a scalar in error
+    assert expected in shown, (out.stdout[-2000:], out.stderr[-2000:])
+    assert "Traceback" not in out.stderr
+    if status:
+        assert [p.name for p in tmp_path.rglob("*") if p.is_file()] == ["hostile.toml"]

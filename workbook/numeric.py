@@ -425,18 +425,29 @@ class Evaluator(Visitor):
 #: such a function runs (Python 3.11 calls Python closures without growing the C stack).
 MAX_RECURSION = 1000
 _FRAMES_PER_LEVEL = 40
+#: Calls of a function to itself within one outer call: a shallow recursion that branches
+#: (``fib(n - 1) + fib(n - 2)``) grows exponentially long before it grows deep.
+MAX_RECURSIVE_CALLS = 200_000
 
 
 def _recursion_bounded(name: str, fn: Fn) -> Fn:
     """``fn`` (a function that calls itself) with its depth counted: deeper than
-    MAX_RECURSION is a LimitError naming it, never Python's RecursionError."""
-    depth = [0]
+    MAX_RECURSION is a LimitError naming it, never Python's RecursionError; so is more than
+    MAX_RECURSIVE_CALLS calls within one outer call."""
+    depth, calls = [0], [0]
 
     def run(env):
         if depth[0] >= MAX_RECURSION:
             raise LimitError(
                 f"{name}() called itself more than {MAX_RECURSION} deep (a recursion that does "
                 "not end?)",
+                definition=name,
+            )
+        calls[0] = calls[0] + 1 if depth[0] else 0
+        if calls[0] > MAX_RECURSIVE_CALLS:
+            raise LimitError(
+                f"{name}() called itself more than {MAX_RECURSIVE_CALLS:,} times in one call "
+                "(a recursion that branches grows exponentially; write it as a loop)",
                 definition=name,
             )
         before = sys.getrecursionlimit()

@@ -902,7 +902,7 @@ def compile_program(
 
             def value(env, last):
                 tick(s)
-                return f(env)
+                return _result(f(env))  # a local set after this line does not change it
 
             return value
         if isinstance(s, Return):

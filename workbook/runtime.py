@@ -19,11 +19,18 @@ import operator
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, LimitError
 from .matrix import (
     power,
     size,  # noqa: F401 - rows/cols/length/last of a run-time value
 )
+
+#: Arrays inside arrays at most this deep: a deeper one (``T := [T, 1]`` in a loop) would
+#: exhaust the C stack when it is freed or printed.
+MAX_NESTING = 100
+#: Elements of one run-time array (80 MB of numbers; its spare room for growing doubles that
+#: at most).
+MAX_RUNTIME_ELEMENTS = 10_000_000
 
 
 def value(v):
@@ -108,8 +115,11 @@ def index(target, indices: list, *, origin: int, what: str):
 def set_item(target, indices: list, x, *, origin: int, what: str):
     """``target`` with element ``[i]`` or ``[i, j]`` set to ``x``: a number or a missing local
     becomes a vector, and an array grows with zeros to reach the index (as Mathcad); an array
-    element makes the array nested. Returns the new array (a copy only when it grows)."""
-    x = value(x)
+    element makes the array nested (it is stored as a copy: the array set stays a value).
+    Returns the new array. ``target`` must be the caller's own (it is changed in place); an
+    array that grows by rows keeps spare rows, so appending one element at a time costs
+    amortised constant time, not a copy of the whole array each time."""
+    x = _element(value(x), what)
     target = value(target) if target is not None else None
     if len(indices) == 1:
         if is_array(target) and target.shape[1] != 1:
@@ -127,24 +137,74 @@ def set_item(target, indices: list, x, *, origin: int, what: str):
     r, c = target.shape
     nested = target.dtype == object or is_array(x)
     if at[0] >= r or at[1] >= c or nested != (target.dtype == object):
-        grown = np.zeros((max(r, at[0] + 1), max(c, at[1] + 1)), dtype=object if nested else float)
-        if nested:
-            grown.fill(0.0)
-        grown[:r, :c] = target
-        target = grown
+        target = _grown(target, max(r, at[0] + 1), max(c, at[1] + 1), nested, what)
     target[at] = x
     return target
 
 
-def build(rows: list[list]):
-    """A matrix literal with run-time elements: nested when an element is an array."""
+def _grown(target: np.ndarray, rows: int, cols: int, nested: bool, what: str) -> np.ndarray:
+    """``target`` grown to ``rows`` x ``cols`` with zeros: a view into spare rows of the array
+    it is a view of when they suffice, else a new array with twice the rows it needs."""
+    r, c = target.shape
+    if rows * cols > MAX_RUNTIME_ELEMENTS:
+        raise LimitError(
+            f"{what}: an array of {rows:,} x {cols:,} elements "
+            f"(limit {MAX_RUNTIME_ELEMENTS:,} elements)"
+        )
+    dtype = object if nested else float
+    base = target.base
+    if (
+        cols == c
+        and target.dtype == dtype
+        and isinstance(base, np.ndarray)
+        and base.ndim == 2
+        and base.dtype == dtype
+        and base.shape[1] == c
+        and base.shape[0] >= rows
+        and target.flags.c_contiguous
+        and base.flags.c_contiguous
+        and target.__array_interface__["data"][0] == base.__array_interface__["data"][0]
+    ):
+        view = base[:rows]
+        view[r:] = 0.0
+        return view
+    spare = min(max(rows, 2 * r), max(rows, MAX_RUNTIME_ELEMENTS // max(cols, 1)))
+    grown = np.zeros((spare if cols == c else rows, cols), dtype=dtype)
+    if nested:
+        grown.fill(0.0)
+    grown[:r, :c] = target
+    return grown[:rows] if grown.shape[0] != rows else grown
+
+
+def _element(x, what: str):
+    """An array stored as an element of another: a copy (a later change to the local it came
+    from does not reach it), nested at most :data:`MAX_NESTING` deep."""
+    if not is_array(x):
+        return x
+    if x.dtype == object and nesting(x) >= MAX_NESTING:
+        raise LimitError(f"{what}: arrays nested more than {MAX_NESTING} deep")
+    return x.copy()
+
+
+def nesting(v) -> int:
+    """How deep arrays are nested in ``v``: 0 for a number, 1 for an array of numbers."""
+    if not is_array(v):
+        return 0
+    if v.dtype != object:
+        return 1
+    return 1 + max((nesting(e) for e in v.ravel()), default=0)
+
+
+def build(rows: list[list], what: str = "array"):
+    """A matrix literal with run-time elements: nested when an element is an array (stored
+    as a copy)."""
     values = [[value(e) for e in row] for row in rows]
     if not any(is_array(e) for row in values for e in row):
         return np.array(values, dtype=float)
     out = np.empty((len(values), len(values[0])), dtype=object)
     for i, row in enumerate(values):
         for j, e in enumerate(row):
-            out[i, j] = e
+            out[i, j] = _element(e, what)
     return out
 
 

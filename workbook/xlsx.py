@@ -34,6 +34,10 @@ MAX_ROWS = 1_048_576
 MAX_COLS = 16_384
 ROW_TOKEN = "\x00"
 PROGRESS_CELLS = 200_000  # a table with more cells than this reports its progress on stderr
+#: Cells of one vector or matrix written as a block (a 4,000,000-cell identity(2000) took
+#: 55 s and 700 MB to write); beyond it, or beyond Excel's grid, it is refused, never cut.
+MAX_ARRAY_CELLS = 500_000
+MAX_CELL_TEXT = 32_767  # characters of one Excel cell
 
 
 def write_labels(ws, row: int, col: int, texts, fmt=None) -> None:
@@ -314,8 +318,9 @@ class WorkbookWriter:
             if tc.is_runtime(t.shape):
                 row = self._write_runtime(ws, row, d, t)
                 continue
-            value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
             r, c = t.shape
+            self._check_block(d, row + 1, r, c)
+            value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
             ws.write_string(row, 0, d.name, self.fmt["header"])
             ws.write_string(row, 1, f"{un.pretty(t.unit) or '1'}   {d.text}   {d.note}".strip())
             top = row + 1
@@ -351,11 +356,22 @@ class WorkbookWriter:
         array, whose elements are arrays, as a line of text), with a comment."""
         value = self._runtime_value(d.name)
         r, c = value.shape
+        if value.dtype != object:
+            self._check_block(d, row + 1, r, c)
         ws.write_string(row, 0, d.name, self.fmt["header"])
         ws.write_string(row, 1, f"{un.pretty(t.unit) or '1'}   {d.text}   {d.note}".strip())
         top = row + 1
         if value.dtype == object:
-            ws.write_string(top, 1, _nested_text(value))
+            text = _nested_text(value)
+            if len(text) > MAX_CELL_TEXT:  # xlsxwriter would cut it without a word
+                raise LimitError(
+                    f"{d.name} is a nested array whose text is {len(text):,} characters; an "
+                    f"Excel cell holds at most {MAX_CELL_TEXT:,}",
+                    file=self.sheet.file,
+                    line=d.line,
+                    definition=d.name,
+                )
+            ws.write_string(top, 1, text)
             ws.write_comment(
                 top, 1, "A nested array (its elements are arrays): shown as text, not cells"
             )
@@ -371,6 +387,21 @@ class WorkbookWriter:
         last = f"{_col_letter(c)}${top + r}"
         self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
         return top + r + 1
+
+    def _check_block(self, d, top: int, r: int, c: int) -> None:
+        """Refuse an array of ``r`` x ``c`` cells from row ``top`` that would pass Excel's grid
+        (xlsxwriter drops such cells without a word) or :data:`MAX_ARRAY_CELLS`."""
+        if top + r <= MAX_ROWS and 1 + c <= MAX_COLS and r * c <= MAX_ARRAY_CELLS:
+            return
+        raise LimitError(
+            f"{d.name} is {r:,} x {c:,} ({r * c:,} elements): a workbook holds an array of at "
+            f"most {MAX_ARRAY_CELLS:,} cells within Excel's grid of {MAX_ROWS:,} rows x "
+            f"{MAX_COLS:,} columns (this one would start at row {top + 1:,}, column B); it is "
+            "refused rather than cut",
+            file=self.sheet.file,
+            line=d.line,
+            definition=d.name,
+        )
 
     def _shape(self, name: str):
         """(rows, columns) of a definition's value, None for a number (or one in error)."""
