@@ -6,6 +6,7 @@ modules of entries and the Mathcad importer's map of Mathcad's names (checked he
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import mpmath
@@ -27,14 +28,15 @@ from workbook.report.mathml import MathML
 
 PACKAGE = Path(__file__).resolve().parents[1] / "workbook"
 
-# The modules of registry entries; and the Mathcad importer's map from Mathcad's names to the
-# language's (data about Mathcad, checked against the registry below).
+# The modules of registry entries; and the importers' maps of Mathcad's and Excel's names to
+# the language's (data about those products, checked against the registry below).
 HOMES = {
     "builtins.py",
     "distributions.py",
     "matrix.py",
     "numerics/entries.py",
     "mathcad/functions.py",
+    "excelimport/functions.py",
 }
 
 # Lists of built-in names that are still kept elsewhere, each exactly as it is now, so that a
@@ -117,6 +119,18 @@ def test_mathcad_names_map_onto_registry_entries():
     for name, order in MATHCAD_FUNCTIONS.values():
         if order is not None and name in REGISTRY:
             REGISTRY[name].check_arity(len(order))  # argument orders fit the entry
+
+
+def test_excel_and_vba_names_map_onto_registry_entries():
+    from workbook.excelimport.functions import EXCEL, EXCEL_VARIADIC, VBA
+
+    called = {
+        name
+        for text, _ in [*EXCEL.values(), *VBA.values()]
+        for name in re.findall(r"([A-Za-z_][A-Za-z0-9_]*)\(", text)
+    }
+    called |= {name for name in EXCEL_VARIADIC.values() if name.isidentifier()}
+    assert called and called <= set(REGISTRY)
 
 
 def test_the_derivatives_names_are_read_from_the_registry():
