@@ -51,6 +51,12 @@ def to_text(el) -> str:
             if a.xpath("ancestor::*[@data-call][1]")[0] is el:
                 args[int(a.get("data-arg"))] = to_text(a)
         return f"{el.get('data-call')}({', '.join(args[i] for i in sorted(args))})"
+    if tag == "mrow" and el.get("class") == "literal":  # 20 mm, a number with its unit
+        number, _space, unit = kids
+        top, slash, bottom = to_text(unit).replace("(", "").replace(")", "").partition("/")
+        if "*" in bottom:  # the unit's denominator is shown without brackets: W/m·K
+            bottom = f"({bottom})"
+        return f"({to_text(number)} {top}{slash}{bottom})"
     if tag == "mrow" and el.get("class") == "over":  # max_over(table, column)
         head, _apply, col = kids
         func, label = (k.text_content() for k in head)

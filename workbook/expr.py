@@ -30,6 +30,15 @@ class Number(Node):
 
 
 @dataclass(frozen=True)
+class Quantity(Node):
+    """A number followed by a unit, ``20 mm`` or ``9.81 m/s^2``: ``unit`` is the unit text as
+    written (read by :mod:`workbook.quantity`, the reader of inputs, when it is typed)."""
+
+    value: float
+    unit: str
+
+
+@dataclass(frozen=True)
 class Text(Node):
     """A string literal: allowed only as the right side of ``choice == "..."``."""
 
@@ -124,6 +133,8 @@ def parse(text: str, *, what: str = "expression") -> Node:
             raise LimitError(f"{what}: parentheses nested {depth} deep (limit {MAX_DEPTH})")
     if "otherwise" in source:
         source = _otherwise_as_else(source)
+    if _MAYBE_LITERAL.search(source):
+        source = _quantity_literals(source)
     try:
         tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
@@ -159,6 +170,88 @@ def _otherwise_as_else(source: str) -> str:
                 comma = starts[before.start[0] - 1] + before.start[1]
                 out = out[:comma] + " " + out[comma + 1 :]
     return out
+
+
+_MAYBE_LITERAL = re.compile(r"[\d.]\s*[^\W\d]")
+#: Words that may follow a number without being its unit (``1 if x > 0 otherwise 0``).
+_NOT_UNITS = frozenset({"if", "else", "and", "or", "not", "in", "is", "for", "otherwise"})
+
+
+def _quantity_literals(source: str) -> str:
+    """Each number followed by a unit (``20 mm``, ``9.81 m/s**2``, ``5 W/(m*K)``) as the
+    Python ``(20 @ "mm")``, which :func:`_convert` reads as a :class:`Quantity` (``@`` is no
+    operator of the language). The unit is the name after the number and what is joined to it
+    without a space by ``*``, ``/``, ``**`` and a power: ``2 m * x`` is 2 m times x."""
+    import io
+    import tokenize
+
+    try:
+        tokens = [
+            t
+            for t in tokenize.generate_tokens(io.StringIO(source).readline)
+            if t.type not in (tokenize.NL, tokenize.NEWLINE, tokenize.ENDMARKER)
+        ]
+    except (tokenize.TokenError, SyntaxError):
+        return source  # ast.parse says what is wrong
+    starts = [0]
+    for line in source.splitlines(keepends=True):
+        starts.append(starts[-1] + len(line))
+
+    def at(pos: tuple[int, int]) -> int:
+        return starts[pos[0] - 1] + pos[1]
+
+    spans = []
+    i = 0
+    while i < len(tokens) - 1:
+        num, name = tokens[i], tokens[i + 1]
+        if (
+            num.type == tokenize.NUMBER
+            and name.type == tokenize.NAME
+            and name.string not in _NOT_UNITS
+            and name.start[0] == num.end[0]
+        ):
+            end = _unit_end(tokens, i + 1)
+            spans.append((at(num.start), at(num.end), at(name.start), at(tokens[end - 1].end)))
+            i = end
+        else:
+            i += 1
+    out = source
+    for n0, n1, u0, u1 in reversed(spans):
+        unit = out[u0:u1].replace('"', "")
+        out = f"{out[:n0]}({out[n0:n1]} @ {unit!r}){out[u1:]}"
+    return out
+
+
+def _unit_end(tokens, i: int) -> int:
+    """Index after the last token of the unit that starts with the name ``tokens[i]``: names
+    joined by ``*`` and ``/`` with no space, each with a power, and parenthesised groups."""
+    import tokenize
+
+    def joined(j: int) -> bool:
+        return j < len(tokens) and tokens[j].start == tokens[j - 1].end
+
+    j, depth = i + 1, 0
+    while j < len(tokens) and joined(j):
+        tok = tokens[j]
+        if tok.string == "**" and joined(j + 1):
+            k = j + 1
+            if tokens[k].string in "-+" and joined(k + 1):
+                k += 1
+            if tokens[k].type != tokenize.NUMBER:
+                break
+            j = k + 1
+        elif tok.string in ("*", "/") and joined(j + 1):
+            k = j + 1
+            while tokens[k].string == "(" and joined(k + 1):
+                k, depth = k + 1, depth + 1
+            if tokens[k].type != tokenize.NAME or tokens[k].string in _NOT_UNITS:
+                break
+            j = k + 1
+        elif tok.string == ")" and depth:
+            j, depth = j + 1, depth - 1
+        else:
+            break
+    return j
 
 
 def _short(text: str, limit: int = 80) -> str:
@@ -203,6 +296,8 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
             raise TemplateError(f"{what}: operator not allowed in {text!r}")
         return Unary(ops[type(node.op)], _convert(node.operand, text, what, d))
     if isinstance(node, ast.BinOp):
+        if isinstance(node.op, ast.MatMult):
+            return _quantity(node, text, what)
         if type(node.op) not in _BINOPS:
             raise TemplateError(
                 f"{what}: operator {type(node.op).__name__} not allowed in {text!r} (use + - * / ^)"
@@ -254,6 +349,23 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
     raise TemplateError(f"{what}: {kind} is not allowed in worksheet expressions ({text!r})")
 
 
+def _quantity(node: ast.BinOp, text: str, what: str) -> Quantity:
+    """``(20 @ "mm")``, as :func:`_quantity_literals` writes ``20 mm``."""
+    number, unit = node.left, node.right
+    if not (
+        isinstance(number, ast.Constant)
+        and isinstance(number.value, (int, float))
+        and not isinstance(number.value, bool)
+        and isinstance(unit, ast.Constant)
+        and isinstance(unit.value, str)
+    ):
+        raise TemplateError(f"{what}: operator MatMult not allowed in {text!r} (use + - * / ^)")
+    value = float(number.value)
+    if not math.isfinite(value):
+        raise TemplateError(f"{what}: a number in {text!r} is too large (limit about 1.8e308)")
+    return Quantity(value, unit.value.replace("**", "^"))
+
+
 def _matrix(node: ast.List, text: str, what: str, depth: int) -> Matrix:
     """``[a, b]`` is a column; ``[[a, b], [c, d]]`` a matrix by rows (``[[a, b]]`` a row);
     a column with some bracketed elements, ``[n, [0, 30]]``, holds those arrays as elements
@@ -282,7 +394,7 @@ class _Children(Visitor):
     def visit_Number(self, node: Number) -> tuple[Node, ...]:
         return ()
 
-    visit_Text = visit_Name = visit_Number
+    visit_Text = visit_Name = visit_Quantity = visit_Number
 
     def visit_Unary(self, node: Unary) -> tuple[Node, ...]:
         return (node.operand,)
@@ -364,6 +476,10 @@ class TextPrinter(Visitor):
         level = PREC["neg"] if math.copysign(1.0, node.value) < 0 else PREC["atom"]
         return number_text(node.value), level
 
+    def visit_Quantity(self, node: Quantity) -> tuple[str, int]:
+        # a product for the precedence of what is around it: F/(20 mm^2) keeps its brackets
+        return f"{number_text(node.value)} {node.unit}", PREC["*"]
+
     def visit_Text(self, node: Text) -> tuple[str, int]:
         return '"' + node.value.replace('"', "") + '"', PREC["atom"]
 
@@ -376,6 +492,8 @@ class TextPrinter(Visitor):
     def visit_Unary(self, node: Unary) -> tuple[str, int]:
         if node.op == "not":
             return "not " + self.text(node.operand, PREC["not"]), PREC["not"]
+        if isinstance(node.operand, Quantity):  # -20 mm, not -(20 mm)
+            return node.op + self.visit(node.operand)[0], PREC["neg"]
         return node.op + self.text(node.operand, PREC["neg"]), PREC["neg"]
 
     def visit_Binary(self, node: Binary) -> tuple[str, int]:

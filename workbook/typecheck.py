@@ -242,7 +242,10 @@ class Typer(ArrayTyping, Visitor):
         spec = self.spec
         known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
         known.update(dict.fromkeys([*spec.blocks, *REGISTRY]))
-        return TemplateError(f"unknown {kind} '{name}'{nearest(name, known)}")
+        hint = nearest(name, known)
+        if kind == "name" and not hint and un.is_unit_name(name):
+            hint = f" (a unit is written after a number: 1 {name})"
+        return TemplateError(f"unknown {kind} '{name}'{hint}")
 
     def _typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
         if d.name in self._stack:
@@ -342,6 +345,8 @@ class Typer(ArrayTyping, Visitor):
         f = un.factor(t.unit, target)
         if f == 1.0:
             return _with_unit(t, target)
+        if isinstance(t, TConst) and t.unit.dimensionality:  # 20 mm in m: 0.02, as Excel shows
+            return TConst(target, value=t.value * f)
         return TScale(target, child=t, factor=f, shape=t.shape)
 
     def _temperature(self, t: T, target: pint.Unit, kinds, where: str) -> T:
@@ -419,6 +424,30 @@ class Typer(ArrayTyping, Visitor):
 
     def visit_Number(self, node: ex.Number, scope) -> T:
         return TConst(self.dimensionless, value=node.value)
+
+    def visit_Quantity(self, node: ex.Quantity, scope) -> T:
+        """``20 mm``: a constant in its unit, read by the reader of input values. A name joined
+        to the unit (``2 m*x``) that is also a name of this sheet is refused: write a space."""
+        shown = ex.to_text(node)
+        joined = re.findall(r"[^\W\d][\w°µμΩ%]*", node.unit)[1:]
+        known = {*scope, *self.spec.inputs, *self.spec.definitions, *self.spec.arguments}
+        clash = next((n for n in joined if n in known), None)
+        if clash is not None:
+            at = re.search(rf"(?<![\w°µμΩ%]){re.escape(clash)}(?![\w°µμΩ%])", node.unit).start()
+            head, tail = node.unit[: at - 1], node.unit[at - 1 :]
+            raise TemplateError(
+                f"{shown!r}: '{clash}' is read as part of the unit of the number, and it is a "
+                f"name of this sheet; for a product write a space: "
+                f"'{ex.number_text(node.value)} {head} {tail[0]} {tail[1:]}'"
+            )
+        try:
+            unit = un.unit(node.unit, what=f"the quantity {shown!r}")
+        except WorkbookError as err:
+            if re.search(r"[*/]", node.unit):
+                err.message += "; a space ends the unit of a number (2 m * x is 2 m times x)"
+                err.args = (err.message,)
+            raise
+        return TConst(unit, value=node.value)
 
     def visit_Text(self, node: ex.Text, scope) -> T:
         return TText(self.dimensionless, value=node.value, text=True)

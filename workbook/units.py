@@ -115,6 +115,15 @@ def _unit_names() -> tuple[str, ...]:
     return tuple(n for n in dir(registry()) if not n.startswith("_"))
 
 
+def is_unit_name(name: str) -> bool:
+    """True when pint knows ``name`` as a unit (``mm``, ``kN``, ``degC``)."""
+    try:
+        _unit_of(name)
+    except Exception:  # noqa: BLE001 - pint raises many kinds for names it does not know
+        return False
+    return True
+
+
 def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
     """pint's unit for a text the quantity reader accepted (a clear error for unknown names)."""
     try:

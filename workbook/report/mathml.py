@@ -264,6 +264,13 @@ class MathML(Visitor):
             return Box(f"<mn>{int(v)}</mn>", 0.5 * len(str(int(v))), numeric=True)
         return number_box(v, 15)
 
+    def visit_Quantity(self, node: ex.Quantity) -> Box:
+        """``20 mm`` as written: the number, then its unit in upright letters."""
+        num = self.visit_Number(ex.Number(node.value))
+        u = unit_box(node.unit)
+        xml = f"<mrow class='literal'>{num.xml}<mspace width='0.2em'/>{u.xml}</mrow>"
+        return Box(xml, num.width + 0.2 + u.width, PREC["*"], numeric=True)
+
     def visit_Text(self, node: ex.Text) -> Box:
         return text_box(f"\u201c{node.value}\u201d")
 

@@ -1,0 +1,166 @@
+"""A number followed by a unit inside a formula (``F/(20 mm^2)``, ``9.81 m/s^2``) is a
+quantity: parsed, typed, computed, printed in Excel and in the report, against pint."""
+
+from __future__ import annotations
+
+import math
+
+import formulas
+import pytest
+import report_parse as rp
+from conftest import write_template
+from recalc import formula_values
+
+import workbook
+from workbook import expr as ex
+from workbook import units as un
+from workbook.errors import WorkbookError
+from workbook.report.mathml import MathML
+
+
+@pytest.mark.parametrize(
+    "text,value,unit",
+    [
+        ("20 mm", 20.0, "mm"),
+        ("9.81 m/s^2", 9.81, "m/s^2"),
+        ("1.5e3 N*m", 1500.0, "N*m"),
+        ("360 deg", 360.0, "deg"),
+        ("5 W/(m*K)", 5.0, "W/(m*K)"),
+        ("2 s^-1", 2.0, "s^-1"),
+        ("0.5 delta_degC", 0.5, "delta_degC"),
+    ],
+)
+def test_a_number_then_a_unit_is_one_quantity(text, value, unit):
+    assert ex.parse(text) == ex.Quantity(value, unit)
+
+
+@pytest.mark.parametrize(
+    "text,tree",
+    [
+        ("F/(20 mm^2)", ex.Binary("/", ex.Name("F"), ex.Quantity(20.0, "mm^2"))),
+        ("2 m * x", ex.Binary("*", ex.Quantity(2.0, "m"), ex.Name("x"))),
+        ("-20 mm + L", ex.Binary("+", ex.Unary("-", ex.Quantity(20.0, "mm")), ex.Name("L"))),
+        ("f(2 mm, 3)", ex.Call("f", (ex.Quantity(2.0, "mm"), ex.Number(3.0)))),
+        (
+            "1 if x > 0 mm otherwise 0",
+            ex.IfElse(
+                ex.Number(1.0),
+                ex.Compare((">",), (ex.Name("x"), ex.Quantity(0.0, "mm"))),
+                ex.Number(0.0),
+            ),
+        ),
+    ],
+)
+def test_a_space_ends_the_unit(text, tree):
+    node = ex.parse(text)
+    assert node == tree
+    assert ex.parse(ex.to_text(node)) == node  # printed back, read again
+
+
+@pytest.mark.parametrize(
+    "text", ["F/(20 mm^2)", "9.81 m/s^2 * mass", "-20 mm + L", "5 W/(m*K) * A*(1.5 K)"]
+)
+def test_the_report_shows_the_literal_as_written(text):
+    doc = rp.parse(f"<div><math>{MathML().box(ex.parse(text)).xml}</math></div>")
+    back = rp.formula_text(doc.xpath("//math")[0])
+    assert ex.to_text(ex.parse(back)) == ex.to_text(ex.parse(text)), back
+    assert doc.xpath("//mrow[@class='literal']")
+
+
+SHEET = """
+[sheet]
+title = "units inside formulas"
+
+[inputs]
+F = { value = "10 kN" }
+L = { value = "2 m" }
+m_1 = { value = "3 kg" }
+theta = { value = "30 deg" }
+
+[arguments]
+x = { unit = "m" }
+
+[definitions]
+sigma = { expr = "F/(20 mm^2)", unit = "MPa" }
+weight = { expr = "9.81 m/s^2 * m_1", unit = "N" }
+longer = { expr = "L + 20 mm", unit = "m" }
+rest = { expr = "360 deg - theta", unit = "deg" }
+torque = { expr = "1.5e3 N*m", unit = "kN*m" }
+"moment(x)" = { expr = "F*x + 2 kN*m", unit = "kN*m" }
+at_half = { expr = "moment(500 mm)", unit = "kN*m" }
+shorter = { expr = "-20 mm + L", unit = "mm" }
+flux = { expr = "5 W/(m^2*K)*(3 m^2)*(T_2 - T_1)", unit = "W" }
+T_1 = "20 degC"
+T_2 = "T_1 + 15 delta_degC"
+"""
+
+
+def _expected():
+    q = un.registry().Quantity
+    force, length, mass, theta = q(10, "kN"), q(2, "m"), q(3, "kg"), q(30, "deg")
+    return {
+        "sigma": (force / q(20, "mm^2")).to("MPa"),
+        "weight": (q(9.81, "m/s^2") * mass).to("N"),
+        "longer": (length + q(20, "mm")).to("m"),
+        "rest": (q(360, "deg") - theta).to("deg"),
+        "torque": q(1.5e3, "N*m").to("kN*m"),
+        "at_half": (force * q(500, "mm") + q(2, "kN*m")).to("kN*m"),
+        "shorter": (-q(20, "mm") + length).to("mm"),
+        "flux": (q(5, "W/(m^2*K)") * q(3, "m^2") * q(15, "delta_degC")).to("W"),
+        "T_2": q(35, "degC"),
+    }
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("literals")
+    sheet = workbook.load(write_template(tmp, SHEET))
+    return sheet, sheet.write_xlsx(tmp / "literals.xlsx")
+
+
+@pytest.mark.parametrize("name", list(_expected()))
+def test_values_are_pints(written, name):
+    sheet, _ = written
+    expected = _expected()[name]
+    got = sheet.evaluate(name)
+    assert str(got.units) == str(expected.units)
+    assert math.isclose(got.magnitude, expected.magnitude, rel_tol=1e-13)
+
+
+def test_excel_writes_the_number_in_the_unit_the_cell_needs(written):
+    """``L + 20 mm`` in m is ``=L_+0.02``; the `formulas` package recalculates every cell."""
+    import openpyxl
+
+    sheet, path = written
+    cells = formula_values(path)
+    results = openpyxl.load_workbook(path)["Results"]
+    rows = {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
+    assert cells[("Results", f"B{rows['longer']}")][0] == "=L_+0.02"
+    assert cells[("Results", f"B{rows['at_half']}")][0] == "=F_*0.5+2"
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    values = {}
+    for key, ranges in solution.items():
+        book_sheet, _, cell = key.rpartition("!")
+        if book_sheet.split("]", 1)[-1].strip("'").upper() == "RESULTS" and ":" not in cell:
+            values[cell.upper()] = ranges.value[0, 0]
+    for name, expected in _expected().items():
+        got = float(values[f"B{rows[name]}"])
+        assert math.isclose(got, expected.magnitude, rel_tol=1e-12), name
+
+
+@pytest.mark.parametrize(
+    "expr,message",
+    [
+        ("2 m*L", "'L' is read as part of the unit of the number, and it is a name of this"),
+        ("2 m*zz", "a space ends the unit of a number"),
+        ("L + mm", "a unit is written after a number: 1 mm"),
+        ("F/(20 kg)", "cannot be converted"),
+    ],
+)
+def test_mistakes_say_what_to_write(tmp_path, expr, message):
+    text = (
+        SHEET.split("[definitions]")[0]
+        + f'[definitions]\nbad = {{ expr = "{expr}", unit = "MPa" }}\n'
+    )
+    with pytest.raises(WorkbookError, match=message):
+        workbook.load(write_template(tmp_path, text))
