@@ -51,6 +51,25 @@ class Bound:
 
         return f
 
+    def enclosure(self, shape: tuple[int, ...]) -> Callable | None:
+        """``g(lo, hi, row) -> (F, D)``: enclosures of EXPR and of its derivative for the
+        variable anywhere in [lo, hi] at the flat rows ``row`` (see numerics.intervals); None
+        where a node of EXPR has no interval extension."""
+        from .intervals import Iv, NoEnclosure, enclosure
+
+        try:
+            g = enclosure(self.evaluator, self.body, self.var)
+        except NoEnclosure:
+            return None
+        flat, env, var = self._flat(shape), self.env, self.var
+
+        def at(lo, hi, row):
+            idx = np.asarray(row).astype(np.intp)
+            with np.errstate(all="ignore"):
+                return g({**env, **{k: a[idx] for k, a in flat.items()}, var: Iv(lo, hi)})
+
+        return at
+
     def describe_row(self, shape: tuple[int, ...]) -> Callable[[int], str]:
         """'for Re = 10000' naming the values of the environment's arrays at one row."""
         flat = self._flat(shape)

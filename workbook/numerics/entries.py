@@ -267,10 +267,11 @@ def _root_numpy(of, a, b=None):
             a,
         )
     else:
+        enclose = of.enclosure(np.broadcast_shapes(of.shape, np.shape(a), np.shape(b)))
         res = _solve(
             of,
             lambda f, a, b, idx, label: roots.root_in(
-                f, a, b, (idx,), tol, var=var, unit=unit, label=label
+                f, a, b, (idx,), tol, var=var, unit=unit, label=label, enclose=enclose
             ),
             a,
             b,
