@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from .. import expr as ex
 from . import names as nm
-from .symbols import Sym, Untranslatable, what
+from .symbols import Sym, Untranslatable, matrix_size, what
 from .symbols import key as name_key
 
 if TYPE_CHECKING:
@@ -336,7 +336,7 @@ class ProgramTranslator:
     def _destructure(self, lhs: MNode, rhs: MNode) -> list[tuple[int, list]]:
         """[a; b; c] <- value: each name an element of the value (a local of its own first),
         at Mathcad's ORIGIN."""
-        rows, cols = int(lhs.attrs.get("rows", 0)), int(lhs.attrs.get("cols", 0))
+        rows, cols = matrix_size(lhs)
         names = lhs.children
         if rows * cols != len(names) or not names:
             raise Untranslatable("a matrix of names whose size does not match its elements")

@@ -70,18 +70,24 @@ class Worksheet:
 
 def read(path: str | Path) -> Worksheet:
     """Read a .xmcd file into regions; a bad or hostile file is an InputError (exit 2)."""
-    path = Path(path)
+    return parse_bytes(read_bounded(Path(path), "the Mathcad worksheet"), Path(path))
+
+
+def read_bounded(path: Path, what: str, max_bytes: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of a regular file of at most ``max_bytes``: a folder, a FIFO or a device
+    (``/dev/zero``, a link to it) is refused before it is opened, a file that grows while it
+    is read is cut off at the limit and refused."""
+    from ..limits import regular_file
+
+    regular_file(path, what=what, max_bytes=max_bytes)
     try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise LimitError(
-                f"{path}: {size} bytes is larger than a Mathcad worksheet may be here "
-                f"(limit {MAX_FILE_BYTES})"
-            )
-        data = path.read_bytes()
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)
     except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror}") from None
-    return parse_bytes(data, path)
+        raise InputError(f"{what} {path}: cannot read it ({exc.strerror})") from None
+    if len(data) > max_bytes:
+        raise LimitError(f"{what} {path} is more than {max_bytes:,} bytes (limit)")
+    return data
 
 
 def parse_bytes(data: bytes, path: Path) -> Worksheet:

@@ -3,6 +3,7 @@ generated worksheet, and how a Mathcad element is named in messages."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -64,3 +65,25 @@ def what(tag: str) -> str:
 def key(node: MNode) -> tuple[str, str]:
     """A Mathcad name and its literal subscript."""
     return node.text.strip(), node.attrs.get("subscript", "")
+
+
+#: Elements of one matrix written in a worksheet (rows x columns).
+MAX_MATRIX_ELEMENTS = 1_000_000
+
+
+def whole_number(text: str, what: str) -> int:
+    """An attribute that must be a whole number (a size, a power), as Mathcad writes it."""
+    text = str(text).strip()
+    if not re.fullmatch(r"[+-]?[0-9]{1,9}", text):
+        raise Untranslatable(f"{what} is {text[:40]!r}, not a whole number")
+    return int(text)
+
+
+def matrix_size(node: MNode) -> tuple[int, int]:
+    """(rows, columns) a matrix element declares: whole numbers, at least 0, at most
+    :data:`MAX_MATRIX_ELEMENTS` elements."""
+    rows = whole_number(node.attrs.get("rows", "0"), "a matrix's number of rows")
+    cols = whole_number(node.attrs.get("cols", "0"), "a matrix's number of columns")
+    if rows < 0 or cols < 0 or rows * cols > MAX_MATRIX_ELEMENTS:
+        raise Untranslatable(f"a matrix of {rows} x {cols} elements")
+    return rows, cols

@@ -23,7 +23,7 @@ from .functions import (
     language_functions,
 )
 from .reader import MNode, Region, Worksheet
-from .symbols import Sym, Untranslatable
+from .symbols import Sym, Untranslatable, matrix_size, whole_number
 from .symbols import key as _key
 from .symbols import what as _what
 from .units import FORMULA_UNITS, result_unit
@@ -304,7 +304,7 @@ class ExprTranslator(Visitor):
         """Mathcad's matrix (rows x cols, stored column by column) as [a, b] or [[a, b], ...]."""
         if not hasattr(ex, "Matrix"):
             raise Untranslatable("a matrix (vectors and matrices are not in the language yet)")
-        rows, cols = int(node.attrs.get("rows", 0)), int(node.attrs.get("cols", 0))
+        rows, cols = matrix_size(node)
         if rows * cols != len(node.children) or rows * cols == 0:
             raise Untranslatable("a matrix whose size does not match its elements")
         cells = [self.value(c) for c in node.children]
@@ -1021,7 +1021,7 @@ class Translator:
     def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> None:
         """[a; b] := value: the value a definition of its own (``parts``), then each name
         its element at ORIGIN."""
-        rows, cols = int(lhs.attrs.get("rows", 0)), int(lhs.attrs.get("cols", 0))
+        rows, cols = matrix_size(lhs)
         names = lhs.children
         if rows * cols != len(names) or not names or any(n.tag != "id" for n in names):
             raise Untranslatable("a definition of a matrix of something that is not names")
@@ -1152,6 +1152,7 @@ class Translator:
             return
         try:
             unit, values = _stored(result.children[0])
+            shape = _shape(result.children[0])
         except Untranslatable as why:
             self.out.results.append(Result(region.id, None, mathcad, "", []))
             self.skip(region.id, f"the result of {mathcad}", str(why))
@@ -1160,7 +1161,6 @@ class Translator:
         if writer is not None:
             self.written(region, *writer[:2], writer[2], node)
             return
-        shape = _shape(result.children[0])
         if target is not None:  # a definition with its value shown: x := ... = value
             if len(values) == 1:
                 self.out.results.append(
@@ -1729,8 +1729,10 @@ def _unit_monomial(node: MNode) -> str:
         if ref.tag != "unitReference":
             continue
         name = result_unit(ref.attrs.get("unit", ""))
-        num = int(ref.attrs.get("power-numerator", "1"))
-        den = int(ref.attrs.get("power-denominator", "1"))
+        num = whole_number(ref.attrs.get("power-numerator", "1"), "a unit's power")
+        den = whole_number(ref.attrs.get("power-denominator", "1"), "a unit's power")
+        if den == 0:
+            raise Untranslatable("a unit's power with the denominator 0")
         power = num / den
         if power == 1:
             parts.append(name)
@@ -1755,7 +1757,7 @@ def _leaves(node: MNode, path: tuple = ()):
             raise Untranslatable("a nested array result with a matrix that has units")
         yield path, unit, values[0]
         return
-    rows, cols = int(node.attrs.get("rows", 0)), int(node.attrs.get("cols", 0))
+    rows, cols = matrix_size(node)
     if rows * cols != len(node.children):
         raise Untranslatable("an array result whose size does not match its values")
     for n, child in enumerate(node.children):
@@ -1767,7 +1769,7 @@ def _shape(node: MNode) -> tuple[int, int]:
     """(rows, cols) of a stored result: (1, 1) for a scalar."""
     inner = node.children[0] if node.tag == "unitedValue" and node.children else node
     if inner.tag == "matrix":
-        return int(inner.attrs.get("rows", 0)), int(inner.attrs.get("cols", 0))
+        return matrix_size(inner)
     return 1, 1
 
 
@@ -1775,7 +1777,13 @@ def _stored(node: MNode) -> tuple[str, list[float | str]]:
     """(unit text, values) of a stored result: a number, a number with units, a matrix (its
     values column by column), a text."""
     if node.tag == "real":
-        return "", [float(node.text)]
+        try:
+            value = float(node.text)
+        except ValueError:
+            raise Untranslatable(f"a stored number {node.text.strip()[:40]!r}") from None
+        if not math.isfinite(value):
+            raise Untranslatable(f"a stored number that is not finite ({node.text.strip()})")
+        return "", [value]
     if node.tag == "str":
         return "", [node.text]
     if node.tag == "unitedValue":
@@ -1873,10 +1881,15 @@ def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNod
         raise
     except Exception:  # noqa: BLE001 - pint's unit errors and numeric ones alike
         raise Untranslatable("a range whose bounds are not values known at import") from None
+    if not all(math.isfinite(v) for v in (a, b, c)):
+        raise Untranslatable("a range whose bounds are not finite numbers")
     step = b - a
     if step == 0:
         raise Untranslatable("a range with step 0")
-    n = math.floor((c - a) / step * (1 + 1e-12) + 1e-9)
+    count = (c - a) / step * (1 + 1e-12) + 1e-9
+    if not math.isfinite(count) or count > 100_000:
+        raise Untranslatable("a range of more than 100,000 values")
+    n = math.floor(count)
     if n < 0:
         raise Untranslatable("an empty range")
     if n > 100_000:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-import json
+import csv
+import io
 import re
 import tempfile
 from dataclasses import dataclass, field
@@ -11,6 +12,7 @@ from pathlib import Path
 from .. import expr as ex
 from ..errors import InputError, WorkbookError
 from .functions import language_functions
+from .tomldoc import Document, is_one_line, one_line
 from .translate import Item, Sym, Translation, _rename
 
 #: Relative tolerance of the printed values: Mathcad stores full doubles.
@@ -41,10 +43,6 @@ def pretty_unit(text: str) -> str:
 def pretty_quantity(text: str) -> str:
     number, _, unit = text.partition(" ")
     return f"{number} {pretty_unit(unit)}" if unit and "/ (" not in text else text
-
-
-def _q(text: str) -> str:
-    return json.dumps(text, ensure_ascii=False)
 
 
 def _assign(tr: Translation) -> None:
@@ -93,19 +91,46 @@ def _text(node: ex.Node, mapping: dict[str, str]) -> str:
     return ex.to_text(_rename(node, mapping))
 
 
-def _comment(text: str, width: int = 96) -> list[str]:
+def _wrapped(text: str, width: int = 96) -> list[str]:
+    """A paragraph text as comment lines of at most ``width`` characters."""
     lines = []
     for para in text.splitlines():
         words, cur = para.split(), ""
         for w in words:
             if cur and len(cur) + len(w) + 1 > width:
-                lines.append("# " + cur)
+                lines.append(cur)
                 cur = w
             else:
                 cur = f"{cur} {w}".strip()
         if cur:
-            lines.append("# " + cur)
+            lines.append(cur)
     return lines
+
+
+class _Section:
+    """The entries of one table, written after the others are known (comments that precede
+    an entry go with it)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.entries: list[tuple] = []
+
+    def comment(self, text: str) -> None:
+        self.entries.append(("comment", text))
+
+    def pair(self, key: str, value, *, multiline: bool = False) -> None:
+        self.entries.append(("pair", key, value, multiline))
+
+    def write(self, doc: Document) -> None:
+        if not self.entries:
+            return
+        doc.table(self.name)
+        for entry in self.entries:
+            if entry[0] == "comment":
+                doc.comment(entry[1])
+            else:
+                doc.pair(entry[1], entry[2], multiline=entry[3])
+        doc.blank()
 
 
 def render(tr: Translation, name: str, src: Path) -> Rendered:
@@ -113,25 +138,27 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
     _assign(tr)
     mapping = {s.token(): s.final for s in tr.syms}
     out = Rendered(name, "")
-    head = [
-        f"# Imported from {src.name} by `workbook import`: Mathcad's definitions in order, its",
-        "# text regions as comments, and every result Mathcad stored as a printed value",
-        "# (`workbook check` compares them with the engine).",
-    ]
+    doc = Document()
+    doc.comment(
+        f"Imported from {src.name} by `workbook import`: Mathcad's definitions in order, its"
+    )
+    doc.comment("text regions as comments, and every result Mathcad stored as a printed value")
+    doc.comment("(`workbook check` compares them with the engine).")
     if tr.skipped:
-        head.append("#")
-        head.append(
-            f"# Not translated ({len({s.region for s in tr.skipped})} regions; their results "
+        doc.comment()
+        doc.comment(
+            f"Not translated ({len({s.region for s in tr.skipped})} regions; their results "
             "count as not reproduced):"
         )
         for s in tr.skipped:
-            head.append(f"#   region {s.region}: {s.what}: {s.why}")
+            doc.comment(f"  region {s.region}: {s.what}: {s.why}")
     if tr.ignored:
-        head.append("#")
-        head += _comment(
+        doc.comment()
+        for line in _wrapped(
             "Regions that define and show nothing in Mathcad (a name or an expression without "
             ":= or =), left out: " + ", ".join(tr.ignored)
-        )
+        ):
+            doc.comment(line)
     renamed = sorted(
         {
             (s.mathcad, s.final)
@@ -140,49 +167,50 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         }
     )
     if renamed:
-        head.append("#")
-        head.append("# Names (Mathcad -> worksheet):")
-        line = "#  "
+        doc.comment()
+        doc.comment("Names (Mathcad -> worksheet):")
+        line = " "
         for mathcad, final in renamed:
             piece = f" {mathcad} -> {final};"
-            if len(line) + len(piece) > 96:
-                head.append(line)
-                line = "#  "
+            if len(line) + len(piece) > 94:
+                doc.comment(line)
+                line = " "
             line += piece
-        head.append(line)
-    sheet = [
-        "[sheet]",
-        f"name = {_q(name)}",
-        f"title = {_q(tr.title or name)}",
-        f"source = {_q('Mathcad worksheet ' + src.name)}",
-    ]
-    if tr.origin and hasattr(ex, "Index"):
-        sheet.append(f"origin = {tr.origin}")
-    inputs, definitions, arguments = ["[inputs]"], ["[definitions]"], ["[arguments]"]
+        doc.comment(line)
+    doc.blank()
+    doc.table("sheet")
+    doc.pair("name", name)
+    doc.pair("title", tr.title or name)
+    doc.pair("source", "Mathcad worksheet " + src.name)
+    if tr.origin:
+        doc.pair("origin", int(tr.origin))
+    doc.blank()
+    inputs, definitions = _Section("inputs"), _Section("definitions")
+    arguments = _Section("arguments")
     notes: list[str] = []
-    units = [s for s in tr.syms if s.kind == "unit"]
-    for sym in units:
-        value = _q("1 " + pretty_unit(sym.unit))
-        inputs.append(f'{sym.final} = {{ value = {value}, note = "the unit {sym.mathcad}" }}')
+    for sym in tr.syms:
+        if sym.kind == "unit":
+            value = {"value": "1 " + pretty_unit(sym.unit), "note": f"the unit {sym.mathcad}"}
+            inputs.pair(sym.final, value)
     seen_args: set[str] = set()
     for sym in tr.syms:
         if (sym.kind == "param" or sym.is_range) and not sym.broken:
             if sym.final in seen_args:
                 continue
             seen_args.add(sym.final)
-            arguments.append(f"{sym.final} = {{ unit = {_q(pretty_unit(sym.unit))} }}")
-    tables: list[str] = []
-    solves: list[str] = []
-    charts: list[str] = []
+            arguments.pair(sym.final, {"unit": pretty_unit(sym.unit)})
+    tables: list = []
+    solves: list = []
+    charts: list = []
     for item in tr.items:
         if item.kind == "note":
-            notes += _comment(item.value)
+            notes += _wrapped(item.value)
             continue
         if item.kind == "solve":
-            solves += _solve(item, mapping, out)
+            solves.append(item)
             continue
         if item.kind == "chart":
-            charts += _chart(item, mapping)
+            charts.append(item)
             continue
         if item.sym is None or item.sym.broken:
             continue
@@ -190,35 +218,33 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         target = inputs if item.kind == "input" else definitions
         if item.kind == "range":
             target = arguments
-        if notes:
-            target += notes
-            notes = []
+        for note in notes:
+            target.comment(note)
+        notes = []
         note = f"{item.sym.mathcad} (region {item.region})"
         if item.kind == "input":
-            value = pretty_quantity(item.value)
-            extra = f", unit = {_q(pretty_unit(item.unit))}" if item.unit else ""
-            target.append(f"{item.sym.final} = {{ value = {_q(value)}{extra}, note = {_q(note)} }}")
+            value = {"value": pretty_quantity(item.value)}
+            if item.unit:
+                value["unit"] = pretty_unit(item.unit)
+            value["note"] = note
+            target.pair(item.sym.final, value)
             out.definitions += 1
         elif item.kind == "range":
-            target.append(
-                f"# {item.sym.final} := {_range_text(item, mapping)} (region {item.region})"
+            target.comment(
+                f"{item.sym.final} := {_range_text(item, mapping)} (region {item.region})"
             )
         else:
             key = item.sym.final
             if item.params:
                 key = f"{key}({', '.join(p.final for p in item.params)})"
-                key = _q(key)
+            multiline = False
             if item.program is not None:
                 lines = []
                 for indent, parts in item.program:
                     text = "".join(p if isinstance(p, str) else _text(p, mapping) for p in parts)
                     lines.append(" " * indent + text)
-                value = (
-                    '"""\n'
-                    + "\n".join(lines).replace("\\", "\\\\").replace('"""', '\\"""')
-                    + '\n"""'
-                )
-                field_ = "program"
+                value = {"program": "\n".join(lines) + "\n"}
+                multiline = True
             elif item.pieces is not None:
                 pieces = [
                     f"{_text(v, mapping)} if {_text(c, mapping)}"
@@ -226,68 +252,80 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
                     else f"{_text(v, mapping)} otherwise"
                     for v, c in item.pieces
                 ]
-                value = "[" + ", ".join(_q(p) for p in pieces) + "]"
-                field_ = "pieces"
+                value = {"pieces": pieces}
             else:
-                value = _q(_text(item.body, mapping))
-                field_ = "expr"
-            extra = f", unit = {_q(pretty_unit(item.unit))}" if item.unit else ""
-            target.append(f"{key} = {{ {field_} = {value}{extra}, note = {_q(note)} }}")
+                value = {"expr": _text(item.body, mapping)}
+            if item.unit:
+                value["unit"] = pretty_unit(item.unit)
+            value["note"] = note
+            target.pair(key, value, multiline=multiline)
             out.definitions += 1
-    if notes:
-        definitions += notes
+    for note in notes:
+        definitions.comment(note)
+    for section in (inputs, arguments, definitions):
+        section.write(doc)
+    for item in solves:
+        _solve(item, mapping, out, doc)
     # printed values: one CSV per argument (scalars: no argument)
-    groups: dict[tuple[str, bool], list[str]] = {}
+    groups: dict[tuple[str, bool], list[list[str]]] = {}
     solved = _from_solve_blocks(tr)
     for res in tr.results:
         arg = res.argument.final if res.argument is not None else ""
         rows = groups.setdefault((arg, res.sym is not None and res.sym.token() in solved), [])
         sym_name = res.sym.final if res.sym is not None else f"result_{res.region}"
-        if not res.rows:
-            rows.append(f"# region {res.region}: {res.name}: the stored result cannot be read")
-            rows.append(f'{sym_name},,"(a result that cannot be read)",')  # counted, not computable
+        texts = [v for _, v in res.rows if isinstance(v, str)]
+        if not res.rows or not all(is_one_line(t) for t in texts):
+            why = "cannot be read" if not res.rows else "is a text of several lines"
+            rows.append([f"# region {res.region}: {res.name}: the stored result {why}"])
+            rows.append([sym_name, "", "(a result that cannot be read)", ""])  # not computable
             continue
-        rows.append(f"# region {res.region}: {res.name}")
+        rows.append([f"# region {res.region}: {res.name}"])
         for at, value in res.rows:
             at_text = "" if at is None else repr(float(at))
-            if isinstance(value, str):  # a text, compared as text ("OK")
-                val = '"' + value.replace('"', '""') + '"'
-            else:
-                val = repr(float(value))
-            rows.append(f"{sym_name},{at_text},{val},{pretty_unit(res.unit) if res.unit else ''}")
-    printed: list[str] = []
+            val = value if isinstance(value, str) else repr(float(value))
+            rows.append([sym_name, at_text, val, pretty_unit(res.unit) if res.unit else ""])
+    printed: list[tuple] = []
     for (arg, from_solve), rows in groups.items():
         fname = f"{name}.mathcad{'.solve' if from_solve else ''}{'.' + arg if arg else ''}.csv"
         title = "Mathcad results" + (" over " + arg if arg else "")
         if from_solve:
             title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
-        out.csv[fname] = (
-            "# Mathcad's stored results (imported by `workbook import`)\nname,argument,value,unit\n"
-            + "\n".join(rows)
-            + "\n"
-        )
-        printed += [
-            "",
-            "[[printed]]",
-            f"file = {_q(fname)}",
-            f"title = {_q(title)}",
-        ]
-        if arg:
-            printed.append(f"argument = {_q(arg)}")
-        if from_solve:  # Mathcad's solver stops at its TOL: its roots are that close
-            printed.append(f"rel_tolerance = {tr.solve_tolerance!r}")
-        else:
-            printed.append(f"rel_tolerance = {REL_TOLERANCE}")
-        printed.append(f"tolerance = {ABS_TOLERANCE}")
+        out.csv[fname] = _csv_text(rows)
+        printed.append((fname, title, arg, from_solve))
         table = _table_for(tr, arg, mapping)
         if table:
-            tables += table
-    parts = head + [""] + sheet + [""]
-    for section in (inputs, arguments, definitions):
-        if len(section) > 1:
-            parts += section + [""]
-    out.toml = "\n".join(parts + solves + tables + charts + printed) + "\n"
+            tables.append(table)
+    for table in tables:
+        _write_table(table, doc)
+    for item in charts:
+        _chart(item, mapping, doc)
+    for fname, title, arg, from_solve in printed:
+        doc.blank()
+        doc.array_table("printed")
+        doc.pair("file", fname)
+        doc.pair("title", title)
+        if arg:
+            doc.pair("argument", arg)
+        # Mathcad's solver stops at its TOL: its roots are that close
+        doc.pair("rel_tolerance", tr.solve_tolerance if from_solve else REL_TOLERANCE)
+        doc.pair("tolerance", ABS_TOLERANCE)
+    out.toml = doc.text()
     return out
+
+
+def _csv_text(rows: list[list[str]]) -> str:
+    """A printed-values CSV: a one-cell row starting with '#' is a comment line; every cell
+    is one line (the reader reads the file line by line)."""
+    buffer = io.StringIO()
+    buffer.write("# Mathcad's stored results (imported by `workbook import`)\n")
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["name", "argument", "value", "unit"])
+    for row in rows:
+        if len(row) == 1 and row[0].startswith("#"):
+            buffer.write(one_line(row[0]) + "\n")
+        else:
+            writer.writerow([one_line(c) for c in row])
+    return buffer.getvalue()
 
 
 def _from_solve_blocks(tr: Translation) -> set[str]:
@@ -305,64 +343,56 @@ def _from_solve_blocks(tr: Translation) -> set[str]:
     return found
 
 
-def _solve(item: Item, mapping, out: Rendered) -> list[str]:
+def _solve(item: Item, mapping, out: Rendered, doc: Document) -> None:
     """A [[solve]] block: Mathcad's Given, its equations and Find."""
     unknowns, equations, regions, conditions = item.solve
     if any(sym.broken for sym, _ in unknowns):
-        return []
+        return
     for sym, _ in unknowns:
         out.region_of[sym.final] = item.region
     tag = f"(region {item.region})"
-    guesses = ", ".join(f"{sym.final} = {_q(g)}" for sym, g in unknowns)
-    eqs = ", ".join(_q(_text(e, mapping)) for e in equations)
-    return [
-        f"[[solve]]  # Given ... Find, regions {', '.join(regions)} {tag}",
-        f"unknowns = {{ {guesses} }}  # {tag}",
-        f"equations = [{eqs}]  # {tag}",
-        *([f"method = {_q(item.value)}"] if item.value else []),
-        *(
-            [f"conditions = [{', '.join(_q(_text(c, mapping)) for c in conditions)}]"]
-            if conditions
-            else []
-        ),
-        "",
-    ]
+    doc.array_table("solve", f"Given ... Find, regions {', '.join(regions)} {tag}")
+    doc.pair("unknowns", {sym.final: g for sym, g in unknowns}, tag)
+    doc.pair("equations", [_text(e, mapping) for e in equations], tag)
+    if item.value:
+        doc.pair("method", item.value)
+    if conditions:
+        doc.pair("conditions", [_text(c, mapping) for c in conditions])
+    doc.blank()
 
 
-def _chart(item: Item, mapping) -> list[str]:
+def _chart(item: Item, mapping, doc: Document) -> None:
     """A [[charts]] entry: Mathcad's X-Y plot, one series per trace over its range."""
     series = [t for t in item.chart if not t[2].sym.broken]
     if not series:
-        return []
+        return
     tag = f"(region {item.region})"
     polar = item.value == "polar"
     kind = "Mathcad polar plot" if polar else "Mathcad plot"
     first = series[0][2]
     first_text = first.sym.final + " := " + _range_text(first, mapping)
-    lines = []
+    entries, comments = [], []
     for x, y, rng, points, n in series:
-        parts = [f"x = {_q(_text(x, mapping))}", f"y = {_q(_text(y, mapping))}"]
+        entry = {"x": _text(x, mapping), "y": _text(y, mapping)}
         text = rng.sym.final + " := " + _range_text(rng, mapping)
         if text != first_text:
-            parts.append(f"range = {_q(text)}")
+            entry["range"] = text
         if points:  # Mathcad draws the points of vectors, or a single point
-            parts += ['line = "none"', "marker = true"]
-        lines.append(f"  {{ {', '.join(parts)} }},  # (region {item.region}, trace {n})")
+            entry.update(line="none", marker=True)
+        entries.append(entry)
+        comments.append(f"(region {item.region}, trace {n})")
     x_title = ", ".join(dict.fromkeys(_text(t[0], mapping) for t in series))
     y_title = ", ".join(dict.fromkeys(_text(t[1], mapping) for t in series))
-    return [
-        "",
-        f"[[charts]]  # Mathcad's plot {tag}",
-        f"name = {_q('plot_' + item.region)}  # {tag}",
-        f"title = {_q(kind + ', region ' + item.region)}",
-        *(["equal_axes = true"] if polar else []),
-        f"range = {_q(first_text)}",
-        f"x_title = {_q(x_title)}",
-        f"y_title = {_q(y_title)}",
-        "series = [",
-        *lines,
-        "]",
-    ]
+    doc.blank()
+    doc.array_table("charts", f"Mathcad's plot {tag}")
+    doc.pair("name", "plot_" + item.region, tag)
+    doc.pair("title", kind + ", region " + item.region)
+    if polar:
+        doc.pair("equal_axes", True)
+    doc.pair("range", first_text)
+    doc.pair("x_title", x_title)
+    doc.pair("y_title", y_title)
+    doc.array("series", entries, comments)
 
 
 def _range_text(item: Item, mapping) -> str:
@@ -373,11 +403,11 @@ def _range_text(item: Item, mapping) -> str:
     return f"{head} .. {_text(last, mapping)}"
 
 
-def _table_for(tr: Translation, arg: str, mapping) -> list[str]:
+def _table_for(tr: Translation, arg: str, mapping) -> dict | None:
     """A table over the range variable `arg` listing what Mathcad listed over it."""
     ranges = [i for i in tr.items if i.kind == "range" and i.sym.final == arg and not i.sym.broken]
     if not ranges:
-        return []
+        return None
     item = ranges[-1]
     funcs = []
     for res in tr.results:
@@ -385,15 +415,20 @@ def _table_for(tr: Translation, arg: str, mapping) -> list[str]:
             if not res.sym.broken and res.sym.final not in funcs:
                 funcs.append(res.sym.final)
     if not funcs:
-        return []
-    cols = ", ".join(f'{_q(f + "(" + arg + ")")} = ""' for f in funcs)
-    return [
-        "",
-        f"[[tables]]  # what Mathcad listed over {item.sym.mathcad} (region {item.region})",
-        f"name = {_q('table_' + arg)}",
-        f"range = {_q(arg + ' := ' + _range_text(item, mapping))}",
-        f"columns = {{ {cols} }}",
-    ]
+        return None
+    return {
+        "comment": f"what Mathcad listed over {item.sym.mathcad} (region {item.region})",
+        "name": "table_" + arg,
+        "range": arg + " := " + _range_text(item, mapping),
+        "columns": {f"{f}({arg})": "" for f in funcs},
+    }
+
+
+def _write_table(table: dict, doc: Document) -> None:
+    doc.blank()
+    doc.array_table("tables", table["comment"])
+    for key in ("name", "range", "columns"):
+        doc.pair(key, table[key])
 
 
 def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
@@ -472,7 +507,12 @@ def _region_of(err: WorkbookError, rendered: Rendered) -> str | None:
 
 def write(rendered: Rendered, out_dir: Path, *, force: bool) -> list[Path]:
     """Write the worksheet and its CSV files; an existing file needs --force."""
-    out_dir.mkdir(parents=True, exist_ok=True)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"--out {out_dir} is a file, not a folder: name the folder to write into")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"--out {out_dir}: cannot make the folder ({exc.strerror})") from None
     targets = [out_dir / f"{rendered.name}.toml"] + [out_dir / f for f in rendered.csv]
     if not force:
         existing = [p for p in targets if p.exists()]
