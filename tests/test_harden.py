@@ -714,3 +714,32 @@ def test_an_array_stays_what_it_was_when_a_local_changes_later(tmp_path):
     n = 1000
     got = list(np.ravel(sheet.evaluate("appended", n=n).magnitude))
     assert got == [99.0, 7.0, n + 1, n + 1, n * (n + 1) / 2]
+
+
+# -- exit 3 cases that are input errors ----------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", ["cspline", "linterp"])
+def test_data_too_large_for_doubles_is_a_numerical_error(tmp_path, kind):
+    # the spline's slopes overflowed: scipy's ValueError was an internal error (exit 3)
+    write(tmp_path / "p.csv", "x,y\n0,-1e308\n1,1e308\n2,0\n3,1e308\n")
+    write(
+        tmp_path / "d.toml",
+        '[inputs]\nu = "1.5 m"\n[data.pump]\nfile = "p.csv"\ncolumns = { x = "m", y = "m" }\n'
+        f'[definitions]\na = "{kind}(x, y, u)"\n',
+    )
+    out = cli(tmp_path, "run", "d.toml", "--out", "d.xlsx")
+    assert out.returncode == 2, out.stderr
+    assert "d.toml:7, in 'a': numerical error" in out.stderr and "overflows" in out.stderr
+
+
+def test_a_tls_scheduler_without_tls_settings_is_an_input_error(tmp_path, monkeypatch):
+    pytest.importorskip("distributed")
+    for key in list(os.environ):
+        if key.startswith("DASK_DISTRIBUTED__COMM__TLS"):
+            monkeypatch.delenv(key)
+    write(tmp_path / "t.toml", INJECT_LABELS)
+    args = ["--vary", "R=1mm,2mm", "--output", "q=y(0.5)", "--out", "s.csv"]
+    out = cli(tmp_path, "sweep", "t.toml", *args, "--scheduler", "tls://127.0.0.1:9")
+    assert out.returncode == 2 and "needs Dask's TLS settings" in out.stderr, out.stderr
+    assert not (tmp_path / "s.csv").exists()

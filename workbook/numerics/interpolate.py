@@ -15,7 +15,15 @@ def check_data(xs: np.ndarray, ys: np.ndarray, what: str) -> None:
         raise NumericsError(f"{what}: at least 2 points are needed, got {xs.size}")
     if not (np.isfinite(xs).all() and np.isfinite(ys).all()):
         raise NumericsError(f"{what}: the data hold a value that is not a finite number")
-    step = np.flatnonzero(np.diff(xs) <= 0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        dx, dy = np.diff(xs), np.diff(ys)
+        slopes = dy / dx
+    if not (np.isfinite(dx).all() and np.isfinite(dy).all() and np.isfinite(slopes).all()):
+        raise NumericsError(
+            f"{what}: the data are too large for an interpolation in doubles (a difference or "
+            "slope between neighbouring points overflows); give them in a larger unit"
+        )
+    step = np.flatnonzero(dx <= 0)
     if step.size:
         i = step[0]
         raise NumericsError(
@@ -43,4 +51,14 @@ def interpolate(xs, ys, x, *, kind: str = "linear", what: str = "linterp()", uni
     from scipy.interpolate import CubicSpline
 
     bc = "not-a-knot" if xs.size > 3 else "natural"
-    return CubicSpline(xs, ys, bc_type=bc)(x)
+    with np.errstate(over="ignore", invalid="ignore"):
+        try:
+            y = CubicSpline(xs, ys, bc_type=bc)(x)
+        except ValueError as exc:
+            raise NumericsError(f"{what}: the data cannot be interpolated ({exc})") from None
+    if not np.isfinite(y).all():
+        raise NumericsError(
+            f"{what}: the spline through the data overflows (its values pass the largest "
+            "double); give the data in a larger unit"
+        )
+    return y

@@ -158,10 +158,13 @@ def _run_dask(tasks: list[tuple], scheduler, timeout: float = 20.0):
             "--scheduler needs dask.distributed: pip install 'workbook[dask]'"
         ) from None
     own = not isinstance(scheduler, Client)
+    options = {}
     if own:
         check_scheduler(scheduler, timeout)
+        if str(scheduler).strip().startswith("tls://"):
+            options["security"] = tls_security(scheduler)
     try:
-        client = Client(scheduler, timeout=f"{timeout}s") if own else scheduler
+        client = Client(scheduler, timeout=f"{timeout}s", **options) if own else scheduler
     except OSError as err:
         raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
     try:
@@ -176,6 +179,29 @@ def _run_dask(tasks: list[tuple], scheduler, timeout: float = 20.0):
     finally:
         if own:
             client.close()
+
+
+def tls_security(address: str):
+    """The client's TLS settings for a ``tls://`` scheduler, from Dask's configuration
+    (``distributed.comm.tls.ca-file``, ``.client.cert``, ``.client.key``, or the
+    ``DASK_DISTRIBUTED__COMM__TLS__...`` environment variables). Dask's TLS is mutual: without
+    a CA file and a client certificate there is no TLS context, and the address is refused."""
+    from distributed.security import Security
+
+    needs = (
+        f"--scheduler {address}: a tls:// scheduler needs Dask's TLS settings, the CA file and "
+        "the client's certificate (and key): distributed.comm.tls.ca-file, .client.cert and "
+        ".client.key in the Dask configuration, or DASK_DISTRIBUTED__COMM__TLS__CA_FILE, "
+        "..._CLIENT__CERT and ..._CLIENT__KEY"
+    )
+    try:
+        security = Security()
+        context = security.get_connection_args("client")["ssl_context"]
+    except (OSError, ValueError) as err:
+        raise InputError(f"{needs} ({err})") from None
+    if context is None:
+        raise InputError(needs)
+    return security
 
 
 def pool_size(workers: int | None) -> int:
