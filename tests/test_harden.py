@@ -4,6 +4,7 @@ visible result, never a silent wrong number, a hang, or a lost file."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import time
@@ -743,3 +744,43 @@ def test_a_tls_scheduler_without_tls_settings_is_an_input_error(tmp_path, monkey
     out = cli(tmp_path, "sweep", "t.toml", *args, "--scheduler", "tls://127.0.0.1:9")
     assert out.returncode == 2 and "needs Dask's TLS settings" in out.stderr, out.stderr
     assert not (tmp_path / "s.csv").exists()
+
+
+ODE_BUDGET = """
+[inputs]
+k = "2 1/s"
+y0 = "1 m"
+budget = "{time}"
+t_end = "3 s"
+
+[arguments]
+t = {{ unit = "s" }}
+
+[[ode]]
+name = "decay"
+time = "t := 0 .. 3"
+max_time = {max_time}
+max_steps = {max_steps}
+states = [{{ name = "y", unit = "m", initial = "y0", derivative = "-k*y" }}]
+
+[definitions]
+y_end = "y(t_end)"
+"""
+
+
+@pytest.mark.parametrize(
+    ("max_time", "max_steps", "message"),
+    [
+        ("1e9", "1000", "max_time = 1e+09 s (limit 30 s)"),
+        ("10", "1e12", "max_steps = 1,000,000,000,000 (limit 1,000,000)"),
+        ('"budget"', "1000", "max_time = 1e+09 s (limit 30 s)"),
+    ],
+)
+def test_a_worksheet_cannot_raise_the_budget_of_an_ode_run(tmp_path, max_time, max_steps, message):
+    # max_time = 1e9 and max_steps = 1e12 were still running after 240 s
+    text = ODE_BUDGET.format(time="1e9 s", max_time=max_time, max_steps=max_steps)
+    with pytest.raises(LimitError, match=re.escape(message)):
+        workbook.load(write(tmp_path / "o.toml", text)).evaluate("y_end")
+    lowered = ODE_BUDGET.format(time="5 s", max_time='"budget"', max_steps="10000")
+    y = workbook.load(write(tmp_path / "o.toml", lowered)).evaluate("y_end")
+    assert float(y.to("m").magnitude) == pytest.approx(np.exp(-6), rel=1e-5)

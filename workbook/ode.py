@@ -123,6 +123,10 @@ def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
         raise TemplateError(f"{where}: rtol {rtol:g} is below what doubles resolve (1e-13)")
     max_time = _setting(raw, "max_time", MAX_TIME, where)
     max_steps = int(_positive(raw, "max_steps", MAX_STEPS, where))
+    # a worksheet may lower its budget, never raise it past the engine's
+    if isinstance(max_time, float):
+        _within_budget(where, "max_time", max_time, line)
+    _within_budget(where, "max_steps", max_steps, line)
     states = raw.get("states")
     if not isinstance(states, list) or not states:
         raise TemplateError(
@@ -198,6 +202,20 @@ def _setting(raw: dict, key: str, default: float, where: str) -> Setting:
     if isinstance(raw.get(key), str):
         return ex.parse(raw[key], what=f"{where}: {key}")
     return _positive(raw, key, default, where)
+
+
+def _within_budget(where: str, key: str, value: float, line: int | None = None) -> None:
+    """Refuse a worksheet's ``max_time`` or ``max_steps`` above the engine's
+    (:data:`MAX_TIME`, :data:`MAX_STEPS`)."""
+    limit = {"max_time": MAX_TIME, "max_steps": MAX_STEPS}[key]
+    if value > limit:
+        shown = f"{value:g} s (limit {limit:g} s)" if key == "max_time" else f"{value:,.0f}"
+        if key == "max_steps":
+            shown += f" (limit {limit:,})"
+        raise LimitError(
+            f"{where}: {key} = {shown}: a worksheet may lower the budget of a run, not raise it",
+            line=line,
+        )
 
 
 def _positive(raw: dict, key: str, default: float, where: str) -> float:
@@ -633,6 +651,7 @@ def settings(typed: TypedOde, compile_expr: Callable) -> Settings:
     for key, v, low in (("rtol", rtol, 1e-13), ("max_time", max_time, 0.0)):
         if not (math.isfinite(v) and v > low):
             raise DomainError(f"ode '{spec.name}': {key} = {v:g} is not above {low:g}")
+    _within_budget(f"ode '{spec.name}'", "max_time", max_time)
     atol = float(value("atol"))
     per_state = [compile_expr(a)({}) if a is not None else atol for a in typed.atols]
     per_state = per_state or [atol] * len(spec.states)
