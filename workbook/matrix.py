@@ -154,10 +154,72 @@ def eigenvecs(m):
 def eigenparts(m):
     """Eigenvalues, complex ones included, as rows (Re, Im): by modulus, then by imaginary
     part (a conjugate pair: the negative imaginary part first)."""
-    lam = np.linalg.eigvals(_last(m))
-    order = np.lexsort((lam.imag, np.abs(lam)), axis=-1)
-    lam = np.take_along_axis(lam, order, axis=-1)
-    return _first(np.stack([lam.real, lam.imag], axis=-1))
+    return _first(_parts_by_modulus(np.linalg.eigvals(_last(m))))
+
+
+def _parts_by_modulus(values: np.ndarray) -> np.ndarray:
+    """Complex values as (Re, Im) in the last axis, by modulus, then by imaginary part; moduli
+    equal to 10 digits are equal (a conjugate pair and a real value of the same modulus keep
+    one order whatever the rounding of each)."""
+    scale = np.max(np.abs(values), axis=-1, keepdims=True)
+    modulus = np.round(np.abs(values) / np.where(scale > 0, scale, 1.0), 10)
+    order = np.lexsort((values.real, values.imag, modulus), axis=-1)
+    values = np.take_along_axis(values, order, axis=-1)
+    return np.stack([values.real, values.imag], axis=-1)
+
+
+def eigenvec(m, z):
+    """The unit eigenvector of the eigenvalue z (the eigenvalue nearest z, which must be within
+    1e-9 of it relative to the largest eigenvalue), its largest component positive as in
+    eigenvecs."""
+    lam, vec = np.linalg.eig(_last(m))
+    z = np.asarray(z, dtype=float)
+    k = np.argmin(np.abs(lam - z[..., None]), axis=-1)
+    nearest = np.take_along_axis(lam, k[..., None], axis=-1)[..., 0]
+    scale = np.maximum(np.max(np.abs(lam), axis=-1), np.finfo(float).tiny)
+    off = np.abs(nearest - z) > 1e-9 * scale
+    if np.any(off):
+        i = np.argmax(np.broadcast_to(off, np.shape(off)).ravel())
+        shown = complex(np.broadcast_to(nearest, np.shape(off)).ravel()[i])
+        shown_text = f"{shown.real:.10g}" if not shown.imag else f"{shown:.10g}"
+        given = float(np.broadcast_to(z, np.shape(off)).ravel()[i])
+        raise InputError(
+            f"eigenvec(M, z): z = {given:.10g} is not an eigenvalue of M (the nearest is "
+            f"{shown_text}); take z from eigenvals(M)"
+        )
+    v = _real(np.take_along_axis(vec, k[..., None, None], axis=-1), "eigenvec()")
+    big = np.take_along_axis(v, np.argmax(np.abs(v), axis=-2)[..., None, :], axis=-2)
+    return _first(v * np.where(big < 0, -1.0, 1.0))
+
+
+def rank(m):
+    """The rank of a matrix (numpy's tolerance: singular values above the largest times the
+    size times the machine epsilon)."""
+    return _scalar(np.linalg.matrix_rank(_last(m)).astype(float))
+
+
+def _polynomial_roots(v, what: str) -> np.ndarray:
+    """The roots (complex) of the polynomial v[0] + v[1] x + ... for each value of v."""
+    coefficients = np.moveaxis(np.asarray(v, dtype=float)[:, 0], 0, -1)  # (..., n)
+    if np.any(coefficients[..., -1] == 0):
+        raise InputError(f"{what}: the last coefficient (of the highest power) is 0")
+    if not np.all(np.isfinite(coefficients)):
+        raise InputError(f"{what}: a coefficient is not a finite number")
+    out = np.empty(coefficients.shape[:-1] + (coefficients.shape[-1] - 1,), dtype=complex)
+    for index in np.ndindex(coefficients.shape[:-1]):
+        out[index] = np.roots(coefficients[index][::-1])
+    return out
+
+
+def polyroots(v):
+    """The roots of v[0] + v[1] x + ... + v[n] x^n, ascending (real roots only)."""
+    roots = np.sort(_real(_polynomial_roots(v, "polyroots()"), "polyroots()"), axis=-1)
+    return np.moveaxis(roots[..., None], (-2, -1), (0, 1))
+
+
+def polyrootparts(v):
+    """The roots, complex ones included, as rows (Re, Im), ordered as eigenparts orders."""
+    return _first(_parts_by_modulus(_polynomial_roots(v, "polyrootparts()")))
 
 
 def cross(a, b):
@@ -435,6 +497,59 @@ def register_entries() -> None:
         lambda m, shapes: eigenvecs(m),
         not_live("eigenvectors have no spreadsheet formula"),
         "unit eigenvectors as columns, in the order of eigenvals",
+    )
+
+    def r_eigenvec(ctx, name, args):
+        n = square(args, name)
+        z = ctx.convert(args[1], args[0].unit, "eigenvec(M, z): z and the elements of M")
+        return func(ctx.dimensionless, name, [args[0], z], (n, 1))
+
+    entry(
+        "eigenvec",
+        2,
+        r_eigenvec,
+        lambda m, z, shapes: eigenvec(m, z),
+        not_live("eigenvectors have no spreadsheet formula"),
+        "eigenvec(M, z): the unit eigenvector of the eigenvalue z (Mathcad's eigenvec)",
+    )
+
+    def r_rank(ctx, name, args):
+        need(args, 0, name, "a matrix")
+        return func(ctx.dimensionless, name, args, None)
+
+    entry(
+        "rank",
+        1,
+        r_rank,
+        lambda m, shapes: rank(m),
+        not_live("the rank of a matrix has no spreadsheet formula"),
+        "rank of a matrix (the number of independent rows)",
+    )
+
+    def r_polyroots(columns: int):
+        def rule(ctx, name, args):
+            n = vector(args, 0, name)
+            if n < 2:
+                raise TemplateError(f"{name}(v): v needs at least 2 coefficients, got {n}")
+            return func(ctx.dimensionless, name, args, (n - 1, columns))
+
+        return rule
+
+    entry(
+        "polyroots",
+        1,
+        r_polyroots(1),
+        lambda v, shapes: polyroots(v),
+        not_live("the roots of a polynomial have no spreadsheet formula"),
+        "polyroots(v): the roots of v[0] + v[1]*x + ... + v[n]*x^n, ascending (real ones only)",
+    )
+    entry(
+        "polyrootparts",
+        1,
+        r_polyroots(2),
+        lambda v, shapes: polyrootparts(v),
+        not_live("the roots of a polynomial have no spreadsheet formula"),
+        "polyrootparts(v): the roots, complex ones included, as rows (Re, Im) by modulus",
     )
 
     # vectors
