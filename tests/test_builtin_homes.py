@@ -59,6 +59,12 @@ KNOWN_ELSEWHERE = {
     # the numerical methods with an error estimate (bench) and their live Excel forms
     ("numerics/bench.py", ("argmax", "argmin", "integral", "maximum", "minimum", "root")),
     ("numerics/live.py", ("argmax", "argmin", "maximum", "minimum")),
+    # interval arithmetic of the one-argument built-ins (root's count of roots): a back end
+    # whose rules could be a field of the entry
+    (
+        "numerics/intervals.py",
+        ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),
+    ),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),
 }  # fmt: skip
