@@ -11,7 +11,7 @@ from . import excel_names
 from . import typecheck as tc
 from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
 from .expr import PREC
-from .registry import REGISTRY
+from .registry import CONSTANTS, REGISTRY
 from .visitor import Visitor
 
 MAX_FORMULA = 8192  # Excel's limit on formula length
@@ -88,8 +88,8 @@ class ExcelPrinter(Visitor):
     def visit_TRef(self, t, s):
         if t.shape is not None:
             self.array = True
-        if t.kind == "builtin":
-            return "PI()", ATOM
+        if t.kind == "builtin":  # a constant: pi, e, g
+            return CONSTANTS[t.name].excel, ATOM
         if t.kind in ("solve", "data"):
             raise NotLive(
                 f"{t.name} is found by a [[solve]] block (scipy.optimize.root)"

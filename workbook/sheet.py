@@ -18,6 +18,7 @@ from .errors import DomainError, InputError, LimitError, TemplateError, Workbook
 from .fields import nearest
 from .numeric import Evaluator
 from .ranges import RangeSpec, range_values
+from .registry import CONSTANTS
 from .template import (
     ColumnSpec,
     SheetSpec,
@@ -206,8 +207,8 @@ class Sheet:
             self.reads.add(name)
         if name in self.spec.inputs:
             return self.values[name]
-        if name == "pi" and name not in self.spec.definitions:
-            return Q(math.pi, "")
+        if name in CONSTANTS and name not in self.spec.definitions:  # pi, e, g
+            return Q(CONSTANTS[name].value, CONSTANTS[name].unit)
         d = self.spec.definitions.get(name)
         block = self.spec.solve_of(name)
         if d is None and block is not None:
@@ -300,8 +301,8 @@ class Sheet:
             return float(self.values[name].magnitude)
         if kind == "choice":
             return self.values[name]
-        if kind == "builtin":
-            return math.pi
+        if kind == "builtin":  # a constant: pi, e, g
+            return CONSTANTS[name].value
         if kind == "data":
             return self.spec.data[name].values
         if kind == "solve":

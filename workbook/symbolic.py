@@ -31,7 +31,7 @@ from fractions import Fraction
 from . import typed as ty
 from . import units as un
 from .errors import NotSymbolic, WorkbookError  # noqa: F401 - NotSymbolic is part of this module's interface
-from .registry import REGISTRY
+from .registry import CONSTANTS, REGISTRY
 from .visitor import Visitor
 
 
@@ -185,8 +185,8 @@ class SympyConverter(Visitor):
             return self.sheet.values[name]
         if name in self.keep:
             return sp.Symbol(name, real=True)
-        if kind == "builtin":
-            return sp.pi
+        if kind == "builtin":  # a constant: pi, e, g
+            return CONSTANTS[name].sympy()
         if kind == "input":
             if self.true_pi and name == "pi":
                 return sp.pi

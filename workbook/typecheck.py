@@ -18,7 +18,7 @@ from . import expr as ex
 from . import units as un
 from .errors import LimitError, ShapeError, TemplateError, UnitError, WorkbookError
 from .fields import nearest
-from .registry import REGISTRY
+from .registry import CONSTANTS, REGISTRY
 from .template import Definition, SheetSpec
 from .typearrays import ArrayTyping
 from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
@@ -241,7 +241,7 @@ class Typer(ArrayTyping, Visitor):
         """``unknown name 'x'`` with the nearest names a formula of this sheet may use."""
         spec = self.spec
         known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
-        known.update(dict.fromkeys([*spec.blocks, *REGISTRY]))
+        known.update(dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS]))
         hint = nearest(name, known)
         if kind == "name" and not hint and un.is_unit_name(name):
             hint = f" (a unit is written after a number: 1 {name})"
@@ -503,10 +503,10 @@ class Typer(ArrayTyping, Visitor):
                 )
             body = self.scalar(name)
             return TRef(body.unit, name=name, kind="definition", shape=body.shape, text=body.text)
-        if name == "pi":
-            return TRef(self.dimensionless, name="pi", kind="builtin")
         if name in self.spec.arguments:
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
+        if name in CONSTANTS:  # the sheet's own pi, e or g came first
+            return TRef(un.unit(CONSTANTS[name].unit), name=name, kind="builtin")
         if name in REGISTRY or name in self.spec.blocks:
             raise TemplateError(f"'{name}' is a function: call it as {name}(...)")
         raise self._unknown("name", name, scope)

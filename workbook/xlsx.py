@@ -23,6 +23,7 @@ from . import units as un
 from . import verdicts as V
 from .atomic import check_target, replacing
 from .checks import tolerances
+from .constants import CONSTANTS, shadowed
 from .errors import InputError, LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
 from .excel_functions import CLASSIC
@@ -977,6 +978,14 @@ class WorkbookWriter:
                     "; ".join(f"{k} is {v}" for k, v in self.names.renamed.items())
                     + " (Excel's defined names ignore case and must not read as cells or "
                     "functions)",
+                )
+            )
+        own = shadowed(spec)
+        if own:
+            rows.append(
+                (
+                    "Built-in constants",
+                    "; ".join(f"{n} is this worksheet's own, not {CONSTANTS[n].doc}" for n in own),
                 )
             )
         for name, part in self.sheet.full_spec.parts.items():
