@@ -74,9 +74,10 @@ def _parser() -> argparse.ArgumentParser:
         "--json", action="store_true", help="print one JSON object (counts and failures)"
     )
     imp = sub.add_parser(
-        "import", help="translate a Mathcad 11-15 worksheet (.xmcd) or an Excel workbook"
+        "import",
+        help="translate a Mathcad worksheet (.xmcd, Prime's .mcdx) or an Excel workbook",
     )
-    imp.add_argument("file", help="the .xmcd file, or the .xlsm/.xlsx/.xls workbook")
+    imp.add_argument("file", help="the .xmcd or .mcdx file, or the .xlsm/.xlsx/.xls workbook")
     imp.add_argument(
         "--vba", action="append", default=[], help="VBA from an add-in or a .bas/.cls module"
     )

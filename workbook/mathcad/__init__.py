@@ -1,6 +1,8 @@
-"""``workbook import``: a Mathcad 11-15 worksheet (.xmcd) as a worksheet of the language.
+"""``workbook import``: a Mathcad 11-15 (.xmcd) or Mathcad Prime (.mcdx) worksheet as a
+worksheet of the language.
 
-:func:`import_file` reads the file safely (:mod:`.reader`), follows its reference regions,
+:func:`import_file` reads the file safely (:mod:`.reader`, :mod:`.prime`: each format its
+reader, one translator of Mathcad's math for both), follows its reference regions,
 translates the regions in order (:mod:`.translate`) and writes ``NAME.toml`` with the
 printed values (Mathcad's stored results) beside it (:mod:`.writer`). A region the engine
 refuses when it loads the result is marked untranslated, with the engine's reason, and the
@@ -90,8 +92,14 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
     from .translate import Translator
 
     src = Path(src)
-    ws = read(src)
-    regions = regions_with_references(ws)
+    if src.suffix.lower() == ".mcdx":
+        from . import prime
+
+        ws = prime.read(src)
+        regions = ws.regions  # a reference region of Prime is listed, not followed
+    else:
+        ws = read(src)
+        regions = regions_with_references(ws)
     name = sheet_name(src)
     out_dir = Path(out_dir)
     forced: dict[str, str] = {}

@@ -459,6 +459,9 @@ class Translator:
             if region.kind == "component":
                 self.component(region)
                 continue
+            if region.kind == "listed":  # a region its reader cannot give: what, and why
+                self.skip(region.id, region.text, region.href)
+                continue
             if region.kind != "math":
                 what = {"plot": "a plot", "picture": "a picture"}.get(region.kind, "a component")
                 if region.kind in ("reference", "area"):
@@ -1724,6 +1727,8 @@ def _has_matrix(tree: ex.Node) -> bool:
 
 # -- stored values, units, literals ----------------------------------------------
 def _unit_monomial(node: MNode) -> str:
+    if "text" in node.attrs:  # a unit its reader wrote as pint text (Mathcad Prime's)
+        return node.attrs["text"]
     parts = []
     for ref in node.children:
         if ref.tag != "unitReference":
@@ -1793,16 +1798,20 @@ def _stored(node: MNode) -> tuple[str, list[float | str]]:
         return (_unit_monomial(mono) if mono is not None else unit), values
     if node.tag == "matrix":
         values = []
-        unit = ""
+        units = set()
         for c in node.children:
             if c.tag == "matrix":
                 raise Untranslatable(
                     "a nested array result (an array of arrays is not in the language)"
                 )
             u, v = _stored(c)
-            unit = unit or u
+            units.add(u)
             values += v
-        return unit, values
+        if len(units) > 1:
+            raise Untranslatable("a matrix result whose elements have different units")
+        return (units.pop() if units else ""), values
+    if node.tag == "unreadable":
+        raise Untranslatable(node.attrs.get("why", "a stored result that cannot be read"))
     if node.tag == "complex":
         raise Untranslatable("a complex result (complex numbers are not in the language)")
     raise Untranslatable(f"a result of kind <{node.tag}>")

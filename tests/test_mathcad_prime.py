@@ -1,0 +1,227 @@
+"""`workbook import` of Mathcad Prime worksheets (.mcdx), checked against Prime's stored results."""
+
+from __future__ import annotations
+
+import io
+import json
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from workbook.cli import main
+
+PRIME = Path(__file__).resolve().parents[1].parent / "shared" / "mathcad-prime"
+needs_corpus = pytest.mark.skipif(not PRIME.is_dir(), reason=f"{PRIME} is absent")
+
+WS = (
+    '<worksheet xmlns="http://schemas.mathsoft.com/worksheet50" '
+    'xmlns:ml="http://schemas.mathsoft.com/math50" '
+    'xmlns:u="http://schemas.mathsoft.com/units10"><regions>{}</regions></worksheet>'
+)
+RESULTS = (
+    '<resultsList xmlns="http://schemas.mathsoft.com/result10" '
+    'xmlns:ml="http://schemas.mathsoft.com/math50" '
+    'xmlns:u="http://schemas.mathsoft.com/units10">{}</resultsList>'
+)
+SPAN = (
+    '<Span xmlns="http://schemas.microsoft.com/winfx/2006/xaml/presentation" '
+    'xmlns:pw="clr-namespace:Ptc.Wpf;assembly=Ptc.Core">{}<pw:Subscript>{}</pw:Subscript></Span>'
+)
+
+
+def _region(rid: int, ref: int, body: str) -> str:
+    return f'<region region-id="{rid}"><math resultRef="{ref}">{body}</math></region>'
+
+
+def _result(ref: int, value: str = "") -> str:
+    inner = f"<ml:result>{value}</ml:result>" if value else ""
+    return f'<resultData result-id="{ref}" calculation-status="Synchronized">{inner}</resultData>'
+
+
+def _package(path: Path, regions: str, results: str, extra: dict | None = None) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("mathcad/worksheet.xml", WS.format(regions))
+        z.writestr("mathcad/result.xml", RESULTS.format(results))
+        z.writestr(
+            "mathcad/settings/calculation.xml",
+            '<calculation xmlns="http://schemas.ptc.com/mathcad/settings/calculation10">'
+            '<builtInVariables array-origin="0" convergence-tolerance="0.001"/></calculation>',
+        )
+        for name, data in (extra or {}).items():
+            z.writestr(name, data)
+    return path
+
+
+def _check(toml: Path, capsys) -> dict:
+    capsys.readouterr()
+    main(["check", str(toml), "--json"])
+    return json.loads(capsys.readouterr().out)
+
+
+def _unit(name: str) -> str:
+    return f'<ml:id labels="UNIT">{name}</ml:id>'
+
+
+def test_prime_results_in_their_displayed_unit(tmp_path, capsys):
+    """q_k := 15.8 kg/m * 10 N/kg = ? kN/m stores 0.158 (the override's unit); M := 637 kN *
+    1.92 m = ? kN stores 1223.04 with the residual unit meter; K := 2500 = ? 10^3 stores 2.5;
+    a := 103.2 deg = stores radians; L := 2 m = (no unit typed) stores meters."""
+    name = SPAN.format("q", "k")
+    q_body = (
+        "<ml:apply><ml:mult/><ml:apply><ml:div/><ml:apply><ml:scale/><ml:real>15.8</ml:real>"
+        f"{_unit('kg')}</ml:apply>{_unit('m')}</ml:apply><ml:apply><ml:div/><ml:apply>"
+        f"<ml:scale/><ml:real>10</ml:real>{_unit('N')}</ml:apply>{_unit('kg')}</ml:apply>"
+        "</ml:apply>"
+    )
+    kn_per_m = f"<ml:apply><ml:div/>{_unit('kN')}{_unit('m')}</ml:apply>"
+    m_body = (
+        f"<ml:apply><ml:mult/><ml:apply><ml:scale/><ml:real>637</ml:real>{_unit('kN')}"
+        f"</ml:apply><ml:apply><ml:scale/><ml:real>1.92</ml:real>{_unit('m')}</ml:apply>"
+        "</ml:apply>"
+    )
+    thousand = "<ml:apply><ml:pow/><ml:real>10</ml:real><ml:real>3</ml:real></ml:apply>"
+    regions = "".join(
+        [
+            _region(
+                1,
+                1,
+                f'<ml:define><ml:id labels="VARIABLE">{name}</ml:id><ml:eval>{q_body}'
+                f"<ml:unitOverride>{kn_per_m}</ml:unitOverride></ml:eval></ml:define>",
+            ),
+            _region(
+                2,
+                2,
+                f'<ml:define><ml:id labels="VARIABLE">M</ml:id><ml:eval>{m_body}'
+                f"<ml:unitOverride>{_unit('kN')}</ml:unitOverride></ml:eval></ml:define>",
+            ),
+            _region(
+                3,
+                3,
+                '<ml:define><ml:id labels="VARIABLE">K</ml:id><ml:eval><ml:real>2500</ml:real>'
+                f"<ml:unitOverride>{thousand}</ml:unitOverride></ml:eval></ml:define>",
+            ),
+            _region(
+                4,
+                4,
+                '<ml:define><ml:id labels="VARIABLE">a</ml:id><ml:eval><ml:apply><ml:scale/>'
+                f"<ml:real>103.2</ml:real>{_unit('deg')}</ml:apply><ml:unitOverride>"
+                "<ml:placeholder/></ml:unitOverride></ml:eval></ml:define>",
+            ),
+            _region(
+                5,
+                5,
+                '<ml:define><ml:id labels="VARIABLE">L</ml:id><ml:eval><ml:apply><ml:scale/>'
+                f"<ml:real>2</ml:real>{_unit('m')}</ml:apply><ml:unitOverride><ml:placeholder/>"
+                "</ml:unitOverride></ml:eval></ml:define>",
+            ),
+        ]
+    )
+    meter = (
+        '<u:unitMonomial><u:unitReference unit="meter" power-numerator="1" '
+        'power-denominator="1"/></u:unitMonomial>'
+    )
+    results = "".join(
+        [
+            _result(1, "<ml:real>0.158</ml:real>"),
+            _result(2, f"<ml:unitedValue><ml:real>1223.04</ml:real>{meter}</ml:unitedValue>"),
+            _result(3, "<ml:real>2.5</ml:real>"),
+            _result(4, "<ml:real>1.8011797880581482</ml:real>"),
+            _result(5, f"<ml:unitedValue><ml:real>2</ml:real>{meter}</ml:unitedValue>"),
+        ]
+    )
+    src = _package(tmp_path / "units.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "units.toml").read_text(encoding="utf-8")
+    assert "q_k = " in text  # the literal subscript of Prime's XAML name
+    result = _check(tmp_path / "units.toml", capsys)
+    assert (result["printed"], result["reproduced"]) == (5, 5), result["failures"]
+
+
+def test_a_wrong_stored_value_is_a_failure_not_a_pass(tmp_path, capsys):
+    """The comparison is real: 0.159 kN/m stored for 0.158 fails."""
+    regions = _region(
+        1,
+        1,
+        '<ml:define><ml:id labels="VARIABLE">q</ml:id><ml:eval><ml:apply><ml:scale/>'
+        f"<ml:real>158</ml:real>{_unit('N')}</ml:apply><ml:unitOverride>{_unit('kN')}"
+        "</ml:unitOverride></ml:eval></ml:define>",
+    )
+    src = _package(tmp_path / "wrong.mcdx", regions, _result(1, "<ml:real>0.159</ml:real>"))
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "wrong.toml", capsys)
+    assert (result["printed"], result["failed"]) == (1, 1)
+
+
+def _bomb() -> bytes:
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("mathcad/worksheet.xml", b" " * 70_000_000)
+    return buf.getvalue()
+
+
+def _many() -> bytes:
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        for k in range(5_001):
+            z.writestr(f"p{k}", b"")
+    return buf.getvalue()
+
+
+def _with(worksheet: bytes) -> bytes:
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        z.writestr("mathcad/worksheet.xml", worksheet)
+    return buf.getvalue()
+
+
+@pytest.mark.parametrize(
+    "data, message",
+    [
+        (b"not a zip", "not a Mathcad Prime worksheet"),
+        (_bomb(), "unpacks to 70,000,000 bytes"),
+        (_many(), "5,001 parts"),
+        (_with(b"<x/>"), "the root element of mathcad/worksheet.xml is x"),
+        (_with(b'<!DOCTYPE x [<!ENTITY a "b">]><x>&a;</x>'), "declares a DTD or entities"),
+        (_with(b"<worksheet"), "not well-formed"),
+    ],
+    ids=["not-zip", "bomb", "members", "not-prime", "dtd", "truncated"],
+)
+def test_hostile_package_is_refused(data, message, tmp_path, capsys):
+    src = tmp_path / "hostile.mcdx"
+    src.write_bytes(data)
+    assert main(["import", str(src), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "hostile.mcdx" in err
+
+
+SMALL = {  # file: (values stored, reproduced) as measured
+    "api-basic-test.mcdx": (10, 10),
+    "beam-elastic-foundation.mcdx": (4, 4),
+    "nm-to-compression-tension.mcdx": (5, 5),
+    "interpolation-task.mcdx": (21, 21),
+}
+
+
+@needs_corpus
+@pytest.mark.parametrize("name", sorted(SMALL))
+def test_small_prime_worksheets_reproduce(name, tmp_path, capsys):
+    assert main(["import", str(PRIME / name), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / (Path(name).stem + ".toml"), capsys)
+    assert result["failed"] == 0, result["failures"]
+    printed, reproduced = SMALL[name]
+    assert result["printed"] == printed
+    assert result["reproduced"] >= reproduced, result["failures"]
+
+
+@needs_corpus
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name", sorted(p.name for p in PRIME.glob("*.mcdx")) if PRIME.is_dir() else []
+)
+def test_every_prime_worksheet_imports_and_none_is_wrong(name, tmp_path, capsys):
+    """Every file imports (exit 0); every stored value is reproduced or not computable (its
+    region listed), none different."""
+    assert main(["import", str(PRIME / name), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / (Path(name).stem + ".toml"), capsys)
+    assert result["reproduced"] + result["not_computable"] == result["printed"], result["failures"]
