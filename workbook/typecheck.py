@@ -796,7 +796,10 @@ class Typer(ArrayTyping, Visitor):
         for i, a in enumerate(node.args):
             if i in entry.data_args:
                 col = self.spec.data.get(a.id) if isinstance(a, ex.Name) else None
-                if col is None and not (isinstance(a, ex.Name) and a.id not in scope):
+                defined = isinstance(a, ex.Name) and (
+                    a.id in scope or a.id in self.spec.definitions
+                )  # a vector of the sheet or of a program, named
+                if col is None and (defined or not isinstance(a, ex.Name)):
                     typed = self._number(self.visit(a, scope), f"argument {i + 1} of {name}()")
                     if typed.shape is not None:  # a vector of the sheet or of a program
                         args.append(typed)

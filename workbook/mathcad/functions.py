@@ -21,6 +21,7 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "sec": ("sec", None), "csc": ("csc", None), "cot": ("cot", None),
     # numerical methods and arrays (built-ins of the language once they exist)
     "root": ("root", None), "linterp": ("linterp", None), "interp": ("interp", None),
+    "lspline": ("lspline", None), "pspline": ("pspline", None), "cspline": ("cspline", None),
     "Find": ("find", None), "Maximize": ("maximize", None), "Minimize": ("minimize", None),
     "length": ("length", None), "rows": ("rows", None), "cols": ("cols", None),
     "last": ("last", None), "transpose": ("transpose", None), "det": ("det", None),

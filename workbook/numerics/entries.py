@@ -783,20 +783,111 @@ def _interp_excel(args) -> tuple[str, int]:
     raise NotLive("interpolation in a [data] table: its values are written as numbers")
 
 
-for _kind, _name in _KINDS.items():
+def _points(ctx, v: ty.T, name: str, k: int) -> int:
+    """The number of points of a [data] column or a vector known at load."""
+    if isinstance(v, ty.TRef) and v.kind == "data":
+        return len(ctx.spec.data[v.name].values)
+    if v.shape is None or ty.is_runtime(v.shape) or v.shape[1] != 1:
+        shown = "a number" if v.shape is None else "not a vector of a length known at load"
+        raise TemplateError(
+            f"{name}(): argument {k} must be a vector or a [data] column, got {shown}"
+        )
+    return v.shape[0]
+
+
+def _spline_unit(ctx, name: str, args: tuple) -> ty.T:
+    """lspline/pspline/cspline(vx, vy): the second derivatives at the points, in vy's unit
+    over vx's squared."""
+    if len(args) == 3:
+        return _interp_unit(ctx, name, args)
+    xs, ys = args
+    n, m = _points(ctx, xs, name, 1), _points(ctx, ys, name, 2)
+    if n != m:
+        raise TemplateError(f"{name}(vx, vy): vx has {n} points and vy {m}")
+    return ty.TFunc(ys.unit / xs.unit**2, func=name, args=(xs, ys), shape=(n, 1))
+
+
+def _spline_numpy(ends: str):
+    def hook(xs, ys, x=None):
+        from .splines import checked, second_derivatives
+
+        if x is not None:  # cspline(X, Y, x)
+            return _interp_numpy("cubic")(xs, ys, x)
+        xs, ys = checked(xs, ys, f"{_SPLINES[ends]}()")
+        return second_derivatives(xs, ys, ends)[:, None]
+
+    return hook
+
+
+def _spline_value_unit(ctx, name: str, args: tuple) -> ty.T:
+    vs, xs, ys, x = args
+    n, m = _points(ctx, xs, name, 2), _points(ctx, ys, name, 3)
+    k = _points(ctx, vs, name, 1)
+    if not n == m == k:
+        raise TemplateError(f"interp(vs, vx, vy, x): vs, vx and vy have {k}, {n} and {m} points")
+    vs = ctx.convert(vs, ys.unit / xs.unit**2, "interp(vs, vx, vy, x): vs (a spline of vx, vy)")
+    if x.shape is not None and not ty.is_runtime(x.shape):
+        raise TemplateError("interp(vs, vx, vy, x): x is a vector or matrix; give a number")
+    x = ctx.convert(x, xs.unit, "interp(vs, vx, vy, x): x")
+    return ty.TFunc(ys.unit, func=name, args=(vs, xs, ys, x))
+
+
+def _spline_value_numpy(vs, xs, ys, x):
+    from .splines import checked, evaluate
+
+    xs, ys = checked(xs, ys, "interp()")
+    ms = np.asarray(vs, dtype=float).reshape(-1)
+    return _out(evaluate(ms, xs, ys, x, "interp()"))
+
+
+_SPLINES = {"linear": "lspline", "parabolic": "pspline", "cubic": "cspline"}
+
+for _ends, _name in _SPLINES.items():
+    if _name == "cspline":
+        continue  # one entry with cspline(X, Y, x), below
     register(
         Builtin(
             _name,
-            3,
-            _interp_unit,
-            _interp_numpy(_kind),
+            2,
+            _spline_unit,
+            _spline_numpy(_ends),
+            _interp_excel,
+            _no_sympy(_name),
+            doc=f"{_name}(vx, vy): the second derivatives at the points of a cubic spline "
+            f"through them with {_ends} ends, for interp (Mathcad's {_name})",
+            data_args=(0, 1),
+        )
+    )
+register(
+    Builtin(
+        "interp",
+        4,
+        _spline_value_unit,
+        _spline_value_numpy,
+        _interp_excel,
+        _no_sympy("interp"),
+        doc="interp(vs, vx, vy, x): the spline of lspline, pspline or cspline(vx, vy) at x "
+        "(Mathcad's interp)",
+        data_args=(1, 2),
+    )
+)
+
+for _kind, _name in _KINDS.items():
+    cubic = _kind == "cubic"
+    register(
+        Builtin(
+            _name,
+            (2, 3) if cubic else 3,
+            _spline_unit if cubic else _interp_unit,
+            _spline_numpy("cubic") if cubic else _interp_numpy(_kind),
             _interp_excel,
             _no_sympy(_name),
             doc=f"{_name}(X, Y, x): y at x, "
             + (
                 "linear between the data points (Mathcad's linterp)"
                 if _kind == "linear"
-                else "on a cubic spline through the data points (Mathcad's interp(cspline(...)))"
+                else "on a cubic spline through the data points (Mathcad's interp(cspline(...))); "
+                "cspline(vx, vy): that spline's second derivatives at the points, for interp"
             ),
             data_args=(0, 1),
         )
