@@ -265,7 +265,7 @@ def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) ->
 
             try:
                 letters, row = coordinate_from_string(ref)
-            except ValueError:
+            except Exception:  # noqa: BLE001 - not one cell
                 continue
             by_cell.setdefault((sheet, row, column_index_from_string(letters)), name)
     wanted = sorted(
@@ -476,3 +476,15 @@ def _addr(row: int, col: int) -> str:
 
 
 __all__ = ["Translation", "translate_book", "Procedure"]
+
+
+def translate_vba(code: str, module: str = "Module1") -> dict[str, FunctionInfo]:
+    """The Functions of VBA source text, translated (each with its program or its problem)."""
+    from .vba import _module
+
+    tr = Translation(Path(module + ".bas"), Book(Path(module + ".bas")), [_module(module, code)])
+    reserved = language_reserved()
+    _collect_functions(tr, reserved)
+    _name_params(tr, reserved)
+    _translate_functions(tr, reserved)
+    return {info.proc.name: info for info in tr.functions.values()}

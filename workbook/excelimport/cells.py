@@ -249,7 +249,8 @@ class FormulaTranslator:
             text, arities = EXCEL[upper]
             if len(args) not in arities:
                 raise FormulaProblem(f"{upper} with {len(args)} arguments")
-            return "(" + text.format(*[self.value(a, 0) for a in args]) + ")"
+            out = text.format(*[self.value(a, 0) for a in args])
+            return out if re.fullmatch(r"\w+\([^()]*\)", text) else f"({out})"
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")

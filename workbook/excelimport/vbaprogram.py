@@ -540,7 +540,10 @@ class Translator:
         j = self.block(lines, i + 1, indent + 1, ("next",))
         if j >= len(lines):
             raise NotTranslated("For without Next")
-        self.emit(indent + 1, f"{var} := {var} + {step_v}")
+        if step_v.startswith("-") and re.fullmatch(r"-[\d.]+", step_v):
+            self.emit(indent + 1, f"{var} := {var} - {step_v[1:]}")
+        else:
+            self.emit(indent + 1, f"{var} := {var} + {step_v}")
         return j + 1
 
     def for_each(self, lines, i, indent, name, source) -> int:
@@ -698,6 +701,10 @@ class Translator:
             raise NotTranslated("an index left out")
         out = []
         for a in args:
+            node = strip(a)
+            if node[0] == "num" and re.fullmatch(r"\d+", node[1]):
+                out.append(str(int(node[1]) - arr.base))
+                continue
             v = self.value(a, 5)
             if arr.base:
                 v = f"{v} - {arr.base}"
@@ -768,7 +775,8 @@ class Translator:
         text, arities = entry
         if len(args) not in arities or any(a is None for a in args):
             raise NotTranslated(f"{name} with {len(args)} arguments")
-        return "(" + text.format(*[self.value(a) for a in args]) + ")"
+        out = text.format(*[self.value(a) for a in args])
+        return out if re.fullmatch(r"\w+\([^()]*\)", text) else f"({out})"
 
     def _call_function(self, key: str, args) -> str:
         info = self.functions[key]

@@ -163,9 +163,12 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
     return toml, files, counts
 
 
-def _load_problem(toml: str, files: dict, name: str) -> tuple[str, str] | None:
-    """(definition, why) the engine refuses, or None when the worksheet loads."""
+def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
+    """{definition: why} of what the engine refuses at load (empty when the worksheet loads):
+    every definition is typed, so one load finds them all."""
     import workbook
+    from workbook import typecheck as tc
+    from workbook.template import load_spec
 
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{name}.toml"
@@ -173,19 +176,40 @@ def _load_problem(toml: str, files: dict, name: str) -> tuple[str, str] | None:
         for fname, text in files.items():
             (Path(tmp) / fname).write_text(text, encoding="utf-8")
         try:
+            spec = load_spec(path)
+            units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+            typer = tc.Typer(spec, units)
+        except WorkbookError as err:
+            return _located(err, toml)
+        found: dict[str, str] = {}
+        for n, d in spec.definitions.items():
+            if d.is_function:
+                continue
+            try:
+                typer.scalar(n)
+            except WorkbookError as err:
+                culprit = err.definition if err.definition in spec.definitions else n
+                found.setdefault(culprit.split("(")[0], f"the engine refuses it: {err.message}")
+            except RecursionError:
+                found.setdefault(n, "the engine refuses it: nested too deeply")
+        if found:
+            return found
+        try:
             workbook.load(str(path))
         except WorkbookError as err:
-            what = err.definition
-            if what is None and err.line:
-                line = toml.splitlines()[err.line - 1] if err.line <= len(toml.splitlines()) else ""
-                m = re.match(r'^"?([A-Za-z_]\w*)', line)
-                what = m.group(1) if m else None
-            if what is None:
-                raise WorkbookError(
-                    f"the translated worksheet does not load: {err.message}"
-                ) from None
-            return what.split("(")[0], f"the engine refuses it: {err.message}"
-    return None
+            return _located(err, toml)
+    return {}
+
+
+def _located(err: WorkbookError, toml: str) -> dict[str, str]:
+    what = err.definition
+    lines = toml.splitlines()
+    if what is None and err.line and err.line <= len(lines):
+        m = re.match(r'^\[?(?:definitions|inputs)?\.?"?([A-Za-z_]\w*)', lines[err.line - 1])
+        what = m.group(1) if m else None
+    if what is None:
+        raise WorkbookError(f"the translated worksheet does not load: {err.message}") from None
+    return {what.split("(")[0]: f"the engine refuses it: {err.message}"}
 
 
 def write(tr: Translation, out_dir: Path, *, force: bool):
@@ -197,14 +221,15 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
     skip: dict[str, str] = {}
     for _ in range(MAX_LOAD_ROUNDS):
         toml, files, counts = render(tr, skip)
-        problem = _load_problem(toml, files, name)
-        if problem is None:
+        refused = _refusals(toml, files, name)
+        if not refused:
             break
-        what, why = problem
-        if what in skip:
-            raise WorkbookError(f"the translated worksheet does not load: {why}")
-        skip[what] = why
-        _drop_dependents(tr, what, skip)
+        for what, why in refused.items():
+            if what in skip:
+                raise WorkbookError(f"the translated worksheet does not load: {why}")
+            skip[what] = why
+        for what in refused:
+            _drop_dependents(tr, what, skip)
     else:
         raise WorkbookError(
             f"the translated worksheet still does not load after leaving out {len(skip)} "
@@ -225,27 +250,25 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
 
 
 def _drop_dependents(tr: Translation, name: str, skip: dict[str, str]) -> None:
-    """Leave out the definitions that use ``name`` (they would be refused next)."""
-    pattern = re.compile(rf"\b{re.escape(name)}\b")
-    changed = True
-    names = {name}
-    while changed:
-        changed = False
-        for d in tr.definitions:
-            if d.problem or d.name in skip:
-                continue
-            uses = d.text or ""
-            if (d.element and d.element[0] in names) or any(
-                re.search(rf"\b{re.escape(n)}\b", uses) for n in names
-            ):
-                skip[d.name] = f"uses {name}, left out"
-                names.add(d.name)
-                changed = True
-        for info in tr.functions.values():
-            if info.problem or info.final in skip:
-                continue
-            if any(re.search(rf"\b{re.escape(n)}\s*\(", info.program) for n in names):
-                skip[info.final] = f"calls {name}, left out"
-                names.add(info.final)
-                changed = True
-    del pattern
+    """Leave out the definitions and functions that use ``name`` (they would be refused
+    next), and those that use them."""
+    users: dict[str, list[str]] = {}
+    for d in tr.definitions:
+        if d.problem:
+            continue
+        used = set(_WORD.findall(d.text or "")) | ({d.element[0]} if d.element else set())
+        for u in used:
+            users.setdefault(u, []).append(d.name)
+    for info in tr.functions.values():
+        if not info.problem:
+            for u in set(_WORD.findall(info.program)):
+                users.setdefault(u, []).append(info.final)
+    todo = [name]
+    while todo:
+        for user in users.get(todo.pop(), []):
+            if user not in skip:
+                skip[user] = f"uses {name}, left out"
+                todo.append(user)
+
+
+_WORD = re.compile(r"[A-Za-z_]\w*")
