@@ -784,3 +784,34 @@ def test_a_worksheet_cannot_raise_the_budget_of_an_ode_run(tmp_path, max_time, m
     lowered = ODE_BUDGET.format(time="5 s", max_time='"budget"', max_steps="10000")
     y = workbook.load(write(tmp_path / "o.toml", lowered)).evaluate("y_end")
     assert float(y.to("m").magnitude) == pytest.approx(np.exp(-6), rel=1e-5)
+
+
+FAMILY = """
+[inputs]
+c = "2"
+[arguments]
+x = { unit = "" }
+[definitions]
+"y(x)" = "c*x"
+[[tables]]
+name = "f"
+range = "x := 0, 1 .. LAST"
+vary = { c = VALUES }
+columns = { y = "" }
+"""
+
+
+def test_a_family_table_is_checked_before_its_curves_are_computed(tmp_path):
+    # 50 curves x 2e6 rows built 1.66 GB before the row check refused the table
+    from workbook.sheet import MAX_FAMILY_CELLS
+
+    values = "[" + ", ".join(f'"{k}"' for k in range(1, 51)) + "]"
+    path = write(tmp_path / "f.toml", FAMILY.replace("LAST", "39999").replace("VALUES", values))
+    with pytest.raises(LimitError, match=f"is 2,000,000 values \\(limit {MAX_FAMILY_CELLS:,}\\)"):
+        workbook.load(path).table("f")
+    write(path, FAMILY.replace("LAST", "1999999").replace("VALUES", '["1", "2"]'))
+    out = cli(tmp_path, "run", "f.toml", "--out", "f.xlsx")
+    assert out.returncode == 2 and "table f has 2,000,000 rows" in out.stderr
+    write(path, FAMILY.replace("LAST", "99").replace("VALUES", '["1", "2"]'))
+    table = workbook.load(path).table("f")
+    assert table.shape == (100, 3) and table.iloc[99, 2] == 2 * 99

@@ -29,6 +29,9 @@ from .template import (
 from .typed import TConst
 from .uses import names_used
 
+#: Values of a table with ``vary`` (curves x columns x points), checked before any is computed.
+MAX_FAMILY_CELLS = 1_000_000
+
 
 @dataclass
 class Column:
@@ -537,6 +540,15 @@ class Sheet:
 
         (name, values), what = next(iter(spec.vary.items())), f"table {spec.name}"
         xs = self.range_values(spec.range, what)
+        cells = len(xs) * len(values) * len(spec.columns)
+        if cells > MAX_FAMILY_CELLS:  # before any curve is computed
+            raise LimitError(
+                f"{what}: {len(values)} values of {name} x {len(spec.columns)} columns x "
+                f"{len(xs):,} points is {cells:,} values (limit {MAX_FAMILY_CELLS:,})",
+                file=self.file,
+                line=spec.line,
+                definition=what,
+            )
         var = spec.range.var
         arg = self.spec.arguments.get(var)
         out = {un.header(var, arg.unit if arg else un.registry().dimensionless): xs}

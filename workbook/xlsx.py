@@ -622,9 +622,15 @@ class WorkbookWriter:
 
     # -- block tables --------------------------------------------------------------------
     def write_computed_table(self, spec) -> None:
-        df = self.sheet.computed_table(spec.name)
         ws = self.ws(spec.sheet)
         start = self.rows[spec.sheet]
+        if spec.vary:  # its rows are its range's points: checked before it is computed
+            n = len(self.sheet.range_values(spec.range, f"table {spec.name}"))
+            if start + n + 3 > MAX_ROWS:
+                raise LimitError(
+                    f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}"
+                )
+        df = self.sheet.computed_table(spec.name)
         n = len(df)
         if start + n + 3 > MAX_ROWS:
             raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}")
