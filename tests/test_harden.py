@@ -815,3 +815,33 @@ def test_a_family_table_is_checked_before_its_curves_are_computed(tmp_path):
     write(path, FAMILY.replace("LAST", "99").replace("VALUES", '["1", "2"]'))
     table = workbook.load(path).table("f")
     assert table.shape == (100, 3) and table.iloc[99, 2] == 2 * 99
+
+
+def test_a_sweep_is_bounded_before_any_case_runs(tmp_path):
+    # 10^6 cases took 148 s; a maximum over 1.9e6 points x 1e4 cases ran past 60 s
+    from workbook.sweep.driver import MAX_SWEEP_POINTS
+    from workbook.sweep.grid import MAX_CASES
+
+    write(tmp_path / "t.toml", INJECT_LABELS)
+    many = f"R=1mm..2mm:{MAX_CASES + 1}"
+    out = cli(tmp_path, "sweep", "t.toml", "--vary", many, "--output", "q=y(0.5)", "--out", "s.csv")
+    assert out.returncode == 2 and f"is more than {MAX_CASES:,}" in out.stderr, out.stderr
+    reduce = "q=max of y(phi) over phi := 0 .. 1.9e6"
+    args = ["--vary", "R=1mm..2mm:10000", "--output", reduce, "--out", "s.csv"]
+    out = cli(tmp_path, "sweep", "t.toml", *args)
+    assert out.returncode == 2 and f"(limit {MAX_SWEEP_POINTS:,})" in out.stderr, out.stderr
+    assert "19,000,010,000 points" in out.stderr and not (tmp_path / "s.csv").exists()
+
+
+def test_sweep_values_converted_at_once_equal_one_by_one(tmp_path):
+    # the values of a vector sweep are converted in one array (not one pint call a case):
+    # bit for bit what the serial mode gives, a value out of bounds failing its case only
+    from workbook import sweep as sw
+
+    text = INJECT_LABELS.replace('R = "2 mm"', 'R = { value = "2 mm", max = "3 cm" }')
+    sheet = workbook.load(write(tmp_path / "t.toml", text))
+    vary = {"R": ["0.1 in", "1.3 cm", "29.7 mm", "3.1 cm", "7 mm"]}
+    vector = sw.sweep(sheet, vary, {"q": "y(0.7)"}, mode="vector").table
+    serial = sw.sweep(sheet, vary, {"q": "y(0.7)"}, mode="serial").table
+    assert vector.equals(serial)
+    assert vector["error"].notna().tolist() == [False, False, False, True, False]
