@@ -222,6 +222,35 @@ def polyrootparts(v):
     return _first(_parts_by_modulus(_polynomial_roots(v, "polyrootparts()")))
 
 
+def histogram(intervals, data, *, counted: bool):
+    """Mathcad's histogram: rows (midpoint, count) of ``intervals`` equal intervals between the
+    smallest and largest value of ``data`` (``counted``), or of the intervals between the
+    points of the vector ``intervals``. A value on an inner boundary counts in the upper
+    interval; the last interval holds both its ends."""
+    values = np.asarray(data, dtype=float)
+    if values.ndim != 2:
+        raise InputError("histogram(): the data must be a vector of numbers (not over a range)")
+    values = values[:, 0]
+    if not np.all(np.isfinite(values)):
+        raise InputError("histogram(): a data value is not a finite number")
+    if counted:
+        lo, hi = float(values.min()), float(values.max())
+        if lo == hi:
+            raise InputError(
+                f"histogram(n, data): every value is {lo:g}; give the intervals as a vector"
+            )
+        edges = np.linspace(lo, hi, int(np.asarray(intervals, dtype=float)) + 1)
+    else:
+        edges = np.asarray(intervals, dtype=float)
+        if edges.ndim != 2:
+            raise InputError("histogram(): the intervals must be a vector (not over a range)")
+        edges = edges[:, 0]
+        if not (np.all(np.isfinite(edges)) and np.all(np.diff(edges) > 0)):
+            raise InputError("histogram(intervals, data): the interval points must increase")
+    counts, _ = np.histogram(values, edges)
+    return np.stack([(edges[:-1] + edges[1:]) / 2, counts.astype(float)], axis=1)
+
+
 def cross(a, b):
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     ra, rb = a.ndim - 2, b.ndim - 2
@@ -322,9 +351,10 @@ def register_entries() -> None:
     """Register the matrix built-ins (called once, by workbook.registry)."""
     from . import typed as ty
     from .entry import Builtin, register
-    from .errors import NotLive, NotSymbolic, ShapeError, TemplateError
+    from .errors import NotLive, NotSymbolic, ShapeError, TemplateError, UnitError
     from .expr import PREC
     from .typed import shape_text
+    from .units import pretty
 
     atom = PREC["atom"]
 
@@ -550,6 +580,41 @@ def register_entries() -> None:
         lambda v, shapes: polyrootparts(v),
         not_live("the roots of a polynomial have no spreadsheet formula"),
         "polyrootparts(v): the roots, complex ones included, as rows (Re, Im) by modulus",
+    )
+
+    def r_histogram(ctx, name, args):
+        intervals, data = args
+        vector(args, 1, name)
+        factor = None if data.unit.dimensionality else (1 * data.unit).to("").magnitude
+        if factor != 1:
+            raise UnitError(
+                f"histogram(): the data are in {pretty(data.unit)}; its midpoints and counts "
+                "are one matrix, of one unit: divide the data by their unit (data/kg)"
+            )
+        if intervals.shape is None:
+            n = ctx.plain(intervals, "histogram(n, data): the number of intervals")
+            if not isinstance(n, ty.TConst) or n.value != int(n.value) or n.value < 1:
+                raise TemplateError(
+                    "histogram(n, data): n must be a positive integer known at load, as the "
+                    "shape of every matrix is (or give the interval points as a vector)"
+                )
+            if n.value > MAX_IDENTITY:
+                raise TemplateError(f"histogram({n.value:g}, data): more than {MAX_IDENTITY} rows")
+            return func(ctx.dimensionless, name, [n, data], (int(n.value), 2))
+        points = vector(args, 0, name)
+        if points < 2:
+            raise TemplateError("histogram(intervals, data): give at least 2 interval points")
+        intervals = ctx.plain(intervals, "histogram(intervals, data): the interval points")
+        return func(ctx.dimensionless, name, [intervals, data], (points - 1, 2))
+
+    entry(
+        "histogram",
+        2,
+        r_histogram,
+        lambda i, d, shapes: histogram(i, d, counted=shapes[0] is None),
+        not_live("a histogram has no spreadsheet formula here"),
+        "histogram(n, data) or histogram(intervals, data): rows (midpoint, count) of each "
+        "interval (Mathcad's histogram)",
     )
 
     # vectors
