@@ -10,11 +10,18 @@ import tempfile
 from pathlib import Path
 
 from ..errors import WorkbookError
-from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE, _comment
+from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
 from .book import Translation
 
 MAX_LOAD_ROUNDS = 60  # loads of the worksheet while refused definitions are left out
+
+
+def _comment(text: str, width: int = 96) -> list[str]:
+    """TOML comment lines of at most ``width`` characters."""
+    import textwrap
+
+    return ["# " + line for line in textwrap.wrap(text, width - 2) or [""]]
 
 
 def _sheet_name(path: Path) -> str:
