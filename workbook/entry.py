@@ -60,6 +60,7 @@ class Builtin:
     arrays: bool = False  # takes vectors/matrices: the hooks get ``shapes=`` (workbook.matrix)
     # the unit rule when an argument is a run-time array (workbook.runtime); None: refused
     runtime: Callable[..., ty.T] | None = None
+    texts: bool = False  # takes text arguments (the unit rule checks each; else numbers only)
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""

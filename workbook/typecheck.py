@@ -671,8 +671,9 @@ class Typer(ArrayTyping, Visitor):
             return self._data_call(node, scope)
         known = name in self.spec.definitions or name in self.spec.blocks or name in REGISTRY
         args = [self.visit(a, scope) for a in node.args] if known else []  # unknown: say so first
-        for a in args:
-            self._number(a, f"argument of {name}()")
+        if not (entry is not None and entry.texts and not local):
+            for a in args:
+                self._number(a, f"argument of {name}()")
         if name in self.spec.definitions:
             d = self.spec.definitions[name]
             if not d.is_function:
