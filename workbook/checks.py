@@ -183,8 +183,9 @@ def run_checks(sheet) -> Report:
 
 def collect_findings(sheet) -> list[Finding]:
     from . import blocks
+    from .angle_slips import angle_findings
 
-    out: list[Finding] = []
+    out: list[Finding] = angle_findings(sheet)
     if sheet.spec.odes:
         from .ode import sheet_findings
 

@@ -54,13 +54,18 @@ _QUANTITY_BOUND = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*[^\W
 
 
 def _bound_node(text: str, what: str) -> tuple[ex.Node, pint.Unit | None]:
-    """A range bound: an expression, or a quantity like ``25 N`` (its number and unit)."""
-    if _QUANTITY_BOUND.match(text.strip()):
-        from . import units as un
+    """A range bound: an expression (``25 N`` and ``360 deg * turns`` are expressions with a
+    quantity in them, whose unit a space ends), or else a quantity the expression language
+    does not read (``1e3 1/s``): its number and unit."""
+    try:
+        return ex.parse(text, what=what), None
+    except TemplateError:
+        if not _QUANTITY_BOUND.match(text.strip()):
+            raise
+    from . import units as un
 
-        q = un.quantity(text, what=f"{what}: range bound")
-        return ex.Number(float(q.magnitude)), q.units
-    return ex.parse(text, what=what), None
+    q = un.quantity(text, what=f"{what}: range bound")
+    return ex.Number(float(q.magnitude)), q.units
 
 
 def range_values(first: float, second: float | None, last: float, *, what: str = "range"):

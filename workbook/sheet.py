@@ -391,7 +391,6 @@ class Sheet:
         """The typed first, second (or None) and last value of a range, in the range
         variable's declared unit (a plain number is taken as already in it)."""
         spec = self.spec.arguments.get(rng.var)
-        dimensionless = un.registry().dimensionless
         out: list[tc.T | None] = []
         for node, unit in zip((rng.first, rng.second, rng.last), rng.units):
             if node is None:
@@ -405,8 +404,11 @@ class Sheet:
                 raise TemplateError(
                     f"{what}: range bound has units but '{rng.var}' has no declared unit"
                 )
-            if spec is not None and (t.unit.dimensionality or t.unit != dimensionless):
-                t = self.typer.convert(t, spec.unit, what)
+            if spec is not None and not (tc.is_bare(t) and not tc.is_angle(spec.unit)):
+                # the typer's one conversion, as for an argument of a call: a bare number is
+                # in the declared unit (0, 5 .. 90 degrees), an expression with pi or a plain
+                # number computed is in radians (a plain argument's bounds are plain numbers)
+                t = self.typer.convert(t, spec.binding_unit, what)
             out.append(t)
         return out
 

@@ -1,0 +1,135 @@
+"""One angle rule everywhere: range bounds go through the typer's conversion as arguments of a
+call do, and the two slips of Mathcad users with angles are reported as warnings."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import write_template
+
+import workbook
+
+SHEET = """
+[sheet]
+title = "angles"
+
+[inputs]
+theta = { value = "30 deg" }
+R = { value = "10 mm" }
+turns = { value = "2" }
+
+[arguments]
+phi = { unit = "deg" }
+psi = { unit = "deg", plain = true }
+
+[definitions]
+"y(phi)" = { expr = "R*sin(phi)", unit = "mm" }
+"w(psi)" = { expr = "R*sin(psi * 1 deg)", unit = "mm" }
+at_half_pi = { expr = "y(pi/2)", unit = "mm" }
+
+[[tables]]
+name = "radians"
+range = "phi := 0, pi/6 .. pi"
+columns = { "y(phi)" = "mm" }
+
+[[tables]]
+name = "degrees"
+range = "phi := 0, 30 .. 180"
+columns = { "y(phi)" = "mm" }
+
+[[tables]]
+name = "quantities"
+range = "phi := 0 deg, 45 deg .. 360 deg * turns"
+columns = { "y(phi)" = "mm" }
+
+[[tables]]
+name = "plain"
+range = "psi := 0, 30 .. 180"
+columns = { "w(psi)" = "mm" }
+"""
+
+
+@pytest.fixture(scope="module")
+def sheet(tmp_path_factory):
+    return workbook.load(write_template(tmp_path_factory.mktemp("angles"), SHEET))
+
+
+def test_pi_in_range_bounds_is_radians_as_in_a_call(sheet):
+    """phi := 0, pi/6 .. pi is 0, 30 .. 180 degrees, as y(pi/2) reads pi/2 as 90 degrees."""
+    radians = sheet.table("radians")
+    degrees = sheet.table("degrees")
+    assert len(radians) == len(degrees) == 7
+    np.testing.assert_allclose(radians.iloc[:, 0], np.arange(0, 181, 30), rtol=1e-14)
+    np.testing.assert_allclose(radians.iloc[:, 1], degrees.iloc[:, 1], rtol=1e-13, atol=1e-14)
+    assert sheet.evaluate("at_half_pi").to("mm").magnitude == pytest.approx(10.0, rel=1e-15)
+
+
+def test_quantities_and_plain_arguments_in_range_bounds(sheet):
+    quantities = sheet.table("quantities")
+    np.testing.assert_allclose(quantities.iloc[:, 0], np.arange(0, 721, 45), rtol=1e-15)
+    plain = sheet.table("plain")  # psi is a plain number of degrees: 0, 30 .. 180
+    np.testing.assert_allclose(plain.iloc[:, 0], np.arange(0, 181, 30), rtol=1e-15)
+    expected = [10 * math.sin(math.radians(a)) for a in range(0, 181, 30)]
+    np.testing.assert_allclose(plain.iloc[:, 1], expected, rtol=1e-13, atol=1e-14)
+
+
+SLIPS = """
+[sheet]
+title = "slips"
+
+[inputs]
+theta = { value = "30 deg" }
+R = { value = "10 mm" }
+
+[arguments]
+phi = { unit = "deg" }
+
+[definitions]
+a = { expr = "R*sin(theta*pi/180)", unit = "mm" }
+b = "cos(90)"
+"c(phi)" = { expr = "R*sin(pi/180*phi)", unit = "mm" }
+fine = "sin(theta) + cos(1.2) + tan(theta/2)"
+"""
+
+
+def test_the_two_slips_are_warnings(tmp_path):
+    sheet = workbook.load(write_template(tmp_path, SLIPS))
+    found = {f.what: f for f in sheet.check().findings if f.topic == "angles"}
+    assert set(found) == {
+        "'a': sin() of an angle in degrees multiplied by pi/180",
+        "'b': cos(90) reads 90 as radians",
+        "'c': sin() of an angle in degrees multiplied by pi/180",
+    }
+    assert all(f.verdict == "warning" for f in found.values())
+    # the values are as written, not changed: the finding says what they are
+    assert sheet.evaluate("a").to("mm").magnitude == pytest.approx(
+        10 * math.sin(math.radians(30) * math.pi / 180), rel=1e-14
+    )
+    assert sheet.evaluate("b").magnitude == pytest.approx(math.cos(90.0), rel=1e-14)
+
+
+def test_no_warning_without_degrees(tmp_path):
+    text = '[inputs]\nx = { value = "2" }\n\n[definitions]\nb = "cos(90*x)"\nc = "sin(90)"\n'
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert not [f for f in sheet.check().findings if f.topic == "angles"]
+
+
+def test_run_prints_the_warnings_and_exits_0(tmp_path):
+    write_template(tmp_path, SLIPS, "slips.toml")
+    code = "import sys; from workbook.cli import main; sys.exit(main())"
+    done = subprocess.run(
+        [sys.executable, "-c", code, "run", "slips.toml", "--out", "slips.xlsx"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "warning: [angles] 'a': sin() of an angle in degrees multiplied by pi/180" in (
+        done.stderr
+    )
+    assert "cos(90 deg)" in done.stderr
