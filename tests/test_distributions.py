@@ -259,3 +259,28 @@ def test_the_normal_density_is_the_derivative_of_its_probability(tmp_path):
     slope = sheet.evaluate("slope", u).magnitude
     assert slope == pytest.approx(sheet.evaluate("dens", u).magnitude, rel=1e-14)
     assert math.isclose(slope[1], float(mpmath.npdf(0.1, 0.3, 1.7)), rel_tol=1e-14)
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculates_the_distributions(tmp_path):
+    """Every distribution cell recalculated by LibreOffice (which reads the _xlfn. names)
+    agrees with the engine; a fraction of degrees of freedom from a cell is #N/A there too."""
+    from recalc import cell_values, formula_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    text = TEMPLATE + "".join(f'{k} = "{v}"\n' for k, v in EXCEL_CASES.items())
+    text += 'fractional = "pt(x, half)"\n'
+    sheet = workbook.load(write_template(tmp_path, text, "dist.toml"))
+    path = sheet.write_xlsx(tmp_path / "dist.xlsx")
+    cells = formula_values(path)
+    again = cell_values(recalculate(path, tmp_path / "out"))
+    checked = 0
+    for key, (formula, cached) in cells.items():
+        if "INT(half)" in formula:
+            assert str(again.get(key)) == "#N/A", formula
+            continue
+        if isinstance(cached, (int, float)):
+            assert float(again[key]) == pytest.approx(cached, rel=1e-12, abs=1e-300), formula
+            checked += 1
+    assert checked >= len(EXCEL_CASES)
