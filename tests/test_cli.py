@@ -127,3 +127,5 @@ def test_a_bug_in_a_block_is_exit_3_in_one_line(tmp_path, monkeypatch, capsys):
     assert out.read_bytes() == before
     with pytest.raises(ZeroDivisionError):
         main(["--debug", *args])
+    with pytest.raises(ZeroDivisionError):  # after the subcommand too, as the message says
+        main([*args, "--debug"])

@@ -236,10 +236,12 @@ def test_hostile_worksheet_is_refused(tmp_path, name):
         written = [p.name for p in tmp_path.rglob("*") if p.is_file()]
         assert written == ["hostile.toml"], written  # not even an empty or partial workbook
     # Nothing written, read, imported or started. Ranges and block tables are evaluated while
-    # the workbook is written: there the temporary file beside the target is made and removed.
+    # the workbook is written: there the temporary file beside the target is made and removed
+    # (a table the check computes fails before the file, and only its folder is removed).
     temporary = [e for e in out.events if e.endswith(".partial None") and str(tmp_path) in e]
     cleanup = ("os.remove", "os.rmdir")  # the temporary file and its folder (atomic.Outputs)
     rest = [e for e in out.events if e not in temporary and not (temporary and e in cleanup)]
+    rest = [] if rest == ["os.rmdir"] else rest
     assert rest == [], out.events
 
 

@@ -9,7 +9,7 @@ import pint
 
 from . import units as un
 from . import verdicts as V
-from .errors import TemplateError, UnitError, WorkbookError
+from .errors import DomainError, LimitError, TemplateError, UnitError, WorkbookError
 from .findings import Finding
 from .printed import PrintedRow, read_commented_csv, read_printed  # noqa: F401 - re-exported
 from .template import PrintedSpec
@@ -172,7 +172,7 @@ def run_checks(sheet) -> Report:
     for spec in sheet.spec.printed:
         for row in read_printed(spec):
             report.rows.append(_check_row(sheet, spec, row))
-    report.findings = collect_findings(sheet)
+    report.findings = collect_findings(sheet) + failed_values(sheet)
     if sheet.spec.relations or sheet.spec.meta.get("hand_checks"):
         from .analysis import findings as hand_checks  # relations, joins, domains, pi
 
@@ -203,6 +203,70 @@ def collect_findings(sheet) -> list[Finding]:
         except WorkbookError as err:
             out.append(
                 Finding(entry.get("title", ref), f"{ref} could not run", None, "", "fail", str(err))
+            )
+    return out
+
+
+#: Errors of a value that fails where it is computed (a domain left, a solver that gives up, a
+#: run over its budget); a piecewise value with no piece for its arguments does not exist there
+#: by the worksheet's own declaration and is shown as such, not counted as a failure.
+FAILURES = (DomainError, LimitError)
+#: Failed rows of one column named in its finding (all are in the workbook's comments).
+ROWS_NAMED = 5
+
+
+def failed_values(sheet) -> list[Finding]:
+    """A failing finding for every value the sheet cannot compute: scalar definitions and the
+    unknowns of [[solve]] blocks (one finding per cause, naming every value it takes), a range
+    table, the rows of a table column that fail."""
+    out: list[Finding] = []
+    causes: dict[str, list[str]] = {}  # the error, located where it arose -> the values
+    for block in sheet.spec.solves:
+        try:
+            sheet.evaluate(next(iter(block.unknowns)))
+        except WorkbookError as err:  # a value shown as an error in any case
+            if isinstance(err, FAILURES):
+                causes.setdefault(str(err), []).append(", ".join(block.unknowns))
+    for name, d in sheet.spec.definitions.items():
+        if d.is_function:
+            continue
+        try:
+            sheet.scalar_quantity(name)
+        except WorkbookError as err:  # a value shown as an error in any case
+            if isinstance(err, FAILURES):
+                causes.setdefault(str(err), []).append(name)
+    for cause, names in causes.items():
+        what = f"{', '.join(names)} {'has' if len(names) == 1 else 'have'} no value"
+        out.append(Finding("failed values", what, None, "", "fail", cause))
+    for t in sheet.spec.tables:
+        if t.computed or t.range is None:
+            continue
+        try:
+            data = sheet.table_data(t.name)
+        except WorkbookError as err:
+            out.append(
+                Finding("failed values", f"table {t.name} has no value", None, "", "fail", str(err))
+            )
+            continue
+        for col in data.columns[1:]:
+            if not col.failed:
+                continue
+            rows = sorted(col.failed)
+            named = "; ".join(
+                f"{data.var} = {data.columns[0].values[i]:g}: {col.failed[i]}"
+                for i in rows[:ROWS_NAMED]
+            )
+            more = f"; and {len(rows) - ROWS_NAMED} more" if len(rows) > ROWS_NAMED else ""
+            out.append(
+                Finding(
+                    "failed values",
+                    f"table {t.name}: {col.text} has no value in {len(rows)} of "
+                    f"{len(col.values)} rows (error cells in the workbook)",
+                    None,
+                    "",
+                    "fail",
+                    named + more,
+                )
             )
     return out
 

@@ -132,6 +132,12 @@ def _parser() -> argparse.ArgumentParser:
     new.add_argument("name", help="name of the new worksheet (writes NAME.toml)")
     new.add_argument("--out", help="file to write (default ./NAME.toml)")
     new.add_argument("--force", action="store_true", help="overwrite an existing file")
+    for (
+        command
+    ) in sub.choices.values():  # `workbook run X --debug` as well as `workbook --debug run X`
+        command.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help="show Python tracebacks"
+        )
     return p
 
 

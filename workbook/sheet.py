@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +42,11 @@ class Column:
     values: np.ndarray
     typed: tc.T | None  # None for the range variable itself
     text: str
+    failed: dict[int, str] = field(default_factory=dict)  # row -> why it has no value (NaN)
+
+    def excel_error(self, row: int) -> str:
+        """The Excel error value of a failed row: #DIV/0! for a division by zero, else #NUM!."""
+        return "#DIV/0!" if "division by zero" in self.failed[row] else "#NUM!"
 
 
 @dataclass
@@ -358,7 +363,15 @@ class Sheet:
             col = next(c for c in spec.columns if c.text == column)
             what = f"table {table}"
             values = self.range_values(spec.range, what)
-            self._memo[key] = self.column(col, spec.range.var, values, what).values
+            column = self.column(col, spec.range.var, values, what)
+            if column.failed:  # an aggregate over a column with holes would be wrong
+                row = min(column.failed)
+                raise DomainError(
+                    f"column '{column.text}' of table {table} has no value in {len(column.failed)} "
+                    f"row(s); the first: {column.failed[row]}",
+                    definition=what,
+                )
+            self._memo[key] = column.values
         return self._memo[key]
 
     def describe_call(self, fname: str, params, env) -> str:
@@ -466,8 +479,15 @@ class Sheet:
                 ),
                 what,
             )
+        failed: dict[int, str] = {}
         try:
             out = fn({var: values})
+        except DomainError as err:  # some rows leave the domain: the others keep their values
+            if t.text or values.ndim != 1:
+                raise self._locate(err, what) from None
+            out, failed = _rows_apart(fn, var, values, err)
+            if len(failed) == values.size:  # no row has a value: the error as it was
+                raise self._locate(err, what) from None
         except WorkbookError as err:
             raise self._locate(err, what) from None
         if t.text:
@@ -475,14 +495,21 @@ class Sheet:
             return Column(col.title, t.unit, out, t, col.text)
         out = np.broadcast_to(np.asarray(out, dtype=float), values.shape).copy()
         bad = ~np.isfinite(out)
-        if bad.any():
+        for i in np.flatnonzero(bad).tolist()[: MAX_FAILED_ROWS + 1]:
+            failed.setdefault(
+                i, f"{col.text} is not a finite number ({out.flat[i]}) for {var} = {values[i]:g}"
+            )
+        if failed and (len(failed) > MAX_FAILED_ROWS or len(failed) == values.size):
+            many = (
+                "every row" if len(failed) == values.size else f"more than {MAX_FAILED_ROWS} rows"
+            )
+            first = failed[min(failed)]
             raise DomainError(
-                f"column '{col.text}' is not a finite number for {var} = "
-                f"{values[bad][0]:g} ({bad.sum()} points)",
+                f"column '{col.text}' has no value in {many}; the first: {first}",
                 file=self.file,
                 definition=what,
             )
-        return Column(col.title, t.unit, out, t, col.text)
+        return Column(col.title, t.unit, out, t, col.text, failed)
 
     def table_spec(self, name: str):
         """The declaration of table ``name``; an error names a part that would add it."""
@@ -503,8 +530,16 @@ class Sheet:
         )
 
     def table_data(self, name: str) -> TableData:
-        """Evaluate one template table (only what it needs)."""
+        """Evaluate one template table (only what it needs), once per Sheet. A row whose value
+        fails is NaN in its column, the cause in ``Column.failed``."""
         spec = self.table_spec(name)
+        key = ("table", name, id(spec))
+        if key not in self._memo:  # the spec is kept with the data, so no id is reused
+            self._memo[key] = (self._table_data(spec), spec)
+        return self._memo[key][0]
+
+    def _table_data(self, spec) -> TableData:
+        name = spec.name
         if spec.range is None:
             raise InputError(f"table '{name}' is computed by a block; use sheet.block_table()")
         what = f"table {name}"
@@ -611,6 +646,31 @@ class Sheet:
         from .notebook import sheet_html
 
         return sheet_html(self)
+
+
+#: A column with more failed rows than this is an error, not a table with error cells.
+MAX_FAILED_ROWS = 1000
+
+
+def _rows_apart(fn, var: str, values: np.ndarray, err: DomainError):
+    """Evaluate a column whose vectorised evaluation failed in halves, down to the rows that
+    fail: (values with NaN where a row fails, {row: the cause}); at most MAX_FAILED_ROWS + 1
+    failed rows are looked for (a column with more is refused by the caller)."""
+    out = np.full(values.shape, np.nan)
+    failed: dict[int, str] = {}
+    pending = [(0, values.size, err)]
+    while pending and len(failed) <= MAX_FAILED_ROWS:
+        lo, hi, why = pending.pop()
+        if hi - lo == 1:
+            failed[lo] = why.message
+            continue
+        for a, b in ((lo + hi) // 2, hi), (lo, (lo + hi) // 2):
+            try:
+                part = fn({var: values[a:b]})
+                out[a:b] = np.broadcast_to(np.asarray(part, dtype=float), (b - a,))
+            except DomainError as e:
+                pending.append((a, b, e))
+    return out, failed
 
 
 def coerce_input(spec, raw, *, file: str | None = None):

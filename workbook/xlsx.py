@@ -596,12 +596,16 @@ class WorkbookWriter:
         except NotLive as why:
             for i in range(n):
                 v = col.values[i]
-                if isinstance(v, str):
+                if i in col.failed:  # an error value, as Excel computes one
+                    error = col.excel_error(i)
+                    ws.write_formula(first + i, j, _ERROR_FORMULAS[error], fmt, error)
+                elif isinstance(v, str):
                     ws.write_string(first + i, j, v, fmt)
                 else:
                     ws.write_number(first + i, j, float(v), fmt)
             ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
             self.not_live.append(f"{table}.{col.text}")
+            _failed_comments(ws, first, j, col)
             return False
         finally:
             self.printer.helpers = None
@@ -611,6 +615,9 @@ class WorkbookWriter:
         if self.printer.array:  # computes with vectors or matrices: one-cell array formulas
             write = lambda r, c, f, fm, v: ws.write_array_formula(r, c, r, c, f, fm, v)  # noqa: E731
         values = col.values.tolist()
+        for i in col.failed:  # the cached value of a failed row is Excel's error value
+            values[i] = col.excel_error(i)
+        _failed_comments(ws, first, j, col)
         for lo in range(0, n, PROGRESS_CELLS):
             if lo:  # a long column says how far it is
                 _progress(f"table {table}: {col.title}, row {lo:,} of {n:,}")
@@ -1006,6 +1013,16 @@ class WorkbookWriter:
         for i, (k, v) in enumerate(rows, start=2):
             ws.write_string(i, 0, k, self.fmt["header"])
             ws.write_string(i, 1, v, self.fmt["wrap"])
+
+
+#: Formulas that give an error value, for a failed row written as a value.
+_ERROR_FORMULAS = {"#DIV/0!": "=1/0", "#NUM!": "=SQRT(-1)"}
+
+
+def _failed_comments(ws, first: int, j: int, col) -> None:
+    """A comment on each failed row of a table column naming why it has no value."""
+    for i, why in col.failed.items():
+        ws.write_comment(first + i, j, f"No value: {why}")
 
 
 def _progress(text: str) -> None:

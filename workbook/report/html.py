@@ -83,6 +83,16 @@ class Values:
         return None
 
 
+def _with_errors(column):
+    """A table column's values, a failed row as its Excel error value."""
+    if not column.failed:
+        return column.values
+    out = column.values.astype(object)
+    for i in column.failed:
+        out[i] = column.excel_error(i)
+    return out
+
+
 def num_html(value, digits: int = mm.PRECISION) -> str:
     """A table cell's number: 6 significant digits, a true minus, powers of ten as 10^n."""
     if isinstance(value, (bool, np.bool_)):
@@ -375,10 +385,16 @@ class Document:
             unit = un.pretty(col.unit)
             unit_html = mm.math_element(mm.unit_box(unit)) if unit else ""
             heads.append(f"{sym}<br><span class='unit'>{unit_html}</span>")
-        columns = [c.values for c in data.columns]
+        columns = [_with_errors(c) for c in data.columns]
         n = len(columns[0])
         rows = f"{n:,} row{'s' if n != 1 else ''}"
-        return f"<p class='range'>{range_math}: {rows}</p>" + self._grid(heads, columns, n)
+        failed = "".join(
+            f"<p class='error'>{escape(c.text)} has no value in {len(c.failed):,} row(s); the "
+            f"first: {escape(c.failed[min(c.failed)])}</p>"
+            for c in data.columns
+            if c.failed
+        )
+        return f"<p class='range'>{range_math}: {rows}</p>" + self._grid(heads, columns, n) + failed
 
     def computed_table(self, t) -> str:
         df = self.sheet.computed_table(t.name)
