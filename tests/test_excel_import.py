@@ -171,7 +171,8 @@ def imported(tmp_path_factory):
 def test_import_reproduces_the_cached_values(imported, capsys):
     toml, _ = imported
     capsys.readouterr()
-    assert main(["check", str(toml), "--json"]) == 0
+    # exit 1: Ratio has no value (a division by zero), as B15 holds #DIV/0! in Excel
+    assert main(["check", str(toml), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
     # 13 formula cells: 12 numbers (B15 holds an error value, B17 is not translated)
     assert report == {

@@ -110,6 +110,9 @@ class Evaluator(Visitor):
                 del self._functions[name]
                 raise
             fn.explain = lambda env, f=f: _explain(self, f, env)
+            d = self.typer.spec.definitions.get(name)
+            if d is not None and d.limits is not None:
+                fn = _limited(name, f.params, fn, d, f.unit, self.describe_args)
             if name in self.typer.recursive:
                 fn = _recursion_bounded(name, fn)
             compiled.append(fn)
@@ -662,6 +665,62 @@ def _checked(name: str, params: tuple, body: Fn, describe) -> Fn:
             )
         return out
 
+    return run
+
+
+def outside_limits(d, unit, values) -> tuple[np.ndarray, str]:
+    """Which of ``values`` (magnitudes in ``unit``) break definition d's declared limits, and
+    the limits in words."""
+    from . import units as un
+
+    lo, hi, positive = d.limits.magnitudes(unit, d.unit, f"'{d.name}'")
+    v = np.asarray(values, dtype=float)
+    bad = (v < lo) | (v > hi)
+    if positive:
+        bad |= v <= 0
+    shown = un.pretty(d.unit) if d.unit is not None else un.pretty(unit)
+    return bad, d.limits.text(shown)
+
+
+def limits_error(d, unit, value: float, where: str = "") -> DomainError:
+    """The error of a value of d outside its declared limits, in the unit it is shown in."""
+    from . import units as un
+
+    shown = d.unit if d.unit is not None else unit
+    q = un.registry().Quantity(value, unit).to(shown)
+    return DomainError(
+        f"{d.name} = {q.magnitude:.6g} {un.pretty(shown)}".rstrip()
+        + (f" {where}" if where else "")
+        + f" breaks its declared limit ({d.limits.text(un.pretty(shown))}): the inputs are "
+        "outside the range where the worksheet's formulas hold",
+        definition=d.name,
+    )
+
+
+def _limited(name: str, params: tuple, body: Fn, d, unit, describe) -> Fn:
+    """Wrap a function so that a value outside the definition's declared limits is an error
+    naming the definition, its limit and the arguments where it is broken."""
+
+    def run(env):
+        out = body(env)
+        if isinstance(out, np.ndarray) and out.dtype == object:
+            return out
+        bad, _ = outside_limits(d, unit, out)
+        if np.any(bad):
+            first = int(np.flatnonzero(np.ravel(bad))[0])
+            value = float(np.ravel(out)[first])
+            sub = {
+                p: (
+                    np.ravel(env[p])[first]
+                    if isinstance(env[p], np.ndarray) and np.shape(env[p]) == np.shape(out)
+                    else env[p]
+                )
+                for p in params
+            }
+            raise limits_error(d, unit, value, describe(name, params, sub))
+        return out
+
+    run.explain = getattr(body, "explain", None)
     return run
 
 

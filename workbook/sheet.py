@@ -107,7 +107,9 @@ class Sheet:
         later = []  # functions whose body needs vectors: typed by the calls of the sheet
         for name, d in self.spec.definitions.items():
             try:
-                self.typer.function(name) if d.is_function else self.typer.scalar(name)
+                t = self.typer.function(name) if d.is_function else self.typer.scalar(name)
+                if d.limits is not None:  # a limit in another dimension is refused at load
+                    d.limits.magnitudes(t.unit, d.unit, f"'{name}'")
             except WorkbookError as err:
                 if not d.is_function:
                     raise err.located(file=self.file, line=d.line, definition=d.name) from None
@@ -339,8 +341,22 @@ class Sheet:
                     line=d.line,
                     definition=name,
                 )
+            if d.limits is not None and not isinstance(value, str):
+                self._check_limits(d, value)
             self._memo[name] = value
         return self._memo[name]
+
+    def _check_limits(self, d, value) -> None:
+        """A scalar definition's value outside its declared limits is an error."""
+        from .numeric import limits_error, outside_limits
+
+        unit = self.typer.scalar(d.name).unit
+        bad, _ = outside_limits(d, unit, value)
+        if np.any(bad):
+            first = float(np.ravel(value)[int(np.flatnonzero(np.ravel(bad))[0])])
+            raise limits_error(d, unit, first).located(
+                file=self.file, line=d.line, definition=d.name
+            )
 
     def _solved(self, name: str) -> float:
         """An unknown of a [[solve]] block (the block is solved once per sheet)."""

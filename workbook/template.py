@@ -6,6 +6,7 @@ The template is data: TOML parsed by the standard library, expressions parsed by
 
 from __future__ import annotations
 
+import math
 import re
 
 try:
@@ -21,7 +22,7 @@ import pint
 from . import expr as ex
 from . import units as un
 from .declared_checks import read_check
-from .errors import InputError, LimitError, TemplateError, WorkbookError
+from .errors import InputError, LimitError, TemplateError, UnitError, WorkbookError
 from .fields import Fields, nearest
 from .ranges import RangeSpec, parse_range
 from .registry import REGISTRY
@@ -65,7 +66,7 @@ SHEET_KEYS = (
 )  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
 INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
 ARGUMENT_KEYS = ("unit", "note", "plain")
-DEFINITION_KEYS = ("expr", "pieces", "program", "unit", "note")
+DEFINITION_KEYS = ("expr", "pieces", "program", "unit", "note", "positive", "min", "max")
 PART_KEYS = ("title", "note")
 TABLE_KEYS = ("name", "title", "range", "columns", "sheet", "block", "part", "vary")
 COLUMN_KEYS = ("expr", "unit", "title")
@@ -143,6 +144,45 @@ class Branch:
     text: str
 
 
+@dataclass(frozen=True)
+class Limits:
+    """What a definition's values must meet, declared like an input's bounds: a value outside
+    is an error naming the definition and its limit, never a number."""
+
+    positive: bool = False
+    minimum: pint.Quantity | None = None  # a plain number is in the definition's unit
+    maximum: pint.Quantity | None = None
+
+    def magnitudes(self, unit, display=None, what: str = "") -> tuple[float, float, bool]:
+        """(lowest, highest, positive) as magnitudes in ``unit``; a plain-number bound is in
+        ``display`` (the unit the definition is shown in), else in ``unit``."""
+        out = []
+        for bound, default in ((self.minimum, -math.inf), (self.maximum, math.inf)):
+            if bound is None:
+                out.append(default)
+                continue
+            q = bound
+            if q.unitless and not un.registry().Quantity(1, unit).unitless:
+                q = un.registry().Quantity(q.magnitude, display or unit)
+            try:
+                out.append(float(q.to(unit).magnitude))
+            except pint.DimensionalityError:
+                raise UnitError(
+                    f"{what}: the limit {bound:~} is {un.dims(bound.units)}, the value "
+                    f"{un.dims(unit)} ({un.pretty(unit)})"
+                ) from None
+        return out[0], out[1], self.positive
+
+    def text(self, display: str = "") -> str:
+        """The limits as the template says them: "positive", "at least 0 mm"."""
+        parts = ["positive"] if self.positive else []
+        for bound, word in ((self.minimum, "at least"), (self.maximum, "at most")):
+            if bound is not None:
+                unit = "" if not bound.unitless else display
+                parts.append(f"{word} {bound:~}{(' ' + unit) if unit else ''}".rstrip())
+        return " and ".join(parts)
+
+
 @dataclass
 class Definition:
     name: str
@@ -155,6 +195,7 @@ class Definition:
     line: int | None = None
     program: Any = None  # workbook.program.Program: a body of statements
     ode: tuple[str, int] | None = None  # a state of an [[ode]]: (ode name, state index)
+    limits: Limits | None = None  # what its values must meet (positive = true, min, max)
 
     @property
     def is_function(self) -> bool:
@@ -353,6 +394,13 @@ def parse_branch(text: str, *, what: str) -> Branch:
 
 def _depth_at(text: str, pos: int) -> int:
     return text[:pos].count("(") - text[:pos].count(")")
+
+
+def _limits(f: Fields, name: str) -> Limits | None:
+    """A definition's declared limits, or None."""
+    if not any(k in f for k in ("positive", "min", "max")):
+        return None
+    return Limits(f.flag("positive"), _bound(f, "min", name), _bound(f, "max", name))
 
 
 def _bound(f: Fields, key: str, name: str):
@@ -887,6 +935,11 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
         f = Fields(raw, DEFINITION_KEYS, f"definition {name}")
         note = f.text("note")
         unit_text = f.text("unit", None)
+        limits = _limits(f, name)
+        if limits is not None:  # the rest of the definition as it would be without them
+            rest = {k: v for k, v in raw.items() if k not in ("positive", "min", "max")}
+            d = _definition(name, params, rest, line)
+            return replace(d, limits=limits)
         if "expr" in f and "pieces" in f:
             raise TemplateError("a definition has either expr or pieces, not both")
         if "expr" in f:
