@@ -1,6 +1,6 @@
 """The table of docs/mathcad.md: each Mathcad worksheet imported, then checked.
 
-For every .xmcd file under the folder (default ../shared/mathcad beside the repository; a
+For every .xmcd or .mcdx file under the folder (default ../shared/mathcad beside the repository; a
 file that is only referenced by another one is skipped), runs ``workbook import`` and
 ``workbook check --json`` and prints a Markdown table: results Mathcad stored, reproduced,
 failed, not computable, and the reasons for those not reproduced (from the untranslated list
@@ -95,7 +95,7 @@ def main() -> int:
     rows = []
     sums = Counter()
     with tempfile.TemporaryDirectory() as tmp:
-        for path in sorted(folder.rglob("*.xmcd")):
+        for path in sorted([*folder.rglob("*.xmcd"), *folder.rglob("*.mcdx")]):
             if path.resolve() in skip:
                 continue
             name = path.relative_to(folder).as_posix()

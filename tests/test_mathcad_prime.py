@@ -225,3 +225,67 @@ def test_every_prime_worksheet_imports_and_none_is_wrong(name, tmp_path, capsys)
     assert main(["import", str(PRIME / name), "--out", str(tmp_path)]) == 0
     result = _check(tmp_path / (Path(name).stem + ".toml"), capsys)
     assert result["reproduced"] + result["not_computable"] == result["printed"], result["failures"]
+
+
+def _id(name: str, label: str = "VARIABLE") -> str:
+    return f'<ml:id labels="{label}">{name}</ml:id>'
+
+
+def _eval(rid: int, body: str) -> str:
+    return _region(
+        rid, rid, f"<ml:eval>{body}<ml:unitOverride><ml:placeholder/></ml:unitOverride></ml:eval>"
+    )
+
+
+def test_constants_labels_and_if_chains(tmp_path, capsys):
+    """g labelled CONSTANT is standard gravity (not the gram), g labelled VARIABLE and not
+    defined is not a unit either (listed); f(x) := if x > 2: 10 else if x > 0: 20 else 30 takes
+    the first true branch: f(3) = 10, f(1) = 20, f(-1) = 30."""
+    branch = "<ml:then><ml:program>{}</ml:program></ml:then>"
+    chain = (
+        f"<ml:if><ml:test><ml:apply><ml:greaterThan/>{_id('x')}<ml:real>2</ml:real></ml:apply>"
+        f"</ml:test>{branch.format('<ml:real>10</ml:real>')}<ml:elseif><ml:test><ml:apply>"
+        f"<ml:greaterThan/>{_id('x')}<ml:real>0</ml:real></ml:apply></ml:test>"
+        f"{branch.format('<ml:real>20</ml:real>')}</ml:elseif><ml:else><ml:program>"
+        "<ml:real>30</ml:real></ml:program></ml:else></ml:if>"
+    )
+    f_def = _region(
+        1,
+        1,
+        f"<ml:define><ml:function>{_id('f')}<ml:boundVars>{_id('x')}</ml:boundVars>"
+        f"</ml:function>{chain}</ml:define>",
+    )
+
+    def call(v: str) -> str:
+        return f"<ml:apply>{_id('f', 'FUNCTION')}<ml:sequence>{v}</ml:sequence></ml:apply>"
+
+    minus_one = "<ml:apply><ml:neg/><ml:real>1</ml:real></ml:apply>"
+    regions = f_def + "".join(
+        [
+            _eval(2, call("<ml:real>3</ml:real>")),
+            _eval(3, call("<ml:real>1</ml:real>")),
+            _eval(4, call(minus_one)),
+            _eval(5, _id("g", "CONSTANT")),
+            _eval(6, _id("g")),
+        ]
+    )
+    per_s2 = (
+        '<u:unitMonomial><u:unitReference unit="meter"/><u:unitReference unit="second" '
+        'power-numerator="-2"/></u:unitMonomial>'
+    )
+    results = "".join(
+        [
+            _result(1),
+            _result(2, "<ml:real>10</ml:real>"),
+            _result(3, "<ml:real>20</ml:real>"),
+            _result(4, "<ml:real>30</ml:real>"),
+            _result(5, f"<ml:unitedValue><ml:real>9.80665</ml:real>{per_s2}</ml:unitedValue>"),
+            _result(6, "<ml:real>1</ml:real>"),
+        ]
+    )
+    src = _package(tmp_path / "labels.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "labels.toml").read_text(encoding="utf-8")
+    assert "region 6: an evaluation ( = ): g is not defined before it is used" in text
+    result = _check(tmp_path / "labels.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (5, 4, 0), result

@@ -297,8 +297,10 @@ def _node(el) -> MNode:
         text, subscript = _name(el)
         if subscript:
             attrs["subscript"] = subscript
-        if attrs.get("labels") == "KEYWORD" and text.strip() in _KEYWORDS:
-            return MNode(_KEYWORDS[text.strip()], attrs, "", [], el.sourceline)
+        if attrs.get("labels") == "KEYWORD" and text.strip().lower() in _KEYWORDS:
+            return MNode(_KEYWORDS[text.strip().lower()], attrs, "", [], el.sourceline)
+        if attrs.get("labels") == "CONSTANT":
+            return _constant(text, subscript, attrs, el.sourceline)
         return MNode("id", attrs, text, [], el.sourceline)
     children = [_node(c) for c in el if isinstance(c.tag, str) and _ns(c.tag) in (ML50, UNITS, "")]
     children = [c for c in children if c.tag != "display"]
@@ -309,6 +311,108 @@ def _node(el) -> MNode:
     node = MNode(tag, attrs, el.text or "", children, el.sourceline)
     if tag == "eval":
         node.children = [c for c in children if c.tag != "noOverride"]
+    if tag == "apply" and children:
+        return _apply(node)
+    if tag == "if":
+        return _if_chain(node)
+    return node
+
+
+#: Prime's built-in constants (labelled CONSTANT) -> pint's name of the same constant.
+_CONSTANTS = {
+    ("c", ""): "speed_of_light",
+    ("g", ""): "standard_gravity",
+    ("h", ""): "planck_constant",
+    ("ℏ", ""): "hbar",
+    ("k", ""): "boltzmann_constant",
+    ("e", "c"): "elementary_charge",
+    ("m", "u"): "atomic_mass_constant",
+    ("N", "A"): "avogadro_constant",
+    ("R", ""): "molar_gas_constant",
+    ("R", "∞"): "rydberg_constant",
+    ("α", ""): "fine_structure_constant",
+    ("ε", "0"): "vacuum_permittivity",
+    ("μ", "0"): "vacuum_permeability",
+    ("σ", ""): "stefan_boltzmann_constant",
+    ("Φ", "0"): "magnetic_flux_quantum",
+}
+_BASE_UNITS = {"[length]": "m", "[mass]": "kg", "[time]": "s", "[current]": "A",
+               "[temperature]": "K", "[substance]": "mol", "[luminosity]": "cd"}  # fmt: skip
+_NUMBERS = {("∞", ""): 1e307, ("γ", ""): 0.57721566490153286}  # Prime's ∞ is 10^307
+
+
+def _constant(text: str, subscript: str, attrs: dict, line) -> MNode:
+    """A built-in constant of Prime as a number times SI base units (π and e stay names the
+    translator knows; a constant it does not know stays a name, not defined)."""
+    key = (text.strip(), subscript)
+    if key in _NUMBERS:
+        return MNode("real", {}, repr(_NUMBERS[key]), [], line)
+    if key not in _CONSTANTS:
+        named = dict(attrs, subscript=subscript) if subscript else attrs
+        return MNode("id", named, text, [], line)
+    from .. import units as un
+
+    q = un.registry().Quantity(1, _CONSTANTS[key]).to_base_units()
+    node = MNode("real", {}, repr(float(q.magnitude)), [], line)
+    for dim, power in q.dimensionality.items():
+        unit = MNode("id", {"labels": "UNIT"}, _BASE_UNITS[dim], [], line)
+        if power != 1:
+            exponent = MNode("real", {}, repr(float(power)), [], line)
+            unit = MNode("apply", {}, "", [MNode("pow", {}, "", []), unit, exponent], line)
+        node = MNode("apply", {}, "", [MNode("mult", {}, "", []), node, unit], line)
+    return MNode("parens", {}, "", [node], line)
+
+
+def _branch_value(node: MNode | None) -> MNode | None:
+    """The expression of a then/else branch that holds one expression, else None."""
+    while node is not None and node.tag in ("then", "else", "program") and len(node.children) == 1:
+        node = node.children[0]
+    if node is None or node.tag in ("then", "else", "program", "localDefine", "return"):
+        return None
+    return node
+
+
+def _if_chain(node: MNode) -> MNode:
+    """Prime's if / else if / else of single expressions as Mathcad 15's nested if(c, a, b)
+    (the first true condition decides); any other if stays as it is (not translated)."""
+    tests, values, other = [], [], None
+    parts = [node] + []
+    test = next((c for c in node.children if c.tag == "test"), None)
+    then = next((c for c in node.children if c.tag == "then"), None)
+    for child in node.children:
+        if child.tag == "elseif":
+            parts.append(child)
+        elif child.tag == "else":
+            other = _branch_value(child)
+            if other is None:
+                return node
+    if test is None or then is None or other is None:
+        return node
+    for part in parts:
+        test = next((c for c in part.children if c.tag == "test"), None)
+        value = _branch_value(next((c for c in part.children if c.tag == "then"), None))
+        if test is None or value is None or len(test.children) != 1:
+            return node
+        tests.append(test.children[0])
+        values.append(value)
+    tree = other
+    for cond, value in zip(reversed(tests), reversed(values)):
+        tree = MNode("apply", {}, "", [MNode("id", {}, "if", []), cond, value, tree], node.line)
+    return tree
+
+
+def _apply(node: MNode) -> MNode:
+    """Prime's forms of operators Mathcad 15 wrote otherwise."""
+    op, args = node.children[0].tag, node.children[1:]
+    if op == "mult" and len(args) == 2 and args[1].tag == "placeholder":
+        return args[0]  # a value with an empty unit placeholder (scale)
+    if op == "nthRoot" and len(args) == 2 and args[0].tag == "placeholder":
+        return MNode("apply", {}, "", [MNode("sqrt", {}, "", []), args[1]], node.line)
+    if op == "percent" and len(args) == 1:  # 9% is 0.09
+        hundred = MNode("real", {}, "100", [])
+        return MNode("apply", {}, "", [MNode("div", {}, "", []), args[0], hundred], node.line)
+    if op == "determinant" and len(args) == 1:  # |M|, as Mathcad 15 wrote it
+        return MNode("apply", {}, "", [MNode("absval", {}, "", []), args[0]], node.line)
     return node
 
 

@@ -150,7 +150,8 @@ class ExprTranslator(Visitor):
             return ex.Name("pi")
         if not sub and text == "e":
             return ex.Call("exp", (ex.Number(1.0),))
-        if not sub and text in FORMULA_UNITS:
+        # Mathcad Prime labels each name: one labelled a variable is never a unit
+        if not sub and text in FORMULA_UNITS and node.attrs.get("labels") in (None, "UNIT"):
             return ex.Name(self.tr.unit_sym(text).token())
         raise Untranslatable(f"{nm.mathcad_text(text, sub)} is not defined before it is used")
 
