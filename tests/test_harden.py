@@ -845,3 +845,83 @@ def test_sweep_values_converted_at_once_equal_one_by_one(tmp_path):
     serial = sw.sweep(sheet, vary, {"q": "y(0.7)"}, mode="serial").table
     assert vector.equals(serial)
     assert vector["error"].notna().tolist() == [False, False, False, True, False]
+
+
+# -- files a worksheet reads: inside its folder after symlinks -------------------------------
+
+DATA_FILE = """
+[data.pump]
+file = "FILE"
+columns = { x = "m", y = "m" }
+[inputs]
+u = "1.5 m"
+[definitions]
+a = "linterp(x, y, u)"
+"""
+
+
+@pytest.mark.parametrize("how", ["file", "folder"])
+def test_a_link_out_of_the_worksheet_folder_is_refused_unread(tmp_path, how):
+    # passwd_link.csv -> /etc/passwd was followed and its first line printed in the error
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    write(outside / "secret.csv", "x,y\nroot:x:0:0:root:/root:/bin/bash\n")
+    sheet_dir = tmp_path / "sheet"
+    sheet_dir.mkdir()
+    if how == "file":
+        (sheet_dir / "p.csv").symlink_to(outside / "secret.csv")
+        name = "p.csv"
+    else:
+        (sheet_dir / "sub").symlink_to(outside, target_is_directory=True)
+        name = "sub/secret.csv"
+    write(sheet_dir / "d.toml", DATA_FILE.replace("FILE", name))
+    out = cli(sheet_dir, "run", "d.toml", "--out", "d.xlsx")
+    assert out.returncode == 2 and "outside the template's folder" in out.stderr, out.stderr
+    assert ":0:0:" not in out.stderr and "d.toml:3" in out.stderr
+    printed = '[inputs]\nR = "1 mm"\n[definitions]\nd = "2*R"\n[[printed]]\nfile = "NAME"\n'
+    write(sheet_dir / "p.toml", printed.replace("NAME", name))
+    out = cli(sheet_dir, "check", "p.toml")
+    assert out.returncode == 2 and "outside the template's folder" in out.stderr, out.stderr
+    assert ":0:0:" not in out.stderr
+
+
+def test_a_link_inside_the_worksheet_folder_is_read(tmp_path):
+    write(tmp_path / "measured.csv", "x,y\n1,10\n2,20\n")
+    (tmp_path / "p.csv").symlink_to(tmp_path / "measured.csv")
+    write(tmp_path / "d.toml", DATA_FILE.replace("FILE", "p.csv"))
+    assert float(workbook.load(tmp_path / "d.toml").evaluate("a").to("m").magnitude) == 15.0
+
+
+XMCD = (
+    '<?xml version="1.0" encoding="UTF-8"?>\n'
+    '<worksheet xmlns="http://schemas.mathsoft.com/worksheet30" '
+    'xmlns:ml="http://schemas.mathsoft.com/math30"><regions>{}</regions></worksheet>'
+)
+
+
+def _references(path: Path, *names: str) -> None:
+    regions = "".join(
+        f'<region region-id="{k}" top="{k}" left="0"><reference/><link href="{n}"/></region>'
+        for k, n in enumerate(names, start=1)
+    )
+    path.write_text(XMCD.format(regions), encoding="utf-8")
+
+
+def test_two_references_to_one_file_are_not_a_cycle(tmp_path):
+    # main -> a -> lib and main -> b -> lib was refused as "references itself in a cycle"
+    from workbook.mathcad import MAX_REFERENCED_FILES, read, regions_with_references
+
+    _references(tmp_path / "lib.xmcd")
+    _references(tmp_path / "a.xmcd", "lib.xmcd")
+    _references(tmp_path / "b.xmcd", "lib.xmcd")
+    _references(tmp_path / "main.xmcd", "a.xmcd", "b.xmcd")
+    assert regions_with_references(read(tmp_path / "main.xmcd")) == []
+    _references(tmp_path / "lib.xmcd", "a.xmcd")  # now a real cycle: a -> lib -> a
+    with pytest.raises(InputError, match="references itself in a cycle"):
+        regions_with_references(read(tmp_path / "main.xmcd"))
+    # diamonds stacked 7 deep include the last file 2^7 times: bounded by files read
+    for k in range(7):
+        _references(tmp_path / f"d{k}.xmcd", f"d{k + 1}.xmcd", f"d{k + 1}.xmcd")
+    _references(tmp_path / "d7.xmcd")
+    with pytest.raises(InputError, match=f"more than {MAX_REFERENCED_FILES} files"):
+        regions_with_references(read(tmp_path / "d0.xmcd"))

@@ -39,6 +39,34 @@ def regular_file(path: Path, *, what: str, max_bytes: int) -> int:
     return st.st_size
 
 
+def file_beside(folder: Path, name: str, *, what: str, max_bytes: int) -> Path:
+    """The regular file ``name`` inside ``folder`` (a worksheet's own folder), after every
+    symlink is resolved; refused when ``name`` is absolute, climbs out with ``..``, or
+    resolves (through a symlink, itself or a folder on the way) to a file outside ``folder``,
+    or is not a regular file of at most ``max_bytes``. Returns the resolved path.
+
+    A worksheet folder from an archive or a clone may hold a symlink to any file of the
+    machine; the error names only the name given, never what it points to.
+    """
+    rel = Path(str(name))
+    if rel.is_absolute() or ".." in rel.parts or not str(name).strip():
+        raise InputError(f"{what} {str(name)!r} must be a file name beside the template")
+    base = Path(folder).resolve()
+    try:
+        target = (base / rel).resolve(strict=True)
+    except FileNotFoundError:
+        raise InputError(f"{what} {str(name)!r}: no such file beside the template") from None
+    except (OSError, RuntimeError) as exc:  # a symlink loop, a name too long
+        raise InputError(f"{what} {str(name)!r}: cannot read it ({exc})") from None
+    if not target.is_relative_to(base):
+        raise InputError(
+            f"{what} {str(name)!r} is a link to a file outside the template's folder; a "
+            "worksheet reads only files in its own folder"
+        )
+    regular_file(target, what=what, max_bytes=max_bytes)
+    return target
+
+
 def read_text(path: Path, *, what: str, max_bytes: int) -> str:
     """The UTF-8 text of a regular file of at most ``max_bytes`` (a UTF-8 BOM is dropped).
 

@@ -63,20 +63,16 @@ def _table(table: str, spec, path: Path, line, claim) -> dict[str, DataColumn]:
         raise TemplateError(
             f'[data.{table}] needs file = "name.csv" and columns = {{ X = "unit", ... }}'
         )
-    rel = Path(str(spec["file"]))
-    if rel.is_absolute() or ".." in rel.parts:  # a worksheet reads only files in its folder
-        raise TemplateError(
-            f"[data.{table}] file {str(rel)!r} must be a file name beside the template"
-        )
     columns = spec["columns"]
     if not isinstance(columns, dict) or not columns:
         raise TemplateError(
             f'[data.{table}] columns = {{ X = "unit", ... }} names the columns used'
         )
-    file = path.parent / rel
-    from .limits import MAX_CSV_BYTES, read_text
+    from .limits import MAX_CSV_BYTES, file_beside, read_text
 
-    text = read_text(file, what=f"[data.{table}] file", max_bytes=MAX_CSV_BYTES)
+    what = f"[data.{table}] file"  # inside the template's folder once symlinks are resolved
+    file = file_beside(path.parent, str(spec["file"]), what=what, max_bytes=MAX_CSV_BYTES)
+    text = read_text(file, what=what, max_bytes=MAX_CSV_BYTES)
     try:
         rows = [r for r in csv.reader(text.splitlines()) if r and not r[0].lstrip().startswith("#")]
     except csv.Error as err:

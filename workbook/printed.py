@@ -9,7 +9,7 @@ from pathlib import Path
 
 from . import units as un
 from .errors import TemplateError, WorkbookError
-from .limits import MAX_CSV_BYTES, read_text
+from .limits import MAX_CSV_BYTES, file_beside, read_text
 from .template import PrintedSpec
 
 
@@ -57,7 +57,15 @@ def _number_or_text(cell: str) -> float | str:
 
 def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
     """Read a printed-values CSV: name, argument value, value, unit ('#' lines are comments)."""
-    header, lines = read_commented_csv(spec.file, "printed values")
+    file = spec.file
+    if spec.folder is not None:  # resolved, and inside the template's folder
+        file = file_beside(
+            spec.folder,
+            str(spec.file.relative_to(spec.folder)),
+            what="[[printed]] file",
+            max_bytes=MAX_CSV_BYTES,
+        )
+    header, lines = read_commented_csv(file, "printed values")
     rows = []
     for number, cells, line in lines:
         if len(cells) != 4:

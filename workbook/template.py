@@ -302,6 +302,7 @@ class PrintedSpec:
     misprints: list[Misprint] = field(default_factory=list)
     note: str = ""
     part: str | None = None
+    folder: Path | None = None  # the template's folder: the file must resolve inside it
 
 
 @dataclass
@@ -1193,6 +1194,7 @@ def _printed_fields(raw: dict, path: Path, text: str) -> PrintedSpec:
         role,
         misprints,
         f.text("note"),
+        folder=path.parent,
     )
 
 

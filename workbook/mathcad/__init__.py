@@ -18,6 +18,7 @@ from ..errors import InputError, WorkbookError
 from .reader import Region, Worksheet, read
 
 MAX_REFERENCE_DEPTH = 8
+MAX_REFERENCED_FILES = 100  # files read for references, a file included twice counted twice
 
 
 @dataclass
@@ -47,11 +48,15 @@ def sheet_name(path: Path) -> str:
     return name[:80]
 
 
-def regions_with_references(ws: Worksheet, depth: int = 0, seen=None) -> list[Region]:
+def regions_with_references(
+    ws: Worksheet, depth: int = 0, seen: frozenset = frozenset(), reads: list | None = None
+) -> list[Region]:
     """The regions in order, a reference region replaced by the referenced file's regions
-    (resolved relative to the file; it must stay inside the file's folder)."""
-    seen = set() if seen is None else seen
-    seen.add(ws.path.resolve())
+    (resolved relative to the file; it must stay inside the file's folder). A cycle is a file
+    among the ones that include it (``seen``); two files that include the same third (a
+    diamond) are not one. At most MAX_REFERENCED_FILES files are read in all."""
+    seen = seen | {ws.path.resolve()}
+    reads = [0] if reads is None else reads
     out: list[Region] = []
     for region in ws.regions:
         if region.kind != "reference":
@@ -62,7 +67,12 @@ def regions_with_references(ws: Worksheet, depth: int = 0, seen=None) -> list[Re
             raise InputError(f"{ws.path}: region {region.id} references itself in a cycle")
         if depth >= MAX_REFERENCE_DEPTH:
             raise InputError(f"{ws.path}: references nested more than {MAX_REFERENCE_DEPTH} deep")
-        out += regions_with_references(read(target), depth + 1, seen)
+        reads[0] += 1
+        if reads[0] > MAX_REFERENCED_FILES:
+            raise InputError(
+                f"{ws.path}: references include more than {MAX_REFERENCED_FILES} files in all"
+            )
+        out += regions_with_references(read(target), depth + 1, seen, reads)
     return out
 
 
