@@ -95,6 +95,24 @@ Function Guarded(x As Double) As Double
     Guarded = 1 / x
 End Function
 
+Function Grade(m As Double) As String
+    If m > 50 Then
+        Grade = "big"
+    ElseIf m >= 10 Then
+        Grade = "mid"
+    Else
+        Grade = "small"
+    End If
+End Function
+
+Function Checked(x As Double) As Variant
+    If x < 0 Then
+        Checked = "x must not be negative"
+    Else
+        Checked = Sqr(x)
+    End If
+End Function
+
 Declare PtrSafe Function GetTickCount Lib "kernel32" () As Long
 
 Sub WriteResults()
@@ -121,6 +139,9 @@ def build(folder: Path) -> tuple[Path, Path, dict[str, object]]:
         "B15": "#DIV/0!",
         "B16": 2.0,  # Rounded(2.5): VBA rounds half to even
         "B17": 1 / 6,
+        "B18": "mid",
+        "B19": 3.0,
+        "B20": "x must not be negative",
     }
     path = folder / "beam.xlsx"
     wb = xlsxwriter.Workbook(str(path))
@@ -148,6 +169,9 @@ def build(folder: Path) -> tuple[Path, Path, dict[str, object]]:
         "B15": ("Ratio", "=SafeRatio(B1, 0)"),
         "B16": ("Rounded", "=Rounded(2.5)"),
         "B17": ("Guarded", "=Guarded(B1)"),
+        "B18": ("Grade", "=Grade(B4)"),
+        "B19": ("Root", "=Checked(9)"),
+        "B20": ("Message", "=Checked(-1)"),
     }
     for cell, (label, formula) in formulas.items():
         row = int(cell[1:]) - 1
@@ -171,17 +195,18 @@ def imported(tmp_path_factory):
 def test_import_reproduces_the_cached_values(imported, capsys):
     toml, _ = imported
     capsys.readouterr()
-    # exit 1: Ratio has no value (a division by zero), as B15 holds #DIV/0! in Excel
+    # exit 1: Ratio has no value (a division by zero), as B15 holds #DIV/0! in Excel; B20
     assert main(["check", str(toml), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # 13 formula cells: 12 numbers (B15 holds an error value, B17 is not translated)
-    assert report == {
-        "printed": 11,
-        "reproduced": 11,
+    # 16 formula cells: B15 holds an error value (not compared), B17 is not translated;
+    # B20 shows a message where the function otherwise gives numbers: an error here
+    assert {k: report[k] for k in ("printed", "reproduced", "failed")} == {
+        "printed": 14,
+        "reproduced": 13,
         "failed": 0,
-        "not_computable": 0,
-        "failures": [],
     }
+    assert report["not_computable"] == 1
+    assert [f["name"] for f in report["failures"]] == ["Message"]
 
 
 def test_the_sheet_gives_the_values_excel_stored(imported):

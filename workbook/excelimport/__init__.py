@@ -19,6 +19,7 @@ class ImportResult:
     functions: int
     printed: int
     not_translated: list[tuple[str, str]] = field(default_factory=list)
+    cells: dict[str, tuple[str, float | None]] = field(default_factory=dict)  # ref -> printed row
 
     def line(self) -> str:
         extra = (

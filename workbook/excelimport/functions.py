@@ -57,14 +57,3 @@ VBA: dict[str, tuple[str, tuple[int, ...]]] = {
     "csng": ("{0}", (1,)),
     "cdec": ("{0}", (1,)),
 }
-
-#: Excel's error codes (CVErr(xlErr...)) and the text a cell shows
-ERRORS = {
-    "xlerrdiv0": "#DIV/0!",
-    "xlerrna": "#N/A",
-    "xlerrname": "#NAME?",
-    "xlerrnull": "#NULL!",
-    "xlerrnum": "#NUM!",
-    "xlerrref": "#REF!",
-    "xlerrvalue": "#VALUE!",
-}

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .functions import ERRORS, EXCEL, EXCEL_VARIADIC, VBA
+from .functions import EXCEL, EXCEL_VARIADIC, VBA
 from .vba import Procedure, split_top
 from .vbaexpr import VbaSyntax, parse, strip
 
@@ -107,6 +107,17 @@ class Translator:
     # -- statements --------------------------------------------------------------------
     def translate(self) -> str:
         body = list(self.proc.lines)
+        self.body = body
+        self.at = 0
+        self.assigned = False
+        rhs_of_result = [
+            text.split("=", 1)[1].strip()
+            for _, text in body
+            if re.match(rf"^{re.escape(self.proc.name)}\s*=", text, re.I)
+        ]
+        self.text_function = self.proc.returns.lower() == "string" or (
+            bool(rhs_of_result) and all(r.startswith('"') for r in rhs_of_result)
+        )
         ret_type = self.proc.returns.lower()
         for i, p in enumerate(self.proc.params):
             if p.type.lower() in INTEGER_TYPES:  # VBA rounds a number passed to an Integer
@@ -114,14 +125,13 @@ class Translator:
                 self.lines.append(f"{name} := {bankers(name)}")
         if ret_type in NUMBER_TYPES or ret_type == "boolean":
             self.lines.append(f"{self.ret} := 0")
-        elif ret_type == "string":
-            self.lines.append(f'{self.ret} := ""')
         start = len(self.lines)
         self.block(body, 0, 0, ())
         # VBA gives every declared number 0 when the function starts (Dim does not run)
         inits = [f"{self.names[k]} := 0" for k in self.declared_numbers if k in self.names]
         self.lines[start:start] = inits
-        self.lines.append(self.ret)
+        if self.assigned or not self.text_function:
+            self.lines.append(self.ret)
         return "\n".join(self.lines)
 
     def emit(self, indent: int, text: str) -> None:
@@ -136,6 +146,8 @@ class Translator:
             low = text.lower()
             if stop and re.match(r"^(" + "|".join(stop) + r")\b", low):
                 break
+            if lines is self.body:
+                self.at = i
             try:
                 i = self.statement(lines, i, indent)
             except NotTranslated as exc:
@@ -222,27 +234,7 @@ class Translator:
         if target[0] == "id":
             key = target[1].lower()
             if key == self.proc.name.lower():
-                if (
-                    rhs[0] == "call"
-                    and rhs[1] == ("id", "CVErr")
-                    or (rhs[0] == "call" and rhs[1][0] == "id" and rhs[1][1].lower() == "cverr")
-                ):
-                    code = rhs[2][0] if rhs[2] else None
-                    what = (
-                        ERRORS.get(code[1].lower(), "an error")
-                        if code and code[0] == "id"
-                        else "an error"
-                    )
-                    # Excel shows an error value: the function has no value here
-                    del what  # Excel shows an error value: the function has no value here
-                    self.emit(indent, "return 1/0")
-                    following = lines[i + 1][1].strip().lower() if i + 1 < len(lines) else ""
-                    return i + 2 if following == "exit function" else i + 1
-                value = self.value(rhs)
-                if self.proc.returns.lower() in INTEGER_TYPES and not self._integral(rhs):
-                    value = bankers(value)  # VBA rounds the value of an Integer function
-                self.emit(indent, f"{self.ret} := {value}")
-                return i + 1
+                return self.assign_result(rhs, indent, i, lines)
             if key in self.functions:
                 raise NotTranslated(f"assigns to the name of another function {target[1]}")
             if key in self.arrays and self.arrays[key].is_range:
@@ -272,6 +264,62 @@ class Translator:
             self.emit(indent, f"{self.local(target[1][1])}[{index}] := {value}")
             return i + 1
         raise NotTranslated(f"{left} = ...: writes to a cell, a property or an object")
+
+    def assign_result(self, rhs, indent: int, i: int, lines) -> int:
+        """``FunctionName = value``: the function's value (a text, or an error value, only
+        where nothing runs after it: it is then what the function gives)."""
+        at = i if lines is self.body else self.at
+        tail = self._tail(at)
+        is_error = rhs[0] == "call" and rhs[1][0] == "id" and rhs[1][1].lower() == "cverr"
+        if is_error or rhs[0] == "str":
+            if not tail:
+                raise NotTranslated("an error value or a text given where code runs after it")
+            if rhs[0] == "str" and self.text_function:
+                self.emit(indent, f"return {self.value(rhs)}")
+            else:  # Excel shows an error value (or a message): the function has no number
+                self.emit(indent, "return 1/0")
+            following = lines[i + 1][1].strip().lower() if i + 1 < len(lines) else ""
+            return i + 2 if following == "exit function" else i + 1
+        if self.text_function:
+            raise NotTranslated("a function whose value is a text, given a value not a text")
+        value = self.value(rhs)
+        if self.proc.returns.lower() in INTEGER_TYPES and not self._integral(rhs):
+            value = bankers(value)  # VBA rounds the value of an Integer function
+        self.emit(indent, f"{self.ret} := {value}")
+        self.assigned = True
+        return i + 1
+
+    def _tail(self, i: int) -> bool:
+        """True if nothing runs after statement ``i`` of the body but the end of the function."""
+        body = self.body
+        j = i + 1
+        while j < len(body):
+            low = body[j][1].strip().lower()
+            if low.startswith("end if") or low.startswith("end select"):
+                j += 1
+            elif low.startswith("elseif") or re.match(r"^else\b", low):
+                j = self._matching(j, ("if",), "end if")
+            elif re.match(r"^case\b", low):
+                j = self._matching(j, ("select case",), "end select")
+            elif low == "exit function":
+                return True
+            else:
+                return False
+        return True
+
+    def _matching(self, j: int, opens: tuple[str, ...], close: str) -> int:
+        """The index of the ``close`` line that ends the block line ``j`` is in."""
+        depth = 0
+        while j < len(self.body):
+            low = self.body[j][1].strip().lower()
+            if low.startswith(opens) and (opens != ("if",) or re.match(r"^if\b.*\bthen$", low)):
+                depth += 1
+            elif low.startswith(close):
+                if depth == 0:
+                    return j
+                depth -= 1
+            j += 1
+        return j
 
     def _integral(self, node) -> bool:
         node = strip(node)

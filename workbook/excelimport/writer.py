@@ -116,7 +116,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         doc["arguments"] = arguments
     if definitions:
         doc["definitions"] = definitions
-    counts = {"numbers": 0, "texts": 0, "errors": 0}
+    counts: dict = {"numbers": 0, "texts": 0, "errors": 0, "cells": {}}
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     out.write("# Excel's cached values of the translated cells (imported by `workbook import`)\n")
@@ -139,6 +139,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
                 continue
             out.write(f"# {ref}\n")
             w.writerow([n, at, text, ""])
+            counts["cells"][ref] = (n, float(at) if at else None)
         fname = f"{name}.excel{label}.csv"
         files[fname] = out.getvalue()
         entry = {
@@ -247,12 +248,13 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
     n_fn = sum(1 for i in tr.functions.values() if not i.problem and i.final not in skip)
     n_def = len(tr.inputs) + sum(1 for d in tr.definitions if not d.problem and d.name not in skip)
     return ImportResult(
-        paths[0],
-        paths,
-        n_def,
-        n_fn,
-        counts["numbers"] + counts["texts"],
-        list(tr.listed) + list(skip.items()),
+        toml=paths[0],
+        files=paths,
+        definitions=n_def,
+        functions=n_fn,
+        printed=counts["numbers"] + counts["texts"],
+        not_translated=list(tr.listed) + list(skip.items()),
+        cells=counts["cells"],
     )
 
 
