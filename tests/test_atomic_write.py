@@ -132,8 +132,17 @@ sys.exit(main(["run", "s.toml", "--out", "out.xlsx"]))
 """
 
 
-@pytest.mark.parametrize("stage", ["writing", "computing"])
-def test_sigint_leaves_the_previous_workbook(previous, stage):
+@pytest.mark.parametrize(
+    ("stage", "sig", "status"),
+    [
+        ("writing", signal.SIGINT, 130),
+        ("computing", signal.SIGINT, 130),
+        # SIGTERM (as `timeout` sends) ended the process at once: .NAME.partial folders stayed
+        ("writing", signal.SIGTERM, 143),
+        ("computing", signal.SIGTERM, 143),
+    ],
+)
+def test_sigint_leaves_the_previous_workbook(previous, stage, sig, status):
     before = digest(previous / "out.xlsx")
     (previous / "s.toml").write_text(TEMPLATE.replace("10 mm", "12 mm"), encoding="utf-8")
     child = subprocess.Popen(
@@ -151,12 +160,12 @@ def test_sigint_leaves_the_previous_workbook(previous, stage):
             time.sleep(0.05)
         if stage == "writing":  # the temporary file exists beside the target while writing
             assert leftovers(previous), "no temporary file while writing"
-        child.send_signal(signal.SIGINT)
+        child.send_signal(sig)
         _, err = child.communicate(timeout=60)
     finally:
         if child.poll() is None:
             child.kill()
-    assert child.returncode == 130, err
+    assert child.returncode == status, err
     assert "interrupted; no output file was changed" in err and "Traceback" not in err
     assert digest(previous / "out.xlsx") == before
     assert leftovers(previous) == []

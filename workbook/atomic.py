@@ -4,12 +4,43 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import tempfile
+import threading
 import zipfile
 from pathlib import Path
 
 from .errors import InputError
 from .limits import writable_target
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (what ``timeout``, ``kill`` and service managers send), handled as Ctrl-C: the
+    temporary files are removed and no output file is changed."""
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """Within the block, SIGTERM raises :class:`Terminated` in the main thread (by default it
+    ends the process at once, leaving ``.NAME.partial`` folders beside the targets). A process
+    forked meanwhile (a sweep's worker) still ends at once on SIGTERM."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pid = os.getpid()
+
+    def on_term(signum, frame):
+        if os.getpid() != pid:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTERM)
+            return
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, on_term)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None:

@@ -449,8 +449,11 @@ def main(argv: list[str] | None = None) -> int:
         import warnings
 
         warnings.simplefilter("ignore", RuntimeWarning)
+    from .atomic import Terminated, sigterm_as_interrupt
+
     try:
-        return handler(args)
+        with sigterm_as_interrupt():
+            return handler(args)
     except WorkbookError as err:
         if args.debug:
             raise
@@ -465,9 +468,9 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_INPUT
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         print("workbook: interrupted; no output file was changed", file=sys.stderr)
-        return 130
+        return 143 if isinstance(exc, Terminated) else 130
     except Exception as exc:  # a bug of the engine or of a solver block, not of the worksheet
         if args.debug:
             raise
