@@ -17,6 +17,7 @@ import bench_builtins  # noqa: E402
 import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
 import bench_load  # noqa: E402
+import bench_ode  # noqa: E402
 import bench_write  # noqa: E402
 from _timing import machine  # noqa: E402
 
@@ -26,6 +27,7 @@ FULL = {
     "write": lambda: bench_write.run(n=100_000, reps=5),
     "load": lambda: bench_load.run(reps=5),
     "builtins": lambda: bench_builtins.run(n=10_000, reps=5),
+    "ode": lambda: bench_ode.run(reps=7),
 }
 QUICK = {
     "evaluate": lambda: bench_evaluate.run(n=1_000, reps=1),
@@ -33,6 +35,7 @@ QUICK = {
     "write": lambda: bench_write.run(n=50, reps=1),
     "load": lambda: bench_load.run(reps=1),
     "builtins": lambda: bench_builtins.run(n=200, reps=1),
+    "ode": lambda: bench_ode.run(reps=1),
 }
 
 

@@ -12,6 +12,7 @@ h, v and j that share their conditions.
 
 from __future__ import annotations
 
+import copy
 import functools
 import operator
 import sys
@@ -23,7 +24,7 @@ import numpy as np
 from . import runtime as rt
 from . import typecheck as tc
 from . import typed as ty
-from .errors import DomainError, InputError, LimitError
+from .errors import DomainError, InputError, LimitError, WorkbookError
 from .numerics.bound import Bound
 from .registry import REGISTRY
 from .subtrees import plan
@@ -395,11 +396,16 @@ class Evaluator(Visitor):
             cache[name] = None  # solving: a derivative that asks for the solution is circular
             try:
                 cache[name] = solve_typed(self.typer.ode(name), self.compile)
+            except WorkbookError as err:  # a run that failed is remembered, not run again
+                cache[name] = err
+                raise
             except BaseException:
                 del cache[name]
                 raise
         elif cache[name] is None:
             raise InputError(f"ode '{name}': its derivatives refer to its own solution")
+        if isinstance(cache[name], WorkbookError):
+            raise copy.copy(cache[name])
         return cache[name]
 
     def _block(self, t: tc.TBlock) -> Fn:

@@ -286,6 +286,75 @@ def choose_method(
     return Choice(method, reason, lam, index)
 
 
+#: An explicit run of "auto" looks at the Jacobian after this many steps and at each doubling
+#: (10, 20, 40, ...): a stiff stretch makes an explicit method take many steps, so it is seen,
+#: and a run that is not stiff pays for a few Jacobians only.
+WATCH_FIRST = 10
+
+
+def stiffness_watch(fun: Callable, t1: float, time_unit: str = "") -> Callable:
+    """A ``watch`` for :func:`run_ode`: stiff when, at the current point, the fastest decay rate
+    times the remaining span exceeds STIFF_INDEX and the step is held by stability (step times
+    that rate above 1; an explicit step that follows the solution is shorter)."""
+    due = [WATCH_FIRST]
+    unit = f" {time_unit}" if time_unit else ""
+    rate = f" 1/{time_unit}" if time_unit else ""
+
+    def watch(solver, nsteps: int) -> str | None:
+        if nsteps < due[0]:
+            return None
+        due[0] *= 2
+        jac = jacobian(fun, solver.t, solver.y)
+        if not np.all(np.isfinite(jac)):
+            return None
+        lam = np.linalg.eigvals(jac)
+        decay = float(np.max(-lam.real, initial=0.0))
+        index, h = decay * abs(t1 - solver.t), float(solver.step_size or 0.0)
+        if index > STIFF_INDEX and h * decay > 1.0:
+            fastest = lam[np.argmax(-lam.real)]
+            return (
+                f"at t = {solver.t:.6g}{unit}, after {nsteps} steps, the Jacobian's fastest "
+                f"decaying eigenvalue is {_complex(fastest)}{rate}"
+                f"; times the remaining span that is {index:.3g} > {STIFF_INDEX:g}, and the "
+                f"step {h:.3g}{unit} is held by stability: stiff"
+            )
+        return None
+
+    return watch
+
+
+def auto_run(fun: Callable, t0: float, t1: float, y0, time_unit: str = "", **options):
+    """The run of method "auto": the method the Jacobian at the start says, and an explicit run
+    watched along the way (:func:`stiffness_watch`); when it turns stiff, an implicit method
+    runs again from the start within what is left of the budget. (run, Choice saying what was
+    used and why)."""
+    choice = choose_method(fun, t0, t1, y0, options.get("rtol", 1e-6), time_unit)
+    if choice.method not in ("RK45", "DOP853"):
+        return run_ode(fun, (t0, t1), y0, method=choice.method, **options), choice
+    first = run_ode(
+        fun,
+        (t0, t1),
+        y0,
+        method=choice.method,
+        watch=stiffness_watch(fun, t1, time_unit),
+        **options,
+    )
+    if first.stop_reason != "stiff":
+        return first, choice
+    method = "Radau" if len(y0) <= 200 else "BDF"
+    budget = dict(options)
+    budget["max_time"] = max(options.get("max_time", MAX_TIME) - first.elapsed, 1e-3)
+    budget["max_steps"] = max(options.get("max_steps", MAX_STEPS) - first.nsteps, 1)
+    run = run_ode(fun, (t0, t1), y0, method=method, **budget)
+    run.elapsed += first.elapsed  # what the result cost, the explicit start included
+    run.nfev += first.nfev
+    reason = (
+        f"{choice.reason}; {first.method} then stopped: {first.notes[-1]}; {method} from the start "
+        f"({first.nsteps} explicit steps, {first.elapsed:.3g} s, before it)"
+    )
+    return run, Choice(method, reason, choice.eigenvalues, choice.index)
+
+
 def _complex(z) -> str:
     z = complex(z)
     if abs(z.imag) <= 1e-12 * max(1.0, abs(z.real)):
@@ -307,6 +376,18 @@ class Solution:
     run: OdeRun
     notes: list[str] = field(default_factory=list)
     sizes: tuple = ()  # per state: None (a number) or n (a vector of n)
+    rerun: Callable | None = (
+        None  # (rtol, atol, max_time) -> OdeRun: the same run, other tolerances
+    )
+    atol: np.ndarray | None = None  # per number of the state vector
+    _estimate: ErrorEstimate | None = None
+
+    def estimate(self) -> ErrorEstimate:
+        """The global error estimate of the states (computed once): the difference from a run
+        of the same method at tolerances REFERENCE_FACTOR tighter, at every step of this run."""
+        if self._estimate is None:
+            self._estimate = estimate_error(self)
+        return self._estimate
 
     def __call__(self, k: int, t) -> np.ndarray | float:
         """State k at time(s) t (magnitudes in the time unit); outside the span is an error.
@@ -365,17 +446,10 @@ def solve(
     if t1 == t0:
         raise TemplateError(f"ode '{name}': the time range is empty ({t0:g} .. {t1:g})")
     choice = None
-    if method == "auto":
-        choice = choose_method(fun, t0, t1, y0, rtol, time_unit)
-        method = choice.method
     f0 = np.asarray(fun(t0, y0), dtype=float)
     if f0.shape != y0.shape or not np.all(np.isfinite(f0)):
         raise DomainError(f"ode '{name}': a derivative is not a finite number at the start")
-    run = run_ode(
-        fun,
-        (t0, t1),
-        y0,
-        method=method,
+    options = dict(
         rtol=rtol,
         atol=atol,
         max_time=max_time,
@@ -383,11 +457,79 @@ def solve(
         dense_output=True,
         blowup=BLOWUP,
     )
+    if method == "auto":
+        run, choice = auto_run(fun, t0, t1, y0, time_unit, **options)
+        method = choice.method
+    else:
+        run = run_ode(fun, (t0, t1), y0, method=method, **options)
     if not run.ok:
         _refuse(run, name, flat_names(states, sizes), time_unit)
+
+    def rerun(r: float, a, seconds: float) -> OdeRun:
+        return run_ode(
+            fun, (t0, t1), y0, method=method, rtol=r, atol=a, max_time=seconds,
+            max_steps=max_steps, dense_output=True, blowup=BLOWUP,
+        )  # fmt: skip
+
     return Solution(
-        name, tuple(states), float(t0), float(t1), method, choice, run, sizes=tuple(sizes)
+        name,
+        tuple(states),
+        float(t0),
+        float(t1),
+        method,
+        choice,
+        run,
+        sizes=tuple(sizes),
+        rerun=rerun,
+        atol=np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy(),
     )
+
+
+#: The reference of a state's error estimate runs at tolerances this much tighter (rtol at
+#: least 1e-13); an estimate above ESTIMATE_LIMIT times the tolerance is a warning (a local
+#: tolerance commonly gives global errors up to some tens of times it; more means they grew).
+REFERENCE_FACTOR = 1000.0
+ESTIMATE_LIMIT = 100.0
+#: Where a state passes through zero its error is measured against this fraction of its largest
+#: size over the run (a velocity crossing zero is not judged by its rtol near zero alone).
+SIZE_FLOOR = 0.01
+
+
+@dataclass(frozen=True)
+class ErrorEstimate:
+    """Per number of the state vector: the largest |y - y_ref| over the run's steps, where, and
+    that error over the run's tolerance there (atol + rtol*|y_ref|, |y_ref| at least SIZE_FLOOR
+    of its largest value); or why there is none."""
+
+    errors: np.ndarray
+    times: np.ndarray
+    ratios: np.ndarray
+    reference: str  # how the reference ran
+    failed: str = ""  # why there is no estimate
+
+    @property
+    def worst(self) -> int:
+        return int(np.argmax(self.ratios)) if self.ratios.size else -1
+
+
+def estimate_error(sol: Solution) -> ErrorEstimate:
+    """The difference between a solution and a run at tolerances REFERENCE_FACTOR tighter."""
+    r = sol.run
+    rtol = max(r.rtol / REFERENCE_FACTOR, 1e-13)
+    atol = sol.atol / REFERENCE_FACTOR
+    ref = sol.rerun(rtol, atol, MAX_TIME)
+    how = f"{ref.method} at rtol {rtol:g}, atol {np.max(atol):g}"
+    if not ref.ok:
+        empty = np.empty(0)
+        return ErrorEstimate(empty, empty, empty, how, f"the reference run {ref.summary()}")
+    y_ref = np.asarray(ref.sol(r.t)).reshape(r.y.shape)
+    diff = np.abs(r.y - y_ref)
+    size = np.maximum(np.abs(y_ref), SIZE_FLOOR * np.max(np.abs(y_ref), axis=1, keepdims=True))
+    scale = (atol * REFERENCE_FACTOR)[:, None] + r.rtol * size
+    ratio = diff / scale
+    at = np.argmax(ratio, axis=1)
+    rows = np.arange(len(at))
+    return ErrorEstimate(diff[rows, at], r.t[at], ratio[rows, at], how)
 
 
 def flat_names(states, sizes) -> list[str]:
@@ -403,10 +545,15 @@ def _refuse(run, name: str, states, time_unit: str) -> None:
     at = f"t = {run.t_reached:.6g}{' ' + time_unit if time_unit else ''} of {run.t_final:g}"
     if run.stop_reason in ("time budget", "step cap"):
         budget = "its time budget" if run.stop_reason == "time budget" else "its step cap"
+        advice = (
+            f"{run.method} is an implicit method already: a looser rtol, or a shorter time range"
+            if run.method in ("Radau", "BDF", "LSODA")
+            else 'a stiff system wants method = "Radau" or "BDF" (or "auto")'
+        )
         raise LimitError(
             f"ode '{name}' ({run.method}) stopped at {at}: {run.notes[-1]}; "
             f"{run.nsteps} steps. {budget.capitalize()} is max_time/max_steps in [[ode]]; "
-            'a stiff system wants method = "Radau" or "BDF" (or "auto")',
+            + advice,
             definition=name,
         )
     if run.stop_reason == "blow-up":
@@ -728,15 +875,8 @@ def run_sheet(
     typed = sheet.typer.ode(name)
     fun, t0, t1, y0 = problem(typed, sheet.evaluator.compile)
     st = settings(typed, sheet.evaluator.compile)
-    method = st.method
-    if method == "auto":
-        method = choose_method(fun, t0, t1, y0, st.rtol).method
     fun(t0, y0)  # what the derivatives share is computed before the clock starts
-    return run_ode(
-        fun,
-        (t0, t1),
-        y0,
-        method=method,
+    options = dict(
         rtol=st.rtol,
         atol=st.atol,
         t_eval=t_eval,
@@ -745,6 +885,9 @@ def run_sheet(
         label=label,
         jac=jac,
     )
+    if st.method == "auto":
+        return auto_run(fun, t0, t1, y0, **options)[0]
+    return run_ode(fun, (t0, t1), y0, method=st.method, **options)
 
 
 def sheet_findings(sheet) -> list:
@@ -762,7 +905,40 @@ def sheet_findings(sheet) -> list:
         out.append(
             Finding(f"ode {name}", f"solved with {sol.method}", None, "", "info", sol.finding())
         )
+        out.append(_estimate_finding(sheet, name, sol))
     return out
+
+
+def _estimate_finding(sheet, name: str, sol: Solution):
+    """The states' global error estimate: a warning when one exceeds ESTIMATE_LIMIT times its
+    tolerance (or when there is no estimate), else for information."""
+    from . import units as un
+    from .findings import Finding
+
+    est = sol.estimate()
+    topic = f"ode {name}"
+    if est.failed:
+        return Finding(topic, "no global error estimate", None, "", "warning", est.failed)
+    typed = sheet.typer.ode(name)
+    names = flat_names(sol.states, sol.sizes)
+    units = [u for u, n in zip(typed.units, typed.sizes) for _ in range(1 if n is None else n)]
+    k = est.worst
+    unit = un.pretty(units[k])
+    t_unit = un.pretty(typed.time_unit)
+    what = (
+        f"global error estimate: {names[k]} off by up to {est.errors[k]:.3g} {unit}".rstrip()
+        + f" at t = {est.times[k]:.6g} {t_unit}".rstrip()
+        + f", {est.ratios[k]:.3g} times its tolerance (rtol {sol.run.rtol:g}, atol "
+        f"{sol.atol[k]:g})"
+    )
+    note = f"the difference from a run of {est.reference}, at each step"
+    if est.ratios[k] > ESTIMATE_LIMIT:
+        note += (
+            f"; over {ESTIMATE_LIMIT:g} times the tolerance: the values of this ode are less "
+            "accurate than asked (tighten rtol and atol, or the solution is growing fast)"
+        )
+        return Finding(topic, what, None, "", "warning", note)
+    return Finding(topic, what, None, "", "info", note)
 
 
 def sheet_bench(sheet, quick: bool = False) -> list[dict]:

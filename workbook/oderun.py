@@ -42,7 +42,7 @@ class OdeRun:
     atol: float
     t: np.ndarray
     y: np.ndarray  # shape (n, len(t))
-    stop_reason: str  # "finished" | "time budget" | "step cap" | "failed: <message>"
+    stop_reason: str  # "finished" | "time budget" | "step cap" | "stiff" | "failed: <message>"
     elapsed: float  # wall-clock seconds (time.perf_counter)
     nfev: int
     njev: int
@@ -100,6 +100,7 @@ def run_ode(
     progress_every: float = 2.0,
     dense_output: bool = False,
     blowup: float | None = None,
+    watch: Callable | None = None,
 ) -> OdeRun:
     """Integrate y' = fun(t, y) over t_span with scipy's solver ``method``, bounded in time.
 
@@ -108,7 +109,8 @@ def run_ode(
     ``max_steps`` steps. ``jac`` is passed to the implicit methods only. With
     ``dense_output`` the run keeps every step's interpolant (``run.sol``, a scipy
     OdeSolution); with ``blowup`` it stops ("blow-up") when a state leaves the finite numbers
-    or exceeds that magnitude.
+    or exceeds that magnitude. ``watch(solver, nsteps)`` is called after each step; a text it
+    returns stops the run ("stiff", the text its note): how "auto" leaves an explicit method.
     """
     from scipy import integrate
 
@@ -178,6 +180,12 @@ def run_ode(
         if solver.status == "finished":
             reason = "finished"
             break
+        if watch is not None:
+            why = watch(solver, nsteps)
+            if why:
+                reason = "stiff"
+                notes.append(why)
+                break
         now = time.perf_counter()
         if now - start > max_time:
             reason = "time budget"
