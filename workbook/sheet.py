@@ -683,9 +683,13 @@ def _rows_apart(fn, var: str, values: np.ndarray, err: DomainError):
         for a, b in ((lo + hi) // 2, hi), (lo, (lo + hi) // 2):
             try:
                 part = fn({var: values[a:b]})
-                out[a:b] = np.broadcast_to(np.asarray(part, dtype=float), (b - a,))
             except DomainError as e:
                 pending.append((a, b, e))
+                continue
+            try:
+                out[a:b] = np.broadcast_to(np.asarray(part, dtype=float), (b - a,))
+            except ValueError:  # not one number a row (an array): the column's own error
+                raise err from None
     return out, failed
 
 
