@@ -155,3 +155,41 @@ states = [{ name = "y", unit = "m", initial = "1", derivative = "-k*y" }]
     assert est.errors[0] >= true / 10 and est.errors[0] <= 10 * true + 1e-15
     f = [f for f in sheet.check().findings if f.what.startswith("global error estimate")]
     assert f[0].verdict == "info"
+
+
+def test_root_integral_and_extrema_of_a_state_use_its_dense_output(tmp_path):
+    """py = cos(2 t): a root at pi/4, the integral to 1 s sin(2)/2, the maximum on [0.5, 3.5]
+    1 at pi (the closed form; the run at rtol 1e-10)."""
+    text = """
+[inputs]
+w = "2 1/s"
+t_a = "0.5 s"
+t_b = "1 s"
+
+[arguments]
+t = { unit = "s" }
+
+[definitions]
+t0 = { expr = "root(py(t), t, t_a, t_b)", unit = "s" }
+I = { expr = "integral(py(t), t, 0 s, t_b)", unit = "m*s" }
+top = { expr = "maximum(py(t), t, t_a, 3.5 s)", unit = "m" }
+at = { expr = "argmax(py(t), t, t_a, 3.5 s)", unit = "s" }
+low = { expr = "minimum(pv(t), t, 0 s, 2 s)", unit = "m/s" }
+
+[[ode]]
+name = "osc"
+time = "t := 0 .. 4"
+rtol = 1e-10
+atol = 1e-12
+states = [
+  { name = "py", unit = "m", initial = "1", derivative = "pv" },
+  { name = "pv", unit = "m/s", initial = "0", derivative = "-w^2*py" },
+]
+"""
+    sheet = workbook.load(write_template(tmp_path, text))
+    value = {n: sheet.evaluate(n).magnitude for n in ("t0", "I", "top", "at", "low")}
+    assert value["t0"] == pytest.approx(np.pi / 4, abs=1e-8)
+    assert value["I"] == pytest.approx(np.sin(2) / 2, abs=1e-8)
+    assert value["top"] == pytest.approx(1, abs=1e-8)
+    assert value["at"] == pytest.approx(np.pi, abs=1e-4)  # a flat top: argmax to sqrt(tol)
+    assert value["low"] == pytest.approx(-2, abs=1e-8)

@@ -405,7 +405,11 @@ class Solution:
             )
         sizes = self.sizes or (None,) * len(self.states)
         first = sum(1 if n is None else n for n in sizes[:k])
-        y = self.run.sol(np.clip(arr, lo, hi))
+        # scipy's dense output takes one time or a line of them: a grid of the numerical
+        # built-ins (rows x samples) is read as a line and given its shape back
+        flat = np.clip(arr, lo, hi).reshape(-1) if arr.ndim else np.clip(arr, lo, hi)
+        y = np.asarray(self.run.sol(flat))
+        y = y.reshape(y.shape[:1] + arr.shape)
         if sizes[k] is not None:
             return y[first : first + sizes[k]].reshape((sizes[k], 1) + arr.shape)
         out = y[first]
