@@ -949,6 +949,9 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         out.add(n)
         d = spec.definitions.get(n)
         if d is None:
+            block = spec.solve_of(n) if n not in spec.inputs else None
+            if block is not None:  # an unknown of [[solve]]: what its equations use
+                todo.extend(m for node in solve_expressions(block) for m in ex.names(node))
             continue
         local: set[str] = set(d.params)
         bodies = d.expressions()
@@ -964,6 +967,13 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         for body in bodies:
             todo.extend(m for m in ex.names(body) if m not in local)
     return out
+
+
+def solve_expressions(block) -> list[ex.Node]:
+    """Every expression of a [[solve]] block: both sides of its equations, its conditions."""
+    return [x for lhs, rhs, _ in block.equations for x in (lhs, rhs)] + [
+        c for c, _ in block.conditions
+    ]
 
 
 def _declared(name: str, unit: pint.Unit) -> str:

@@ -1,9 +1,10 @@
 """What a sheet's outputs use: the one place that lists the expressions a sheet shows.
 
-Tables, charts, printed values (and, for the hand checks, relations, findings and checks) are the
-outputs; :func:`names_used` follows their expressions through the definitions to the inputs
-and blocks they need. The writer writes only those (``xlsx.needed_names``), ``Sheet``
-reports the inputs nothing uses, and the analysis finds the ranges that show a function.
+Tables, charts, printed values (and, for the hand checks, relations, findings, checks,
+[[solve]] blocks and [[ode]] sections) are the outputs; :func:`names_used` follows their
+expressions through the definitions to the inputs and blocks they need. The writer writes only
+those (``xlsx.needed_names``), ``Sheet`` reports the inputs nothing uses, and the analysis
+finds the ranges that show a function.
 """
 
 from __future__ import annotations
@@ -49,7 +50,11 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
         roots += [n for n in (rng.first, rng.second, rng.last) if n is not None]
     for p in spec.printed:
         roots += [ex.Name(n) for n in printed_names(p)]
-    if hand_checks:
+    if hand_checks:  # the check report solves every [[solve]] block and [[ode]]
+        for block in spec.solves:
+            roots += tc.solve_expressions(block)
+        for o in spec.odes.values():
+            roots += [ex.Name(s.name) for s in o.states]
         for r in spec.relations:
             roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
         for c in spec.checks:

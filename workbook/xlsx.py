@@ -186,6 +186,7 @@ class WorkbookWriter:
         ws.set_column(2, 2, 10)
         ws.set_column(3, 3, 70)
         row = 1
+        unused = set(self.sheet.unused_inputs())  # results, checks, solves and odes use too
         for name, spec in self.sheet.spec.inputs.items():
             value = self.sheet.values[name]
             ws.write_string(row, 0, name)
@@ -200,7 +201,7 @@ class WorkbookWriter:
                 unit_text = spec.label or un.pretty(spec.unit)
             ws.write_string(row, 2, unit_text)
             note = spec.note
-            if name not in needed:
+            if name in unused:
                 note = (note + "; " if note else "") + "not used by any output of this workbook"
             ws.write_string(row, 3, note)
             self._define(ws, row, name, f"=Inputs!$B${row + 1}")
