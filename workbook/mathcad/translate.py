@@ -194,6 +194,8 @@ class ExprTranslator(Visitor):
             return self._column(args)
         if tag in _BINDERS:
             return self._binder(tag, args)
+        if tag == "vectorize" and len(args) == 1:
+            return self._vectorize(self.value(args[0]))
         if tag == "Find":
             return self.tr.find(self, args, op.attrs.get("method", ""))
         if tag in ("Maximize", "Minimize") and _solve_methods():
@@ -349,6 +351,59 @@ class ExprTranslator(Visitor):
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.value(node.children[0])])
+
+    def _vectorize(self, tree: ex.Node) -> ex.Node:
+        """Mathcad's vectorize: the expression element by element over the vectors in it (of
+        one length known at import), as a vector of the elements' expressions."""
+        o = self.tr.sheet_origin
+        lengths: set[int] = set()
+
+        def vector_length(node: ex.Node) -> int | None:
+            if isinstance(node, ex.Matrix):
+                if all(len(r) == 1 for r in node.rows):
+                    return len(node.rows)
+                raise Untranslatable("a vectorised expression over a matrix")
+            if isinstance(node, ex.Name) and self.tr.is_array(node.id):
+                n = self.tr._length(node)
+                if n is None:
+                    raise Untranslatable(
+                        "a vectorised expression over a vector of a length not known at import"
+                    )
+                return n
+            return None
+
+        def scan(node: ex.Node) -> None:
+            n = vector_length(node)
+            if n is not None:
+                lengths.add(n)
+                return
+            if isinstance(node, ex.Call):
+                for a in node.args:
+                    if vector_length(a) is not None and node.func not in _ELEMENTWISE:
+                        raise Untranslatable(
+                            f"a vectorised call of {node.func} (only functions of one "
+                            "number are applied element by element)"
+                        )
+            if isinstance(node, ex.Index):
+                raise Untranslatable("a vectorised expression with an index")
+            for child in ex._CHILDREN.visit(node):
+                scan(child)
+
+        scan(tree)
+        if not lengths:
+            return tree  # no vector in it: vectorize changes nothing
+        if len(lengths) > 1:
+            raise Untranslatable("a vectorised expression over vectors of different lengths")
+        (n,) = lengths
+
+        def element(node: ex.Node, k: int) -> ex.Node:
+            if isinstance(node, ex.Matrix):
+                return node.rows[k][0]
+            if vector_length(node) is not None:
+                return ex.Index(node, (ex.Number(float(o + k)),))
+            return _replace_children(node, lambda c: element(c, k))
+
+        return ex.Matrix(tuple((element(tree, k),) for k in range(n)))
 
     def _absval(self, x: ex.Node) -> ex.Node:
         """Mathcad's |x|: abs of a number, but the length of a vector and the determinant of
@@ -1507,6 +1562,34 @@ class _Renamer(Visitor):
 
     def visit_IfElse(self, n):
         return type(n)(self.visit(n.value), self.visit(n.condition), self.visit(n.other))
+
+
+#: Built-ins of one number that vectorize applies element by element.
+_ELEMENTWISE = frozenset(
+    {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "ln",
+     "log10", "sqrt", "abs", "floor", "ceil", "round", "trunc", "sign", "atan2", "mod"}
+)  # fmt: skip
+
+
+def _replace_children(node: ex.Node, f) -> ex.Node:
+    """``node`` with ``f`` applied to each direct sub-tree."""
+    if isinstance(node, ex.Unary):
+        return ex.Unary(node.op, f(node.operand))
+    if isinstance(node, ex.Binary):
+        return ex.Binary(node.op, f(node.left), f(node.right))
+    if isinstance(node, ex.Compare):
+        return ex.Compare(node.ops, tuple(f(o) for o in node.operands))
+    if isinstance(node, ex.Logic):
+        return ex.Logic(node.op, tuple(f(v) for v in node.values))
+    if isinstance(node, ex.Call):
+        return ex.Call(node.func, tuple(f(a) for a in node.args))
+    if isinstance(node, ex.IfElse):
+        return ex.IfElse(f(node.value), f(node.condition), f(node.other))
+    if isinstance(node, ex.Index):
+        return ex.Index(f(node.target), tuple(f(i) for i in node.indices))
+    if isinstance(node, ex.Matrix):
+        return ex.Matrix(tuple(tuple(f(e) for e in row) for row in node.rows))
+    return node
 
 
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
