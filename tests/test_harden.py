@@ -925,3 +925,57 @@ def test_two_references_to_one_file_are_not_a_cycle(tmp_path):
     _references(tmp_path / "d7.xmcd")
     with pytest.raises(InputError, match=f"more than {MAX_REFERENCED_FILES} files"):
         regions_with_references(read(tmp_path / "d0.xmcd"))
+
+
+# -- errors named where they happen ----------------------------------------------------------
+
+
+@pytest.mark.parametrize("error", [MemoryError, RecursionError])
+def test_memory_and_recursion_errors_name_the_definition(tmp_path, monkeypatch, error):
+    # they fell through to the command line's last resort: no file, line or definition
+    from workbook import numeric
+
+    text = '[inputs]\nR = "1 mm"\n[definitions]\na = "2*R"\nb = "3*a"\n'
+    sheet = workbook.load(write(tmp_path / "m.toml", text))
+    real = numeric.Evaluator.compile
+
+    def compile_failing(self, t):
+        fn = real(self, t)
+        if "3" not in str(t):
+            return fn
+
+        def run(env):
+            raise error()
+
+        return run
+
+    monkeypatch.setattr(numeric.Evaluator, "compile", compile_failing)
+    with pytest.raises(LimitError) as err:
+        sheet.evaluate("b")
+    assert (err.value.definition, err.value.line) == ("b", 5)
+    assert err.value.file == str(tmp_path / "m.toml")
+    word = "too large for memory" if error is MemoryError else "nested too deeply"
+    assert word in str(err.value)
+
+
+def test_a_solve_using_a_definition_of_its_unknown_names_the_circle(tmp_path):
+    # it recursed into Python's limit and said "nested too deeply"
+    text = (
+        '[inputs]\nR = "2 m"\n[[solve]]\nunknowns = { x = "1 m" }\nequations = ["d == R"]\n'
+        '[definitions]\nd = { expr = "2*x", unit = "mm" }\nz = "x + d"\n'
+    )
+    out = cli(tmp_path, "run", str(write(tmp_path / "s.toml", text)), "--out", "s.xlsx")
+    assert out.returncode == 2 and "circular definition: x -> d -> x" in out.stderr, out.stderr
+    assert "in 'solve x'" in out.stderr
+    fine = text.replace('"d == R"', '"2*x == R"')  # d and z use x after it is solved
+    sheet = workbook.load(write(tmp_path / "s.toml", fine))
+    assert float(sheet.evaluate("z").to("m").magnitude) == pytest.approx(3.0, rel=1e-9)
+
+
+def test_a_sweep_of_a_text_output_is_refused_at_load(tmp_path):
+    # every case failed with a raw ValueError and the sweep exited 0
+    write(tmp_path / "t.toml", INJECT_LABELS)
+    args = ["--vary", "R=1mm,2mm", "--output", "q=v(0.5)", "--out", "s.csv"]
+    out = cli(tmp_path, "sweep", "t.toml", *args)
+    assert out.returncode == 2 and "must be a number, not a text" in out.stderr, out.stderr
+    assert not (tmp_path / "s.csv").exists()

@@ -178,3 +178,11 @@ def _sheet_member(path: Path, sheet: str, sizes: dict[str, int], what: str) -> s
             target = el.get("Target", "")
             return target.lstrip("/") if target.startswith("/") else "xl/" + target
     return None
+
+
+def exhausted(exc: BaseException) -> LimitError:
+    """A RecursionError or MemoryError met while computing, as the limit error it is (the
+    caller gives it the file, line and definition)."""
+    if isinstance(exc, RecursionError):
+        return LimitError("nested too deeply for the engine (Python's recursion limit)")
+    return LimitError("too large for memory (an array or a computation could not be allocated)")

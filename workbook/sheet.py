@@ -16,6 +16,7 @@ from . import typecheck as tc
 from . import units as un
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .fields import nearest
+from .limits import exhausted
 from .numeric import Evaluator
 from .ranges import RangeSpec, range_values
 from .registry import CONSTANTS
@@ -101,6 +102,7 @@ class Sheet:
             from .given_find import typed_equations
 
             try:
+                self._check_not_circular(block)
                 typed_equations(self.typer, block)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=block.line, definition=block.what) from None
@@ -146,6 +148,25 @@ class Sheet:
                 self.typer.function(d.name)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
+
+    def _check_not_circular(self, block) -> None:
+        """Refuse a [[solve]] block whose equations use a definition that needs one of its
+        unknowns: solving needs the definition, which needs the solution (it recursed until
+        Python's limit, reported as "nested too deeply")."""
+        nodes = [n for lhs, rhs, _ in block.equations for n in (lhs, rhs)]
+        nodes += [c for c, _ in block.conditions]
+        used = sorted({n for node in nodes for n in ex.names(node)} - set(block.unknowns))
+        for name in used:
+            if name not in self.spec.definitions:
+                continue
+            needs = tc.dependencies(self.spec, ex.parse(name, what=name)) & set(block.unknowns)
+            if needs:
+                x = sorted(needs)[0]
+                raise TemplateError(
+                    f"circular definition: {x} -> {name} -> {x} (the equations of [[solve]] "
+                    f"use {name}, which needs the unknown {x}; write the equation with {x} "
+                    f"itself, or make {name} a function of it)"
+                )
 
     def _check_vary(self, t, name: str, values) -> None:
         where = dict(file=self.file, line=t.line, definition=f"table {t.name}")
@@ -250,6 +271,8 @@ class Sheet:
             return q.to("") if un.is_compound_ratio(f.unit) else q
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
+        except (RecursionError, MemoryError) as exc:
+            raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
 
     def scalar_typed(self, name: str) -> tc.T:
         """The typed tree of scalar definition ``name`` in the unit it is shown in: a
@@ -323,6 +346,8 @@ class Sheet:
                 value = self.evaluator.compile(self.typer.scalar(name))({})
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=name) from None
+            except (RecursionError, MemoryError) as exc:
+                raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
             if isinstance(value, str):
                 pass  # a text: "OK"
             elif np.ndim(value) == 0:
@@ -506,6 +531,8 @@ class Sheet:
                 raise self._locate(err, what) from None
         except WorkbookError as err:
             raise self._locate(err, what) from None
+        except (RecursionError, MemoryError) as exc:
+            raise self._locate(exhausted(exc), what) from None
         if t.text:
             out = np.broadcast_to(np.asarray(out, dtype=object), values.shape).copy()
             return Column(col.title, t.unit, out, t, col.text)

@@ -121,8 +121,9 @@ def type_output(sheet, out: Output) -> TypedOutput:
             )
         scope = {out.range.var: spec.binding_unit}
     t = sheet.typer.expression(out.node, scope, what)
-    if isinstance(t, tc.TText) or getattr(t, "boolean", False):
-        raise TemplateError(f"{what}: the output must be a number")
+    if isinstance(t, tc.TText) or getattr(t, "text", False) or getattr(t, "boolean", False):
+        # a text (a design check's "OK") failed every case with a raw ValueError, exit 0
+        raise TemplateError(f"{what}: the output must be a number, not a text or a condition")
     if out.reduction in ("argmax", "argmin"):
         shown = sheet.spec.arguments[out.range.var].unit
         return TypedOutput(out, t, shown, 1.0, shown)
