@@ -979,3 +979,29 @@ def test_a_sweep_of_a_text_output_is_refused_at_load(tmp_path):
     out = cli(tmp_path, "sweep", "t.toml", *args)
     assert out.returncode == 2 and "must be a number, not a text" in out.stderr, out.stderr
     assert not (tmp_path / "s.csv").exists()
+
+
+# -- the report shows the operator between two numbers ---------------------------------------
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["2*10^e", "2*10^(-3)*x", "2*(3/4)", "0.5*10^k", "3*2^n*a", "2*(10^e)", "4*1e3^x"],
+)
+def test_a_product_of_two_numbers_shows_its_operator(text):
+    # 2*10^e was typeset with an invisible times: it read "210^e" in the concave-cam report
+    from workbook import expr as ex
+    from workbook.report.mathml import MathML
+
+    xml = MathML().box(ex.parse(text)).xml
+    opening = r"(?:<(?:mrow|msup|msub|msubsup|mfrac|mstyle|mpadded)(?:\s[^>]*)?>)*"
+    assert not re.search("<mo>\u2062</mo>" + opening + "<mn", xml), xml
+    assert "<mo>\u22c5</mo>" in xml
+
+
+def test_a_number_before_a_name_keeps_the_invisible_times():
+    from workbook import expr as ex
+    from workbook.report.mathml import MathML
+
+    for text in ("2*a", "0.5*x^2", "2*(a + b)", "2*sin(x)"):
+        assert "<mo>\u2062</mo>" in MathML().box(ex.parse(text)).xml, text

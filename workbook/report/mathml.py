@@ -312,6 +312,7 @@ class MathML(Visitor):
                 and not right.numeric
                 and left.prec >= PREC["neg"]
                 and _leftmost(node.right) not in ("e", "E")  # 2e would read as a number
+                and not _starts_with_number(right.xml)  # 2⁢10^e would read as 210^e
                 and not (isinstance(node.left, ex.Number) and node.left.value == 0)  # 0⋅α
             ):
                 sign = Box("<mo>\u2062</mo>", 0.1)  # 2a: invisible times after a number
@@ -446,6 +447,15 @@ class MathML(Visitor):
             cond_widths.append(cond.width)
         xml = f"<mrow><mo stretchy='true'>{{</mo><mtable>{''.join(rows)}</mtable></mrow>"
         return Box(xml, max(widths, default=0) + max(cond_widths, default=0) + 2.0)
+
+
+_OPENING = re.compile(r"^(?:\s*<(?:mrow|msup|msub|msubsup|mfrac|mstyle|mpadded)(?:\s[^>]*)?>)*\s*")
+
+
+def _starts_with_number(xml: str) -> bool:
+    """Whether the first thing ``xml`` shows is a number (``<mn>``), also as the base of a
+    power or the numerator of a fraction: after a number it needs a visible times."""
+    return xml[_OPENING.match(xml).end() :].startswith("<mn")
 
 
 def _leftmost(node: ex.Node) -> str:
