@@ -56,6 +56,15 @@ KNOWN_ELSEWHERE = {
             "sin", "sinh", "sqrt", "tan", "tanh",
         ),
     ),
+    # the built-ins vectorize applies element by element (could be read from the registry:
+    # the entries of plain numbers)
+    (
+        "mathcad/translate.py",
+        (
+            "abs", "acos", "asin", "atan", "atan2", "ceil", "cos", "cosh", "exp", "floor", "ln",
+            "log10", "mod", "round", "sign", "sin", "sinh", "sqrt", "tan", "tanh", "trunc",
+        ),
+    ),
     # the numerical methods with an error estimate (bench) and their live Excel forms
     ("numerics/bench.py", ("argmax", "argmin", "integral", "maximum", "minimum", "root")),
     ("numerics/live.py", ("argmax", "argmin", "maximum", "minimum")),
