@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 
 import pint
 
@@ -135,6 +136,7 @@ def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
         raise InputError(f"{what}: cannot read {shown!r}: {bad} is not a unit{near}") from None
     except Exception as exc:  # noqa: BLE001 - pint raises many kinds for malformed text
         raise InputError(f"{what}: cannot read {shown!r} as a unit ({exc})") from None
+    _remember_spelling(text)
     big = [(n, p) for n, p in u.dimensionality.items() if abs(p) > MAX_UNIT_POWER]
     if big:  # ((kg^12)^12)^12: each power is allowed, the product of them is not
         name, power = big[0]
@@ -238,12 +240,45 @@ def is_compound_ratio(u: pint.Unit) -> bool:
     return not u.dimensionality and ("/" in text or "*" in text) and not is_angle(u)
 
 
+#: How a worksheet spelt a unit, by pint's name: "L" for liter, "degC" (see :func:`pretty`).
+_SPELLING: dict[str, str] = {}
+
+
 def pretty(u: pint.Unit) -> str:
-    """Compact unit text for headers: 'mm', 'm/s', 'm/s^2'."""
+    """Compact unit text for headers, in the order and spelling the worksheet declared it:
+    'mm', 'm/s^2', 'N*m' (not pint's sorted 'm*N'), 'L/s' (pint's symbol is 'l'),
+    'W/(m*K)'. A unit name is shown as a worksheet spelt it when that is shorter than pint's
+    name, else by pint's symbol ('%' for percent)."""
     if u == registry().dimensionless:
         return ""
-    text = f"{u:~C}"
-    return text.replace("**", "^").replace("°", "deg")
+    top, bottom = [], []
+    for name, power in u._units.items():
+        symbol = _SPELLING.get(name) or _symbol(name)
+        p = abs(power)
+        text = symbol if p == 1 else f"{symbol}^{p:g}"
+        (top if power > 0 else bottom).append(text)
+    out = "*".join(top) or "1"
+    if bottom:
+        out += "/" + (bottom[0] if len(bottom) == 1 else "(" + "*".join(bottom) + ")")
+    return out
+
+
+@functools.lru_cache(maxsize=512)
+def _symbol(name: str) -> str:
+    return registry().get_symbol(name).replace("°", "deg").replace("Δ", "delta_")
+
+
+def _remember_spelling(text: str) -> None:
+    """Note how each unit name of a unit text the reader accepted is spelt (see pretty)."""
+    for token in re.findall(r"[^\W\d][\w°µμΩ%]*|[°%Ω]", text):
+        try:
+            items = list(_unit_of(token)._units.items())
+        except Exception:  # noqa: BLE001 - a name pint reads only in context
+            continue
+        if len(items) == 1 and items[0][1] == 1:
+            name = items[0][0]
+            if len(token) < len(name) and name not in _SPELLING:
+                _SPELLING[name] = token
 
 
 def close(a: float, b: float, rel: float = 1e-12) -> bool:

@@ -1,0 +1,77 @@
+"""Units are shown as the worksheet declared them (order and spelling), not as pint sorts them."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import openpyxl
+import pytest
+from conftest import write_template
+
+import workbook
+from workbook import units as un
+
+SHEET = """
+[sheet]
+title = "units as declared"
+
+[inputs]
+F = { value = "2 kN" }
+arm = { value = "0.5 m" }
+Q = { value = "3 L/s" }
+k = { value = "40 W/(m*K)" }
+
+[definitions]
+torque = { expr = "F*arm", unit = "N*m" }
+flow = { expr = "2*Q", unit = "L/min" }
+energy = { expr = "F*arm*3600", unit = "kW*h" }
+conduct = { expr = "2*k", unit = "W/(m*K)" }
+"""
+
+
+@pytest.mark.parametrize(
+    "text,shown",
+    [
+        ("N*m", "N*m"),
+        ("m*N", "m*N"),
+        ("W/(m*K)", "W/(m*K)"),
+        ("kW*h", "kW*h"),
+        ("mm^2*deg", "mm^2*deg"),
+        ("m/s^2", "m/s^2"),
+        ("1/s", "1/s"),
+        ("percent", "%"),
+        ("delta_degC", "delta_degC"),
+    ],
+)
+def test_pretty_keeps_the_declared_order(text, shown):
+    assert un.pretty(un.unit(text)) == shown
+    assert un.unit(shown) == un.unit(text)  # what is shown reads back as the same unit
+
+
+def test_run_and_the_workbook_show_the_declared_units(tmp_path):
+    path = write_template(tmp_path, SHEET, "shown.toml")
+    code = "import sys; from workbook.cli import main; sys.exit(main())"
+    done = subprocess.run(
+        [sys.executable, "-c", code, "run", "shown.toml", "--out", "shown.xlsx"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    for line in (
+        "torque = 1000 N*m",
+        "flow = 360 L/min",
+        "energy = 1 kW*h",
+        "conduct = 80 W/(m*K)",
+    ):
+        assert line in done.stdout, done.stdout
+    results = openpyxl.load_workbook(tmp_path / "shown.xlsx")["Results"]
+    units = {r[0]: r[2] for r in results.iter_rows(min_row=2, values_only=True) if r[0]}
+    assert units["torque"] == "N*m" and units["flow"] == "L/min" and units["energy"] == "kW*h"
+    inputs = openpyxl.load_workbook(tmp_path / "shown.xlsx")["Inputs"]
+    shown = [c for r in inputs.iter_rows(values_only=True) for c in r if isinstance(c, str)]
+    assert "L/s" in shown and "W/(m*K)" in shown
+    sheet = workbook.load(path)
+    assert sheet.evaluate("energy").to("J").magnitude == pytest.approx(3.6e6)
