@@ -133,3 +133,78 @@ def test_run_prints_the_warnings_and_exits_0(tmp_path):
         done.stderr
     )
     assert "cos(90 deg)" in done.stderr
+
+
+# -- a log-spaced range ------------------------------------------------------------------------
+
+LOG = """
+[sheet]
+title = "a low-pass filter"
+
+[inputs]
+R = { value = "10 ohm" }
+C = { value = "1 uF" }
+n = { value = "7" }
+
+[arguments]
+f = { unit = "Hz" }
+
+[definitions]
+"gain(f)" = "1/sqrt(1 + (2*pi*f*R*C)^2)"
+
+[[tables]]
+name = "bode"
+range = "f := logspace(10 Hz, 10 MHz, n)"
+columns = { "gain(f)" = "" }
+"""
+
+
+def test_a_log_spaced_range_is_mathcads_logspace(tmp_path):
+    sheet = workbook.load(write_template(tmp_path, LOG))
+    table = sheet.table("bode")
+    np.testing.assert_allclose(table.iloc[:, 0], np.logspace(1, 7, 7), rtol=1e-14)
+    assert table.iloc[0, 0] == 10.0 and table.iloc[-1, 0] == 1e7  # the bounds exactly
+    expected = 1 / np.sqrt(1 + (2 * np.pi * np.logspace(1, 7, 7) * 10 * 1e-6) ** 2)
+    np.testing.assert_allclose(table.iloc[:, 1], expected, rtol=1e-13)
+    assert len(sheet.with_inputs(n="13").table("bode")) == 13
+
+
+def test_a_log_spaced_range_in_the_workbook_recalculates(tmp_path):
+    import formulas
+    import openpyxl
+
+    sheet = workbook.load(write_template(tmp_path, LOG))
+    path = sheet.write_xlsx(tmp_path / "bode.xlsx")
+    ws = openpyxl.load_workbook(path)["Listing"]
+    header = next(r for r in range(1, 10) if ws.cell(r, 1).value == "f [Hz]")
+    xs = [ws.cell(header + 1 + i, 1).value for i in range(7)]
+    np.testing.assert_allclose(xs, np.logspace(1, 7, 7), rtol=1e-14)  # numbers, not FIRST+i*STEP
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    got = {}
+    for key, ranges in solution.items():
+        book_sheet, _, cell = key.rpartition("!")
+        if book_sheet.split("]", 1)[-1].strip("'").upper() == "LISTING" and ":" not in cell:
+            got[cell.upper()] = ranges.value[0, 0]
+    for i, want in enumerate(sheet.table("bode").iloc[:, 1]):
+        assert float(got[f"B{header + 1 + i}"]) == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "range_text,message",
+    [
+        ("f := logspace(0 Hz, 10 MHz, 7)", "above zero"),
+        ("f := logspace(10 Hz, 10 MHz, 2.5)", "whole number >= 2 of points"),
+        ("f := logspace(10 Hz, 10 MHz)", r"write logspace\(first, last, points\)"),
+    ],
+)
+def test_log_spaced_range_mistakes(tmp_path, range_text, message):
+    text = LOG.replace("f := logspace(10 Hz, 10 MHz, n)", range_text)
+    with pytest.raises(workbook.WorkbookError, match=message):
+        workbook.load(write_template(tmp_path, text)).table("bode")
+
+
+def test_a_program_loop_is_not_log_spaced(tmp_path):
+    from workbook.ranges import parse_range
+
+    with pytest.raises(workbook.WorkbookError, match="for tables, charts and sweep outputs"):
+        parse_range("k := logspace(1, 100, 3)")

@@ -25,15 +25,26 @@ class RangeSpec:
     text: str
     # the unit of a bound written as a quantity ("25 N"): its node is then the number
     units: tuple[pint.Unit | None, ...] = (None, None, None)
+    # a log-spaced range, ``var := logspace(first, last, points)``: the number of points
+    points: ex.Node | None = None
 
 
 _RANGE = re.compile(r"^\s*(?:([A-Za-z][A-Za-z0-9_]*)\s*:=\s*)?(.+?)\s*\.\.\s*(.+?)\s*$")
 
 
-def parse_range(text: str, *, default_var: str | None = None, what: str = "range") -> RangeSpec:
-    """Parse Mathcad's range form ``phi := first, second .. last`` (or ``first .. last``)."""
+_LOGSPACE = re.compile(r"^\s*(?:([A-Za-z][A-Za-z0-9_]*)\s*:=\s*)?logspace\s*\((.*)\)\s*$", re.S)
+
+
+def parse_range(
+    text: str, *, default_var: str | None = None, what: str = "range", log: bool = False
+) -> RangeSpec:
+    """Parse Mathcad's range form ``phi := first, second .. last`` (or ``first .. last``);
+    with ``log``, also a log-spaced range ``f := logspace(first, last, points)``."""
     if not isinstance(text, str):
         raise TemplateError(f"{what}: expected a range like 'phi := 0, 5 .. 22'")
+    m = _LOGSPACE.match(text)
+    if m:
+        return _log_range(m, text, default_var, what, log)
     m = _RANGE.match(text)
     if not m:
         raise TemplateError(f"{what}: cannot read range {text!r} (expected 'phi := 0, 5 .. 22')")
@@ -48,6 +59,44 @@ def parse_range(text: str, *, default_var: str | None = None, what: str = "range
     nodes = [None if b is None else b[0] for b in bounds]
     units = tuple(None if b is None else b[1] for b in bounds)
     return RangeSpec(var, nodes[0], nodes[1], nodes[2], text.strip(), units)
+
+
+def _log_range(m, text: str, default_var, what: str, allowed: bool) -> RangeSpec:
+    if not allowed:
+        raise TemplateError(
+            f"{what}: a log-spaced range (logspace) is for tables, charts and sweep outputs; "
+            "write 'first, second .. last' here"
+        )
+    var = m.group(1) or default_var
+    if not var:
+        raise TemplateError(f"{what}: range {text!r} names no variable (f := logspace(...))")
+    args = split_top(m.group(2), ",")
+    if len(args) != 3 or not all(args):
+        raise TemplateError(
+            f"{what}: write logspace(first, last, points), e.g. 'f := logspace(1 Hz, 1 kHz, 31)'"
+        )
+    (first, u1), (last, u2) = (_bound_node(a, what) for a in args[:2])
+    return RangeSpec(
+        var, first, None, last, text.strip(), (u1, None, u2), ex.parse(args[2], what=what)
+    )
+
+
+def log_range_values(first: float, last: float, points: float, *, what: str = "range"):
+    """``points`` values from ``first`` to ``last`` (both included), evenly spaced on a log
+    scale (Mathcad's logspace): both bounds above zero, at least 2 points."""
+    import numpy as np
+
+    if not (math.isfinite(first) and math.isfinite(last)) or first <= 0 or last <= 0:
+        raise TemplateError(
+            f"{what}: the bounds of a log-spaced range are above zero (got {first:g}, {last:g})"
+        )
+    if not float(points).is_integer() or points < 2:
+        raise TemplateError(f"{what}: a log-spaced range has a whole number >= 2 of points")
+    if points > MAX_RANGE_POINTS:
+        raise LimitError(f"{what}: range has {points:,.0f} points (limit {MAX_RANGE_POINTS:,})")
+    values = np.geomspace(first, last, int(points))
+    values[0], values[-1] = first, last
+    return values
 
 
 _QUANTITY_BOUND = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*[^\W\d]")

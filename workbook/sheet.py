@@ -18,7 +18,7 @@ from .errors import DomainError, InputError, LimitError, TemplateError, Workbook
 from .fields import nearest
 from .limits import exhausted
 from .numeric import Evaluator
-from .ranges import RangeSpec, range_values
+from .ranges import RangeSpec, log_range_values, range_values
 from .registry import CONSTANTS
 from .template import (
     ColumnSpec,
@@ -471,6 +471,10 @@ class Sheet:
             None if t is None else float(self.evaluator.compile(t)({}))
             for t in self.range_bounds(rng, what)
         ]
+        if rng.points is not None:  # logspace(first, last, points)
+            points = self.typer.plain(self.typer.expression(rng.points, {}, what), what)
+            n = float(self.evaluator.compile(points)({}))
+            return log_range_values(nums[0], nums[2], n, what=what)
         return range_values(nums[0], nums[1], nums[2], what=what)
 
     def _scope(self, var: str) -> dict:

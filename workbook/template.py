@@ -1016,7 +1016,7 @@ def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
     try:
         f = Fields(raw, TABLE_KEYS, f"table {name}")
         f.text("name"), f.text("part", None)
-        rng = parse_range(f.text("range"), what=f"table {name}") if "range" in f else None
+        rng = parse_range(f.text("range"), what=f"table {name}", log=True) if "range" in f else None
         cols = _columns(raw.get("columns", []), rng.var if rng else None, f"table {name}")
         shown = [(c.title, None if c.unit is None else str(c.unit)) for c in cols]
         twice = next((c for c, k in zip(cols, shown) if shown.count(k) > 1), None)
@@ -1085,7 +1085,7 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
     try:
         f = Fields(raw, CHART_KEYS, what)
         f.text("name"), f.text("part", None)
-        rng = parse_range(f.text("range"), what=what) if "range" in f else None
+        rng = parse_range(f.text("range"), what=what, log=True) if "range" in f else None
         x_raw = raw.get("x", rng.var if rng else None)
         x_title = ""
         if isinstance(x_raw, dict):
@@ -1120,7 +1120,7 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
                 )
                 continue
             y = _column(y_text, s.text("unit", None), None, what, common["name"])
-            srange = parse_range(s.text("range"), what=what) if "range" in s else None
+            srange = parse_range(s.text("range"), what=what, log=True) if "range" in s else None
             sx = _column(s.text("x"), s.text("x_unit", None), None, what) if "x" in s else None
             series.append(SeriesSpec(y, x=sx, range=srange, **common))
         if not series:

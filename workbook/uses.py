@@ -47,7 +47,7 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
             roots += [c.node for c in t.columns]
     for rng, nodes in ranged_outputs(spec):
         roots += nodes
-        roots += [n for n in (rng.first, rng.second, rng.last) if n is not None]
+        roots += [n for n in (rng.first, rng.second, rng.last, rng.points) if n is not None]
     for p in spec.printed:
         roots += [ex.Name(n) for n in printed_names(p)]
     if hand_checks:  # the check report solves every [[solve]] block and [[ode]]

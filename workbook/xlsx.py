@@ -572,6 +572,8 @@ class WorkbookWriter:
     def _live_bounds(self, rng) -> tuple[str, str | None, str] | None:
         """Excel texts of a range's bounds in the variable's unit, or None when the bounds are
         constants (written as numbers) or cannot be live formulas."""
+        if rng.points is not None:  # log-spaced: its values are numbers, not FIRST+i*STEP
+            return None
         nodes = (rng.first, rng.second, rng.last)
         names = set().union(*(tc.dependencies(self.sheet.spec, x) for x in nodes if x))
         if not names & (set(self.sheet.spec.inputs) | set(self.sheet.spec.definitions)):

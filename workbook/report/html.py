@@ -368,13 +368,19 @@ class Document:
         if rng.second is not None:
             comma = Box("<mo separator='true'>,</mo>", 0.5)
             first = _eq_box(first, comma, self.formula.box(rng.second))
-        range_math = mm.math_element(
-            mm.name_box(rng.var),
-            Box("<mo>:=</mo>", 1.2),
-            first,
-            Box("<mo>..</mo>", 1.0),
-            self.formula.box(rng.last),
-        )
+        if rng.points is not None:  # f := logspace(first, last, points)
+            call = ex.Call("logspace", (rng.first, rng.last, rng.points))
+            range_math = mm.math_element(
+                mm.name_box(rng.var), Box("<mo>:=</mo>", 1.2), self.formula.box(call)
+            )
+        else:
+            range_math = mm.math_element(
+                mm.name_box(rng.var),
+                Box("<mo>:=</mo>", 1.2),
+                first,
+                Box("<mo>..</mo>", 1.0),
+                self.formula.box(rng.last),
+            )
         heads = []
         for i, col in enumerate(data.columns):
             node = ex.Name(rng.var) if i == 0 else self.sheet.column_node(t.columns[i - 1], rng.var)

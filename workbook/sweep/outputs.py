@@ -44,7 +44,7 @@ class Output:
                 text,
                 ex.parse(body, what=what),
                 reduction,
-                parse_range(rng, what=what),
+                parse_range(rng, what=what, log=True),
                 unit,
             )
         if re.match(r"^\s*(max|min|mean|argmax|argmin)\s+of\b", text):

@@ -84,7 +84,7 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
         if aggregates:
             why.append(f"{out.name} uses the table aggregate {', '.join(aggregates)}()")
         if out.range is not None:
-            for node in (out.range.first, out.range.second, out.range.last):
+            for node in (out.range.first, out.range.second, out.range.last, out.range.points):
                 if node is not None and tc.dependencies(sheet.spec, node) & swept:
                     why.append(f"the range of {out.name} depends on a swept input")
                     break
