@@ -237,3 +237,27 @@ def test_libreoffice_recalculates_the_temperature_sheet(rod, tmp_path):
     for name, expected in _expected().items():
         got = values[("Results", f"B{rows[name]}")]
         assert math.isclose(float(got), expected.magnitude, rel_tol=1e-12, abs_tol=1e-12), name
+
+
+def test_a_data_column_in_degc_read_at_a_temperature_in_k(tmp_path):
+    """linterp over a column in degC at an input in K converts the input affinely (not by a
+    factor 1/274.15), and a column of differences in delta_degC gives a difference."""
+    (tmp_path / "oil.csv").write_text("T_col,nu,rise\n0,180,0\n40,46,5\n100,10,12\n", "utf-8")
+    text = """
+[inputs]
+T = { value = "333.15 K" }
+
+[data.oil]
+file = "oil.csv"
+columns = { T_col = "degC", nu = "mm^2/s", rise = "delta_degC" }
+
+[definitions]
+viscosity = { expr = "linterp(T_col, nu, T)", unit = "mm^2/s" }
+heated = { expr = "T + linterp(T_col, rise, T)", unit = "degC" }
+"""
+    sheet = workbook.load(write_template(tmp_path, text))
+    t = 333.15 - 273.15  # 60 degC
+    nu = 46 + (t - 40) / 60 * (10 - 46)
+    assert sheet.evaluate("viscosity").to("mm^2/s").magnitude == pytest.approx(nu, rel=1e-13)
+    rise = 5 + (t - 40) / 60 * (12 - 5)
+    assert sheet.evaluate("heated").to("degC").magnitude == pytest.approx(t + rise, rel=1e-13)
