@@ -74,7 +74,8 @@ KNOWN_ELSEWHERE = {
         "numerics/intervals.py",
         ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),
     ),
-    # the functions whose argument in degrees times pi/180 is warned about
+    # the trigonometric functions whose argument the angle warnings look at (a slip of theta
+    # in degrees times pi/180, a bare number of degrees read as radians)
     ("angle_slips.py", ("cos", "sin", "tan")),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),

@@ -243,8 +243,8 @@ class Typer(ArrayTyping, Visitor):
         known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
         known.update(dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS]))
         hint = nearest(name, known)
-        if kind == "name" and un.is_unit_name(name):
-            hint = f" (a unit is written after a number: 1 {name}){hint}"
+        if kind == "name" and not hint and un.is_unit_name(name):
+            hint = f" (a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")
 
     def _typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
