@@ -102,3 +102,56 @@ def test_the_count_of_roots_is_proven_by_interval_arithmetic():
     assert np.all((sq.lo <= x**2) & (x**2 <= sq.hi))
     t = iv.tan(iv.Iv(np.array([1.0, 1.0]), np.array([1.5, 2.0])))
     assert np.isfinite(t.hi[0]) and t.hi[1] == np.inf  # the pole pi/2 inside the second box
+
+
+def _max_of(f, a, b, bracket):
+    """The maximum of f in a bracket by mpmath (50 digits): f at the root of f' there."""
+    x = mpmath.findroot(lambda t: mpmath.diff(f, t), bracket, solver="anderson")
+    assert a <= x <= b
+    return f(x), x
+
+
+@pytest.mark.parametrize(
+    "expr, f, bounds, bracket",
+    [
+        (
+            "exp(-((x - 0.3)/1e-4)^2)",
+            lambda x: mpmath.exp(-(((x - mpmath.mpf("0.3")) / mpmath.mpf("1e-4")) ** 2)),
+            (0, 1),
+            (mpmath.mpf("0.29999"), mpmath.mpf("0.30001")),
+        ),
+        (
+            "sin(100*x)*exp(-x)",
+            lambda x: mpmath.sin(100 * x) * mpmath.exp(-x),
+            (0, 10),
+            (mpmath.mpf("0.015"), mpmath.mpf("0.016")),
+        ),
+        (
+            "1/(1 + ((x - 0.61)/1e-5)^2) + 0.5*x",
+            lambda x: 1 / (1 + ((x - mpmath.mpf("0.61")) / mpmath.mpf("1e-5")) ** 2) + x / 2,
+            (0, 1),
+            (mpmath.mpf("0.609995"), mpmath.mpf("0.610005")),
+        ),
+        ("x*(1 - x)", lambda x: x * (1 - x), (0, 1), (mpmath.mpf("0.4"), mpmath.mpf("0.6"))),
+    ],
+)
+def test_a_maximum_between_the_samples_is_found(tmp_path, expr, f, bounds, bracket):
+    """The samples (33 on the bracket) miss the peak; branch and bound on the enclosures
+    does not. maximum was 0 for the first (true 1) and 0.00092 for the second (true 0.984)."""
+    top, where = _max_of(f, *bounds, bracket)
+    a, b = bounds
+    right(tmp_path, f"maximum({expr}, x, {a}, {b})", top, rel=1e-9)
+    v, est = value(tmp_path, f"argmax({expr}, x, {a}, {b})")
+    assert abs(v - float(where)) <= max(est, 1e-7 * abs(float(where)))
+
+
+def test_a_minimum_at_a_narrow_dip_in_a_table(tmp_path):
+    """One row per width of the dip: each minimum is -1 at x = 0.4 (the samples see 0)."""
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[arguments]\nw = { unit = "" }\nx = { unit = "" }\n'
+        '[definitions]\n"m(w)" = "minimum(-exp(-((x - 0.4)/w)^2), x, 0, 1)"\n',
+        encoding="utf-8",
+    )
+    got = workbook.load(path).evaluate("m", np.array([1e-1, 1e-3, 1e-5, 1e-6])).magnitude
+    assert np.allclose(got, -1.0, rtol=1e-9, atol=0)

@@ -320,6 +320,7 @@ def _extremum_numpy(name: str):
             steps = _live_chain(of, a, b, lambda f, a, b, idx: _golden(f, a, b, idx, kind, of))
             return _out(steps["where" if where else "value"])
         tol, var, unit = of.tolerance, of.var, of.unit_text
+        enclose = of.enclosure(np.broadcast_shapes(of.shape, np.shape(a), np.shape(b)))
         res = _solve(
             of,
             lambda f, a, b, idx, label: extrema.extremum(
@@ -333,6 +334,7 @@ def _extremum_numpy(name: str):
                 var=var,
                 unit=unit,
                 label=label,
+                enclose=enclose,
             ),
             a,
             b,

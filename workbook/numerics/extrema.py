@@ -24,6 +24,7 @@ def extremum(
     var: str = "x",
     unit: str = "",
     label: Callable[[int], str] | None = None,
+    enclose: Callable | None = None,
 ) -> Result:
     """The largest (``kind="max"``) or smallest value of ``f(x, *args)`` on [a, b] per row.
 
@@ -32,6 +33,13 @@ def extremum(
     compared with the end points, so the global extremum among all local ones is returned.
     ``where`` is its position (argmax/argmin). With ``need_where``, a function that is flat on
     [a, b] (all samples equal within the tolerance) is an error: it has no one argmax.
+
+    With ``enclose(lo, hi, *args) -> (F, D)`` (interval enclosures of f and its derivative,
+    :mod:`workbook.numerics.intervals`), the value is then certified by branch and bound
+    (:func:`workbook.numerics.globalmin.global_min`): a peak narrower than the samples is
+    found, and where the search cannot close (too many boxes), the gap between the value and
+    the bound left is added to the error estimate. Without it, the value assumes no feature
+    narrower than the samples' spacing.
     """
     from scipy.optimize.elementwise import find_minimum
 
@@ -53,13 +61,6 @@ def extremum(
     spread = fs.max(axis=1) - fs.min(axis=1)
     scale = np.abs(fs).max(axis=1)
     flat = spread <= np.maximum(tol.rtol * scale, tol.atol)
-    if need_where and flat.any():
-        i = np.flatnonzero(flat)[0]
-        raise NumericsError(
-            f"arg{kind}(): the function is flat on [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
-            f"{row_text(label, i, n)} (all {k + 1} samples equal {num(sgn * fs[i, 0])} within "
-            f"the tolerance): it has no one arg{kind}"
-        )
     # interior local minima of the samples (of sgn*f), each bracketed by its neighbours
     mid = fs[:, 1:-1]
     cand = (mid <= fs[:, :-2]) & (mid <= fs[:, 2:]) & ~((mid == fs[:, :-2]) & (mid == fs[:, 2:]))
@@ -96,7 +97,20 @@ def extremum(
         best_x[take] = where[first][better]
         best_ve[take] = verr[first][better]
         best_xe[take] = werr[first][better]
+    if enclose is not None:
+        evaluations += _certify(
+            f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, best_xe
+        )
     if need_where:
+        # flat samples, and no better value between them (branch and bound may find one)
+        flat &= ~(best_v < fs.min(axis=1) - np.maximum(tol.rtol * scale, tol.atol))
+        if flat.any():
+            i = np.flatnonzero(flat)[0]
+            raise NumericsError(
+                f"arg{kind}(): the function is flat on [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
+                f"{row_text(label, i, n)} (all {k + 1} samples equal {num(sgn * fs[i, 0])} "
+                f"within the tolerance): it has no one arg{kind}"
+            )
         _no_plateau(kind, xs, fs, best_v, tol, var, unit, label)
     return Result(
         (sgn * best_v).reshape(shape),
@@ -104,6 +118,85 @@ def extremum(
         best_x.reshape(shape),
         best_xe.reshape(shape),
         evaluations=evaluations,
+    )
+
+
+#: rows of one call certified by branch and bound; of a larger table, PROBE rows spread over
+#: it are, and all of them when one of those finds a better value than its samples did
+CERTIFY_ROWS = 2_000
+PROBE = 64
+
+
+def _certify(f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, best_xe) -> int:
+    """Branch and bound from the samples' best (in place); the evaluations of f it took."""
+    from .globalmin import global_min
+    from .intervals import neg
+
+    n = lo.size
+    scale = np.abs(fs).max(axis=1)
+
+    def g(p, q, r):
+        fv, dv = enclose(p, q, *[a[r] for a in args])
+        if sgn > 0:
+            return fv, dv
+        return neg(fv), None if dv is None else neg(dv)
+
+    def h(x, r):
+        return sgn * np.asarray(f(x, *[a[r] for a in args]), dtype=float)
+
+    def run(sel):
+        floor = np.maximum(tol.rtol * scale[sel], tol.atol)
+        # the rows' index into sel: the boxes carry rows of sel, allowed maps them back
+        cert = global_min(
+            lambda p, q, r: g(p, q, sel[r]),
+            lambda x, r: h(x, sel[r]),
+            lo[sel],
+            hi[sel],
+            best_v[sel],
+            best_x[sel],
+            lambda b, floor=floor: np.maximum(tol.rtol * np.abs(b), floor.max()),
+        )
+        improved = cert.value < best_v[sel]
+        best_v[sel], best_x[sel] = cert.value, cert.where
+        best_ve[sel] = np.maximum(best_ve[sel], cert.gap)
+        best_xe[sel] = np.where(improved, np.maximum(best_xe[sel], cert.width), best_xe[sel])
+        if improved.any():
+            _polish(h, sel[improved], best_v, best_x, best_ve, best_xe, tol)
+        return improved
+
+    if n <= CERTIFY_ROWS:
+        run(np.arange(n))
+    elif run(np.linspace(0, n - 1, PROBE).astype(np.intp)).any():
+        run(np.arange(n))
+    return 0
+
+
+def _polish(h, idx, best_v, best_x, best_ve, best_xe, tol) -> None:
+    """A better point branch and bound found, refined by find_minimum in the box around it
+    (where that box is a bracket of a minimum)."""
+    from scipy.optimize.elementwise import find_minimum
+
+    x, w = best_x[idx], np.maximum(best_xe[idx], 4 * np.spacing(np.abs(best_x[idx])))
+    a, b = x - w, x + w
+    with np.errstate(all="ignore"):
+        fa, fx, fb = (np.asarray(h(v, idx), dtype=float) for v in (a, x, b))
+        valid = (fx <= fa) & (fx <= fb)
+        if not valid.any():
+            return
+        tols = {"xatol": tol.atol, "xrtol": max(tol.rtol, np.finfo(float).eps ** 0.5)}
+        res = find_minimum(
+            lambda t, r: h(t, r.astype(np.intp)),
+            (a[valid], x[valid], b[valid]),
+            args=(idx[valid].astype(float),),
+            tolerances=tols,
+        )
+    ok = (np.asarray(res.success) | (np.asarray(res.status) == -2)) & (res.f_x <= fx[valid])
+    rows_ = idx[valid][ok]
+    best_v[rows_] = res.f_x[ok]
+    best_x[rows_] = res.x[ok]
+    best_xe[rows_] = np.abs(res.bracket[1] - res.bracket[0])[ok]
+    best_ve[rows_] = np.maximum(
+        best_ve[rows_], np.abs(np.maximum(res.f_bracket[0], res.f_bracket[2]) - res.f_x)[ok]
     )
 
 
