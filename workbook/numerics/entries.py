@@ -296,10 +296,20 @@ def _integral_numpy(of, a, b):
     shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
     breaks = of.breaks(shape)
     tol, var, unit = of.tolerance, of.var, of.unit_text
+    enclose = of.enclosure(shape)
     res = _solve(
         of,
         lambda f, a, b, *rest: quadrature.integrate(
-            f, a, b, (rest[-2],), tol, breaks=rest[:-2], var=var, unit=unit, label=rest[-1]
+            f,
+            a,
+            b,
+            (rest[-2],),
+            tol,
+            breaks=rest[:-2],
+            var=var,
+            unit=unit,
+            label=rest[-1],
+            enclose=enclose,
         ),
         a,
         b,

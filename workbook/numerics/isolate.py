@@ -72,8 +72,8 @@ def isolate(g, lo: np.ndarray, hi: np.ndarray, min_width: np.ndarray) -> Isolati
         # excludes 0 on a box across its pole too)
         one = maybe & monotone & np.isfinite(f_lo) & np.isfinite(f_hi)
         if one.any():
-            s_lo = _sign(g, blo[one], row[one])
-            s_hi = _sign(g, bhi[one], row[one])
+            both = _sign(g, np.concatenate([blo[one], bhi[one]]), np.tile(row[one], 2))
+            s_lo, s_hi = np.split(both, 2)
             known = (s_lo != 0) & (s_hi != 0)
             change = known & (s_lo != s_hi)
             found.append((row[one][change], blo[one][change], bhi[one][change]))

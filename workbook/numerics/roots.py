@@ -142,7 +142,7 @@ def root_in(
 #: about three evaluations of f a row); of a larger table, PROBE rows spread over it are
 #: counted, the others are decided by their samples and the final bracket's values
 CERTIFY_ROWS = 2_000
-PROBE = 64
+PROBE = 16
 #: a value at the final bracket's ends larger than this times what a root's slope gives
 #: there (the samples' secant times the bracket's width) is no root: a pole or a jump
 NOT_A_ROOT = 1e3
