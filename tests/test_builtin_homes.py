@@ -68,8 +68,8 @@ KNOWN_ELSEWHERE = {
     # the numerical methods with an error estimate (bench) and their live Excel forms
     ("numerics/bench.py", ("argmax", "argmin", "integral", "maximum", "minimum", "root")),
     ("numerics/live.py", ("argmax", "argmin", "maximum", "minimum")),
-    # interval arithmetic of the one-argument built-ins (root's count of roots): a back end
-    # whose rules could be a field of the entry
+    # interval arithmetic of the one-argument built-ins (root counts, global extrema,
+    # features of integrands): a back end whose rules could be a field of the entry
     (
         "numerics/intervals.py",
         ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),

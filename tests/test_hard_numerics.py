@@ -207,3 +207,57 @@ def test_an_end_point_singularity_estimate_covers_the_rounding_of_its_nodes(tmp_
     estimate was 2.3e-10 (98 times too small)."""
     exact = 2 * mpmath.sqrt(_MP("0.3")) + 2 * mpmath.sqrt(_MP("0.7"))
     right(tmp_path, "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)", exact, rel=1e-7)
+
+
+HARD_SHEET = """
+[sheet]
+title = "hard cases"
+[definitions]
+peak = "maximum(exp(-((x - 0.3)/1e-4)^2), x, 0, 1)"
+wave = "maximum(sin(100*x)*exp(-x), x, 0, 10)"
+narrow = "integral(exp(-((x - 3.7)/1e-2)^2), x, 0, 10)"
+step = "integral(tanh(1e3*x), x, -1, 2)"
+lorentz = "integral(1/(1 + ((x - 0.4)/1e-3)^2), x, 0, 1)"
+cusp = "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)"
+triple = "root(x^3 - 3*x^2 + 3*x - 1, x, 0, 1.7)"
+sqrt2 = "root(x^2 - 2, x, 0, 2)"
+where = "argmax(sin(100*x)*exp(-x), x, 0, 10)"
+"""
+
+EXACT = {
+    "peak": mpmath.mpf(1),
+    "wave": mpmath.sin(mpmath.atan(100)) * mpmath.exp(-mpmath.atan(100) / 100),
+    "narrow": mpmath.sqrt(mpmath.pi) * _MP("1e-2") / 2
+    * (mpmath.erf(_MP("6.3") / _MP("1e-2")) + mpmath.erf(_MP("3.7") / _MP("1e-2"))),
+    "step": (mpmath.log(mpmath.cosh(2000)) - mpmath.log(mpmath.cosh(1000))) / 1000,
+    "lorentz": _MP("1e-3") * (mpmath.atan(_MP("0.6") / _MP("1e-3")) + mpmath.atan(400)),
+    "cusp": 2 * mpmath.sqrt(_MP("0.3")) + 2 * mpmath.sqrt(_MP("0.7")),
+    "triple": mpmath.mpf(1),
+    "sqrt2": mpmath.sqrt(2),
+    "where": mpmath.atan(100) / 100,
+}  # fmt: skip
+
+
+def test_bench_verdicts_agree_with_mpmath(tmp_path):
+    """`workbook bench` on the hard cases: its reference is other methods (Brent, QUADPACK,
+    dense sampling), never the engine's routine; every "ok" is right against mpmath (50
+    digits) within the tolerance, every estimate is at least a tenth of the true error, and
+    a line that is not "ok" is one whose error is beyond the tolerance."""
+    from workbook.numerics import bench
+
+    path = tmp_path / "hard.toml"
+    path.write_text(HARD_SHEET, encoding="utf-8")
+    sheet = workbook.load(path)
+    lines = {line.what: line for line in bench.run(sheet, repeats=1)}
+    assert set(lines) == set(EXACT)
+    for name, line in lines.items():
+        got = float(sheet.evaluate(name).magnitude)
+        true = abs(got - float(EXACT[name])) / abs(float(EXACT[name]))
+        assert line.estimate >= true / 10, (name, line.estimate, true)
+        floor = bench.WHERE_ACCURACY if name == "where" else bench.REFERENCE_ACCURACY
+        if line.verdict == "ok":
+            assert true <= max(line.tolerance, floor) * 1.5, (name, true)
+        else:
+            assert true > line.tolerance, (name, line.verdict, true)
+    assert lines["triple"].verdict == "beyond tolerance (estimated)"
+    assert lines["peak"].verdict == "ok" and lines["narrow"].verdict == "ok"

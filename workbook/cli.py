@@ -349,7 +349,7 @@ def cmd_bench(args) -> int:
     ref = sheet.spec.meta.get("bench")
     from .numerics import bench
 
-    lines = bench.run(sheet)
+    lines = bench.run(sheet, repeats=1 if args.quick else bench.REPEATS)
     if lines:
         print(bench.text(sheet, lines))
     if not ref and not sheet.spec.odes:

@@ -12,7 +12,10 @@ and solves every row in one call of a SciPy vectorised routine:
 - :func:`series.reduce`: sums and products over integers;
 - :func:`given.solve`: a Given/Find system (``scipy.optimize.root``);
 - :func:`interpolate.interpolate`: linear and cubic-spline interpolation of measured data;
-- :mod:`gauss`: fixed Gauss-Legendre rules (the integral's live Excel form).
+- :mod:`gauss`: fixed Gauss-Legendre rules (the integral's live Excel form);
+- :mod:`reference`: other algorithms for the same built-ins (``workbook bench``'s
+  reference); :mod:`intervals`, :mod:`isolate`, :mod:`globalmin`, :mod:`features`: interval
+  enclosures of EXPR and what they prove (root counts, global extrema, features).
 
 Every result carries an error estimate; every failure is a :class:`NumericsError` that says
 what was sampled and found. This package knows nothing of worksheets (no typed tree): the
@@ -28,6 +31,7 @@ from ._common import (
     current,
     live_forms,
     recording_chains,
+    reference_methods,
     sheet_tolerance,
     tolerance,
 )
@@ -39,6 +43,7 @@ __all__ = [
     "current",
     "live_forms",
     "recording_chains",
+    "reference_methods",
     "sheet_tolerance",
     "tolerance",
 ]

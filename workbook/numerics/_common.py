@@ -80,6 +80,28 @@ def live_forms() -> Iterator[None]:
         _live.reset(token)
 
 
+_reference: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "workbook_numerics_reference", default=False
+)
+
+
+def reference() -> bool:
+    """True inside :func:`reference_methods`: built-ins compute by other algorithms."""
+    return _reference.get()
+
+
+@contextlib.contextmanager
+def reference_methods(on: bool = True) -> Iterator[None]:
+    """Compute root, integral and the extrema by the methods of
+    :mod:`workbook.numerics.reference` (not the engine's): ``workbook bench``'s reference
+    (``on=False``: the engine's methods again, for the rows the reference leaves out)."""
+    token = _reference.set(on)
+    try:
+        yield
+    finally:
+        _reference.reset(token)
+
+
 _chains: contextvars.ContextVar[dict | None] = contextvars.ContextVar(
     "workbook_numerics_chains", default=None
 )

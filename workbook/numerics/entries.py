@@ -19,7 +19,15 @@ from .. import units as un
 from ..entry import Builtin, register
 from ..errors import NotLive, NotSymbolic, TemplateError, UnitError, WorkbookError
 from ..expr import PREC
-from ._common import NumericsError, Result, chains, live, sheet_tolerance
+from ._common import (
+    NumericsError,
+    Result,
+    chains,
+    live,
+    reference,
+    reference_methods,
+    sheet_tolerance,
+)
 
 ATOM = PREC["atom"]
 #: rows solved at once (a bracket's samples take rows x samples memory)
@@ -258,6 +266,14 @@ def _root_numpy(of, a, b=None):
     tol, var, unit = of.tolerance, of.var, of.unit_text
     if live() and b is not None:
         return _out(_live_chain(of, a, b, _bisection)["root"])
+    if reference():
+        from . import reference as ref
+
+        if b is None:
+            res = _solve(of, lambda f, a, idx, label: ref.root_near(f, a, (idx,)), a)
+        else:
+            res = _solve(of, lambda f, a, b, idx, label: ref.root_in(f, a, b, (idx,)), a, b)
+        return _merged(res.value, _root_numpy, of, a, b)
     if b is None:
         res = _solve(
             of,
@@ -295,6 +311,17 @@ def _integral_numpy(of, a, b):
         return _out(res.value)
     shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
     breaks = of.breaks(shape)
+    if reference():
+        from . import reference as ref
+
+        res = _solve(
+            of,
+            lambda f, a, b, *rest: ref.integral(f, a, b, (rest[-2],), rest[:-2]),
+            a,
+            b,
+            *breaks,
+        )
+        return _merged(res.value, _integral_numpy, of, a, b)
     tol, var, unit = of.tolerance, of.var, of.unit_text
     enclose = of.enclosure(shape)
     res = _solve(
@@ -329,6 +356,16 @@ def _extremum_numpy(name: str):
         if live():  # what the workbook's samples and golden-section steps compute
             steps = _live_chain(of, a, b, lambda f, a, b, idx: _golden(f, a, b, idx, kind, of))
             return _out(steps["where" if where else "value"])
+        if reference():
+            from . import reference as ref
+
+            res = _solve(
+                of,
+                lambda f, a, b, idx, label: ref.extremum(f, a, b, (idx,), kind, where),
+                a,
+                b,
+            )
+            return _merged(res.where if where else res.value, hook, of, a, b)
         tol, var, unit = of.tolerance, of.var, of.unit_text
         enclose = of.enclosure(np.broadcast_shapes(of.shape, np.shape(a), np.shape(b)))
         res = _solve(
@@ -379,6 +416,15 @@ def _product_numpy(of, a, b):
         b,
     )
     return _out(res.value)
+
+
+def _merged(ref: np.ndarray, hook, of, *bounds):
+    """The reference's values, and the engine's where the reference left a row out (NaN)."""
+    if not np.isnan(ref).any():
+        return _out(ref)
+    with reference_methods(False):
+        engine = np.broadcast_to(np.asarray(hook(of, *bounds), dtype=float), np.shape(ref))
+    return _out(np.where(np.isnan(ref), engine, ref))
 
 
 def _out(v: np.ndarray):
