@@ -731,7 +731,7 @@ for _name, _text, _shown in (
             _extremum_numpy(_name),
             _extremum_excel(_name),
             _no_sympy(_name),
-            doc=f"{_name}(EXPR, X, A, B): {_text} (the global one among all local ones)",
+            doc=f"{_name}(EXPR, X, A, B): {_text} (the global one: see docs/numerics.md)",
             binds=(0, 1),
             mathml=f"<munder><mi>{_shown}</mi><mrow>{{1}}<mo>\u2208</mo><mrow><mo>[</mo>{{2}}"
             "<mo separator='true'>,</mo>{3}<mo>]</mo></mrow></mrow></munder>{0:group}",
