@@ -584,3 +584,63 @@ def test_a_function_that_calls_itself_is_a_recursion(tmp_path, capsys):
     main(["check", str(tmp_path / "fact.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
+
+
+def test_compound_result_unit_names():
+    from workbook.mathcad.units import result_unit
+
+    assert un.registry().Unit(result_unit("kiloNewton_meter")) == un.registry().Unit("kN*m")
+    assert result_unit("Ms") == "Ms"  # a symbol is never lowered (Ms is not ms)
+
+
+def test_a_result_in_an_unknown_unit_costs_only_that_result(tmp_path, capsys):
+    """x := 2 (stored in a unit no registry knows) and y := 3 (stored plainly): the check
+    compares y, lists x's result, and does not stop."""
+    odd = (
+        '<ml:unitedValue><ml:real>2</ml:real><u:unitMonomial xmlns:u="http://schemas.mathsoft.'
+        'com/units10"><u:unitReference unit="furlongFortnightXyz"/></u:unitMonomial>'
+        "</ml:unitedValue>"
+    )
+    src = tmp_path / "odd.xmcd"
+    src.write_text(
+        _worksheet(
+            _region(1, _id("x") + _real(2)),
+            _region(2, _id("y") + _real(3)),
+            _eval(3, _id("x"), odd),
+            _eval(4, _id("y"), _real(3)),
+        ),
+        encoding="utf-8",
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "odd.toml").read_text(encoding="utf-8")
+    assert "its unit 'furlongfortnightxyz' is not a unit the engine knows" in text
+    capsys.readouterr()
+    assert main(["check", str(tmp_path / "odd.toml"), "--json"]) == 1  # one not computable
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"], result["not_computable"]) == (2, 1, 1)
+
+
+SHARED = __import__("pathlib").Path(__file__).resolve().parents[1].parent / "shared"
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason="../shared is absent")
+def test_every_unit_name_of_both_corpora_is_mapped():
+    """Every unit named in a stored result (unitReference) and every name Prime labels a
+    unit in a formula, in ../shared/mathcad and ../shared/mathcad-prime, is a pint unit."""
+    import re
+    import zipfile
+
+    from workbook.mathcad.units import result_unit
+
+    texts = [p.read_text("utf-8", "replace") for p in (SHARED / "mathcad").rglob("*.xmcd")]
+    for p in (SHARED / "mathcad-prime").glob("*.mcdx"):
+        with zipfile.ZipFile(p) as z:
+            texts += [z.read(n).decode("utf-8-sig") for n in z.namelist() if n.endswith(".xml")]
+    results = {n for t in texts for n in re.findall(r'unitReference unit="([^"]+)"', t)}
+    formulas = {
+        n for t in texts for n in re.findall(r'<ml:id[^>]*labels="UNIT"[^>]*>([^<]+)</ml:id>', t)
+    }
+    assert len(results) > 5 and len(formulas) > 5
+    for name in sorted(results):
+        un.registry().Unit(result_unit(name))
+    assert sorted(formulas - set(FORMULA_UNITS)) == []

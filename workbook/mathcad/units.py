@@ -37,7 +37,8 @@ FORMULA_UNITS: dict[str, str] = {
     # electric
     "A": "ampere", "mA": "milliampere", "kA": "kiloampere", "V": "volt", "mV": "millivolt",
     "kV": "kilovolt", "Ω": "ohm", "ohm": "ohm", "kΩ": "kiloohm", "C": "coulomb",
-    "F": "farad", "μF": "microfarad", "H": "henry", "Wb": "weber", "T": "tesla",
+    "F": "farad", "μF": "microfarad", "pC": "picocoulomb", "nC": "nanocoulomb",
+    "μC": "microcoulomb", "H": "henry", "Wb": "weber", "T": "tesla",
     "S": "siemens",
     # frequency, speed
     "Hz": "hertz", "kHz": "kilohertz", "MHz": "megahertz", "rpm": "revolutions_per_minute",
@@ -64,5 +65,13 @@ RESULT_UNITS: dict[str, str] = {
 
 
 def result_unit(name: str) -> str:
-    """pint text of a unit named in a stored result (full names pint mostly knows)."""
-    return RESULT_UNITS.get(name, name)
+    """pint text of a unit named in a stored result (full names pint mostly knows; a
+    compound name such as ``kiloNewton_meter`` is read as the product of its parts)."""
+    if name in RESULT_UNITS:
+        return RESULT_UNITS[name]
+    if "_" in name or name != name.lower():
+        parts = [p.lower() for p in name.split("_") if p]
+        # full names only: lowering a symbol would change it (Ms, megasecond, is not ms)
+        if parts and all(p.isalpha() and len(p) >= 4 for p in parts):
+            return " * ".join(parts)
+    return name

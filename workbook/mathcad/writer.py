@@ -13,7 +13,7 @@ from .. import expr as ex
 from ..errors import InputError, WorkbookError
 from .functions import language_functions
 from .tomldoc import Document, is_one_line, one_line
-from .translate import Item, Sym, Translation, _rename
+from .translate import Item, Skipped, Sym, Translation, _rename
 
 #: Relative tolerance of the printed values: Mathcad stores full doubles.
 REL_TOLERANCE = 1e-9
@@ -136,6 +136,7 @@ class _Section:
 def render(tr: Translation, name: str, src: Path) -> Rendered:
     """The worksheet text and its CSV files."""
     _assign(tr)
+    _list_unknown_units(tr)
     mapping = {s.token(): s.final for s in tr.syms}
     out = Rendered(name, "")
     doc = Document()
@@ -277,7 +278,8 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         if not res.rows or not all(is_one_line(t) for t in texts):
             why = "cannot be read" if not res.rows else "is a text of several lines"
             rows.append([f"# region {res.region}: {res.name}: the stored result {why}"])
-            rows.append([sym_name, "", "(a result that cannot be read)", ""])  # not computable
+            # under a name no worksheet defines: counted, and not computable (never compared)
+            rows.append([f"unreadable result of region {res.region}", "", "(unreadable)", ""])
             continue
         rows.append([f"# region {res.region}: {res.name}"])
         for at, value in res.rows:
@@ -311,6 +313,27 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         doc.pair("tolerance", ABS_TOLERANCE)
     out.toml = doc.text()
     return out
+
+
+def _list_unknown_units(tr: Translation) -> None:
+    """A stored result in a unit the engine does not know costs that result (listed, not
+    computable), never the check of the whole worksheet."""
+    from .. import units as un
+
+    for res in tr.results:
+        if not res.unit or not res.rows:
+            continue
+        try:
+            un.registry().Unit(res.unit)
+        except Exception:  # noqa: BLE001 - pint's parse and definition errors alike
+            tr.skipped.append(
+                Skipped(
+                    res.region,
+                    f"the result of {res.name}",
+                    f"its unit {res.unit!r} is not a unit the engine knows",
+                )
+            )
+            res.rows = []
 
 
 def _csv_text(rows: list[list[str]]) -> str:
