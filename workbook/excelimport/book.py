@@ -24,7 +24,8 @@ class Definition:
     cell: Cell
     text: str | None = None  # the expression
     problem: str | None = None
-    element: tuple[str, int] | None = None  # (array formula's name, index) of a block cell
+    element: tuple[str, int] | None = None  # (array formula's name, k) of a cell of a block
+    block: tuple[int, int] | None = None  # (rows, columns) of the array formula's cells
 
 
 @dataclass
@@ -321,33 +322,34 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
     all_params = {
         p.lower() for i in tr.functions.values() for p in list(i.params) + list(i.given.values())
     }
-    for info in tr.functions.values():
-        own = {p.lower() for p in list(info.params) + list(info.given.values())}
-        block = (
-            reserved
-            | sheet_names
-            | (all_params - own)
-            | {i.final.lower() for i in tr.functions.values()}
-        )
-        t = Translator(info, tr.functions, block)
-        t.option_base = info.option_base  # type: ignore[attr-defined]
-        body = "\n".join(x for _, x in info.proc.lines)
-        try:
-            for name in info.module_vars:  # type: ignore[attr-defined]
-                if re.search(rf"\b{re.escape(name)}\b", body, re.I):
-                    raise NotTranslated(
-                        f"uses the module variable {name} (state kept between calls)"
-                    )
-            consts = [c for c in info.consts if _const_name(c) and _mentions(body, _const_name(c))]  # type: ignore[attr-defined]
-            if consts:
-                info.proc.lines[:0] = [
-                    (0, re.sub(r"^(public|private)\s+", "", c, flags=re.I)) for c in consts
-                ]
-            info.program = t.translate()
-        except NotTranslated as exc:
-            info.problem = str(exc)
-        except Exception as exc:  # noqa: BLE001 - a construct the reader did not foresee
-            info.problem = f"not translated ({type(exc).__name__}: {exc})"
+    for _round in range(2):  # the second knows the lower bound of the arrays callees give
+        for info in tr.functions.values():
+            own = {p.lower() for p in list(info.params) + list(info.given.values())}
+            block = (
+                reserved
+                | sheet_names
+                | (all_params - own)
+                | {i.final.lower() for i in tr.functions.values()}
+            )
+            t = Translator(info, tr.functions, block)
+            t.option_base = info.option_base  # type: ignore[attr-defined]
+            body = "\n".join(x for _, x in info.proc.lines)
+            info.problem, info.calls = None, set()
+            try:
+                for name in info.module_vars:  # type: ignore[attr-defined]
+                    if re.search(rf"\b{re.escape(name)}\b", body, re.I):
+                        raise NotTranslated(
+                            f"uses the module variable {name} (state kept between calls)"
+                        )
+                consts = [
+                    c for c in info.consts if _const_name(c) and _mentions(body, _const_name(c))
+                ]  # type: ignore[attr-defined]
+                t.prefix = [(0, re.sub(r"^(public|private)\s+", "", c, flags=re.I)) for c in consts]
+                info.program = t.translate()
+            except NotTranslated as exc:
+                info.problem = str(exc)
+            except Exception as exc:  # noqa: BLE001 - a construct the reader did not foresee
+                info.problem = f"not translated ({type(exc).__name__}: {exc})"
     changed = True
     while changed:  # a function that calls one not translated is not translated either
         changed = False
@@ -392,10 +394,9 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 from openpyxl.utils.cell import range_boundaries
 
                 c1, r1, c2, r2 = range_boundaries(cell.array)
-                if r1 != r2:
-                    d.problem = "part of a block array formula of several rows (not translated)"
-                else:
-                    d.element = (master.name, cell.col - c1)
+                width = c2 - c1 + 1
+                d.element = (master.name, (cell.row - r1) * width + cell.col - c1)
+                master.block = (r2 - r1 + 1, width)
             tr.definitions.append(d)
             continue
         try:

@@ -43,6 +43,7 @@ class FunctionInfo:
     problem: str | None = None
     volatile: bool = False
     calls: set[str] = field(default_factory=set)  # lower-case VBA names it calls
+    result_base: int = 0  # the lower bound of the array it gives
 
     @property
     def arity(self) -> int:
@@ -77,6 +78,7 @@ class Translator:
         self.counter = 0
         self.option_base = 0
         self.declared_numbers: list[str] = []
+        self.prefix: list[tuple[int, str]] = []  # module-level Const lines it uses
         for i, p in enumerate(self.proc.params):
             self.names[p.name.lower()] = info.params[i]
             self.types[p.name.lower()] = p.type.lower()
@@ -106,7 +108,7 @@ class Translator:
 
     # -- statements --------------------------------------------------------------------
     def translate(self) -> str:
-        body = list(self.proc.lines)
+        body = list(self.prefix) + list(self.proc.lines)
         self.body = body
         self.at = 0
         self.assigned = False
@@ -246,6 +248,8 @@ class Translator:
                     self.arrays[key] = _Array(1, 2, True)
             elif rhs[0] == "id" and rhs[1].lower() in self.arrays:
                 self.arrays[key] = self.arrays[rhs[1].lower()]
+            elif self._callee(rhs) is not None:  # an array a VBA function gives, or a number
+                self.arrays[key] = _Array(self._callee(rhs).result_base, 0)
             if self.types.get(key) in INTEGER_TYPES and not self._integral(rhs):
                 value = bankers(value)
             self.emit(indent, f"{self.local(target[1])} := {value}")
@@ -283,6 +287,8 @@ class Translator:
         if self.text_function:
             raise NotTranslated("a function whose value is a text, given a value not a text")
         value = self.value(rhs)
+        if rhs[0] == "id" and rhs[1].lower() in self.arrays:
+            self.info.result_base = self.arrays[rhs[1].lower()].base
         if self.proc.returns.lower() in INTEGER_TYPES and not self._integral(rhs):
             value = bankers(value)  # VBA rounds the value of an Integer function
         self.emit(indent, f"{self.ret} := {value}")
@@ -320,6 +326,18 @@ class Translator:
                 depth -= 1
             j += 1
         return j
+
+    def _callee(self, node):
+        """The FunctionInfo of a call of a VBA function (``f(...)``, ``Module.f(...)``)."""
+        node = strip(node)
+        if node[0] != "call":
+            return None
+        base = strip(node[1])
+        if base[0] == "mem":
+            base = ("id", base[2])
+        if base[0] == "id" and base[1].lower() in self.functions:
+            return self.functions[base[1].lower()]
+        return None
 
     def _integral(self, node) -> bool:
         node = strip(node)

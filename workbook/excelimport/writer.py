@@ -12,7 +12,7 @@ from pathlib import Path
 from ..errors import WorkbookError
 from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
-from .book import Translation
+from .book import Definition, Translation
 
 MAX_LOAD_ROUNDS = 60  # loads of the worksheet while refused definitions are left out
 
@@ -94,17 +94,26 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             elements.append((d, cached))
             continue
         definitions[d.name] = {"expr": d.text, "note": note}
-        if cached is not None:
+        if d.block is not None:  # the first cell of an array formula: its element 0
+            elements.append((Definition(d.name, d.cell, element=(d.name, 0)), cached))
+        elif cached is not None:
             rows.append((d.name, "", cached, d.cell.ref))
     # cells of an array formula: the function NAME_at(k) gives element k of NAME
     at_rows = []
     made = set()
+    masters = {d.name: d for d in tr.definitions}
     for d, cached in elements:
         fn = f"{d.element[0]}_at"
         if fn not in made:
             made.add(fn)
+            n_rows, cols = masters[d.element[0]].block or (1, 1)
+            element = (
+                f"{d.element[0]}[k_at]"  # a row of cells shows a vector
+                if n_rows == 1
+                else f"{d.element[0]}[floor(k_at/{cols}), mod(k_at, {cols})]"
+            )
             definitions[f"{fn}(k_at)"] = {
-                "expr": f"{d.element[0]}[k_at]",
+                "expr": element,
                 "note": f"the cells of the array formula {d.element[0]}, one by one",
             }
             arguments["k_at"] = {"unit": "", "note": "the position of a cell in its array formula"}
