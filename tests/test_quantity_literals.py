@@ -164,3 +164,39 @@ def test_mistakes_say_what_to_write(tmp_path, expr, message):
     )
     with pytest.raises(WorkbookError, match=message):
         workbook.load(write_template(tmp_path, text))
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculates_literals_constants_and_a_log_range(tmp_path):
+    """The quantities, g, e and pi, and a logspace table, recalculated by LibreOffice."""
+    import numpy as np
+    from recalc import cell_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    text = SHEET.replace('x = { unit = "m" }\n', 'x = { unit = "m" }\nf = { unit = "Hz" }\n')
+    text += """weight_g = { expr = "m_1*g", unit = "N" }
+growth = "e^2 + pi"
+
+[[tables]]
+name = "bode"
+range = "f := logspace(10 Hz, 10 kHz, 4)"
+columns = { "1/(1 + f/(1 kHz))" = "" }
+"""
+    sheet = workbook.load(write_template(tmp_path, text, "lo.toml"))
+    path = sheet.write_xlsx(tmp_path / "lo.xlsx")
+    import openpyxl
+
+    results = openpyxl.load_workbook(path)["Results"]
+    rows = {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
+    values = cell_values(recalculate(path, tmp_path / "out"))
+    for name in [*_expected(), "weight_g", "growth"]:
+        engine = sheet.evaluate(name)
+        if sheet.spec.definitions[name].unit is not None:
+            engine = engine.to(sheet.spec.definitions[name].unit)
+        got = float(values[("Results", f"B{rows[name]}")])
+        assert got == pytest.approx(float(engine.magnitude), rel=1e-12), name
+    table = sheet.table("bode")
+    listing = {k[1]: v for k, v in values.items() if k[0] == "Listing"}
+    got = [float(listing[f"B{3 + i}"]) for i in range(4)]
+    np.testing.assert_allclose(got, table.iloc[:, 1], rtol=1e-12)

@@ -261,3 +261,10 @@ heated = { expr = "T + linterp(T_col, rise, T)", unit = "degC" }
     assert sheet.evaluate("viscosity").to("mm^2/s").magnitude == pytest.approx(nu, rel=1e-13)
     rise = 5 + (t - 40) / 60 * (12 - 5)
     assert sheet.evaluate("heated").to("degC").magnitude == pytest.approx(t + rise, rel=1e-13)
+
+
+def test_set_refuses_a_difference_for_an_absolute_temperature(tmp_path):
+    sheet = workbook.load(write_template(tmp_path, SHEET))
+    with pytest.raises(workbook.WorkbookError, match="is a temperature difference, but T1 is an"):
+        sheet.with_inputs(T1="5 delta_degC")
+    assert sheet.with_inputs(T1="68 degF").evaluate("dT").to("K").magnitude == pytest.approx(65)

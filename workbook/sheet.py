@@ -741,6 +741,20 @@ def coerce_input(spec, raw, *, file: str | None = None):
     try:
         q = q.to(spec.unit)
     except pint.DimensionalityError:
+        kinds = (un.temperature_kind(q.units), un.temperature_kind(spec.unit))
+        if q.units.dimensionality == spec.unit.dimensionality and "difference" in kinds:
+            what = (
+                "a temperature difference"
+                if kinds[0] == "difference"
+                else "an absolute temperature"
+            )
+            raise InputError(
+                f"{spec.name} = {raw!s} is {what}, but {spec.name} is "
+                f"{'an absolute temperature' if kinds[1] == 'absolute' else 'a difference'} "
+                f"({un.pretty(spec.unit)}): give it in {un.pretty(spec.unit)} or K",
+                file=file,
+                definition=spec.name,
+            ) from None
         raise InputError(
             f"{spec.name} = {raw!s} is {un.dims(q.units)}, but {spec.name} is "
             f"{un.dims(spec.unit)} ({un.pretty(spec.unit) or 'dimensionless'})",
