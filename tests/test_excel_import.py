@@ -334,3 +334,41 @@ def test_minimum_radius_loop_from_a_bas_module(tmp_path, capsys):
     capsys.readouterr()
     assert main(["check", str(out / "cam.toml"), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
+
+
+def test_a_filled_down_column_is_one_definition_over_a_range(tmp_path, capsys):
+    import workbook
+
+    book = tmp_path / "fill.xlsx"
+    wb = xlsxwriter.Workbook(str(book))
+    ws = wb.add_worksheet("Table")
+    ws.write("A1", "Factor")
+    ws.write("B1", 2.0)
+    for col, header in zip("ABCDE", ["x (m)", "Load (kN)", "Moment", "Double", "Total"]):
+        ws.write(f"{col}3", header)
+    moments = []
+    for i in range(10):
+        r = 4 + i
+        x, load = 0.5 * i, 1.0 + i * i
+        moments.append(x * load * 2.0)
+        ws.write(f"A{r}", x)
+        ws.write(f"B{r}", load)
+        ws.write_formula(f"C{r}", f"=A{r}*B{r}*$B$1", None, moments[-1])
+        ws.write_formula(f"D{r}", f"=C{r}*2", None, 2 * moments[-1])
+        # a running total reads its own column: each cell is translated on its own
+        running = f"=E{r - 1}+C{r}" if i else f"=C{r}"
+        ws.write_formula(f"E{r}", running, None, sum(moments))
+    ws.write("A15", "Total")
+    ws.write_formula("B15", "=SUM(C4:C13)", None, sum(moments))
+    wb.close()
+    out = tmp_path / "out"
+    assert main(["import", str(book), "--out", str(out)]) == 0
+    sheet = workbook.load(str(out / "fill.toml"))
+    assert "Moment" in sheet.spec.definitions and "Double" in sheet.spec.definitions
+    assert not any(n.startswith("Moment_") for n in sheet.spec.definitions)
+    assert [t.name for t in sheet.spec.tables] == ["table_Moment"]  # one table, two columns
+    assert float(sheet.evaluate("Moment", i_row=3).magnitude) == moments[3]
+    capsys.readouterr()
+    assert main(["check", str(out / "fill.toml"), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["printed"] == report["reproduced"] == 31  # 10 + 10 + 10 running + 1

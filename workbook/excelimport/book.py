@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .cells import FormulaProblem, FormulaTranslator, parse_formula
 from .reader import Book, Cell, read_book
+from .runs import ROW, Run, find_runs
 from .vba import Module, Procedure, is_event, read_modules
 from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
 
@@ -25,6 +26,7 @@ class Definition:
     text: str | None = None  # the expression
     problem: str | None = None
     element: tuple[str, int] | None = None  # (array formula's name, k) of a cell of a block
+    run: Run | None = None  # a filled-down column: the definition is a function of the row
     block: tuple[int, int] | None = None  # (rows, columns) of the array formula's cells
 
 
@@ -39,6 +41,8 @@ class Translation:
     definitions: list[Definition] = field(default_factory=list)
     listed: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
     cell_names: dict[tuple[str, int, int], str] = field(default_factory=dict)
+    runs: dict[tuple[str, int, int], Run] = field(default_factory=dict)  # cell -> its run
+    vectors: dict[str, str] = field(default_factory=dict)  # name -> vector literal
 
 
 def language_reserved() -> set[str]:
@@ -83,6 +87,7 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
             except FormulaProblem:
                 pass
     _name_cells(tr, cells, read, reserved)
+    _runs(tr, cells, parsed, reserved)
     _name_params(tr, reserved)
     _translate_functions(tr, reserved)
     _translate_cells(tr, cells, parsed)
@@ -294,6 +299,88 @@ def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) ->
         tr.cell_names[key] = name
 
 
+def _runs(tr: Translation, cells: list[Cell], parsed, reserved: set[str]) -> None:
+    """Filled-down columns: one function of the row each (see runs.py)."""
+    book = tr.book
+
+    def ref_of(token, sheet):
+        return FormulaTranslator(book, sheet, None, {}, book.names).ref_of(token)
+
+    runs = find_runs(book, cells, parsed, ref_of)
+    spans = {(r.sheet, r.col, r.first, r.count): r for r in runs}
+    valid = set(spans)
+    changed = True
+    while changed:  # a run reading a column that is neither numbers nor a valid run is not one
+        changed = False
+        for span in list(valid):
+            run = spans[span]
+            for sheet, col, offset in run.moving.values():
+                other = (sheet, col, run.first + offset, run.count)
+                if other in valid:
+                    continue
+                if other in spans or not _constant_column(
+                    book, sheet, col, run.first + offset, run.count
+                ):
+                    valid.discard(span)
+                    changed = True
+                    break
+    in_runs = {key for span in valid for key in spans[span].keys()}
+    taken = {n.lower() for k, n in tr.cell_names.items() if k not in in_runs} | set(reserved)
+    taken |= {i.final.lower() for i in tr.functions.values()}
+    for span in sorted(valid, key=lambda s: (s[0], s[2], s[1])):
+        run = spans[span]
+        header = book.cell(run.sheet, run.first - 1, run.col)
+        base = (
+            _ident(header.value) if header is not None and isinstance(header.value, str) else None
+        )
+        base = base or f"col_{_addr(run.first, run.col)}"
+        run.name = _unique(base, taken)
+        for k, key in enumerate(run.keys()):
+            tr.cell_names[key] = f"{run.name}({k})"
+            tr.runs[key] = run
+    for span in valid:
+        run = spans[span]
+        columns = {}
+        for key, (sheet, col, offset) in run.moving.items():
+            other = spans.get((sheet, col, run.first + offset, run.count))
+            if other is not None and other.name:
+                columns[key] = f"{other.name}({ROW})"
+                continue
+            header = book.cell(sheet, run.first + offset - 1, col)
+            base = (
+                _ident(header.value)
+                if header is not None and isinstance(header.value, str)
+                else None
+            )
+            vname = _unique((base or f"col_{_addr(run.first + offset, col)}") + "_col", taken)
+            values = [
+                book.cell(sheet, r, col).value
+                for r in range(run.first + offset, run.first + offset + run.count)
+            ]
+            tr.vectors[vname] = "[" + ", ".join(repr(float(v)) for v in values) + "]"
+            columns[key] = f"{vname}[{ROW}]"
+        run.moving = columns
+
+
+def _constant_column(book: Book, sheet: str, col: int, first: int, count: int) -> bool:
+    for r in range(first, first + count):
+        cell = book.cell(sheet, r, col)
+        if cell is None or cell.formula is not None or isinstance(cell.value, bool):
+            return False
+        if not isinstance(cell.value, (int, float)):
+            return False
+    return True
+
+
+def _unique(base: str, taken: set[str]) -> str:
+    name, n = base, 2
+    while name.lower() in taken:
+        name = f"{base}_{n}"
+        n += 1
+    taken.add(name.lower())
+    return name
+
+
 def _name_params(tr: Translation, reserved: set[str]) -> None:
     taken = set(reserved) | {n.lower() for n in tr.cell_names.values()}
     taken |= {i.final.lower() for i in tr.functions.values()}
@@ -381,7 +468,11 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
     by_key: dict[tuple[str, int, int], Definition] = {}
     for cell in cells:
         key = _key(cell)
-        d = Definition(tr.cell_names[key], cell)
+        run = tr.runs.get(key)
+        if run is not None and key != (run.sheet, run.first, run.col):
+            by_key[key] = by_key[(run.sheet, run.first, run.col)]  # the run's definition
+            continue
+        d = Definition(run.name if run else tr.cell_names[key], cell, run=run)
         by_key[key] = d
         if key not in parsed:
             d.problem = "cannot parse the formula"
@@ -400,7 +491,14 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             tr.definitions.append(d)
             continue
         try:
-            ft = FormulaTranslator(book, cell.sheet, name_of, tr.functions, book.names)
+            names = name_of
+            if run is not None:
+                moving = run.moving
+
+                def names(sheet, row, col, moving=moving):
+                    return moving.get((sheet, row, col)) or name_of(sheet, row, col)
+
+            ft = FormulaTranslator(book, cell.sheet, names, tr.functions, book.names)
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:
                 d.note_link = True  # type: ignore[attr-defined]
@@ -409,6 +507,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 for ref in ft.out.refs
                 for r in range(ref.r1, ref.r2 + 1)
                 for c in range(ref.c1, ref.c2 + 1)
+                if run is None or (ref.sheet, r, c) not in run.moving
             ]
         except FormulaProblem as exc:
             d.problem = str(exc)

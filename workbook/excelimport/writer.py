@@ -13,6 +13,7 @@ from ..errors import WorkbookError
 from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
 from .book import Definition, Translation
+from .runs import ROW
 
 MAX_LOAD_ROUNDS = 60  # loads of the worksheet while refused definitions are left out
 
@@ -82,7 +83,15 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             "note": f"VBA Function {info.proc.name} (module {info.proc.module})",
         }
     rows = []
+    run_rows: list = []
+    tables: dict = {}
     elements: list = []
+    for vname, text in tr.vectors.items():
+        if vname not in skip:
+            definitions[vname] = {
+                "expr": text,
+                "note": "a column of numbers a filled-down formula reads",
+            }
     for d in tr.definitions:
         if d.problem or d.name in skip:
             continue
@@ -92,6 +101,28 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             if d.element[0] in skip:
                 continue
             elements.append((d, cached))
+            continue
+        if d.run is not None:  # a filled-down column: a function of the row
+            run = d.run
+            definitions[f"{d.name}({ROW})"] = {
+                "expr": d.text,
+                "note": f"{run.count} cells filled down from {note}",
+            }
+            arguments[ROW] = {"unit": "", "note": "the row of a filled-down column, from 0"}
+            span = (d.cell.sheet, run.first, run.count)
+            if span not in tables:  # the filled-down columns of the same rows: one table
+                tables[span] = {
+                    "name": f"table_{d.name}",
+                    "title": f"{d.cell.sheet}: rows {run.first} to {run.last}, filled down",
+                    "range": f"{ROW} := 0 .. {run.count - 1}",
+                    "columns": [],
+                }
+            tables[span]["columns"].append({"expr": d.name, "title": d.name})
+            for k, key in enumerate(run.keys()):
+                cell = tr.book.cell(*key)
+                cached = _cached(cell.value) if cell is not None else None
+                if cached is not None:
+                    run_rows.append((d.name, str(k), cached, cell.ref))
             continue
         definitions[d.name] = {"expr": d.text, "note": note}
         if d.block is not None:  # the first cell of an array formula: its element 0
@@ -132,7 +163,9 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
     w.writerow(["name", "argument", "value", "unit"])
     printed = []
     files = {}
-    for label, group, arg in (("", rows, None), (".at", at_rows, "k_at")):
+    if tables:
+        doc["tables"] = list(tables.values())
+    for label, group, arg in (("", rows, None), (".at", at_rows, "k_at"), (".rows", run_rows, ROW)):
         if not group:
             continue
         out = io.StringIO()
@@ -153,7 +186,10 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         files[fname] = out.getvalue()
         entry = {
             "file": fname,
-            "title": "Excel's cached values" + (" of the cells of array formulas" if arg else ""),
+            "title": "Excel's cached values"
+            + {None: "", "k_at": " of the cells of array formulas", ROW: " of filled-down columns"}[
+                arg
+            ],
             "rel_tolerance": REL_TOLERANCE,
             "tolerance": ABS_TOLERANCE,
         }
