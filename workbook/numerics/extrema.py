@@ -145,7 +145,13 @@ def _certify(f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, be
         return sgn * np.asarray(f(x, *[a[r] for a in args]), dtype=float)
 
     def run(sel):
-        floor = np.maximum(tol.rtol * scale[sel], tol.atol)
+        # the function's size: its samples', or its enclosure's on the bracket (a narrow dip
+        # in a function that is 0 at every sample has the size of the dip)
+        with np.errstate(all="ignore"):
+            whole, _ = g(lo[sel], hi[sel], sel)
+            top = np.maximum(np.abs(whole.lo), np.abs(whole.hi))
+        size = np.maximum(scale[sel], np.where(np.isfinite(top), top, 0.0))
+        floor = np.maximum(tol.rtol * size, tol.atol)
         # the rows' index into sel: the boxes carry rows of sel, allowed maps them back
         cert = global_min(
             lambda p, q, r: g(p, q, sel[r]),
@@ -154,14 +160,17 @@ def _certify(f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, be
             hi[sel],
             best_v[sel],
             best_x[sel],
-            lambda b, floor=floor: np.maximum(tol.rtol * np.abs(b), floor.max()),
+            lambda b, r, floor=floor: np.maximum(tol.rtol * np.abs(b), floor[r]),
         )
         improved = cert.value < best_v[sel]
         best_v[sel], best_x[sel] = cert.value, cert.where
-        best_ve[sel] = np.maximum(best_ve[sel], cert.gap)
         best_xe[sel] = np.where(improved, np.maximum(best_xe[sel], cert.width), best_xe[sel])
         if improved.any():
-            _polish(h, sel[improved], best_v, best_x, best_ve, best_xe, tol)
+            _polish(h, sel[improved], best_v, best_x, best_xe, tol)
+        # the gap to the lowest bound left, from the value after the polish (its error where
+        # branch and bound found a better value than the samples did)
+        gap = np.maximum(cert.gap, best_v[sel] - cert.bound)
+        best_ve[sel] = np.where(improved, gap, np.maximum(best_ve[sel], gap))
         return improved
 
     if n <= CERTIFY_ROWS:
@@ -171,7 +180,7 @@ def _certify(f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, be
     return 0
 
 
-def _polish(h, idx, best_v, best_x, best_ve, best_xe, tol) -> None:
+def _polish(h, idx, best_v, best_x, best_xe, tol) -> None:
     """A better point branch and bound found, refined by find_minimum in the box around it
     (where that box is a bracket of a minimum)."""
     from scipy.optimize.elementwise import find_minimum
@@ -195,9 +204,6 @@ def _polish(h, idx, best_v, best_x, best_ve, best_xe, tol) -> None:
     best_v[rows_] = res.f_x[ok]
     best_x[rows_] = res.x[ok]
     best_xe[rows_] = np.abs(res.bracket[1] - res.bracket[0])[ok]
-    best_ve[rows_] = np.maximum(
-        best_ve[rows_], np.abs(np.maximum(res.f_bracket[0], res.f_bracket[2]) - res.f_x)[ok]
-    )
 
 
 def _no_plateau(kind, xs, fs, best, tol: Tolerance, var: str, unit: str, label) -> None:

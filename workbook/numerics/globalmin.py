@@ -24,13 +24,15 @@ MAX_BOXES = 64
 
 @dataclass
 class Certified:
-    """Per row: the best value and where, and how far the global minimum may be below it
-    (0 where the search ended with no box left: within the tolerance)."""
+    """Per row: the best value and where, how far the global minimum may be below it (the
+    tolerance where the search ended with no box left); ``bound``: the lowest lower bound
+    left (the value itself where none is left)."""
 
     value: np.ndarray
     where: np.ndarray
     gap: np.ndarray
     width: np.ndarray  # the width of the box the best point was found in (0: not improved)
+    bound: np.ndarray
 
 
 def global_min(g, h, lo, hi, best, best_x, allowed) -> Certified:
@@ -38,8 +40,8 @@ def global_min(g, h, lo, hi, best, best_x, allowed) -> Certified:
 
     ``g(xlo, xhi, rows) -> (F, D)``: enclosures of the function minimised and of its
     derivative; ``h(x, rows)``: its value at points (as the engine computes it); ``best``,
-    ``best_x``: the best value known per row and where; ``allowed(best)``: the tolerance of
-    a row's value.
+    ``best_x``: the best value known per row and where; ``allowed(best, rows)``: the
+    tolerance of those rows' values.
     """
     n = lo.size
     best, best_x = best.astype(float).copy(), best_x.astype(float).copy()
@@ -73,7 +75,7 @@ def global_min(g, h, lo, hi, best, best_x, allowed) -> Certified:
         best[r1[better]] = h1[better]
         best_x[r1[better]] = c_ok[first][better]
         width[r1[better]] = w_ok[first][better]
-        keep = ~(bound >= best[row] - allowed(best[row]))  # NaN bound: kept
+        keep = ~(bound >= best[row] - allowed(best[row], row))  # NaN bound: kept
         crowded = np.bincount(row[keep], minlength=n)[row] > MAX_BOXES
         narrow = (bhi - blo) <= tiny[row]
         stop = keep & (crowded | narrow)
@@ -89,7 +91,10 @@ def global_min(g, h, lo, hi, best, best_x, allowed) -> Certified:
             f, _ = g(blo, bhi, row)
         np.maximum.at(gap, row, best[row] - _lower(f.lo, row))
     gap = np.where(np.isnan(gap), np.inf, gap)
-    return Certified(best, best_x, gap, width)
+    bound = best - gap
+    # a dropped box could still beat the best value by up to the tolerance
+    gap = np.maximum(gap, allowed(best, np.arange(n)))
+    return Certified(best, best_x, gap, width, bound)
 
 
 def _full(v, row) -> np.ndarray:
