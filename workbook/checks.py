@@ -190,6 +190,10 @@ def collect_findings(sheet) -> list[Finding]:
         from .ode import sheet_findings
 
         out.extend(sheet_findings(sheet))
+    if sheet.spec.solves:
+        from .given_find import solve_findings
+
+        out.extend(solve_findings(sheet))
     if sheet.spec.checks:
         from .declared_checks import check_findings
 

@@ -260,10 +260,11 @@ def _print_scalars(sheet) -> None:
     from .errors import WorkbookError
     from .units import pretty
 
-    names = [n for n, d in sheet.spec.definitions.items() if not d.is_function]
+    unknowns = [n for block in sheet.spec.solves for n in block.unknowns]  # [[solve]] results
+    names = unknowns + [n for n, d in sheet.spec.definitions.items() if not d.is_function]
     for name in names[:MAX_SUMMARY_SCALARS]:
         try:
-            q = sheet.scalar_quantity(name)
+            q = sheet.evaluate(name) if name in unknowns else sheet.scalar_quantity(name)
             if isinstance(q, str):  # a text: "OK"
                 print(f'  {name} = "{q}"')
                 continue

@@ -169,6 +169,48 @@ def _violations(sheet, block: SolveSpec, names: list[str]):
     return violations
 
 
+class Solved(dict):
+    """The unknowns' values of a solved block, with ``errors`` (their estimates, same units)
+    and ``condition`` (the condition number of the relative residuals' Jacobian)."""
+
+    errors: dict[str, float]
+    condition: float
+
+
+def solve_findings(sheet) -> list:
+    """A finding per solved [[solve]] block: its solution, each unknown's error estimate and
+    the condition number; a warning when an estimate exceeds the sheet's tolerance relative
+    to its unknown (a block that fails is a failed value, not listed here)."""
+    from .findings import Finding
+    from .numerics import sheet_tolerance
+
+    rtol = sheet_tolerance(sheet.spec.meta).rtol
+    out = []
+    for block in sheet.spec.solves:
+        try:
+            sheet.evaluate(next(iter(block.unknowns)))
+        except WorkbookError:
+            continue
+        solved = sheet._memo[("solve", block.index)]
+        parts, worst = [], 0.0
+        for name, q in block.unknowns.items():
+            v, e = solved[name], solved.errors.get(name, float("nan"))
+            unit = f" {un.pretty(q.units)}" if un.pretty(q.units) else ""
+            parts.append(f"{name} = {v:.10g}{unit} (error estimate {e:.2g}{unit})")
+            rel = e / abs(v) if v else e
+            worst = max(worst, rel) if np.isfinite(rel) else float("inf")
+        what = "; ".join(parts)
+        note = f"condition number {solved.condition:.3g} of the equations' Jacobian"
+        if worst > rtol:
+            note += (
+                f"; an estimate exceeds the sheet's tolerance {rtol:g} relative: the equations "
+                "are ill-conditioned (nearly dependent), the solution is known only to the "
+                "estimate"
+            )
+        out.append(Finding(block.what, what, None, "", "warning" if worst > rtol else "info", note))
+    return out
+
+
 def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
     """The unknowns' values (magnitudes in their guesses' units)."""
     from .numerics import current, sheet_tolerance
@@ -205,7 +247,9 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
         method=block.method,
         violations=_violations(sheet, block, names) if block.conditions else None,
     )
-    found = dict(zip(names, (float(v) for v in result.value)))
+    found = Solved(zip(names, (float(v) for v in result.value)))
+    found.errors = dict(zip(names, (float(e) for e in result.error)))
+    found.condition = float(result.notes.get("condition", float("nan")))
     for cond, text in typed_conditions(sheet.typer, block):
         if not bool(sheet.evaluator.compile(cond)(dict(found))):
             from .numerics import NumericsError

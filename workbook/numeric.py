@@ -694,11 +694,17 @@ def limits_error(d, unit, value: float, where: str = "") -> DomainError:
 
     shown = d.unit if d.unit is not None else unit
     q = un.registry().Quantity(value, unit).to(shown)
+    v = float(q.magnitude)
+    number = str(int(v)) if v.is_integer() and abs(v) < 1e15 else f"{v:.6g}"
     return DomainError(
-        f"{d.name} = {q.magnitude:.6g} {un.pretty(shown)}".rstrip()
+        f"{d.name} = {number} {un.pretty(shown)}".rstrip()
         + (f" {where}" if where else "")
-        + f" breaks its declared limit ({d.limits.text(un.pretty(shown))}): the inputs are "
-        "outside the range where the worksheet's formulas hold",
+        + f" breaks its declared limit ({d.limits.text(un.pretty(shown))})"
+        + (
+            f": {d.note}"
+            if d.note
+            else ": the inputs are outside the range where the worksheet's formulas hold"
+        ),
         definition=d.name,
     )
 

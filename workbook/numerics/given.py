@@ -68,12 +68,44 @@ def solve(
             f"solve did not converge ({why}): at {at} the relative residuals are {lines} "
             f"(limit {limit:g}); try other guesses"
         )
+    err, cond = conditioned_error(residuals, x, s, r)
+    return Result(x, err, evaluations=int(sol.nfev), notes={"condition": cond})
+
+
+#: A relative residual is known to about this (its terms are rounded to doubles).
+RESIDUAL_FLOOR = 4 * np.finfo(float).eps
+
+
+def conditioned_error(residuals, x: np.ndarray, s: np.ndarray, r: np.ndarray):
+    """(error estimate per unknown, condition number) at a solution x: the first-order effect
+    of the residuals' uncertainty, |J^-1| (max(|r|, RESIDUAL_FLOOR)), with J the central-
+    difference Jacobian of the relative residuals in the scaled unknowns x/s. An ill-
+    conditioned system (p + q = 2, p + (1 + 1e-10) q = 2 + 1e-10: condition near 4e10) gets
+    an estimate of its size, not the solver's last step."""
+    z = x / s
+    n, m = z.size, np.asarray(r).size
+    if m != n:  # fewer equations than unknowns: a point reached, not a root to condition
+        return np.full(n, np.nan), float("nan")
+    jac = np.empty((m, n))
+    with np.errstate(all="ignore"):
+        for j in range(n):
+            h = 1e-6 * max(1.0, abs(z[j]))
+            up, down = z.copy(), z.copy()
+            up[j] += h
+            down[j] -= h
+            jac[:, j] = (
+                np.asarray(residuals(up * s), dtype=float)
+                - np.asarray(residuals(down * s), dtype=float)
+            ) / (2 * h)
+    if not np.all(np.isfinite(jac)):
+        return np.full(n, np.nan), float("nan")
+    cond = float(np.linalg.cond(jac))
     try:
-        jac = np.asarray(sol.fjac).T @ np.triu(_unpack_r(sol.r, x0.size))
-        err = np.abs(np.linalg.solve(jac, r)) * s
-    except (AttributeError, np.linalg.LinAlgError, ValueError):
-        err = np.full(x.size, np.nan)
-    return Result(x, err, evaluations=int(sol.nfev))
+        inverse = np.linalg.inv(jac)
+    except np.linalg.LinAlgError:
+        return np.full(n, np.inf), float("inf")
+    delta = np.maximum(np.abs(r), RESIDUAL_FLOOR)
+    return (np.abs(inverse) @ delta) * s, cond
 
 
 def _hybrid(residuals, x0, s, tol):
