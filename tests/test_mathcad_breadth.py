@@ -2,7 +2,17 @@
 
 from __future__ import annotations
 
-from test_mathcad_programs import _apply, _check, _define, _eval, _id, _import, _matrix, _real
+from test_mathcad_programs import (
+    _apply,
+    _check,
+    _define,
+    _eval,
+    _id,
+    _import,
+    _index,
+    _matrix,
+    _real,
+)
 
 
 def _vectorize(body: str) -> str:
@@ -50,3 +60,36 @@ def test_vectorize_that_cannot_be_element_by_element_is_listed(tmp_path, capsys)
     )
     assert "a vectorised call of max" in text
     assert "vectors of different lengths" in text
+
+
+def _range_def(rid: int, name: str, first: int, last: int) -> str:
+    return _define(rid, _id(name), f"<ml:range>{_real(first)}{_real(last)}</ml:range>")
+
+
+def _shown(body: str, result: str) -> str:
+    return f"<ml:eval>{body}<ml:result>{result}</ml:result></ml:eval>"
+
+
+def test_element_definition_shown_is_the_whole_vector(tmp_path, capsys):
+    """i := 0 .. 2, v[i] := i^2 = [0; 1; 4] (Mathcad shows the vector it built), then
+    v[i] := 10 + i over the same range (every element again) = [10; 11; 12]; j := 0 .. 1,
+    v[j] := 5 (Mathcad keeps v[2] = 12: not every element) is listed, never a vector of
+    two."""
+    square = _apply("pow", _id("i"), _real(2))
+    text = _import(
+        tmp_path,
+        capsys,
+        "elements",
+        _range_def(1, "i", 0, 2),
+        _define(2, _index(_id("v"), _id("i")), _shown(square, _matrix(*map(_real, (0, 1, 4))))),
+        _define(
+            3,
+            _index(_id("v"), _id("i")),
+            _shown(_apply("plus", _real(10), _id("i")), _matrix(*map(_real, (10, 11, 12)))),
+        ),
+        _range_def(4, "j", 0, 1),
+        _define(5, _index(_id("v"), _id("j")), _shown(_real(5), _matrix(*map(_real, (5, 5, 12))))),
+    )
+    assert "not over all its elements (Mathcad keeps the others)" in text
+    result = _check(tmp_path, capsys, "elements")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (9, 6, 0), result

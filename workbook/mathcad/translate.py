@@ -839,8 +839,20 @@ class Translator:
             fname, bound = lhs.children[0], lhs.children[1]
             self.function(region, fname, [c for c in bound.children if c.tag == "id"], rhs)
             return
-        if _is_indexer(lhs) and evaluation is None:
-            self.elements(region, lhs, rhs)
+        if _is_indexer(lhs):  # v[i] := f(i), shown (= the whole vector) or not
+            target = lhs.children[1] if len(lhs.children) > 1 else None
+            try:
+                self.elements(region, lhs, rhs)
+            except Untranslatable:
+                if evaluation is not None:
+                    sym = self.scope.get(_key(target)) if target is not None else None
+                    if sym is not None and sym.region == region.id:
+                        self.evaluation(region, evaluation, sym)
+                    else:
+                        self.stored_but_broken(region, evaluation, "an element assignment")
+                raise
+            if evaluation is not None:
+                self.evaluation(region, evaluation, self.scope[_key(target)])
             return
         if lhs.tag == "matrix" and evaluation is None and hasattr(ex, "Index"):
             self.destructure(region, lhs, rhs)
@@ -1032,7 +1044,11 @@ class Translator:
         if all(r is None for r in ranges) and available_programs():
             self.element(region, key, lhs, rhs)
             return
+        before = self.scope.get(key)
         sym = self.define(key, "var", region.id)
+        if len({id(r) for r in ranges if r is not None}) < len(ranges):
+            sym.broken = "an element assignment with one range variable at two indices"
+            raise Untranslatable(sym.broken)
         try:
             self._forced(region, sym)
             if not hasattr(ex, "Matrix"):
@@ -1048,6 +1064,11 @@ class Translator:
             if any(min(v) < self.origin for v in values):
                 raise Untranslatable("an element assignment below ORIGIN")
             size = [max(v) - self.origin + 1 for v in values]
+            if before is not None and not self._replaces(before, values, size):
+                raise Untranslatable(
+                    "an element assignment over a range to a name defined before, not over "
+                    "all its elements (Mathcad keeps the others)"
+                )
             if math.prod(size) > 10_000:
                 raise Untranslatable("an element assignment of more than 10,000 elements")
             local, params = {}, []
@@ -1076,6 +1097,15 @@ class Translator:
         else:
             rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
         self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
+
+    def _replaces(self, before: Sym, values: list[list[int]], size: list[int]) -> bool:
+        """Does an element assignment over ``values`` set every element the vector defined
+        before had (so that none of its old elements is left)?"""
+        if before.broken or len(values) != 1:
+            return False
+        old = self._length(ex.Name(before.token()))
+        every = set(range(self.origin, self.origin + size[0]))
+        return old is not None and old <= size[0] and set(values[0]) == every
 
     def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> None:
         """[a; b] := value: the value a definition of its own (``parts``), then each name
