@@ -63,3 +63,22 @@ def test_run_prints_the_unknowns_as_results(tmp_path):
     assert code == 0
     assert "  x = 1.91067 m" in out.getvalue() and "  y = 0.59104 m" in out.getvalue()
     assert "warning: [solve p, q]" in err.getvalue()
+
+
+def test_the_results_sheet_and_the_report_show_the_block(tmp_path):
+    import openpyxl
+
+    from workbook.report import write_report
+
+    sheet = workbook.load(write_template(tmp_path, SHEET))
+    sheet.write_xlsx(tmp_path / "s.xlsx")
+    rows = {
+        r[0]: r
+        for r in openpyxl.load_workbook(tmp_path / "s.xlsx")["Results"].iter_rows(values_only=True)
+    }
+    assert rows["x"][1] == pytest.approx(1.91067297825, abs=1e-10) and rows["x"][2] == "m"
+    assert rows["x"][3] == "Given x^2 + y^2 == R^2; y == x*tan(theta): Find(x, y)"
+    assert "condition number 1.51" in rows["x"][4]
+    html = write_report(sheet, tmp_path / "s.html")[0].read_text(encoding="utf-8")
+    assert "<div class='definition given'>" in html and "guesses: x = 1 m, y = 0.5 m" in html
+    assert "Find(x, y): x = 1.91067" in html and "condition number 1.8e+10" in html

@@ -261,7 +261,8 @@ class WorkbookWriter:
         written = getattr(self, "on_matrices", set())
         if [d for d in matrices if d.name not in written]:
             self.write_matrices([d for d in matrices if d.name not in written])
-        if not defs:
+        unknowns = [(n, b) for b in self.sheet.spec.solves for n in b.unknowns]
+        if not defs and not unknowns:
             return
         done = getattr(self, "on_definitions", set())
         name = next((n for n in self.sheets if n.casefold() == "results"), "Results")
@@ -305,7 +306,31 @@ class WorkbookWriter:
             finally:
                 self.printer.helpers = None
             self._define(ws, row, d.name, f"='{name}'!$B${row + 1}")
-        self.rows[name] = start + len(defs) + 2
+        for row, (unknown, block) in enumerate(unknowns, start=start + 1 + len(defs)):
+            self._write_unknown(ws, row, unknown, block)
+        self.rows[name] = start + len(defs) + len(unknowns) + 2
+
+    def _write_unknown(self, ws, row: int, unknown: str, block) -> None:
+        """An unknown of a [[solve]] block on the Results sheet: its value (a number), its
+        unit, the block as Given ... Find, and its error estimate."""
+        ws.write_string(row, 0, unknown)
+        given = "; ".join(text for _, _, text in block.equations)
+        ws.write_string(row, 3, f"Given {given}: Find({', '.join(block.unknowns)})")
+        try:
+            q = self.sheet.evaluate(unknown)
+        except WorkbookError as err:
+            ws.write_string(row, 1, f"error: {err.message}", self.fmt["fail"])
+            return
+        solved = self.sheet._memo[("solve", block.index)]
+        ws.write_number(row, 1, float(q.magnitude), self.fmt["number"])
+        ws.write_comment(row, 1, "A value, not a formula: found by a [[solve]] block")
+        ws.write_string(row, 2, un.pretty(q.units))
+        ws.write_string(
+            row,
+            4,
+            f"error estimate {solved.errors.get(unknown, float('nan')):.2g} "
+            f"{un.pretty(q.units)}, condition number {solved.condition:.3g}".replace(" ,", ","),
+        )
 
     def write_matrices(self, defs) -> None:
         """Vector and matrix definitions, each a named block of cells: elements written out

@@ -255,8 +255,39 @@ class Document:
 
     # -- definitions ------------------------------------------------------------------------
     def definitions(self) -> str:
-        out = [self.definition(d) for d in self.spec.definitions.values()]
+        out = [self.given_find(b) for b in self.spec.solves]
+        out += [self.definition(d) for d in self.spec.definitions.values()]
         return "".join(out)
+
+    def given_find(self, block) -> str:
+        """A [[solve]] block as Mathcad shows one: the guesses, Given, the equations and the
+        conditions, then Find and the solution with its error estimate."""
+        guesses = ", ".join(f"{n} = {q:~}" for n, q in block.unknowns.items())
+        lines = [f"<p class='note'>guesses: {escape(guesses)}</p>", "<p>Given</p>"]
+        for lhs, rhs, text in block.equations:
+            try:
+                eq = _eq_box(self.formula.box(lhs), _EQ, self.formula.box(rhs))
+                lines.append(_fit(eq))
+            except Exception:  # a node the printer does not know: the text
+                lines.append(f"<p>{escape(text)}</p>")
+        for node, text in block.conditions:
+            try:
+                lines.append(_fit(self.formula.box(node)))
+            except Exception:
+                lines.append(f"<p>{escape(text)}</p>")
+        find = f"Find({', '.join(block.unknowns)})"
+        try:
+            values = [self.sheet.evaluate(n) for n in block.unknowns]
+            solved = self.sheet._memo[("solve", block.index)]
+            shown = "; ".join(
+                f"{n} = {num_html(float(q.magnitude))} {escape(un.pretty(q.units))}".rstrip()
+                + f" (error estimate {solved.errors.get(n, float('nan')):.2g})"
+                for n, q in zip(block.unknowns, values)
+            )
+            result = f"<p>{escape(find)}: {shown}; condition number {solved.condition:.3g}</p>"
+        except Exception as err:
+            result = f"<p class='error'>{escape(find)} not computed: {escape(_error_text(err))}</p>"
+        return f"<div class='definition given'>{''.join(lines)}{result}</div>"
 
     def definition(self, d) -> str:
         try:
