@@ -289,3 +289,58 @@ def test_constants_labels_and_if_chains(tmp_path, capsys):
     assert "region 6: an evaluation ( = ): g is not defined before it is used" in text
     result = _check(tmp_path / "labels.toml", capsys)
     assert (result["printed"], result["reproduced"], result["failed"]) == (5, 4, 0), result
+
+
+def test_if_blocks_in_a_program(tmp_path, capsys):
+    """f(x) := | if x > 10: (y <- 100; y) / else if x > 0: (y <- 2 x; y + 0) / else: -x |
+    in a program with a line after the first: f(20) = 100, f(3) = 6, f(-2) = 2."""
+    x = _id("x")
+    y = _id("y")
+
+    def block(*lines: str) -> str:
+        return f"<ml:program>{''.join(lines)}</ml:program>"
+
+    def local(name: str, value: str) -> str:
+        return f"<ml:localDefine>{_id(name)}{value}</ml:localDefine>"
+
+    def test(limit: str) -> str:
+        compare = f"<ml:apply><ml:greaterThan/>{x}<ml:real>{limit}</ml:real></ml:apply>"
+        return f"<ml:test>{compare}</ml:test>"
+
+    twice = f"<ml:apply><ml:mult/><ml:real>2</ml:real>{x}</ml:apply>"
+    chain = (
+        f"<ml:if>{test('10')}<ml:then>{block(local('y', '<ml:real>100</ml:real>'), y)}</ml:then>"
+        f"<ml:elseif>{test('0')}<ml:then>{block(local('y', twice), y)}</ml:then></ml:elseif>"
+        f"<ml:else>{block(f'<ml:apply><ml:neg/>{x}</ml:apply>')}</ml:else></ml:if>"
+    )
+    body = block(local("z", "<ml:real>1</ml:real>"), chain)
+    f_def = _region(
+        1,
+        1,
+        f"<ml:define><ml:function>{_id('f')}<ml:boundVars>{x}</ml:boundVars></ml:function>"
+        f"{body}</ml:define>",
+    )
+
+    def call(v: str) -> str:
+        return f"<ml:apply>{_id('f', 'FUNCTION')}<ml:sequence>{v}</ml:sequence></ml:apply>"
+
+    minus_two = "<ml:apply><ml:neg/><ml:real>2</ml:real></ml:apply>"
+    regions = f_def + "".join(
+        [
+            _eval(2, call("<ml:real>20</ml:real>")),
+            _eval(3, call("<ml:real>3</ml:real>")),
+            _eval(4, call(minus_two)),
+        ]
+    )
+    results = "".join(
+        [
+            _result(1),
+            _result(2, "<ml:real>100</ml:real>"),
+            _result(3, "<ml:real>6</ml:real>"),
+            _result(4, "<ml:real>2</ml:real>"),
+        ]
+    )
+    src = _package(tmp_path / "blocks.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "blocks.toml", capsys)
+    assert (result["printed"], result["reproduced"]) == (3, 3), result

@@ -314,8 +314,50 @@ def _node(el) -> MNode:
     if tag == "apply" and children:
         return _apply(node)
     if tag == "if":
-        return _if_chain(node)
+        chain = _if_chain(node)
+        if chain is not node:
+            return chain
+        statements = _if_statements(node)
+        if statements is None:
+            return node
+        return statements[0] if len(statements) == 1 else MNode("program", {}, "", statements)
+    if tag == "program":
+        node.children = [
+            s for c in children for s in (_if_statements(c) if c.tag == "if" else None) or [c]
+        ]
     return node
+
+
+def _if_statements(node: MNode) -> list[MNode] | None:
+    """Prime's if / else if / else with blocks as Mathcad 15's statements: ``if`` then
+    ``otherwise`` holding the rest of the chain (None: not of that form)."""
+    parts = [node] + [c for c in node.children if c.tag == "elseif"]
+    other = next((c for c in node.children if c.tag == "else"), None)
+
+    def block(holder: MNode | None) -> MNode | None:
+        if holder is None or not holder.children:
+            return None
+        kids = holder.children
+        return kids[0] if len(kids) == 1 else MNode("program", {}, "", kids)
+
+    pairs = []
+    for part in parts:
+        test = next((c for c in part.children if c.tag == "test"), None)
+        then = block(next((c for c in part.children if c.tag == "then"), None))
+        if test is None or len(test.children) != 1 or then is None:
+            return None
+        pairs.append((test.children[0], then))
+    tail: list[MNode] = []
+    if other is not None:
+        rest = block(other)
+        if rest is None:
+            return None
+        tail = [MNode("otherwise", {}, "", [rest])]
+    for cond, then in reversed(pairs[1:]):
+        inner = [MNode("ifThen", {}, "", [cond, then])] + tail
+        tail = [MNode("otherwise", {}, "", [MNode("program", {}, "", inner)])]
+    cond, then = pairs[0]
+    return [MNode("ifThen", {}, "", [cond, then])] + tail
 
 
 #: Prime's built-in constants (labelled CONSTANT) -> pint's name of the same constant.
