@@ -421,7 +421,7 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
             t = Translator(info, tr.functions, block)
             t.option_base = info.option_base  # type: ignore[attr-defined]
             body = "\n".join(x for _, x in info.proc.lines)
-            info.problem, info.calls = None, set()
+            info.problem, info.calls, info.dropped = None, set(), set()
             try:
                 for name in info.module_vars:  # type: ignore[attr-defined]
                     if re.search(rf"\b{re.escape(name)}\b", body, re.I):

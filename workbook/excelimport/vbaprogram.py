@@ -44,6 +44,7 @@ class FunctionInfo:
     volatile: bool = False
     calls: set[str] = field(default_factory=set)  # lower-case VBA names it calls
     result_base: int = 0  # the lower bound of the array it gives
+    dropped: set[str] = field(default_factory=set)  # statements without effect on the value
 
     @property
     def arity(self) -> int:
@@ -120,6 +121,14 @@ class Translator:
         self.text_function = self.proc.returns.lower() == "string" or (
             bool(rhs_of_result) and all(r.startswith('"') for r in rhs_of_result)
         )
+        self.error_flag = None
+        error_value = re.compile(
+            rf"^(?:If\b.*\bThen\s+)?{re.escape(self.proc.name)}\s*=\s*(?:CVErr\b|\")", re.I
+        )
+        if not self.text_function and any(
+            error_value.match(text) and not self._tail(j) for j, (_, text) in enumerate(body)
+        ):  # an error value (or a message) that a later value may replace
+            self.error_flag = self.local("is_error", fresh=True)
         ret_type = self.proc.returns.lower()
         for i, p in enumerate(self.proc.params):
             if p.type.lower() in INTEGER_TYPES:  # VBA rounds a number passed to an Integer
@@ -132,6 +141,10 @@ class Translator:
         # VBA gives every declared number 0 when the function starts (Dim does not run)
         inits = [f"{self.names[k]} := 0" for k in self.declared_numbers if k in self.names]
         self.lines[start:start] = inits
+        if self.error_flag is not None:
+            inits.append(f"{self.error_flag} := 0")
+            self.lines[start:start] = [inits[-1]]
+            self.lines.append(f"return 1/0 if {self.error_flag} != 0")
         if self.assigned or not self.text_function:
             self.lines.append(self.ret)
         return "\n".join(self.lines)
@@ -189,7 +202,12 @@ class Translator:
             self.emit(indent, "break")
             return i + 1
         if low == "exit function":
+            if self.error_flag is not None:
+                self.emit(indent, f"return 1/0 if {self.error_flag} != 0")
             self.emit(indent, f"return {self.ret}")
+            return i + 1
+        if word == "msgbox" or low.startswith("msgbox("):
+            self.info.dropped.add("MsgBox")  # a message shown: no effect on the value
             return i + 1
         if word == "on":
             if re.match(r"^on\s+error\s+goto\s+0$", low):
@@ -248,6 +266,16 @@ class Translator:
                     self.arrays[key] = _Array(1, 2, True)
             elif rhs[0] == "id" and rhs[1].lower() in self.arrays:
                 self.arrays[key] = self.arrays[rhs[1].lower()]
+            elif (
+                rhs[0] == "call"
+                and strip(rhs[1]) == ("id", "Array")
+                or (
+                    rhs[0] == "call"
+                    and strip(rhs[1])[0] == "id"
+                    and strip(rhs[1])[1].lower() == "array"
+                )
+            ):  # Array(...) starts at Option Base
+                self.arrays[key] = _Array(self.option_base, 1)
             elif self._callee(rhs) is not None:  # an array a VBA function gives, or a number
                 self.arrays[key] = _Array(self._callee(rhs).result_base, 0)
             if self.types.get(key) in INTEGER_TYPES and not self._integral(rhs):
@@ -276,8 +304,11 @@ class Translator:
         tail = self._tail(at)
         is_error = rhs[0] == "call" and rhs[1][0] == "id" and rhs[1][1].lower() == "cverr"
         if is_error or rhs[0] == "str":
-            if not tail:
-                raise NotTranslated("an error value or a text given where code runs after it")
+            if not tail and (self.text_function or self.error_flag is None):
+                raise NotTranslated("a text given where code runs after it")
+            if not tail:  # a later value may replace the error value: a flag keeps it
+                self.emit(indent, f"{self.error_flag} := 1")
+                return i + 1
             if rhs[0] == "str" and self.text_function:
                 self.emit(indent, f"return {self.value(rhs)}")
             else:  # Excel shows an error value (or a message): the function has no number
@@ -292,6 +323,8 @@ class Translator:
         if self.proc.returns.lower() in INTEGER_TYPES and not self._integral(rhs):
             value = bankers(value)  # VBA rounds the value of an Integer function
         self.emit(indent, f"{self.ret} := {value}")
+        if self.error_flag is not None:
+            self.emit(indent, f"{self.error_flag} := 0")
         self.assigned = True
         return i + 1
 

@@ -80,7 +80,12 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         key = f"{info.final}({', '.join(params)})" if params else info.final
         definitions[key] = {
             "program": info.program + "\n",
-            "note": f"VBA Function {info.proc.name} (module {info.proc.module})",
+            "note": f"VBA Function {info.proc.name} (module {info.proc.module})"
+            + (
+                f"; left out, without effect on its value: {', '.join(sorted(info.dropped))}"
+                if info.dropped
+                else ""
+            ),
         }
     rows = []
     run_rows: list = []
