@@ -344,3 +344,37 @@ def test_if_blocks_in_a_program(tmp_path, capsys):
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
     result = _check(tmp_path / "blocks.toml", capsys)
     assert (result["printed"], result["reproduced"]) == (3, 3), result
+
+
+def _combo(selected: int, cols: int, *values: float) -> str:
+    reals = "".join(f"<ml:real>{v}</ml:real>" for v in values)
+    places = "<ml:placeholder/>" * cols
+    return (
+        f'<ml:ComboBoxControl rows="{len(values) // cols}" cols="{cols}" '
+        f'SelectedRow="{selected}"><ml:ComboBoxRowNames/><ml:ComboBoxScaleFactors>{places}'
+        f"</ml:ComboBoxScaleFactors><ml:ComboBoxValues>{reals}</ml:ComboBoxValues>"
+        "</ml:ComboBoxControl>"
+    )
+
+
+def test_combo_box_is_the_selected_row(tmp_path, capsys):
+    """f_yk from a combo box of 410, 500, 550 with SelectedRow 2 (counted from 0) is 550;
+    [a; b] from rows (1, 2) and (3, 4) with SelectedRow 1 is a = 3, b = 4."""
+    pair = '<ml:matrix rows="2" cols="1">' + _id("a") + _id("b") + "</ml:matrix>"
+    regions = "".join(
+        [
+            _region(1, 1, f"<ml:define>{_id('f')}{_combo(2, 1, 410, 500, 550)}</ml:define>"),
+            _region(2, 2, f"<ml:define>{pair}{_combo(1, 2, 1, 2, 3, 4)}</ml:define>"),
+            _eval(3, _id("f")),
+            _eval(4, _id("a")),
+            _eval(5, _id("b")),
+        ]
+    )
+    results = "".join(
+        [_result(1), _result(2)]
+        + [_result(k, f"<ml:real>{v}</ml:real>") for k, v in ((3, 550), (4, 3), (5, 4))]
+    )
+    src = _package(tmp_path / "combo.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "combo.toml", capsys)
+    assert (result["printed"], result["reproduced"]) == (3, 3), result

@@ -321,11 +321,36 @@ def _node(el) -> MNode:
         if statements is None:
             return node
         return statements[0] if len(statements) == 1 else MNode("program", {}, "", statements)
+    if tag == "ComboBoxControl":
+        return _combo_box(node)
     if tag == "program":
         node.children = [
             s for c in children for s in (_if_statements(c) if c.tag == "if" else None) or [c]
         ]
     return node
+
+
+def _combo_box(node: MNode) -> MNode:
+    """A combo box input control: the value of the row selected when the file was saved
+    (``SelectedRow`` counts from 0), when its rows have no scale factors; else as it is
+    (listed as not translated)."""
+    values = next((c for c in node.children if c.tag == "ComboBoxValues"), None)
+    scales = next((c for c in node.children if c.tag == "ComboBoxScaleFactors"), None)
+    row = node.attrs.get("SelectedRow", "")
+    if values is None or not re.fullmatch(r"[0-9]{1,6}", row.strip()):
+        return node
+    if scales is not None and any(c.tag != "placeholder" for c in scales.children):
+        return node
+    k, cells = int(row), values.children
+    cols = node.attrs.get("cols", "1").strip()
+    if not re.fullmatch(r"[0-9]{1,4}", cols) or int(cols) < 1:
+        return node
+    n = int(cols)  # the values are stored row by row; a row of several is a column vector
+    if (k + 1) * n > len(cells):
+        return node
+    if n == 1:
+        return cells[k]
+    return MNode("matrix", {"rows": str(n), "cols": "1"}, "", cells[k * n : (k + 1) * n])
 
 
 def _if_statements(node: MNode) -> list[MNode] | None:
