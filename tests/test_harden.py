@@ -1005,3 +1005,42 @@ def test_a_number_before_a_name_keeps_the_invisible_times():
 
     for text in ("2*a", "0.5*x^2", "2*(a + b)", "2*sin(x)"):
         assert "<mo>\u2062</mo>" in MathML().box(ex.parse(text)).xml, text
+
+
+# -- SymPy's work is bounded -------------------------------------------------------------------
+
+NESTED = """
+[arguments]
+x = { unit = "" }
+[definitions]
+"f0(x)" = "sin(x)*exp(x)/(1 + x^2)"
+"f1(x)" = "f0(f0(x))*f0(x)"
+"f2(x)" = "f1(f1(x))*f1(x)"
+"f3(x)" = "f2(f2(x))*f2(x)"
+"f4(x)" = "f3(f3(x))*f3(x)"
+"f5(x)" = "f4(f4(x))*f4(x)"
+"g(x)" = "diff(FN(x), x)"
+"""
+
+
+def test_diff_of_functions_nested_in_themselves_is_bounded(tmp_path, monkeypatch):
+    # diff of ten such levels ran in SymPy for more than 60 s (3 levels: more than 120 s)
+    from workbook.numerics import derivative
+
+    sheet = workbook.load(write(tmp_path / "n.toml", NESTED.replace("FN", "f5")))
+    with pytest.raises(LimitError, match=r"nodes with the functions it calls written out") as e:
+        sheet.evaluate("g", x=0.3)
+    assert e.value.definition == "g" and e.value.line == 11
+    monkeypatch.setattr(derivative, "MAX_DIFF_SECONDS", 0.5)
+    sheet = workbook.load(write(tmp_path / "n.toml", NESTED.replace("FN", "f3")))
+    with pytest.raises(LimitError, match=r"SymPy's derivative .* took more than 0.5 s"):
+        sheet.evaluate("g", x=0.3)
+    with pytest.raises(LimitError, match="took more than 0.5 s"):  # remembered, not redone
+        sheet.evaluate("g", x=0.4)
+    # a small one is found as before: d/dx of f0 at 0.3
+    sheet = workbook.load(write(tmp_path / "n.toml", NESTED.replace("FN", "f0")))
+    x = 0.3
+    expected = (np.cos(x) + np.sin(x)) * np.exp(x) / (1 + x**2) - np.sin(x) * np.exp(x) * 2 * x / (
+        1 + x**2
+    ) ** 2
+    assert float(sheet.evaluate("g", x=x).magnitude) == pytest.approx(expected, rel=1e-12)

@@ -8,8 +8,11 @@ bomb). Each is refused here, before any parser sees it, with an error of kind
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import stat
+import threading
 import zipfile
 from pathlib import Path
 
@@ -186,3 +189,32 @@ def exhausted(exc: BaseException) -> LimitError:
     if isinstance(exc, RecursionError):
         return LimitError("nested too deeply for the engine (Python's recursion limit)")
     return LimitError("too large for memory (an array or a computation could not be allocated)")
+
+
+@contextlib.contextmanager
+def within_seconds(seconds: float, what: str):
+    """Stop the block with a LimitError after ``seconds`` of wall-clock time (SIGALRM: pure
+    Python work such as SymPy's is interrupted between bytecodes). Only in the main thread of
+    a process where no other timer is set; elsewhere the block runs unbounded."""
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getitimer(signal.ITIMER_REAL)[0] > 0
+    ):
+        yield
+        return
+
+    class _Expired(Exception):
+        pass
+
+    def expire(signum, frame):
+        raise _Expired
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    except _Expired:
+        raise LimitError(f"{what} took more than {seconds:g} s") from None
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)

@@ -18,7 +18,8 @@ import weakref
 from dataclasses import dataclass, field
 
 from .. import typed as ty
-from ..errors import NotSymbolic, TemplateError, WorkbookError
+from ..errors import LimitError, NotSymbolic, TemplateError, WorkbookError
+from ..limits import within_seconds
 from ..visitor import Visitor
 
 
@@ -74,6 +75,7 @@ class Pending:
     unit: object
     where: dict = field(default_factory=dict)  # file, line, definition
     tree: ty.T | None = None
+    error: WorkbookError | None = None  # SymPy's failure, remembered: it is not tried again
     compiled: weakref.WeakKeyDictionary = field(default_factory=weakref.WeakKeyDictionary)
 
     def __getstate__(self) -> dict:  # a Sheet pickles: the compiled closures are left out
@@ -99,11 +101,14 @@ def formula(typer, body: ty.T, var: ty.TParam, order: int) -> ty.T:
     if rec is None or rec.body is not body or rec.order != order:
         # a call not met at load (a tree rebuilt by an analysis): no location known
         rec = Pending(body, var, order, body.unit / var.unit**order)
+    if rec.error is not None:
+        raise rec.error
     if rec.tree is None:
         try:
             rec.tree = derivative(typer, body, var, order, rec.unit)
         except WorkbookError as err:
-            raise err.located(**rec.where) from None
+            rec.error = err.located(**rec.where)
+            raise rec.error from None
     return rec.tree
 
 
@@ -123,19 +128,57 @@ def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
     """The ``order``-th derivative of ``body`` with respect to ``var``, in ``unit``."""
     import sympy as sp
 
+    size = inlined_size(typer, body)
+    if size > MAX_DIFF_NODES:  # SymPy's derivative grows with it (a product rule per node)
+        raise LimitError(
+            f"diff(): the expression is {size:,} nodes with the functions it calls written out "
+            f"(limit {MAX_DIFF_NODES:,}); SymPy would take minutes. Differentiate a simpler "
+            "function, or give the derivative as a formula"
+        )
     leaves = _leaves(typer, body)
     refs = {n: t for n, t in leaves.items() if isinstance(t, ty.TRef)}
     conv = typer.sympy_converter(keep=set(refs))
-    try:
-        expr = conv.convert(body)
-    except NotSymbolic as err:
-        raise TemplateError(f"diff(): {err.message}") from None
-    symbol = sp.Symbol(var.name, real=True)
-    d = sp.diff(expr, symbol, order)
-    nodes = {sp.Symbol(n, real=True): t for n, t in leaves.items()}
-    nodes[symbol] = var
-    out = _Back(nodes, typer.dimensionless).visit(d)
+    what = "diff(): SymPy's derivative (a function nested in itself grows it exponentially)"
+    with within_seconds(MAX_DIFF_SECONDS, what):
+        try:
+            expr = conv.convert(body)
+        except NotSymbolic as err:
+            raise TemplateError(f"diff(): {err.message}") from None
+        symbol = sp.Symbol(var.name, real=True)
+        d = sp.diff(expr, symbol, order)
+        nodes = {sp.Symbol(n, real=True): t for n, t in leaves.items()}
+        nodes[symbol] = var
+        out = _Back(nodes, typer.dimensionless).visit(d)
     return ty.TScale(unit, child=out, factor=1.0)
+
+
+#: Nodes of an expression given to SymPy's diff, the sheet functions it calls written out
+#: (a call inside a call repeats the inner body; the largest in the templates is 144).
+MAX_DIFF_NODES = 1_000
+#: Wall-clock seconds of SymPy's work for one diff() (a 125-node nest took 3.6 s, 377 nodes
+#: more than 40 s).
+MAX_DIFF_SECONDS = 10.0
+
+
+def inlined_size(typer, body: ty.T) -> int:
+    """Nodes of ``body`` with every sheet function it calls written out at each call (what
+    SymPy receives); each function's size is counted once, so this is cheap however large."""
+    sizes: dict[str, int] = {}
+
+    def size(node: ty.T) -> int:
+        total, stack = 0, [node]
+        while stack:
+            n = stack.pop()
+            total += 1
+            if isinstance(n, ty.TCall):
+                if n.name not in sizes:
+                    sizes[n.name] = 0  # a function calling itself: not written out
+                    sizes[n.name] = size(typer.function(n.name).body)
+                total += sizes[n.name]
+            stack.extend(ty.children(n))
+        return total
+
+    return size(body)
 
 
 def _leaves(typer, body: ty.T) -> dict[str, ty.T]:
