@@ -113,6 +113,17 @@ Function Checked(x As Double) As Variant
     End If
 End Function
 
+Function Accumulate(n As Long) As Double
+    Dim i As Long
+    For i = 1 To n
+        Accumulate = Accumulate + i * i
+    Next i
+End Function
+
+Function Gravity() As Double
+    Gravity = 9.80665
+End Function
+
 Declare PtrSafe Function GetTickCount Lib "kernel32" () As Long
 
 Sub WriteResults()
@@ -142,6 +153,8 @@ def build(folder: Path) -> tuple[Path, Path, dict[str, object]]:
         "B18": "mid",
         "B19": 3.0,
         "B20": "x must not be negative",
+        "B21": 14.0,  # Accumulate(3): the function's own name reads its value so far
+        "B22": 2 * 9.80665,
     }
     path = folder / "beam.xlsx"
     wb = xlsxwriter.Workbook(str(path))
@@ -172,6 +185,8 @@ def build(folder: Path) -> tuple[Path, Path, dict[str, object]]:
         "B18": ("Grade", "=Grade(B4)"),
         "B19": ("Root", "=Checked(9)"),
         "B20": ("Message", "=Checked(-1)"),
+        "B21": ("Sum of squares", "=Accumulate(3)"),
+        "B22": ("Twice g", "=Gravity()*2"),
     }
     for cell, (label, formula) in formulas.items():
         row = int(cell[1:]) - 1
@@ -198,11 +213,11 @@ def test_import_reproduces_the_cached_values(imported, capsys):
     # exit 1: Ratio has no value (a division by zero), as B15 holds #DIV/0! in Excel; B20
     assert main(["check", str(toml), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # 16 formula cells: B15 holds an error value (not compared), B17 is not translated;
+    # 18 formula cells: B15 holds an error value (not compared), B17 is not translated;
     # B20 shows a message where the function otherwise gives numbers: an error here
     assert {k: report[k] for k in ("printed", "reproduced", "failed")} == {
-        "printed": 14,
-        "reproduced": 13,
+        "printed": 16,
+        "reproduced": 15,
         "failed": 0,
     }
     assert report["not_computable"] == 1

@@ -142,7 +142,13 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
             taken.add(final.lower())
             info = FunctionInfo(proc, final, [])
             info.option_base = 1 if option_base else 0  # type: ignore[attr-defined]
-            info.consts = _module_consts(mod)  # type: ignore[attr-defined]
+            info.consts = _module_consts(mod) + [  # type: ignore[attr-defined]
+                line
+                for other in tr.modules
+                if other is not mod and not other.document
+                for line in _module_consts(other)
+                if re.match(r"^(public|global)\s+const\b", line, re.I)
+            ]
             info.module_vars = _module_vars(mod)  # type: ignore[attr-defined]
             tr.functions[key] = info
     tr.reserved_functions = {i.final.lower() for i in tr.functions.values()}  # type: ignore[attr-defined]
@@ -431,7 +437,9 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
                 consts = [
                     c for c in info.consts if _const_name(c) and _mentions(body, _const_name(c))
                 ]  # type: ignore[attr-defined]
-                t.prefix = [(0, re.sub(r"^(public|private)\s+", "", c, flags=re.I)) for c in consts]
+                t.prefix = [
+                    (0, re.sub(r"^(public|private|global)\s+", "", c, flags=re.I)) for c in consts
+                ]
                 info.program = t.translate()
             except NotTranslated as exc:
                 info.problem = str(exc)

@@ -299,6 +299,8 @@ class FormulaTranslator:
                 texts.append(self.value(a))
             if k < len(info.params) and info.params[k] in info.given:
                 flags.append("1" if given else "0")
+        if not texts + flags:  # a function without arguments is a definition
+            return info.final
         return f"{info.final}({', '.join(texts + flags)})"
 
 

@@ -255,7 +255,7 @@ class Translator:
             key = target[1].lower()
             if key == self.proc.name.lower():
                 return self.assign_result(rhs, indent, i, lines)
-            if key in self.functions:
+            if key in self.functions and key not in self.names:
                 raise NotTranslated(f"assigns to the name of another function {target[1]}")
             if key in self.arrays and self.arrays[key].is_range:
                 raise NotTranslated(f"{target[1]} is a range given as an argument: writes cells")
@@ -781,6 +781,8 @@ class Translator:
         key = vba.lower()
         if key in self.names:
             return self.names[key]
+        if key == self.proc.name.lower():  # the function's own name reads its value so far
+            return self.ret
         if key == "true":
             return "-1"
         if key == "false":
@@ -897,6 +899,8 @@ class Translator:
                 texts.append(self.value(a))
             if info.params[k] in info.given:
                 flags.append("1" if given else "0")
+        if not texts + flags:  # a function without arguments is a definition
+            return info.final
         return f"{info.final}({', '.join(texts + flags)})"
 
     def member(self, node, args) -> str:
