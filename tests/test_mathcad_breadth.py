@@ -93,3 +93,29 @@ def test_element_definition_shown_is_the_whole_vector(tmp_path, capsys):
     assert "not over all its elements (Mathcad keeps the others)" in text
     result = _check(tmp_path, capsys, "elements")
     assert (result["printed"], result["reproduced"], result["failed"]) == (9, 6, 0), result
+
+
+def test_sum_over_a_range_variable(tmp_path, capsys):
+    """i := 1 .. 4: Σ_i i^2 = 30 (Mathcad's sum over a range variable, without bounds);
+    k := 0, 0.5 .. 2 (not of whole steps) is listed."""
+
+    def range_sum(var: str) -> str:
+        lam = (
+            f"<ml:lambda><ml:boundVars>{_id(var)}</ml:boundVars>"
+            f"{_apply('pow', _id(var), _real(2))}</ml:lambda>"
+        )
+        return f"<ml:apply><ml:summation/>{lam}</ml:apply>"
+
+    halves = f"<ml:range><ml:sequence>{_real(0)}{_real(0.5)}</ml:sequence>{_real(2)}</ml:range>"
+    text = _import(
+        tmp_path,
+        capsys,
+        "sums",
+        _range_def(1, "i", 1, 4),
+        _eval(2, range_sum("i"), _real(30)),
+        _define(3, _id("k"), halves),
+        _eval(4, range_sum("k"), _real(7.5)),
+    )
+    assert "not of whole steps of 1" in text
+    result = _check(tmp_path, capsys, "sums")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 1, 0), result

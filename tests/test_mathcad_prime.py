@@ -378,3 +378,19 @@ def test_combo_box_is_the_selected_row(tmp_path, capsys):
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
     result = _check(tmp_path / "combo.toml", capsys)
     assert (result["printed"], result["reproduced"]) == (3, 3), result
+
+
+def test_bounds_of_a_sum(tmp_path, capsys):
+    """Prime writes a sum's bounds as lowerBound and upperBound: Σ_{i=1}^{4} i^2 = 30."""
+    lam = (
+        f"<ml:lambda><ml:boundVars>{_id('i')}</ml:boundVars><ml:apply><ml:pow/>{_id('i')}"
+        "<ml:real>2</ml:real></ml:apply></ml:lambda>"
+    )
+    total = (
+        f"<ml:apply><ml:summation/>{lam}<ml:lowerBound><ml:real>1</ml:real></ml:lowerBound>"
+        "<ml:upperBound><ml:real>4</ml:real></ml:upperBound></ml:apply>"
+    )
+    src = _package(tmp_path / "sum.mcdx", _eval(1, total), _result(1, "<ml:real>30</ml:real>"))
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "sum.toml", capsys)
+    assert (result["printed"], result["reproduced"]) == (1, 1), result

@@ -471,6 +471,12 @@ def _if_chain(node: MNode) -> MNode:
 def _apply(node: MNode) -> MNode:
     """Prime's forms of operators Mathcad 15 wrote otherwise."""
     op, args = node.children[0].tag, node.children[1:]
+    lower = next((a for a in args if a.tag == "lowerBound"), None)
+    upper = next((a for a in args if a.tag == "upperBound"), None)
+    if lower is not None and upper is not None and len(lower.children) == len(upper.children) == 1:
+        bounds = MNode("bounds", {}, "", [lower.children[0], upper.children[0]])
+        rest = [a for a in args if a is not lower and a is not upper]
+        return MNode("apply", node.attrs, "", [node.children[0], *rest, bounds], node.line)
     if op == "mult" and len(args) == 2 and args[1].tag == "placeholder":
         return args[0]  # a value with an empty unit placeholder (scale)
     if op == "nthRoot" and len(args) == 2 and args[0].tag == "placeholder":

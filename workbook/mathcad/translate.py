@@ -287,12 +287,28 @@ class ExprTranslator(Visitor):
             if bounds is not None:
                 raise Untranslatable("a derivative with bounds")
             return self._builtin(name, tag, [body, var])
+        if bounds is None and tag in ("summation", "product"):
+            a, b = self._range_bounds(bvars[0], tag)
+            return self._builtin(name, tag, [body, var, a, b])
         if bounds is None or len(bounds.children) != 2:
             raise Untranslatable(f"{_what(tag)} over a range variable (no bounds)")
         a, b = (self.visit(c) for c in bounds.children)
         if tag == "integral":
             self.tr.sym_of(var).hint = a  # the variable's unit is its bounds'
         return self._builtin(name, tag, [body, var, a, b])
+
+    def _range_bounds(self, var: MNode, tag: str) -> tuple[ex.Node, ex.Node]:
+        """Σ over a range variable: the first and last values of its range (of step 1)."""
+        sym = self.tr.scope.get(_key(var)) if var.tag == "id" else None
+        item = self.tr._range_of(var) if sym is not None and sym.is_range else None
+        if item is None or sym.broken:
+            raise Untranslatable(f"{_what(tag)} over a range variable that is not translated")
+        values = item.range_values or []
+        steps = {b - a for a, b in zip(values, values[1:])}
+        if not values or steps - {1.0} or any(v != int(v) for v in values):
+            raise Untranslatable(f"{_what(tag)} over a range variable not of whole steps of 1")
+        # the range's values as the import found them (a range's bounds are known at import)
+        return ex.Number(float(values[0])), ex.Number(float(values[-1]))
 
     def _root(self, args: list[MNode]) -> ex.Node:
         """Mathcad's root(f(x), x, a, b), or root(f(x), x) from the current value of x."""
