@@ -115,6 +115,7 @@ dL = { expr = "alpha*L*(T2 - T1)", unit = "mm" }
 T_mid = "T1 + (T2 - T1)/2"
 T_mid_F = { expr = "T1 + (T2 - T1)/2", unit = "degF" }
 ratio = "T2/T1"
+hot = "max(T1, T2)"
 warm = "1 if T2 > T3 otherwise 0"
 """
 
@@ -138,6 +139,7 @@ def _expected():
         "T_mid": (t1 + (t2 - t1) / 2).to("degC"),
         "T_mid_F": (t1 + (t2 - t1) / 2).to("degF"),
         "ratio": (t2.to("K") / t1.to("K")).to(""),
+        "hot": max(t1.to("K"), t2.to("K")),
         "warm": q(1 if t2.to("K") > t3 else 0, ""),
     }
 

@@ -595,8 +595,8 @@ class Typer(ArrayTyping, Visitor):
         if op == "+":
             raise UnitError(
                 f"{shown}: two absolute temperatures cannot be added (20 degC + 20 degC is "
-                "not 40 degC); add a difference (T1 + (T2 - T1)/2 is their mean), or convert "
-                "both to K"
+                "not 40 degC); add a difference (T + 5 delta_degC; T1 + (T2 - T1)/2 is their "
+                "mean), or convert both to K"
             )
         # absolute - absolute: a difference, in the scale of the left one
         return left, self.convert(right, left.unit, "difference"), un.difference_unit(left.unit)
