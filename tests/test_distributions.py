@@ -83,7 +83,18 @@ CASES = {
         [(x, r) for x in [-1.0, *_POS] for r in (0.2, 3)],
         1e-14,
     ),
+    "dexp": (
+        lambda x, r: r * mpmath.exp(-r * x) if x >= 0 else mpmath.mpf(0),
+        [(x, r) for x in [-1.0, *_POS] for r in (0.2, 3)],
+        1e-14,
+    ),
     "qexp": (lambda p, r: -mpmath.log1p(-p) / r, [(p, r) for p in _P for r in (0.2, 3)], 1e-14),
+    "dunif": (
+        lambda x, a, b: 1 / (b - a) if a <= x <= b else mpmath.mpf(0),
+        [(x, -1, 2.5) for x in [*_X, 2.5]],
+        1e-15,
+    ),
+    "qunif": (lambda p, a, b: a + p * (b - a), [(p, -1, 2.5) for p in [0.0, *_P, 1.0]], 1e-15),
     "punif": (
         lambda x, a, b: min(max((x - a) / (b - a), 0), 1),
         [(x, -1, 2.5) for x in _X],
@@ -156,8 +167,12 @@ EXCEL_CASES = {
     "c_pexp": "pexp(x, r)",
     "c_qexp": "qexp(p, r)",
     "c_punif": "punif(x, a, b)",
+    "c_dexp": "dexp(x, r)",
+    "c_dunif": "dunif(x, a, b) + 10*dunif(b + x, a, b)",
+    "c_qunif": "qunif(p, a, b)",
     # below zero: 0, as mpmath above (Excel's own functions give #NUM!)
-    "c_below": "dchisq(-x, d) + 10*pchisq(-x, d) + 100*pF(-x, d, d2) + 1000*pexp(-x, r)",
+    "c_below": "dchisq(-x, d) + 10*pchisq(-x, d) + 100*pF(-x, d, d2) + 1000*pexp(-x, r) "
+    "+ 10000*dexp(-x, r)",
     "c_constants": "pt(0.4, 4) + qchisq(0.6, 2)",
 }
 

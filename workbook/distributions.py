@@ -1,7 +1,7 @@
 """Probability distributions as Mathcad names them: ``dX`` the density, ``pX`` the cumulative
-probability, ``qX`` the quantile (its inverse), for the normal (``norm``), Student's t (``t``)
-and chi-squared (``chisq``) distributions; ``pF``/``qF`` (F), ``pexp``/``qexp`` (exponential)
-and ``punif`` (uniform).
+probability, ``qX`` the quantile (its inverse), for the normal (``norm``), Student's t (``t``),
+chi-squared (``chisq``), exponential (``exp``) and uniform (``unif``) distributions, and
+``pF``/``qF`` (F).
 
 Every argument is a plain number (SciPy computes them). In Excel each is its worksheet function
 (``_xlfn.NORM.DIST`` ...) or a formula of classic ones; Excel reads degrees of freedom as
@@ -158,11 +158,19 @@ def _excel_f(kind, x, d1, d2):
 def _excel_exp(kind, x, r):
     if kind == "ppf":  # Excel has no EXPON.INV
         return f"IF(({r})>0, -LN(1-({x}))/({r}), NA())"
-    return _call("EXPON.DIST", f"MAX({x}, 0)", r, "TRUE")
+    if kind == "cdf":
+        return _call("EXPON.DIST", f"MAX({x}, 0)", r, "TRUE")
+    return _density_of_positive(_call("EXPON.DIST", x, r, "FALSE"), x)
 
 
 def _excel_unif(kind, x, a, b):
-    return f"IF(({b})>({a}), MIN(MAX((({x})-({a}))/(({b})-({a})), 0), 1), NA())"
+    if kind == "ppf":
+        value = f"IF(AND(({x})>=0, ({x})<=1), ({a})+({x})*(({b})-({a})), NA())"
+    elif kind == "cdf":
+        value = f"MIN(MAX((({x})-({a}))/(({b})-({a})), 0), 1)"
+    else:
+        value = f"IF(AND(({x})>=({a}), ({x})<=({b})), 1/(({b})-({a})), 0)"
+    return f"IF(({b})>({a}), {value}, NA())"
 
 
 _EXCEL = {
@@ -222,10 +230,10 @@ KINDS: dict[str, tuple[str, ...]] = {
     "norm": ("pdf", "cdf", "ppf"),
     "t": ("pdf", "cdf", "ppf"),
     "chisq": ("pdf", "cdf", "ppf"),
-    # Mathcad's dF, dexp, dunif and qunif are not built-ins: dF is a function name in a template
+    # Mathcad's dF is not a built-in: a template names a function of its own so
     "F": ("cdf", "ppf"),
-    "exp": ("cdf", "ppf"),
-    "unif": ("cdf",),
+    "exp": ("pdf", "cdf", "ppf"),
+    "unif": ("pdf", "cdf", "ppf"),
 }
 
 

@@ -37,8 +37,9 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),
     "dt": ("dt", None), "pt": ("pt", None), "qt": ("qt", None),
     "dchisq": ("dchisq", None), "pchisq": ("pchisq", None), "qchisq": ("qchisq", None),
-    "pF": ("pF", None), "qF": ("qF", None), "pexp": ("pexp", None), "qexp": ("qexp", None),
-    "punif": ("punif", None),
+    "pF": ("pF", None), "qF": ("qF", None),
+    "dexp": ("dexp", None), "pexp": ("pexp", None), "qexp": ("qexp", None),
+    "dunif": ("dunif", None), "punif": ("punif", None), "qunif": ("qunif", None),
 }  # fmt: skip
 
 #: Mathcad functions that are never translated, and why (a worksheet reads and writes no
