@@ -1044,3 +1044,46 @@ def test_diff_of_functions_nested_in_themselves_is_bounded(tmp_path, monkeypatch
         1 + x**2
     ) ** 2
     assert float(sheet.evaluate("g", x=x).magnitude) == pytest.approx(expected, rel=1e-12)
+
+
+# -- --inputs bounded by what openpyxl parses ---------------------------------------------
+
+
+def _swollen(src: Path, dst: Path, member: str, grow) -> Path:
+    import zipfile
+
+    with zipfile.ZipFile(src) as zi, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zo:
+        for info in zi.infolist():
+            data = zi.read(info)
+            zo.writestr(info, grow(data) if info.filename == member else data)
+    return dst
+
+
+def test_inputs_with_swollen_styles_or_shared_strings_are_refused_unparsed(tmp_path):
+    # a 60 MB styles.xml took 57 s and 1.55 GB in openpyxl; 3.5 million shared strings 59 s
+    from workbook.limits import MAX_SHARED_STRINGS, MAX_STYLES_BYTES
+
+    write(tmp_path / "t.toml", INJECT_LABELS)
+    assert cli(tmp_path, "run", "t.toml", "--out", "base.xlsx").returncode == 0
+    base = tmp_path / "base.xlsx"
+    fonts = b"<font><b/></font>" * (MAX_STYLES_BYTES // 17 + 1)
+    styles = _swollen(
+        base,
+        tmp_path / "s.xlsx",
+        "xl/styles.xml",
+        lambda d: d.replace(b"</fonts>", fonts + b"</fonts>"),
+    )
+    out = cli(tmp_path, "run", "t.toml", "--inputs", str(styles), "--out", "o.xlsx")
+    assert out.returncode == 2 and f"(limit {MAX_STYLES_BYTES:,})" in out.stderr, out.stderr
+    many = b"<x:si><x:t>a</x:t></x:si>" * (MAX_SHARED_STRINGS + 1)
+    strings = _swollen(
+        base,
+        tmp_path / "t.xlsx",
+        "xl/sharedStrings.xml",
+        lambda d: d.replace(b"</sst>", many + b"</sst>"),
+    )
+    out = cli(tmp_path, "run", "t.toml", "--inputs", str(strings), "--out", "o.xlsx")
+    assert out.returncode == 2, out.stderr
+    assert f"more than {MAX_SHARED_STRINGS:,} shared strings" in out.stderr
+    # the workbook as written reads back
+    assert cli(tmp_path, "run", "t.toml", "--inputs", str(base), "--out", "o.xlsx").returncode == 0

@@ -22,6 +22,12 @@ MAX_CSV_BYTES = 20_000_000  # a printed-values CSV
 MAX_INPUTS_XLSX_BYTES = 200_000_000  # an edited workbook given to --inputs (compressed)
 MAX_XLSX_MEMBER_BYTES = 64_000_000  # one member of it that is read, decompressed
 MAX_XLSX_MEMBERS = 10_000
+# Parts openpyxl parses whole before a cell is read, bounded by what they hold: a 60 MB
+# styles.xml took 57 s and 1.55 GB, 3.5 million tiny shared strings 59 s.
+MAX_STYLES_BYTES = 2_000_000
+MAX_SHARED_STRINGS = 300_000
+_STYLES_TYPE = "application/vnd.openxmlformats-officedocument.spreadsheetml.styles+xml"
+_STRINGS_TYPE = "application/vnd.openxmlformats-officedocument.spreadsheetml.sharedStrings+xml"
 
 
 def regular_file(path: Path, *, what: str, max_bytes: int) -> int:
@@ -133,6 +139,60 @@ def check_xlsx_archive(path: Path, *, what: str, sheet: str) -> None:
                 f"{what} {path}: member {info.filename} inflates to {info.file_size:,} bytes "
                 f"(limit {MAX_XLSX_MEMBER_BYTES:,})"
             )
+    _check_parsed_parts(path, infos, what)
+
+
+def _check_parsed_parts(path: Path, infos: list, what: str) -> None:
+    """Bound the parts openpyxl parses whole: the styles by their size, the shared strings by
+    how many they are (counted in a stream, stopping at the limit). The parts are found by
+    their content types, as openpyxl finds them, and by their usual names."""
+    import re
+
+    types = _content_types(path, infos)
+    by_name = {i.filename: i for i in infos}
+    styles = {n for n, t in types.items() if t == _STYLES_TYPE} | {"xl/styles.xml"}
+    strings = {n for n, t in types.items() if t == _STRINGS_TYPE} | {"xl/sharedStrings.xml"}
+    for name in sorted(styles):
+        info = by_name.get(name)
+        if info is not None and info.file_size > MAX_STYLES_BYTES:
+            raise LimitError(
+                f"{what} {path}: its styles part {name} is {info.file_size:,} bytes "
+                f"(limit {MAX_STYLES_BYTES:,})"
+            )
+    item = re.compile(rb"<(?:[A-Za-z_][\w.-]*:)?si[\s/>]")
+    for name in sorted(strings):
+        if name not in by_name:
+            continue
+        count, tail = 0, b""
+        with zipfile.ZipFile(path) as z, z.open(name) as f:
+            while chunk := f.read(1 << 20):
+                data = tail + chunk
+                count += len(item.findall(data))
+                tail = data[-32:]
+                count -= len(item.findall(tail))  # counted again with the next chunk
+                if count > MAX_SHARED_STRINGS:
+                    raise LimitError(
+                        f"{what} {path}: more than {MAX_SHARED_STRINGS:,} shared strings"
+                    )
+
+
+def _content_types(path: Path, infos: list) -> dict[str, str]:
+    """Part name -> content type, from [Content_Types].xml (empty when it is unreadable)."""
+    from defusedxml import ElementTree
+
+    info = next((i for i in infos if i.filename == "[Content_Types].xml"), None)
+    if info is None or info.file_size > MAX_XLSX_MEMBER_BYTES:
+        return {}
+    try:
+        with zipfile.ZipFile(path) as z:
+            root = ElementTree.fromstring(z.read(info))
+    except Exception:  # noqa: BLE001 - openpyxl will name the fault
+        return {}
+    return {
+        el.get("PartName", "").lstrip("/"): el.get("ContentType", "")
+        for el in root.iter()
+        if el.tag.endswith("}Override")
+    }
 
 
 def writable_target(path: Path) -> None:
