@@ -14,6 +14,7 @@ import math
 import operator
 
 import formulas
+import numpy as np
 import pint
 import pytest
 from conftest import write_template
@@ -270,3 +271,23 @@ def test_set_refuses_a_difference_for_an_absolute_temperature(tmp_path):
     with pytest.raises(workbook.WorkbookError, match="is a temperature difference, but T1 is an"):
         sheet.with_inputs(T1="5 delta_degC")
     assert sheet.with_inputs(T1="68 degF").evaluate("dT").to("K").magnitude == pytest.approx(65)
+
+
+def test_a_sweep_output_shown_in_degf_adds_the_offset(tmp_path):
+    """A sweep output in degF of a temperature in degC is pint's conversion (it was refused
+    as 'cannot show'; a scale factor would have been wrong), in both sweep modes."""
+    from workbook import sweep as sw
+
+    sheet = workbook.load(write_template(tmp_path, SHEET))
+    q = un.registry().Quantity
+    for mode in ("vector", "serial"):
+        res = sw.sweep(
+            sheet,
+            {"T2": "60degC..100degC:5"},
+            [sw.parse_output_option("mid[degF]=T_mid")],
+            mode=mode,
+        )
+        got = res.table["mid [degF]"].to_numpy()
+        t2 = [60, 70, 80, 90, 100]
+        want = [(q(20, "degC") + (q(t, "degC") - q(20, "degC")) / 2).to("degF").m for t in t2]
+        np.testing.assert_allclose(got, want, rtol=1e-13)

@@ -128,6 +128,9 @@ def type_output(sheet, out: Output) -> TypedOutput:
         shown = sheet.spec.arguments[out.range.var].unit
         return TypedOutput(out, t, shown, 1.0, shown)
     shown = un.unit(out.unit_text, what=what) if out.unit_text is not None else t.unit
+    if "absolute" in (un.temperature_kind(t.unit), un.temperature_kind(shown)):
+        # degC, degF: not a factor; the typer's conversion adds the offset (or refuses)
+        return TypedOutput(out, sheet.typer.convert(t, shown, what), shown, 1.0)
     try:
         f = un.factor(t.unit, shown)
     except Exception:
