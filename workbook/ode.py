@@ -494,6 +494,10 @@ def solve(
 #: tolerance commonly gives global errors up to some tens of times it; more means they grew).
 REFERENCE_FACTOR = 1000.0
 ESTIMATE_LIMIT = 100.0
+#: The reference run's wall-clock budget: this many times the run's own time, at least
+#: REFERENCE_SECONDS (and at most MAX_TIME); a reference that needs more gives no estimate.
+REFERENCE_SLOWER = 20.0
+REFERENCE_SECONDS = 5.0
 #: Where a state passes through zero its error is measured against this fraction of its largest
 #: size over the run (a velocity crossing zero is not judged by its rtol near zero alone).
 SIZE_FLOOR = 0.01
@@ -521,7 +525,8 @@ def estimate_error(sol: Solution) -> ErrorEstimate:
     r = sol.run
     rtol = max(r.rtol / REFERENCE_FACTOR, 1e-13)
     atol = sol.atol / REFERENCE_FACTOR
-    ref = sol.rerun(rtol, atol, MAX_TIME)
+    budget = min(MAX_TIME, max(REFERENCE_SECONDS, REFERENCE_SLOWER * r.elapsed))
+    ref = sol.rerun(rtol, atol, budget)
     how = f"{ref.method} at rtol {rtol:g}, atol {np.max(atol):g}"
     if not ref.ok:
         empty = np.empty(0)
