@@ -6,6 +6,7 @@ import contextlib
 import io
 import os
 
+import numpy as np
 import pytest
 from conftest import write_template
 
@@ -82,3 +83,70 @@ def test_the_results_sheet_and_the_report_show_the_block(tmp_path):
     html = write_report(sheet, tmp_path / "s.html")[0].read_text(encoding="utf-8")
     assert "<div class='definition given'>" in html and "guesses: x = 1 m, y = 0.5 m" in html
     assert "Find(x, y): x = 1.91067" in html and "condition number 1.8e+10" in html
+
+
+FOUR_BAR = """
+[inputs]
+a = "40 mm"
+b = "120 mm"
+c = "80 mm"
+d = "100 mm"
+
+[arguments]
+th2 = { unit = "deg" }
+
+[[solve]]
+parameters = ["th2"]
+unknowns = { th3 = "20 deg", th4 = "60 deg" }
+equations = [
+  "a*cos(th2) + b*cos(th3) == d + c*cos(th4)",
+  "a*sin(th2) + b*sin(th3) == c*sin(th4)",
+]
+
+[definitions]
+th4_at_90 = { expr = "th4(90 deg)", unit = "deg" }
+
+[[tables]]
+name = "positions"
+range = "th2 := 0, 30 .. 180"
+columns = { th3 = "deg", th4 = "deg" }
+"""
+
+
+def freudenstein(th2: np.ndarray, a=40.0, b=120.0, c=80.0, d=100.0) -> np.ndarray:
+    """Both closed-form output angles of a four-bar linkage (Freudenstein's equation)."""
+    k1, k2, k3 = d / a, d / c, (a**2 - b**2 + c**2 + d**2) / (2 * a * c)
+    big_a = np.cos(th2) - k1 - k2 * np.cos(th2) + k3
+    big_b = -2 * np.sin(th2)
+    big_c = k1 - (k2 + 1) * np.cos(th2) + k3
+    root = np.sqrt(big_b**2 - 4 * big_a * big_c)
+    return np.array([2 * np.arctan2(-big_b + s * root, 2 * big_a) for s in (1, -1)])
+
+
+def test_a_block_with_parameters_is_a_function_over_a_table(tmp_path):
+    sheet = workbook.load(write_template(tmp_path, FOUR_BAR))
+    table = sheet.table("positions")
+    th2 = np.radians(table["th2 [deg]"].to_numpy())
+    th4 = np.radians(table["th4 [deg]"].to_numpy())
+    exact = freudenstein(th2)
+    off = np.min(np.abs(np.angle(np.exp(1j * (exact - th4)))), axis=0)
+    assert np.max(off) < 1e-9  # the branch the guesses lead to, to the sheet's tolerance
+    at_90 = sheet.evaluate("th4_at_90").to("rad").magnitude
+    assert at_90 == pytest.approx(th4[3], abs=1e-12)
+    assert sheet.evaluate("th3", 90).to("deg").magnitude == pytest.approx(
+        table["th3 [deg]"][3], abs=1e-9
+    )
+
+
+def test_an_unknown_of_a_block_with_parameters_is_used_as_a_function(tmp_path):
+    from workbook.errors import TemplateError
+
+    text = FOUR_BAR.replace('"th4(90 deg)"', '"th4"')
+    with pytest.raises(TemplateError, match=r"it is a function, write th4\(th2\)"):
+        workbook.load(write_template(tmp_path, text))
+
+
+def test_inputs_of_a_block_with_parameters_are_used(tmp_path):
+    text = FOUR_BAR.replace('d = "100 mm"', 'd = "100 mm"\nspare = "1 mm"')
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert sheet.unused_inputs() == ["spare"]

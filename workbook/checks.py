@@ -226,6 +226,8 @@ def failed_values(sheet) -> list[Finding]:
     out: list[Finding] = []
     causes: dict[str, list[str]] = {}  # the error, located where it arose -> the values
     for block in sheet.spec.solves:
+        if block.parameters:  # a function of its parameters: its values are where it is used
+            continue
         try:
             sheet.evaluate(next(iter(block.unknowns)))
         except WorkbookError as err:  # a value shown as an error in any case

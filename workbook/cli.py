@@ -260,7 +260,9 @@ def _print_scalars(sheet) -> None:
     from .errors import WorkbookError
     from .units import pretty
 
-    unknowns = [n for block in sheet.spec.solves for n in block.unknowns]  # [[solve]] results
+    unknowns = [  # [[solve]] results (a block with parameters is a function)
+        n for block in sheet.spec.solves if not block.parameters for n in block.unknowns
+    ]
     names = unknowns + [n for n, d in sheet.spec.definitions.items() if not d.is_function]
     for name in names[:MAX_SUMMARY_SCALARS]:
         try:

@@ -10,7 +10,9 @@ The unknowns are names for the rest of the sheet (references of kind ``solve``).
 equations are typed when the sheet is loaded (each side in the unknowns' units; the two sides
 of an equation must agree), and solved when a value is first needed, by
 :func:`workbook.numerics.given.solve`. Not converging is an error that lists every equation's
-residual. In the workbook the unknowns, and what uses them, are written as numbers.
+residual. In the workbook the unknowns, and what uses them, are written as numbers. A block
+with ``parameters`` (arguments) is a function: each unknown is a definition of them, solved at
+each value it is called with (:func:`solved_at`).
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ class SolveSpec:
     line: int | None
     method: str = "hybrid"  # or "levenberg-marquardt" (Mathcad's Find)
     conditions: tuple[tuple[ex.Node, str], ...] = ()  # inequalities the root must meet
+    parameters: tuple[str, ...] = ()  # arguments: the unknowns are functions of them
 
     @property
     def what(self) -> str:
@@ -52,7 +55,7 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
         if not isinstance(block, dict) or not (
             {"unknowns", "equations"}
             <= set(block)
-            <= {"unknowns", "equations", "method", "conditions"}
+            <= {"unknowns", "equations", "method", "conditions", "parameters"}
         ):
             raise TemplateError(
                 '[[solve]] needs unknowns = { x = "1 m", ... } and equations = ["... == ...", ...]'
@@ -93,9 +96,14 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
             if not isinstance(conditions, list):
                 raise TemplateError('[[solve]] conditions = ["x > 0", ...] (a list)')
             conds = tuple(_condition(c) for c in conditions)
+            params = block.get("parameters", [])
+            if not isinstance(params, list) or not all(
+                isinstance(q, str) and ex.is_identifier(q) for q in params
+            ):
+                raise TemplateError('[[solve]] parameters = ["th2", ...] (argument names)')
         except WorkbookError as err:
             raise err.located(line=line, definition=what) from None
-        out.append(SolveSpec(i, guesses, eqs, line, method, conds))
+        out.append(SolveSpec(i, guesses, eqs, line, method, conds, tuple(params)))
     return out
 
 
@@ -107,9 +115,22 @@ def _condition(text) -> tuple[ex.Node, str]:
     return node, str(text)
 
 
+def scope_of(typer, block: SolveSpec) -> dict:
+    """The names in scope in a block's equations: the unknowns, and its parameters."""
+    scope = {n: q.units for n, q in block.unknowns.items()}
+    for name in block.parameters:
+        arg = typer.spec.arguments.get(name)
+        if arg is None:
+            raise TemplateError(
+                f"[[solve]] parameter '{name}' has no declared unit: add it to [arguments]"
+            )
+        scope[name] = arg.binding_unit
+    return scope
+
+
 def typed_conditions(typer, block: SolveSpec) -> list[tuple[ty.T, str]]:
     """The conditions, typed with the unknowns in scope (units checked at load)."""
-    scope = {n: q.units for n, q in block.unknowns.items()}
+    scope = scope_of(typer, block)
     return [(typer.expression(node, scope, block.what), text) for node, text in block.conditions]
 
 
@@ -122,7 +143,7 @@ def _equation(text) -> tuple[ex.Node, ex.Node, str]:
 
 def typed_equations(typer, block: SolveSpec) -> list[tuple[ty.T, ty.T]]:
     """Both sides of every equation, typed with the unknowns in scope (rhs in lhs's unit)."""
-    scope = {n: q.units for n, q in block.unknowns.items()}
+    scope = scope_of(typer, block)
     out = []
     for lhs, rhs, text in block.equations:
         left = typer.expression(lhs, scope, block.what)
@@ -144,10 +165,10 @@ def typed_equations(typer, block: SolveSpec) -> list[tuple[ty.T, ty.T]]:
     return out
 
 
-def _violations(sheet, block: SolveSpec, names: list[str]):
+def _violations(sheet, block: SolveSpec, names: list[str], at: dict):
     """x -> how far x is outside each condition (0 inside), relative to the size of the two
     sides at the guess: residuals for the solvers that honour the conditions while solving."""
-    scope = {n: q.units for n, q in block.unknowns.items()}
+    scope = scope_of(sheet.typer, block)
     pairs = []  # (smaller side, larger side) of every comparison of a chain
     for node, text in block.conditions:
         sides = [sheet.typer.expression(o, scope, block.what) for o in node.operands]
@@ -155,13 +176,13 @@ def _violations(sheet, block: SolveSpec, names: list[str]):
             b = sheet.typer.convert(b, a.unit, f"condition {text!r}")
             lo, hi = (a, b) if op in ("<", "<=") else (b, a)
             pairs.append((sheet.evaluator.compile(lo), sheet.evaluator.compile(hi)))
-    guess = dict(zip(names, (q.magnitude for q in block.unknowns.values())))
+    guess = dict(zip(names, (q.magnitude for q in block.unknowns.values())), **at)
     with np.errstate(all="ignore"):
         sizes = [abs(float(lo(guess))) + abs(float(hi(guess))) for lo, hi in pairs]
     sizes = [z if np.isfinite(z) and z else 1.0 for z in sizes]
 
     def violations(x):
-        env = dict(zip(names, (float(v) for v in x)))
+        env = dict(zip(names, (float(v) for v in x)), **at)
         return np.array(
             [max(float(lo(env)) - float(hi(env)), 0.0) / z for (lo, hi), z in zip(pairs, sizes)]
         )
@@ -177,6 +198,35 @@ class Solved(dict):
     condition: float
 
 
+#: Most points at which a block with parameters is solved in one evaluation.
+MAX_POINTS = 100_000
+
+
+def solved_at(sheet, block: SolveSpec, name: str, env: dict):
+    """Unknown ``name`` of a block with parameters at the parameters' values in ``env``
+    (numbers or arrays, broadcast): the block solved at each distinct point, once per sheet."""
+    values = np.broadcast_arrays(*[np.asarray(env[p], dtype=float) for p in block.parameters])
+    shape = values[0].shape
+    if values[0].size > MAX_POINTS:
+        from .errors import LimitError
+
+        raise LimitError(
+            f"{block.what}: {values[0].size:,} points to solve at (limit {MAX_POINTS:,})"
+        )
+    out = np.empty(shape)
+    memo = sheet._memo.setdefault(("solve at", block.index), {})
+    for ix in np.ndindex(shape):
+        point = tuple(float(v[ix]) for v in values)
+        if point not in memo:
+            try:
+                memo[point] = solve_block(sheet, block, dict(zip(block.parameters, point)))
+            except WorkbookError as err:
+                where = ", ".join(f"{p} = {v:g}" for p, v in zip(block.parameters, point))
+                raise type(err)(f"{err.message} (at {where})") from None
+        out[ix] = memo[point][name]
+    return float(out) if out.ndim == 0 else out
+
+
 def solve_findings(sheet) -> list:
     """A finding per solved [[solve]] block: its solution, each unknown's error estimate and
     the condition number; a warning when an estimate exceeds the sheet's tolerance relative
@@ -187,6 +237,8 @@ def solve_findings(sheet) -> list:
     rtol = sheet_tolerance(sheet.spec.meta).rtol
     out = []
     for block in sheet.spec.solves:
+        if block.parameters:  # a function: each point's estimate is not listed
+            continue
         try:
             sheet.evaluate(next(iter(block.unknowns)))
         except WorkbookError:
@@ -211,8 +263,10 @@ def solve_findings(sheet) -> list:
     return out
 
 
-def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
-    """The unknowns' values (magnitudes in their guesses' units)."""
+def solve_block(sheet, block: SolveSpec, at: dict | None = None) -> dict[str, float]:
+    """The unknowns' values (magnitudes in their guesses' units); ``at``: the values of the
+    block's parameters (magnitudes in their binding units)."""
+    at = dict(at or {})
     from .numerics import current, sheet_tolerance
     from .numerics.given import solve
 
@@ -223,7 +277,7 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
     ]
 
     def values(x):
-        env = dict(zip(names, (float(v) for v in x)))
+        env = dict(zip(names, (float(v) for v in x)), **at)
         return [(float(left(env)), float(right(env))) for left, right in sides]
 
     guess = [q.magnitude for q in block.unknowns.values()]
@@ -245,13 +299,13 @@ def solve_block(sheet, block: SolveSpec) -> dict[str, float]:
         names=names,
         equations=[text for _, _, text in block.equations],
         method=block.method,
-        violations=_violations(sheet, block, names) if block.conditions else None,
+        violations=_violations(sheet, block, names, at) if block.conditions else None,
     )
     found = Solved(zip(names, (float(v) for v in result.value)))
     found.errors = dict(zip(names, (float(e) for e in result.error)))
     found.condition = float(result.notes.get("condition", float("nan")))
     for cond, text in typed_conditions(sheet.typer, block):
-        if not bool(sheet.evaluator.compile(cond)(dict(found))):
+        if not bool(sheet.evaluator.compile(cond)(dict(found, **at))):
             from .numerics import NumericsError
 
             at = ", ".join(f"{n} = {v:.6g}" for n, v in found.items())

@@ -61,6 +61,7 @@ class Evaluator(Visitor):
     ):
         self.typer = typer
         self.column_values = column_values  # (table, column) -> values, for max_over()
+        self.solve_at: Callable | None = None  # (unknown, env) -> values, set by the Sheet
         self.scalar_value = scalar_value  # (name, kind) -> magnitude in the ref's unit
         self.describe_args = describe_args
         self._functions: dict[str, Fn] = {}
@@ -140,6 +141,9 @@ class Evaluator(Visitor):
 
     def visit_TRef(self, t: tc.TRef) -> Fn:
         name, kind, get = t.name, t.kind, self.scalar_value
+        if kind == "solve" and self.typer.spec.solve_of(name).parameters:
+            at = self.solve_at  # a [[solve]] block with parameters: solved at env's values
+            return lambda env: at(name, env)
         return lambda env: get(name, kind)
 
     def visit_TScale(self, t: tc.TScale) -> Fn:

@@ -84,6 +84,7 @@ class Sheet:
         self.evaluator = Evaluator(
             self.typer, self.scalar_value, self.describe_call, self._column_values
         )
+        self.evaluator.solve_at = self._solved_at
         if typer is None:
             self.check_units()
 
@@ -395,6 +396,12 @@ class Sheet:
             except WorkbookError as err:
                 raise err.located(file=self.file, line=block.line, definition=block.what) from None
         return self._memo[key][name]
+
+    def _solved_at(self, name: str, env: dict):
+        """An unknown of a [[solve]] block with parameters, at their values in ``env``."""
+        from .given_find import solved_at
+
+        return solved_at(self, self.spec.solve_of(name), name, env)
 
     def _column_values(self, table: str, column: str) -> np.ndarray:
         """Values of one column of a range table (for max_over/min_over), memoised."""

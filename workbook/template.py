@@ -642,6 +642,24 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     )
 
     solves = read_solves(_list(data, "solve"), lambda v: _value_line(text, v), claim)
+    for block in solves:  # Mathcad's th(a) := Find(x): each unknown a function of the parameters
+        for p in block.parameters:
+            if p not in arguments:
+                raise TemplateError(
+                    f"[[solve]] parameter '{p}' has no declared unit: add it to [arguments]",
+                    line=block.line,
+                    definition=block.what,
+                )
+        for unknown in block.parameters and block.unknowns:
+            definitions[unknown] = Definition(
+                unknown,
+                block.parameters,
+                ex.Name(unknown),
+                None,
+                f"Find({', '.join(block.unknowns)}) of the [[solve]] block",
+                "solved at each value of " + ", ".join(block.parameters),
+                line=block.line,
+            )
 
     tables = [_table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
     charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]

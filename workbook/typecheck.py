@@ -482,6 +482,11 @@ class Typer(ArrayTyping, Visitor):
             return TParam(scope[name], name=name)
         block = self.spec.solve_of(name)
         if block is not None:
+            if not all(p in scope for p in block.parameters):
+                raise TemplateError(
+                    f"'{name}' is found by a [[solve]] block with parameters: it is a function, "
+                    f"write {name}({', '.join(block.parameters)})"
+                )
             return TRef(block.unknowns[name].units, name=name, kind="solve")
         if name in self.spec.data:
             col = self.spec.data[name]
@@ -947,11 +952,16 @@ def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
         if n in out:
             continue
         out.add(n)
+        block = spec.solve_of(n) if n not in spec.inputs else None
+        if block is not None:  # an unknown of [[solve]]: what its equations use
+            todo.extend(
+                m
+                for node in solve_expressions(block)
+                for m in ex.names(node)
+                if m not in block.parameters
+            )
         d = spec.definitions.get(n)
         if d is None:
-            block = spec.solve_of(n) if n not in spec.inputs else None
-            if block is not None:  # an unknown of [[solve]]: what its equations use
-                todo.extend(m for node in solve_expressions(block) for m in ex.names(node))
             continue
         local: set[str] = set(d.params)
         bodies = d.expressions()

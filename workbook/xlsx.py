@@ -261,7 +261,7 @@ class WorkbookWriter:
         written = getattr(self, "on_matrices", set())
         if [d for d in matrices if d.name not in written]:
             self.write_matrices([d for d in matrices if d.name not in written])
-        unknowns = [(n, b) for b in self.sheet.spec.solves for n in b.unknowns]
+        unknowns = [(n, b) for b in self.sheet.spec.solves if not b.parameters for n in b.unknowns]
         if not defs and not unknowns:
             return
         done = getattr(self, "on_definitions", set())

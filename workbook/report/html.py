@@ -276,6 +276,13 @@ class Document:
             except Exception:
                 lines.append(f"<p>{escape(text)}</p>")
         find = f"Find({', '.join(block.unknowns)})"
+        if block.parameters:  # a function: solved where it is called
+            at = ", ".join(block.parameters)
+            calls = ", ".join(f"{n}({at})" for n in block.unknowns)
+            return (
+                f"<div class='definition given'>{''.join(lines)}<p>{escape(calls)} := "
+                f"{escape(find)}, solved at each value of {escape(at)}</p></div>"
+            )
         try:
             values = [self.sheet.evaluate(n) for n in block.unknowns]
             solved = self.sheet._memo[("solve", block.index)]
