@@ -73,8 +73,8 @@ def _shown(body: str, result: str) -> str:
 def test_element_definition_shown_is_the_whole_vector(tmp_path, capsys):
     """i := 0 .. 2, v[i] := i^2 = [0; 1; 4] (Mathcad shows the vector it built), then
     v[i] := 10 + i over the same range (every element again) = [10; 11; 12]; j := 0 .. 1,
-    v[j] := 5 (Mathcad keeps v[2] = 12: not every element) is listed, never a vector of
-    two."""
+    v[j] := 5 = [5; 5; 12] (Mathcad keeps v[2], never a vector of two or a 0 there);
+    M := [[1, 2], [3, 4]], M[j, j] := 9 = [[9, 2], [3, 9]] (a diagonal, the rest kept)."""
     square = _apply("pow", _id("i"), _real(2))
     text = _import(
         tmp_path,
@@ -89,10 +89,16 @@ def test_element_definition_shown_is_the_whole_vector(tmp_path, capsys):
         ),
         _range_def(4, "j", 0, 1),
         _define(5, _index(_id("v"), _id("j")), _shown(_real(5), _matrix(*map(_real, (5, 5, 12))))),
+        _define(6, _id("M"), _matrix(*map(_real, (1, 3, 2, 4)), cols=2)),
+        _define(
+            7,
+            _index(_id("M"), _id("j"), _id("j")),
+            _shown(_real(9), _matrix(*map(_real, (9, 3, 2, 9)), cols=2)),
+        ),
     )
-    assert "not over all its elements (Mathcad keeps the others)" in text
+    assert "region 5" not in text.split("[sheet]")[0]  # nothing listed
     result = _check(tmp_path, capsys, "elements")
-    assert (result["printed"], result["reproduced"], result["failed"]) == (9, 6, 0), result
+    assert (result["printed"], result["reproduced"], result["failed"]) == (13, 13, 0), result
 
 
 def test_sum_over_a_range_variable(tmp_path, capsys):

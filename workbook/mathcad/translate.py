@@ -1062,34 +1062,40 @@ class Translator:
             return
         before = self.scope.get(key)
         sym = self.define(key, "var", region.id)
-        if len({id(r) for r in ranges if r is not None}) < len(ranges):
-            sym.broken = "an element assignment with one range variable at two indices"
-            raise Untranslatable(sym.broken)
         try:
             self._forced(region, sym)
-            if not hasattr(ex, "Matrix"):
-                raise Untranslatable("an element assignment (vectors are not in the language yet)")
             if any(r is None for r in ranges) or len(ranges) > 2:
                 raise Untranslatable(
                     "an element assignment v[k] := ... at a single index (the language "
                     "defines whole vectors)"
                 )
-            values = [[int(v) for v in r.range_values] for r in ranges]
-            if any(v != r.range_values for v, r in zip(values, ranges)):
+            unique: list[Item] = []  # M[i, i] := ...: one range at two indices (a diagonal)
+            for r in ranges:
+                if all(r is not u for u in unique):
+                    unique.append(r)
+            place = [next(k for k, u in enumerate(unique) if u is r) for r in ranges]
+            values = [[int(v) for v in u.range_values] for u in unique]
+            if any(v != u.range_values for v, u in zip(values, unique)):
                 raise Untranslatable("an element assignment over a range of fractional values")
             if any(min(v) < self.origin for v in values):
                 raise Untranslatable("an element assignment below ORIGIN")
-            size = [max(v) - self.origin + 1 for v in values]
-            if before is not None and not self._replaces(before, values, size):
-                raise Untranslatable(
-                    "an element assignment over a range to a name defined before, not over "
-                    "all its elements (Mathcad keeps the others)"
-                )
+            old = None
+            if before is not None:  # Mathcad keeps the elements the range does not reach
+                old = self._shape_of(before)
+                if old is None or (len(ranges) == 1 and old[1] != 1):
+                    raise Untranslatable(
+                        "an element assignment over a range to a name defined before whose "
+                        "size is not known at import"
+                    )
+            size = [max(values[place[k]]) - self.origin + 1 for k in range(len(ranges))]
+            if old is not None:
+                size = [max(n, old[k]) for k, n in enumerate(size)]
             if math.prod(size) > 10_000:
                 raise Untranslatable("an element assignment of more than 10,000 elements")
             local, params = {}, []
-            for n, r in zip(nodes, ranges):
-                p = self.new_sym("param", r.sym.base, r.sym.mathcad, unit="")
+            for u in unique:
+                n = nodes[ranges.index(u)]
+                p = self.new_sym("param", u.sym.base, u.sym.mathcad, unit="")
                 local[_key(n)] = p
                 params.append(p)
             et = ExprTranslator(self, local)
@@ -1101,27 +1107,50 @@ class Translator:
             raise
         of = self.new_sym("func", sym.base + "_of", nm.mathcad_text(*key) + "[...]", region.id)
         self.out.items.append(Item("function", region.id, sym=of, params=params, body=body))
+        o = self.origin
 
         def cell(*at: int) -> ex.Node:
-            if all(a in v for a, v in zip(at, values)):
-                return ex.Call(of.token(), tuple(ex.Number(float(a)) for a in at))
+            chosen: dict[int, int] = {}
+            reached = True
+            for k, a in enumerate(at):
+                u = place[k]
+                if a not in values[u] or chosen.setdefault(u, a) != a:
+                    reached = False
+            if reached:
+                return ex.Call(
+                    of.token(), tuple(ex.Number(float(chosen[u])) for u in range(len(unique)))
+                )
+            if old is not None and all(a - o < old[k] for k, a in enumerate(at)):
+                return ex.Index(ex.Name(before.token()), tuple(ex.Number(float(a)) for a in at))
             return ex.Number(0.0)
 
-        o = self.origin
         if len(size) == 1:
             rows = tuple((cell(o + r),) for r in range(size[0]))
         else:
             rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
         self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
 
-    def _replaces(self, before: Sym, values: list[list[int]], size: list[int]) -> bool:
-        """Does an element assignment over ``values`` set every element the vector defined
-        before had (so that none of its old elements is left)?"""
-        if before.broken or len(values) != 1:
-            return False
-        old = self._length(ex.Name(before.token()))
-        every = set(range(self.origin, self.origin + size[0]))
-        return old is not None and old <= size[0] and set(values[0]) == every
+    def _shape_of(self, before: Sym) -> tuple[int, int] | None:
+        """(rows, columns) of a vector or matrix the worksheet wrote out before (None: not
+        known at import)."""
+        if before.broken:
+            return None
+        tree: ex.Node = ex.Name(before.token())
+        seen: set[str] = set()
+        while isinstance(tree, ex.Name) and tree.id not in seen:
+            seen.add(tree.id)
+            item = next(
+                (i for i in self.out.items if i.sym is not None and i.sym.token() == tree.id),
+                None,
+            )
+            if item is None or item.kind != "definition" or item.body is None:
+                return None
+            tree = item.body
+        if isinstance(tree, ex.Matrix) and not any(
+            isinstance(e, ex.Matrix) for row in tree.rows for e in row
+        ):
+            return len(tree.rows), len(tree.rows[0])
+        return None
 
     def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> None:
         """[a; b] := value: the value a definition of its own (``parts``), then each name
