@@ -423,3 +423,147 @@ def fuzz_folder(tmp_path_factory):
 
 def test_slow_budget_is_at_least_ten_thousand_each():
     assert SLOW_EXAMPLES >= 10_000
+
+
+# -- hostile payloads: labels that look like references, CSV cells, names, arrays ---------------
+
+LABEL_PIECES = [
+    "=",
+    "+",
+    "-",
+    "@",
+    "!",
+    "'",
+    "A1",
+    "$B$2",
+    "Sheet1!A1",
+    "Inputs!B2",
+    "'\\\\evil.example\\s\\[x.xlsx]S'!A1",
+    "[x.xlsx]",
+    "http://x.example/a",
+    "cmd|' /C calc'!A0",
+    '=DDE("cmd";"/C calc";"x")',
+    "HYPERLINK(",
+    ")",
+    "\t",
+    "\r",
+    "\n",
+    "\x7f",
+    "\x01",
+    " ",
+    "\u00a0",
+    "\uff1d",
+    "phi",
+    "mm",
+    "\u03c6",
+]
+
+
+def labels():
+    """Texts made of reference, formula and control-character pieces, and random text."""
+    pieces = st.lists(st.sampled_from(LABEL_PIECES), min_size=1, max_size=6).map("".join)
+    return st.one_of(pieces, st.text(min_size=1, max_size=30))
+
+
+@_fuzz(FAST_EXAMPLES // 2)  # a workbook each: about 0.1 s
+@given(texts=st.lists(labels(), min_size=4, max_size=4))
+def test_chart_labels_are_never_references(tmp_path_factory, texts):
+    """A title, axis title or series name is shown as written: the chart refers to nothing but
+    its data and the text cells that hold labels xlsxwriter would read as a reference."""
+    import re
+    import zipfile
+
+    import openpyxl
+    import xlsxwriter
+
+    from workbook import style
+    from workbook.xlsx import chart_label
+
+    texts = [t.replace("\x00", "") or "x" for t in texts]  # no cell or XML holds NUL
+    path = tmp_path_factory.mktemp("labels") / "c.xlsx"
+    wb = xlsxwriter.Workbook(str(path), {"strings_to_formulas": False, "strings_to_urls": False})
+    data, charts = wb.add_worksheet("Data"), wb.add_worksheet("Charts")
+    for i in range(3):
+        data.write_number(i, 0, i)
+        data.write_number(i, 1, i * i)
+    row, shown = 0, []
+    for text in texts:
+        label, row = chart_label(charts, "Charts", text, row)
+        shown.append(label)
+    c = style.scatter_chart(wb)
+    c.add_series(
+        {"name": shown[0], "categories": ["Data", 0, 0, 2, 0], "values": ["Data", 0, 1, 2, 1]}
+    )
+    c.set_title({"name": shown[1]})
+    c.set_x_axis(style.axis(shown[2]))
+    c.set_y_axis(style.axis(shown[3]))
+    style.place_chart(charts, 0, c)
+    wb.close()
+    with zipfile.ZipFile(path) as z:
+        assert not [n for n in z.namelist() if "externalLink" in n]
+        xml = z.read("xl/charts/chart1.xml").decode()
+    refs = re.findall(r"<c:f>([^<]*)</c:f>", xml)
+    assert all(r.startswith(("Charts!$P$", "Data!$A$", "Data!$B$")) for r in refs), refs
+    cells = openpyxl.load_workbook(path)["Charts"]
+    for text, label in zip(texts, shown):
+        if isinstance(label, list):  # a text cell the chart refers to: exactly the label
+            cell = cells.cell(row=label[1] + 1, column=label[2] + 1)
+            shown_text = re.sub(  # the OOXML escape of a control character, as Excel reads it
+                r"_x([0-9A-Fa-f]{4})_", lambda m: chr(int(m.group(1), 16)), cell.value
+            )
+            assert cell.data_type == "s" and shown_text == text
+        else:  # given as it is: xlsxwriter takes it as literal text
+            assert not text.startswith("=") and "!" not in text
+
+
+@_fuzz(FAST_EXAMPLES)
+@given(cells=st.lists(labels(), min_size=1, max_size=8), dtype=st.sampled_from([object, "str"]))
+def test_csv_cells_never_run_and_never_forge_rows(tmp_path_factory, cells, dtype):
+    """Every text cell reads back as written or behind one apostrophe (never starting with a
+    formula character a spreadsheet runs), one row per row written."""
+    import csv
+
+    import pandas as pd
+
+    from workbook.atomic import write_csv
+
+    cells = [c.replace("\x00", "") for c in cells]
+    path = tmp_path_factory.mktemp("csv") / "t.csv"
+    write_csv(pd.DataFrame({"text": pd.Series(cells, dtype=dtype), "n": range(len(cells))}), path)
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    assert len(rows) == len(cells) + 1
+    for k, (written, (back, n)) in enumerate(zip(cells, rows[1:])):
+        assert back in (written, "'" + written) and n == str(k)
+        first = back.lstrip(" \t\r\n\u00a0\u3000")[:1]
+        assert back[:1] in ("'", "") or (
+            first not in set("=+-@\uff1d\uff0b\uff0d\uff20") and back[:1] not in set("\t\r\n")
+        ), repr(back)
+
+
+NAME_CHARS = st.sampled_from(
+    list("abcXYZ_019") + ["\t", "\n", "\r", "\x7f", "\x01", "\u200b", "\u03c6", " ", ".", "-"]
+)
+
+
+@_fuzz(FAST_EXAMPLES)
+@given(name=st.lists(NAME_CHARS, min_size=1, max_size=8).map("".join))
+def test_names_with_control_characters(fuzz_folder, name):
+    """A name with control characters, spaces or invisible characters in [inputs] or
+    [definitions] is refused with the engine's error, or is a valid name that computes."""
+    import json
+
+    key = json.dumps(name)  # a TOML basic string (DEL written as an escape)
+    key = key.replace("\x7f", "\\u007f")
+    for text in (
+        f'[inputs]\n{key} = "2 mm"\n[definitions]\nd = "1"\n',
+        f'[inputs]\nR = "2 mm"\n[definitions]\n{key} = "2*R"\n',
+    ):
+        path = fuzz_folder / "names.toml"
+        path.write_text(text, encoding="utf-8")
+        try:
+            sheet = Sheet(load_spec(path))
+            sheet.evaluate(name)
+        except WorkbookError:
+            continue
+        assert ex.is_identifier(name), repr(name)

@@ -1087,3 +1087,23 @@ def test_inputs_with_swollen_styles_or_shared_strings_are_refused_unparsed(tmp_p
     assert f"more than {MAX_SHARED_STRINGS:,} shared strings" in out.stderr
     # the workbook as written reads back
     assert cli(tmp_path, "run", "t.toml", "--inputs", str(base), "--out", "o.xlsx").returncode == 0
+
+
+@pytest.mark.parametrize(("n", "fits"), [(16_382, True), (16_383, False)])
+def test_a_row_vector_at_the_last_column_is_written_whole_or_refused(tmp_path, n, fits):
+    # a 1 x 20,001 result was cut at column XFD with exit 0
+    text = (
+        '[arguments]\nn = { unit = "" }\n[definitions]\n"wide(n)" = { program = """\n'
+        'for k in 1 .. n\n    w[k] := k\ntranspose(w)\n""" }\n'
+        f'x = "wide({n})"\n'
+    )
+    write(tmp_path / "w.toml", text)
+    out = cli(tmp_path, "run", "w.toml", "--out", "w.xlsx")
+    if not fits:
+        assert out.returncode == 2 and f"x is 1 x {n + 1:,}" in out.stderr, out.stderr
+        assert "refused rather than cut" in out.stderr and not (tmp_path / "w.xlsx").exists()
+        return
+    assert out.returncode == 0, out.stderr
+    ws = openpyxl.load_workbook(tmp_path / "w.xlsx", read_only=True)["Matrices"]
+    values = next(ws.iter_rows(min_row=2, max_row=2, values_only=True))
+    assert len(values) == 16_384 and values[1] == 0 and values[-1] == n  # B2 .. XFD2
