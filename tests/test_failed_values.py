@@ -171,3 +171,41 @@ columns = ["q"]
     code, _, err = _cli(tmp_path, "run", str(write_template(tmp_path, text)), "--out", "f.xlsx")
     assert code == 2 and "domain error" in err
     assert not (tmp_path / "f.xlsx").exists()
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculates_the_error_cells_as_written(tmp_path):
+    """LibreOffice's own evaluation of the written formulas gives the same error values in the
+    failed rows (#DIV/0! for 1/0; for sqrt(-1) an error value too) and the engine's numbers in
+    the others."""
+    from recalc import cell_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    text = """
+[inputs]
+b = "0"
+
+[arguments]
+x = { unit = "" }
+
+[definitions]
+"q(x)" = "1/(x - b)"
+"r(x)" = "sqrt(x)"
+
+[[tables]]
+name = "t"
+range = "x := -1, 0 .. 2"
+columns = ["q", "r"]
+"""
+    sheet = workbook.load(write_template(tmp_path, text))
+    written = sheet.write_xlsx(tmp_path / "t.xlsx")
+    ours = cell_values(written)
+    theirs = cell_values(recalculate(written, tmp_path / "lo"))
+    table = next(s for s, _ in ours if s not in ("Inputs", "Results", "Checks", "About"))
+    assert ours[(table, "B4")] == theirs[(table, "B4")] == "#DIV/0!"
+    # Excel's SQRT(-1) is #NUM! (what the engine caches); LibreOffice's is its Err:502,
+    # saved as #VALUE!: an error value either way, never a number
+    assert ours[(table, "C3")] == "#NUM!" and theirs[(table, "C3")] in ("#NUM!", "#VALUE!")
+    for cell in ("B3", "B5", "B6", "C4", "C5", "C6"):
+        assert theirs[(table, cell)] == pytest.approx(ours[(table, cell)], rel=1e-12)
