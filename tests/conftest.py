@@ -49,6 +49,18 @@ columns = { y = "mm" }
 )
 
 
+@pytest.fixture
+def sheet_from(tmp_path):
+    """``sheet_from(text)``: a Sheet from template text (workbook.loads); files the text
+    names ([data] CSV) are read from the test's tmp_path."""
+    import workbook
+
+    def load(text: str, name: str = "sheet", parts=None):
+        return workbook.loads(text, name=name, folder=tmp_path, parts=parts)
+
+    return load
+
+
 def write_template(tmp_path: Path, text: str, name: str = "t.toml") -> Path:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")

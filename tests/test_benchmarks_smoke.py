@@ -23,6 +23,7 @@ sys.path.insert(0, str(BENCH))
 import bench_builtins  # noqa: E402
 import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
+import bench_livecheck  # noqa: E402
 import bench_load  # noqa: E402
 import bench_write  # noqa: E402
 
@@ -32,6 +33,11 @@ def _check(results, n):
     for r in results:
         assert r.value > 0 and r.target > 0
         assert f"target <= {r.target:g}" in r.line()
+
+
+@pytest.mark.slow
+def test_livecheck_bench_tiny():
+    _check(bench_livecheck.run(n=20, reps=1), 3)
 
 
 @pytest.mark.slow

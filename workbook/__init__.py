@@ -13,7 +13,15 @@ from .data import list_templates
 from .errors import WorkbookError
 from .version import __version__
 
-__all__ = ["load", "list_templates", "template_path", "Sheet", "WorkbookError", "__version__"]
+__all__ = [
+    "load",
+    "loads",
+    "list_templates",
+    "template_path",
+    "Sheet",
+    "WorkbookError",
+    "__version__",
+]
 
 
 def template_path(name_or_path: str | Path) -> Path:
@@ -47,6 +55,19 @@ def load(name_or_path: str | Path, parts=None):
 
     path = template_path(name_or_path)
     return Sheet(load_spec(path), parts=parts)
+
+
+def loads(text: str, name: str = "sheet", folder: str | Path = ".", parts=None):
+    """A :class:`Sheet` from template text (TOML), its units checked, as :func:`load` gives
+    from a file. Messages name ``FOLDER/NAME.toml`` (no file is read or written), and files
+    the text names ([data] CSV) are read from ``folder``."""
+    from .errors import LimitError
+    from .sheet import Sheet
+    from .template import MAX_TEMPLATE_BYTES, parse_spec
+
+    if len(text.encode("utf-8")) > MAX_TEMPLATE_BYTES:
+        raise LimitError(f"template text is larger than {MAX_TEMPLATE_BYTES:,} bytes")
+    return Sheet(parse_spec(text, Path(folder) / f"{name}.toml", name), parts=parts)
 
 
 def __getattr__(name):

@@ -235,7 +235,10 @@ def cmd_run(args) -> int:
             write_csv(frame, csv_tmps[table])
         if exporter is not None:
             exporter(sheet, export_tmp)
-        sheet.write_xlsx(xlsx_tmp, force=True, command=_command_line(args), report=report)
+        refusals: list = []
+        sheet.write_xlsx(
+            xlsx_tmp, force=True, command=_command_line(args), report=report, refusals=refusals
+        )
     for path in csv_paths.values():
         print(f"wrote {path}")
     if exporter is not None:
@@ -248,6 +251,8 @@ def cmd_run(args) -> int:
     if n_checked:
         summary += f", {n_ok} of {n_checked} printed values reproduced"
     print(f"wrote {out}: {summary}")
+    for r in refusals:  # a live formula that an independent evaluation does not confirm
+        print(f"written as a value: {r.where}: {r.disagreement}")
     _print_scalars(sheet)
     for name in sheet.left_out:
         part = sheet.full_spec.parts[name]

@@ -7,12 +7,20 @@ definitions are referred to by defined names.
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
 from . import excel_names
-from . import typecheck as tc
+from . import typed as tc
 from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
 from .expr import PREC
 from .registry import CONSTANTS, REGISTRY
 from .visitor import Visitor
+
+if TYPE_CHECKING:
+    from .typecheck import Typer
 
 MAX_FORMULA = 8192  # Excel's limit on formula length
 
@@ -36,37 +44,71 @@ _CMP = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "=", "!=": "<>"}
 ATOM, POW, MUL, ADD, CMP = PREC["atom"], PREC["^"], PREC["*"], PREC["+"], PREC["cmp"]
 
 
+@dataclasses.dataclass(frozen=True)
+class PrintContext:
+    """What the printer prints in, set for a block of formulas by :meth:`ExcelPrinter.context`
+    (as SymPy's ``printer_context``) rather than attributes set and reset by the caller."""
+
+    #: the writer's allocator of helper cells (a root's bisection steps) where the formula
+    #: goes; a binding hook finds it as ``body.helpers``
+    helpers: object = None
+
+
+class Formula(str):
+    """A printed formula (``=...``); ``array`` is true when it computes with vectors or
+    matrices (the writer writes it as an array formula)."""
+
+    array: bool = False
+
+
 class ExcelPrinter(Visitor):
     """Prints typed trees of one sheet; ``subst`` maps parameters to cell references.
 
     ``visit(t, subst)`` returns (text, precedence level); one ``visit_<Node>`` per node kind.
     """
 
-    def __init__(self, typer: tc.Typer, names: dict[str, str] | None = None):
+    def __init__(self, typer: Typer, names: dict[str, str] | None = None):
         self.typer = typer
         self.names = names or {}
         # (table, column) -> absolute cell range, filled by the writer for max_over()/min_over()
         self.ranges: dict[tuple[str, str], str] = {}
-        # the writer's allocator of helper cells (a root's bisection steps), set while it
-        # writes scalar definitions; a binding hook finds it as ``body.helpers`` (and EXPR's
-        # typed tree, the variable and the other arguments as body.typed, .var, .rest;
-        # ``body.tree(t)`` prints another typed tree in the call's scope)
-        self.helpers = None
+        self._context = PrintContext()
+        self._array = False  # set while one formula is printed when it computes with arrays
         self._calls: dict[tuple, tuple[str, int]] = {}  # (function, argument texts) -> printed
+
+    @contextlib.contextmanager
+    def context(self, **changes) -> Iterator[ExcelPrinter]:
+        """Print the formulas of the ``with`` block in a context with ``changes``
+        (``helpers=...``); the previous context is back after it."""
+        saved = self._context
+        self._context = dataclasses.replace(saved, **changes)
+        try:
+            yield self
+        finally:
+            self._context = saved
+
+    @property
+    def helpers(self):
+        """The helper-cell allocator of the current context (None outside one)."""
+        return self._context.helpers
 
     def visit(self, t, *args):
         if tc.is_runtime(getattr(t, "shape", None)):
             raise NotLive("an array whose size is known only when its program runs")
         return super().visit(t, *args)
 
-    def formula(self, t: tc.T, subst: dict[str, str]) -> str:
-        self.array = False  # set when the formula computes with arrays (an array formula)
+    def formula(self, t: tc.T, subst: dict[str, str]) -> Formula:
+        """The live formula of ``t`` (NotLive when it has none); ``.array`` says whether it
+        computes with arrays."""
+        self._array = False
         text = "=" + self.print(t, subst)
         if text.endswith("}"):  # xlsxwriter drops a last "}" (it reads {=...} array braces)
             text = f"=({text[1:]})"
         if len(text) > MAX_FORMULA:
             raise NotLive(f"formula is {len(text)} characters long (Excel's limit {MAX_FORMULA})")
-        return text
+        out = Formula(text)
+        out.array = self._array
+        return out
 
     def print(self, t: tc.T, subst: dict[str, str]) -> str:
         return self.visit(t, subst)[0]
@@ -87,7 +129,7 @@ class ExcelPrinter(Visitor):
 
     def visit_TRef(self, t, s):
         if t.shape is not None:
-            self.array = True
+            self._array = True
         if t.kind == "builtin":  # a constant: pi, e, g
             return CONSTANTS[t.name].excel, ATOM
         if t.kind in ("solve", "data"):
@@ -111,7 +153,7 @@ class ExcelPrinter(Visitor):
 
     def visit_TBinary(self, t, s):
         if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
-            self.array = True
+            self._array = True
             if t.op == "@":
                 return f"MMULT({self.print(t.left, s)}, {self.print(t.right, s)})", ATOM
             if t.op == "@^":
@@ -136,7 +178,7 @@ class ExcelPrinter(Visitor):
     def visit_TFunc(self, t, s):
         entry = REGISTRY[t.func]
         if entry.arrays and any(a.shape is not None for a in t.args):
-            self.array = True
+            self._array = True
             shapes = tuple(a.shape for a in t.args)
             return entry.excel([self.print(a, s) for a in t.args], shapes=shapes)
         if not entry.binds or len(t.args) <= max(entry.binds):
@@ -149,7 +191,10 @@ class ExcelPrinter(Visitor):
         def printed(value: str) -> str:
             return self.print(body, {**s, var: value})
 
+        # EXPR's typed tree, the variable and the other arguments as printed.typed, .var, .rest;
+        # printed.tree(t) prints another typed tree in the call's scope
         printed.helpers = self.helpers
+        printed.scope = tuple(s.values())  # the printed values of the variables around it
         printed.typed, printed.var, printed.rest = body, var, rest
         # another tree printed in the call's scope (diff's derivative) and the sheet's typer
         printed.var_param, printed.typer = t.args[var_at], self.typer
@@ -200,7 +245,7 @@ class ExcelPrinter(Visitor):
         return tail, ATOM
 
     def visit_TMatrix(self, t, s):
-        self.array = True
+        self._array = True
         if not all(isinstance(e, tc.TConst) for row in t.rows for e in row):
             raise NotLive("a matrix written with formulas inside an expression (name it)")
         rows = (",".join(number(e.value) for e in row) for row in t.rows)

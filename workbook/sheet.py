@@ -583,11 +583,12 @@ class Sheet:
             f"{', '.join(names) or 'none'})"
         )
 
-    def table_data(self, name: str) -> TableData:
-        """Evaluate one template table (only what it needs), once per Sheet. A row whose value
-        fails is NaN in its column, the cause in ``Column.failed``."""
-        spec = self.table_spec(name)
-        key = ("table", name, id(spec))
+    def table_data(self, table) -> TableData:
+        """Evaluate one template table (only what it needs), once per Sheet: its name, or a
+        table spec that is not in the template (a chart's data, which the writer writes as a
+        table). A row whose value fails is NaN in its column, the cause in ``Column.failed``."""
+        spec = self.table_spec(table) if isinstance(table, str) else table
+        key = ("table", spec.name, id(spec))
         if key not in self._memo:  # the spec is kept with the data, so no id is reused
             self._memo[key] = (self._table_data(spec), spec)
         return self._memo[key][0]

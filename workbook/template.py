@@ -425,6 +425,13 @@ def load_spec(path: Path, name: str | None = None) -> SheetSpec:
         raise TemplateError(err.message, file=file, line=err.line) from None
     except WorkbookError as err:
         raise err.located(file=file) from None
+    return parse_spec(text, path, name)
+
+
+def parse_spec(text: str, path: Path, name: str | None = None) -> SheetSpec:
+    """Read and validate a template's text; ``path`` names it in messages and is where
+    files it names ([data] CSV) are found."""
+    file = str(path)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

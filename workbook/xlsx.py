@@ -18,7 +18,7 @@ from xlsxwriter.utility import xl_rowcol_to_cell
 from . import expr as ex
 from . import runtime as rt
 from . import style
-from . import typecheck as tc
+from . import typed as tc
 from . import units as un
 from . import verdicts as V
 from .atomic import check_target, replacing
@@ -28,6 +28,7 @@ from .errors import InputError, LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
 from .excel_functions import CLASSIC
 from .excel_names import ExcelNames
+from .livecheck import RELATIVE, ROWS_CHECKED, CellLog, RecordingSheet
 from .uses import names_used
 from .version import __version__
 
@@ -134,7 +135,7 @@ def _cells_text(c: ColumnCells) -> str:
 
 
 class WorkbookWriter:
-    def __init__(self, sheet, path: Path, command: str | None = None):
+    def __init__(self, sheet, path: Path, command: str | None = None, refused: dict | None = None):
         import xlsxwriter
 
         self.sheet = sheet
@@ -169,11 +170,17 @@ class WorkbookWriter:
         self.planned: dict[tuple[str, str], ColumnCells] = {}
         # the next free column and the cells used of the row-wise blocks of 'Solver rows'
         self.step_col, self.step_cells = RowSteps.FIRST_COL, 0
+        # every cell written, for the independent check of the live formulas (livecheck.py),
+        # and the formulas it refused: (Excel sheet, row, col) -> comment
+        self.log = CellLog()
+        self.refused = refused or {}
+        self.verified = None  # the check's outcome (livecheck.Outcome), once made
 
     def ws(self, name: str):
         if name not in self.sheets:
-            self.sheets[name] = self.wb.add_worksheet(name[:31])
-            _classic_formulas_as_they_are(self.sheets[name])
+            ws = self.wb.add_worksheet(name[:31])
+            _classic_formulas_as_they_are(ws)
+            self.sheets[name] = RecordingSheet(ws, self.log, self.refused)
             self.rows[name] = 0
         return self.sheets[name]
 
@@ -235,11 +242,8 @@ class WorkbookWriter:
             q = self.sheet.scalar_quantity(d.name)
             ws.write_string(row, 0, d.name)
             value = q if t.text else float(q.magnitude)
-            self.printer.helpers = HelperCells(self, d.name, t)
-            try:
+            with self.printer.context(helpers=HelperCells(self, d.name, t)):
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
-            finally:
-                self.printer.helpers = None
             ws.write_string(row, 2, un.pretty(t.unit))
             ws.write_string(row, 3, d.text)
             ws.write_string(row, 4, d.note)
@@ -249,6 +253,7 @@ class WorkbookWriter:
     def _define(self, ws, row: int, name: str, ref: str) -> None:
         """Give the cell of ``name`` its defined name; a renamed one gets a comment saying why."""
         self.wb.define_name(self.names[name], ref)
+        self.log.names[self.names[name].upper()] = ref
         if self.names[name] != name:
             ws.write_comment(row, 0, self.names.why(name))
 
@@ -300,11 +305,8 @@ class WorkbookWriter:
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
                 self.formula_cells += 1
                 continue
-            self.printer.helpers = HelperCells(self, d.name, t)
-            try:
+            with self.printer.context(helpers=HelperCells(self, d.name, t)):
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
-            finally:
-                self.printer.helpers = None
             self._define(ws, row, d.name, f"='{name}'!$B${row + 1}")
         for row, (unknown, block) in enumerate(unknowns, start=start + 1 + len(defs)):
             self._write_unknown(ws, row, unknown, block)
@@ -469,6 +471,9 @@ class WorkbookWriter:
 
     def _write_cell(self, ws, row, col, t: tc.T, subst, value: float, fmt, what: str) -> bool:
         try:
+            refused = self.refused.get((ws.name, row, col))
+            if refused is not None:
+                raise NotLive(refused.removeprefix("A value, not a formula: "))
             formula = self.printer.formula(t, subst)
         except NotLive as why:
             if isinstance(value, str):
@@ -478,7 +483,7 @@ class WorkbookWriter:
             ws.write_comment(row, col, f"A value, not a formula: {why}")
             self.not_live.append(what)
             return False
-        if self.printer.array:  # computes with vectors or matrices: an array formula
+        if formula.array:  # computes with vectors or matrices: an array formula
             ws.write_array_formula(row, col, row, col, formula, fmt, value)
         else:
             ws.write_formula(row, col, formula, fmt, value)
@@ -496,6 +501,7 @@ class WorkbookWriter:
         if diff is None:
             return
         ws.write_comment(row, col, diff.note)
+        self.log.state(ws.name, row, col, rows, diff.largest)
         cells = xl_rowcol_to_cell(row, col, row_abs=True, col_abs=True)
         if rows:  # a table column: its cells below the header
             first = xl_rowcol_to_cell(row + 1, col, row_abs=True, col_abs=True)
@@ -530,7 +536,7 @@ class WorkbookWriter:
             rows[t.sheet] = first + n + 2
 
     def write_range_table(self, spec) -> None:
-        data = self.sheet.table_data(spec.name)
+        data = self.sheet.table_data(spec)
         n = len(data.columns[0].values)
         ws = self.ws(spec.sheet)
         start = self.rows[spec.sheet]
@@ -600,7 +606,8 @@ class WorkbookWriter:
         if rng.points is not None:  # log-spaced: its values are numbers, not FIRST+i*STEP
             return None
         nodes = (rng.first, rng.second, rng.last)
-        names = set().union(*(tc.dependencies(self.sheet.spec, x) for x in nodes if x))
+        # a bound that names no input or definition names none through them either
+        names = set().union(*(ex.names(x) for x in nodes if x))
         if not names & (set(self.sheet.spec.inputs) | set(self.sheet.spec.definitions)):
             return None
         try:
@@ -618,9 +625,12 @@ class WorkbookWriter:
         """Write one column, live formulas if it can be; True if it is live."""
         fmt = self.fmt["value"]
         steps = RowSteps(self, ws.name, first, n, var_ref, col.typed, {var: var_values})
-        self.printer.helpers = steps  # a root's bisection steps, one chain a row
         try:
-            template = self.printer.formula(col.typed, {var: var_ref})
+            refused = self.refused.get((ws.name, first, j))
+            if refused is not None:
+                raise NotLive(refused.removeprefix("A value, not a formula: "))
+            with self.printer.context(helpers=steps):  # a root's steps, one chain a row
+                template = self.printer.formula(col.typed, {var: var_ref})
         except NotLive as why:
             for i in range(n):
                 v = col.values[i]
@@ -635,17 +645,16 @@ class WorkbookWriter:
             self.not_live.append(f"{table}.{col.text}")
             _failed_comments(ws, first, j, col)
             return False
-        finally:
-            self.printer.helpers = None
         steps.write()
         pieces = template.split(ROW_TOKEN)
         write = ws.write_formula
-        if self.printer.array:  # computes with vectors or matrices: one-cell array formulas
+        if template.array:  # computes with vectors or matrices: one-cell array formulas
             write = lambda r, c, f, fm, v: ws.write_array_formula(r, c, r, c, f, fm, v)  # noqa: E731
         values = col.values.tolist()
         for i in col.failed:  # the cached value of a failed row is Excel's error value
             values[i] = col.excel_error(i)
         _failed_comments(ws, first, j, col)
+        self.log.column(ws.name, j, first, n, pieces)
         for lo in range(0, n, PROGRESS_CELLS):
             if lo:  # a long column says how far it is
                 _progress(f"table {table}: {col.title}, row {lo:,} of {n:,}")
@@ -737,11 +746,7 @@ class WorkbookWriter:
         target = "Chart data"
         name = f"{chart.name}_{len(self.columns)}"
         spec = TableSpec(name, f"Data of {chart.title}: {s.name}", rng, wanted, target)
-        self.sheet.spec.tables.append(spec)
-        try:
-            self.write_range_table(spec)
-        finally:
-            self.sheet.spec.tables.remove(spec)
+        self.write_range_table(spec)  # a table of the workbook, not of the Sheet
         found = [self.columns[(k[0], target, k[1], k[2])] for k in keys]
         xcells = found[0] if x is not None else self.columns[(rng.text, target, rng.var, "var")]
         return xcells, found[-1]
@@ -992,6 +997,26 @@ class WorkbookWriter:
         ws.write_formula(row, col, formula, self.fmt["number"], value)
         self.formula_cells += 1
 
+    def _checked_text(self) -> str:
+        """What the independent check of the live formulas did (livecheck.py)."""
+        v = self.verified
+        if v is None:
+            return "not checked"
+        text = (
+            f"{v.checked} formula cells with arrays, numerical built-ins or helper cells, "
+            "computed by an evaluator independent of the engine (the formulas package; "
+            f"{ROWS_CHECKED} rows of each table column), agree with the engine to {RELATIVE:g} "
+            f"relative (or the difference a live form states); {v.plain} of scalar "
+            "arithmetic only, or helper cells, are not computed"
+        )
+        if v.refusals:
+            text += f"; {len(v.refusals)} that did not are values, with a comment"
+        if v.unchecked:
+            text += "; not computed by it: " + "; ".join(
+                f"{n} cells ({why})" for why, n in sorted(v.unchecked.items())
+            )
+        return text
+
     def write_about(self) -> None:
         ws = self.ws("About")
         spec = self.sheet.spec
@@ -1006,6 +1031,7 @@ class WorkbookWriter:
             ("Regenerate with", self.command),
             ("Live formulas", f"{self.formula_cells} cells recalculate when an input changes"),
             ("Values, not formulas", ", ".join(sorted(set(self.not_live))) or "none"),
+            ("Formulas checked", self._checked_text()),
             (
                 "Units",
                 "Every column header names its unit; input cells are in the unit beside them.",
@@ -1081,27 +1107,37 @@ def needed_names(sheet) -> set[str]:
 
 
 def write_workbook(
-    sheet, path: Path, *, force: bool = False, command: str | None = None, report=None
+    sheet,
+    path: Path,
+    *,
+    force: bool = False,
+    command: str | None = None,
+    report=None,
+    verify: bool = True,
+    refusals: list | None = None,
 ) -> Path:
-    """Write ``sheet`` to ``path`` atomically (the old file survives any failure)."""
+    """Write ``sheet`` to ``path`` atomically (the old file survives any failure).
+
+    With ``verify`` every live formula is first computed by an independent evaluator
+    (:mod:`workbook.livecheck`); one that disagrees with the engine is written as the
+    engine's value with a comment, and appended to ``refusals`` (a list) when given."""
     path = Path(path)
     check_target(path, force=force)
     if report is None:
         report = sheet.check()
     with replacing(path) as tmp:
-        w = WorkbookWriter(sheet, tmp, command)
-        needed = needed_names(sheet)
-        w.plan_range_tables()
-        w.write_inputs(needed)
-        w.write_definitions(needed)
-        for t in sheet.spec.tables:
-            if t.computed:
-                w.write_computed_table(t)
-            else:
-                w.write_range_table(t)
-        w.write_charts()
-        w.write_results()
-        w.write_checks(report)
+        w = _write(sheet, tmp, command, report, {})
+        if verify:
+            from .livecheck import check
+
+            outcome = check(w.log)
+            if outcome.refusals:
+                w.wb.close()  # discarded: written again with the refused cells as values
+                w = _write(sheet, tmp, command, report, outcome.refused())
+                w.not_live.extend(_refused_what(outcome.refusals))
+            if refusals is not None:
+                refusals.extend(outcome.refusals)
+            w.verified = outcome
         w.write_about()
         if w.formula_cells > PROGRESS_CELLS:
             _progress(f"{path.name}: saving {w.formula_cells:,} formula cells")
@@ -1115,6 +1151,28 @@ def write_workbook(
                 ) from None
             raise
     return path
+
+
+def _refused_what(refusals) -> list[str]:
+    return [f"'{r.sheet}'!{xl_rowcol_to_cell(r.row, r.col)}" for r in refusals]
+
+
+def _write(sheet, tmp: Path, command: str | None, report, refused: dict) -> WorkbookWriter:
+    """Every Excel sheet but About, written (not yet saved)."""
+    w = WorkbookWriter(sheet, tmp, command, refused)
+    needed = needed_names(sheet)
+    w.plan_range_tables()
+    w.write_inputs(needed)
+    w.write_definitions(needed)
+    for t in sheet.spec.tables:
+        if t.computed:
+            w.write_computed_table(t)
+        else:
+            w.write_range_table(t)
+    w.write_charts()
+    w.write_results()
+    w.write_checks(report)
+    return w
 
 
 class HelperCells:
@@ -1211,6 +1269,7 @@ class RowSteps:
             for j, (formula, values) in enumerate(b.cells):
                 pieces = formula.replace(self.var_ref, self.table_ref).split(ROW_TOKEN)
                 values = np.broadcast_to(np.asarray(values, dtype=float), (self.n,)).tolist()
+                w.log.column(ws.name, b.col + j, self.first, self.n, pieces)
                 for i in range(self.n):
                     row = self.first + i
                     ws.write_formula(row, b.col + j, str(row + 1).join(pieces), None, values[i])

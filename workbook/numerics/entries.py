@@ -436,6 +436,9 @@ def _root_excel(body, args, consts) -> tuple[str, int]:
     """A live root of a scalar definition: BISECTION_STEPS bisection steps in helper cells
     (lo, hi, mid, f(lo), f(mid) a row, each with its cached value); #N/A when f(A) and f(B)
     have the same sign. In a table column: one chain a table row (:func:`_root_rows`)."""
+    from . import gauss
+
+    gauss.refuse_in_integral("root", (*body.scope, *args), EXCEL_NODES)
     helpers = getattr(body, "helpers", None)
     if getattr(helpers, "per_row", False):
         return _root_rows(body, args, helpers)
@@ -576,6 +579,9 @@ def _extremum_excel(name: str):
         """A live extremum: EXPR at 4 x samples + 1 points of [A, B], the first best one
         (MATCH), then GOLDEN_STEPS golden-section steps around it, in helper cells (a row of
         the sheet 'Solver steps'; in a table, one row per table row on 'Solver rows')."""
+        from . import gauss
+
+        gauss.refuse_in_integral(name, (*body.scope, *args), EXCEL_NODES)
         helpers = getattr(body, "helpers", None)
         if helpers is None or not hasattr(helpers, "chain"):
             raise NotLive(
@@ -631,17 +637,12 @@ def _extremum_excel(name: str):
 
 
 def _integral_excel(body, args, consts) -> tuple[str, int]:
-    """A live integral: the EXCEL_NODES-point Gauss-Legendre rule on [A, B] as SUMPRODUCT
-    over constant arrays of nodes and weights (EXPR printed once, over the node array)."""
-    a, b = args
+    """A live integral: the EXCEL_NODES-point Gauss-Legendre rule on [A, B] over constant
+    arrays of nodes and weights (EXPR printed once, over the node array; see gauss.py)."""
     from . import gauss
 
-    t, w = gauss.rule(EXCEL_NODES)
-    nodes = "{" + ",".join(repr(float(x)).upper() for x in t) + "}"
-    weights = "{" + ",".join(repr(float(x)).upper() for x in w) + "}"
-    width = f"(({b})-({a}))"
-    x = f"(({a})+{width}*{nodes})"
-    return f"{width}*SUMPRODUCT({weights}*({body(x)}))", PREC["*"]
+    a, b = args
+    return gauss.excel_form(body, a, b, EXCEL_NODES, body.scope), PREC["*"]
 
 
 def _product_excel(body, args, consts) -> tuple[str, int]:
