@@ -50,8 +50,11 @@ def differences(original: Path, recalculated: Path) -> list:
             if isinstance(value, float) and not math.isfinite(value):
                 continue  # an error cell in the engine too (#NUM!)
             read = [
-                number(written.get((key[0], f"{c}{r}")))
-                for c, r in re.findall(r"(?<![\w$'!])\$?([A-Z]{1,3})\$?(\d+)(?![\w(])", formula)
+                number(written.get((quoted or bare or key[0], f"{c}{r}")))
+                for quoted, bare, c, r in re.findall(
+                    r"(?:'([^']+)'!|(?<![\w$'])([A-Za-z_]\w*)!)?(?<![\w$])\$?([A-Z]{1,3})\$?(\d+)(?![\w(])",
+                    formula,
+                )
             ]
             scale = max(
                 [abs(value), number(got), column[(key[0], key[1].rstrip("0123456789"))]] + read

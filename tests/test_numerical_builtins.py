@@ -806,7 +806,7 @@ r = { unit = "mm" }
 Re = { unit = "" }
 f = { unit = "" }
 [definitions]
-"u(r)" = { expr = "u_max*(1 - r/R)^(1/7)", unit = "m/s" }
+"u(r)" = { expr = "u_max*(1 - (r/R)^2)", unit = "m/s" }
 Q = { expr = "integral(2*pi*r*u(r), r, 0, R)", unit = "L/s" }
 "colebrook(f, Re)" = "1/sqrt(f) + 2*log10(eps/(3.7*D) + 2.51/(Re*sqrt(f)))"
 "friction(Re)" = "root(colebrook(f, Re), f, 0.005, 0.1)"

@@ -2,13 +2,13 @@
 
 The writer records each cell it writes (:class:`CellLog`, through :class:`RecordingSheet`):
 formulas with their cached values (the engine's), numbers, texts and defined names. Each
-formula is then computed by an evaluator independent of the engine, the ``formulas`` package
-(its own parser and its own implementation of Excel's functions and array rules), from the
-cached values of the cells and names it reads; a formula whose value differs from its cached
-value beyond :data:`RELATIVE` (plus the difference a live approximate form states, an
-integral's Gauss-Legendre sum) is refused, and the writer writes that cell as a number with a
-comment saying why. Checked cell by cell from cached inputs, a chain of formulas agrees with
-the engine wherever each link does.
+formula that is not :func:`plain` is then computed by an evaluator independent of the engine,
+the ``formulas`` package (its own parser and its own implementation of Excel's functions and
+array rules), from the cached values of the cells and names it reads; a formula whose value
+differs from its cached value beyond :data:`RELATIVE` is refused (a live approximate form too:
+an integral's 20-point Gauss-Legendre sum of an integrand with an end-point singularity), and
+the writer writes that cell as a number with a comment saying why. Checked cell by cell from
+cached inputs, a chain of formulas agrees with the engine wherever each link does.
 
 A table column (or a column of helper cells) is one formula with the row number filled in: it
 is compiled once and computed at :data:`ROWS_CHECKED` rows spread over the column, first and
@@ -66,7 +66,6 @@ class Column:
     first: int
     n: int
     pieces: list[str]
-    stated: float = 0.0  # the difference its live approximate form states (a comment)
 
 
 @dataclass
@@ -129,7 +128,6 @@ class CellLog:
     formulas: dict[tuple[str, int, int], Formula] = field(default_factory=dict)
     columns: list[Column] = field(default_factory=list)
     names: dict[str, str] = field(default_factory=dict)  # NAME (upper) -> "=Sheet!$B$3"
-    stated: dict[tuple[str, int, int], float] = field(default_factory=dict)
     in_columns: set[tuple[str, int, int]] = field(default_factory=set)
 
     def column(self, sheet: str, col: int, first: int, n: int, pieces: list[str]) -> Column:
@@ -138,15 +136,6 @@ class CellLog:
         self.columns.append(c)
         self.in_columns.update((sheet, first + i, col) for i in range(n))
         return c
-
-    def state(self, sheet: str, row: int, col: int, rows: int, largest: float) -> None:
-        """The difference a live approximate form states for a cell or the column below it."""
-        if rows:
-            for c in self.columns:
-                if c.sheet == sheet and c.col == col and c.first == row + 1:
-                    c.stated = max(c.stated, largest)
-            return
-        self.stated[(sheet, row, col)] = largest
 
 
 class RecordingSheet:
@@ -306,28 +295,33 @@ def _compile(text: str):
     return formulas.Parser().ast(text)[1].compile()
 
 
-def plain(text: str, sheet: str) -> bool:
+def plain(text: str, sheet: str, arrays: frozenset[str] = frozenset()) -> bool:
     """A formula the default check leaves out: scalar arithmetic only (no array constant, no
-    range, no function but the scalar ones), which the engine and the printer compute by the
-    same operations in the same order (tests/test_excel_golden.py checks the printer's scalar
-    forms against the same evaluator); and a helper cell of a root's bisection or an
-    extremum's golden-section steps, whose cached value is the engine's own step of the same
-    form (the cell that reads the last step is checked)."""
-    from .registry import REGISTRY
-
+    range, no defined name of a vector or matrix (``arrays``, upper case), no function but
+    :data:`SCALAR`), which the engine and the printer compute by the same operations in the
+    same order (tests/test_excel_golden.py checks the printer's scalar forms against the same
+    evaluator); and a helper cell of a root's bisection or an extremum's golden-section
+    steps, whose cached value is the engine's own step of the same form (the cell that reads
+    the last step is checked)."""
     if sheet in HELPER_SHEETS:
         return True
     if "{" in text or ":" in text:
         return False
-    scalar = _SCALAR | {
-        f for e in REGISTRY.values() if not e.binds and not e.arrays for f in e.excel_functions
-    }
-    return all(f.upper() in scalar for f in re.findall(r"([A-Za-z_][\w.]*)\(", text))
+    for name, call in re.findall(r"([A-Za-z_][\w.]*)\s*(\(?)", _CONSTANTS.sub("", text)):
+        if call and name.upper() not in SCALAR:
+            return False
+        if not call and name.upper() in arrays:
+            return False
+    return True
 
 
+#: Excel functions of numbers that return a number (any other function is checked)
+SCALAR = frozenset(
+    "ABS ACOS AND ASIN ATAN ATAN2 COS COSH EXP IF INT LN LOG10 MAX MIN MOD NA NOT OR PI "
+    "POWER ROUND SIGN SIN SINH SQRT TAN TANH TRUNC".split()
+)
 #: Excel sheets of helper cells (a root's bisection, an extremum's samples)
 HELPER_SHEETS = ("Solver steps", "Solver rows")
-_SCALAR = frozenset("IF AND OR NOT PI NA POWER INT ABS MAX MIN".split())
 
 
 def _first(result):
@@ -335,7 +329,7 @@ def _first(result):
     return a.ravel()[0] if a.size else None
 
 
-def _agrees(got, cached, scale: float, stated: float) -> bool:
+def _agrees(got, cached, scale: float) -> bool:
     if isinstance(cached, (str, bool, np.bool_)):
         return not isinstance(got, (float, int)) and str(got) == str(cached) or got == cached
     cached = float(cached)
@@ -344,7 +338,7 @@ def _agrees(got, cached, scale: float, stated: float) -> bool:
     got = float(got)
     if not math.isfinite(cached) or not math.isfinite(got):
         return False
-    return abs(got - cached) <= RELATIVE * max(abs(cached), abs(got), scale) + stated * 1.01
+    return abs(got - cached) <= RELATIVE * max(abs(cached), abs(got), scale)
 
 
 def check(log: CellLog, everything: bool = False) -> Outcome:
@@ -379,10 +373,11 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
         unchecked[why] = unchecked.get(why, 0) + cells
 
     plain_cells = 0
+    arrays = frozenset(name for name, ref in log.names.items() if ":" in ref)
     for key, f in log.formulas.items():
         if key in log.in_columns:
             continue
-        if not everything and plain(f.text, f.sheet):
+        if not everything and plain(f.text, f.sheet, arrays):
             plain_cells += 1
             continue
         try:
@@ -401,8 +396,7 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
                     value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
                 except IndexError:
                     value = None
-                stated = log.stated.get((f.sheet, f.row, f.col), 0.0)
-                if cached is not None and not _agrees(value, cached, 0.0, stated):
+                if cached is not None and not _agrees(value, cached, 0.0):
                     refusals.append(Refusal(f.sheet, f.row, f.col, f.text, value, cached))
                     break
             else:
@@ -411,7 +405,7 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
 
     for c in log.columns:
         template = str(SENTINEL).join(c.pieces)
-        if not everything and plain(template, c.sheet):
+        if not everything and plain(template, c.sheet, arrays):
             plain_cells += c.n
             continue
         cached_all = [log.values.get((c.sheet, c.first + i, c.col)) for i in range(c.n)]
@@ -428,7 +422,7 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
                 skipped(err, c.n)
                 break
             checked += 1
-            if not _agrees(got, cached_all[i], scale, c.stated):
+            if not _agrees(got, cached_all[i], scale):
                 text = str(row + 1).join(c.pieces)
                 refusals.append(Refusal(c.sheet, c.first, c.col, text, got, cached_all[i], c.n))
                 break

@@ -501,7 +501,6 @@ class WorkbookWriter:
         if diff is None:
             return
         ws.write_comment(row, col, diff.note)
-        self.log.state(ws.name, row, col, rows, diff.largest)
         cells = xl_rowcol_to_cell(row, col, row_abs=True, col_abs=True)
         if rows:  # a table column: its cells below the header
             first = xl_rowcol_to_cell(row + 1, col, row_abs=True, col_abs=True)
@@ -1006,7 +1005,7 @@ class WorkbookWriter:
             f"{v.checked} formula cells with arrays, numerical built-ins or helper cells, "
             "computed by an evaluator independent of the engine (the formulas package; "
             f"{ROWS_CHECKED} rows of each table column), agree with the engine to {RELATIVE:g} "
-            f"relative (or the difference a live form states); {v.plain} of scalar "
+            f"relative; {v.plain} of scalar "
             "arithmetic only, or helper cells, are not computed"
         )
         if v.refusals:
