@@ -261,3 +261,28 @@ def test_bench_verdicts_agree_with_mpmath(tmp_path):
             assert true > line.tolerance, (name, line.verdict, true)
     assert lines["triple"].verdict == "beyond tolerance (estimated)"
     assert lines["peak"].verdict == "ok" and lines["narrow"].verdict == "ok"
+
+
+@pytest.mark.parametrize(
+    "expr, exact",
+    [
+        (
+            "integral(abs(sin(x)), x, 0, 10)",
+            7 + mpmath.cos(10),  # three humps of 2, then cos(10) - cos(3 pi)
+        ),
+        ("integral(max(sin(x), 0), x, 0, 10)", mpmath.mpf(4)),
+        (
+            "integral(abs(x^2 - 0.5), x, 0, 1)",
+            mpmath.quad(lambda x: abs(x**2 - _MP("0.5")), [0, mpmath.sqrt(_MP("0.5")), 1]),
+        ),
+        (
+            "integral(min(x^2, 1 - x), x, 0, 1)",
+            mpmath.quad(lambda x: min(x**2, 1 - x), [0, (mpmath.sqrt(5) - 1) / 2, 1]),
+        ),
+    ],
+)
+def test_kinks_where_a_curve_crosses_zero_are_break_points(tmp_path, expr, exact):
+    """abs, min and max of curves (not only of x - c) kink where the curve crosses 0; the
+    crossings are found by interval arithmetic and the integral split there (abs(sin(x)) on
+    [0, 10] was refused as singular or divergent)."""
+    right(tmp_path, expr, exact, rel=1e-10)

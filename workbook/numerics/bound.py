@@ -96,6 +96,37 @@ class Bound:
             out.append(np.broadcast_to(v, shape))
         return out
 
+    def switches(self, shape: tuple[int, ...]) -> list[tuple[Callable, Callable]]:
+        """(g, h) per sub-tree whose zeros are kinks or jumps of EXPR (numerics.kinks.
+        switching) and that has interval enclosures: ``g(lo, hi, row) -> (F, D)`` and
+        ``h(x, row)`` its values, as :meth:`enclosure` and :meth:`over`."""
+        from .intervals import Iv, NoEnclosure, enclosure
+        from .kinks import switching
+
+        flat, env, var = self._flat(shape), self.env, self.var
+        out = []
+        for u in switching(self.body, var):
+            if not ty.parameters(u) <= {var, *env}:
+                continue
+            try:
+                g = enclosure(self.evaluator, u, var)
+            except NoEnclosure:
+                continue
+            fn = self.evaluator.compile(u)
+
+            def at(lo, hi, row, g=g):
+                idx = np.asarray(row).astype(np.intp)
+                with np.errstate(all="ignore"):
+                    return g({**env, **{k: a[idx] for k, a in flat.items()}, var: Iv(lo, hi)})
+
+            def value(x, row, fn=fn):
+                idx = np.asarray(row).astype(np.intp)
+                with np.errstate(all="ignore"):
+                    return fn({**env, **{k: a[idx] for k, a in flat.items()}, var: x})
+
+            out.append((at, value))
+        return out
+
     def record(self, name: str, result: Result) -> None:
         """Keep the result's error estimate for ``workbook bench``."""
         self.evaluator.records.append((name, result))

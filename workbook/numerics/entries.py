@@ -310,7 +310,7 @@ def _integral_numpy(of, a, b):
         )
         return _out(res.value)
     shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
-    breaks = of.breaks(shape)
+    breaks = of.breaks(shape) + _kinks_located(of, shape, a, b)
     if reference():
         from . import reference as ref
 
@@ -344,6 +344,24 @@ def _integral_numpy(of, a, b):
     )
     of.record("integral", res)
     return _out(res.value)
+
+
+def _kinks_located(of, shape, a, b) -> list[np.ndarray]:
+    """Break points where a sub-tree whose zeros are kinks of EXPR (abs(sin(x)), min of two
+    curves) is 0, found by interval arithmetic (numerics.features.kink_points)."""
+    from .features import kink_points
+
+    switches = of.switches(shape)
+    if not switches:
+        return []
+    a, b = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    span = np.maximum(np.abs(lo), np.abs(hi))
+    min_width = np.maximum(of.tolerance.rtol * span, 64 * np.spacing(span))
+    out = []
+    for g, h in switches:
+        out += [p.reshape(shape) for p in kink_points(g, h, lo, hi, min_width)]
+    return out
 
 
 def _extremum_numpy(name: str):

@@ -86,3 +86,39 @@ def breaks(g, h, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
     slot = np.arange(row.size) - np.searchsorted(row, row)
     out[row, slot] = points
     return list(out.T)
+
+
+def kink_points(g, h, lo: np.ndarray, hi: np.ndarray, min_width: np.ndarray) -> list[np.ndarray]:
+    """Per row, the zeros in [lo, hi] of a sub-tree whose zeros are kinks of EXPR (the
+    argument of abs, the difference of min's arguments; see numerics.kinks.switching),
+    isolated by interval arithmetic and refined by ``find_root``; a cluster the intervals
+    cannot resolve gives its middle. Arrays of the rows' length (a row with fewer repeats
+    its lower bound), [] when no row has one."""
+    from scipy.optimize.elementwise import find_root
+
+    from .isolate import isolate
+
+    iso = isolate(g, lo, hi, min_width)
+    rows_, points = [iso.row], [0.5 * (iso.lo + iso.hi)]
+    if iso.row.size:
+        with np.errstate(all="ignore"):
+            res = find_root(lambda x, r: h(x, r), (iso.lo, iso.hi), args=(iso.row.astype(float),))
+        ok = np.asarray(res.success)
+        points[0] = np.where(ok, res.x, points[0])
+    for r, clusters in iso.unresolved.items():
+        for c in clusters:
+            if np.isfinite(c.lo) and np.isfinite(c.hi):
+                rows_.append(np.array([r]))
+                points.append(np.array([0.5 * (c.lo + c.hi)]))
+    row, x = np.concatenate(rows_).astype(np.intp), np.concatenate(points)
+    inside = (x > lo[row]) & (x < hi[row])
+    row, x = row[inside], x[inside]
+    if not row.size:
+        return []
+    order = np.lexsort((x, row))
+    row, x = row[order], x[order]
+    counts = np.bincount(row, minlength=lo.size)
+    out = np.repeat(lo[:, None], counts.max(), axis=1)
+    slot = np.arange(row.size) - np.searchsorted(row, row)
+    out[row, slot] = x
+    return list(out.T)

@@ -156,3 +156,37 @@ def breaks(typer, body: ty.T, var: str) -> list[ty.T]:
     k = Kinks(typer)
     k.visit(body, {var: 1.0}, None)
     return k.found
+
+
+def switching(body: ty.T, var: str) -> list[ty.T]:
+    """Typed sub-trees of ``body`` (outside the sheet's functions) that depend on ``var`` and
+    whose zeros are where EXPR may have a kink or a jump: the argument of ``abs`` and
+    ``sign``, the difference of the two arguments of ``min`` and ``max``, and of the two
+    sides of a comparison (a piecewise condition). Their zeros are found numerically
+    (:func:`workbook.numerics.features.kink_points`); the linear cases are also found
+    above, exactly."""
+    from ..registry import REGISTRY
+
+    found: list[ty.T] = []
+    stack = [body]
+    while stack:
+        t = stack.pop()
+        entry = REGISTRY.get(t.func) if isinstance(t, ty.TFunc) else None
+        if entry is not None and entry.binds:
+            continue  # another built-in's own variable: its own business
+        stack.extend(ty.children(t))
+        if isinstance(t, ty.TFunc) and t.func in ("abs", "sign") and len(t.args) == 1:
+            pairs = [(t.args[0], None)]
+        elif isinstance(t, ty.TFunc) and t.func in ("min", "max") and len(t.args) == 2:
+            pairs = [(t.args[0], t.args[1])]
+        elif isinstance(t, ty.TCompare):
+            pairs = list(zip(t.operands, t.operands[1:]))
+        else:
+            continue
+        for x, y in pairs:
+            if x.shape is not None or (y is not None and y.shape is not None):
+                continue
+            u = x if y is None else ty.TBinary(x.unit, op="-", left=x, right=y)
+            if var in ty.parameters(u):
+                found.append(u)
+    return found
