@@ -356,8 +356,10 @@ def _kinks_located(of, shape, a, b) -> list[np.ndarray]:
         return []
     a, b = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
     lo, hi = np.minimum(a, b), np.maximum(a, b)
+    # boxes of a millionth of the bracket at least: a root box is refined by find_root, an
+    # unresolved one (a curve that touches zero) is split at its middle
     span = np.maximum(np.abs(lo), np.abs(hi))
-    min_width = np.maximum(of.tolerance.rtol * span, 64 * np.spacing(span))
+    min_width = np.maximum(1e-6 * (hi - lo), 64 * np.spacing(span))
     out = []
     for g, h in switches:
         out += [p.reshape(shape) for p in kink_points(g, h, lo, hi, min_width)]
