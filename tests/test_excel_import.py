@@ -387,3 +387,18 @@ def test_a_filled_down_column_is_one_definition_over_a_range(tmp_path, capsys):
     assert main(["check", str(out / "fill.toml"), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["printed"] == report["reproduced"] == 31  # 10 + 10 + 10 running + 1
+
+
+def test_a_zip_bomb_is_refused_before_it_inflates(tmp_path, capsys):
+    import zipfile
+
+    from workbook.limits import MAX_XLSX_MEMBER_BYTES
+
+    bomb = tmp_path / "bomb.xlsm"
+    with zipfile.ZipFile(bomb, "w", compression=zipfile.ZIP_DEFLATED) as z:
+        with z.open("xl/worksheets/sheet1.xml", "w", force_zip64=True) as member:
+            block = b"\0" * 1_000_000
+            for _ in range(MAX_XLSX_MEMBER_BYTES // len(block) + 1):
+                member.write(block)
+    assert main(["import", str(bomb), "--out", str(tmp_path)]) == 2
+    assert "inflates to" in capsys.readouterr().err
