@@ -19,8 +19,8 @@ rescaled integrand). The profile has no kink, so no side splits the interval (th
 finds no break point in it either, and no narrow feature: its interval search runs on 32
 rows spread over the table). What the engine still does besides: it first tries a 21-point
 Gauss-Kronrod rule on 32 rows spread over the table (all go to tanh-sinh here, so the rest
-does without trying), and for the roots it counts the roots of 16 rows spread over the
-table by interval arithmetic.
+does without trying); for the roots, it checks that each final bracket's values are those of
+a root (not a pole or a jump): a table this long is not counted by interval arithmetic.
 """
 
 from __future__ import annotations

@@ -65,23 +65,8 @@ def root_in(
     else:
         count = change.sum(axis=1)
     proven = None
-    if enclose is not None:
-        sel = np.arange(n) if n <= CERTIFY_ROWS else np.linspace(0, n - 1, PROBE).astype(np.intp)
-        part = _counted(
-            f,
-            enclose,
-            [g[sel] for g in args],
-            lo[sel],
-            hi[sel],
-            xs[sel],
-            fs[sel],
-            tol,
-            var,
-            unit,
-            None if label is None and n == sel.size else lambda i: _label(label, sel[i], n),
-        )
-        proven = _Proven(np.zeros(n, dtype=bool), np.full(n, np.nan), np.zeros(n))
-        proven.one[sel], proven.value[sel], proven.error[sel] = part.one, part.value, part.error
+    if enclose is not None and n <= CERTIFY_ROWS:
+        proven = _counted(f, enclose, args, lo, hi, xs, fs, tol, var, unit, label)
         count = np.where(proven.one, 1, count)
     none = np.flatnonzero(count == 0)
     if none.size:
@@ -138,11 +123,10 @@ def root_in(
     return Result(value.reshape(shape), error.reshape(shape), evaluations=evaluations)
 
 
-#: rows of one call whose roots are all counted by interval arithmetic (the count costs
-#: about three evaluations of f a row); of a larger table, PROBE rows spread over it are
-#: counted, the others are decided by their samples and the final bracket's values
+#: rows of one call whose roots are counted by interval arithmetic (the count costs about
+#: three evaluations of f a row); a larger table is decided by its samples and the final
+#: bracket's values (the pole-or-jump test), to stay near SciPy's find_root in time
 CERTIFY_ROWS = 2_000
-PROBE = 16
 #: a value at the final bracket's ends larger than this times what a root's slope gives
 #: there (the samples' secant times the bracket's width) is no root: a pole or a jump
 NOT_A_ROOT = 1e3
@@ -280,11 +264,6 @@ def _cluster_kind(f, c, args, scale: float) -> str | None:
     if abs(v[1]) <= 1e-12 * scale or v[1] * v[0] <= 0:
         return "touch"
     return None
-
-
-def _label(label, i: int, n: int) -> str:
-    text = row_text(label, i, n)
-    return text[2:-1] if text else ""
 
 
 def _not_a_pole(res, idx, fa, fb, width, lo, hi, var, unit, label, n, which) -> None:
