@@ -200,3 +200,28 @@ columns = { "1/(1 + f/(1 kHz))" = "" }
     listing = {k[1]: v for k, v in values.items() if k[0] == "Listing"}
     got = [float(listing[f"B{3 + i}"]) for i in range(4)]
     np.testing.assert_allclose(got, table.iloc[:, 1], rtol=1e-12)
+
+
+def test_a_bound_with_a_unit_is_converted_in_an_ode_time_range(tmp_path):
+    """t := 0 .. 2 min with t in s runs to 120 s (the unit of the bound was dropped before:
+    the run ended at 2 s)."""
+    text = """
+[inputs]
+k = "0.1 1/s"
+tq = "100 s"
+
+[arguments]
+t = { unit = "s" }
+
+[[ode]]
+name = "decay"
+time = "t := 0 .. 2 min"
+states = [{ name = "y", unit = "", initial = "1", derivative = "-k*y" }]
+
+[definitions]
+y_q = "y(tq)"
+y_end = "y(2 min)"
+"""
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert sheet.evaluate("y_q").magnitude == pytest.approx(math.exp(-10), rel=1e-4)
+    assert sheet.evaluate("y_end").magnitude == pytest.approx(math.exp(-12), rel=1e-4)
