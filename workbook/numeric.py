@@ -440,7 +440,7 @@ MAX_RECURSION = 1000
 _FRAMES_PER_LEVEL = 40
 #: Calls of a function to itself within one outer call: a shallow recursion that branches
 #: (``fib(n - 1) + fib(n - 2)``) grows exponentially long before it grows deep.
-MAX_RECURSIVE_CALLS = 200_000
+MAX_RECURSIVE_CALLS = 100_000
 
 
 def _recursion_bounded(name: str, fn: Fn) -> Fn:
