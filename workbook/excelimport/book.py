@@ -15,6 +15,8 @@ from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
 
 #: formula cells translated at most (those that call VBA functions and what they read first)
 MAX_DEFINITIONS = 4000
+#: constant cells imported as inputs at most
+MAX_INPUTS = 4000
 _UNIT_IN_LABEL = re.compile(r"[\(\[]\s*([^\)\]]{1,16}?)\s*[\)\]]")
 _UNIT_IN_FORMAT = re.compile(r'"\s*([^"]{1,12}?)\s*"\s*$')
 
@@ -520,6 +522,16 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
         except FormulaProblem as exc:
             d.problem = str(exc)
         tr.definitions.append(d)
+    # inputs are bounded: a formula that would take the count past MAX_INPUTS is listed
+    constants: set = set()
+    for d in tr.definitions:
+        if d.problem:
+            continue
+        new = {k for k in getattr(d, "reads", []) if k not in formula_keys} - constants
+        if len(constants) + len(new) > MAX_INPUTS:
+            d.problem = f"reads more constant cells than the {MAX_INPUTS:,} inputs imported"
+            continue
+        constants |= new
     # a formula reading a formula cell that is not translated is not translated either
     changed = True
     while changed:
