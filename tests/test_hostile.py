@@ -18,7 +18,11 @@ import time
 
 import pytest
 
-from workbook import expr, numeric, ranges, runtime, template, typecheck, xlsx
+from workbook import expr, numeric, ode, ranges, runtime, sheet, template, typecheck, xlsx
+from workbook import limits as file_limits
+from workbook.numerics import derivative
+from workbook.sweep.driver import MAX_SWEEP_POINTS
+from workbook.sweep.grid import MAX_CASES
 
 MEMORY = 1536 * 2**20  # bytes of address space for one run
 CPU_SECONDS = 60
@@ -266,6 +270,13 @@ def test_limits_are_documented():
         runtime.MAX_NESTING,
         runtime.MAX_RUNTIME_ELEMENTS,
         xlsx.MAX_ARRAY_CELLS,
+        derivative.MAX_DIFF_NODES,
+        sheet.MAX_FAMILY_CELLS,
+        MAX_CASES,
+        MAX_SWEEP_POINTS,
+        file_limits.MAX_SHARED_STRINGS,
+        file_limits.MAX_STYLES_BYTES,
+        ode.MAX_STEPS,
     ):
         assert f"{value:,}" in limits or str(value) in limits, value
 
