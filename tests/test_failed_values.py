@@ -209,3 +209,38 @@ columns = ["q", "r"]
     assert ours[(table, "C3")] == "#NUM!" and theirs[(table, "C3")] in ("#NUM!", "#VALUE!")
     for cell in ("B3", "B5", "B6", "C4", "C5", "C6"):
         assert theirs[(table, cell)] == pytest.approx(ours[(table, cell)], rel=1e-12)
+
+
+def test_a_failed_value_is_computed_once(tmp_path, monkeypatch):
+    """A table whose every row needs a [[solve]] that fails asks for it at every halving of
+    its rows; the failure is remembered, so the block is solved once."""
+    from workbook import given_find
+
+    calls = []
+    solve_block = given_find.solve_block
+
+    def counted(*args, **kw):
+        calls.append(1)
+        return solve_block(*args, **kw)
+
+    monkeypatch.setattr(given_find, "solve_block", counted)
+    text = """
+[arguments]
+x = { unit = "" }
+
+[[solve]]
+unknowns = { z = "1" }
+equations = ["z^2 == -1"]
+
+[definitions]
+"q(x)" = "x + z"
+
+[[tables]]
+name = "t"
+range = "x := 0 .. 1000"
+columns = ["q"]
+"""
+    sheet = workbook.load(write_template(tmp_path, text))
+    with pytest.raises(DomainError, match="did not converge"):
+        sheet.table("t")
+    assert len(calls) == 1

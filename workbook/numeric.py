@@ -12,7 +12,6 @@ h, v and j that share their conditions.
 
 from __future__ import annotations
 
-import copy
 import functools
 import operator
 import sys
@@ -409,7 +408,7 @@ class Evaluator(Visitor):
         elif cache[name] is None:
             raise InputError(f"ode '{name}': its derivatives refer to its own solution")
         if isinstance(cache[name], WorkbookError):
-            raise copy.copy(cache[name])
+            raise cache[name]
         return cache[name]
 
     def _block(self, t: tc.TBlock) -> Fn:

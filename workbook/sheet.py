@@ -342,35 +342,45 @@ class Sheet:
         if kind == "solve":
             return self._solved(name)
         if name not in self._memo:
-            d = self.spec.definitions[name]
             try:
-                value = self.evaluator.compile(self.typer.scalar(name))({})
-            except WorkbookError as err:
-                raise err.located(file=self.file, line=d.line, definition=name) from None
-            except (RecursionError, MemoryError) as exc:
-                raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
-            if isinstance(value, str):
-                pass  # a text: "OK"
-            elif np.ndim(value) == 0:
-                value = float(value)
-                if not math.isfinite(value):
-                    raise DomainError(
-                        f"{name} is not a finite number ({value}); its formula is {d.text}",
-                        file=self.file,
-                        line=d.line,
-                        definition=name,
-                    )
-            elif not rt.all_finite(value):
+                self._memo[name] = self._scalar(name)
+            except WorkbookError as err:  # remembered: a table's rows ask again and again
+                self._memo[name] = err
+                raise
+        if isinstance(self._memo[name], WorkbookError):
+            raise self._memo[name]
+        return self._memo[name]
+
+    def _scalar(self, name: str):
+        """The value of scalar definition ``name``, checked (finite, within its limits)."""
+        d = self.spec.definitions[name]
+        try:
+            value = self.evaluator.compile(self.typer.scalar(name))({})
+        except WorkbookError as err:
+            raise err.located(file=self.file, line=d.line, definition=name) from None
+        except (RecursionError, MemoryError) as exc:
+            raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
+        if isinstance(value, str):
+            pass  # a text: "OK"
+        elif np.ndim(value) == 0:
+            value = float(value)
+            if not math.isfinite(value):
                 raise DomainError(
-                    f"{name} has elements that are not finite numbers; its formula is {d.text}",
+                    f"{name} is not a finite number ({value}); its formula is {d.text}",
                     file=self.file,
                     line=d.line,
                     definition=name,
                 )
-            if d.limits is not None and not isinstance(value, str):
-                self._check_limits(d, value)
-            self._memo[name] = value
-        return self._memo[name]
+        elif not rt.all_finite(value):
+            raise DomainError(
+                f"{name} has elements that are not finite numbers; its formula is {d.text}",
+                file=self.file,
+                line=d.line,
+                definition=name,
+            )
+        if d.limits is not None and not isinstance(value, str):
+            self._check_limits(d, value)
+        return value
 
     def _check_limits(self, d, value) -> None:
         """A scalar definition's value outside its declared limits is an error."""
@@ -393,8 +403,12 @@ class Sheet:
         if key not in self._memo:
             try:
                 self._memo[key] = solve_block(self, block)
-            except WorkbookError as err:
-                raise err.located(file=self.file, line=block.line, definition=block.what) from None
+            except WorkbookError as err:  # remembered, not solved again by each value
+                self._memo[key] = err.located(
+                    file=self.file, line=block.line, definition=block.what
+                )
+        if isinstance(self._memo[key], WorkbookError):
+            raise self._memo[key]
         return self._memo[key][name]
 
     def _solved_at(self, name: str, env: dict):
