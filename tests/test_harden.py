@@ -1107,3 +1107,16 @@ def test_a_row_vector_at_the_last_column_is_written_whole_or_refused(tmp_path, n
     ws = openpyxl.load_workbook(tmp_path / "w.xlsx", read_only=True)["Matrices"]
     values = next(ws.iter_rows(min_row=2, max_row=2, values_only=True))
     assert len(values) == 16_384 and values[1] == 0 and values[-1] == n  # B2 .. XFD2
+
+
+def test_a_report_names_a_huge_array_instead_of_showing_it(tmp_path):
+    # a 2,000,001-element vector made a 90 MB report page
+    from workbook.report import mathml as mm
+
+    big = mm.matrix_box(np.zeros((mm.MAX_SHOWN_ELEMENTS + 1, 1)), "mm").xml
+    assert "<mtable>" not in big and f"a vector of {mm.MAX_SHOWN_ELEMENTS + 1:,}" in big
+    nested = np.empty((2, 1), dtype=object)
+    nested[0, 0] = nested[1, 0] = np.zeros((mm.MAX_SHOWN_ELEMENTS // 2 + 1, 1))
+    assert "not shown" in mm.matrix_box(nested, "").xml
+    small = mm.matrix_box(np.arange(6.0).reshape(3, 2), "m").xml
+    assert small.count("<mtd>") == 6 and "not shown" not in small

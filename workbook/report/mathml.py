@@ -210,9 +210,33 @@ def quantity_box(value: float, unit: str, digits: int = PRECISION, attrs: str = 
     return Box(xml, num.width + 0.25 + u.width, min(num.prec, PREC["*"]), numeric=True)
 
 
+#: Elements of one vector or matrix shown in the report (a 2,000,001-element vector made a
+#: 90 MB page); a larger one is named with its size instead, never shown cut.
+MAX_SHOWN_ELEMENTS = 10_000
+
+
+def _elements(values) -> int:
+    """Numbers in ``values``, those of its nested arrays included."""
+    if np.ndim(values) != 2:
+        return 1
+    arr = np.asarray(values)
+    if arr.dtype.kind != "O":
+        return int(arr.size)
+    return sum(_elements(v) for v in arr.ravel())
+
+
 def matrix_box(values, unit: str, digits: int = PRECISION) -> Box:
     """A vector or matrix of numbers in brackets, with its unit after; an element that is
-    itself an array (a nested array) is a bracketed matrix in its place."""
+    itself an array (a nested array) is a bracketed matrix in its place. One of more than
+    :data:`MAX_SHOWN_ELEMENTS` elements is a text naming its size."""
+    count = _elements(values)
+    if count > MAX_SHOWN_ELEMENTS:
+        r, c = np.shape(values)
+        what = f"a vector of {r:,}" if c == 1 else f"a {r:,} x {c:,} matrix"
+        return text_box(
+            f"[{what} ({count:,} numbers): more than {MAX_SHOWN_ELEMENTS:,}, not shown]"
+            + (f" {unit}" if unit else "")
+        )
 
     def element(v) -> Box:
         if np.ndim(v) == 2:
