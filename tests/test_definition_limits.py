@@ -94,3 +94,23 @@ def test_the_valve_at_89_degrees_names_the_value_that_fails(tmp_path):
     code, _, err = _cli(tmp_path, "run", "cam-wear-valve", "--set", "alpha=89 deg")
     assert code == 1
     assert "fail: [failed values] phi_lim has no value" in err
+
+
+def test_a_sweep_checks_the_limits_case_by_case(tmp_path):
+    """The vector sweep computes scalar definitions without a Sheet; one with declared limits
+    makes the cases run one by one, so a case that breaks them fails instead of a number."""
+    code, out, _ = _cli(
+        tmp_path,
+        "sweep",
+        str(write_template(tmp_path, SHEET)),
+        "--vary",
+        "d_stem=30mm..50mm:3",
+        "--output",
+        "A=2*A_port",
+        "--out",
+        "s.csv",
+    )
+    assert code == 0 and "serial" in out and "2 failed" in out
+    rows = (tmp_path / "s.csv").read_text().splitlines()
+    assert rows[1].startswith("30.0,1099.557428756")
+    assert rows[3].startswith("50.0,,A_port = -706.858 mm^2 breaks its declared limit")

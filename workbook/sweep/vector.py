@@ -80,6 +80,15 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
         )
         if stepwise:
             why.append(f"{out.name} uses programs or ODE solutions ({', '.join(stepwise)})")
+        limited = sorted(  # a scalar's declared limits are checked where a Sheet computes it
+            n
+            for n in deps
+            if n in sheet.spec.definitions
+            and sheet.spec.definitions[n].limits is not None
+            and not sheet.spec.definitions[n].is_function
+        )
+        if limited:
+            why.append(f"{out.name} uses values with declared limits ({', '.join(limited)})")
         aggregates = sorted(deps & {"max_over", "min_over"} - set(sheet.spec.definitions))
         if aggregates:
             why.append(f"{out.name} uses the table aggregate {', '.join(aggregates)}()")
