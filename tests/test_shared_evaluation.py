@@ -16,6 +16,9 @@ from workbook.sweep import sweep
 from workbook.template import load_spec
 
 LEVELS = 40
+# Without sharing, f40 is 2^40 calls of f0: a run that never ends. The bound below only turns
+# such a hang into a failure; it is far above the time taken (timings are in benchmarks/).
+HANG_SECONDS = 60.0
 
 
 def _deep(tmp_path, levels: int = LEVELS) -> Sheet:
@@ -54,14 +57,14 @@ def test_nested_calls_are_computed_once(tmp_path):
     x = np.linspace(0.0, 10.0, 1001)
     got, seconds = _timed(lambda: sheet.evaluate(f"f{LEVELS}", x))
     assert np.array_equal(got.to("mm").magnitude, x + 2.0)  # (y + y)/2 is exact
-    assert seconds < 2.0
+    assert seconds < HANG_SECONDS
     assert sheet.evaluate("top").to("mm").magnitude == 4.0
 
 
 def test_nested_calls_in_the_workbook_and_a_sweep(tmp_path):
     sheet = _deep(tmp_path)
     _, seconds = _timed(lambda: sheet.write_xlsx(tmp_path / "deep.xlsx"))
-    assert seconds < 2.0
+    assert seconds < HANG_SECONDS
     import openpyxl
 
     ws = openpyxl.load_workbook(tmp_path / "deep.xlsx")["Listing"]
@@ -73,7 +76,7 @@ def test_nested_calls_in_the_workbook_and_a_sweep(tmp_path):
         result, seconds = _timed(
             lambda mode=mode: sweep(sheet, {"a": "1 mm..3 mm:21"}, {"top": "top"}, mode=mode)
         )
-        assert seconds < 2.0, mode
+        assert seconds < HANG_SECONDS, mode
         assert result.table["top [mm]"].tolist() == pytest.approx(np.linspace(2, 6, 21))
 
 
