@@ -186,3 +186,29 @@ def test_loads_reads_template_text_and_names_it_in_messages(sheet_from, tmp_path
     with pytest.raises(workbook.WorkbookError) as err:
         sheet_from('[definitions]\nA = { expr = "2", unit = "kg" }', name="bad")
     assert str(tmp_path / "bad.toml") + ":2, in 'A'" in str(err.value)
+
+
+class _NoChanges(list):
+    """A list of tables that fails on any change (the writer must not change the Sheet)."""
+
+    def _refuse(self, *args, **kwargs):
+        raise AssertionError("the writer changed the Sheet's tables")
+
+    append = remove = extend = insert = pop = __setitem__ = __delitem__ = _refuse
+
+
+def test_writing_a_chart_leaves_the_sheets_tables_as_they_are(tmp_path, sheet_from):
+    from conftest import SINE
+
+    chart = """
+[[charts]]
+name = "wave"
+range = "phi := 0, 30 .. 360"
+series = [{ y = "y", unit = "mm", name = "y" }]
+"""
+    sheet = sheet_from(SINE + chart)
+    before = list(sheet.spec.tables)
+    sheet.spec.tables = _NoChanges(before)
+    out = sheet.write_xlsx(tmp_path / "wave.xlsx")
+    assert list(sheet.spec.tables) == before == []
+    assert "Chart data" in openpyxl.load_workbook(out).sheetnames
