@@ -214,7 +214,7 @@ def solved_at(sheet, block: SolveSpec, name: str, env: dict):
             f"{block.what}: {values[0].size:,} points to solve at (limit {MAX_POINTS:,})"
         )
     out = np.empty(shape)
-    memo = sheet._memo.setdefault(("solve at", block.index), {})
+    memo = sheet.solutions_at(block)
     for ix in np.ndindex(shape):
         point = tuple(float(v[ix]) for v in values)
         if point not in memo:
@@ -243,7 +243,7 @@ def solve_findings(sheet) -> list:
             sheet.evaluate(next(iter(block.unknowns)))
         except WorkbookError:
             continue
-        solved = sheet._memo[("solve", block.index)]
+        solved = sheet.solution(block)
         parts, worst = [], 0.0
         for name, q in block.unknowns.items():
             v, e = solved[name], solved.errors.get(name, float("nan"))

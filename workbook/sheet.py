@@ -396,9 +396,13 @@ class Sheet:
 
     def _solved(self, name: str) -> float:
         """An unknown of a [[solve]] block (the block is solved once per sheet)."""
+        return self.solution(self.spec.solve_of(name))[name]
+
+    def solution(self, block):
+        """The solution of a [[solve]] block without parameters: solved once per sheet, and a
+        failure remembered and raised again (with the block's line) instead of solved again."""
         from .given_find import solve_block
 
-        block = self.spec.solve_of(name)
         key = ("solve", block.index)
         if key not in self._memo:
             try:
@@ -409,7 +413,11 @@ class Sheet:
                 )
         if isinstance(self._memo[key], WorkbookError):
             raise self._memo[key]
-        return self._memo[key][name]
+        return self._memo[key]
+
+    def solutions_at(self, block) -> dict:
+        """The solutions of a [[solve]] block with parameters, by point, as they are found."""
+        return self._memo.setdefault(("solve at", block.index), {})
 
     def _solved_at(self, name: str, env: dict):
         """An unknown of a [[solve]] block with parameters, at their values in ``env``."""

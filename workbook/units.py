@@ -7,6 +7,7 @@ import math
 import re
 
 import pint
+from pint.util import to_units_container
 
 from .errors import InputError, LimitError, UnitError
 from .fields import nearest
@@ -195,14 +196,13 @@ def temperature_kind(u: pint.Unit) -> str | None:
     (degC, degF: a temperature on a scale with an offset), ``"difference"`` (delta_degC,
     delta_degF), ``"kelvin"`` (K, degR: either); None for any other unit, compound ones
     included (W/(m*degC) is per degree of difference)."""
-    items = list(u._units.items())
+    items = list(to_units_container(u).items())
     if len(items) != 1 or items[0][1] != 1:
         return None
     name = items[0][0]
-    definition = registry()._units.get(name)
-    if definition is None or u.dimensionality != registry().kelvin.dimensionality:
+    if u.dimensionality != registry().kelvin.dimensionality:
         return None
-    if not definition.converter.is_multiplicative:
+    if registry().Quantity(0.0, name).to_base_units().magnitude != 0:  # a scale with an offset
         return "absolute"
     return "difference" if name.startswith("delta_") else "kelvin"
 
@@ -211,7 +211,7 @@ def difference_unit(u: pint.Unit) -> pint.Unit:
     """The unit of a difference of two temperatures in ``u``: delta_degC for degC, else ``u``."""
     if temperature_kind(u) != "absolute":
         return u
-    (name,) = u._units
+    (name,) = to_units_container(u)
     return registry().Unit("delta_" + name)
 
 
@@ -252,7 +252,7 @@ def pretty(u: pint.Unit) -> str:
     if u == registry().dimensionless:
         return ""
     top, bottom = [], []
-    for name, power in u._units.items():
+    for name, power in to_units_container(u).items():
         symbol = _SPELLING.get(name) or _symbol(name)
         p = abs(power)
         text = symbol if p == 1 else f"{symbol}^{p:g}"
@@ -272,7 +272,7 @@ def _remember_spelling(text: str) -> None:
     """Note how each unit name of a unit text the reader accepted is spelt (see pretty)."""
     for token in re.findall(r"[^\W\d][\w°µμΩ%]*|[°%Ω]", text):
         try:
-            items = list(_unit_of(token)._units.items())
+            items = list(to_units_container(_unit_of(token)).items())
         except Exception:  # noqa: BLE001 - a name pint reads only in context
             continue
         if len(items) == 1 and items[0][1] == 1:

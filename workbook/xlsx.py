@@ -323,7 +323,7 @@ class WorkbookWriter:
         except WorkbookError as err:
             ws.write_string(row, 1, f"error: {err.message}", self.fmt["fail"])
             return
-        solved = self.sheet._memo[("solve", block.index)]
+        solved = self.sheet.solution(block)
         ws.write_number(row, 1, float(q.magnitude), self.fmt["number"])
         ws.write_comment(row, 1, "A value, not a formula: found by a [[solve]] block")
         ws.write_string(row, 2, un.pretty(q.units))

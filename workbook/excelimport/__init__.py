@@ -7,28 +7,11 @@ with Excel's cached values as printed values. See docs/excel-import.md.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-
-@dataclass
-class ImportResult:
-    toml: Path
-    files: list[Path]
-    definitions: int
-    functions: int
-    printed: int
-    not_translated: list[tuple[str, str]] = field(default_factory=list)
-    cells: dict[str, tuple[str, float | None]] = field(default_factory=dict)  # ref -> printed row
-
-    def line(self) -> str:
-        extra = (
-            f"; {len(self.not_translated)} listed as not translated" if self.not_translated else ""
-        )
-        return (
-            f"wrote {self.toml} ({self.definitions} inputs and definitions, {self.functions} VBA "
-            f"functions, {self.printed} of Excel's cached values as printed values{extra})"
-        )
+if TYPE_CHECKING:
+    from .writer import ImportResult
 
 
 def import_file(

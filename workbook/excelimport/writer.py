@@ -7,6 +7,7 @@ import csv
 import io
 import re
 import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import WorkbookError
@@ -16,6 +17,28 @@ from .book import Definition, Translation
 from .runs import ROW
 
 MAX_LOAD_ROUNDS = 60  # loads of the worksheet while refused definitions are left out
+
+
+@dataclass
+class ImportResult:
+    """What an import wrote: the worksheet, its files, counts and what was not translated."""
+
+    toml: Path
+    files: list[Path]
+    definitions: int
+    functions: int
+    printed: int
+    not_translated: list[tuple[str, str]] = field(default_factory=list)
+    cells: dict[str, tuple[str, float | None]] = field(default_factory=dict)  # ref -> printed row
+
+    def line(self) -> str:
+        extra = (
+            f"; {len(self.not_translated)} listed as not translated" if self.not_translated else ""
+        )
+        return (
+            f"wrote {self.toml} ({self.definitions} inputs and definitions, {self.functions} VBA "
+            f"functions, {self.printed} of Excel's cached values as printed values{extra})"
+        )
 
 
 def _comment(text: str, width: int = 96) -> list[str]:
@@ -273,7 +296,6 @@ def _located(err: WorkbookError, toml: str) -> dict[str, str]:
 def write(tr: Translation, out_dir: Path, *, force: bool):
     """Write NAME.toml and its CSV files (existing ones need --force)."""
     from ..mathcad.writer import Rendered
-    from . import ImportResult
 
     name = _sheet_name(tr.path)
     skip: dict[str, str] = {}

@@ -300,7 +300,7 @@ class ExprTranslator(Visitor):
     def _range_bounds(self, var: MNode, tag: str) -> tuple[ex.Node, ex.Node]:
         """Σ over a range variable: the first and last values of its range (of step 1)."""
         sym = self.tr.scope.get(_key(var)) if var.tag == "id" else None
-        item = self.tr._range_of(var) if sym is not None and sym.is_range else None
+        item = self.tr.range_of(var) if sym is not None and sym.is_range else None
         if item is None or sym.broken:
             raise Untranslatable(f"{_what(tag)} over a range variable that is not translated")
         values = item.range_values or []
@@ -380,7 +380,7 @@ class ExprTranslator(Visitor):
                     return len(node.rows)
                 raise Untranslatable("a vectorised expression over a matrix")
             if isinstance(node, ex.Name) and self.tr.is_array(node.id):
-                n = self.tr._length(node)
+                n = self.tr.vector_length_of(node)
                 if n is None:
                     raise Untranslatable(
                         "a vectorised expression over a vector of a length not known at import"
@@ -679,7 +679,7 @@ class Translator:
     def points(self, xt: ex.Node, yt: ex.Node) -> tuple:
         """A trace without a range variable: a vector against a vector (Mathcad draws a point
         for each element: a series over their index) or a single point (a marker)."""
-        lengths = [self._length(t) for t in (xt, yt)]
+        lengths = [self.vector_length_of(t) for t in (xt, yt)]
         o = self.sheet_origin
         index = self.index_sym()
         if lengths == [None, None]:  # numbers: one point (the engine refuses a vector here)
@@ -711,7 +711,7 @@ class Translator:
                 memo[token] = _has_matrix(body) or any(self.is_array(n) for n in ex.names(body))
         return memo[token]
 
-    def _length(self, tree: ex.Node) -> int | None:
+    def vector_length_of(self, tree: ex.Node) -> int | None:
         """The length of a vector the worksheet defines by name (None: not a known vector)."""
         seen = set()
         while isinstance(tree, ex.Name) and tree.id not in seen:
@@ -879,8 +879,8 @@ class Translator:
             what = "an element assignment" if _is_indexer(lhs) else _what(lhs.tag)
             raise Untranslatable(f"a definition of {what} is not in the language yet")
         key = _key(lhs)
-        if rhs.tag == "id" and self._range_of(rhs) is not None:  # j := i, a range again
-            self.range_alias(region, key, self._range_of(rhs))
+        if rhs.tag == "id" and self.range_of(rhs) is not None:  # j := i, a range again
+            self.range_alias(region, key, self.range_of(rhs))
             return
         if key == ("TOL", "") and _quantity_text(rhs) is not None:
             try:
@@ -1027,7 +1027,7 @@ class Translator:
             raise Untranslatable("an if() over a range variable")
         return out
 
-    def _range_of(self, node: MNode) -> Item | None:
+    def range_of(self, node: MNode) -> Item | None:
         sym = self.scope.get(_key(node))
         if sym is None or not sym.is_range or sym.broken:
             return None
@@ -1056,7 +1056,7 @@ class Translator:
             raise Untranslatable("an element assignment to something that is not a name")
         key = _key(target)
         nodes = index.children if index.tag == "sequence" else [index]
-        ranges = [self._range_of(n) if n.tag == "id" else None for n in nodes]
+        ranges = [self.range_of(n) if n.tag == "id" else None for n in nodes]
         if all(r is None for r in ranges) and available_programs():
             self.element(region, key, lhs, rhs)
             return

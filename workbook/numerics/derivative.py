@@ -28,9 +28,11 @@ def sympy_functions() -> dict[str, str]:
     read from the registry: an entry whose SymPy form, given symbols, is one SymPy function of
     exactly those symbols (``Abs(x)``, ``atan2(y, x)``). Plain built-ins come before those of
     vectors (``abs`` before ``mag``, whose SymPy form is ``Abs`` too)."""
-    from ..registry import REGISTRY
+    # workbook.registry.REGISTRY is this dict; it imports this module's entry, so the dict is
+    # read from its home. By the time a derivative is read back every entry is registered.
+    from ..entry import ENTRIES
 
-    return _sympy_functions(tuple(REGISTRY.values()))  # read again when an entry is added
+    return _sympy_functions(tuple(ENTRIES.values()))  # read again when an entry is added
 
 
 @functools.lru_cache(maxsize=4)

@@ -382,14 +382,14 @@ class Enclosure(Visitor):
         args = [self.compile(a) for a in t.args]
         inner = Enclosure(self.evaluator, _CALL)
         inner.depth = self.depth + 1
-        body = inner._in_call(f.body, f.params)
+        body = inner.in_call(f.body, f.params)
 
         def call(env):
             return body([a(env) for a in args])
 
         return call
 
-    def _in_call(self, body: ty.T, params) -> Callable:
+    def in_call(self, body: ty.T, params) -> Callable:
         """A function body of pairs: each parameter is a pair its argument computed."""
         names = list(params)
         compiled = self.compile(body)

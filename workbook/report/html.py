@@ -285,7 +285,7 @@ class Document:
             )
         try:
             values = [self.sheet.evaluate(n) for n in block.unknowns]
-            solved = self.sheet._memo[("solve", block.index)]
+            solved = self.sheet.solution(block)
             shown = "; ".join(
                 f"{n} = {num_html(float(q.magnitude))} {escape(un.pretty(q.units))}".rstrip()
                 + f" (error estimate {solved.errors.get(n, float('nan')):.2g})"
