@@ -31,7 +31,7 @@ theta = "0.3"
 def test_an_ill_conditioned_system_warns_with_an_estimate_above_its_error(tmp_path):
     sheet = workbook.load(write_template(tmp_path, SHEET))
     p = sheet.evaluate("p").magnitude
-    solved = sheet._memo[("solve", 0)]
+    solved = sheet.solution(sheet.spec.solves[0])
     assert solved.condition > 1e9  # exact: 4e10 for the relative residuals
     assert solved.errors["p"] >= abs(p - 1.0)  # the exact solution is p = q = 1
     found = {f.topic: f for f in sheet.check().findings}
@@ -42,7 +42,7 @@ def test_an_ill_conditioned_system_warns_with_an_estimate_above_its_error(tmp_pa
 def test_a_well_conditioned_system_is_for_information(tmp_path):
     sheet = workbook.load(write_template(tmp_path, SHEET))
     x = sheet.evaluate("x").to("m").magnitude
-    solved = sheet._memo[("solve", 1)]
+    solved = sheet.solution(sheet.spec.solves[1])
     assert solved.condition < 10
     assert x == pytest.approx(1.91067297825, abs=1e-10)
     assert solved.errors["x"] < 1e-12
