@@ -711,9 +711,10 @@ class Translator:
                 memo[token] = _has_matrix(body) or any(self.is_array(n) for n in ex.names(body))
         return memo[token]
 
-    def vector_length_of(self, tree: ex.Node) -> int | None:
-        """The length of a vector the worksheet defines by name (None: not a known vector)."""
-        seen = set()
+    def written_out(self, tree: ex.Node) -> ex.Node | None:
+        """The expression a name stands for, following definitions of one name by another
+        (None: a name not defined before, or defined by a region the translation left out)."""
+        seen: set[str] = set()
         while isinstance(tree, ex.Name) and tree.id not in seen:
             seen.add(tree.id)
             item = next(
@@ -723,6 +724,11 @@ class Translator:
             if item is None or item.kind != "definition" or item.body is None:
                 return None
             tree = item.body
+        return tree
+
+    def vector_length_of(self, tree: ex.Node) -> int | None:
+        """The length of a vector the worksheet defines by name (None: not a known vector)."""
+        tree = self.written_out(tree)
         if isinstance(tree, ex.Matrix) and all(len(r) == 1 for r in tree.rows):
             return len(tree.rows)
         return None
@@ -1135,17 +1141,7 @@ class Translator:
         known at import)."""
         if before.broken:
             return None
-        tree: ex.Node = ex.Name(before.token())
-        seen: set[str] = set()
-        while isinstance(tree, ex.Name) and tree.id not in seen:
-            seen.add(tree.id)
-            item = next(
-                (i for i in self.out.items if i.sym is not None and i.sym.token() == tree.id),
-                None,
-            )
-            if item is None or item.kind != "definition" or item.body is None:
-                return None
-            tree = item.body
+        tree = self.written_out(ex.Name(before.token()))
         if isinstance(tree, ex.Matrix) and not any(
             isinstance(e, ex.Matrix) for row in tree.rows for e in row
         ):
