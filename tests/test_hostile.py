@@ -223,7 +223,14 @@ HOSTILE = {
 }
 
 
-@pytest.mark.parametrize("name", sorted(HOSTILE))
+#: Cases that take more than about 5 s (a 3,000-deep chain typed through): the slow run's.
+SLOW_HOSTILE = {"definition_chain"}
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_HOSTILE else n for n in sorted(HOSTILE)],
+)
 def test_hostile_worksheet_is_refused(tmp_path, name):
     text, expected = HOSTILE[name]
     if name == "findings_block_os":  # a findings block that cannot be found is reported

@@ -1,0 +1,58 @@
+"""Findings about the numerical built-ins' error estimates: a value whose estimate is far above
+the sheet's tolerance is printed by ``run`` and ``check`` (a warning), never kept silent."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._common import sheet_tolerance
+
+#: An estimate this many times the sheet's tolerance (relative to the value) is reported.
+ESTIMATE_LIMIT = 100.0
+
+#: An estimate below this times the larger of the value and 1 (in the unit the built-in
+#: computes in) is the rounding of the numbers it works with (a maximum of a difference that
+#: is 0 but for rounding), not an uncertainty worth a warning.
+ROUNDING = 100 * np.finfo(float).eps
+
+#: The position of a smooth extremum is known only to about the square root of the rounding
+#: of its expression (docs/numerics.md): its estimate is information, not a warning.
+POSITIONS = frozenset({"argmax", "argmin"})
+
+
+def estimate_findings(sheet) -> list:
+    """One warning per definition or column whose built-in's largest error estimate, relative
+    to its largest value, exceeds ESTIMATE_LIMIT times ``[sheet] tolerance``; computed from
+    what the sheet has evaluated so far (call it after the values)."""
+    from ..findings import Finding
+
+    rtol = sheet_tolerance(sheet.spec.meta).rtol
+    worst: dict[tuple[str, str], tuple[float, float, float]] = {}
+    for builtin, result in sheet.evaluator.records:
+        if builtin in POSITIONS or not np.size(result.error):
+            continue
+        size = float(np.max(np.abs(result.value), initial=0.0))
+        err = float(np.max(np.abs(result.error), initial=0.0))
+        if err <= ROUNDING * max(size, 1.0):  # a value at the rounding of numbers near 1
+            continue
+        relative = err / size if size > 0 else np.inf
+        key = (result.notes.get("in") or "a formula", builtin)
+        if relative > worst.get(key, (-1.0,))[0]:
+            worst[key] = (relative, err, size)
+    out = []
+    for (where, builtin), (relative, err, size) in worst.items():
+        if relative <= ESTIMATE_LIMIT * rtol:
+            continue
+        out.append(
+            Finding(
+                f"estimate {where}",
+                f"{builtin}: error estimate {err:.3g} for a value of size {size:.6g} "
+                f"(relative {relative:.2g})",
+                None,
+                "",
+                "warning",
+                f"over {ESTIMATE_LIMIT:g} times the sheet's tolerance ({rtol:g}): the value is "
+                "less certain than asked; docs/numerics.md says what each built-in certifies",
+            )
+        )
+    return out
