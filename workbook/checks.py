@@ -173,6 +173,10 @@ def run_checks(sheet) -> Report:
         for row in read_printed(spec):
             report.rows.append(_check_row(sheet, spec, row))
     report.findings = collect_findings(sheet) + failed_values(sheet)
+    if sheet.evaluator.records:  # after the values: their built-ins' estimates
+        from .numerics.estimates import estimate_findings
+
+        report.findings += estimate_findings(sheet)
     if sheet.spec.relations or sheet.spec.meta.get("hand_checks"):
         from .analysis import findings as hand_checks  # relations, joins, domains, pi
 

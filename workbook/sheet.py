@@ -18,6 +18,7 @@ from .errors import DomainError, InputError, LimitError, TemplateError, Workbook
 from .fields import nearest
 from .limits import exhausted
 from .numeric import Evaluator
+from .numerics import defining
 from .ranges import RangeSpec, log_range_values, range_values
 from .registry import CONSTANTS
 from .template import (
@@ -355,7 +356,8 @@ class Sheet:
         """The value of scalar definition ``name``, checked (finite, within its limits)."""
         d = self.spec.definitions[name]
         try:
-            value = self.evaluator.compile(self.typer.scalar(name))({})
+            with defining(name):
+                value = self.evaluator.compile(self.typer.scalar(name))({})
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
         except (RecursionError, MemoryError) as exc:
@@ -555,7 +557,8 @@ class Sheet:
             )
         failed: dict[int, str] = {}
         try:
-            out = fn({var: values})
+            with defining(f"{what}: {col.text}"):
+                out = fn({var: values})
         except DomainError as err:  # some rows leave the domain: the others keep their values
             if t.text or values.ndim != 1:
                 raise self._locate(err, what) from None

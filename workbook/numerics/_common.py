@@ -59,6 +59,27 @@ def current(default: Tolerance) -> Tolerance:
     return _current.get() or default
 
 
+_defining: contextvars.ContextVar[str | None] = contextvars.ContextVar(
+    "workbook_numerics_defining", default=None
+)
+
+
+@contextlib.contextmanager
+def defining(what: str) -> Iterator[None]:
+    """Name the definition or table column being computed: the built-ins' results keep it
+    (``Result.notes["in"]``), so that a finding about an estimate can say where it is."""
+    token = _defining.set(what)
+    try:
+        yield
+    finally:
+        _defining.reset(token)
+
+
+def defined() -> str | None:
+    """The name given by the innermost :func:`defining`, if any."""
+    return _defining.get()
+
+
 _live: contextvars.ContextVar[bool] = contextvars.ContextVar(
     "workbook_numerics_live", default=False
 )

@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import typed as ty
 from .. import units as un
-from ._common import Result, Tolerance, current, num, sheet_tolerance
+from ._common import Result, Tolerance, current, defined, num, sheet_tolerance
 
 
 class Bound:
@@ -128,5 +128,7 @@ class Bound:
         return out
 
     def record(self, name: str, result: Result) -> None:
-        """Keep the result's error estimate for ``workbook bench``."""
+        """Keep the result's error estimate (``workbook bench``, the estimate findings), with
+        the definition being computed."""
+        result.notes.setdefault("in", defined())
         self.evaluator.records.append((name, result))
