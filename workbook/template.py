@@ -534,12 +534,12 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         )
     seen: dict[str, str] = {}
 
-    def claim(key: str, section: str, line):
+    def claim(key: str, section: str, line, function: bool = True):
         if not ex.is_identifier(key):
             raise TemplateError(
                 f"'{key}' is not a valid name (letters, digits, _)", line=line, definition=key
             )
-        if key in REGISTRY:
+        if key in REGISTRY and function:
             raise TemplateError(
                 f"'{key}' shadows the built-in function {key}(); choose another name",
                 line=line,
@@ -556,7 +556,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     inputs: dict[str, InputSpec] = {}
     for key, raw in _table(data, "inputs").items():
         line = find_line(text, key, "inputs")
-        claim(key, "inputs", line)
+        claim(key, "inputs", line, function=False)
         try:
             inputs[key] = _input(key, raw, line)
         except WorkbookError as err:
@@ -607,7 +607,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         params = tuple(p.strip() for p in m.group(2).split(",")) if m.group(2) else ()
         if m.group(2) is not None and not m.group(2).strip():
             params = ()
-        claim(dname, "definitions", line)
+        claim(dname, "definitions", line, function=m.group(2) is not None)
         for p in params:
             if not ex.is_identifier(p):
                 raise TemplateError(f"bad parameter name {p!r}", line=line, definition=dname)
