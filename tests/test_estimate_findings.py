@@ -41,3 +41,12 @@ def test_an_estimate_far_above_the_tolerance_is_a_warning_naming_the_definition(
     assert finding.verdict == "warning"
     assert "maximum: error estimate" in finding.what
     assert f"over {ESTIMATE_LIMIT:g} times the sheet's tolerance" in finding.note
+
+
+def test_the_findings_do_not_depend_on_what_was_written_before(tmp_path):
+    # the writer's own evaluations (live forms) repeat the definitions' built-ins: they must
+    # not add findings to the next check
+    sheet = workbook.load("concave-cam-geometry")
+    before = sorted(_estimates(sheet))
+    sheet.write_xlsx(tmp_path / "once.xlsx")
+    assert sorted(_estimates(sheet)) == before

@@ -29,14 +29,18 @@ def estimate_findings(sheet) -> list:
     rtol = sheet_tolerance(sheet.spec.meta).rtol
     worst: dict[tuple[str, str], tuple[float, float, float]] = {}
     for builtin, result in sheet.evaluator.records:
-        if builtin in POSITIONS or not np.size(result.error):
+        where = result.notes.get("in")
+        # a result computed outside a definition or a column (a writer's live form, a report)
+        # repeats one of theirs; counting it would make the findings depend on what was
+        # written before the check
+        if where is None or builtin in POSITIONS or not np.size(result.error):
             continue
         size = float(np.max(np.abs(result.value), initial=0.0))
         err = float(np.max(np.abs(result.error), initial=0.0))
         if err <= ROUNDING * max(size, 1.0):  # a value at the rounding of numbers near 1
             continue
         relative = err / size if size > 0 else np.inf
-        key = (result.notes.get("in") or "a formula", builtin)
+        key = (where, builtin)
         if relative > worst.get(key, (-1.0,))[0]:
             worst[key] = (relative, err, size)
     out = []
