@@ -155,6 +155,8 @@ def test_excel_writes_the_number_in_the_unit_the_cell_needs(written):
         ("2 m*zz", "a space ends the unit of a number"),
         ("L + mm", "a unit is written after a number: 1 mm"),
         ("F/(20 kg)", "cannot be converted"),
+        ("1" + "0" * 309 + " MPa", "too large"),  # an int past the largest double
+        ("1e999 MPa", "too large"),
     ],
 )
 def test_mistakes_say_what_to_write(tmp_path, expr, message):

@@ -279,13 +279,7 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
             raise TemplateError(f"{what}: {node.value!r} is not allowed in {text!r}")
         if isinstance(node.value, str):
             return Text(node.value)
-        try:
-            value = float(node.value)
-        except OverflowError:
-            value = math.inf
-        if not math.isfinite(value):
-            raise TemplateError(f"{what}: a number in {text!r} is too large (limit about 1.8e308)")
-        return Number(value)
+        return Number(_finite(node.value, text, what))
     if isinstance(node, ast.Name):
         if not is_identifier(node.id):
             raise TemplateError(f"{what}: name {node.id!r} is not allowed in {text!r}")
@@ -360,10 +354,19 @@ def _quantity(node: ast.BinOp, text: str, what: str) -> Quantity:
         and isinstance(unit.value, str)
     ):
         raise TemplateError(f"{what}: operator MatMult not allowed in {text!r} (use + - * / ^)")
-    value = float(number.value)
+    return Quantity(_finite(number.value, text, what), unit.value.replace("**", "^"))
+
+
+def _finite(number: int | float, text: str, what: str) -> float:
+    """A number of the text as a float; one past the largest double is refused (an int of
+    310 digits raises OverflowError in float(), a float literal becomes inf)."""
+    try:
+        value = float(number)
+    except OverflowError:
+        value = math.inf
     if not math.isfinite(value):
         raise TemplateError(f"{what}: a number in {text!r} is too large (limit about 1.8e308)")
-    return Quantity(value, unit.value.replace("**", "^"))
+    return value
 
 
 def _matrix(node: ast.List, text: str, what: str, depth: int) -> Matrix:
