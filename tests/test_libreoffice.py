@@ -15,6 +15,11 @@ pytestmark = [
 ]
 
 
+#: Excel's error values. LibreOffice saves some errors under another code (SQRT(-1) is #NUM!
+#: in Excel, #VALUE! in LibreOffice): an error must stay an error, never become a number.
+ERRORS = frozenset({"#NULL!", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#N/A"})
+
+
 def assert_same(original, recalculated, rel=1e-9):
     cached = formula_values(original)
     new = cell_values(recalculated)
@@ -24,6 +29,9 @@ def assert_same(original, recalculated, rel=1e-9):
         got = new.get(key)
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             if not isinstance(got, (int, float)) or abs(got - value) > rel * max(1.0, abs(value)):
+                bad.append((key, formula[:80], value, got))
+        elif value in ERRORS:
+            if got not in ERRORS:
                 bad.append((key, formula[:80], value, got))
         elif value != got:
             bad.append((key, formula[:80], value, got))
