@@ -288,13 +288,9 @@ def test_kinks_where_a_curve_crosses_zero_are_break_points(tmp_path, expr, exact
     right(tmp_path, expr, exact, rel=1e-10)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known: SciPy's tanh-sinh stops early on 1/sqrt(t + 1e-3) over [0, 0.79] (a "
-    "near-singularity just outside the interval) with an estimate of 4.5e-11 for an error of "
-    "6e-8, and the engine takes its estimate; a second, independent rule is needed",
-)
 def test_a_near_singular_integrand_over_many_rows_has_an_honest_estimate():
+    # SciPy's tanh-sinh alone stops early on 1/sqrt(t + 1e-3) over [0, 0.79] (nearly singular
+    # just outside the interval) with an estimate of 4.5e-11 for an error of 6e-8
     from workbook.numerics import quadrature
     from workbook.numerics._common import Tolerance
 
