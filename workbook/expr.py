@@ -391,6 +391,27 @@ def _matrix(node: ast.List, text: str, what: str, depth: int) -> Matrix:
     return Matrix(tuple(rows))
 
 
+def map_children(node: Node, f) -> Node:
+    """``node`` with ``f`` applied to each direct sub-tree (a leaf is returned as it is)."""
+    if isinstance(node, Unary):
+        return Unary(node.op, f(node.operand))
+    if isinstance(node, Binary):
+        return Binary(node.op, f(node.left), f(node.right))
+    if isinstance(node, Compare):
+        return Compare(node.ops, tuple(f(o) for o in node.operands))
+    if isinstance(node, Logic):
+        return Logic(node.op, tuple(f(v) for v in node.values))
+    if isinstance(node, Call):
+        return Call(node.func, tuple(f(a) for a in node.args))
+    if isinstance(node, IfElse):
+        return IfElse(f(node.value), f(node.condition), f(node.other))
+    if isinstance(node, Index):
+        return Index(f(node.target), tuple(f(i) for i in node.indices))
+    if isinstance(node, Matrix):
+        return Matrix(tuple(tuple(f(e) for e in row) for row in node.rows))
+    return node
+
+
 class _Children(Visitor):
     """The direct sub-trees of a node."""
 

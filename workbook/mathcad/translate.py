@@ -417,7 +417,7 @@ class ExprTranslator(Visitor):
                 return node.rows[k][0]
             if vector_length(node) is not None:
                 return ex.Index(node, (ex.Number(float(o + k)),))
-            return _replace_children(node, lambda c: element(c, k))
+            return ex.map_children(node, lambda c: element(c, k))
 
         return ex.Matrix(tuple((element(tree, k),) for k in range(n)))
 
@@ -1597,44 +1597,6 @@ class Translator:
         return "an expression"
 
 
-class _Renamer(Visitor):
-    def __init__(self, mapping: dict[str, str]):
-        self.mapping = mapping
-
-    def visit_Number(self, n):
-        return n
-
-    def visit_Text(self, n):
-        return n
-
-    def visit_Name(self, n):
-        return ex.Name(self.mapping.get(n.id, n.id))
-
-    def visit_Unary(self, n):
-        return ex.Unary(n.op, self.visit(n.operand))
-
-    def visit_Binary(self, n):
-        return ex.Binary(n.op, self.visit(n.left), self.visit(n.right))
-
-    def visit_Compare(self, n):
-        return ex.Compare(n.ops, tuple(self.visit(o) for o in n.operands))
-
-    def visit_Logic(self, n):
-        return ex.Logic(n.op, tuple(self.visit(v) for v in n.values))
-
-    def visit_Call(self, n):
-        return ex.Call(self.mapping.get(n.func, n.func), tuple(self.visit(a) for a in n.args))
-
-    def visit_Matrix(self, n):
-        return type(n)(tuple(tuple(self.visit(e) for e in row) for row in n.rows))
-
-    def visit_Index(self, n):
-        return type(n)(self.visit(n.target), tuple(self.visit(i) for i in n.indices))
-
-    def visit_IfElse(self, n):
-        return type(n)(self.visit(n.value), self.visit(n.condition), self.visit(n.other))
-
-
 #: Built-ins of one number that vectorize applies element by element.
 _ELEMENTWISE = frozenset(
     {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "ln",
@@ -1642,30 +1604,14 @@ _ELEMENTWISE = frozenset(
 )  # fmt: skip
 
 
-def _replace_children(node: ex.Node, f) -> ex.Node:
-    """``node`` with ``f`` applied to each direct sub-tree."""
-    if isinstance(node, ex.Unary):
-        return ex.Unary(node.op, f(node.operand))
-    if isinstance(node, ex.Binary):
-        return ex.Binary(node.op, f(node.left), f(node.right))
-    if isinstance(node, ex.Compare):
-        return ex.Compare(node.ops, tuple(f(o) for o in node.operands))
-    if isinstance(node, ex.Logic):
-        return ex.Logic(node.op, tuple(f(v) for v in node.values))
-    if isinstance(node, ex.Call):
-        return ex.Call(node.func, tuple(f(a) for a in node.args))
-    if isinstance(node, ex.IfElse):
-        return ex.IfElse(f(node.value), f(node.condition), f(node.other))
-    if isinstance(node, ex.Index):
-        return ex.Index(f(node.target), tuple(f(i) for i in node.indices))
-    if isinstance(node, ex.Matrix):
-        return ex.Matrix(tuple(tuple(f(e) for e in row) for row in node.rows))
-    return node
-
-
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
-    return _Renamer(mapping).visit(node)
+    if isinstance(node, ex.Name):
+        return ex.Name(mapping.get(node.id, node.id))
+    node = ex.map_children(node, lambda c: _rename(c, mapping))
+    if isinstance(node, ex.Call):
+        return ex.Call(mapping.get(node.func, node.func), node.args)
+    return node
 
 
 def _writer(node: MNode, arity: int) -> tuple[str, str, MNode | None] | None:
