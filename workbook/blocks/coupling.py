@@ -293,10 +293,10 @@ def _speeds_text(xs, ws) -> str:
     return text + " rad/s" if runs else "none"
 
 
-def departures(sheet, key: str, ws, form: str = "printed", limit: float = 0.05):
+def departures(sheet, key: str, ws, form: str = "printed"):
     """Per family member: (value, speeds where the template's departure dev_lin (dev_newton)
-    exceeds limit, the largest, speeds where the denominator is <= 0)."""
-    out = []
+    exceeds its departure_limit, the largest, speeds where the denominator is <= 0)."""
+    limit, out = _v(sheet, "departure_limit", ""), []
     for value, d in family(sheet, key, ws).items():
         mask, lin = d["root"] > 0, d[form]
         rel = np.where(mask, np.abs(d[f"dev {form}"]), np.nan)
@@ -322,12 +322,13 @@ def findings(sheet):
         out.append(Finding(topic, TREND_TEXT[key], n, "speeds", verdict, note))
     for form, title in (("printed", "printed linear form"), ("newton", "Newton-step linear form")):
         topic = f"linear form vs nonlinear root ({form})"
+        limit = f"{_v(sheet, 'departure_limit', 'percent'):g} %"
         for key in FAMILY_TABLES:
             for value, where, worst, zero in departures(sheet, key, ws, form):
                 what = f"{title}, {key} = {value}: largest departure"
-                note, verdict = "within 5 % at every speed off the stop", "ok"
+                note, verdict = f"within {limit} at every speed off the stop", "ok"
                 if where:
-                    note, verdict = f"more than 5 % at {_speeds_text(where, ws)}", "warning"
+                    note, verdict = f"more than {limit} at {_speeds_text(where, ws)}", "warning"
                 if zero:
                     note += f"; denominator <= 0 at {_speeds_text(zero, ws)}: reported, not "
                     note += "divided by"
@@ -367,7 +368,8 @@ def study_findings(sheet):
 
 
 def choice_findings(sheet, df) -> list[Finding]:
-    """Is the default solver within 2x of the fastest run that reaches the rigid limit? And
+    """Is the default solver within the template's choice_time_ratio (2x) of the fastest run
+    that reaches the rigid limit? And
     per c2 of the study: the fastest run with error <= 1e-6 rad beside what auto takes."""
     topic, sub = "solver choice", df[df["c2 [N/m]"] == CHOICE_C2]
     if sub.empty:
@@ -391,7 +393,7 @@ def choice_findings(sheet, df) -> list[Finding]:
     what = f"fastest run reaching the rigid limit: {best['method']} rtol {best['rtol']:.0e}"
     note = f"deviation {best['deviation from rigid [rad]']:.3g} rad"
     out.append(Finding(topic, what, t_best, "s", "info", note))
-    verdict = "ok" if ratio <= 2 and dev <= tol else "warning"
+    verdict = "ok" if ratio <= _v(sheet, "choice_time_ratio", "") and dev <= tol else "warning"
     note = f"{t_def:.3g} s, deviation from the rigid limit {dev:.3g} rad (<= {tol:.3g})"
     out.append(
         Finding(

@@ -25,15 +25,14 @@ from . import Finding, cached, export_block, findings_block, table_block
 CLOSURE_TOL_MM = 1e-9
 #: Step of the dense sampling used to find nearest points and undercut intervals (deg of phi).
 _SAMPLE_DEG = 0.25
-_UNITS = {"x_t": "mm", "y_t": "mm", "dx_t": "mm/deg", "dy_t": "mm/deg", "ddx_t": "mm/deg^2"}
-_UNITS.update({"ddy_t": "mm/deg^2", "x_k": "mm", "y_k": "mm", "dx_k": "mm/deg", "dy_k": "mm/deg"})
-_UNITS.update({"kappa_n": "1/mm", "rho": "mm", "a": "deg"})
 
 
 def _f(sheet, name: str, k, phi_deg):
-    """The sheet's profile function ``name(k, phi)`` (phi in deg) as numbers, broadcast."""
-    args = {"phi": phi_deg} if name == "a" else {"k": k, "phi": phi_deg}
-    out = sheet.evaluate(name, **args).to(_UNITS[name]).magnitude
+    """The sheet's profile function ``name(k, phi)`` or ``name(phi)`` (phi in deg) as numbers
+    in the unit the template declares for it, broadcast."""
+    spec = sheet.spec.definitions[name]
+    args = {"k": k, "phi": phi_deg} if "k" in spec.params else {"phi": phi_deg}
+    out = sheet.evaluate(name, **args).to(spec.unit or "").magnitude
     shape = np.broadcast(np.asarray(k), np.asarray(phi_deg)).shape
     return np.broadcast_to(np.asarray(out, dtype=float), shape)
 
@@ -61,18 +60,19 @@ def validate(sheet) -> None:
 def _period(sheet) -> float:
     """Eccentric angle (deg) after which roller 0 has traced the whole closed profile."""
     validate(sheet)
-    return 360.0 * _mag(sheet, "turns")
+    return _mag(sheet, "period", "deg")
 
 
-def _grid(sheet, last_deg: float) -> np.ndarray:
-    from ..ranges import range_values
-
-    return range_values(0.0, _mag(sheet, "dphi", "deg"), last_deg, what="reducer grid")
+def _grid(sheet, table: str) -> np.ndarray:
+    """The eccentric angles (deg) of the template's table ``table``."""
+    validate(sheet)
+    return sheet.range_values(sheet.table_spec(table).range, f"table {table}")
 
 
 def _rollers(sheet):
-    """(k, phi) of every roller over one eccentric turn, roller by roller."""
-    phi = _grid(sheet, 360.0)
+    """(k, phi) of every roller over one eccentric turn (the angles of the table roller0),
+    roller by roller."""
+    phi = _grid(sheet, "roller0")
     n = int(round(_mag(sheet, "n")))
     return np.repeat(np.arange(n), phi.size), np.tile(phi, n)
 
@@ -133,9 +133,9 @@ def undercut(sheet) -> dict:
 def _undercut(sheet) -> dict:
     from scipy.optimize import brentq
 
-    L, rp = _period(sheet), _mag(sheet, "rp", "mm")
+    L = _period(sheet)
     s = np.arange(0.0, L, _SAMPLE_DEG)
-    g = 1.0 - rp * _f(sheet, "kappa_n", 0, s)
+    g = _f(sheet, "offset_margin", 0, s)
     out = {"cusps": [], "loops": [], "teeth": 0}
     if _mag(sheet, "kappa_max", "1/mm") <= 0 or not np.any(g <= 0):
         return out
@@ -145,7 +145,7 @@ def _undercut(sheet) -> dict:
     gg = np.concatenate([g[start:], g[:start], [g[start]]])
 
     def gfun(t):
-        return 1.0 - rp * float(_f(sheet, "kappa_n", 0, t))
+        return float(_f(sheet, "offset_margin", 0, t))
 
     crossings = np.nonzero(np.sign(gg[:-1]) != np.sign(gg[1:]))[0]
     roots = [brentq(gfun, ss[j], ss[j + 1], xtol=1e-12) for j in crossings]
@@ -240,14 +240,14 @@ def _verdict_text(sheet) -> str:
     """Why the practical profile is invalid ("" when it is regular)."""
     rp, packing = _mag(sheet, "rp", "mm"), _mag(sheet, "rp_packing", "mm")
     parts = []
-    if rp * _mag(sheet, "kappa_max", "1/mm") >= 1:
+    if _mag(sheet, "below_curvature") != 1:
         parts.append(
             f"rp = {rp:g} mm exceeds the smallest radius of curvature of the concave "
             f"parts of the theoretical profile, {_mag(sheet, 'rho_min', 'mm'):.6g} mm: the "
             f"practical profile is undercut (cusps and a loop on each of its "
             f"{undercut(sheet)['teeth']} teeth)"
         )
-    if rp >= packing:
+    if _mag(sheet, "below_packing") != 1:
         parts.append(
             f"rp = {rp:g} mm reaches the packing limit (r2 - e1)*sin(pi/n) = "
             f"{packing:.6g} mm: neighbouring rollers overlap"
@@ -338,7 +338,7 @@ def findings(sheet) -> list[Finding]:
             add("undercut", what + ": see the table 'undercut'", len(uc["cusps"]), "", "fail")
 
     # the practical profile must keep the distance rp from the theoretical one
-    prof = _grid(sheet, _period(sheet))
+    prof = _grid(sheet, "profile")
     d, _ = distance_to_trace(sheet, _f(sheet, "x_k", 0, prof), _f(sheet, "y_k", 0, prof))
     gap = float(np.max(np.abs(d - rp)))
     what = (

@@ -44,6 +44,8 @@ def _measured(sheet):
     def make():
         from scipy.signal import savgol_coeffs, savgol_filter
 
+        from .. import units as un
+
         phi, h = measured_points(sheet)
         dphi = float(phi[1] - phi[0])
         omega = float(sheet.evaluate("n").to("deg/s").magnitude)
@@ -60,14 +62,17 @@ def _measured(sheet):
         mid = np.abs(phi - phi.mean()) < np.ptp(phi) / 3
         sigma = float(np.sqrt(np.mean((h - hs)[mid] ** 2) / (1 - g0**2)))
         truth = {k: sheet.evaluate(k, phi=phi) for k in ("h_w2", "v_w2", "a_w2")}
+        # the filter's derivatives are in mm/deg and mm/deg^2; omega in deg/s
+        to_v = un.factor(un.unit("mm/s"), un.unit("m/s"))
+        to_a = un.factor(un.unit("mm/s^2"), un.unit("m/s^2"))
         return dict(
             phi=phi,
             h=h,
             hs=hs,
-            v=d1 * omega * 1e-3,
-            a=d2 * omega**2 * 1e-3,
-            vc=np.gradient(h, dphi) * omega * 1e-3,
-            ac=np.gradient(np.gradient(h, dphi), dphi) * omega**2 * 1e-3,
+            v=d1 * omega * to_v,
+            a=d2 * omega**2 * to_a,
+            vc=np.gradient(h, dphi) * omega * to_v,
+            ac=np.gradient(np.gradient(h, dphi), dphi) * omega**2 * to_a,
             gain=(g0, g1, g2),
             central=(c1, c2),
             sigma=sigma,
