@@ -25,10 +25,13 @@ Five kinds:
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
+
+import numpy as np
 
 from ..errors import TemplateError
 from ..findings import Finding
@@ -65,11 +68,24 @@ class Block:
 _CACHE: dict = {}
 
 
+def content_key(spec) -> str:
+    """A digest of what a template's results depend on besides its input values: its text
+    and the measured data read beside it. Two loads of the same file before and after an
+    edit differ; copies of the same text at two paths share their results."""
+    digest = hashlib.sha256(spec.text.encode())
+    for name in sorted(spec.data):
+        column = spec.data[name]
+        digest.update(f"\0{name}\0{column.unit}\0".encode())
+        digest.update(np.ascontiguousarray(column.values, dtype=float).tobytes())
+    return digest.hexdigest()
+
+
 def cached(sheet, key, make):
-    """``make()`` computed once per template, input values and ``key``, and kept (many input
-    variations, as in a sweep, start the store afresh). A result is stored only when complete:
-    a Ctrl-C leaves no half-filled entry."""
-    full = (str(sheet.spec.path), tuple(sorted((k, str(v)) for k, v in sheet.values.items())), key)
+    """``make()`` computed once per template content (:func:`content_key`), input values and
+    ``key``, and kept (many input variations, as in a sweep, start the store afresh). A result
+    is stored only when complete: a Ctrl-C leaves no half-filled entry."""
+    values = tuple(sorted((k, str(v)) for k, v in sheet.values.items()))
+    full = (content_key(sheet.spec), values, key)
     if full not in _CACHE:
         value = make()
         if len(_CACHE) > 512:
