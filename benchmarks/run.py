@@ -16,6 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_builtins  # noqa: E402
 import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
+import bench_import  # noqa: E402
 import bench_livecheck  # noqa: E402
 import bench_load  # noqa: E402
 import bench_ode  # noqa: E402
@@ -30,6 +31,7 @@ FULL = {
     "builtins": lambda: bench_builtins.run(n=10_000, reps=5),
     "ode": lambda: bench_ode.run(reps=7),
     "livecheck": lambda: bench_livecheck.run(n=1_000, reps=5),
+    "import": lambda: bench_import.run(reps=3),
 }
 QUICK = {
     "evaluate": lambda: bench_evaluate.run(n=1_000, reps=1),
@@ -39,6 +41,7 @@ QUICK = {
     "builtins": lambda: bench_builtins.run(n=200, reps=1),
     "ode": lambda: bench_ode.run(reps=1),
     "livecheck": lambda: bench_livecheck.run(n=20, reps=1),
+    "import": lambda: bench_import.run(reps=1, only={"wind-load"}),
 }
 
 

@@ -23,6 +23,7 @@ sys.path.insert(0, str(BENCH))
 import bench_builtins  # noqa: E402
 import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
+import bench_import  # noqa: E402
 import bench_livecheck  # noqa: E402
 import bench_load  # noqa: E402
 import bench_write  # noqa: E402
@@ -33,6 +34,12 @@ def _check(results, n):
     for r in results:
         assert r.value > 0 and r.target > 0
         assert f"target <= {r.target:g}" in r.line()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not bench_import.FOLDERS[0].is_dir(), reason="../shared/mathcad is absent")
+def test_import_bench_tiny():
+    _check(bench_import.run(reps=1, only={"wind-load"}), 1)
 
 
 @pytest.mark.slow
