@@ -448,6 +448,15 @@ def parse_spec(text: str, path: Path, name: str | None = None) -> SheetSpec:
         raise err.located(file=file) from None
 
 
+def spec_from_data(data: dict, path: Path, name: str) -> SheetSpec:
+    """A spec from template data already read (a dict as TOML gives), built in memory: errors
+    name ``path`` but no line."""
+    try:
+        return _build(path, name, "", data)
+    except WorkbookError as err:
+        raise err.located(file=str(path)) from None
+
+
 def _fields(raw: dict, allowed, what: str, text: str, section: str) -> Fields:
     """Fields of a [section] table; an unknown key's error names its line."""
     try:

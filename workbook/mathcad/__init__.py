@@ -3,10 +3,11 @@ worksheet of the language.
 
 :func:`import_file` reads the file safely (:mod:`.reader`, :mod:`.prime`: each format its
 reader, one translator of Mathcad's math for both), follows its reference regions,
-translates the regions in order (:mod:`.translate`) and writes ``NAME.toml`` with the
-printed values (Mathcad's stored results) beside it (:mod:`.writer`). A region the engine
-refuses when it loads the result is marked untranslated, with the engine's reason, and the
-translation is redone, so the written worksheet always loads.
+translates the regions in order (:mod:`.translate`), types the translation once in memory
+with the engine's typer (:mod:`.engine`), and writes ``NAME.toml`` with the printed values
+(Mathcad's stored results) beside it (:mod:`.writer`). A region the engine refuses is listed
+untranslated with the engine's reason, and so is everything that uses it: the written
+worksheet always loads.
 """
 
 from __future__ import annotations
@@ -98,7 +99,7 @@ def _reference_path(path: Path, href: str) -> Path:
 
 def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = False):
     """Translate ``src`` and write ``out_dir/NAME.toml`` and its printed values."""
-    from . import writer
+    from . import engine, writer
     from .translate import Translator
 
     src = Path(src)
@@ -112,17 +113,16 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
         regions = regions_with_references(ws)
     name = sheet_name(src)
     out_dir = Path(out_dir)
-    forced: dict[str, str] = {}
-    for _ in range(2 * len(regions) + 10):  # a region, or a trace of a plot, at a time
-        tr = Translator(forced).run(ws, regions)
-        rendered = writer.render(tr, name, src)
-        problem = writer.engine_problem(rendered, out_dir)
-        if problem is None:
-            break
-        region, why = problem
-        if region in forced:  # the same region again: give up rather than loop
-            raise WorkbookError(f"{src}: region {region} cannot be translated: {why}")
-        forced[region] = why
+    translator = Translator()
+    tr = translator.run(ws, regions)
+    doc, rendered = writer.document(tr, name, src)
+    refused = engine.refusals(doc.data, rendered, out_dir)
+    if refused:
+        engine.leave_out(tr, refused, _descriptions(translator, regions))
+        doc, rendered = writer.document(tr, name, src)
+    rendered.toml = doc.text()
+    if refused:  # what is left loads as it is: anything else is a bug of the import
+        _loads(rendered, out_dir)
     files = writer.write(rendered, out_dir, force=force)
     return ImportSummary(
         files[0],
@@ -131,3 +131,26 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
         len({s.region for s in tr.skipped}),
         files,
     )
+
+
+def _descriptions(translator, regions: list[Region]) -> dict[str, str]:
+    """Region id -> what it is, as the list of untranslated regions names it, in the order
+    the translator reads the regions (global definitions first)."""
+    out = {}
+    first = [r for r in regions if r.math is not None and r.math.tag == "globalDefine"]
+    for r in first + [r for r in regions if r not in first]:
+        out[r.id] = translator.describe(r.math) if r.math is not None else f"a {r.kind}"
+    return out
+
+
+def _loads(rendered, out_dir: Path) -> None:
+    """Load the written worksheet's text once; an error is the import's own (exit 3)."""
+    import workbook
+
+    try:
+        workbook.loads(rendered.toml, rendered.name, out_dir)
+    except WorkbookError as err:
+        raise RuntimeError(
+            f"the translated worksheet does not load after leaving out what the engine "
+            f"refused: {err}"
+        ) from None

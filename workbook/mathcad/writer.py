@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import csv
 import io
-import re
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import expr as ex
-from ..errors import InputError, WorkbookError
+from ..errors import InputError
 from .functions import language_functions
 from .tomldoc import Document, is_one_line, one_line
 from .translate import Item, Skipped, Sym, Translation, _rename
@@ -28,6 +26,9 @@ class Rendered:
     csv: dict[str, str] = field(default_factory=dict)
     definitions: int = 0
     region_of: dict[str, str] = field(default_factory=dict)  # identifier -> region id
+    #: chart name -> (region id, the number of Mathcad's trace of each series in order)
+    chart_of: dict[str, tuple[str, list[int]]] = field(default_factory=dict)
+    table_of: dict[str, str] = field(default_factory=dict)  # table name -> its range's region
 
 
 def pretty_unit(text: str) -> str:
@@ -135,6 +136,14 @@ class _Section:
 
 def render(tr: Translation, name: str, src: Path) -> Rendered:
     """The worksheet text and its CSV files."""
+    doc, out = document(tr, name, src)
+    out.toml = doc.text()
+    return out
+
+
+def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]:
+    """The worksheet as a TOML document (its data, not yet written as text) and its CSV files;
+    the document's text is left to :meth:`Document.text`, once the engine has typed it."""
     _assign(tr)
     _list_unknown_units(tr)
     mapping = {s.token(): s.final for s in tr.syms}
@@ -299,8 +308,9 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
             tables.append(table)
     for table in tables:
         _write_table(table, doc)
+        out.table_of[table["name"]] = table["region"]
     for item in charts:
-        _chart(item, mapping, doc)
+        _chart(item, mapping, doc, out)
     for fname, title, arg, from_solve in printed:
         doc.blank()
         doc.array_table("printed")
@@ -311,8 +321,7 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
         # Mathcad's solver stops at its TOL: its roots are that close
         doc.pair("rel_tolerance", tr.solve_tolerance if from_solve else REL_TOLERANCE)
         doc.pair("tolerance", ABS_TOLERANCE)
-    out.toml = doc.text()
-    return out
+    return doc, out
 
 
 def _list_unknown_units(tr: Translation) -> None:
@@ -384,7 +393,7 @@ def _solve(item: Item, mapping, out: Rendered, doc: Document) -> None:
     doc.blank()
 
 
-def _chart(item: Item, mapping, doc: Document) -> None:
+def _chart(item: Item, mapping, doc: Document, out: Rendered) -> None:
     """A [[charts]] entry: Mathcad's X-Y plot, one series per trace over its range."""
     series = [t for t in item.chart if not t[2].sym.broken]
     if not series:
@@ -409,6 +418,7 @@ def _chart(item: Item, mapping, doc: Document) -> None:
     doc.blank()
     doc.array_table("charts", f"Mathcad's plot {tag}")
     doc.pair("name", "plot_" + item.region, tag)
+    out.chart_of["plot_" + item.region] = (item.region, [n for *_, n in series])
     doc.pair("title", kind + ", region " + item.region)
     if polar:
         doc.pair("equal_axes", True)
@@ -442,6 +452,7 @@ def _table_for(tr: Translation, arg: str, mapping) -> dict | None:
     return {
         "comment": f"what Mathcad listed over {item.sym.mathcad} (region {item.region})",
         "name": "table_" + arg,
+        "region": item.region,
         "range": arg + " := " + _range_text(item, mapping),
         "columns": {f"{f}({arg})": "" for f in funcs},
     }
@@ -452,80 +463,6 @@ def _write_table(table: dict, doc: Document) -> None:
     doc.array_table("tables", table["comment"])
     for key in ("name", "range", "columns"):
         doc.pair(key, table[key])
-
-
-def engine_problem(rendered: Rendered, out_dir: Path) -> tuple[str, str] | None:
-    """Load the rendered worksheet with the engine: None if it loads, else (region, why)."""
-    import workbook
-
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"{rendered.name}.toml"
-        path.write_text(rendered.toml, encoding="utf-8")
-        for fname, text in rendered.csv.items():
-            (Path(tmp) / fname).write_text(text, encoding="utf-8")
-        try:
-            sheet = workbook.load(str(path))
-            _draw_charts(sheet)
-        except WorkbookError as err:
-            trace = _trace_of(err, rendered)
-            if trace is not None:  # one trace of a plot: the plot keeps the others
-                return trace, f"the engine cannot draw it: {err.message}"
-            region = _region_of(err, rendered)
-            if region is None:
-                raise WorkbookError(
-                    f"the translated worksheet does not load: {err.message}"
-                ) from None
-            return region, f"the engine refuses it: {err.message}"
-    return None
-
-
-def _draw_charts(sheet) -> None:
-    """Compute every series of the charts translated from plots, as ``workbook run`` will
-    (a trace Mathcad drew may fail here: an index beyond a vector), located at its line."""
-    for chart in sheet.spec.charts:
-        for s in chart.series:
-            rng = s.range or chart.range
-            what = f"chart {chart.name}"
-            try:
-                values = sheet.range_values(rng, what)
-                for col in (s.x, s.y):
-                    if col is not None:
-                        sheet.column(col, rng.var, values, what)
-            except WorkbookError as err:  # the chart's region, not the definition's
-                err.line, err.definition = chart.line, None
-                err.series = chart.series.index(s)
-                raise
-
-
-def _trace_of(err: WorkbookError, rendered: Rendered) -> str | None:
-    """'REGION/trace N' of the chart series that failed (its line's comment), or None."""
-    k = getattr(err, "series", None)
-    if k is None or not err.line:
-        return None
-    lines = rendered.toml.splitlines()[err.line :]
-    series = [
-        ln for ln in lines[: lines.index("]") if "]" in lines else None] if ln.startswith("  {")
-    ]
-    if k >= len(series):
-        return None
-    m = re.search(r"# \(region ([^,]+), trace (\d+)\)$", series[k])
-    return f"{m.group(1)}/trace {m.group(2)}" if m else None
-
-
-def _region_of(err: WorkbookError, rendered: Rendered) -> str | None:
-    if err.definition and err.definition in rendered.region_of:
-        return rendered.region_of[err.definition]
-    if err.definition and err.definition.startswith("solve "):  # a [[solve]] block's name
-        first = err.definition[len("solve ") :].split(",")[0].strip()
-        if first in rendered.region_of:
-            return rendered.region_of[first]
-    if err.line:
-        lines = rendered.toml.splitlines()
-        if 0 < err.line <= len(lines):
-            m = re.search(r"\(region ([^)]+)\)", lines[err.line - 1])
-            if m:
-                return m.group(1)
-    return None
 
 
 def write(rendered: Rendered, out_dir: Path, *, force: bool) -> list[Path]:
