@@ -8,6 +8,8 @@ tree, so the unit logic lives only here.
 
 from __future__ import annotations
 
+import contextlib
+import copy
 import functools
 import math
 import re
@@ -55,6 +57,14 @@ from .visitor import Visitor
 MAX_CHAIN = 100
 
 
+def _fresh(err: WorkbookError) -> WorkbookError:
+    """A copy of ``err`` with its own attributes (``copy.copy`` of an exception may share
+    them with the original)."""
+    out = copy.copy(err)
+    out.__dict__ = dict(err.__dict__)
+    return out
+
+
 class Typer(ArrayTyping, Visitor):
     """Types the definitions of one sheet (lazily, each once, with cycle detection).
 
@@ -82,6 +92,10 @@ class Typer(ArrayTyping, Visitor):
         self._assumed: dict[str, TypedFunction] = {}
         self._recursive: set[str] = set()
         self.recursive: set[str] = set()  # specialization keys of functions that call themselves
+        # typings that failed, by specialization key (("scalar", name) for a scalar): asked
+        # again, the same error is raised without typing again (see _remembered)
+        self._failed: dict[object, WorkbookError] = {}
+        self._assumption_reads = 0  # calls typed by an assumed unit (recursion), counted
 
     # -- public -------------------------------------------------------------------
     def sympy_converter(self, keep: set[str]):
@@ -99,9 +113,10 @@ class Typer(ArrayTyping, Visitor):
             d = self._definition(name)
             if d.is_function:
                 raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
-            body = self._typed_body(d, {})
-            if d.unit is not None:
-                body = self.convert(body, d.unit, _declared(name, d.unit))
+            with self._remembered(("scalar", name)):
+                body = self._typed_body(d, {})
+                if d.unit is not None:
+                    body = self.convert(body, d.unit, _declared(name, d.unit))
             self.scalars[name] = body
         return self.scalars[name]
 
@@ -150,14 +165,35 @@ class Typer(ArrayTyping, Visitor):
                 cycle = " -> ".join(self._stack[self._stack.index(name) :] + [name])
                 raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=name)
             self._recursive.add(key)
+            self._assumption_reads += 1
             return self._assumed[key]
         if key not in self.functions:
             d = self._definition(name)
             shapes = tuple(shapes) or (None,) * len(d.params)
             units = tuple(self.spec.arguments[p].binding_unit for p in d.params)
             scope = {p: u if sh is None else (u, sh) for p, u, sh in zip(d.params, units, shapes)}
-            self.functions[key] = self._settled(d, key, units, scope, shapes)
+            with self._remembered(key):
+                self.functions[key] = self._settled(d, key, units, scope, shapes)
         return self.functions[key]
+
+    @contextlib.contextmanager
+    def _remembered(self, key):
+        """Type under ``key`` remembering a failure: asked again, the error is raised again
+        without typing (a chain of functions over a failing one was typed through once per
+        function, quadratic in its length). A failure that rests on the unit assumed for a
+        call of a function inside its own body is not remembered (another assumption may
+        hold). One made because definitions nest more than ``MAX_CHAIN`` deep is, wherever
+        it happened in the chain: that chain is over the limit from any start."""
+        failed = self._failed.get(key)
+        if failed is not None:
+            raise _fresh(failed)
+        reads = self._assumption_reads
+        try:
+            yield
+        except WorkbookError as err:
+            if self._assumption_reads == reads:
+                self._failed[key] = _fresh(err)  # callers may rewrite the one they catch
+            raise
 
     def _settled(self, d: Definition, key: str, units, scope, shapes) -> TypedFunction:
         """Function ``d`` typed for one specialization. A function that calls itself (Mathcad
