@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from conftest import SINE
 
-from workbook import xlsx
+from workbook import excelform, xlsx
 from workbook.cli import main
 
 TEMPLATE = (
@@ -62,18 +62,37 @@ def leftovers(folder: Path) -> list[str]:
 @pytest.mark.parametrize("failure", [KeyboardInterrupt, RuntimeError])
 def test_failure_while_writing_keeps_the_previous_workbook(previous, monkeypatch, method, failure):
     before = digest(previous / "out.xlsx")
-    original = getattr(xlsx.WorkbookWriter, method)
+    original = getattr(excelform.ExcelLayout, method)
 
     def half_then_fail(self, *args, **kwargs):
         original(self, *args, **kwargs)  # something has been written to the temporary file
         raise failure("forced failure in the middle of writing")
 
-    monkeypatch.setattr(xlsx.WorkbookWriter, method, half_then_fail)
+    monkeypatch.setattr(excelform.ExcelLayout, method, half_then_fail)
     (previous / "s.toml").write_text(TEMPLATE.replace("10 mm", "12 mm"), encoding="utf-8")
     if failure is KeyboardInterrupt:
         assert main(["run", "s.toml", "--out", "out.xlsx"]) == 130
     else:  # an unexpected exception is an internal error: exit 3, one line
         assert main(["run", "s.toml", "--out", "out.xlsx"]) == 3
+    assert digest(previous / "out.xlsx") == before
+    assert leftovers(previous) == []
+
+
+@pytest.mark.parametrize("failure", [KeyboardInterrupt, RuntimeError])
+def test_failure_while_saving_keeps_the_previous_workbook(previous, monkeypatch, failure):
+    """The file itself: half of the laid-out cells written, then a failure."""
+    before = digest(previous / "out.xlsx")
+    original = xlsx._replay
+
+    def half_then_fail(wb, sheets, ops, formats):
+        original(wb, sheets, ops[: len(ops) // 2], formats)
+        raise failure("forced failure in the middle of writing")
+
+    monkeypatch.setattr(xlsx, "_replay", half_then_fail)
+    (previous / "s.toml").write_text(TEMPLATE.replace("10 mm", "12 mm"), encoding="utf-8")
+    assert main(["run", "s.toml", "--out", "out.xlsx"]) == (
+        130 if failure is KeyboardInterrupt else 3
+    )
     assert digest(previous / "out.xlsx") == before
     assert leftovers(previous) == []
 
@@ -112,14 +131,14 @@ from workbook.cli import main
 
 stage = sys.argv[1]
 def pause(original):
-    def run(self, *args, **kwargs):
-        out = original(self, *args, **kwargs)
+    def run(*args, **kwargs):
+        out = original(*args, **kwargs)
         Path("ready").write_text("writing")
         time.sleep(60)  # SIGINT arrives here
         return out
     return run
 if stage == "writing":
-    xlsx.WorkbookWriter.write_charts = pause(xlsx.WorkbookWriter.write_charts)
+    xlsx._replay = pause(xlsx._replay)  # the file is being written
 else:
     import workbook.sheet
     original = workbook.sheet.Sheet.check

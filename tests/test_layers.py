@@ -1,6 +1,7 @@
-"""The layer contract of pyproject.toml ([tool.importlinter]), run by import-linter: the
-renderers (workbook, Excel printer, live check, notebook, report) do not import the typer or
-the evaluator."""
+"""The layer contracts of pyproject.toml ([tool.importlinter]), run by import-linter: the
+renderers (xlsx, report, notebook, the CSV and sweep writers) read the computed sheet and
+import no typer, evaluator, numerics, programs, Sheet or Excel printer; the Excel printer and
+the live check import no typer or evaluator. tests/test_computed.py counts the calls."""
 
 from pathlib import Path
 
@@ -21,8 +22,8 @@ def test_the_renderers_keep_the_layer_contract():
 
 
 def test_a_broken_contract_is_reported(tmp_path):
-    """The same kind of contract on an import that exists (the writer imports the printer)
-    is reported broken: the contract above is not kept by accident."""
+    """The same kind of contract on an import that exists (the Excel form imports the
+    printer) is reported broken: the contract above is not kept by accident."""
     pytest.importorskip("importlinter")
     config = tmp_path / "contract.toml"
     config.write_text(
@@ -32,9 +33,9 @@ root_package = "workbook"
 exclude_type_checking_imports = true
 
 [[tool.importlinter.contracts]]
-name = "the writer does not import the printer"
+name = "the Excel form does not import the printer"
 type = "forbidden"
-source_modules = ["workbook.xlsx"]
+source_modules = ["workbook.excelform"]
 forbidden_modules = ["workbook.excel"]
 allow_indirect_imports = true
 """,

@@ -16,6 +16,7 @@ import workbook
 from workbook import expr as ex
 from workbook import units as un
 from workbook.cli import main
+from workbook.computed import compute
 from workbook.report import render
 from workbook.report.mathml import MathML, name_box
 
@@ -138,12 +139,12 @@ def _same(shown: float, engine: float, digits: int = 6) -> bool:
 
 @pytest.fixture(scope="module")
 def concave_report(concave) -> str:
-    return render(concave)
+    return render(compute(concave))
 
 
 def check_numbers(sheet, text: str | None = None) -> int:
     """Compare every number of the report of ``sheet`` with the engine; returns how many."""
-    doc = rp.parse(text or render(sheet))
+    doc = rp.parse(text or render(compute(sheet)))
     count = 0
     # inputs
     for row in doc.xpath("//table[@class='inputs']/tbody/tr"):
@@ -330,7 +331,7 @@ range = "t := -2 .. 2"
 columns = { f = "" }
 """,
     )
-    text = render(workbook.load(path))
+    text = render(compute(workbook.load(path)))
     assert "a &lt;b&gt; note" in text
     doc = rp.parse(text)
     assert "not computed" in doc.get_element_by_id("def-r").text_content()
@@ -340,11 +341,11 @@ columns = { f = "" }
 def test_long_tables_show_their_ends(tmp_path):
     path = write_template(tmp_path, SINE_TABLE.replace("0, 10 .. 90", "0, 0.05 .. 90"))
     sheet = workbook.load(path)
-    doc = rp.parse(render(sheet))
+    doc = rp.parse(render(compute(sheet)))
     rows = doc.get_element_by_id("table-t").xpath(".//tbody/tr")
     assert len(rows) == 21 and "1,781 rows not shown" in rows[10].text_content()
     assert rp.number(rows[-1].xpath("td")[0].text_content()) == 90
-    full = rp.parse(render(sheet, full_tables=True))
+    full = rp.parse(render(compute(sheet), full_tables=True))
     assert len(full.get_element_by_id("table-t").xpath(".//tbody/tr")) == 1801
 
 
@@ -409,8 +410,9 @@ def test_charts_leave_pyplot_alone_and_run_does_not_draw(tmp_path):
         "from workbook.cli import main\n"
         f"main(['run', 'concave-cam', '--out', {str(tmp_path / 'c.xlsx')!r}])\n"
         "print(sorted(m for m in ('matplotlib', 'workbook.report') if m in sys.modules))\n"
+        "from workbook.computed import compute\n"
         "from workbook.report import render\n"
-        "assert render(workbook.load('concave-cam')).count('<svg') == 2\n"
+        "assert render(compute(workbook.load('concave-cam'))).count('<svg') == 2\n"
         "print('matplotlib.pyplot' in sys.modules)\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -10,6 +10,7 @@ import pytest
 from chromium import measure, pdf_pages, pdf_text, screenshots
 
 import workbook
+from workbook.computed import compute
 from workbook.report import write_report
 from workbook.report.pdf import chromium
 
@@ -26,7 +27,7 @@ if os.environ.get("CI") and not shutil.which("pdftoppm"):
 @pytest.mark.parametrize("name", list(workbook.list_templates()))
 def test_the_report_prints_on_a4(name, tmp_path):
     sheet = workbook.load(name)
-    html, pdf = write_report(sheet, tmp_path / f"{name}.html", pdf=True)
+    html, pdf = write_report(compute(sheet), tmp_path / f"{name}.html", pdf=True)
     found = measure(html.read_text(encoding="utf-8"))
     assert found["display"] == "math"  # Chromium lays <math> out as MathML
     assert found["stacked"] > 0 and found["flat"] == 0, found  # fractions are stacked

@@ -69,6 +69,7 @@ def test_run_prints_the_unknowns_as_results(tmp_path):
 def test_the_results_sheet_and_the_report_show_the_block(tmp_path):
     import openpyxl
 
+    from workbook.computed import compute
     from workbook.report import write_report
 
     sheet = workbook.load(write_template(tmp_path, SHEET))
@@ -80,7 +81,7 @@ def test_the_results_sheet_and_the_report_show_the_block(tmp_path):
     assert rows["x"][1] == pytest.approx(1.91067297825, abs=1e-10) and rows["x"][2] == "m"
     assert rows["x"][3] == "Given x^2 + y^2 == R^2; y == x*tan(theta): Find(x, y)"
     assert "condition number 1.51" in rows["x"][4]
-    html = write_report(sheet, tmp_path / "s.html")[0].read_text(encoding="utf-8")
+    html = write_report(compute(sheet), tmp_path / "s.html")[0].read_text(encoding="utf-8")
     assert "<div class='definition given'>" in html and "guesses: x = 1 m, y = 0.5 m" in html
     assert "Find(x, y): x = 1.91067" in html and "condition number 1.8e+10" in html
 

@@ -205,7 +205,9 @@ def cmd_run(args) -> int:
     warning or fail are printed; exit 1 (after writing) when one fails. Printed values that an
     override (--set) no longer reproduces are counted in the summary, not an error."""
     from .atomic import Outputs, write_csv
+    from .computed import compute
     from .errors import InputError
+    from .xlsx import write_workbook
 
     if args.out and Path(args.out).suffix.lower() != ".xlsx":
         raise InputError(
@@ -229,16 +231,16 @@ def cmd_run(args) -> int:
         xlsx_tmp = outs.add(out, "xlsx")
         csv_tmps = {table: outs.add(path, "csv") for table, path in csv_paths.items()}
         export_tmp = outs.add(Path(args.export), "csv") if exporter else None
-        frames = {table: sheet.table(table) for table in args.csv}  # all computed first
-        report = sheet.check()
-        for table, frame in frames.items():
-            write_csv(frame, csv_tmps[table])
+        for table in args.csv:  # a table that is not there is said before any work
+            sheet.table_spec(table)
+        computed = compute(sheet, excel=True, command=_command_line(args))
+        report = computed.check_report()
+        for table in args.csv:
+            write_csv(computed.frame(table), csv_tmps[table])
         if exporter is not None:
             exporter(sheet, export_tmp)
-        refusals: list = []
-        sheet.write_xlsx(
-            xlsx_tmp, force=True, command=_command_line(args), report=report, refusals=refusals
-        )
+        write_workbook(computed, xlsx_tmp, force=True)
+        refusals = computed.excel.refusals
     for path in csv_paths.values():
         print(f"wrote {path}")
     if exporter is not None:
@@ -301,7 +303,8 @@ def _print_findings(report) -> int:
 
 
 def cmd_report(args) -> int:
-    from .report import regenerate_command, write_report
+    from .computed import compute
+    from .report import regenerate_command, report_targets, write_report
 
     sheet = load_sheet(args, args.part or None)
     command = regenerate_command(sheet, parse_sets(args.set))
@@ -309,9 +312,12 @@ def cmd_report(args) -> int:
         command += " --full-tables"
     if args.pdf:
         command += " --pdf"
+    path, _ = report_targets(
+        sheet.name, Path(args.out) if args.out else None, pdf=args.pdf, force=args.force
+    )
     written = write_report(
-        sheet,
-        Path(args.out) if args.out else None,
+        compute(sheet),
+        path,
         pdf=args.pdf,
         force=args.force,
         command=command,

@@ -139,8 +139,9 @@ class CellLog:
 
 
 class RecordingSheet:
-    """An xlsxwriter worksheet that records what is written into a :class:`CellLog`, and
-    writes a refused formula as its cached value with a comment."""
+    """An Excel sheet being laid out (:class:`workbook.excelform.FormSheet`) that records
+    what is written into a :class:`CellLog`, and writes a refused formula as its cached value
+    with a comment."""
 
     def __init__(self, ws, log: CellLog, refused: dict[tuple[str, int, int], str]):
         self._ws, self._log, self._refused = ws, log, refused
@@ -189,6 +190,14 @@ class RecordingSheet:
         return self._ws.write_array_formula(
             first_row, first_col, last_row, last_col, formula, fmt, value
         )
+
+    def write_formula_column(self, first, col, pieces, values, fmt=None, array=False, label=""):
+        """A formula down a column (``pieces`` joined by each row's number), checked as one
+        (:meth:`CellLog.column`); the caller lays a refused column out as values."""
+        self._log.column(self.name, col, first, len(values), pieces)
+        name = self.name
+        self._log.values.update(((name, first + i, col), v) for i, v in enumerate(values))
+        return self._ws.write_formula_column(first, col, pieces, values, fmt, array, label)
 
     def _write_cached(self, row, col, value, fmt) -> None:
         if isinstance(value, str):

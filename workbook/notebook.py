@@ -3,7 +3,8 @@
 Jupyter calls the Sheet's ``_repr_html_``, which is :func:`sheet_html`: what ``workbook
 report`` writes (:mod:`workbook.report`). Tables are pandas DataFrames with the unit in every header
 (``sheet.table(name)``, :func:`tables`). A value that fails is shown with its error instead of
-breaking the display.
+breaking the display. Each function reads a computed sheet (:func:`workbook.computed.compute`);
+given a Sheet, it computes it first.
 """
 
 from __future__ import annotations
@@ -11,7 +12,13 @@ from __future__ import annotations
 import html
 
 from . import units as un
+from .computed import ComputedSheet, compute
 from .errors import WorkbookError
+
+
+def computed(sheet) -> ComputedSheet:
+    """``sheet`` computed (as the report computes it), or itself if it already is."""
+    return sheet if isinstance(sheet, ComputedSheet) else compute(sheet)
 
 
 def inputs_frame(sheet):
@@ -32,18 +39,21 @@ def definitions_frame(sheet):
     """Scalar definitions with their values (or the error that stops them)."""
     import pandas as pd
 
+    sheet = computed(sheet)
     rows = []
     for name, d in sheet.spec.definitions.items():
         if d.is_function:
             continue
         try:
-            q = sheet.evaluate(name)
-            unit = d.unit or q.units
-            q = q.to(unit)
+            scalar = sheet.scalars[name]
+            if scalar.error is not None:
+                raise scalar.error
+            q = scalar.value
+            q = q.to(d.unit or q.units)
             value, shown = float(q.magnitude), un.pretty(q.units)
         except WorkbookError as err:
             value, shown = f"error: {err.message}", ""
-        except Exception as err:  # a solver block failing in its own way
+        except Exception as err:  # noqa: BLE001 - a solver block failing in its own way
             value, shown = f"error: {type(err).__name__}: {err}", ""
         rows.append((name, value, shown, d.text, d.note))
     return pd.DataFrame(rows, columns=["name", "value", "unit", "formula", "note"])
@@ -53,21 +63,21 @@ def functions_frame(sheet):
     """Functions: signature, unit, formula, note."""
     import pandas as pd
 
+    sheet = computed(sheet)
     rows = []
     for name, d in sheet.spec.definitions.items():
         if not d.is_function:
             continue
-        try:
-            unit = un.pretty(d.unit or sheet.typer.function(name).unit)
-        except WorkbookError:
-            unit = ""
+        unit = sheet.function_units.get(name)
+        unit = "" if unit is None else un.pretty(unit)
         rows.append((f"{name}({', '.join(d.params)})", unit, d.text, d.note))
     return pd.DataFrame(rows, columns=["function", "unit", "formula", "note"])
 
 
 def tables(sheet) -> dict:
     """Every range table as a DataFrame (unit in every header); block tables are skipped."""
-    return {t.name: sheet.table(t.name) for t in sheet.spec.tables if not t.block}
+    sheet = computed(sheet)
+    return {t.name: sheet.frame(t.name) for t in sheet.spec.tables if not t.block}
 
 
 def _choice_note(spec) -> str:
@@ -81,6 +91,6 @@ def sheet_html(sheet) -> str:
     from .report import fragment
 
     try:
-        return fragment(sheet)
+        return fragment(computed(sheet))
     except Exception as err:  # the display must not fail
         return f"<p>{html.escape(sheet.name)}: error: {html.escape(str(err))}</p>"

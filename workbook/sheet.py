@@ -25,6 +25,7 @@ from .template import (
     ColumnSpec,
     SheetSpec,
     check_input_value,
+    column_node,
     resolve_parts,
     select_parts,
 )
@@ -514,7 +515,7 @@ class Sheet:
 
     def column_node(self, col: ColumnSpec, var: str) -> ex.Node:
         """A bare function name as a column means that function of the range variable."""
-        return tc.column_node(self.spec, col, var)
+        return column_node(self.spec, col, var)
 
     def typed_column(self, col: ColumnSpec, var: str, what: str) -> tc.T:
         try:
@@ -694,18 +695,38 @@ class Sheet:
             )
         return self._memo[key]
 
-    def write_xlsx(self, path, **options) -> Path:
-        """Write the workbook (atomically); returns the path written."""
+    def write_xlsx(
+        self,
+        path,
+        *,
+        force: bool = False,
+        command: str | None = None,
+        report=None,
+        verify: bool = True,
+        refusals: list | None = None,
+    ) -> Path:
+        """Write the workbook (atomically); returns the path written. ``report``: the check
+        report if already made; ``verify``: check every live formula with an independent
+        evaluator first (one that disagrees is written as the engine's value, and appended
+        to ``refusals`` when given)."""
+        from .atomic import check_target
+        from .computed import compute
         from .xlsx import write_workbook
 
-        return write_workbook(self, Path(path), **options)
+        check_target(Path(path), force=force)  # before any work
+        computed = compute(self, report=report, excel=True, command=command, verify=verify)
+        if refusals is not None:
+            refusals.extend(computed.excel.refusals)
+        return write_workbook(computed, Path(path), force=force)
 
     def report(self, path=None, pdf: bool = False, **options) -> Path:
         """Write the calculation as a document: ``path`` (default ``reports/NAME.html``) and,
         with ``pdf``, the PDF beside it (needs Chromium). Returns the HTML path."""
-        from .report import write_report
+        from .computed import compute
+        from .report import report_targets, write_report
 
-        return write_report(self, path, pdf=pdf, **options)[0]
+        path, _ = report_targets(self.name, path, pdf=pdf, force=options.get("force", False))
+        return write_report(compute(self), path, pdf=pdf, **options)[0]
 
     def check(self):
         """Compare with the printed values; returns a :class:`workbook.checks.Report`."""

@@ -1275,3 +1275,13 @@ def _value_line(text: str, value: str) -> int | None:
         if value in line:
             return number
     return None
+
+
+def column_node(spec: SheetSpec, col, var: str) -> ex.Node:
+    """A bare one-argument function name as a column means that function of the range variable."""
+    node = col.node
+    if isinstance(node, ex.Name):
+        d = spec.definitions.get(node.id)
+        if d is not None and d.is_function and len(d.params) == 1:
+            return ex.Call(node.id, (ex.Name(var),))
+    return node

@@ -21,7 +21,7 @@ from . import units as un
 from .errors import LimitError, ShapeError, TemplateError, UnitError, WorkbookError
 from .fields import nearest
 from .registry import CONSTANTS, REGISTRY
-from .template import Definition, SheetSpec
+from .template import Definition, SheetSpec, column_node
 from .typearrays import ArrayTyping
 from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
     RUNTIME,
@@ -901,16 +901,6 @@ def _shape_key(shape) -> str:
 def _key_of(key: str) -> str:
     """The function a specialization key belongs to."""
     return key.split("@", 1)[0]
-
-
-def column_node(spec: SheetSpec, col, var: str) -> ex.Node:
-    """A bare one-argument function name as a column means that function of the range variable."""
-    node = col.node
-    if isinstance(node, ex.Name):
-        d = spec.definitions.get(node.id)
-        if d is not None and d.is_function and len(d.params) == 1:
-            return ex.Call(node.id, (ex.Name(var),))
-    return node
 
 
 def column_type(typer: Typer, col, var: str, what: str) -> T:

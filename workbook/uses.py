@@ -3,7 +3,7 @@
 Tables, charts, printed values (and, for the hand checks, relations, findings, checks,
 [[solve]] blocks and [[ode]] sections) are the outputs; :func:`names_used` follows their
 expressions through the definitions to the inputs and blocks they need. The writer writes only
-those (``xlsx.needed_names``), ``Sheet`` reports the inputs nothing uses, and the analysis
+those (``excelform.needed_names``), ``Sheet`` reports the inputs nothing uses, and the analysis
 finds the ranges that show a function.
 """
 
@@ -15,7 +15,7 @@ from .declared_checks import placeholders
 from .errors import WorkbookError
 from .printed import read_printed
 from .ranges import RangeSpec
-from .template import SheetSpec
+from .template import SheetSpec, column_node
 
 
 def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
@@ -23,16 +23,16 @@ def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
     out = []
     for t in spec.tables:
         if t.range is not None:
-            out.append((t.range, [tc.column_node(spec, c, t.range.var) for c in t.columns]))
+            out.append((t.range, [column_node(spec, c, t.range.var) for c in t.columns]))
     for c in spec.charts:
         for s in c.series:
             rng = s.range or c.range
             if s.table is not None or rng is None:
                 continue
-            nodes = [tc.column_node(spec, s.y, rng.var)]
+            nodes = [column_node(spec, s.y, rng.var)]
             x = s.x or c.x
             if x is not None:
-                nodes.append(tc.column_node(spec, x, rng.var))
+                nodes.append(column_node(spec, x, rng.var))
             out.append((rng, nodes))
     return out
 

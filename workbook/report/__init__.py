@@ -13,7 +13,7 @@ from ..atomic import check_target, replacing
 from ..errors import InputError
 from .html import fragment, regenerate_command, render
 
-__all__ = ["fragment", "regenerate_command", "render", "write_report"]
+__all__ = ["fragment", "regenerate_command", "render", "report_targets", "write_report"]
 
 _GENERATOR = "<meta name='generator' content='workbook report"
 
@@ -31,8 +31,30 @@ def _check_output(path: Path, kind: str, force: bool) -> None:
         raise InputError(f"{path} exists and is not {what}; use --force to overwrite it")
 
 
+def report_targets(
+    name: str, path: Path | str | None = None, *, pdf: bool = False, force: bool = False
+) -> tuple[Path, str | None]:
+    """The report's HTML path (default ``reports/NAME.html``) and, with ``pdf``, Chromium:
+    both checked before any work (a missing Chromium or a file of another kind is said at
+    once)."""
+    if path is None:
+        path = Path("reports") / f"{name}.html"
+        path.parent.mkdir(parents=True, exist_ok=True)
+    path = Path(path)
+    if path.with_suffix(".pdf") == path:
+        raise InputError(f"{path}: the report is HTML; give a .html path (the PDF goes beside it)")
+    _check_output(path, "html", force)
+    exe = None
+    if pdf:
+        from .pdf import require_chromium
+
+        exe = require_chromium()
+        _check_output(path.with_suffix(".pdf"), "pdf", force)
+    return path, exe
+
+
 def write_report(
-    sheet,
+    computed,
     path: Path | str | None = None,
     *,
     pdf: bool = False,
@@ -40,23 +62,12 @@ def write_report(
     command: str | None = None,
     full_tables: bool = False,
 ) -> list[Path]:
-    """Write the report of ``sheet`` to ``path`` (default ``reports/NAME.html``) and, with
-    ``pdf``, the PDF beside it (same name, ``.pdf``). Returns the paths written."""
-    if path is None:
-        path = Path("reports") / f"{sheet.name}.html"
-        path.parent.mkdir(parents=True, exist_ok=True)
-    path = Path(path)
+    """Write the report of ``computed`` (a :class:`workbook.computed.ComputedSheet`) to
+    ``path`` (default ``reports/NAME.html``) and, with ``pdf``, the PDF beside it (same name,
+    ``.pdf``). Returns the paths written."""
+    path, exe = report_targets(computed.name, path, pdf=pdf, force=force)
     pdf_path = path.with_suffix(".pdf")
-    if pdf_path == path:
-        raise InputError(f"{path}: the report is HTML; give a .html path (the PDF goes beside it)")
-    _check_output(path, "html", force)
-    exe = None
-    if pdf:
-        from .pdf import require_chromium
-
-        exe = require_chromium()  # before any work: a missing Chromium is said at once
-        _check_output(pdf_path, "pdf", force)
-    text = render(sheet, command=command, full_tables=full_tables)
+    text = render(computed, command=command, full_tables=full_tables)
     written = []
     with replacing(path) as tmp:
         tmp.write_text(text, encoding="utf-8")

@@ -2,8 +2,8 @@
 
 matplotlib is imported here only (reports draw charts; ``workbook run`` does not). A
 ``Figure`` is drawn without pyplot, so no display is needed and the backend a notebook chose
-is left alone. The data are the engine's: the same range values and
-columns the workbook writes, or the block table a series names.
+is left alone. The data are the computed sheet's (:mod:`workbook.computed`): the same range
+values and columns the workbook writes, or the block table a series names.
 """
 
 from __future__ import annotations
@@ -18,21 +18,11 @@ WIDTH_IN, HEIGHT_IN = 6.6, 3.7  # fits the A4 text width
 
 
 def series_data(sheet, chart, s) -> tuple[np.ndarray, np.ndarray]:
-    """x and y of one series, as the engine computes them."""
-    if s.table is not None:
-        df = sheet.computed_table(s.table)
-        return (
-            np.asarray(df[s.x_column], dtype=float),
-            np.asarray(df[s.y_column], dtype=float),
-        )
-    rng = s.range or chart.range
-    what = f"chart {chart.name}"
-    x = sheet.range_values(rng, what)
-    y = sheet.column(s.y, rng.var, x, what).values
-    xcol = s.x or chart.x
-    if xcol is not None and not (xcol.unit is None and getattr(xcol.node, "id", None) == rng.var):
-        x = sheet.column(xcol, rng.var, x, what).values
-    return x, y
+    """x and y of one series of a computed sheet, as the engine computed them."""
+    series = sheet.series[(chart.name, chart.series.index(s))]
+    if isinstance(series, BaseException):
+        raise series
+    return np.asarray(series.x, dtype=float), np.asarray(series.y, dtype=float)
 
 
 def chart_svg(sheet, chart) -> str:

@@ -18,6 +18,7 @@ import numpy as np
 from .. import expr as ex
 from .. import units as un
 from ..errors import WorkbookError
+from ..template import column_node
 from ..verdicts import NOT_FAILED
 from ..version import __version__
 from . import mathml as mm
@@ -41,7 +42,8 @@ def _error_text(err: BaseException) -> str:
 
 
 class Values:
-    """The engine's values of a sheet's inputs and scalar definitions, each computed once."""
+    """The computed values of a sheet's inputs and scalar definitions, as the report shows
+    them."""
 
     def __init__(self, sheet):
         self.sheet = sheet
@@ -51,8 +53,11 @@ class Values:
         """A scalar definition's value and unit (its display unit), or the error."""
         if name not in self._results:
             d = self.sheet.spec.definitions[name]
+            scalar = self.sheet.scalars[name]
             try:
-                q = self.sheet.evaluate(name)
+                if scalar.error is not None:
+                    raise scalar.error
+                q = scalar.value
                 if isinstance(q, str):  # a text: "OK"
                     self._results[name] = q
                     return q
@@ -160,7 +165,7 @@ def _too_wide(box: Box, lead: float = 0.0) -> bool:
 
 
 class Document:
-    """Builds the report of one sheet."""
+    """Builds the report of one computed sheet (:class:`workbook.computed.ComputedSheet`)."""
 
     def __init__(self, sheet, *, command: str | None = None, full_tables: bool = False):
         self.sheet = sheet
@@ -284,8 +289,12 @@ class Document:
                 f"{escape(find)}, solved at each value of {escape(at)}</p></div>"
             )
         try:
-            values = [self.sheet.evaluate(n) for n in block.unknowns]
-            solved = self.sheet.solution(block)
+            found = [self.sheet.unknowns[n] for n in block.unknowns]
+            error = next((u.error for u in found if u.error is not None), None)
+            if error is not None:
+                raise error
+            values = [u.value for u in found]
+            solved = found[0].solution
             shown = "; ".join(
                 f"{n} = {num_html(float(q.magnitude))} {escape(un.pretty(q.units))}".rstrip()
                 + f" (error estimate {solved.errors.get(n, float('nan')):.2g})"
@@ -316,10 +325,8 @@ class Document:
         notes = [d.note] if d.note else []
         error = ""
         if d.is_function:
-            try:
-                unit = un.pretty(d.unit or self.sheet.typer.function(d.name).unit)
-            except Exception:
-                unit = ""
+            unit = self.sheet.function_units.get(d.name)
+            unit = "" if unit is None else un.pretty(unit)
             if unit:
                 notes.append(f"in {unit}")
             shown = self._shown_in(d.name)
@@ -367,7 +374,7 @@ class Document:
         out = []
         for t in self.spec.tables:
             if t.range is not None and any(
-                name in ex.names(self.sheet.column_node(c, t.range.var)) for c in t.columns
+                name in ex.names(column_node(self.spec, c, t.range.var)) for c in t.columns
             ):
                 out.append(f"table {t.name}")
         for c in self.spec.charts:
@@ -375,7 +382,7 @@ class Document:
             if any(
                 s.table is None
                 and (s.range or rng) is not None
-                and name in ex.names(self.sheet.column_node(s.y, (s.range or rng).var))
+                and name in ex.names(column_node(self.spec, s.y, (s.range or rng).var))
                 for s in c.series
             ):
                 out.append(f"chart {c.name}")
@@ -400,7 +407,7 @@ class Document:
         return "".join(out)
 
     def range_table(self, t) -> str:
-        data = self.sheet.table_data(t.name)
+        data = self.sheet.table(t.name)
         rng = t.range
         first = self.formula.box(rng.first)
         if rng.second is not None:
@@ -421,7 +428,7 @@ class Document:
             )
         heads = []
         for i, col in enumerate(data.columns):
-            node = ex.Name(rng.var) if i == 0 else self.sheet.column_node(t.columns[i - 1], rng.var)
+            node = ex.Name(rng.var) if i == 0 else column_node(self.spec, t.columns[i - 1], rng.var)
             try:
                 sym = mm.math_element(self.formula.box(node))
             except Exception:
@@ -441,7 +448,7 @@ class Document:
         return f"<p class='range'>{range_math}: {rows}</p>" + self._grid(heads, columns, n) + failed
 
     def computed_table(self, t) -> str:
-        df = self.sheet.computed_table(t.name)
+        df = self.sheet.table(t.name)
         heads = []
         for name in df.columns:
             m = re.match(r"^(.*?)\s*\[(.*)\]$", str(name))
@@ -525,7 +532,7 @@ class Document:
     def checks(self) -> str:
         if not (self.spec.printed or self.spec.findings or self.spec.relations):
             return ""
-        report = self.sheet.check()
+        report = self.sheet.check_report()
         out = []
         by_source: dict[str, list] = {}
         for r in report.rows:
@@ -764,7 +771,8 @@ def page_css(title: str) -> str:
 
 
 def render(sheet, *, command: str | None = None, full_tables: bool = False) -> str:
-    """The report of ``sheet`` as a complete HTML document (inline CSS, no script)."""
+    """The report of ``sheet`` (a :class:`workbook.computed.ComputedSheet`) as a complete
+    HTML document (inline CSS, no script)."""
     doc = Document(sheet, command=command, full_tables=full_tables)
     with np.errstate(all="ignore"):
         body = doc.body()
@@ -778,7 +786,8 @@ def render(sheet, *, command: str | None = None, full_tables: bool = False) -> s
 
 
 def fragment(sheet, *, full_tables: bool = False) -> str:
-    """The same report as an HTML fragment with its scoped style (for notebooks)."""
+    """The same report of a computed sheet as an HTML fragment with its scoped style (for
+    notebooks)."""
     doc = Document(sheet, full_tables=full_tables)
     with np.errstate(all="ignore"):
         body = doc.body()
