@@ -62,8 +62,8 @@ class Raw:
     def __init__(self, sheet):
         from workbook import units as un
         from workbook.excel import ExcelPrinter, excel_name
+        from workbook.excelform import ROW_TOKEN
         from workbook.units import header
-        from workbook.xlsx import ROW_TOKEN
 
         data = sheet.table_data("big")
         printer = ExcelPrinter(sheet.typer)

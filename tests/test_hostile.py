@@ -18,7 +18,7 @@ import time
 
 import pytest
 
-from workbook import expr, numeric, ode, ranges, runtime, sheet, template, typecheck, xlsx
+from workbook import excelform, expr, numeric, ode, ranges, runtime, sheet, template, typecheck
 from workbook import limits as file_limits
 from workbook.numerics import derivative
 from workbook.sweep.driver import MAX_SWEEP_POINTS
@@ -276,7 +276,7 @@ def test_limits_are_documented():
         numeric.MAX_RECURSIVE_CALLS,
         runtime.MAX_NESTING,
         runtime.MAX_RUNTIME_ELEMENTS,
-        xlsx.MAX_ARRAY_CELLS,
+        excelform.MAX_ARRAY_CELLS,
         derivative.MAX_DIFF_NODES,
         sheet.MAX_FAMILY_CELLS,
         MAX_CASES,
@@ -356,7 +356,7 @@ RUNTIME_HOSTILE = {
     "too_many_cells_to_write": (
         '[definitions]\nI = "identity(2000)"\n',
         2,
-        f"at most {xlsx.MAX_ARRAY_CELLS:,} cells",
+        f"at most {excelform.MAX_ARRAY_CELLS:,} cells",
     ),
     "branching_recursion": (
         program("return n if n < 2\np(n - 1) + p(n - 2)", "p(30)"),

@@ -54,6 +54,34 @@ class PrintContext:
     helpers: object = None
 
 
+@dataclasses.dataclass(frozen=True)
+class BoundBody:
+    """EXPR of a built-in that binds a variable (``root(EXPR, x, a, b)``), as the entry's
+    Excel hook receives it: ``body(text)`` prints EXPR with the variable replaced by
+    ``text`` (a cell, a node array); ``tree(t)`` prints another typed tree in the call's scope
+    (diff's derivative)."""
+
+    printer: ExcelPrinter
+    subst: dict
+    typed: tc.T  # EXPR's typed tree
+    var: str  # the variable it binds
+    var_param: tc.T  # the variable as typed
+    rest: tuple  # the other arguments, typed
+    helpers: object  # the context's helper cells (None outside one)
+    scope: tuple  # the printed values of the variables around the call
+
+    @property
+    def typer(self) -> Typer:
+        """The typer of the sheet (for a tree built from EXPR: diff's derivative)."""
+        return self.printer.typer
+
+    def __call__(self, value: str) -> str:
+        return self.printer.print(self.typed, {**self.subst, self.var: value})
+
+    def tree(self, tree: tc.T) -> tuple[str, int]:
+        return self.printer.visit(tree, self.subst)
+
+
 class Formula(str):
     """A printed formula (``=...``); ``array`` is true when it computes with vectors or
     matrices (the writer writes it as an array formula)."""
@@ -188,17 +216,9 @@ class ExcelPrinter(Visitor):
         rest = [a for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
         consts = [a.value if isinstance(a, tc.TConst) else None for a in rest]
 
-        def printed(value: str) -> str:
-            return self.print(body, {**s, var: value})
-
-        # EXPR's typed tree, the variable and the other arguments as printed.typed, .var, .rest;
-        # printed.tree(t) prints another typed tree in the call's scope
-        printed.helpers = self.helpers
-        printed.scope = tuple(s.values())  # the printed values of the variables around it
-        printed.typed, printed.var, printed.rest = body, var, rest
-        # another tree printed in the call's scope (diff's derivative) and the sheet's typer
-        printed.var_param, printed.typer = t.args[var_at], self.typer
-        printed.tree = lambda tree: self.visit(tree, s)
+        printed = BoundBody(
+            self, s, body, var, t.args[var_at], tuple(rest), self.helpers, tuple(s.values())
+        )
         return entry.excel(printed, [self.print(a, s) for a in rest], consts)
 
     def visit_TCall(self, t, s):
