@@ -48,6 +48,8 @@ KNOWN_ELSEWHERE = {
     ("mathcad/translate.py", ("abs", "mag", "max", "min", "mod")),
     ("mathcad/translate.py", ("acos", "asin", "atan", "cos", "exp", "ln", "log10", "sin", "tan")),
     ("mathcad/translate.py", ("ceil", "floor", "round", "trunc")),
+    # the sizes the import-time value reader takes of a matrix written out
+    ("mathcad/translate.py", ("cols", "length", "rows")),
     ("mathcad/translate.py", ("acos", "asin", "atan", "ln")),
     (
         "mathcad/translate.py",

@@ -356,7 +356,8 @@ def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
         raise UnitError(f"sum(): the index {var.name} must be a plain number (integers A..B)")
     a = ctx.plain(a, "sum(): the first index")
     b = ctx.plain(b, "sum(): the last index")
-    return ty.TFunc(body.unit, func=name, args=(body, var, a, b))
+    # a sum of vectors or matrices (of one shape, or of a run-time array) has their shape
+    return ty.TFunc(body.unit, func=name, args=(body, var, a, b), shape=body.shape)
 
 
 def _bound(value, which: str) -> int:

@@ -205,7 +205,8 @@ class ExcelPrinter(Visitor):
 
     def visit_TFunc(self, t, s):
         entry = REGISTRY[t.func]
-        if entry.arrays and any(a.shape is not None for a in t.args):
+        bound = entry.binds is not None and len(t.args) > max(entry.binds)  # sum(EXPR, I, A, B)
+        if entry.arrays and not bound and any(a.shape is not None for a in t.args):
             self._array = True
             shapes = tuple(a.shape for a in t.args)
             return entry.excel([self.print(a, s) for a in t.args], shapes=shapes)

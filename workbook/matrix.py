@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from . import factorizations
 from .errors import DomainError, InputError
 from .excel_functions import stored
 
@@ -554,6 +555,55 @@ def register_entries() -> None:
         lambda m, shapes: rank(m),
         not_live("the rank of a matrix has no spreadsheet formula"),
         "rank of a matrix (the number of independent rows)",
+    )
+
+    # factorizations (workbook.factorizations): Mathcad's choices of pivot
+    def r_lu(ctx, name, args):
+        n = square(args, name)
+        if args[0].unit.dimensionality:
+            raise UnitError(
+                f"lu(): the matrix is in {pretty(args[0].unit)}; P and L are plain and U in the "
+                "matrix's unit, and augment(P, L, U) is one matrix of one unit: divide the "
+                "matrix by its unit"
+            )
+        plain = ctx.convert(args[0], ctx.dimensionless, "lu(M)")
+        return func(ctx.dimensionless, name, [plain], (n, 3 * n))
+
+    def r_rref(ctx, name, args):
+        # rref(c M) = rref(M): the result is plain whatever the unit of M
+        return func(ctx.dimensionless, name, args, need(args, 0, name, "a matrix"))
+
+    def r_geninv(ctx, name, args):
+        r, c = need(args, 0, name, "a matrix")
+        if r < c:
+            raise TemplateError(
+                f"geninv() needs at least as many rows as columns, got a {shape_text((r, c))}"
+            )
+        return func(1 / args[0].unit, name, args, (c, r))
+
+    entry(
+        "lu",
+        1,
+        r_lu,
+        lambda m, shapes: factorizations.lu(m),
+        not_live("an LU factorization has no spreadsheet formula"),
+        "lu(M): augment(P, L, U) with P M = L U (Mathcad's lu: Crout's method, its pivots)",
+    )
+    entry(
+        "rref",
+        1,
+        r_rref,
+        lambda m, shapes: factorizations.rref(m),
+        not_live("the reduced row echelon form has no spreadsheet formula"),
+        "rref(M): the reduced row echelon form of M",
+    )
+    entry(
+        "geninv",
+        1,
+        r_geninv,
+        lambda m, shapes: factorizations.geninv(m, SINGULAR_COND),
+        not_live("the generalized inverse has no spreadsheet formula"),
+        "geninv(M): the left inverse of a matrix of independent columns (Mathcad's geninv)",
     )
 
     def r_polyroots(columns: int):

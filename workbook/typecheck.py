@@ -828,7 +828,14 @@ class Typer(ArrayTyping, Visitor):
             else:
                 args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         self.scope = scope
-        return entry.unit_rule(self, name, tuple(args))
+        typed = entry.unit_rule(self, name, tuple(args))
+        body = args[expr_at]
+        if body.shape is not None and typed.shape is None:  # never a matrix taken as a number
+            raise TemplateError(
+                f"{name}(): the expression is a {shape_text(body.shape)}; {name}() takes an "
+                "expression that is a number"
+            )
+        return typed
 
     def _data_call(self, node: ex.Call, scope) -> T:
         """A built-in reading [data] columns: those arguments are column names (their values)."""

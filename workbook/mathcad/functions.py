@@ -32,6 +32,7 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "csort": ("csort", None), "rsort": ("rsort", None), "sort": ("sort", None),
     "reverse": ("reverse", None),
     "eigenvec": ("eigenvec", None), "rank": ("rank", None), "polyroots": ("polyroots", None),
+    "lu": ("lu", None), "rref": ("rref", None), "geninv": ("geninv", None),
     "histogram": ("histogram", None), "concat": ("concat", None), "num2str": ("num2str", None),
     # probability distributions (workbook.distributions)
     "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),

@@ -58,6 +58,8 @@ class Result:
     unit: str
     rows: list[tuple[float | None, float | str]]
     argument: Sym | None = None
+    # a difference a - b: the largest value Mathcad stored of a or b (its round-off scale)
+    terms_size: float | None = None
 
 
 @dataclass
@@ -454,6 +456,8 @@ class ExprTranslator(Visitor):
         text = key[0]
         if text == "root" and not key[1]:
             return self._root(args)
+        if text == "matrix" and not key[1] and len(args) == 3:
+            return self._matrix_of_function(args)
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
             args = args[0].children  # min of a literal vector: min of its elements
         if text in MATHCAD_FUNCTIONS and not key[1]:
@@ -468,6 +472,50 @@ class ExprTranslator(Visitor):
         raise Untranslatable(
             f"{nm.mathcad_text(*key)}() is neither defined before nor a known built-in"
         )
+
+    def _matrix_of_function(self, args: list[MNode]) -> ex.Node:
+        """Mathcad's matrix(m, n, f): the m x n matrix of f(i, j), i and j counted from 0
+        (whatever ORIGIN), written out as a matrix of calls; m and n must be whole numbers
+        known at import. At an ORIGIN other than 0, only a function that does not read its
+        arguments is translated: no stored result shows which indices Mathcad gives f there."""
+        f = _unparen(args[2])
+        sym = (self.local.get(_key(f)) or self.tr.scope.get(_key(f))) if f.tag == "id" else None
+        if sym is None or sym.kind != "func":
+            raise Untranslatable("matrix(m, n, f) whose f is not the name of a function")
+        if sym.broken:
+            raise Untranslatable(_uses(sym))
+        m, n = (_whole_at_import(self.tr, a, "matrix(m, n, f)") for a in args[:2])
+        if m * n > MAX_WRITTEN_ELEMENTS:
+            raise Untranslatable(f"matrix(m, n, f) of more than {MAX_WRITTEN_ELEMENTS} elements")
+        if self.tr.origin != 0 and not self.tr.ignores_arguments(sym):
+            raise Untranslatable(
+                f"matrix(m, n, f) at ORIGIN {self.tr.origin} of a function of its indices "
+                "(which indices Mathcad gives f there is not known)"
+            )
+        rows = []
+        for i in range(m):
+            row = []
+            for j in range(n):
+                call = ex.Call(sym.token(), (ex.Number(float(i)), ex.Number(float(j))))
+                self.tr.calls.setdefault(sym, []).append(call.args)
+                row.append(call)
+            rows.append(tuple(row))
+        return ex.Matrix(tuple(rows))
+
+
+#: The most elements a construct written out element by element may have (matrix(m, n, f)).
+MAX_WRITTEN_ELEMENTS = 10_000
+
+
+def _whole_at_import(tr: Translator, node: MNode, what: str) -> int:
+    """A size Mathcad gives as an expression: a whole number of at least 1 known at import."""
+    try:
+        value = float(_Values(tr).quantity(node).to("").magnitude)
+    except Exception:  # noqa: BLE001 - not a value known at import, or not a plain number
+        raise Untranslatable(f"{what} whose size is not a number known at import") from None
+    if not (math.isfinite(value) and value == int(value) and value >= 1):
+        raise Untranslatable(f"{what} whose size {value:g} is not a whole number of at least 1")
+    return int(value)
 
 
 class Translator:
@@ -487,6 +535,7 @@ class Translator:
         self.origin = 0  # Mathcad's ORIGIN where the translation is
         self.sheet_origin = 0  # the worksheet's [sheet] origin
         self.writes = 0  # values written to a file (WRITEPRN and friends) so far
+        self.shown: dict[str, tuple[str, list]] = {}  # a name -> (unit, values Mathcad stored)
 
     # -- symbols --------------------------------------------------------------
     def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
@@ -502,6 +551,14 @@ class Translator:
             self.units[name] = self.new_sym("unit", nm.identifier(name), name)
             self.units[name].unit = FORMULA_UNITS[name]
         return self.units[name]
+
+    def ignores_arguments(self, sym: Sym) -> bool:
+        """Is the function ``sym`` one whose value does not depend on its arguments (a
+        single expression without its parameters)?"""
+        item = next((i for i in self.out.items if i.sym is sym and i.kind == "function"), None)
+        if item is None or item.body is None or item.pieces or item.program:
+            return False
+        return not ex.names(item.body) & {p.token() for p in item.params}
 
     def define(self, key: tuple[str, str], kind: str, region: str) -> Sym:
         sym = self.new_sym(kind, nm.identifier(*key), nm.mathcad_text(*key), region)
@@ -1248,8 +1305,13 @@ class Translator:
             ps = self.new_sym("param", nm.identifier(*pkey), nm.mathcad_text(*pkey), unit=unit)
             local[pkey] = ps
             psyms.append(ps)
-        # defined before its body is read: a call of f inside f is Mathcad's recursion
-        sym = self.define(key, "func", region.id)
+        # a call of f inside f is Mathcad's recursion, unless f was a function before: then
+        # it is that function (B(x) := stack(B(x), M) redefines B from the previous B)
+        previous = self.scope.get(key)
+        if previous is not None and previous.kind == "func":
+            sym = self.new_sym("func", nm.identifier(*key), nm.mathcad_text(*key), region.id)
+        else:
+            sym = self.define(key, "func", region.id)
         try:
             if body.tag == "program":
                 item = Item("function", region.id, params=psyms, **self.program(body, local))
@@ -1264,7 +1326,9 @@ class Translator:
                     )
         except Untranslatable as why:
             sym.broken = str(why)
+            self.scope[key] = sym
             raise
+        self.scope[key] = sym
         item.sym = sym
         self._forced(region, sym)
         self.out.items.append(item)
@@ -1291,6 +1355,46 @@ class Translator:
         if writer is not None:
             self.written(region, *writer[:2], writer[2], node)
             return
+        self.remember_shown(expr, target, unit, values)
+        before = len(self.out.results)
+        try:
+            self.evaluation_values(region, expr, target, unit, values, shape, mathcad)
+        finally:
+            size = self.terms_size(expr, unit)
+            for res in self.out.results[before:]:
+                res.terms_size = size
+
+    def remember_shown(self, expr: MNode, target: Sym | None, unit: str, values) -> None:
+        """The values Mathcad stored for a name (``w =``, or ``w := ... =``)."""
+        expr = _unparen(expr)
+        sym = target
+        if sym is None and expr.tag == "id":
+            sym = self.scope.get(_key(expr))
+        numbers = [v for v in values if isinstance(v, float)]
+        if sym is not None and numbers:
+            self.shown[sym.token()] = (unit, numbers)
+
+    def terms_size(self, expr: MNode, unit: str) -> float | None:
+        """For a difference ``a - b`` (or a sum) of which a or b is a name whose values Mathcad
+        stored, in the same unit: the largest of them. Mathcad's value of a difference whose
+        terms cancel is round-off of that size (a residual ``N x - w`` stores 5e-12 for terms
+        near 2401), which no other computation reproduces digit for digit."""
+        expr = _unparen(expr)
+        if expr.tag != "apply" or len(expr.children) != 3:
+            return None
+        if expr.children[0].tag not in ("minus", "plus"):
+            return None
+        sizes = []
+        for term in expr.children[1:]:
+            term = _unparen(term)
+            sym = self.scope.get(_key(term)) if term.tag == "id" else None
+            shown = self.shown.get(sym.token()) if sym is not None else None
+            if shown is not None and shown[0] == unit:
+                sizes.append(max(abs(v) for v in shown[1]))
+        return max(sizes) if sizes else None
+
+    def evaluation_values(self, region: Region, expr: MNode, target, unit, values, shape, mathcad):
+        """The printed values of an evaluation whose stored values are read."""
         if target is not None:  # a definition with its value shown: x := ... = value
             if len(values) == 1:
                 self.out.results.append(
@@ -2045,6 +2149,22 @@ class _Values(Visitor):
             return self.visit(item.body)
         raise Untranslatable("a range whose bounds are not values known at import")
 
+    def _size(self, func: str, node: ex.Node) -> int:
+        """rows, cols or length of a matrix written out, or of a name defined as one."""
+        self.depth += 1
+        while isinstance(node, ex.Name) and self.depth <= 200:
+            item = self.items.get(node.id)
+            if item is None or item.kind != "definition" or item.body is None:
+                break
+            node = item.body
+            self.depth += 1
+        if not isinstance(node, ex.Matrix):
+            raise Untranslatable("a range whose bounds are not values known at import")
+        rows, cols = len(node.rows), len(node.rows[0])
+        if func == "length" and cols != 1:
+            raise Untranslatable("length() of a matrix")
+        return cols if func == "cols" else rows
+
     def visit_Unary(self, n):
         v = self.visit(n.operand)
         return -v if n.op == "-" else v
@@ -2058,6 +2178,8 @@ class _Values(Visitor):
     def visit_Call(self, n):
         import numpy as np
 
+        if n.func in ("rows", "cols", "length") and len(n.args) == 1:
+            return self.ureg.Quantity(float(self._size(n.func, n.args[0])))
         if n.func in ("min", "max"):
             vals = [self.visit(a) for a in n.args]
             return (min if n.func == "min" else max)(vals)

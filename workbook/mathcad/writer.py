@@ -17,6 +17,8 @@ from .translate import Item, Skipped, Sym, Translation, _rename
 REL_TOLERANCE = 1e-9
 #: Absolute tolerance (in the printed unit), for results Mathcad stores as exactly 0.
 ABS_TOLERANCE = 1e-12
+#: A difference a - b is compared within this much of the size of its terms (round-off).
+TERMS_TOLERANCE = 1e-9
 
 
 @dataclass
@@ -277,11 +279,14 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
     for item in solves:
         _solve(item, mapping, out, doc)
     # printed values: one CSV per argument (scalars: no argument)
-    groups: dict[tuple[str, bool], list[list[str]]] = {}
+    groups: dict[tuple[str, bool, str], list[list[str]]] = {}
     solved = _from_solve_blocks(tr)
     for res in tr.results:
         arg = res.argument.final if res.argument is not None else ""
-        rows = groups.setdefault((arg, res.sym is not None and res.sym.token() in solved), [])
+        from_solve = res.sym is not None and res.sym.token() in solved
+        # a difference whose terms Mathcad showed: a file of its own, within their round-off
+        own = res.region if res.terms_size and not from_solve else ""
+        rows = groups.setdefault((arg, from_solve, own), [])
         sym_name = res.sym.final if res.sym is not None else f"result_{res.region}"
         texts = [v for _, v in res.rows if isinstance(v, str)]
         if not res.rows or not all(is_one_line(t) for t in texts):
@@ -296,13 +301,22 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             val = value if isinstance(value, str) else repr(float(value))
             rows.append([sym_name, at_text, val, pretty_unit(res.unit) if res.unit else ""])
     printed: list[tuple] = []
-    for (arg, from_solve), rows in groups.items():
-        fname = f"{name}.mathcad{'.solve' if from_solve else ''}{'.' + arg if arg else ''}.csv"
+    sizes = {r.region: r.terms_size for r in tr.results if r.terms_size}
+    for (arg, from_solve, own), rows in groups.items():
+        kind = ".solve" if from_solve else (f".difference-{own}" if own else "")
+        fname = f"{name}.mathcad{kind}{'.' + arg if arg else ''}.csv"
         title = "Mathcad results" + (" over " + arg if arg else "")
         if from_solve:
             title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
+        absolute = ABS_TOLERANCE
+        if own:
+            absolute = max(ABS_TOLERANCE, TERMS_TOLERANCE * sizes[own])
+            title += (
+                f" of a difference, within {TERMS_TOLERANCE:g} of its terms' size "
+                f"({sizes[own]:g}, as Mathcad showed a term): its round-off"
+            )
         out.csv[fname] = _csv_text(rows)
-        printed.append((fname, title, arg, from_solve))
+        printed.append((fname, title, arg, from_solve, absolute))
         table = _table_for(tr, arg, mapping)
         if table:
             tables.append(table)
@@ -311,7 +325,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         out.table_of[table["name"]] = table["region"]
     for item in charts:
         _chart(item, mapping, doc, out)
-    for fname, title, arg, from_solve in printed:
+    for fname, title, arg, from_solve, absolute in printed:
         doc.blank()
         doc.array_table("printed")
         doc.pair("file", fname)
@@ -320,7 +334,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             doc.pair("argument", arg)
         # Mathcad's solver stops at its TOL: its roots are that close
         doc.pair("rel_tolerance", tr.solve_tolerance if from_solve else REL_TOLERANCE)
-        doc.pair("tolerance", ABS_TOLERANCE)
+        doc.pair("tolerance", absolute)
     return doc, out
 
 

@@ -1,0 +1,174 @@
+"""Mathcad Prime's matrix(m, n, f), a function redefined from its previous definition and a
+sum of matrices, imported from small packages this test writes, checked against the results
+stored in them."""
+
+from __future__ import annotations
+
+import zipfile
+from pathlib import Path
+
+from test_mathcad_prime import RESULTS, WS, _check, _id, _region, _result
+
+from workbook.cli import main
+
+
+def _package(path: Path, regions: str, results: str, origin: int = 0) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("mathcad/worksheet.xml", WS.format(regions))
+        z.writestr("mathcad/result.xml", RESULTS.format(results))
+        z.writestr(
+            "mathcad/settings/calculation.xml",
+            '<calculation xmlns="http://schemas.ptc.com/mathcad/settings/calculation10">'
+            f'<builtInVariables array-origin="{origin}" convergence-tolerance="0.001"/>'
+            "</calculation>",
+        )
+    return path
+
+
+def _real(v: float) -> str:
+    if v < 0:
+        return f"<ml:apply><ml:neg/><ml:real>{-v!r}</ml:real></ml:apply>"
+    return f"<ml:real>{v!r}</ml:real>"
+
+
+def _stored_matrix(rows: list[list[float]]) -> str:
+    """A result matrix as Prime stores it: column by column."""
+    cells = "".join(
+        f"<ml:real>{rows[i][j]!r}</ml:real>" for j in range(len(rows[0])) for i in range(len(rows))
+    )
+    return f'<ml:matrix rows="{len(rows)}" cols="{len(rows[0])}">{cells}</ml:matrix>'
+
+
+def _call(name: str, *args: str) -> str:
+    return f"<ml:apply>{_id(name, 'FUNCTION')}<ml:sequence>{''.join(args)}</ml:sequence></ml:apply>"
+
+
+def _function(rid: int, name: str, params: list[str], body: str) -> str:
+    bound = "".join(_id(p) for p in params)
+    return _region(
+        rid,
+        rid,
+        f"<ml:define><ml:function>{_id(name)}<ml:boundVars>{bound}</ml:boundVars>"
+        f"</ml:function>{body}</ml:define>",
+    )
+
+
+def _eval(rid: int, body: str) -> str:
+    return _region(rid, rid, f"<ml:eval>{body}</ml:eval>")
+
+
+def _f_of_indices() -> str:
+    """f(x, y) := x^2 - y"""
+    square = f"<ml:apply><ml:pow/>{_id('x')}<ml:real>2</ml:real></ml:apply>"
+    body = f"<ml:apply><ml:minus/>{square}{_id('y')}</ml:apply>"
+    return _function(1, "f", ["x", "y"], body)
+
+
+def test_matrix_of_a_function_counts_from_0(tmp_path, capsys):
+    """matrix(3, 2, f) with f(x, y) = x^2 - y is [[0, -1], [1, 0], [4, 3]] (i and j from 0)."""
+    want = [[i * i - j for j in range(2)] for i in range(3)]
+    regions = _f_of_indices() + _eval(2, _call("matrix", _real(3), _real(2), _id("f")))
+    results = _result(1) + _result(2, _stored_matrix(want))
+    src = _package(tmp_path / "m.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "m.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (6, 6, 0), result
+
+
+def test_matrix_of_a_function_at_origin_1(tmp_path, capsys):
+    """At ORIGIN 1, matrix(m, n, f) of a function of its indices is listed (which indices
+    Mathcad gives f there is not known); of a function that ignores them, translated."""
+    zero = _function(3, "g", ["x", "y"], "<ml:real>0</ml:real>")
+    regions = (
+        _f_of_indices()
+        + _eval(2, _call("matrix", _real(2), _real(2), _id("f")))
+        + zero
+        + _eval(4, _call("matrix", _real(2), _real(3), _id("g")))
+    )
+    results = (
+        _result(1)
+        + _result(2, _stored_matrix([[0, -1], [1, 0]]))
+        + _result(3)
+        + _result(4, _stored_matrix([[0, 0, 0], [0, 0, 0]]))
+    )
+    src = _package(tmp_path / "m1.mcdx", regions, results, origin=1)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "m1.toml").read_text(encoding="utf-8")
+    assert "matrix(m, n, f) at ORIGIN 1 of a function of its indices" in text
+    result = _check(tmp_path / "m1.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (10, 6, 0), result
+
+
+def test_matrix_of_a_size_not_known_at_import_is_listed(tmp_path, capsys):
+    regions = _f_of_indices() + _eval(2, _call("matrix", _id("n"), _real(2), _id("f")))
+    results = _result(1) + _result(2, _stored_matrix([[0, -1]]))
+    src = _package(tmp_path / "mn.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "mn.toml").read_text(encoding="utf-8")
+    assert "region 2: an evaluation ( = ): matrix(m, n, f) whose size is not a number known" in text
+
+
+def test_a_function_redefined_from_its_previous_definition(tmp_path, capsys):
+    """B(x) := x + 1, then B(x) := B(x)*2 (Mathcad reads the previous B): B(3) = 8; a
+    function first defined calling itself stays Mathcad's recursion."""
+    first = _function(
+        1, "B", ["x"], f"<ml:apply><ml:plus/>{_id('x')}<ml:real>1</ml:real></ml:apply>"
+    )
+    again = _function(
+        2, "B", ["x"], f"<ml:apply><ml:mult/>{_call('B', _id('x'))}<ml:real>2</ml:real></ml:apply>"
+    )
+    regions = first + again + _eval(3, _call("B", _real(3)))
+    results = _result(1) + _result(2) + _result(3, "<ml:real>8</ml:real>")
+    src = _package(tmp_path / "b.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "b.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (1, 1, 0), result
+
+
+def test_a_sum_of_matrices(tmp_path, capsys):
+    """K := Σ_{j=1}^{3} M·j with M = [[1, 2], [3, 4]]: 6 M, a matrix (not a number)."""
+    m = (
+        '<ml:matrix rows="2" cols="2"><ml:real>1</ml:real><ml:real>3</ml:real>'
+        "<ml:real>2</ml:real><ml:real>4</ml:real></ml:matrix>"
+    )
+    define_m = _region(1, 1, f"<ml:define>{_id('M')}{m}</ml:define>")
+    lam = (
+        f"<ml:lambda><ml:boundVars>{_id('j')}</ml:boundVars><ml:apply><ml:mult/>{_id('M')}"
+        f"{_id('j')}</ml:apply></ml:lambda>"
+    )
+    total = (
+        f"<ml:apply><ml:summation/>{lam}<ml:lowerBound><ml:real>1</ml:real></ml:lowerBound>"
+        "<ml:upperBound><ml:real>3</ml:real></ml:upperBound></ml:apply>"
+    )
+    plus_m = f"<ml:apply><ml:plus/>{total}{_id('M')}</ml:apply>"
+    regions = define_m + _eval(2, plus_m)
+    results = _result(1) + _result(2, _stored_matrix([[7, 14], [21, 28]]))
+    src = _package(tmp_path / "s.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "s.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (4, 4, 0), result
+
+
+def test_a_difference_is_compared_within_the_round_off_of_its_terms(tmp_path, capsys):
+    """w := [2401; 1000.3], shown; Mathcad stored (w/7)*7 - w as round-off (5e-12, 6e-12),
+    which is reproduced within 1e-9 of the largest term Mathcad showed (2401); a stored
+    value 1e-3 off is not."""
+    w = '<ml:matrix rows="2" cols="1"><ml:real>2401</ml:real><ml:real>1000.3</ml:real></ml:matrix>'
+    define_w = _region(1, 1, f"<ml:define>{_id('w')}{w}</ml:define>")
+    scaled = (
+        f"<ml:apply><ml:mult/><ml:apply><ml:div/>{_id('w')}<ml:real>7</ml:real></ml:apply>"
+        "<ml:real>7</ml:real></ml:apply>"
+    )
+    residual = f"<ml:apply><ml:minus/>{scaled}{_id('w')}</ml:apply>"
+    regions = define_w + _eval(2, _id("w")) + _eval(3, residual) + _eval(4, residual)
+    results = (
+        _result(1)
+        + _result(2, _stored_matrix([[2401], [1000.3]]))
+        + _result(3, _stored_matrix([[5e-12], [-6e-12]]))
+        + _result(4, _stored_matrix([[1e-3], [0]]))
+    )
+    src = _package(tmp_path / "d.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "d.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (6, 5, 1), result
+    assert [f["name"] for f in result["failures"]] == ["result_4"]
