@@ -172,3 +172,95 @@ def test_a_difference_is_compared_within_the_round_off_of_its_terms(tmp_path, ca
     result = _check(tmp_path / "d.toml", capsys)
     assert (result["printed"], result["reproduced"], result["failed"]) == (6, 5, 1), result
     assert [f["name"] for f in result["failures"]] == ["result_4"]
+
+
+def _local(lhs: str, rhs: str) -> str:
+    return f"<ml:localDefine>{lhs}{rhs}</ml:localDefine>"
+
+
+def _index(target: str, *at: str) -> str:
+    inner = at[0] if len(at) == 1 else f"<ml:sequence>{''.join(at)}</ml:sequence>"
+    return f"<ml:apply><ml:indexer/>{target}{inner}</ml:apply>"
+
+
+def test_a_program_with_a_local_function_and_an_element_matrix(tmp_path, capsys):
+    """K[i] := | g(r, c) <- r + 10 c           (a local function)
+                | K[i] <- matrix(2, 2, g)        (the local vector K, used only at i)
+                | (K[i])[0, 1] <- i
+                | K[i]
+    over i := 0 .. 1 is the vector of [[0, i], [1, 11]]; K[1] = [[0, 1], [1, 11]]. A local
+    function that reads a local of the program is listed."""
+    g = f"<ml:function>{_id('g')}<ml:boundVars>{_id('r')}{_id('c')}</ml:boundVars></ml:function>"
+    g_body = (
+        f"<ml:apply><ml:plus/>{_id('r')}<ml:apply><ml:mult/><ml:real>10</ml:real>{_id('c')}"
+        "</ml:apply></ml:apply>"
+    )
+    k_i = _index(_id("K"), _id("i"))
+    program = (
+        "<ml:program>"
+        + _local(g, g_body)
+        + _local(k_i, _call("matrix", _real(2), _real(2), _id("g")))
+        + _local(_index(f"<ml:parens>{k_i}</ml:parens>", _real(0), _real(1)), _id("i"))
+        + k_i
+        + "</ml:program>"
+    )
+    rng = "<ml:range><ml:real>0</ml:real><ml:real>1</ml:real></ml:range>"
+    regions = (
+        _region(1, 1, f"<ml:define>{_id('i')}{rng}</ml:define>")
+        + _region(2, 2, f"<ml:define>{k_i}{program}</ml:define>")
+        + _eval(3, _index(_id("K"), _real(1)))
+    )
+    results = _result(1) + _result(2) + _result(3, _stored_matrix([[0, 1], [1, 11]]))
+    src = _package(tmp_path / "p.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "p.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (4, 4, 0), result
+
+    reads_local = (
+        "<ml:program>"
+        + _local(_id("a"), _real(2))
+        + _local(g, f"<ml:apply><ml:plus/>{_id('r')}{_id('a')}</ml:apply>")
+        + _call("g", _real(1), _real(1))
+        + "</ml:program>"
+    )
+    src = _package(
+        tmp_path / "q.mcdx",
+        _region(1, 1, f"<ml:define>{_id('h')}{reads_local}</ml:define>") + _eval(2, _id("h")),
+        _result(1) + _result(2, "<ml:real>3</ml:real>"),
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "q.toml").read_text(encoding="utf-8")
+    assert "a local function that reads the program's a" in text
+
+
+def test_a_stored_zero_among_large_elements_is_round_off(tmp_path, capsys):
+    """stack(M, (M/3)*3 - M) with M = [128822157.11805557; 0.1]: Mathcad stored exact zeros
+    below, ours are 1.5e-8 and 0 (round-off of 1.3e8): compared within 1e-15 of the largest
+    element, they pass; a stored 0 where the value is 1e-3 does not."""
+    m = (
+        '<ml:matrix rows="2" cols="1"><ml:real>128822157.11805557</ml:real>'
+        "<ml:real>0.1</ml:real></ml:matrix>"
+    )
+    define_m = _region(1, 1, f"<ml:define>{_id('M')}{m}</ml:define>")
+    third = (
+        f"<ml:apply><ml:mult/><ml:apply><ml:div/>{_id('M')}<ml:real>3</ml:real></ml:apply>"
+        "<ml:real>3</ml:real></ml:apply>"
+    )
+    residual = f"<ml:apply><ml:minus/>{third}{_id('M')}</ml:apply>"
+    small = '<ml:matrix rows="1" cols="1"><ml:real>0.001</ml:real></ml:matrix>'
+    regions = (
+        define_m
+        + _eval(2, _call("stack", _id("M"), residual))
+        + _eval(3, _call("stack", _id("M"), small))
+    )
+    big = 128822157.11805557
+    results = (
+        _result(1)
+        + _result(2, _stored_matrix([[big], [0.1], [0], [0]]))
+        + _result(3, _stored_matrix([[big], [0.1], [0]]))
+    )
+    src = _package(tmp_path / "z.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "z.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (7, 6, 1), result
+    assert [f["at"] for f in result["failures"]] == [2.0]

@@ -9,15 +9,11 @@ try/catch) is untranslatable.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from .. import expr as ex
 from . import names as nm
+from .reader import MNode
 from .symbols import Sym, Untranslatable, matrix_size, what
 from .symbols import key as name_key
-
-if TYPE_CHECKING:
-    from .reader import MNode
 
 Line = tuple[int, list]  # (indent, parts: text or expression trees)
 
@@ -48,6 +44,7 @@ class ProgramTranslator:
         self.taken: set[str] = set()  # identifiers of the program's names
 
     def lines(self, program: MNode) -> list[Line]:
+        program = _one_index_locals(program, set(self.params))
         body = program.children if program.tag == "program" else [program]
         self.taken = {nm.identifier(*name_key(n)) for n in _walk(program) if n.tag == "id"}
         out: list[Line] = []
@@ -285,16 +282,50 @@ class ProgramTranslator:
             return self._column(lhs, rhs)
         if lhs.tag == "matrix":
             return self._destructure(lhs, rhs)
+        if lhs.tag == "function":
+            self._local_function(lhs, rhs)
+            return []
         if lhs.tag != "id":
             raise Untranslatable("an assignment to something that is not a name in a program")
         value = self._expr(rhs)  # the right side sees the local's previous value
         return [(0, [self._local(lhs), " := ", value])]
+
+    def _local_function(self, lhs: MNode, rhs: MNode) -> None:
+        """f(x, y) <- EXPR: a local function, written out at each call (``f(2, 3)`` is EXPR
+        with x = 2, y = 3). Its EXPR may read its parameters and the sheet's names, not the
+        program's locals (whose values may change between the definition and a call)."""
+        fname, bound = lhs.children[0], lhs.find("boundVars")
+        if fname.tag != "id" or bound is None or any(p.tag != "id" for p in bound.children):
+            raise Untranslatable("a local function whose name or parameters are not names")
+        params = {}
+        for p in bound.children:
+            key = name_key(p)
+            params[key] = self.tr.new_sym("param", nm.identifier(*key), nm.mathcad_text(*key))
+        et = self.expressions(self.tr, {**self.scope, **params})
+        body = et.value(rhs)
+        if et.ranges:
+            raise Untranslatable("a local function over a range variable")
+        program_locals = {s.token() for s in self.locals.values()}
+        program_locals |= {s.token() for s in self.params.values()}
+        read = ex.names(body) & program_locals
+        if read:
+            names = sorted(s.mathcad for s in self.locals.values() if s.token() in read)
+            raise Untranslatable(
+                f"a local function that reads the program's {', '.join(names) or 'parameters'}"
+            )
+        sym = self.tr.new_sym(
+            "func", nm.identifier(*name_key(fname)), nm.mathcad_text(*name_key(fname))
+        )
+        self.tr.inline[sym.token()] = ([q.token() for q in params.values()], body)
+        self.scope[name_key(fname)] = sym
 
     def _element(self, lhs: MNode, rhs: MNode) -> list:
         """v[i] <- value: an element of a local vector; one the program has not given, or
         an index beyond its length, makes or grows it (the language does where the length
         is known at load, and says why not where it is not)."""
         target = lhs.children[1]
+        while target.tag == "parens" and target.children:
+            target = target.children[0]
         if target.tag != "id":
             raise Untranslatable("an element assignment to something that is not a name")
         value = self._expr(rhs)  # the right side sees the vector before the assignment
@@ -436,6 +467,57 @@ def _walk(node: MNode):
 
 def _statements(body: MNode) -> list[MNode]:
     return body.children if body.tag == "program" else [body]
+
+
+def _one_index_locals(program: MNode, params: set) -> MNode:
+    """The program with each local vector that it uses only at one index, a parameter the
+    program does not assign (``K[i] <- M``, ``(K[i])[a, b] <- x``, ``K[i]`` read), made a
+    local of its own (``K_i``): Mathcad builds that vector, but only its element i is ever
+    set or read, so the element is the local (the language sets no element of an element)."""
+    whole, elements = _targets(_statements(program))
+    uses: dict[tuple[str, str], set] = {}
+
+    def scan(node: MNode) -> None:
+        if node.tag == "apply" and len(node.children) == 3 and node.children[0].tag == "indexer":
+            target, index = node.children[1], node.children[2]
+            if target.tag == "id":
+                at = name_key(index) if index.tag == "id" else None
+                uses.setdefault(name_key(target), set()).add(at)
+                scan(index)
+                return
+        if node.tag == "id":
+            uses.setdefault(name_key(node), set()).add(None)
+        for c in node.children:
+            scan(c)
+
+    scan(program)
+    single = {
+        key: next(iter(at))
+        for key, at in uses.items()
+        if key in elements
+        and key not in whole
+        and key not in params
+        and len(at) == 1
+        and next(iter(at)) in params
+        and next(iter(at)) not in whole
+    }
+    if not single:
+        return program
+
+    def rewrite(node: MNode) -> MNode:
+        if node.tag == "apply" and len(node.children) == 3 and node.children[0].tag == "indexer":
+            target = node.children[1]
+            if target.tag == "id" and name_key(target) in single:
+                text, sub = name_key(target)
+                index = single[name_key(target)]
+                attrs = dict(target.attrs)
+                attrs["subscript"] = "_".join(p for p in (sub, *index) if p)
+                return MNode("id", attrs, text, [], target.line)
+        return MNode(
+            node.tag, node.attrs, node.text, [rewrite(c) for c in node.children], node.line
+        )
+
+    return rewrite(program)
 
 
 def _targets(body: list[MNode]) -> tuple[dict, set]:

@@ -58,8 +58,9 @@ class Result:
     unit: str
     rows: list[tuple[float | None, float | str]]
     argument: Sym | None = None
-    # a difference a - b: the largest value Mathcad stored of a or b (its round-off scale)
-    terms_size: float | None = None
+    # where Mathcad's value is round-off of a larger size (a difference whose terms cancel, a
+    # stored 0 among large elements): the absolute tolerance, and why
+    round_off: tuple[float, str] | None = None
 
 
 @dataclass
@@ -451,6 +452,8 @@ class ExprTranslator(Visitor):
                     f"{sym.mathcad}(...) multiplies or indexes a value (not a function call)"
                 )
             call = ex.Call(sym.token(), tuple(self.value(a) for a in args))
+            if sym.token() in self.tr.inline:
+                return self.tr.local_call(sym, call.args)
             self.tr.calls.setdefault(sym, []).append(call.args)
             return call
         text = key[0]
@@ -496,12 +499,23 @@ class ExprTranslator(Visitor):
         for i in range(m):
             row = []
             for j in range(n):
-                call = ex.Call(sym.token(), (ex.Number(float(i)), ex.Number(float(j))))
-                self.tr.calls.setdefault(sym, []).append(call.args)
-                row.append(call)
+                args = (ex.Number(float(i)), ex.Number(float(j)))
+                if sym.token() in self.tr.inline:
+                    row.append(self.tr.local_call(sym, args))
+                    continue
+                self.tr.calls.setdefault(sym, []).append(args)
+                row.append(ex.Call(sym.token(), args))
             rows.append(tuple(row))
         return ex.Matrix(tuple(rows))
 
+
+#: Absolute tolerance of a stored 0 (in its unit), and of a value of a difference relative to
+#: its terms' size, and of an array's element relative to its largest element: Mathcad's value
+#: where terms cancel is round-off of their size (a residual N x - w: 5e-12 for terms up to
+#: 2401; an element of a sum of stiffness matrices stored as 0 is -5.8e-11 here, of 1.3e8).
+ZERO_TOLERANCE = 1e-12
+DIFFERENCE_TOLERANCE = 1e-9
+MATRIX_ZERO_TOLERANCE = 1e-15
 
 #: The most elements a construct written out element by element may have (matrix(m, n, f)).
 MAX_WRITTEN_ELEMENTS = 10_000
@@ -536,6 +550,8 @@ class Translator:
         self.sheet_origin = 0  # the worksheet's [sheet] origin
         self.writes = 0  # values written to a file (WRITEPRN and friends) so far
         self.shown: dict[str, tuple[str, list]] = {}  # a name -> (unit, values Mathcad stored)
+        # local functions of programs, written out at each call: token -> (parameters, body)
+        self.inline: dict[str, tuple[list[str], ex.Node]] = {}
 
     # -- symbols --------------------------------------------------------------
     def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
@@ -552,9 +568,20 @@ class Translator:
             self.units[name].unit = FORMULA_UNITS[name]
         return self.units[name]
 
+    def local_call(self, sym: Sym, args: tuple[ex.Node, ...]) -> ex.Node:
+        """A call of a program's local function: its body with the arguments in place of
+        its parameters."""
+        params, body = self.inline[sym.token()]
+        if len(params) != len(args):
+            raise Untranslatable(f"{sym.mathcad}() called with {len(args)} arguments")
+        return _substitute(body, dict(zip(params, args)))
+
     def ignores_arguments(self, sym: Sym) -> bool:
         """Is the function ``sym`` one whose value does not depend on its arguments (a
         single expression without its parameters)?"""
+        if sym.token() in self.inline:
+            params, body = self.inline[sym.token()]
+            return not ex.names(body) & set(params)
         item = next((i for i in self.out.items if i.sym is sym and i.kind == "function"), None)
         if item is None or item.body is None or item.pieces or item.program:
             return False
@@ -1161,15 +1188,18 @@ class Translator:
                 p = self.new_sym("param", u.sym.base, u.sym.mathcad, unit="")
                 local[_key(n)] = p
                 params.append(p)
-            et = ExprTranslator(self, local)
-            body = et.value(rhs)
-            if et.ranges:
-                raise Untranslatable("an element assignment over another range variable")
+            if rhs.tag == "program":  # K[i] := a program of i: a function of i
+                parts = self.program(rhs, local)
+            else:
+                et = ExprTranslator(self, local)
+                parts = {"body": et.value(rhs)}
+                if et.ranges:
+                    raise Untranslatable("an element assignment over another range variable")
         except Untranslatable as why:
             sym.broken = str(why)
             raise
         of = self.new_sym("func", sym.base + "_of", nm.mathcad_text(*key) + "[...]", region.id)
-        self.out.items.append(Item("function", region.id, sym=of, params=params, body=body))
+        self.out.items.append(Item("function", region.id, sym=of, params=params, **parts))
         o = self.origin
 
         def cell(*at: int) -> ex.Node:
@@ -1360,9 +1390,27 @@ class Translator:
         try:
             self.evaluation_values(region, expr, target, unit, values, shape, mathcad)
         finally:
-            size = self.terms_size(expr, unit)
             for res in self.out.results[before:]:
-                res.terms_size = size
+                res.round_off = self.round_off(expr, unit, values)
+
+    def round_off(self, expr: MNode, unit: str, values) -> tuple[float, str] | None:
+        """The absolute tolerance of an evaluation whose stored values include round-off of a
+        larger size than 1e-12 (the tolerance of a stored 0), and why; None: there is none."""
+        size = self.terms_size(expr, unit)
+        if size is not None and DIFFERENCE_TOLERANCE * size > ZERO_TOLERANCE:
+            return DIFFERENCE_TOLERANCE * size, (
+                f"a difference, within {DIFFERENCE_TOLERANCE:g} of its terms' size ({size:g}, "
+                "as Mathcad showed a term)"
+            )
+        numbers = [abs(v) for v in values if isinstance(v, float)]
+        if len(numbers) > 1 and 0.0 in numbers:
+            largest = max(numbers)
+            if MATRIX_ZERO_TOLERANCE * largest > ZERO_TOLERANCE:
+                return MATRIX_ZERO_TOLERANCE * largest, (
+                    f"an array with elements stored as 0, within {MATRIX_ZERO_TOLERANCE:g} of "
+                    f"its largest element ({largest:g})"
+                )
+        return None
 
     def remember_shown(self, expr: MNode, target: Sym | None, unit: str, values) -> None:
         """The values Mathcad stored for a name (``w =``, or ``w := ... =``)."""
@@ -1716,6 +1764,13 @@ def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     if isinstance(node, ex.Call):
         return ex.Call(mapping.get(node.func, node.func), node.args)
     return node
+
+
+def _substitute(node: ex.Node, values: dict[str, ex.Node]) -> ex.Node:
+    """The tree with the names in ``values`` replaced by their trees."""
+    if isinstance(node, ex.Name):
+        return values.get(node.id, node)
+    return ex.map_children(node, lambda c: _substitute(c, values))
 
 
 def _writer(node: MNode, arity: int) -> tuple[str, str, MNode | None] | None:

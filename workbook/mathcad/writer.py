@@ -17,8 +17,6 @@ from .translate import Item, Skipped, Sym, Translation, _rename
 REL_TOLERANCE = 1e-9
 #: Absolute tolerance (in the printed unit), for results Mathcad stores as exactly 0.
 ABS_TOLERANCE = 1e-12
-#: A difference a - b is compared within this much of the size of its terms (round-off).
-TERMS_TOLERANCE = 1e-9
 
 
 @dataclass
@@ -284,8 +282,8 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
     for res in tr.results:
         arg = res.argument.final if res.argument is not None else ""
         from_solve = res.sym is not None and res.sym.token() in solved
-        # a difference whose terms Mathcad showed: a file of its own, within their round-off
-        own = res.region if res.terms_size and not from_solve else ""
+        # values that are round-off of a larger size: a file of their own, within it
+        own = res.region if res.round_off and not from_solve else ""
         rows = groups.setdefault((arg, from_solve, own), [])
         sym_name = res.sym.final if res.sym is not None else f"result_{res.region}"
         texts = [v for _, v in res.rows if isinstance(v, str)]
@@ -301,20 +299,17 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             val = value if isinstance(value, str) else repr(float(value))
             rows.append([sym_name, at_text, val, pretty_unit(res.unit) if res.unit else ""])
     printed: list[tuple] = []
-    sizes = {r.region: r.terms_size for r in tr.results if r.terms_size}
+    round_off = {r.region: r.round_off for r in tr.results if r.round_off}
     for (arg, from_solve, own), rows in groups.items():
-        kind = ".solve" if from_solve else (f".difference-{own}" if own else "")
+        kind = ".solve" if from_solve else (f".round-off-{own}" if own else "")
         fname = f"{name}.mathcad{kind}{'.' + arg if arg else ''}.csv"
         title = "Mathcad results" + (" over " + arg if arg else "")
         if from_solve:
             title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
         absolute = ABS_TOLERANCE
         if own:
-            absolute = max(ABS_TOLERANCE, TERMS_TOLERANCE * sizes[own])
-            title += (
-                f" of a difference, within {TERMS_TOLERANCE:g} of its terms' size "
-                f"({sizes[own]:g}, as Mathcad showed a term): its round-off"
-            )
+            absolute, why = round_off[own]
+            title += f" of {why}: their round-off"
         out.csv[fname] = _csv_text(rows)
         printed.append((fname, title, arg, from_solve, absolute))
         table = _table_for(tr, arg, mapping)
