@@ -101,24 +101,52 @@ def live_forms() -> Iterator[None]:
         _live.reset(token)
 
 
-_reference: contextvars.ContextVar[bool] = contextvars.ContextVar(
-    "workbook_numerics_reference", default=False
+@dataclass
+class ReferenceLog:
+    """What :func:`reference_methods` saw: (method, rows, of) per call, and (EXPR's tree,
+    values) per call, in the order of the calls."""
+
+    methods: list = field(default_factory=list)
+    values: list = field(default_factory=list)
+
+
+_reference: contextvars.ContextVar[ReferenceLog | None] = contextvars.ContextVar(
+    "workbook_numerics_reference", default=None
 )
 
 
 def reference() -> bool:
     """True inside :func:`reference_methods`: built-ins compute by other algorithms."""
-    return _reference.get()
+    return _reference.get() is not None
+
+
+def reference_note(method: str, rows: int, of: int) -> None:
+    """Inside :func:`reference_methods`: the reference of one call was ``method``, on
+    ``rows`` of its ``of`` rows (the rest take the engine's values)."""
+    log = _reference.get()
+    if log is not None:
+        log.methods.append((method, rows, of))
+
+
+def reference_values(body, values) -> None:
+    """Inside :func:`reference_methods`: the reference's values of one call of the built-in
+    whose EXPR is the typed tree ``body`` (NaN in the rows it did not compute)."""
+    log = _reference.get()
+    if log is not None:
+        log.values.append((body, np.array(values, dtype=float)))
 
 
 @contextlib.contextmanager
-def reference_methods(on: bool = True) -> Iterator[None]:
+def reference_methods(on: bool = True) -> Iterator[ReferenceLog]:
     """Compute root, integral and the extrema by the methods of
-    :mod:`workbook.numerics.reference` (not the engine's): ``workbook bench``'s reference
-    (``on=False``: the engine's methods again, for the rows the reference leaves out)."""
-    token = _reference.set(on)
+    :mod:`workbook.numerics.mpref` (mpmath on EXPR's tree) or, where EXPR has no mpmath
+    form, of :mod:`workbook.numerics.reference` (other algorithms in doubles), never the
+    engine's: ``workbook bench``'s reference (``on=False``: the engine's methods again, for
+    the rows the reference leaves out). Yields the log of the calls."""
+    log = ReferenceLog() if on else None
+    token = _reference.set(log)
     try:
-        yield
+        yield log if log is not None else ReferenceLog()
     finally:
         _reference.reset(token)
 

@@ -3,13 +3,15 @@
 Every scalar definition and every table column whose formula uses a numerical built-in
 (root, integral, maximum, ...; also through the sheet's functions) is computed from fresh
 sheets: its time is the median of repeated runs at the sheet's tolerance; its reference is
-the same definition computed by other algorithms (:mod:`workbook.numerics.reference`:
-Brent's method, QUADPACK, dense sampling then a bounded Brent search), never the engine's
-own routine at another tolerance. The line gives the time, the reference's time, the
-largest error estimate the engine reported, the largest difference from the reference, and
-a verdict: "ok" only where that difference is within the sheet's tolerance (or the
-reference's own accuracy, 1e-12, if that is larger) and the estimate is at least a tenth of
-it; a reference that cannot be computed is named, not a crash.
+the same definition with every built-in computed by mpmath on EXPR's typed tree at 32
+digits or more (:mod:`workbook.numerics.mpref`), or, where EXPR has a node without an
+mpmath form, by other algorithms in doubles (:mod:`workbook.numerics.reference`: Brent's
+method, QUADPACK, dense sampling then a bounded Brent search), never the engine's own
+routine at another tolerance. The line gives the time, the reference's time, the largest
+error estimate the engine reported, the largest difference from the reference, the
+reference's method, and a verdict: "ok" only where that difference is within the sheet's
+tolerance (or the reference's own accuracy, if that is larger) and the estimate is at
+least a tenth of it; a reference that cannot be computed is named, not a crash.
 """
 
 from __future__ import annotations
@@ -26,8 +28,11 @@ from ._common import current, reference_methods, sheet_tolerance
 
 #: built-ins whose values come from an iterative method with an error estimate
 NUMERICAL = ("root", "integral", "maximum", "minimum", "argmax", "argmin")
-#: the relative accuracy the reference methods are trusted to
+#: the relative accuracy the reference methods in doubles are trusted to
 REFERENCE_ACCURACY = 1e-12
+#: ... and the mpmath reference (its value is rounded to a double, and the arithmetic of the
+#: definition around the built-in is the sheet's, in doubles)
+MPMATH_ACCURACY = 1e-14
 #: ... and for the place of an extremum (argmax, argmin): f is flat there
 WHERE_ACCURACY = 1e-7
 #: a tighter tolerance of the same methods (a scene's own study of its error may use it)
@@ -47,7 +52,8 @@ class Line:
     difference: float  # largest |value - reference|, relative to the largest |reference|
     tolerance: float = 1e-10
     failed: str = ""  # why the reference could not be computed
-    checked: int = 0  # values compared with the reference (rows spread over a long table)
+    checked: int = 0  # the built-ins' values compared with the reference's
+    reference: str = "mpmath"  # the reference's method(s)
 
     @property
     def verdict(self) -> str:
@@ -55,7 +61,9 @@ class Line:
         if self.failed:
             return f"no reference: {self.failed}"
         # the place of a smooth extremum is known to about sqrt(eps) by any method
-        floor = WHERE_ACCURACY if "arg" in self.builtins else REFERENCE_ACCURACY
+        floor = MPMATH_ACCURACY if self.reference == "mpmath" else REFERENCE_ACCURACY
+        if "arg" in self.builtins:
+            floor = WHERE_ACCURACY
         within = self.difference <= max(self.tolerance, floor)
         honest = self.estimate >= self.difference / 10
         if within:
@@ -64,21 +72,17 @@ class Line:
 
     def text(self) -> str:
         diff = "" if self.failed else f"{self.difference:>10.1e}"
-        count = (
-            f"{self.values}"
-            if self.checked in (0, self.values)
-            else f"{self.checked}/{self.values}"
-        )
+        count = f"{self.values} ({self.checked})"
         ref = "" if self.failed else _ms(self.reference_seconds)
         return (
-            f"{self.what:<34} {self.builtins:<18} {count:>11} {_ms(self.seconds):>10} "
-            f"{ref:>10} {self.estimate:>10.1e} {diff:>10}  {self.verdict}"
+            f"{self.what:<34} {self.builtins:<18} {count:>13} {_ms(self.seconds):>10} "
+            f"{ref:>10} {self.estimate:>10.1e} {diff:>10}  {self.reference:<8} {self.verdict}"
         )
 
 
 HEADER = (
-    f"{'definition or column':<34} {'built-ins':<18} {'values':>11} {'time':>10} "
-    f"{'ref. time':>10} {'est. error':>10} {'vs ref.':>10}"
+    f"{'definition or column':<34} {'built-ins':<18} {'values (ref.)':>13} {'time':>10} "
+    f"{'ref. time':>10} {'est. error':>10} {'vs ref.':>10}  {'ref.':<8} verdict"
 )
 
 
@@ -138,6 +142,38 @@ def _relative(result) -> float:
     return err / size if size > 0 else err
 
 
+def _differences(engine: list, reference: list) -> tuple[float, int]:
+    """(largest difference, values compared): each call of a built-in against the
+    reference's call of the same EXPR (the n-th with the n-th), relative to the larger of
+    the two calls' largest |value| (as the estimate is relative to the call's value). A call
+    inside another built-in's EXPR (an inner integral) is part of the outer one's reference
+    and has no call of its own there."""
+    by_body: dict = {}
+    for body, values in reference:
+        by_body.setdefault(body, []).append(values)
+    seen: dict = {}
+    worst, count = 0.0, 0
+    for r in engine:
+        body = r.notes.get("body")
+        k = seen[body] = seen.get(body, -1) + 1
+        refs = by_body.get(body, [])
+        if k >= len(refs):
+            continue
+        got, want = np.ravel(r.value), np.ravel(refs[k])
+        if got.shape != want.shape:
+            continue
+        rows = np.isfinite(want)
+        size = max(
+            float(np.max(np.abs(want[rows]), initial=0.0)),
+            float(np.max(np.abs(got[rows]), initial=0.0)),
+        )
+        diff = float(np.max(np.abs(got - want)[rows], initial=0.0))
+        if size > 0:
+            worst = max(worst, diff / size)
+        count += int(rows.sum())
+    return worst, count
+
+
 def run(sheet, repeats: int = REPEATS) -> list[Line]:
     """One :class:`Line` per target of :func:`targets` (each computed once untimed first)."""
     base = current(sheet_tolerance(sheet.spec.meta))
@@ -150,20 +186,20 @@ def run(sheet, repeats: int = REPEATS) -> list[Line]:
             t0 = time.perf_counter()
             values = np.atleast_1d(np.asarray(compute(fresh), dtype=float))
             times.append(time.perf_counter() - t0)
-        estimates = [_relative(r) for _, r in fresh.evaluator.records if r.error.size]
-        failed, ref_seconds, ref = "", 0.0, values
+        engine = [r for _, r in fresh.evaluator.records if r.error.size]
+        estimates = [_relative(r) for r in engine]
+        failed, ref_seconds, log = "", 0.0, None
         try:
-            with reference_methods():
+            with reference_methods() as log:
                 t0 = time.perf_counter()
-                ref = np.atleast_1d(np.asarray(compute(sheet.with_inputs()), dtype=float))
+                compute(sheet.with_inputs())
                 ref_seconds = time.perf_counter() - t0
         except WorkbookError as err:
             failed = getattr(err, "message", str(err)).splitlines()[0]
-        checked = np.isfinite(ref)
-        scale = max(float(np.max(np.abs(ref[checked]), initial=0.0)), np.finfo(float).tiny)
-        difference = float(np.max(np.abs(values - ref)[checked], initial=0.0)) / scale
-        if not failed and not checked.any():
+        difference, count = _differences(engine, log.values) if log else (0.0, 0)
+        if not failed and not count:
             failed = "no row computed"
+        methods = sorted({method for method, _, _ in log.methods}) if log else []
         lines.append(
             Line(
                 what,
@@ -175,7 +211,8 @@ def run(sheet, repeats: int = REPEATS) -> list[Line]:
                 difference,
                 base.rtol,
                 failed,
-                int(checked.sum()),
+                count,
+                "; ".join(methods) or "mpmath",
             )
         )
     return lines
@@ -186,8 +223,11 @@ def text(sheet, lines: list[Line]) -> str:
     tol = sheet_tolerance(sheet.spec.meta)
     head = (
         f"{sheet.name}: numerical built-ins at tolerance {tol.rtol:g} (samples {tol.samples}),"
-        f" times the median of the runs; reference by other methods (Brent, QUADPACK, dense "
-        "sampling; of a long table, 64 rows spread over it); errors relative to the largest "
-        "value"
+        f" times the median of the runs; reference: mpmath at 32+ digits on the same formula "
+        "(quad, bisection, dense sampling then golden section; of a long table, 16 rows spread "
+        "over it), or other methods in doubles where the formula has no mpmath form (Brent, "
+        "QUADPACK, dense sampling; 64 rows); errors of each built-in call relative to its "
+        "largest value; values (ref.): the definition's values (the built-ins' values "
+        "compared)"
     )
     return "\n".join([head, HEADER, *(line.text() for line in lines)])

@@ -131,4 +131,5 @@ class Bound:
         """Keep the result's error estimate (``workbook bench``, the estimate findings), with
         the definition being computed."""
         result.notes.setdefault("in", defined())
+        result.notes["body"] = self.body  # which call it is (workbook bench's comparison)
         self.evaluator.records.append((name, result))

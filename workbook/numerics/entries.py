@@ -26,6 +26,7 @@ from ._common import (
     live,
     reference,
     reference_methods,
+    reference_values,
     sheet_tolerance,
 )
 
@@ -267,13 +268,17 @@ def _root_numpy(of, a, b=None):
     if live() and b is not None:
         return _out(_live_chain(of, a, b, _bisection)["root"])
     if reference():
+        from . import mpref
         from . import reference as ref
 
-        if b is None:
-            res = _solve(of, lambda f, a, idx, label: ref.root_near(f, a, (idx,)), a)
-        else:
-            res = _solve(of, lambda f, a, b, idx, label: ref.root_in(f, a, b, (idx,)), a, b)
-        return _merged(res.value, _root_numpy, of, a, b)
+        values = mpref.root(of, a, b)
+        if values is None and b is None:
+            values = _solve(of, lambda f, a, idx, label: ref.root_near(f, a, (idx,)), a).value
+        elif values is None:
+            values = _solve(
+                of, lambda f, a, b, idx, label: ref.root_in(f, a, b, (idx,)), a, b
+            ).value
+        return _merged(values, _root_numpy, of, a, b)
     if b is None:
         res = _solve(
             of,
@@ -312,16 +317,19 @@ def _integral_numpy(of, a, b):
     shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
     breaks = of.breaks(shape) + _kinks_located(of, shape, a, b)
     if reference():
+        from . import mpref
         from . import reference as ref
 
-        res = _solve(
-            of,
-            lambda f, a, b, *rest: ref.integral(f, a, b, (rest[-2],), rest[:-2]),
-            a,
-            b,
-            *breaks,
-        )
-        return _merged(res.value, _integral_numpy, of, a, b)
+        values = mpref.integral(of, a, b, breaks)
+        if values is None:
+            values = _solve(
+                of,
+                lambda f, a, b, *rest: ref.integral(f, a, b, (rest[-2],), rest[:-2]),
+                a,
+                b,
+                *breaks,
+            ).value
+        return _merged(values, _integral_numpy, of, a, b)
     tol, var, unit = of.tolerance, of.var, of.unit_text
     enclose = of.enclosure(shape)
     res = _solve(
@@ -377,15 +385,19 @@ def _extremum_numpy(name: str):
             steps = _live_chain(of, a, b, lambda f, a, b, idx: _golden(f, a, b, idx, kind, of))
             return _out(steps["where" if where else "value"])
         if reference():
+            from . import mpref
             from . import reference as ref
 
-            res = _solve(
-                of,
-                lambda f, a, b, idx, label: ref.extremum(f, a, b, (idx,), kind, where),
-                a,
-                b,
-            )
-            return _merged(res.where if where else res.value, hook, of, a, b)
+            values = mpref.extremum_of(of, a, b, kind, where)
+            if values is None:
+                res = _solve(
+                    of,
+                    lambda f, a, b, idx, label: ref.extremum(f, a, b, (idx,), kind, where),
+                    a,
+                    b,
+                )
+                values = res.where if where else res.value
+            return _merged(values, hook, of, a, b)
         tol, var, unit = of.tolerance, of.var, of.unit_text
         enclose = of.enclosure(np.broadcast_shapes(of.shape, np.shape(a), np.shape(b)))
         res = _solve(
@@ -440,6 +452,7 @@ def _product_numpy(of, a, b):
 
 def _merged(ref: np.ndarray, hook, of, *bounds):
     """The reference's values, and the engine's where the reference left a row out (NaN)."""
+    reference_values(of.body, ref)
     if not np.isnan(ref).any():
         return _out(ref)
     with reference_methods(False):

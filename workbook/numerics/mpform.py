@@ -1,0 +1,225 @@
+"""EXPR evaluated with mpmath over the typed tree: ``workbook bench``'s reference arithmetic.
+
+``MpForm(evaluator, ctx).compile(t)`` gives ``env -> mpf``: the same typed tree the numpy
+back end computes, every operation in the precision of the mpmath context ``ctx`` (the
+constants of the tree are the doubles numpy computes with, so both compute the same
+function; only the rounding differs). The sheet's inputs and definitions are read as the
+doubles the sheet computed. A node without an mpmath form here (a vector, a text, a data
+interpolant, a program, a solve block, a probability distribution, a numerical built-in
+other than an inner integral) raises :class:`NoMpForm` when compiled, naming it; a point
+where EXPR has no real value (a negative square root, a division by zero, no piece whose
+condition holds) raises :class:`NoValue` when evaluated.
+"""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Callable
+
+from .. import typed as ty
+from ..visitor import Visitor
+
+#: a sheet function nested deeper than this is not expanded
+_MAX_DEPTH = 20
+
+_COMPARE = {
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "==": operator.eq,
+    "!=": operator.ne,
+}
+
+Mp = Callable[[dict], object]
+
+
+class NoMpForm(Exception):
+    """EXPR has a node without an mpmath form; the message names it."""
+
+
+class NoValue(ArithmeticError):
+    """EXPR has no real value at this point."""
+
+
+def _real(ctx, v):
+    if isinstance(v, ctx.mpc):
+        if v.imag:
+            raise NoValue("a complex value")
+        return v.real
+    return v
+
+
+def _functions(ctx) -> dict[str, Callable]:
+    """The plain built-ins of one argument (numpy's meaning, in mpmath)."""
+    return {
+        "sin": ctx.sin,
+        "cos": ctx.cos,
+        "tan": ctx.tan,
+        "asin": ctx.asin,
+        "acos": ctx.acos,
+        "atan": ctx.atan,
+        "sinh": ctx.sinh,
+        "cosh": ctx.cosh,
+        "tanh": ctx.tanh,
+        "exp": ctx.exp,
+        "sqrt": ctx.sqrt,
+        "ln": ctx.ln,
+        "log10": ctx.log10,
+        "abs": abs,
+        "sign": ctx.sign,
+        "floor": ctx.floor,
+        "ceil": ctx.ceil,
+    }
+
+
+class MpForm(Visitor):
+    """Compiles a scalar typed tree into ``env -> mpf`` (``env``: parameter -> number)."""
+
+    def __init__(self, evaluator, ctx, depth: int = 0):
+        self.evaluator, self.ctx, self.depth = evaluator, ctx, depth
+        self.plain = _functions(ctx)
+
+    def compile(self, t: ty.T) -> Mp:
+        if t.shape is not None or t.text:
+            raise NoMpForm("a vector, matrix or text")
+        return self.visit(t)
+
+    def visit_TConst(self, t):
+        v = self.ctx.mpf(t.value)
+        return lambda env: v
+
+    def visit_TParam(self, t):
+        name, mpf = t.name, self.ctx.mpf
+        return lambda env: mpf(env[name])
+
+    def visit_TRef(self, t):
+        if t.kind == "solve" and self.evaluator.typer.spec.solve_of(t.name).parameters:
+            raise NoMpForm(f"the solve block {t.name}")
+        name, kind, get, mpf = t.name, t.kind, self.evaluator.scalar_value, self.ctx.mpf
+        return lambda env: mpf(float(get(name, kind)))
+
+    def visit_TScale(self, t):
+        child, k = self.compile(t.child), self.ctx.mpf(t.factor)
+        return lambda env: child(env) * k
+
+    def visit_TUnary(self, t):
+        child = self.compile(t.child)
+        if t.op == "not":
+            return lambda env: not child(env)
+        return lambda env: -child(env)
+
+    def visit_TBinary(self, t):
+        left, right, ctx = self.compile(t.left), self.compile(t.right), self.ctx
+        if t.op == "^":
+            return lambda env: _real(ctx, ctx.power(left(env), right(env)))
+        if t.op == "/":
+
+            def divide(env):
+                d = right(env)
+                if not d:
+                    raise NoValue("a division by zero")
+                return left(env) / d
+
+            return divide
+        op = {"+": operator.add, "-": operator.sub, "*": operator.mul}.get(t.op)
+        if op is None:
+            raise NoMpForm(f"the operator {t.op}")
+        return lambda env: op(left(env), right(env))
+
+    def visit_TCompare(self, t):
+        parts = [self.compile(o) for o in t.operands]
+        ops = [_COMPARE[o] for o in t.ops]
+
+        def chain(env):
+            vals = [p(env) for p in parts]
+            return all(op(x, y) for op, x, y in zip(ops, vals, vals[1:]))
+
+        return chain
+
+    def visit_TLogic(self, t):
+        parts = [self.compile(v) for v in t.values]
+        if t.op == "and":
+            return lambda env: all(p(env) for p in parts)
+        return lambda env: any(p(env) for p in parts)
+
+    def visit_TPiecewise(self, t):
+        conds = [None if k is None else self.compile(k) for k in t.conditions]
+        values = [self.compile(v) for v in t.values]
+
+        def piecewise(env):
+            for cond, val in zip(conds, values):
+                if cond is None or cond(env):
+                    return val(env)
+            raise NoValue("no piece whose condition holds")
+
+        return piecewise
+
+    def visit_TFunc(self, t):
+        ctx, args = self.ctx, t.args
+        if t.func == "integral" and len(args) == 4:
+            return self._integral(t)
+        if t.func in ("min", "max") and all(a.shape is None for a in args):
+            parts = [self.compile(a) for a in args]
+            pick = min if t.func == "min" else max
+            return lambda env: pick(p(env) for p in parts)
+        if t.func == "atan2" and len(args) == 2:
+            y, x = (self.compile(a) for a in args)
+            return lambda env: ctx.atan2(y(env), x(env))
+        f = self.plain.get(t.func)
+        if f is None or len(args) != 1:
+            raise NoMpForm(f"{t.func}()")
+        a = self.compile(args[0])
+        if t.func in ("ln", "log10"):
+
+            def log(env):
+                v = a(env)
+                if v <= 0:
+                    raise NoValue(f"{t.func} of a value that is not positive")
+                return f(v)
+
+            return log
+        return lambda env: _real(ctx, f(a(env)))
+
+    def _integral(self, t):
+        from .mpref import quad
+
+        body, var = self.compile(t.args[0]), t.args[1].name
+        lo, hi = self.compile(t.args[2]), self.compile(t.args[3])
+        ctx = self.ctx
+
+        def integral(env):
+            return quad(ctx, lambda x: body({**env, var: x}), lo(env), hi(env), (), refine=False)
+
+        return integral
+
+    def visit_TCall(self, t):
+        typer = self.evaluator.typer
+        if t.name in typer.recursive or self.depth > _MAX_DEPTH:
+            raise NoMpForm(f"the recursive function {t.name}")
+        f = typer.function(t.name)
+        body = MpForm(self.evaluator, self.ctx, self.depth + 1).compile(f.body)
+        names = list(f.params)
+        args = [self.compile(a) for a in t.args]
+        return lambda env: body({n: a(env) for n, a in zip(names, args)})
+
+    def __getattr__(self, name):
+        if name.startswith("visit_"):  # every other node kind: no mpmath form here
+            raise NoMpForm(_NODES.get(name[6:], name[6:]))
+        raise AttributeError(name)
+
+
+_NODES = {
+    "TBlock": "a solve block",
+    "TIndex": "indexing",
+    "TProgram": "a program",
+    "TOde": "an ODE state",
+    "TAggregate": "max_over or min_over",
+    "TMatrix": "a vector or matrix",
+    "TText": "a text",
+}
+
+
+def mp_form(evaluator, ctx, body: ty.T) -> Mp:
+    """EXPR's mpmath form (raises :class:`NoMpForm`)."""
+    return MpForm(evaluator, ctx).compile(body)

@@ -1,0 +1,330 @@
+"""``workbook bench``'s reference: the built-ins computed with mpmath on EXPR's typed tree.
+
+Inside :func:`workbook.numerics.reference_methods`, root, integral and the extrema compute
+each row by these methods, EXPR evaluated by :mod:`workbook.numerics.mpform` (every
+operation in mpmath, not numpy):
+
+- integral: ``mpmath.quad`` (tanh-sinh) at 32 digits on pieces: the kinks the tree shows,
+  the narrow and steep features its interval enclosures locate, and 8 equal pieces; a piece
+  whose estimate is above 1e-26 of the integral's scale is halved (256 pieces at most);
+- root in a bracket: bisection at 60 digits (to 1e-40 relative) on [A, B] or, where EXPR
+  has the same sign at both ends, on the one of 64 sample intervals with a sign change; a
+  bracket whose ends end far from 0 is a pole or a jump, not a root;
+- root from a guess: the nearest sign change outward from the guess (both sides to the same
+  distance, as the engine searches), past poles and jumps, then bisection as above;
+- maximum, minimum, argmax, argmin: EXPR at 4,001 points and at the ends of the feature
+  boxes (in doubles, to find candidates), then golden-section search at 32 digits around
+  the 8 best local extrema of the samples and the ends; the best is the value.
+
+Of a call with more than ``ROWS`` rows, ``ROWS`` rows spread over it are computed (the
+others are NaN, filled with the engine's values by the hooks). EXPR without an mpmath form
+returns None, and the hook falls back to :mod:`workbook.numerics.reference` (other
+algorithms in doubles); :func:`workbook.numerics._common.reference_note` records which.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath
+import numpy as np
+
+from ._common import reference_note
+from .mpform import NoMpForm, NoValue, mp_form
+from .reference import ReferenceFailed
+
+#: digits of the integral's and the extrema's reference
+DIGITS = 32
+#: digits of a root's reference (a multiple root is as exact as the cube root of rounding)
+ROOT_DIGITS = 60
+#: rows of one call computed at most (spread over it)
+ROWS = 16
+#: the relative estimate a piece of an integral is accepted at (fixed: an inner integral runs
+#: at the raised precision of the outer one's nodes, where mpmath's estimate stays near 1e-23)
+GOAL = "1e-20"
+#: pieces of one integral at most
+MAX_PIECES = 256
+#: points of the extremum's sampling, and the local extrema polished
+DENSE = 4000
+CANDIDATES = 8
+
+
+class Unconverged(ArithmeticError):
+    """The mpmath method did not reach its accuracy."""
+
+
+def context(digits: int):
+    """A private mpmath context (the global ``mpmath.mp`` is left alone)."""
+    ctx = mpmath.MPContext()
+    ctx.dps = digits
+    return ctx
+
+
+# -- the methods on one row: g(x) is EXPR at an mpf x ------------------------------------------
+def quad(ctx, g, a, b, points, refine: bool = True) -> object:
+    """The integral of g over [a, b] (an mpf), split at ``points``; with ``refine``, also in
+    8 equal pieces, and a piece whose estimate is above GOAL of the scale is halved (an
+    inner integral is not refined: its error is part of the outer integrand's, which the
+    outer integral's estimate sees)."""
+    a, b = ctx.mpf(a), ctx.mpf(b)
+    if a == b:
+        return ctx.zero
+    sign = 1
+    if a > b:
+        a, b, sign = b, a, -1
+    edges = sorted({a, b, *(ctx.mpf(p) for p in points if a < p < b)})
+    if refine:
+        edges = sorted({*edges, *(a + (b - a) * k / 8 for k in range(1, 8))})
+    scale = (b - a) * max(_abs_or_zero(g, a + (b - a) * (k + 0.5) / 33) for k in range(33))
+    goal = ctx.mpf(GOAL)
+    pieces, total, done = list(zip(edges, edges[1:])), ctx.zero, 0
+    while pieces:
+        lo, hi = pieces.pop()
+        v, e = ctx.quad(lambda x, lo=lo, hi=hi: _inside(g, x, lo, hi), [lo, hi], error=True)
+        scale = max(scale, abs(v))
+        share = (hi - lo) / (b - a)
+        if not refine or e <= goal * max(scale, ctx.mpf(10) ** -300) * share:
+            total += v
+            done += 1
+            continue
+        if done + len(pieces) + 2 > MAX_PIECES:
+            raise Unconverged(
+                f"mpmath quad: estimate {float(e):.1e} on [{float(lo):.6g}, {float(hi):.6g}] "
+                f"after {MAX_PIECES} pieces"
+            )
+        mid = (lo + hi) / 2
+        pieces += [(lo, mid), (mid, hi)]
+    return sign * total
+
+
+def _inside(g, x, lo, hi):
+    """g at a node of a piece; 0 at a node that rounds to an end (a singular end's nodes
+    come closer to it than the precision: they weigh less than 1e-16 of an integrable
+    singularity's integral, below the reference's accuracy)."""
+    return 0 if x in (lo, hi) else g(x)
+
+
+def _abs_or_zero(g, x):
+    try:
+        return abs(g(x))
+    except (NoValue, ZeroDivisionError):
+        return 0
+
+
+def _bisect(ctx, g, lo, hi, glo):
+    """A sign change of g in [lo, hi] to 1e-40 relative; refused when it is a pole or a jump."""
+    scale = max(abs(glo), abs(g(hi)))
+    flo = glo
+    for _ in range(2000):
+        mid = (lo + hi) / 2
+        if hi - lo <= ctx.mpf(10) ** -40 * max(abs(lo), abs(hi), ctx.mpf(10) ** -300):
+            break
+        if mid in (lo, hi):
+            break
+        try:
+            fm = g(mid)
+        except (NoValue, ZeroDivisionError):  # EXPR has no value inside the sign change
+            raise Unconverged(f"a pole or a jump at x = {float(mid):.6g}, not a root") from None
+        if fm == 0:
+            return mid
+        if (fm > 0) == (flo > 0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    ends = min(abs(flo), abs(g(hi)))
+    if ends > scale * ctx.mpf(10) ** -12:
+        raise Unconverged(f"a pole or a jump at x = {float(lo):.6g}, not a root")
+    return (lo + hi) / 2
+
+
+def root_in(ctx, g, a, b):
+    """The one root of g in [a, b] (mpf)."""
+    lo, hi = sorted((ctx.mpf(a), ctx.mpf(b)))
+    glo, ghi = g(lo), g(hi)
+    if glo == 0 or ghi == 0:
+        return lo if glo == 0 else hi
+    if (glo > 0) == (ghi > 0):
+        xs = [lo + (hi - lo) * k / 64 for k in range(65)]
+        fs = [g(x) for x in xs]
+        change = [k for k in range(64) if (fs[k] > 0) != (fs[k + 1] > 0) or fs[k] == 0]
+        if len(change) != 1:
+            raise Unconverged(f"{len(change)} sign changes at 65 samples")
+        k = change[0]
+        if fs[k] == 0:
+            return xs[k]
+        lo, hi, glo = xs[k], xs[k + 1], fs[k]
+    return _bisect(ctx, g, lo, hi, glo)
+
+
+def root_near(ctx, g, guess):
+    """The root of g nearest to ``guess`` whose sign change is no pole or jump (4 at most)."""
+    x = ctx.mpf(guess)
+    f0 = g(x)
+    if f0 == 0:
+        return x
+    h, skipped = max(abs(x) * ctx.mpf("1e-6"), ctx.mpf("1e-9")), 0
+    inner = ctx.zero
+    for _ in range(400):
+        found = []
+        for t, s in ((x + h, x + inner), (x - h, x - inner)):
+            try:
+                ft, fs = g(t), g(s)
+            except NoValue:
+                continue
+            if (ft > 0) != (fs > 0) or ft == 0:
+                lo, hi = sorted((s, t))
+                try:
+                    found.append(_bisect(ctx, g, lo, hi, g(lo)))
+                except Unconverged:
+                    skipped += 1
+                    if skipped > 4:
+                        raise Unconverged("more than 4 poles or jumps near the guess") from None
+        if found:
+            return min(found, key=lambda r: abs(r - x))
+        inner, h = h, h * ctx.mpf("1.25")
+    raise Unconverged("no sign change around the guess")
+
+
+def _golden(ctx, g, lo, hi, sgn):
+    """(best value of sgn*g, where) on [lo, hi] by golden-section search to 1e-20 relative."""
+    r = (ctx.sqrt(5) - 1) / 2
+    c, d = hi - r * (hi - lo), lo + r * (hi - lo)
+    fc, fd = sgn * g(c), sgn * g(d)
+    tol = ctx.mpf(10) ** -20 * max(abs(lo), abs(hi), ctx.mpf(10) ** -300)
+    while hi - lo > tol:
+        if fc < fd:
+            hi, d, fd = d, c, fc
+            c = hi - r * (hi - lo)
+            fc = sgn * g(c)
+        else:
+            lo, c, fc = c, d, fd
+            d = lo + r * (hi - lo)
+            fd = sgn * g(d)
+    best = [(fc, c), (fd, d), (sgn * g(lo), lo), (sgn * g(hi), hi)]
+    return min(best, key=lambda p: p[0])
+
+
+def extremum(ctx, g, xs: np.ndarray, fs: np.ndarray, kind: str):
+    """(value, where) of g's extremum, polished around the samples' best local extrema."""
+    sgn = -1 if kind == "max" else 1
+    s = sgn * np.where(np.isfinite(fs), fs, np.inf)
+    n = xs.size
+    local = [
+        k for k in range(n) if (k == 0 or s[k] <= s[k - 1]) and (k == n - 1 or s[k] <= s[k + 1])
+    ]
+    local = sorted(local, key=lambda k: s[k])[:CANDIDATES]
+    best = None
+    for k in {*local, 0, n - 1}:
+        lo, hi = ctx.mpf(xs[max(k - 1, 0)]), ctx.mpf(xs[min(k + 1, n - 1)])
+        cand = _golden(ctx, g, lo, hi, sgn)
+        if best is None or cand[0] < best[0]:
+            best = cand
+    return sgn * best[0], best[1]
+
+
+# -- the hooks' side: every row of a call --------------------------------------------------------
+def _rows(n: int) -> np.ndarray:
+    return np.arange(n) if n <= ROWS else np.unique(np.linspace(0, n - 1, ROWS).astype(np.intp))
+
+
+def _prepared(of, name: str, digits: int, *bounds):
+    """(ctx, form, shape, flat bounds, row environments) or None without an mpmath form."""
+    from .. import typed as ty
+    from .reference import ROWS as SCIPY_ROWS
+
+    ctx = context(digits)
+    shape = np.broadcast_shapes(of.shape, *(np.shape(b) for b in bounds))
+    n = math.prod(shape)
+    try:
+        form = mp_form(of.evaluator, ctx, of.body)
+    except NoMpForm as err:
+        reference_note(f"scipy ({err}: no mpmath form)", min(n, SCIPY_ROWS), n)
+        return None
+    flat = [np.broadcast_to(np.asarray(b, dtype=float), shape).reshape(-1) for b in bounds]
+    arrays = of._flat(shape)
+    used = ty.parameters(of.body) - {of.var}
+    fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
+    rows = _rows(n)
+
+    def env(i):
+        return {**fixed, **{k: float(a[i]) for k, a in arrays.items()}}
+
+    reference_note("mpmath", rows.size, n)
+    return ctx, form, shape, flat, rows, env
+
+
+def _each(name: str, var: str, prepared, one) -> np.ndarray:
+    """``one(ctx, g, bounds, row)`` for every row computed; NaN in the others."""
+    ctx, form, shape, flat, rows, env = prepared
+    out = np.full(math.prod(shape), np.nan)
+    for i in rows:
+        e = env(i)
+
+        def g(x, e=e):
+            return form({**e, var: x})
+
+        try:
+            out[i] = float(one(ctx, g, [b[i] for b in flat], i))
+        except (NoValue, Unconverged, ZeroDivisionError) as err:
+            raise ReferenceFailed(f"mpmath {name}: {err}") from None
+    return out.reshape(shape)
+
+
+def root(of, a, b=None) -> np.ndarray | None:
+    """The reference of root(EXPR, X, A, B) or root(EXPR, X, GUESS), or None (no mpmath form)."""
+    bounds = (a,) if b is None else (a, b)
+    prepared = _prepared(of, "root", ROOT_DIGITS, *bounds)
+    if prepared is None:
+        return None
+    if b is None:
+        return _each("root", of.var, prepared, lambda ctx, g, ab, i: root_near(ctx, g, ab[0]))
+    return _each("root", of.var, prepared, lambda ctx, g, ab, i: root_in(ctx, g, ab[0], ab[1]))
+
+
+def _feature_points(of, shape, lo, hi, rows) -> dict[int, list[float]]:
+    """Row -> the ends of the boxes where EXPR's enclosures show a narrow or steep feature."""
+    from .quadrature import _features
+
+    enclose = of.enclosure(shape)
+    if enclose is None:
+        return {}
+    found = _features(of.over(shape), enclose, (rows.astype(float),), lo[rows], hi[rows])
+    return {int(r): [float(p[k]) for p in found] for k, r in enumerate(rows)}
+
+
+def integral(of, a, b, breaks) -> np.ndarray | None:
+    """The reference of integral(EXPR, X, A, B), or None (no mpmath form)."""
+    prepared = _prepared(of, "integral", DIGITS, a, b, *breaks)
+    if prepared is None:
+        return None
+    shape, flat, rows = prepared[2], prepared[3], prepared[4]
+    lo, hi = np.minimum(flat[0], flat[1]), np.maximum(flat[0], flat[1])
+    extra = _feature_points(of, shape, lo, hi, rows)
+
+    def one(ctx, g, ab, i):
+        lo, hi, *pts = ab
+        return quad(ctx, g, lo, hi, [*pts, *extra.get(i, ())])
+
+    return _each("integral", of.var, prepared, one)
+
+
+def extremum_of(of, a, b, kind: str, where: bool) -> np.ndarray | None:
+    """The reference of maximum/minimum (or argmax/argmin: ``where``), or None (no mpmath
+    form)."""
+    prepared = _prepared(of, "argmax" if where else kind, DIGITS, a, b)
+    if prepared is None:
+        return None
+    shape, flat, rows = prepared[2], prepared[3], prepared[4]
+    lo, hi = np.minimum(flat[0], flat[1]), np.maximum(flat[0], flat[1])
+    extra = _feature_points(of, shape, lo, hi, rows)
+    f = of.over(shape)
+
+    def one(ctx, g, ab, i):
+        xs = np.unique(np.r_[np.linspace(lo[i], hi[i], DENSE + 1), extra.get(i, [])])
+        xs = xs[(xs >= lo[i]) & (xs <= hi[i])]
+        with np.errstate(all="ignore"):
+            fs = np.broadcast_to(np.asarray(f(xs, np.full(xs.size, i)), dtype=float), xs.shape)
+        value, at = extremum(ctx, g, xs, fs, kind)
+        return at if where else value
+
+    return _each(kind, of.var, prepared, one)
