@@ -59,7 +59,8 @@ def test_the_mpmath_form_of_a_tree_is_its_formula_at_32_digits(tmp_path, x):
 def test_no_real_value_and_no_form_are_said(tmp_path):
     s = _sheet(
         tmp_path,
-        '[arguments]\nx = { unit = "" }\n[definitions]\n"r(x)" = "sqrt(x - 1)"\n"m(x)" = "mod(x, 1)"\n',
+        '[arguments]\nx = { unit = "" }\n[definitions]\n'
+        '"r(x)" = "sqrt(x - 1)"\n"m(x)" = "mod(x, 1)"\n',
     )
     ctx = mpref.context(32)
     with pytest.raises(NoValue):
@@ -71,7 +72,8 @@ def test_no_real_value_and_no_form_are_said(tmp_path):
 def test_a_formula_without_an_mpmath_form_falls_back_and_says_so(tmp_path):
     s = _sheet(
         tmp_path,
-        '[definitions]\nsaw = "integral(pnorm(x, 0, 1), x, 0, 2.5)"\nsq = "integral(x^2, x, 0, 3)"\n',
+        '[definitions]\nsaw = "integral(pnorm(x, 0, 1), x, 0, 2.5)"\n'
+        'sq = "integral(x^2, x, 0, 3)"\n',
     )
     lines = {line.what: line for line in bench.run(s, repeats=1)}
     assert lines["saw"].reference == "scipy (pnorm(): no mpmath form)"
@@ -120,13 +122,21 @@ bump = "minimum(x^2 - 1/(1 + ((x - 0.61)/1e-5)^2), x, 0, 1)"
 nested = "integral(integral(1/sqrt(t + 1e-3), t, 0, u), u, 0, 1)"
 """
 
+#: the one formula of the templates without an mpmath form: data interpolation, whose
+#: reference is QUADPACK in doubles (said on its line)
+FALLBACK = "scipy (linterp(): no mpmath form)"
+
+
 def _verdicts_are_honest(where: str, lines) -> None:
     for line in lines:
         assert line.verdict not in ("WRONG", "ESTIMATE LOW"), (where, line.text())
         assert not line.failed, (where, line.text())
-        assert line.estimate >= line.difference / 10, (where, line.text())
+        assert line.estimate >= line.difference / 10 or line.difference <= bench.ROUNDING, (
+            where,
+            line.text(),
+        )
         if line.verdict == "ok":
-            assert line.reference == "mpmath", (where, line.text())
+            assert line.reference in ("mpmath", FALLBACK), (where, line.text())
             assert line.checked > 0
 
 

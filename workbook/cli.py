@@ -259,7 +259,17 @@ def cmd_run(args) -> int:
     for name in sheet.left_out:
         part = sheet.full_spec.parts[name]
         print(f"left out part {name} ({part.title}): add it with --part {name}")
+    _estimates_after_writing(sheet, report)
     return _print_findings(report)
+
+
+def _estimates_after_writing(sheet, report) -> None:
+    """The built-ins' estimate and assumption findings of the values computed after the
+    check (the writer and the scalars computed the rest), each once."""
+    from .numerics.estimates import estimate_findings
+
+    known = {(f.topic, f.what) for f in report.findings}
+    report.findings += [f for f in estimate_findings(sheet) if (f.topic, f.what) not in known]
 
 
 def _print_scalars(sheet) -> None:

@@ -35,6 +35,8 @@ REFERENCE_ACCURACY = 1e-12
 MPMATH_ACCURACY = 1e-14
 #: ... and for the place of an extremum (argmax, argmin): f is flat there
 WHERE_ACCURACY = 1e-7
+#: the rounding of a double result (relative): a difference below it is no error to estimate
+ROUNDING = 4 * float(np.finfo(float).eps)
 #: a tighter tolerance of the same methods (a scene's own study of its error may use it)
 REFERENCE_RTOL = 1e-14
 #: timed runs of each target (the median is shown)
@@ -65,7 +67,8 @@ class Line:
         if "arg" in self.builtins:
             floor = WHERE_ACCURACY
         within = self.difference <= max(self.tolerance, floor)
-        honest = self.estimate >= self.difference / 10
+        # a difference within the rounding of a double needs no estimate to cover it
+        honest = self.estimate >= self.difference / 10 or self.difference <= ROUNDING
         if within:
             return "ok" if honest else "ESTIMATE LOW"
         return "beyond tolerance (estimated)" if honest else "WRONG"

@@ -21,6 +21,9 @@ class Bound:
     environment's arrays taken at the flat indices ``row`` of the call's shape.
     """
 
+    #: why :meth:`enclosure` gave None: the node of EXPR without an interval extension
+    no_enclosure = ""
+
     def __init__(self, evaluator, body: ty.T, fn: Callable, var: ty.TParam, env: dict):
         self.evaluator = evaluator
         self.body, self.fn, self.env = body, fn, env
@@ -59,7 +62,8 @@ class Bound:
 
         try:
             g = enclosure(self.evaluator, self.body, self.var)
-        except NoEnclosure:
+        except NoEnclosure as err:
+            self.no_enclosure = _node_text(str(err))
             return None
         flat, env, var = self._flat(shape), self.env, self.var
 
@@ -133,3 +137,24 @@ class Bound:
         result.notes.setdefault("in", defined())
         result.notes["body"] = self.body  # which call it is (workbook bench's comparison)
         self.evaluator.records.append((name, result))
+
+
+_NODES = {
+    "TPiecewise": "a piecewise value",
+    "TIndex": "indexing",
+    "TBlock": "a solve block",
+    "TProgram": "a program",
+    "TMatrix": "a vector",
+    "TAggregate": "max_over or min_over",
+    "TOde": "an ODE state",
+    "TCompare": "a comparison",
+    "TLogic": "a condition",
+}
+
+
+def _node_text(node: str) -> str:
+    """The node that has no interval extension, as a message says it: ``sign()``, ``a
+    piecewise value``."""
+    if node in _NODES:
+        return _NODES[node]
+    return f"{node}()" if node.isidentifier() and not node.startswith("T") else node

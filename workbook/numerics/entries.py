@@ -187,7 +187,17 @@ def _solve(of, solve, *bounds) -> Result:
         join("where"),
         join("where_error"),
         evaluations=max(r.evaluations for r in parts),
+        notes=_joined_notes(parts),
     )
+
+
+def _joined_notes(parts: list[Result]) -> dict:
+    """The notes of the chunks of one call: the widest assumption of them all."""
+    notes = dict(parts[0].notes)
+    widths = [r.notes["assumes"] for r in parts if "assumes" in r.notes]
+    if widths:
+        notes["assumes"] = max(widths)
+    return notes
 
 
 def _bisection(f, a, b, idx) -> dict[str, np.ndarray]:
@@ -297,6 +307,11 @@ def _root_numpy(of, a, b=None):
             a,
             b,
         )
+    # a root hidden within the rounding of EXPR (a multiple root): polished in mpmath
+    from .mpref import polish_roots
+
+    shape = np.broadcast_shapes(of.shape, np.shape(a), *(() if b is None else (np.shape(b),)))
+    polish_roots(of, res, shape, tol)
     of.record("root", res)
     return _out(res.value)
 
@@ -419,7 +434,9 @@ def _extremum_numpy(name: str):
             b,
         )
         if where:
-            res = Result(res.where, res.where_error, evaluations=res.evaluations)
+            res = Result(res.where, res.where_error, evaluations=res.evaluations, notes=res.notes)
+        if "assumes" in res.notes:
+            res.notes["why"] = of.no_enclosure
         of.record(name, res)
         kept = chains()
         if kept is not None:  # the writer compares the live form with it

@@ -1,5 +1,6 @@
 """Findings about the numerical built-ins' error estimates: a value whose estimate is far above
-the sheet's tolerance is printed by ``run`` and ``check`` (a warning), never kept silent."""
+the sheet's tolerance, and an extremum that rests on an assumption (no feature narrower than
+its samples' spacing), are printed by ``run`` and ``check`` (warnings), never kept silent."""
 
 from __future__ import annotations
 
@@ -43,7 +44,7 @@ def estimate_findings(sheet) -> list:
         key = (where, builtin)
         if relative > worst.get(key, (-1.0,))[0]:
             worst[key] = (relative, err, size)
-    out = []
+    out = assumption_findings(sheet)
     for (where, builtin), (relative, err, size) in worst.items():
         if relative <= ESTIMATE_LIMIT * rtol:
             continue
@@ -57,6 +58,42 @@ def estimate_findings(sheet) -> list:
                 "warning",
                 f"over {ESTIMATE_LIMIT:g} times the sheet's tolerance ({rtol:g}): the value is "
                 "less certain than asked; docs/numerics.md says what each built-in certifies",
+            )
+        )
+    return out
+
+
+def assumption_findings(sheet) -> list:
+    """A warning per assumption that maximum, minimum, argmax or argmin values rest on where
+    EXPR has a node without an interval extension (the global extremum is then not
+    certified): no feature narrower than the samples' spacing h. The values that share one
+    h and one cause are named in one warning."""
+    from ..findings import Finding
+
+    widest: dict[tuple[str, str], tuple[float, str, str]] = {}
+    for builtin, result in sheet.evaluator.records:
+        where, h = result.notes.get("in"), result.notes.get("assumes")
+        if where is None or h is None:
+            continue
+        key = (where, builtin)
+        if h > widest.get(key, (-1.0,))[0]:
+            widest[key] = (h, result.notes.get("unit", ""), result.notes.get("why", ""))
+    shared: dict[tuple[float, str, str], list[str]] = {}
+    for (where, builtin), same in widest.items():
+        shared.setdefault(same, []).append(f"{builtin} {where}")
+    out = []
+    for (h, unit, why), values in shared.items():
+        cause = f"{why} has no interval extension" if why else "no interval extension"
+        size = f"{h:.4g} {unit}".rstrip()
+        out.append(
+            Finding(
+                f"assumption {', '.join(values)}",
+                f"assumes no feature narrower than h = {size} (the spacing of the samples)",
+                None,
+                "",
+                "warning",
+                f"{cause}, so the global extremum is not certified between the samples; more "
+                "[sheet] samples narrow h; docs/numerics.md says what each built-in certifies",
             )
         )
     return out

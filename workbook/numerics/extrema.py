@@ -112,12 +112,16 @@ def extremum(
                 f"within the tolerance): it has no one arg{kind}"
             )
         _no_plateau(kind, xs, fs, best_v, tol, var, unit, label)
+    # without enclosures nothing is known between the samples: the value rests on no feature
+    # narrower than their spacing, which the result carries (``run`` prints it)
+    notes = {} if enclose is not None else {"assumes": float(np.max((hi - lo) / k)), "unit": unit}
     return Result(
         (sgn * best_v).reshape(shape),
         best_ve.reshape(shape),
         best_x.reshape(shape),
         best_xe.reshape(shape),
         evaluations=evaluations,
+        notes=notes,
     )
 
 

@@ -4,9 +4,9 @@
 back end computes, every operation in the precision of the mpmath context ``ctx`` (the
 constants of the tree are the doubles numpy computes with, so both compute the same
 function; only the rounding differs). The sheet's inputs and definitions are read as the
-doubles the sheet computed. A node without an mpmath form here (a vector, a text, a data
+doubles the sheet computed. A node without an mpmath form here (a vector, a data
 interpolant, a program, a solve block, a probability distribution, a numerical built-in
-other than an inner integral) raises :class:`NoMpForm` when compiled, naming it; a point
+other than an inner integral or diff) raises :class:`NoMpForm` when compiled, naming it; a point
 where EXPR has no real value (a negative square root, a division by zero, no piece whose
 condition holds) raises :class:`NoValue` when evaluated.
 """
@@ -81,9 +81,13 @@ class MpForm(Visitor):
         self.plain = _functions(ctx)
 
     def compile(self, t: ty.T) -> Mp:
-        if t.shape is not None or t.text:
-            raise NoMpForm("a vector, matrix or text")
+        if t.shape is not None:
+            raise NoMpForm("a vector or matrix")
         return self.visit(t)
+
+    def visit_TText(self, t):
+        v = t.value
+        return lambda env: v
 
     def visit_TConst(self, t):
         v = self.ctx.mpf(t.value)
@@ -97,7 +101,12 @@ class MpForm(Visitor):
         if t.kind == "solve" and self.evaluator.typer.spec.solve_of(t.name).parameters:
             raise NoMpForm(f"the solve block {t.name}")
         name, kind, get, mpf = t.name, t.kind, self.evaluator.scalar_value, self.ctx.mpf
-        return lambda env: mpf(float(get(name, kind)))
+
+        def ref(env):
+            v = get(name, kind)
+            return v if isinstance(v, str) else mpf(float(v))  # a choice: 'law == "stepped"'
+
+        return ref
 
     def visit_TScale(self, t):
         child, k = self.compile(t.child), self.ctx.mpf(t.factor)
@@ -159,6 +168,8 @@ class MpForm(Visitor):
         ctx, args = self.ctx, t.args
         if t.func == "integral" and len(args) == 4:
             return self._integral(t)
+        if t.func == "diff":
+            return self._derivative(t)
         if t.func in ("min", "max") and all(a.shape is None for a in args):
             parts = [self.compile(a) for a in args]
             pick = min if t.func == "min" else max
@@ -192,6 +203,17 @@ class MpForm(Visitor):
             return quad(ctx, lambda x: body({**env, var: x}), lo(env), hi(env), (), refine=False)
 
         return integral
+
+    def _derivative(self, t):
+        """diff(EXPR, X, N): the compiled formula of the derivative SymPy found (the one the
+        numpy back end computes)."""
+        from .derivative import formula
+
+        order = t.args[2] if len(t.args) > 2 else ty.TConst(t.unit, value=1.0)
+        if not isinstance(order, ty.TConst):
+            raise NoMpForm("diff() of a computed order")
+        tree = formula(self.evaluator.typer, t.args[0], t.args[1], int(order.value))
+        return self.compile(tree)
 
     def visit_TCall(self, t):
         typer = self.evaluator.typer

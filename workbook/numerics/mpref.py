@@ -328,3 +328,104 @@ def extremum_of(of, a, b, kind: str, where: bool) -> np.ndarray | None:
         return at if where else value
 
     return _each(kind, of.var, prepared, one)
+
+
+# -- roots inside the rounding noise: polished in extended precision ----------------------------
+#: rows of one call polished at most (a table of multiple roots keeps its noise-limited
+#: estimates beyond that)
+POLISH_ROWS = 64
+
+
+def polish_roots(of, result, shape, tol) -> int:
+    """Roots checked, and polished where needed, on EXPR's mpmath form at 60 digits, in
+    place. A root is certain within its estimate e where EXPR's signs at value -/+ e differ
+    in mpmath. A root whose estimate is above the tolerance (a multiple root, hidden within
+    the rounding of EXPR in doubles), and one whose signs there do not differ (an estimate
+    too small: the nearest sign change is sought outward, 4 times wider at each step), is
+    polished by bisection to 1e-40, and its estimate becomes the rounding of the double it is
+    returned as. Every row of a call of at most POLISH_ROWS rows is checked (unless EXPR
+    has an inner integral); of a larger call, only the rows whose estimate is above the
+    tolerance. Rows without an mpmath form,
+    or where no sign change is found, keep their value and estimate. Returns the number of
+    rows changed."""
+    from .. import typed as ty
+
+    value = np.ravel(result.value).copy()
+    error = np.ravel(result.error).copy()
+    finite = np.isfinite(value) & np.isfinite(error)
+    noisy = finite & (error > np.maximum(tol.rtol * np.abs(value), tol.atol))
+    # an inner integral costs an mpmath quadrature per evaluation: only noisy rows then
+    check_all = value.size <= POLISH_ROWS and not _has_integral(of.evaluator, of.body)
+    rows = np.flatnonzero(finite if check_all else noisy)
+    if not rows.size or rows.size > POLISH_ROWS:
+        return 0
+    ctx = context(ROOT_DIGITS)
+    try:
+        form = mp_form(of.evaluator, ctx, of.body)
+    except NoMpForm:
+        return 0
+    arrays = of._flat(shape)
+    used = ty.parameters(of.body) - {of.var}
+    fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
+    done = 0
+    for i in rows:
+        env = {**fixed, **{k: float(a[i]) for k, a in arrays.items()}}
+
+        def g(x, env=env):
+            return form({**env, of.var: x})
+
+        try:
+            x = _checked_root(ctx, g, value[i], error[i], bool(noisy[i]))
+        except (NoValue, Unconverged, ZeroDivisionError):
+            continue
+        if x is None:
+            continue
+        value[i] = float(x)
+        error[i] = max(abs(float(x - ctx.mpf(value[i]))), np.spacing(abs(value[i])))
+        done += 1
+    result.value = value.reshape(np.shape(result.value))
+    result.error = error.reshape(np.shape(result.error))
+    return done
+
+
+def _has_integral(evaluator, body) -> bool:
+    """Whether EXPR calls integral, also through the sheet's functions."""
+    from .. import typed as ty
+
+    stack, seen = [body], set()
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ty.TFunc) and n.func == "integral":
+            return True
+        if isinstance(n, ty.TCall) and n.name not in seen:
+            seen.add(n.name)
+            stack.append(evaluator.typer.function(n.name).body)
+        stack.extend(ty.children(n))
+    return False
+
+
+def _checked_root(ctx, g, v: float, e: float, polish: bool):
+    """None where the root is certain within e and need not be polished; else the root
+    polished in mpmath (None too where no sign change is found near v)."""
+    d = max(e, 4 * float(np.spacing(abs(v))), float(np.finfo(float).tiny))
+    certain = True
+    for _ in range(40):
+        lo, hi = ctx.mpf(v) - ctx.mpf(d), ctx.mpf(v) + ctx.mpf(d)
+        glo, ghi = g(lo), g(hi)
+        if glo == 0 or ghi == 0:
+            return None if certain and not polish else (lo if glo == 0 else hi)
+        if (glo > 0) != (ghi > 0):
+            break
+        certain = False
+        d *= 4
+    else:
+        return None
+    if certain and not polish:
+        return None
+    # two roots within the noise (a cluster the doubles cannot tell apart): the value keeps
+    # its estimate, which covers them both
+    xs = [lo + (hi - lo) * k / 64 for k in range(65)]
+    fs = [g(x) for x in xs]
+    if sum((p > 0) != (q > 0) or p == 0 for p, q in zip(fs, fs[1:])) > 1:
+        return None
+    return _bisect(ctx, g, lo, hi, glo)
