@@ -115,7 +115,7 @@ def _reasons(listed) -> dict[str, int]:
             ("external link", "external links"),
             ("engine refuses", "refused at load"),
             ("not mapped", "Excel functions not mapped"),
-            ("formula cells", "beyond the cap"),
+            ("formulas translated", "beyond the cap"),
         ):
             if key in low:
                 kinds[label] += 1

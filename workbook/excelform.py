@@ -15,6 +15,7 @@ writes to a file without typing or evaluating anything.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 
@@ -283,7 +284,7 @@ class ExcelLayout:
         for row, d in enumerate(defs, start=1):
             t, q = self._scalar(d.name)
             ws.write_string(row, 0, d.name)
-            value = q if t.text else float(q.magnitude)
+            value = q if t.text or isinstance(q, str) else float(q.magnitude)
             with self.printer.context(helpers=HelperCells(self, d.name, t)):
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             ws.write_string(row, 2, un.pretty(t.unit))
@@ -347,7 +348,7 @@ class ExcelLayout:
                 continue
             unit = un.pretty(t.unit)
             ws.write_string(row, 2, unit)
-            value = q if t.text else float(q.magnitude)
+            value = q if t.text or isinstance(q, str) else float(q.magnitude)
             if d.name in done:
                 ref = self.names[d.name]
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
@@ -1349,6 +1350,8 @@ def _nested_text(value) -> str:
     [[a, b], [c, d]], an array element in its place ([1, [0, 30]])."""
 
     def text(v) -> str:
+        if isinstance(v, str):  # a text element
+            return json.dumps(v, ensure_ascii=False)
         if not rt.is_array(v):
             return f"{float(v):.10g}"
         if v.shape[1] == 1:

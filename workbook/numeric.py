@@ -34,6 +34,9 @@ Env = dict[str, object]
 Fn = Callable[[Env], object]
 
 _CMP = rt.COMPARE
+#: Built-ins of arrays that read only their sizes: an array that holds text may be given to
+#: them (every other built-in wants numbers).
+_SIZES = frozenset({"rows", "cols", "length", "last"})
 # Powers by products and square roots (x^1.5, x^3 and x^4 in Evaluator._power_by_parts):
 # several times faster than np.power, within 2 ulp (tests/test_numeric_golden.py, mpmath).
 _POWERS = {
@@ -157,12 +160,17 @@ class Evaluator(Visitor):
         child = self.compile(c)
         if f == 1.0:
             return child
+        if ty.is_runtime(t.shape):  # an array that holds text: its numbers scaled
+            return lambda env: rt.scale(rt.value(child(env)), f)
         return lambda env: child(env) * f
 
     def visit_TUnary(self, t: tc.TUnary) -> Fn:
         child = self.compile(t.child)
         if t.op == "not":
             return lambda env: np.logical_not(child(env))
+        if ty.is_runtime(t.shape):
+            what = _text(t)
+            return lambda env: rt.negate(child(env), what)
         return lambda env: -child(env)
 
     def visit_TBinary(self, t: tc.TBinary) -> Fn:
@@ -242,8 +250,12 @@ class Evaluator(Visitor):
         if entry.arrays and any(ty.is_runtime(a.shape) for a in t.args):
             args, hook, what = [self.compile(a) for a in t.args], f, _text(t)
 
+            sizes = t.func in _SIZES
+
             def runtime_call(env):
                 values = [rt.value(a(env)) for a in args]
+                if not sizes:
+                    values = [rt.no_text(v, what) for v in values]
                 try:
                     return rt.value(hook(*values, shapes=rt.shapes(values)))
                 except (TypeError, ValueError) as err:  # numpy refusing a nested array
@@ -253,6 +265,12 @@ class Evaluator(Visitor):
         if entry.arrays:
             f = functools.partial(f, shapes=tuple(a.shape for a in t.args))
         args = [self.compile(a) for a in t.args]
+        if any(ty.is_runtime(a.shape) for a in t.args):  # an element that may be text
+            what, plain = _text(t), args
+            args = [
+                (lambda env, a=a: rt.no_text(a(env), what)) if ty.is_runtime(arg.shape) else a
+                for a, arg in zip(plain, t.args)
+            ]
         if len(args) == 1:
             a0 = args[0]
             return lambda env: f(a0(env))

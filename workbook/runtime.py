@@ -7,10 +7,13 @@ and still checks its unit (one unit for all its elements, as every matrix). Its 
 checked here, when it runs, by Mathcad's rules; every mistake is an error naming the
 expression, never a guess.
 
-A run-time value is a number (a float) or a matrix: a 2-D numpy array (rows, columns) of
-floats, or of objects when an element is itself an array (a nested array). Run-time values
-never carry the range axes of a table (:mod:`workbook.matrix`): a program runs once per
-point.
+A run-time value is a number (a float), a text (a str: an element of an array that holds
+text) or a matrix: a 2-D numpy array (rows, columns) of floats, or of objects when an element
+is itself an array (a nested array) or a text (a table of load kinds beside their values, as
+Mathcad's arrays and Excel's ranges hold). A text element is compared with text (``==``,
+``!=``); arithmetic on it, ordering it or comparing it with a number is an error naming it,
+never a number. Run-time values never carry the range axes of a table
+(:mod:`workbook.matrix`): a program runs once per point.
 """
 
 from __future__ import annotations
@@ -59,18 +62,63 @@ def shape_of(v) -> tuple[int, int] | None:
 
 def all_finite(v) -> bool:
     """Every number of ``v`` (of its elements' elements, for a nested array) is finite."""
+    if isinstance(v, str):
+        return True
     if isinstance(v, np.ndarray) and v.dtype == object:
         return all(all_finite(value(e)) for e in v.ravel())
     return bool(np.all(np.isfinite(v)))
 
 
+def holds_text(v) -> bool:
+    """``v`` is a text, or an array with a text element (at any depth)."""
+    if isinstance(v, str):
+        return True
+    return is_array(v) and v.dtype == object and any(holds_text(e) for e in v.ravel())
+
+
+def no_text(v, what: str):
+    """``v``, which must hold no text here (an argument of a function of numbers)."""
+    if holds_text(v):
+        raise InputError(f"{what}: {_text_shown(v)} where a number is wanted")
+    return v
+
+
+def _text_shown(v) -> str:
+    if isinstance(v, str):
+        return f"the text {v!r}"
+    first = next(e for e in v.ravel() if holds_text(e))
+    return f"{describe(v)} holding text ({_text_shown(first)})"
+
+
+def scale(v, factor: float):
+    """``v`` times a unit's factor: the numbers of an array that holds text, its texts kept."""
+    if isinstance(v, str):
+        return v
+    if is_array(v) and v.dtype == object:
+        out = np.empty(v.shape, dtype=object)
+        for at, e in np.ndenumerate(v):
+            out[at] = scale(value(e), factor)
+        return out
+    return v * factor
+
+
+def negate(v, what: str):
+    """``-v`` of a run-time value (an error on text)."""
+    v = value(v)
+    if holds_text(v):
+        raise InputError(f"{what}: arithmetic on {_text_shown(v)}")
+    if is_array(v) and v.dtype == object:
+        raise InputError(f"{what}: arithmetic on a nested array; use its elements")
+    return -v
+
+
 def describe(v) -> str:
     if is_array(v):
         r, c = v.shape
-        nested = " (nested)" if v.dtype == object else ""
+        nested = " (nested)" if v.dtype == object and any(is_array(e) for e in v.ravel()) else ""
         return (f"a vector of {r}" if c == 1 else f"a {r}x{c} matrix") + nested
     if isinstance(v, str):
-        return "text"
+        return f"the text {v!r}"
     return "a number"
 
 
@@ -199,7 +247,7 @@ def build(rows: list[list], what: str = "array"):
     """A matrix literal with run-time elements: nested when an element is an array (stored
     as a copy)."""
     values = [[value(e) for e in row] for row in rows]
-    if not any(is_array(e) for row in values for e in row):
+    if not any(is_array(e) or isinstance(e, str) for row in values for e in row):
         return np.array(values, dtype=float)
     out = np.empty((len(values), len(values[0])), dtype=object)
     for i, row in enumerate(values):
@@ -218,6 +266,9 @@ def binary(op: str, a, b, what: str):
     array, the dot product of two vectors of one length, else the matrix product; ``/`` by a
     number; ``^`` a power of a number, or a matrix power (``M^-1`` the inverse)."""
     a, b = value(a), value(b)
+    for v in (a, b):
+        if holds_text(v):
+            raise InputError(f"{what}: arithmetic on {_text_shown(v)}")
     sa, sb = shape_of(a), shape_of(b)
     if sa is None and sb is None:
         if op == "^":
@@ -265,6 +316,12 @@ def compare(op: str, a, b, what: str) -> bool:
     """``a op b`` of numbers; ``==`` and ``!=`` of arrays compare whole values (same shape
     and elements), as Mathcad's; ``<`` of an array is an error."""
     a, b = value(a), value(b)
+    if isinstance(a, str) or isinstance(b, str):
+        if not (isinstance(a, str) and isinstance(b, str)):
+            raise InputError(f"{what}: cannot compare {describe(a)} with {describe(b)}")
+        if op not in ("==", "!="):
+            raise InputError(f"{what}: text is compared with == or != only")
+        return bool(COMPARE[op](a, b))
     if is_array(a) or is_array(b):
         if op not in ("==", "!="):
             raise InputError(f"{what}: cannot order {describe(a)} and {describe(b)}")
@@ -290,6 +347,6 @@ def shapes(values) -> tuple:
 def number(v, what: str) -> float:
     """A run-time value that must be a number here (a loop bound, a table cell)."""
     v = value(v)
-    if is_array(v):
+    if is_array(v) or isinstance(v, str):
         raise InputError(f"{what}: {describe(v)} where a number is wanted")
     return v

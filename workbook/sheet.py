@@ -289,9 +289,10 @@ class Sheet:
         """The value of scalar definition ``name`` in the unit it is shown in (a text as
         it is)."""
         t = self.typer.scalar(name)
-        if t.text:
-            return self.scalar_value(name, "definition")
-        q = un.registry().Quantity(self.scalar_value(name, "definition"), t.unit)
+        value = self.scalar_value(name, "definition")
+        if t.text or isinstance(value, str):  # a text element of a run-time array, too
+            return value
+        q = un.registry().Quantity(value, t.unit)
         return q.to("") if un.is_compound_ratio(t.unit) else q
 
     def _bind(self, fname: str, params, args, kwargs) -> dict:

@@ -56,12 +56,15 @@ class ArrayTyping:
         typed = [[self.visit(e, scope) for e in row] for row in node.rows]
         first = None
         nested = any(e.shape is not None for row in typed for e in row)
+        # text beside numbers (a table of load kinds): its elements are looked at when it runs
+        texts = any(e.text for row in typed for e in row)
         for i, row in enumerate(typed):
             for j, e in enumerate(row):
                 where = f"element [{i}, {j}] of the matrix"
-                if e.boolean or e.text:
-                    what = "a comparison" if e.boolean else "text"
-                    raise TemplateError(f"{where} is {what}; elements are numbers")
+                if e.boolean:
+                    raise TemplateError(f"{where} is a comparison; elements are numbers or text")
+                if e.text:
+                    continue
                 self._number(e, where)
                 if first is None and not is_zero(e):
                     first = (e, i, j)
@@ -70,6 +73,9 @@ class ArrayTyping:
         for i, row in enumerate(typed):
             out = []
             for j, e in enumerate(row):
+                if e.text:
+                    out.append(e)
+                    continue
                 if not is_zero(e) and e.unit.dimensionality != unit.dimensionality:
                     f, fi, fj = first
                     raise UnitError(
@@ -81,7 +87,7 @@ class ArrayTyping:
                 out.append(self.convert(e, unit, f"element [{i}, {j}] of the matrix"))
             rows.append(tuple(out))
         # an array of arrays (Mathcad's nested array): its shape is looked at when it runs
-        return TMatrix(unit, rows=tuple(rows), shape=RUNTIME if nested else (r, c))
+        return TMatrix(unit, rows=tuple(rows), shape=RUNTIME if nested or texts else (r, c))
 
     def visit_Index(self, node: ex.Index, scope) -> T:
         target = self.visit(node.target, scope)

@@ -674,7 +674,8 @@ class Typer(ArrayTyping, Visitor):
         if any(texts):
             if len(typed) != 2 or node.ops[0] not in ("==", "!="):
                 raise TemplateError('text is compared with == or != only: law == "stepped"')
-            if not all(texts):
+            # an element of a run-time array may be text: compared when it runs
+            if not all(x or is_runtime(t.shape) for x, t in zip(texts, typed)):
                 raise TemplateError("cannot compare text with a number")
             for a, b in ((typed[0], typed[1]), (typed[1], typed[0])):
                 if isinstance(a, TRef) and a.kind == "choice" and isinstance(b, TText):

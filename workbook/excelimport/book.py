@@ -13,7 +13,8 @@ from .runs import ROW, Run, find_runs
 from .vba import Module, Procedure, is_event, read_modules
 from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
 
-#: formula cells translated at most (those that call VBA functions and what they read first)
+#: formulas translated at most (those that call VBA functions first; a multi-cell array
+#: formula counts once)
 MAX_DEFINITIONS = 4000
 #: constant cells imported as inputs at most
 MAX_INPUTS = 4000
@@ -187,35 +188,49 @@ def _mentions(body: str, name: str) -> bool:
 
 
 def _formula_cells(tr: Translation) -> list[Cell]:
-    """Formula cells to translate, in reading order: those that call a VBA function and the
-    formula cells they read first, then the others, at most MAX_DEFINITIONS."""
+    """Formula cells to translate, in reading order: those that call a VBA function first,
+    then the others, at most MAX_DEFINITIONS formulas (a multi-cell array formula is one
+    formula: its other cells come with it)."""
     out = []
     for cells in tr.book.sheets.values():
         for r, c in sorted(cells):
             cell = cells[(r, c)]
             if cell.formula is not None:
                 out.append(cell)
-    if len(out) <= MAX_DEFINITIONS:
+    formulas = [c for c in out if not _follows_master(c)]
+    if len(formulas) <= MAX_DEFINITIONS:
         return out
     names = set(tr.functions)
     calls = [
-        c for c in out if any(re.search(rf"\b{re.escape(n)}\s*\(", c.formula, re.I) for n in names)
+        c
+        for c in formulas
+        if any(re.search(rf"\b{re.escape(n)}\s*\(", c.formula, re.I) for n in names)
     ]
     chosen = {id(c) for c in calls[:MAX_DEFINITIONS]}
-    for c in out:
+    for c in formulas:
         if len(chosen) >= MAX_DEFINITIONS:
             break
         chosen.add(id(c))
-    kept = [c for c in out if id(c) in chosen]
-    left = len(out) - len(kept)
+    masters = {(c.sheet, c.row, c.col) for c in formulas if id(c) in chosen}
+    kept = [
+        c
+        for c in out
+        if id(c) in chosen or (_follows_master(c) and (c.sheet, *c.array_master) in masters)
+    ]
+    left = len(formulas) - len(chosen)
     tr.listed.append(
         (
-            f"{left:,} formula cells",
-            f"beyond the {MAX_DEFINITIONS:,} formula cells translated (those that call VBA "
+            f"{left:,} formulas",
+            f"beyond the {MAX_DEFINITIONS:,} formulas translated (those that call VBA "
             "functions first)",
         )
     )
     return kept
+
+
+def _follows_master(cell: Cell) -> bool:
+    """A cell of a multi-cell array formula other than its first: translated with it."""
+    return cell.array_master is not None and (cell.row, cell.col) != cell.array_master
 
 
 def _ident(text: str) -> str | None:
@@ -472,6 +487,15 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
 
     def name_of(sheet, row, col):
         used[(sheet, row, col)] = None
+        cell = book.cell(sheet, row, col)
+        if cell is not None and cell.array is not None and cell.formula is not None:
+            # a cell of a multi-cell array formula shows one element of the array
+            from openpyxl.utils.cell import range_boundaries
+
+            c1, r1, c2, _ = range_boundaries(cell.array)
+            master = tr.cell_names.get((sheet, *cell.array_master))
+            if master is not None:
+                return f"{master}_at({(row - r1) * (c2 - c1 + 1) + col - c1})"
         return tr.cell_names.get((sheet, row, col)) or f"missing_{row}_{col}"
 
     formula_keys = {_key(c) for c in cells}
@@ -508,7 +532,13 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 def names(sheet, row, col, moving=moving):
                     return moving.get((sheet, row, col)) or name_of(sheet, row, col)
 
-            ft = FormulaTranslator(book, cell.sheet, names, tr.functions, book.names)
+            block = None
+            if cell.array is not None:
+                from openpyxl.utils.cell import range_boundaries
+
+                c1, r1, c2, r2 = range_boundaries(cell.array)
+                block = (r2 - r1 + 1, c2 - c1 + 1)
+            ft = FormulaTranslator(book, cell.sheet, names, tr.functions, book.names, block)
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:
                 d.note_link = True  # type: ignore[attr-defined]
@@ -533,6 +563,9 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             continue
         constants |= new
     # a formula reading a formula cell that is not translated is not translated either
+    by_name = {}
+    for d in tr.definitions:
+        by_name.setdefault(d.name, d)
     changed = True
     while changed:
         changed = False
@@ -540,7 +573,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             if d.problem:
                 continue
             if d.element is not None:
-                master = next((x for x in tr.definitions if x.name == d.element[0]), None)
+                master = by_name.get(d.element[0])
                 if master is not None and master.problem:
                     d.problem = f"part of the array formula {master.name}, not translated"
                     changed = True

@@ -18,6 +18,8 @@ _LINK = re.compile(
     r"(?:\[\d+\]|'[^']*\.xla[m]?'|[A-Za-z0-9_.\- ]+\.xla[m]?)!(?=[A-Za-z_][\w.]*\()", re.I
 )
 MAX_RANGE_CELLS = 100_000
+#: a formula that is one cell's reference: =D63, =Sheet2!$B$4, ='Load table'!C7
+_PLAIN_REF = re.compile(r"(?:'?([^'!]+)'?!)?\$?([A-Za-z]{1,3})\$?(\d+)")
 
 
 class FormulaProblem(Exception):
@@ -97,8 +99,9 @@ class FormulaText:
 class FormulaTranslator:
     """Walks a formula tree; ``name_of(sheet, row, col)`` gives a cell's name."""
 
-    def __init__(self, book, sheet: str, name_of, functions: dict, names: dict):
+    def __init__(self, book, sheet: str, name_of, functions: dict, names: dict, block=None) -> None:
         self.book = book
+        self.block = block  # (rows, columns) of the cells of a multi-cell array formula
         self.sheet = sheet
         self.name_of = name_of
         self.functions = functions
@@ -106,8 +109,30 @@ class FormulaTranslator:
         self.out = FormulaText("")
 
     def translate(self, tree) -> FormulaText:
-        self.out.text = self.value(tree)
+        if tree[0] == "fn" and tree[1].upper() == "MMULT":
+            self.out.text = self.matrix_product(tree[2])
+        else:
+            self.out.text = self.value(tree)
         return self.out
+
+    def matrix_product(self, args) -> str:
+        """``MMULT(A, B)`` of two ranges, as the whole formula of an array formula whose
+        cells are the product's shape (each cell then shows its element, never another's)."""
+        refs = [self.ref_of(a[2]) if a[0] == "leaf" and a[1] == "Range" else None for a in args]
+        if len(args) != 2 or None in refs:
+            raise FormulaProblem("MMULT of other than two ranges")
+        a, b = refs
+        ra, ca = a.r2 - a.r1 + 1, a.c2 - a.c1 + 1
+        rb, cb = b.r2 - b.r1 + 1, b.c2 - b.c1 + 1
+        if ca != rb:
+            raise FormulaProblem(f"MMULT of a {ra}x{ca} by a {rb}x{cb} range (#VALUE! in Excel)")
+        if self.block != (ra, cb):
+            raise FormulaProblem(
+                f"MMULT whose {ra}x{cb} product is not shown in as many cells of an array formula"
+            )
+        if ca == 1 and cb == 1:
+            raise FormulaProblem("MMULT of a column by one cell")  # the language's dot product
+        return f"{self.reference(args[0][2])}*{self.reference(args[1][2])}"
 
     # Excel precedence levels for brackets: 1 comparison, 2 &, 3 + -, 4 * /, 5 ^, 6 unary, 7 %
     def value(self, node, ctx: int = 0) -> str:
@@ -251,9 +276,75 @@ class FormulaTranslator:
                 raise FormulaProblem(f"{upper} with {len(args)} arguments")
             out = text.format(*[self.value(a, 0) for a in args])
             return out if re.fullmatch(r"\w+\([^()]*\)", text) else f"({out})"
+        if upper == "SUMIF":
+            return self.sum_if(args)
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
+
+    def sum_if(self, args) -> str:
+        """``SUMIF(range, criterion, sum_range)`` whose criterion is a text cell (a load kind
+        such as "DL") and whose range holds constants: which cells match is Excel's rule
+        (texts equal but for case) applied here, so the sum is of the matching cells' names.
+        Texts are definitions that never change, and a number never equals such a text."""
+        if len(args) not in (2, 3):
+            raise FormulaProblem(f"SUMIF with {len(args)} arguments")
+        refs = [self.ref_of(a[2]) if a[0] == "leaf" and a[1] == "Range" else None for a in args]
+        if None in refs:
+            raise FormulaProblem("SUMIF of other than cell ranges")
+        where, crit = refs[0], refs[1]
+        total = refs[2] if len(refs) == 3 else where
+        shape = (where.r2 - where.r1, where.c2 - where.c1)
+        if (total.r2 - total.r1, total.c2 - total.c1) != shape:
+            raise FormulaProblem("SUMIF whose ranges differ in size")
+        if not crit.single:
+            raise FormulaProblem("SUMIF whose criterion is a range")
+        key = self.criterion(crit)
+        items = []
+        for dr in range(shape[0] + 1):
+            for dc in range(shape[1] + 1):
+                value = self.constant_behind(where.sheet, where.r1 + dr, where.c1 + dc)
+                if not isinstance(value, str) or value.casefold() != key:
+                    continue
+                r, c = total.r1 + dr, total.c1 + dc
+                add = self.book.cell(total.sheet, r, c)
+                if add is None or add.value is None or isinstance(add.value, (str, bool)):
+                    continue  # SUMIF adds numbers only; an empty cell is 0
+                self.out.refs.append(Ref(total.sheet, r, c, r, c))
+                items.append(self.name_of(total.sheet, r, c))
+        return "(" + " + ".join(items) + ")" if items else "0"
+
+    def constant_behind(self, sheet: str, row: int, col: int):
+        """The constant a cell holds, or that a chain of plain references (``=D63``) leads
+        to (None for an empty cell); a cell that computes is refused."""
+        for _ in range(20):
+            cell = self.book.cell(sheet, row, col)
+            if cell is None or cell.formula is None:
+                return None if cell is None else cell.value
+            m = _PLAIN_REF.fullmatch(cell.formula.strip())
+            if m is None:
+                raise FormulaProblem("SUMIF over a range that holds formulas")
+            if m.group(1):
+                sheet = self.book.sheet_named(m.group(1))
+                if sheet is None:
+                    raise FormulaProblem(f"a reference to the sheet {m.group(1)}")
+            row, col = int(m.group(3)), _col(m.group(2))
+        raise FormulaProblem("SUMIF over a chain of references")
+
+    def criterion(self, ref: Ref) -> str:
+        """The text of a SUMIF criterion cell, folded for Excel's comparison without case."""
+        cell = self.book.cell(ref.sheet, ref.r1, ref.c1)
+        value = None if cell is None else cell.value
+        if cell is None or cell.formula is not None or not isinstance(value, str):
+            raise FormulaProblem("SUMIF whose criterion is not a text cell")
+        text = value.strip()
+        if not text or text != value or re.search(r"[*?~]|^[=<>]", text):
+            raise FormulaProblem(f"SUMIF whose criterion {value!r} is a pattern or an operator")
+        try:
+            float(text)
+        except ValueError:
+            return text.casefold()
+        raise FormulaProblem(f"SUMIF whose criterion {value!r} reads as a number")
 
     def udf(self, key: str, args) -> str:
         info = self.functions[key]

@@ -338,7 +338,7 @@ def _drop_dependents(tr: Translation, name: str, skip: dict[str, str]) -> None:
         if d.problem:
             continue
         used = set(_WORD.findall(d.text or "")) | ({d.element[0]} if d.element else set())
-        for u in used:
+        for u in used | {u[:-3] for u in used if u.endswith("_at")}:  # NAME_at(k) uses NAME
             users.setdefault(u, []).append(d.name)
     for info in tr.functions.values():
         if not info.problem:
