@@ -166,7 +166,7 @@ HOSTILE = {
         + '"f0(x)" = "x"\n'
         + "".join(f'"f{i}(x)" = "f{i - 1}(x) + 1"\n' for i in range(1, 400))
         + '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { f399 = "" }\n',
-        "limit exceeded: the worksheet is nested too deeply",
+        "hostile.toml:410, in 'table t': limit exceeded: nested too deeply for the engine",
     ),
     "range_1e10_points": (
         HEAD + 's = "1"\n\n[[tables]]\nname = "t"\nrange = "x := 0, 1 .. 1e10"\n'

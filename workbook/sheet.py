@@ -542,7 +542,10 @@ class Sheet:
 
     def column(self, col: ColumnSpec, var: str, values: np.ndarray, what: str) -> Column:
         t = self.typed_column(col, var, what)
-        fn = self.evaluator.compile(t)
+        try:
+            fn = self.evaluator.compile(t)
+        except (RecursionError, MemoryError) as exc:  # functions inlined into one another
+            raise self._locate(exhausted(exc), what) from None
         if tc.is_runtime(t.shape):  # a run-time value: each row's must be a number
             run = fn
             where = f"column '{col.text}'"
