@@ -979,8 +979,16 @@ def _with_unit(t: T, unit: pint.Unit) -> T:
 
 def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
     """Names of inputs/definitions/blocks an expression needs, transitively."""
+    return _closure(spec, [n for n in ex.names(node) if n not in scope])
+
+
+def dependencies_of_all(spec: SheetSpec, nodes: list[ex.Node]) -> set[str]:
+    """Names that any of ``nodes`` needs, transitively (one walk for all of them)."""
+    return _closure(spec, [n for node in nodes for n in ex.names(node)])
+
+
+def _closure(spec: SheetSpec, todo: list[str]) -> set[str]:
     out: set[str] = set()
-    todo = [n for n in ex.names(node) if n not in scope]
     while todo:
         n = todo.pop()
         if n in out:

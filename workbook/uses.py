@@ -67,10 +67,8 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
 
 def names_used(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> set[str]:
     """Inputs, definitions and blocks the outputs (and ``reads``) need, transitively."""
-    out: set[str] = set()
-    for node in output_roots(spec, hand_checks=hand_checks, reads=reads):
-        out |= tc.dependencies(spec, node)
-    return out
+    roots = output_roots(spec, hand_checks=hand_checks, reads=reads)
+    return tc.dependencies_of_all(spec, roots)  # one closure: linear in the definitions
 
 
 def printed_names(p) -> set[str]:

@@ -52,6 +52,9 @@ def _assign(tr: Translation) -> None:
     reserved = set(language_functions()) | {"pi"}
     taken: dict[str, Sym] = {}
     lower: set[str] = set()
+    # (base, candidates) -> the first number not tried by a claim that shares nothing: the
+    # numbers before it stay taken (20,000 redefinitions of x tried 2e8 names)
+    untried: dict[tuple[str, int], int] = {}
 
     def claim(sym: Sym, share=None, alt=True) -> None:
         base = sym.base if sym.base not in reserved else sym.base + "_"
@@ -59,7 +62,10 @@ def _assign(tr: Translation) -> None:
         candidates = [base] + ([base + "_"] if share is not None and alt else [])
         if sym.kind == "unit":  # a unit whose name the worksheet uses: kN_unit
             candidates.append(base + "_unit")
-        n = 1
+        key = (base, len(candidates))
+        n, named = 1, set(candidates)
+        if share is None and key in untried:  # its candidates were taken then, so are now
+            n, candidates = untried[key], []
         while True:
             name = candidates.pop(0) if candidates else f"{base}_{n}"
             other = taken.get(name)
@@ -68,6 +74,8 @@ def _assign(tr: Translation) -> None:
             if other is not None and share is not None and share(other):
                 break
             n += 1
+        if share is None and name not in named:  # a number, after every candidate
+            untried[key] = n + 1
         sym.final = name
         taken[name] = sym
         lower.add(name.lower())
