@@ -283,6 +283,7 @@ def test_limits_are_documented():
         MAX_SWEEP_POINTS,
         file_limits.MAX_SHARED_STRINGS,
         file_limits.MAX_STYLES_BYTES,
+        file_limits.MAX_MATRIX_WORK,
         ode.MAX_STEPS,
     ):
         assert f"{value:,}" in limits or str(value) in limits, value

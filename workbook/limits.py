@@ -9,6 +9,7 @@ bomb). Each is refused here, before any parser sees it, with an error of kind
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import signal
 import stat
@@ -26,6 +27,14 @@ MAX_XLSX_MEMBERS = 10_000
 # styles.xml took 57 s and 1.55 GB, 3.5 million tiny shared strings 59 s.
 MAX_STYLES_BYTES = 2_000_000
 MAX_SHARED_STRINGS = 300_000
+#: Matrix work of one evaluation, in multiply-adds of a matrix product: a product of
+#: (n x k) by (k x m) is n*k*m, a decomposition a multiple of n^3 (below), an element-wise
+#: operation ELEMENT_WORK per element. 40e9 is five products of 2000 x 2000 matrices, about
+#: 3 s of one core (numpy's BLAS, 12.7e9 multiply-adds a second, measured unloaded).
+MAX_MATRIX_WORK = 40_000_000_000
+#: What an element-wise operation on a large array costs per element, in multiply-adds of a
+#: product (adding two 2000 x 2000 arrays took 7.9 ms, their product 0.63 s: about 20).
+ELEMENT_WORK = 20
 _STYLES_TYPE = "application/vnd.openxmlformats-officedocument.spreadsheetml.styles+xml"
 _STRINGS_TYPE = "application/vnd.openxmlformats-officedocument.spreadsheetml.sharedStrings+xml"
 
@@ -278,3 +287,37 @@ def within_seconds(seconds: float, what: str):
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+
+
+_matrix_work: contextvars.ContextVar[list[float] | None] = contextvars.ContextVar(
+    "workbook_matrix_work", default=None
+)
+
+
+@contextlib.contextmanager
+def matrix_work():
+    """One evaluation's budget of matrix work (:data:`MAX_MATRIX_WORK`): the outermost block
+    opens it, blocks inside share it."""
+    if _matrix_work.get() is not None:
+        yield
+        return
+    token = _matrix_work.set([0.0])
+    try:
+        yield
+    finally:
+        _matrix_work.reset(token)
+
+
+def charge_matrix_work(work: float, what: str) -> None:
+    """Count ``work`` (multiply-adds, see :data:`MAX_MATRIX_WORK`) against the evaluation's
+    budget before it is done; past the budget a LimitError says what was asked (the caller
+    adds the definition). Outside an evaluation one operation is checked alone."""
+    spent = _matrix_work.get()
+    total = work + (spent[0] if spent is not None else 0.0)
+    if total > MAX_MATRIX_WORK:
+        raise LimitError(
+            f"{what} would bring the matrix work of this evaluation to {total:,.0f} "
+            f"multiply-adds (limit {MAX_MATRIX_WORK:,})"
+        )
+    if spent is not None:
+        spent[0] = total

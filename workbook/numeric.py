@@ -24,6 +24,7 @@ from . import runtime as rt
 from . import typecheck as tc
 from . import typed as ty
 from .errors import DomainError, InputError, LimitError, WorkbookError
+from .limits import matrix_work
 from .numerics.bound import Bound
 from .registry import REGISTRY
 from .subtrees import plan
@@ -79,7 +80,8 @@ class Evaluator(Visitor):
             return
         self._shared = {}
         try:
-            yield
+            with matrix_work():  # one evaluation's budget of matrix work
+                yield
         finally:
             self._shared = None
 

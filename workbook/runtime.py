@@ -23,6 +23,7 @@ import operator
 import numpy as np
 
 from .errors import InputError, LimitError
+from .limits import ELEMENT_WORK, charge_matrix_work
 from .matrix import (
     power,
     size,  # noqa: F401 - rows/cols/length/last of a run-time value
@@ -277,21 +278,29 @@ def binary(op: str, a, b, what: str):
     for v in (a, b):
         if is_array(v) and v.dtype == object:
             raise InputError(f"{what}: arithmetic on a nested array; use its elements")
+    elements = max(a.size if sa else 1, b.size if sb else 1)
     if op in "+-":
         if sa is not None and sb is not None and sa != sb:
             raise InputError(f"{what}: cannot add or subtract {describe(a)} and {describe(b)}")
+        charge_matrix_work(ELEMENT_WORK * float(elements), what)
         return _ARITH[op](a, b)
     if op == "*":
         if sa is None or sb is None:
+            charge_matrix_work(ELEMENT_WORK * float(elements), what)
             return a * b
         if sa[1] == 1 and sb[1] == 1 and sa[0] == sb[0]:
             return float(np.sum(a * b))  # Mathcad's v*w of two vectors
         if sa[1] != sb[0]:
             raise InputError(f"{what}: cannot multiply {describe(a)} by {describe(b)}")
+        charge_matrix_work(
+            float(sa[0]) * sa[1] * sb[1],
+            f"{what}: a product of {describe(a)} by {describe(b)}",
+        )
         return a @ b
     if op == "/":
         if sb is not None:
             raise InputError(f"{what}: cannot divide by {describe(b)}")
+        charge_matrix_work(ELEMENT_WORK * float(elements), what)
         return a / b
     if sb is not None:
         raise InputError(f"{what}: an exponent must be a number, got {describe(b)}")

@@ -16,7 +16,7 @@ from . import typecheck as tc
 from . import units as un
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .fields import nearest
-from .limits import exhausted
+from .limits import exhausted, matrix_work
 from .numeric import Evaluator
 from .numerics import defining
 from .ranges import RangeSpec, log_range_values, range_values
@@ -358,7 +358,7 @@ class Sheet:
         """The value of scalar definition ``name``, checked (finite, within its limits)."""
         d = self.spec.definitions[name]
         try:
-            with defining(name):
+            with defining(name), matrix_work():
                 value = self.evaluator.compile(self.typer.scalar(name))({})
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
@@ -562,7 +562,7 @@ class Sheet:
             )
         failed: dict[int, str] = {}
         try:
-            with defining(f"{what}: {col.text}"):
+            with defining(f"{what}: {col.text}"), matrix_work():
                 out = fn({var: values})
         except DomainError as err:  # some rows leave the domain: the others keep their values
             if t.text or values.ndim != 1:
