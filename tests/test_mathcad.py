@@ -96,14 +96,6 @@ def test_imported_worksheet_runs(name, status, tmp_path, capsys):
     assert out.exists()
 
 
-def _has_arrays() -> bool:
-    from workbook import expr as ex
-    from workbook.mathcad.program import available
-
-    return hasattr(ex, "Matrix") and available()
-
-
-@pytest.mark.skipif(not _has_arrays(), reason="the language has no vectors and programs yet")
 @pytest.mark.parametrize("name", ["lagrange-polynomial.xmcd", "fermat-spiral.xmcd"])
 def test_vectors_over_ranges_reproduce_every_stored_value(name, tmp_path, capsys):
     """t1[i] := ..., A[i, j] := f(i, j) over ranges, columns and a matrix Mathcad showed."""
@@ -230,14 +222,7 @@ def test_a_trace_with_a_gap_is_drawn_with_the_others(tmp_path, capsys):
     assert len(_charts(out)) == text.count("[[charts]]")
 
 
-def _has_runtime_arrays() -> bool:
-    from workbook.registry import REGISTRY
-
-    return "csort" in REGISTRY
-
-
 @pytest.mark.slow
-@pytest.mark.skipif(not _has_runtime_arrays(), reason="the language has no run-time arrays yet")
 def test_frame_library_programs_reproduce_every_stored_value(tmp_path, capsys):
     """frame/example.xmcd with its library: the train table TT (a nested array: one printed
     value per number of it), x.e(TT, 1, 3), I.Н := Uk(1, 0)/2 and E.Н(1) (through r_EH, a

@@ -210,13 +210,6 @@ def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 
 
-def _has_programs() -> bool:
-    from workbook.mathcad.program import available
-
-    return available()
-
-
-@pytest.mark.skipif(not _has_programs(), reason="the language has no programs yet")
 def test_program_with_a_loop(tmp_path, capsys):
     """s(n) := | a <- 0 ; for i in 1..n: a <- a + i ; a |, and s(4) = 10 as stored."""
     loop = (

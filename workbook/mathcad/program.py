@@ -20,21 +20,12 @@ Line = tuple[int, list]  # (indent, parts: text or expression trees)
 _SIMPLE = ("localDefine", "return", "break", "continue")
 
 
-def available() -> bool:
-    """Whether the language has programs (a definition may be a program)."""
-    from ..template import Definition
-
-    return "program" in getattr(Definition, "__dataclass_fields__", {})
-
-
 class ProgramTranslator:
     """One Mathcad program (its locals shared by all its lines)."""
 
     def __init__(self, tr, local: dict, expressions):
         """``tr``: the worksheet's Translator; ``expressions``: the class that translates one
         expression in a scope (``expressions(tr, scope)``)."""
-        if not available():
-            raise Untranslatable("a program (programs are not in the language yet)")
         self.tr = tr
         self.expressions = expressions
         self.params = dict(local)

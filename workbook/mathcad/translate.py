@@ -187,7 +187,7 @@ class ExprTranslator(Visitor):
         if tag in OPERATOR_FUNCTIONS and len(args) == 1:
             return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.value(args[0])])
         if tag == "id":
-            if _is_if(node) and hasattr(ex, "IfElse"):
+            if _is_if(node):
                 cond, a, b = _if_args(node)
                 return ex.IfElse(self.value(a), self.condition(cond), self.value(b))
             return self._call(op, args)
@@ -201,7 +201,7 @@ class ExprTranslator(Visitor):
             return self._vectorize(self.value(args[0]))
         if tag == "Find":
             return self.tr.find(self, args, op.attrs.get("method", ""))
-        if tag in ("Maximize", "Minimize") and _solve_methods():
+        if tag in ("Maximize", "Minimize"):
             return self.tr.extremum(self, args, tag == "Maximize")
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
 
@@ -324,8 +324,6 @@ class ExprTranslator(Visitor):
 
     def visit_matrix(self, node: MNode) -> ex.Node:
         """Mathcad's matrix (rows x cols, stored column by column) as [a, b] or [[a, b], ...]."""
-        if not hasattr(ex, "Matrix"):
-            raise Untranslatable("a matrix (vectors and matrices are not in the language yet)")
         rows, cols = matrix_size(node)
         if rows * cols != len(node.children) or rows * cols == 0:
             raise Untranslatable("a matrix whose size does not match its elements")
@@ -340,8 +338,6 @@ class ExprTranslator(Visitor):
         )
 
     def _index(self, args: list[MNode]) -> ex.Node:
-        if not hasattr(ex, "Index"):
-            raise Untranslatable("an array index (arrays are not in the language yet)")
         target, index = args[0], args[1]
         indices = [self.value(i) for i in (index.children if index.tag == "sequence" else [index])]
         shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
@@ -351,9 +347,6 @@ class ExprTranslator(Visitor):
 
     def _column(self, args: list[MNode]) -> ex.Node:
         """Mathcad's column M<j>: submatrix(M, first row, last row, j, j)."""
-        for name in ("submatrix", "rows"):
-            if name not in language_functions():
-                raise Untranslatable(f"a matrix column ({name}() is not in the language yet)")
         m, j = self.value(args[0]), self.value(args[1])
         shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
         if shift:
@@ -535,11 +528,10 @@ def _whole_at_import(tr: Translator, node: MNode, what: str) -> int:
 class Translator:
     """Regions in order -> a :class:`Translation`."""
 
-    def __init__(self, forced: dict[str, str] | None = None):
+    def __init__(self):
         self.scope: dict[tuple[str, str], Sym] = {}
         self.units: dict[str, Sym] = {}
         self.out = Translation()
-        self.forced = forced or {}  # region id -> why (found when the engine loads it)
         self.note: list[str] = []
         self.calls: dict[Sym, list[tuple[ex.Node, ...]]] = {}  # call sites of each function
         self._index: Sym | None = None
@@ -673,7 +665,6 @@ class Translator:
             return ex.Unary("-", ex.Number(-v)) if v < 0 else ex.Number(v)
 
         body = ex.Matrix(tuple(tuple(number(v) for v in row) for row in cells))
-        self._forced(region, None)
         sym = self.define(_key(region.outputs[0]), "var", region.id)
         rows, cols = len(cells), len(cells[0])
         self.out.items.append(
@@ -688,16 +679,12 @@ class Translator:
 
         if not region.binary:
             raise Untranslatable("a plot without its binary item (its definition)")
-        self.forced_region(region)
         series, why = [], []
         data = payload(region.binary)
         pairs, polar = traces(data)
         limits = None if polar else x_limits(data)
         for n, (x, y) in enumerate(pairs, 1):
-            forced = self.forced.get(f"{region.id}/trace {n}")
             try:
-                if forced is not None:  # the engine could not draw it
-                    raise Untranslatable(forced)
                 series.append((*self.trace(x, y, limits), n))
             except Untranslatable as err:
                 why.append(f"trace {n}: {err}")
@@ -890,47 +877,16 @@ class Translator:
     def find(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         """Find(x, ...) of a solve block: a [[solve]] block of the language (its unknowns are
         names of their own, the guesses the values the variables had before the block, as in
-        Mathcad's), or root(lhs - rhs, x, guess) for one equation where there is none."""
+        Mathcad's)."""
         if self.given is None:
             raise Untranslatable("Find without Given")
-        if _has_solve():
-            try:
-                tree = self.solve_block(et, args, method)
-            except Untranslatable as why:
-                self.close_given(str(why))
-                raise
-            self.close_given(None)
-            return tree
         try:
-            if len(args) != 1 or args[0].tag != "id":
-                raise Untranslatable(
-                    f"a solve block in {len(args)} unknowns (the language solves one: root)"
-                )
-            eqs = [c for c in self.constraints if c.children[0].tag == "equal"]
-            if len(eqs) != 1 or len(self.constraints) != 1:
-                raise Untranslatable(
-                    "a solve block with inequalities or more than one equation (the language "
-                    "solves one equation in one unknown: root)"
-                )
-            lhs, rhs = eqs[0].children[1], eqs[0].children[2]
-            if "root" not in language_functions():
-                raise Untranslatable("root() is not in the language yet")
-            diff = MNode("apply", {}, "", [MNode("minus", {}, "", []), lhs, rhs])
-            body, var = et.bound(args[0], diff)
-            guess = et.visit(args[0])  # x's value before the block
-            self.sym_of(var).hint = guess
+            tree = self.solve_block(et, args, method)
         except Untranslatable as why:
             self.close_given(str(why))
             raise
         self.close_given(None)
-        return ex.Call("root", (body, var, guess))
-
-    def _forced(self, region: Region, sym: Sym | None) -> None:
-        why = self.forced.get(region.id)
-        if why is not None:
-            if sym is not None:
-                sym.broken = why
-            raise Untranslatable(why)
+        return tree
 
     def definition(self, region: Region, node: MNode) -> None:
         lhs, rhs = node.children[0], node.children[1]
@@ -960,7 +916,7 @@ class Translator:
             if evaluation is not None:
                 self.evaluation(region, evaluation, self.scope[_key(target)])
             return
-        if lhs.tag == "matrix" and evaluation is None and hasattr(ex, "Index"):
+        if lhs.tag == "matrix" and evaluation is None:
             self.destructure(region, lhs, rhs)
             return
         if lhs.tag != "id":
@@ -999,12 +955,6 @@ class Translator:
             raise
         sym = self.define(key, "var", region.id)
         item.sym = sym
-        try:
-            self._forced(region, sym)
-        except Untranslatable:
-            if evaluation is not None:
-                self.evaluation(region, evaluation, sym)
-            raise
         self.out.items.append(item)
         if evaluation is not None:
             self.evaluation(region, evaluation, sym)
@@ -1024,7 +974,6 @@ class Translator:
             )
         )
         try:
-            self._forced(region, sym)
             item = self.value_item(region, value, "")
         except Untranslatable as why:
             sym.broken = sym.broken or str(why)
@@ -1066,10 +1015,8 @@ class Translator:
         try:
             return {"pieces": self.pieces(program, local)}
         except Untranslatable as why:
-            from .program import ProgramTranslator, available
+            from .program import ProgramTranslator
 
-            if not available():
-                raise
             try:
                 return {"program": ProgramTranslator(self, local, ExprTranslator).lines(program)}
             except Untranslatable as why2:
@@ -1126,7 +1073,6 @@ class Translator:
     def range_alias(self, region: Region, key, item: Item) -> None:
         sym = self.define(key, "var", region.id)
         sym.is_range, sym.unit = True, item.sym.unit
-        self._forced(region, sym)
         self.out.items.append(
             Item(
                 "range",
@@ -1147,13 +1093,12 @@ class Translator:
         key = _key(target)
         nodes = index.children if index.tag == "sequence" else [index]
         ranges = [self.range_of(n) if n.tag == "id" else None for n in nodes]
-        if all(r is None for r in ranges) and available_programs():
+        if all(r is None for r in ranges):
             self.element(region, key, lhs, rhs)
             return
         before = self.scope.get(key)
         sym = self.define(key, "var", region.id)
         try:
-            self._forced(region, sym)
             if any(r is None for r in ranges) or len(ranges) > 2:
                 raise Untranslatable(
                     "an element assignment v[k] := ... at a single index (the language "
@@ -1245,7 +1190,6 @@ class Translator:
         whole = self.new_sym("var", "parts", f"[...] := (region {region.id})", region.id)
         whole.generated = True
         try:
-            self._forced(region, whole)
             et = ExprTranslator(self)
             body = et.value(rhs)
             if et.ranges:
@@ -1273,7 +1217,6 @@ class Translator:
         previous = self.scope.get(key)
         sym = self.define(key, "var", region.id)
         try:
-            self._forced(region, sym)
             if previous is not None and previous.broken:
                 raise Untranslatable(_uses(previous))
             if previous is not None and (previous.kind == "func" or previous.is_range):
@@ -1304,7 +1247,6 @@ class Translator:
         sym = self.define(key, "var", region.id)
         sym.is_range = True
         try:
-            self._forced(region, sym)
             first_node = rng.children[0]
             et = ExprTranslator(self)
             if first_node.tag == "sequence":
@@ -1360,7 +1302,6 @@ class Translator:
             raise
         self.scope[key] = sym
         item.sym = sym
-        self._forced(region, sym)
         self.out.items.append(item)
 
     # -- results --------------------------------------------------------------
@@ -1459,7 +1400,6 @@ class Translator:
                     self.skip(region.id, f"the result of {mathcad}", str(why))
             return
         try:
-            self.forced_region(region)
             self.standalone(region, expr, unit, values, mathcad, shape)
         except Untranslatable as why:
             self.broken_result(region, mathcad, unit, values, str(why))
@@ -1479,8 +1419,6 @@ class Translator:
     def array_result(self, region: Region, base: ex.Node, shape, values, unit, mathcad) -> None:
         """A vector or matrix Mathcad shows: each element a printed value of a function of
         its index (for a matrix, of the element's number row by row from 0)."""
-        if not hasattr(ex, "Index"):
-            raise Untranslatable("an array result (arrays are not in the language yet)")
         rows, cols = shape
         if rows * cols != len(values):
             raise Untranslatable("an array result whose size does not match its values")
@@ -1524,7 +1462,6 @@ class Translator:
                     raise Untranslatable(target.broken)
                 base = ex.Name(target.token())
             else:
-                self.forced_region(region)
                 et = ExprTranslator(self)
                 base = et.value(expr)
                 if et.ranges:
@@ -1572,21 +1509,15 @@ class Translator:
             self.out.results.append(Result(region.id, sym, what, unit, at, k))
 
     def solve_block(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
-        if self.given[0] in self.forced:
-            raise Untranslatable(self.forced[self.given[0]])
         if not args or any(a.tag != "id" for a in args):
             raise Untranslatable("Find of something that is not a list of names")
         eqs = [c for c in self.constraints if c.children[0].tag == "equal"]
         ineqs = [c for c in self.constraints if c.children[0].tag != "equal"]
-        if ineqs and not _solve_conditions():
-            raise Untranslatable("a solve block with inequalities (the language's are equations)")
         if any(c.children[0].tag not in _INEQUALITY for c in ineqs):
             raise Untranslatable("a solve block with a condition that is not < <= > >=")
-        method = _METHODS.get(method, "") if _solve_methods() else ""
+        method = _METHODS.get(method, "")
         if len(eqs) != len(args) and not (0 < len(eqs) < len(args) and method):
             raise Untranslatable(f"a solve block of {len(eqs)} equations in {len(args)} unknowns")
-        if len(args) > 1 and not hasattr(ex, "Matrix"):
-            raise Untranslatable("Find of several unknowns (a vector: not in the language yet)")
         values = _Values(self)
         local, unknowns = {}, []
         for a in args:
@@ -1638,8 +1569,6 @@ class Translator:
             fsym = et.local.get(_key(args[0])) or self.scope.get(_key(args[0]))
             if fsym is None or fsym.kind != "func" or fsym.broken:
                 raise Untranslatable(f"{what} of something that is not a function of the sheet")
-            if "diff" not in language_functions():
-                raise Untranslatable("diff() is not in the language yet")
             key = _key(args[1])
             try:
                 q = _Values(self).visit(et.visit(args[1]))  # the guess: the value before
@@ -1690,10 +1619,6 @@ class Translator:
         self.calls.setdefault(out, []).append((guess,))
         self.calls.setdefault(fsym, []).append((guess,))
         return out
-
-    def forced_region(self, region: Region) -> None:
-        if region.id in self.forced:
-            raise Untranslatable(self.forced[region.id])
 
     def standalone(self, region: Region, expr: MNode, unit: str, values, mathcad: str, shape):
         et = ExprTranslator(self)
@@ -1793,19 +1718,6 @@ def _is_indexer(node: MNode) -> bool:
     return node.tag == "apply" and len(node.children) == 3 and node.children[0].tag == "indexer"
 
 
-def available_programs() -> bool:
-    from .program import available
-
-    return available()
-
-
-def _has_solve() -> bool:
-    """Whether the language has [[solve]] blocks (Given ... Find)."""
-    from ..template import SECTIONS
-
-    return "solve" in SECTIONS
-
-
 #: the solver Mathcad's Find used (its AutoSelect stores the one that succeeded) -> the
 #: [[solve]] method that reaches the same root: Mathcad's Levenberg-Marquardt is MINPACK's;
 #: where it fell back to its conjugate-gradient solver (the Levenberg-Marquardt root missed a
@@ -1818,21 +1730,6 @@ QUICK_PLOT_STEPS = 200
 _KNOWN = {*FORMULA_UNITS, "π", "e"}
 
 _INEQUALITY = {"lessThan", "greaterThan", "lessOrEqual", "greaterOrEqual"}
-
-
-def _solve_conditions() -> bool:
-    """Whether [[solve]] blocks take conditions (inequalities the root must meet)."""
-    from ..given_find import SolveSpec
-
-    return "conditions" in getattr(SolveSpec, "__dataclass_fields__", {})
-
-
-def _solve_methods() -> bool:
-    """Whether [[solve]] blocks take a method."""
-    import importlib
-
-    given = importlib.import_module("workbook.numerics.given")
-    return "nearest" in getattr(given, "METHODS", {})
 
 
 def _has_index(node: MNode) -> bool:
@@ -2261,7 +2158,7 @@ def _is_boolean(tree: ex.Node) -> bool:
 
 def _as_number(tree: ex.Node) -> ex.Node:
     """A condition where Mathcad uses its value: ``(1 if C otherwise 0)``."""
-    if _is_boolean(tree) and hasattr(ex, "IfElse"):
+    if _is_boolean(tree):
         return ex.IfElse(ex.Number(1.0), tree, ex.Number(0.0))
     return tree
 
