@@ -826,6 +826,6 @@ def findings(sheet) -> list[Finding]:
         out += join_findings(sheet)
         out += domain_margins(sheet)
         out += pi_findings(sheet)
-    except Exception as exc:  # noqa: BLE001 - analysis is information, never a crash
-        out.append(Finding("analysis", "analysis stopped", None, "", "info", str(exc)))
+    except WorkbookError as exc:  # a value the analysis needs cannot be computed: said, loud
+        out.append(Finding("analysis", "analysis stopped", None, "", "warning", str(exc)))
     return out

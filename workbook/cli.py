@@ -187,10 +187,9 @@ def cmd_list(args) -> int:
 
     for name, path in workbook.list_templates().items():
         try:
-            title = (
-                tomllib.loads(path.read_text(encoding="utf-8")).get("sheet", {}).get("title", "")
-            )
-        except Exception:  # a broken template still gets listed
+            meta = tomllib.loads(path.read_text(encoding="utf-8")).get("sheet", {})
+            title = meta.get("title", "") if isinstance(meta, dict) else "(cannot read)"
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):  # still listed
             title = "(cannot read)"
         print(f"{name}\t{title}")
     return EXIT_OK

@@ -23,6 +23,7 @@ import re
 from dataclasses import dataclass, field
 
 import numpy as np
+import pint
 
 from . import expr as ex
 from . import typed as ty
@@ -210,7 +211,7 @@ def _factor(t, dst, dst_text: str | None) -> float:
     src = t.unit
     try:
         return un.factor(src, dst)
-    except Exception:
+    except (pint.errors.PintError, WorkbookError):  # other dimensions, or an offset (degC)
         raise TemplateError(
             f"cannot show {un.dims(src)} ({un.pretty(src)}) in {dst_text!r}"
         ) from None

@@ -92,5 +92,5 @@ def sheet_html(sheet) -> str:
 
     try:
         return fragment(computed(sheet))
-    except Exception as err:  # the display must not fail
+    except WorkbookError as err:  # a worksheet's error is shown (a bug raises: IPython shows it)
         return f"<p>{html.escape(sheet.name)}: error: {html.escape(str(err))}</p>"

@@ -57,7 +57,7 @@ def _cache_folder():
 
         base = platformdirs.user_cache_path("workbook", appauthor=False)
         return base / f"pint-{pint.__version__}"
-    except Exception:  # noqa: BLE001
+    except Exception:  # noqa: BLE001 - no cache folder (no platformdirs, no home): no cache
         return None
 
 

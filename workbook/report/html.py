@@ -14,6 +14,7 @@ import re
 from html import escape
 
 import numpy as np
+import pint
 
 from .. import expr as ex
 from .. import units as un
@@ -21,6 +22,7 @@ from ..errors import WorkbookError
 from ..template import column_node
 from ..verdicts import NOT_FAILED
 from ..version import __version__
+from ..visitor import UnhandledNode
 from . import mathml as mm
 from .mathml import Box, MathML
 
@@ -65,7 +67,7 @@ class Values:
                     q = q.to(d.unit)
                 mag = q.magnitude if np.ndim(q.magnitude) else float(q.magnitude)
                 self._results[name] = (mag, un.pretty(q.units))
-            except Exception as err:  # shown in the report, never blank
+            except (WorkbookError, pint.errors.PintError) as err:  # shown, never blank
                 self._results[name] = err
         return self._results[name]
 
@@ -190,7 +192,7 @@ class Document:
         ):
             try:
                 inner = make()
-            except Exception as err:  # one failing section must not hide the others
+            except (WorkbookError, UnhandledNode) as err:  # one section does not hide the others
                 inner = f"<p class='error'>error: {escape(_error_text(err))}</p>"
             if inner:
                 self.section += 1
@@ -273,12 +275,12 @@ class Document:
             try:
                 eq = _eq_box(self.formula.box(lhs), _EQ, self.formula.box(rhs))
                 lines.append(_fit(eq))
-            except Exception:  # a node the printer does not know: the text
+            except (UnhandledNode, WorkbookError):  # a node the printer does not know: the text
                 lines.append(f"<p>{escape(text)}</p>")
         for node, text in block.conditions:
             try:
                 lines.append(_fit(self.formula.box(node)))
-            except Exception:
+            except (UnhandledNode, WorkbookError):
                 lines.append(f"<p>{escape(text)}</p>")
         find = f"Find({', '.join(block.unknowns)})"
         if block.parameters:  # a function: solved where it is called
@@ -301,7 +303,7 @@ class Document:
                 for n, q in zip(block.unknowns, values)
             )
             result = f"<p>{escape(find)}: {shown}; condition number {solved.condition:.3g}</p>"
-        except Exception as err:
+        except WorkbookError as err:
             result = f"<p class='error'>{escape(find)} not computed: {escape(_error_text(err))}</p>"
         return f"<div class='definition given'>{''.join(lines)}{result}</div>"
 
@@ -313,7 +315,7 @@ class Document:
             else:
                 sym = mm.name_box(d.name)
             formula = self.formula.pieces(d.branches) if d.branches else self.formula.box(d.body)
-        except Exception as err:  # a node kind the printer does not know: show the text
+        except (UnhandledNode, WorkbookError) as err:  # a node the printer does not know: text
             sym, formula = mm.name_box(d.name), mm.text_box(d.text)
             del err
         pieces: list[str] = []
@@ -401,7 +403,7 @@ class Document:
             head = f"<h3>Table {escape(t.name)}: {escape(t.title)}</h3>"
             try:
                 body = self.computed_table(t) if t.computed else self.range_table(t)
-            except Exception as err:
+            except WorkbookError as err:
                 body = f"<p class='error'>not computed: {escape(_error_text(err))}</p>"
             out.append(f"<div class='table' id='table-{escape(t.name)}'>{head}{body}</div>")
         return "".join(out)
@@ -431,7 +433,7 @@ class Document:
             node = ex.Name(rng.var) if i == 0 else column_node(self.spec, t.columns[i - 1], rng.var)
             try:
                 sym = mm.math_element(self.formula.box(node))
-            except Exception:
+            except (UnhandledNode, WorkbookError):
                 sym = escape(col.text)
             unit = un.pretty(col.unit)
             unit_html = mm.math_element(mm.unit_box(unit)) if unit else ""
@@ -520,7 +522,7 @@ class Document:
         for c in self.spec.charts:
             try:
                 svg = chart_svg(self.sheet, c)
-            except Exception as err:
+            except WorkbookError as err:
                 svg = f"<p class='error'>not drawn: {escape(_error_text(err))}</p>"
             out.append(
                 f"<figure id='chart-{escape(c.name)}'>{svg}"
@@ -672,7 +674,7 @@ def _unit_math(text: str) -> str:
         return ""
     try:
         shown = un.pretty(un.unit(text))
-    except Exception:
+    except WorkbookError:
         return escape(text)
     return mm.math_element(mm.unit_box(shown)) if shown else escape(text)
 

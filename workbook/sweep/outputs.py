@@ -7,6 +7,7 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
+import pint
 
 from .. import expr as ex
 from .. import typecheck as tc
@@ -133,7 +134,7 @@ def type_output(sheet, out: Output) -> TypedOutput:
         return TypedOutput(out, sheet.typer.convert(t, shown, what), shown, 1.0)
     try:
         f = un.factor(t.unit, shown)
-    except Exception:
+    except (pint.errors.PintError, WorkbookError):  # other dimensions, or an offset (degC)
         raise InputError(
             f"{what}: cannot show {un.dims(t.unit)} ({un.pretty(t.unit)}) in {out.unit_text!r}"
         ) from None

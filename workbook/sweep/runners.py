@@ -91,7 +91,9 @@ def run_case(task: tuple) -> tuple[int, dict | None, str | None, float]:
         return index, values, None, time.perf_counter() - start
     except WorkbookError as err:
         return index, None, getattr(err, "message", str(err)), time.perf_counter() - start
-    except Exception as err:  # a solver may fail in its own way; record it, go on
+    except Exception as err:  # noqa: BLE001 - a worker's last resort: any failure of one case is
+        # returned to the driver as that case's error (named by its type), which the sweep
+        # reports; raised in a pool process, it would stop every case
         return index, None, f"{type(err).__name__}: {err}", time.perf_counter() - start
 
 
