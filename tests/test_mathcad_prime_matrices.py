@@ -264,3 +264,98 @@ def test_a_stored_zero_among_large_elements_is_round_off(tmp_path, capsys):
     result = _check(tmp_path / "z.toml", capsys)
     assert (result["printed"], result["reproduced"], result["failed"]) == (7, 6, 1), result
     assert [f["at"] for f in result["failures"]] == [2.0]
+
+
+def _range_def(rid: int, name: str, first: float, last: float) -> str:
+    rng = f"<ml:range>{_real(first)}{_real(last)}</ml:range>"
+    return _region(rid, rid, f"<ml:define>{_id(name)}{rng}</ml:define>")
+
+
+def _define_shown(rid: int, lhs: str, rhs: str) -> str:
+    return _region(rid, rid, f"<ml:define>{lhs}<ml:eval>{rhs}</ml:eval></ml:define>")
+
+
+def test_a_column_of_a_computed_index_and_sorted_eigenvalues(tmp_path, capsys):
+    """X[i, j] := D[i, j] - mean(D<j>) over i := 0..1, j := 0..2 (a column whose index is a
+    parameter); sort(eigenvals(S)) (Prime's order of eigenvalues does not matter once they
+    are sorted), while eigenvec and eigenvecs are listed (their sign is Mathcad's solver's)."""
+    d = (
+        '<ml:matrix rows="2" cols="3"><ml:real>1</ml:real><ml:real>4</ml:real>'
+        "<ml:real>2</ml:real><ml:real>5</ml:real><ml:real>3</ml:real><ml:real>9</ml:real>"
+        "</ml:matrix>"
+    )
+    s = (
+        '<ml:matrix rows="2" cols="2"><ml:real>2</ml:real><ml:real>1</ml:real>'
+        "<ml:real>1</ml:real><ml:real>2</ml:real></ml:matrix>"
+    )
+    column = f"<ml:apply><ml:matcol/>{_id('D')}{_id('j')}</ml:apply>"
+    rhs = (
+        f"<ml:apply><ml:minus/>{_index(_id('D'), _id('i'), _id('j'))}"
+        f"{_call('mean', column)}</ml:apply>"
+    )
+    regions = (
+        _region(1, 1, f"<ml:define>{_id('D')}{d}</ml:define>")
+        + _range_def(2, "i", 0, 1)
+        + _range_def(3, "j", 0, 2)
+        + _define_shown(4, _index(_id("X"), _id("i"), _id("j")), rhs)
+        + _region(5, 5, f"<ml:define>{_id('S')}{s}</ml:define>")
+        + _eval(6, _call("sort", _call("eigenvals", _id("S"))))
+        + _eval(7, _call("eigenvecs", _id("S")))
+    )
+    results = (
+        _result(1)
+        + _result(2)
+        + _result(3)
+        + _result(4, _stored_matrix([[-1.5, -1.5, -3], [1.5, 1.5, 3]]))
+        + _result(5)
+        + _result(6, _stored_matrix([[1], [3]]))
+        + _result(
+            7,
+            _stored_matrix(
+                [
+                    [0.7071067811865475, -0.7071067811865475],
+                    [0.7071067811865475, 0.7071067811865475],
+                ]
+            ),
+        )
+    )
+    src = _package(tmp_path / "c.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "c.toml").read_text(encoding="utf-8")
+    assert (
+        "region 7: an evaluation ( = ): Mathcad's eigenvecs() gives eigenvectors whose sign" in text
+    )
+    result = _check(tmp_path / "c.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (12, 8, 0), result
+
+
+def test_elements_over_a_range_replace_a_vector_when_mathcad_shows_so(tmp_path, capsys):
+    """x := [7; 8; 9], then x[j] := 2 j over j := 0..1, shown by Mathcad with 2 rows: Prime
+    replaced x (it keeps no element of the old x), x = [0; 2]; shown with 3 rows, it kept
+    x[2] (9)."""
+    old = (
+        '<ml:matrix rows="3" cols="1"><ml:real>7</ml:real><ml:real>8</ml:real>'
+        "<ml:real>9</ml:real></ml:matrix>"
+    )
+    twice = f"<ml:apply><ml:mult/><ml:real>2</ml:real>{_id('j')}</ml:apply>"
+
+    def sheet(name: str, shown: list[list[float]]) -> Path:
+        regions = (
+            _region(1, 1, f"<ml:define>{_id('x')}{old}</ml:define>")
+            + _range_def(2, "j", 0, 1)
+            + _define_shown(3, _index(_id("x"), _id("j")), twice)
+            + _eval(4, _call("length", _id("x")))
+        )
+        results = (
+            _result(1)
+            + _result(2)
+            + _result(3, _stored_matrix(shown))
+            + _result(4, f"<ml:real>{len(shown)}</ml:real>")
+        )
+        return _package(tmp_path / f"{name}.mcdx", regions, results)
+
+    for name, shown in (("replaced", [[0], [2]]), ("kept", [[0], [2], [9]])):
+        assert main(["import", str(sheet(name, shown)), "--out", str(tmp_path)]) == 0
+        result = _check(tmp_path / f"{name}.toml", capsys)
+        n = len(shown) + 1
+        assert (result["printed"], result["reproduced"], result["failed"]) == (n, n, 0), result

@@ -828,6 +828,8 @@ def register_entries() -> None:
     def r_submatrix(ctx, name, args):
         r, c = need(args, 0, name)
         origin = ctx.spec.origin
+        if not isinstance(args[3], ty.TConst) and same_tree(args[3], args[4]):
+            return r_column(ctx, name, args, r)
         bounds = []
         for k, a in enumerate(args[1:], start=2):
             a = ctx.plain(a, f"submatrix(): argument {k}")
@@ -842,6 +844,36 @@ def register_entries() -> None:
             )
         consts = [ty.TConst(ctx.dimensionless, value=float(b)) for b in bounds]
         return func(args[0].unit, name, [args[0], *consts], (jr - ir + 1, jc - ic + 1))
+
+    def same_tree(a, b) -> bool:
+        from .subtrees import Keys
+
+        keys = Keys()
+        return keys.key(a) == keys.key(b)
+
+    def r_column(ctx, name, args, r):
+        """submatrix(M, ir, jr, j, j): one column whose index j is computed (Mathcad's M<j>
+        with j a parameter): rows constant, the column checked when it is computed."""
+        origin = ctx.spec.origin
+        rows = []
+        for k in (1, 2):
+            a = ctx.plain(args[k], f"submatrix(): argument {k + 1}")
+            if not isinstance(a, ty.TConst) or a.value != int(a.value):
+                raise TemplateError(f"submatrix(): argument {k + 1} must be a constant integer")
+            rows.append(int(a.value) - origin)
+        if not 0 <= rows[0] <= rows[1] < r:
+            raise TemplateError(
+                f"submatrix(M, {rows[0] + origin}, {rows[1] + origin}, j, j): rows outside the "
+                f"{r} rows of M (origin {origin})"
+            )
+        j = ctx.plain(args[3], "submatrix(): the column")
+        consts = [ty.TConst(ctx.dimensionless, value=float(b + origin)) for b in rows]
+        return func(
+            args[0].unit,
+            name,
+            [args[0], *consts, j, j, origin_arg(ctx)],
+            (rows[1] - rows[0] + 1, 1),
+        )
 
     entry(
         "submatrix",
@@ -1069,9 +1101,11 @@ def numpy_submatrix(m, ir, jr, ic, jc, origin=0.0, *, shapes):
     """submatrix(M, ir, jr, ic, jc): bounds made origin 0 at load, or (a run-time array)
     checked here against the shape M has."""
     origin = int(origin)
+    if any(np.ndim(b) for b in (ir, jr, ic, jc)):
+        raise InputError("submatrix(): a bound that varies over a range; give one number")
     bounds = [int(round(float(b))) - origin for b in (ir, jr, ic, jc)]
-    if origin or shapes[0] is not None and np.ndim(m) == 2:
-        r, c = np.shape(m)
+    if origin or shapes[0] is not None and np.ndim(m) >= 2:
+        r, c = np.shape(m)[:2]
         ir, jr, ic, jc = bounds
         if not (0 <= ir <= jr < r and 0 <= ic <= jc < c):
             raise InputError(

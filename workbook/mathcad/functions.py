@@ -31,7 +31,7 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
     "csort": ("csort", None), "rsort": ("rsort", None), "sort": ("sort", None),
     "reverse": ("reverse", None),
-    "eigenvec": ("eigenvec", None), "rank": ("rank", None), "polyroots": ("polyroots", None),
+    "rank": ("rank", None), "polyroots": ("polyroots", None),
     "lu": ("lu", None), "rref": ("rref", None), "geninv": ("geninv", None),
     "histogram": ("histogram", None), "concat": ("concat", None), "num2str": ("num2str", None),
     # probability distributions (workbook.distributions)
@@ -53,6 +53,12 @@ REFUSED: dict[str, str] = {
     name: "reads a file (a worksheet reads measured data from a [data] table: see the language)"
     for name in ("READPRN", "READ", "READFILE", "READEXCEL", "READCSV", "READBMP", "READRGB",
                  "READWAV", "READBIN")
+} | {
+    # an eigenvector's sign is its solver's: Prime stores [-0.805; 0.575; -0.143] (the
+    # largest component negative) and [-0.272; -0.145; 0.951] in one worksheet, no rule
+    name: "gives eigenvectors whose sign is that of Mathcad's solver, which the language "
+    "cannot reproduce (the language's eigenvec has the largest component positive)"
+    for name in ("eigenvec", "eigenvecs")
 }  # fmt: skip
 
 #: Mathcad functions that write a value to a file (``WRITEPRN("f", M)``, or

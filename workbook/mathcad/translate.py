@@ -454,6 +454,11 @@ class ExprTranslator(Visitor):
             return self._root(args)
         if text == "matrix" and not key[1] and len(args) == 3:
             return self._matrix_of_function(args)
+        if text == "sort" and not key[1] and len(args) == 1:
+            values = _eigenvals_argument(args[0])
+            if values is not None:  # sorted: Prime's order of eigenvalues does not matter
+                inner = self._builtin("eigenvals", "eigenvals", [self.value(values)])
+                return self._builtin("sort", "sort", [inner])
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
             args = args[0].children  # min of a literal vector: min of its elements
         if text in MATHCAD_FUNCTIONS and not key[1]:
@@ -904,7 +909,7 @@ class Translator:
         if _is_indexer(lhs):  # v[i] := f(i), shown (= the whole vector) or not
             target = lhs.children[1] if len(lhs.children) > 1 else None
             try:
-                self.elements(region, lhs, rhs)
+                self.elements(region, lhs, rhs, _shown_rows(evaluation))
             except Untranslatable:
                 if evaluation is not None:
                     sym = self.scope.get(_key(target)) if target is not None else None
@@ -1083,10 +1088,11 @@ class Translator:
             )
         )
 
-    def elements(self, region: Region, lhs: MNode, rhs: MNode) -> None:
+    def elements(self, region: Region, lhs: MNode, rhs: MNode, shown: int | None = None) -> None:
         """v[i] := f(i) over range variables with whole values (Mathcad builds the vector
         element by element): the vector [v_of(0), v_of(1), ...] of a function v_of, 0 where
-        the range does not reach."""
+        the range does not reach. ``shown``: the rows of the vector Mathcad showed after it
+        (where it shows no more rows than the range reaches, nothing of v before is kept)."""
         target, index = lhs.children[1], lhs.children[2]
         if target.tag != "id":
             raise Untranslatable("an element assignment to something that is not a name")
@@ -1115,6 +1121,9 @@ class Translator:
             if any(min(v) < self.origin for v in values):
                 raise Untranslatable("an element assignment below ORIGIN")
             old = None
+            reach = max(values[place[0]]) - self.origin + 1
+            if shown is not None and len(ranges) == 1 and shown == reach:
+                before = None  # Mathcad showed the range's elements only: none kept
             if before is not None:  # Mathcad keeps the elements the range does not reach
                 old = self._shape_of(before)
                 if old is None or (len(ranges) == 1 and old[1] != 1):
@@ -1689,6 +1698,30 @@ def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     if isinstance(node, ex.Call):
         return ex.Call(mapping.get(node.func, node.func), node.args)
     return node
+
+
+def _eigenvals_argument(node: MNode) -> MNode | None:
+    """M of ``eigenvals(M)`` (None: ``node`` is not that call)."""
+    node = _unparen(node)
+    if node.tag != "apply" or len(node.children) != 2 or node.children[0].tag != "id":
+        return None
+    if _key(node.children[0]) != ("eigenvals", ""):
+        return None
+    arg = node.children[1]
+    if arg.tag == "sequence":
+        return arg.children[0] if len(arg.children) == 1 else None
+    return arg
+
+
+def _shown_rows(evaluation: MNode | None) -> int | None:
+    """The rows of the array Mathcad stored for ``v[i] := ... =`` (None: none stored)."""
+    result = evaluation.find("result") if evaluation is not None else None
+    if result is None or not result.children or result.children[0].tag != "matrix":
+        return None
+    try:
+        return matrix_size(result.children[0])[0]
+    except Untranslatable:
+        return None
 
 
 def _substitute(node: ex.Node, values: dict[str, ex.Node]) -> ex.Node:
