@@ -268,7 +268,7 @@ class Sheet:
                 )
             env = self._bind(name, d.params, args, kwargs)
             out = self.evaluator.function(name)(env)
-            if f.body.text:
+            if f.body.text or isinstance(out, str):  # a text, or an array's element that is one
                 return out if np.ndim(out) == 0 else np.asarray(out, dtype=object)
             q = Q(np.asarray(out, dtype=float) if np.ndim(out) else float(out), f.unit)
             return q.to("") if un.is_compound_ratio(f.unit) else q
