@@ -131,6 +131,26 @@ class Bound:
             out.append((at, value))
         return out
 
+    def singular(self, shape: tuple[int, ...]) -> list[Callable]:
+        """``h(x, row)`` per sub-tree whose zeros are singular points of EXPR (a denominator,
+        a power's base, the argument of sqrt or ln: numerics.singular), as :meth:`over`."""
+        from .singular import singular_arguments
+
+        flat, env, var = self._flat(shape), self.env, self.var
+        out = []
+        for u in singular_arguments(self.evaluator.typer, self.body, var):
+            if not ty.parameters(u) <= {var, *env}:
+                continue
+            fn = self.evaluator.compile(u)
+
+            def value(x, row, fn=fn):
+                idx = np.asarray(row).astype(np.intp)
+                with np.errstate(all="ignore"):
+                    return fn({**env, **{k: a[idx] for k, a in flat.items()}, var: x})
+
+            out.append(value)
+        return out
+
     def record(self, name: str, result: Result) -> None:
         """Keep the result's error estimate (``workbook bench``, the estimate findings), with
         the definition being computed."""

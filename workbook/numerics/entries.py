@@ -346,7 +346,7 @@ def _integral_numpy(of, a, b):
             ).value
         return _merged(values, _integral_numpy, of, a, b)
     tol, var, unit = of.tolerance, of.var, of.unit_text
-    enclose = of.enclosure(shape)
+    enclose, singular = of.enclosure(shape), of.singular(shape)
     res = _solve(
         of,
         lambda f, a, b, *rest: quadrature.integrate(
@@ -360,6 +360,7 @@ def _integral_numpy(of, a, b):
             unit=unit,
             label=rest[-1],
             enclose=enclose,
+            singular=singular,
         ),
         a,
         b,

@@ -33,6 +33,14 @@ ATOL_SHARE = 1e-3
 MAX_INTERVALS_PER_ROW = 64
 #: rows tried first in a table of at least 8 x PROBE rows (see the module's docstring)
 PROBE = 32
+#: tanh-sinh's first level for a nearly singular row (SciPy's default, 2, for the others)
+CHECK_LEVEL = 3
+#: a singular sub-tree whose |value| at a piece's end is below this share of its largest
+#: |value| there (end, middle, other end) has its zero just outside the piece
+NEAR = 1e-2
+#: a row whose |f| at an end times the interval's width is above this many times the
+#: integral is computed a second time by tanh-sinh, in two halves
+STEEP_END = 10.0
 
 _WHY = {
     -1: "the error estimate did not fall below the tolerance (a singular or divergent integral?)",
@@ -53,6 +61,7 @@ def integrate(
     unit: str = "",
     label: Callable[[int], str] | None = None,
     enclose: Callable | None = None,
+    singular: Sequence[Callable] = (),
 ) -> Result:
     """The integral of ``f(x, *args)`` from a to b for every row.
 
@@ -61,7 +70,9 @@ def integrate(
     With ``enclose(lo, hi, *args) -> (F, D)`` (interval enclosures of f), narrow and steep
     features are located first (:func:`workbook.numerics.features.breaks`) and the interval
     is split there too. The error estimate is the sum of the pieces' (QUADPACK's, or
-    tanh-sinh's).
+    tanh-sinh's). ``singular``: ``h(x, *args)`` per sub-tree of f whose zeros are singular
+    points of f (:mod:`workbook.numerics.singular`); a row where one is 0 just outside a
+    piece has a second tanh-sinh computation (see :func:`_tanhsinh`).
     """
     shape, (a, b, *rest) = rows(a, b, *args, *breaks)
     args, brk = rest[: len(args)], rest[len(args) :]
@@ -84,7 +95,7 @@ def integrate(
         value, error, pending, evals = _adaptive(f, left, right, args, tol, n)
     if pending.any():
         v, e, ev = _tanhsinh(
-            f, left[:, pending], right[:, pending], args, pending, tol, n, label, unit
+            f, left[:, pending], right[:, pending], args, pending, tol, n, label, unit, singular
         )
         value[pending], error[pending] = v, e
         evals = max(evals, ev)
@@ -168,66 +179,113 @@ def _adaptive(f, left, right, args, tol, n):
     return value, error, pending, evals
 
 
-def _tanhsinh(f, left, right, args, pending, tol, n, label, unit):
+def _tanhsinh(f, left, right, args, pending, tol, n, label, unit, singular=()):
     from scipy.integrate import tanhsinh
 
     idx = np.flatnonzero(pending)
     args = [g[None, pending] for g in args]
-    scale = _size(f, left, right, args) if not tol.atol else np.ones(idx.size)
+    size = _size(f, left, right, args)
+    scale = size if not tol.atol else np.ones(idx.size)
 
-    def run(lo, hi):
-        return tanhsinh(
-            lambda x, inverse, *a: f(x, *a) * inverse,
-            lo,
-            hi,
-            args=(1.0 / scale[None], *args),
-            rtol=max(tol.rtol, 1e-15),
-            # the integrand is divided by the row's size: a piece's error is allowed its share
-            # of the tolerance of the whole row, as in the Gauss-Kronrod pass (and a piece where
-            # f is 0 converges at once)
-            atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
-        )
-
-    # tanh-sinh's own estimate can be far too small: on 1/sqrt(t + 1e-3) over [0, 0.79]
-    # (nearly singular just outside the interval) it said 4.5e-11 for an error of 6e-8. So
-    # every piece is integrated again in two halves, on other nodes: their sum is the value,
-    # and the difference between the two results is added to its error estimate.
-    mid = (left + right) / 2.0
-    halves_left, halves_right = np.vstack([left, mid]), np.vstack([mid, right])
-    with np.errstate(all="ignore"):
-        whole, halves = run(left, right), run(halves_left, halves_right)
-    for res, lo, hi in ((whole, left, right), (halves, halves_left, halves_right)):
+    def run(lo, hi, cols, minlevel=2):
+        with np.errstate(all="ignore"):
+            res = tanhsinh(
+                lambda x, inverse, *a: f(x, *a) * inverse,
+                lo,
+                hi,
+                args=(1.0 / scale[None, cols], *[g[:, cols] for g in args]),
+                rtol=max(tol.rtol, 1e-15),
+                # the integrand is divided by the row's size: a piece's error is allowed its
+                # share of the tolerance of the whole row, as in the Gauss-Kronrod pass (and a
+                # piece where f is 0 converges at once)
+                atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
+                minlevel=minlevel,
+            )
         status = np.asarray(res.status)
         if (status != 0).any():
             p, i = np.argwhere(status != 0)[0]
             raise NumericsError(
                 f"integral(): {_WHY.get(int(status[p, i]), f'status {int(status[p, i])}')}: "
                 f"on [{num(lo[p, i])}, {num(hi[p, i])}]{_u(unit)}"
-                f"{row_text(label, idx[i], n)} the estimate is "
-                f"{num(scale[i] * res.integral[p, i])} +- {num(scale[i] * res.error[p, i])}"
+                f"{row_text(label, idx[cols][i], n)} the estimate is "
+                f"{num(scale[cols][i] * res.integral[p, i])} +- "
+                f"{num(scale[cols][i] * res.error[p, i])}"
             )
-    value = halves.integral.sum(axis=0) * scale
-    # either of the two may be the worse: the difference is added, not taken as a floor
-    error = halves.error.sum(axis=0) * scale + np.abs(whole.integral.sum(axis=0) * scale - value)
-    error += _rounding(f, left, right, args)
-    evals = whole.nfev.sum(axis=0) + halves.nfev.sum(axis=0)
-    return value, error, int(evals.max())
+        return res
+
+    # tanh-sinh's own estimate (the difference between its last levels) can be far too small
+    # when it stops at its first levels: on 1/sqrt(t + 1e-3) over [0, 0.79] (nearly singular
+    # just outside the interval) it said 4.5e-11 for an error of 6e-8. A row whose integrand
+    # is nearly singular beside a piece (a singular sub-tree's zero just outside it, or |f|
+    # at an end STEEP_END times its mean) is integrated from level CHECK_LEVEL, whole and
+    # again in two halves on other nodes: the halves' sum is its value, and the difference
+    # between the two results is added to its error estimate. Another row (smooth, or
+    # singular at an end itself, as the power-law profile: what tanh-sinh is made for) is
+    # computed once.
+    rounding, at_ends = _rounding(f, left, right, args)
+    width = (right - left).sum(axis=0)
+    steep = ~(at_ends * width <= STEEP_END * size)  # also where f is not finite there
+    steep |= _nearly_singular(singular, left, right, args)
+    value, error, evals = np.zeros(idx.size), np.zeros(idx.size), np.zeros(idx.size, dtype=int)
+    plain = np.flatnonzero(~steep)
+    if plain.size:
+        once = run(left[:, plain], right[:, plain], plain)
+        value[plain] = once.integral.sum(axis=0) * scale[plain]
+        error[plain] = once.error.sum(axis=0) * scale[plain]
+        evals[plain] = once.nfev.sum(axis=0)
+    checked = np.flatnonzero(steep)
+    if checked.size:
+        lo, hi = left[:, checked], right[:, checked]
+        mid = (lo + hi) / 2.0
+        whole = run(lo, hi, checked, CHECK_LEVEL)
+        halves = run(np.vstack([lo, mid]), np.vstack([mid, hi]), checked, CHECK_LEVEL)
+        first = whole.integral.sum(axis=0) * scale[checked]
+        value[checked] = halves.integral.sum(axis=0) * scale[checked]
+        # either of the two may be the worse: the difference is added, not taken as a floor
+        error[checked] = halves.error.sum(axis=0) * scale[checked] + np.abs(first - value[checked])
+        evals[checked] = whole.nfev.sum(axis=0) + halves.nfev.sum(axis=0)
+    return value, error + rounding, int(evals.max())
 
 
-def _rounding(f, left, right, args) -> np.ndarray:
+def _nearly_singular(singular, left, right, args) -> np.ndarray:
+    """Per row: whether a singular sub-tree's zero is just outside one of its pieces (|h| at
+    an end below NEAR of its largest |h| at the ends and middle, and not 0 but for rounding:
+    a zero at the end itself is tanh-sinh's strength)."""
+    out = np.zeros(left.shape[1], dtype=bool)
+    mid = (left + right) / 2.0
+    for h in singular:
+        with np.errstate(all="ignore"):
+            vals = [
+                np.abs(np.broadcast_to(np.asarray(h(x, *args), dtype=float), x.shape))
+                for x in (left, mid, right)
+            ]
+        top = np.maximum.reduce(vals)
+        for end in (vals[0], vals[2]):
+            near = (end > 1e3 * np.finfo(float).eps * top) & (end < NEAR * top)
+            out |= (near & (right > left)).any(axis=0)
+    return out
+
+
+def _rounding(f, left, right, args) -> tuple[np.ndarray, np.ndarray]:
     """Per row, what rounding the nodes next to a piece's ends costs: a node a + t is a
     double, off from a + t by up to an ulp of a, which near an end-point singularity moves
     f a lot (1/sqrt(x - 0.3) on [0.3, 1]: about 2e-8, where tanh-sinh's estimate said 2e-10).
-    Estimated as 2 d |f(a + d)| at each end a, d a few ulp of a (2 sqrt(d) for that f)."""
+    Estimated as 2 d |f(a + d)| at each end a, d a few ulp of a (2 sqrt(d) for that f).
+    Also, per row, the largest |f| there (inf where it is not finite)."""
     out = np.zeros(left.shape[1])
+    top = np.zeros(left.shape[1])
     for end, inward in ((left, 1.0), (right, -1.0)):
         d = 4 * np.spacing(np.abs(end))
         with np.errstate(all="ignore"):
             fv = np.abs(
                 np.broadcast_to(np.asarray(f(end + inward * d, *args), dtype=float), end.shape)
             )
-        out += np.where(np.isfinite(fv) & (right > left), 2 * d * fv, 0.0).sum(axis=0)
-    return out
+        inside = right > left
+        out += np.where(np.isfinite(fv) & inside, 2 * d * fv, 0.0).sum(axis=0)
+        top = np.maximum(
+            top, np.where(inside, np.where(np.isfinite(fv), fv, np.inf), 0.0).max(axis=0)
+        )
+    return out, top
 
 
 def _size(f, left, right, args) -> np.ndarray:
