@@ -76,6 +76,18 @@ KNOWN_ELSEWHERE = {
         "numerics/intervals.py",
         ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),
     ),
+    # the same functions in mpmath (workbook bench's reference, roots polished): another back
+    # end whose rules could be a field of the entry
+    (
+        "numerics/mpform.py",
+        (
+            "abs", "acos", "asin", "atan", "ceil", "cos", "cosh", "exp", "floor", "ln", "log10",
+            "sign", "sin", "sinh", "sqrt", "tan", "tanh",
+        ),
+    ),
+    # the functions singular where their argument is 0 (an integrand nearly singular beside
+    # its interval gets a second tanh-sinh computation)
+    ("numerics/singular.py", ("ln", "log10", "sqrt")),
     # the trigonometric functions whose argument the angle warnings look at (a slip of theta
     # in degrees times pi/180, a bare number of degrees read as radians)
     ("angle_slips.py", ("cos", "sin", "tan")),
