@@ -37,7 +37,7 @@ PROBE = 32
 CHECK_LEVEL = 3
 #: a singular sub-tree whose |value| at a piece's end is below this share of its largest
 #: |value| there (end, middle, other end) has its zero just outside the piece
-NEAR = 1e-2
+NEAR = 0.1
 #: a row whose |f| at an end times the interval's width is above this many times the
 #: integral is computed a second time by tanh-sinh, in two halves
 STEEP_END = 10.0
