@@ -16,9 +16,10 @@ from .computed import ComputedSheet, compute
 from .errors import WorkbookError
 
 
-def computed(sheet) -> ComputedSheet:
-    """``sheet`` computed (as the report computes it), or itself if it already is."""
-    return sheet if isinstance(sheet, ComputedSheet) else compute(sheet)
+def computed(sheet, *, check: bool | None = None) -> ComputedSheet:
+    """``sheet`` computed (as the report computes it; ``check=False``: without the check
+    report), or itself if it already is."""
+    return sheet if isinstance(sheet, ComputedSheet) else compute(sheet, check=check)
 
 
 def inputs_frame(sheet):
@@ -39,7 +40,7 @@ def definitions_frame(sheet):
     """Scalar definitions with their values (or the error that stops them)."""
     import pandas as pd
 
-    sheet = computed(sheet)
+    sheet = computed(sheet, check=False)
     rows = []
     for name, d in sheet.spec.definitions.items():
         if d.is_function:
@@ -63,7 +64,7 @@ def functions_frame(sheet):
     """Functions: signature, unit, formula, note."""
     import pandas as pd
 
-    sheet = computed(sheet)
+    sheet = computed(sheet, check=False)
     rows = []
     for name, d in sheet.spec.definitions.items():
         if not d.is_function:
@@ -76,7 +77,7 @@ def functions_frame(sheet):
 
 def tables(sheet) -> dict:
     """Every range table as a DataFrame (unit in every header); block tables are skipped."""
-    sheet = computed(sheet)
+    sheet = computed(sheet, check=False)
     return {t.name: sheet.frame(t.name) for t in sheet.spec.tables if not t.block}
 
 
