@@ -812,6 +812,7 @@ def test_a_family_table_is_checked_before_its_curves_are_computed(tmp_path):
     write(path, FAMILY.replace("LAST", "1999999").replace("VALUES", '["1", "2"]'))
     out = cli(tmp_path, "run", "f.toml", "--out", "f.xlsx")
     assert out.returncode == 2 and "table f has 2,000,000 rows" in out.stderr
+    assert "f.toml:" in out.stderr and "in 'table f'" in out.stderr, out.stderr  # located
     write(path, FAMILY.replace("LAST", "99").replace("VALUES", '["1", "2"]'))
     table = workbook.load(path).table("f")
     assert table.shape == (100, 3) and table.iloc[99, 2] == 2 * 99
@@ -831,6 +832,7 @@ def test_a_sweep_is_bounded_before_any_case_runs(tmp_path):
     out = cli(tmp_path, "sweep", "t.toml", *args)
     assert out.returncode == 2 and f"(limit {MAX_SWEEP_POINTS:,})" in out.stderr, out.stderr
     assert "19,000,010,000 points" in out.stderr and not (tmp_path / "s.csv").exists()
+    assert "t.toml, in 'sweep output q'" in out.stderr  # --output's: the file, no line
 
 
 def test_sweep_values_converted_at_once_equal_one_by_one(tmp_path):

@@ -284,6 +284,7 @@ def test_limits_are_documented():
         file_limits.MAX_SHARED_STRINGS,
         file_limits.MAX_STYLES_BYTES,
         file_limits.MAX_MATRIX_WORK,
+        file_limits.MAX_TABLE_CELLS,
         ode.MAX_STEPS,
     ):
         assert f"{value:,}" in limits or str(value) in limits, value

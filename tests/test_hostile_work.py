@@ -21,7 +21,8 @@ import pytest
 from test_hostile import guarded
 
 import workbook
-from workbook import limits
+from workbook import excelform, limits
+from workbook.cli import main
 from workbook.errors import LimitError
 from workbook.excel_names import ExcelNames, needs_change
 from workbook.mathcad import writer
@@ -219,8 +220,6 @@ def test_imported_names_are_chosen_as_by_the_scan():
         assert [s.final for s in mine] == [s.final for s in theirs]
 
 
-# -- the heavy cases, each in a fresh guarded interpreter --------------------------------------
-
 ML = "http://schemas.mathsoft.com/math30"
 
 
@@ -240,6 +239,55 @@ def _mathcad(definitions: list[tuple[str, str]]) -> str:
 def _plus_one(name: str) -> str:
     return f"<ml:apply><ml:plus/><ml:id>{name}</ml:id><ml:real>1</ml:real></ml:apply>"
 
+
+# -- tables written to a workbook, engine refusals of an import -------------------------------
+
+
+def table(rows: int, columns: int = 1) -> str:
+    cols = ", ".join(f'"{k + 1}*f(x)" = "mm"' for k in range(columns))
+    return (
+        '[inputs]\na = "2 mm"\n[arguments]\nx = { unit = "" }\n'
+        '[definitions]\n"f(x)" = { expr = "a*x", unit = "mm" }\n'
+        f'[[tables]]\nname = "t"\nrange = "x := 1 .. {rows}"\ncolumns = {{ {cols} }}\n'
+    )
+
+
+def test_tables_past_the_cells_of_a_workbook_are_refused_before_they_are_written(
+    tmp_path, monkeypatch
+):
+    # a table of 1,000,001 rows took 75 s to write; the cells of a workbook's tables are bounded
+    monkeypatch.setattr(excelform, "MAX_TABLE_CELLS", 300)
+    path = tmp_path / "t.toml"
+    path.write_text(table(100, 2), encoding="utf-8")  # 100 rows x 3 columns: 300 cells
+    workbook.load(path).write_xlsx(tmp_path / "t.xlsx")
+    book = openpyxl.load_workbook(tmp_path / "t.xlsx", data_only=True)
+    assert [tuple(r)[:3] for r in book["Listing"].iter_rows(values_only=True)][-1] == (
+        100,
+        200,
+        400,
+    )
+    path.write_text(table(100, 3), encoding="utf-8")  # 400 cells
+    with pytest.raises(LimitError) as err:
+        workbook.load(path).write_xlsx(tmp_path / "u.xlsx")
+    assert (err.value.definition, err.value.line) == ("table t", 8)
+    assert "100 rows x 4 columns" in str(err.value) and "limit 300" in str(err.value)
+    assert "--csv" in str(err.value)
+    assert not (tmp_path / "u.xlsx").exists() and not list(tmp_path.glob(".*partial*"))
+
+
+def test_an_import_of_two_thousand_refused_definitions_is_one_pass(tmp_path, capsys):
+    # 125/250/500/2,000 refused definitions took 2.8/9.3/37/>60 s: the import was retried once
+    # for each refusal, and each retry loaded the whole worksheet
+    plus = "<ml:apply><ml:plus/><ml:id>m</ml:id><ml:id>s</ml:id></ml:apply>"
+    src = tmp_path / "refused.xmcd"
+    src.write_text(_mathcad([(f"a{i}", plus) for i in range(2000)]), encoding="utf-8")
+    assert main(["import", str(src), "--out", str(tmp_path / "out")]) == 0
+    assert "2000 regions not translated" in capsys.readouterr().out
+    text = (tmp_path / "out" / "refused.toml").read_text(encoding="utf-8")
+    assert text.count("the engine refuses it: cannot add [time] (s) to [length] (m)") == 2000
+
+
+# -- the heavy cases, each in a fresh guarded interpreter --------------------------------------
 
 ALIKE = [
     "".join(c.upper() if b else c for c, b in zip("abcdefghijklm", bits))
@@ -283,6 +331,12 @@ HEAVY = {
         ("sweep", "hostile.toml", "--vary", "R=1mm..100mm:10000", "--out", "s.csv"),
         2,
         "(limit 50,000,000)",
+    ),
+    "table_of_1000001_rows": (
+        table(1_000_001),
+        ("run", "hostile.toml"),
+        2,
+        f"(limit {limits.MAX_TABLE_CELLS:,}). Write it as CSV instead",
     ),
     "import_20000_redefinitions": (
         {"r.xmcd": _mathcad([("x", "<ml:real>1</ml:real>")] + [("x", _plus_one("x"))] * 20_000)},

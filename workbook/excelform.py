@@ -34,6 +34,7 @@ from .constants import CONSTANTS, shadowed
 from .errors import LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
 from .excel_names import ExcelNames
+from .limits import MAX_TABLE_CELLS
 from .livecheck import RELATIVE, ROWS_CHECKED, CellLog, RecordingSheet
 from .uses import names_used
 from .version import __version__
@@ -212,6 +213,7 @@ class ExcelLayout:
         # live approximate forms (integral, root, extrema): where, what, how far from the engine
         self.live_forms: list[tuple[str, str, object, float | None]] = []
         self.formula_cells = 0
+        self.table_cells = 0  # cells of the tables written so far (limits.MAX_TABLE_CELLS)
         self.planned: dict[tuple[str, str], ColumnCells] = {}
         # the next free column and the cells used of the row-wise blocks of 'Solver rows'
         self.step_col, self.step_cells = RowSteps.FIRST_COL, 0
@@ -596,6 +598,7 @@ class ExcelLayout:
                 f"table {spec.name} has {n:,} rows; an Excel sheet holds "
                 f"{MAX_ROWS:,}. Write it as CSV instead (workbook run --csv)"
             )
+        self._count_table_cells(spec, n, len(data.columns))
         ws.write_string(start, 0, spec.title, self.fmt["title"])
         heads = [un.header(c.title, c.unit) for c in data.columns]
         write_labels(ws, start + 1, 0, heads, self.fmt["header"])
@@ -707,6 +710,20 @@ class ExcelLayout:
         self.formula_cells += n
         return True
 
+    def _count_table_cells(self, spec, rows: int, columns: int) -> None:
+        """Refuse a table that would bring the cells of the workbook's tables past
+        :data:`workbook.limits.MAX_TABLE_CELLS`, before it is written."""
+        self.table_cells += rows * columns
+        if self.table_cells > MAX_TABLE_CELLS:
+            raise LimitError(
+                f"table {spec.name} has {rows:,} rows x {columns} columns: the workbook's "
+                f"tables would hold {self.table_cells:,} cells (limit {MAX_TABLE_CELLS:,}). "
+                "Write it as CSV instead (workbook run --csv)",
+                file=self.sheet.file,
+                line=getattr(spec, "line", None),
+                definition=f"table {spec.name}",
+            )
+
     # -- block tables --------------------------------------------------------------------
     def write_computed_table(self, spec) -> None:
         ws = self.ws(spec.sheet)
@@ -715,12 +732,16 @@ class ExcelLayout:
             n = len(self.sheet.range_values(spec.range, f"table {spec.name}"))
             if start + n + 3 > MAX_ROWS:
                 raise LimitError(
-                    f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}"
+                    f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}",
+                    file=self.sheet.file,
+                    line=spec.line,
+                    definition=f"table {spec.name}",
                 )
         df = self.computed.table(spec.name)
         n = len(df)
         if start + n + 3 > MAX_ROWS:
             raise LimitError(f"table {spec.name} has {n:,} rows; an Excel sheet holds {MAX_ROWS:,}")
+        self._count_table_cells(spec, n, len(df.columns))
         ws.write_string(start, 0, spec.title, self.fmt["title"])
         write_labels(ws, start + 1, 0, [str(c) for c in df.columns], self.fmt["header"])
         how = (

@@ -97,8 +97,21 @@ def check_points(sheet, outs: list[Output], cases: int) -> None:
             raise LimitError(
                 f"sweep output {out.name}: {cases:,} cases x {points:,} points of its range is "
                 f"{cases * points:,} points (limit {MAX_SWEEP_POINTS:,}); fewer cases or a "
-                "coarser range"
+                "coarser range",
+                file=sheet.file,
+                line=_declared_line(sheet, out),
+                definition=f"sweep output {out.name}",
             )
+
+
+def _declared_line(sheet, out: Output) -> int | None:
+    """The line of ``[sweep] outputs`` when ``out`` is the template's own (not --output's)."""
+    from .outputs import template_outputs
+
+    declared = template_outputs(sheet.spec).get(out.name)
+    if declared is None or declared.text != out.text:
+        return None
+    return sheet.spec.line_of(out.name, "sweep") or sheet.spec.line_of("outputs", "sweep")
 
 
 def sweep(
