@@ -359,3 +359,23 @@ def test_elements_over_a_range_replace_a_vector_when_mathcad_shows_so(tmp_path, 
         result = _check(tmp_path / f"{name}.toml", capsys)
         n = len(shown) + 1
         assert (result["printed"], result["reproduced"], result["failed"]) == (n, n, 0), result
+
+
+def test_names_of_a_matrix_defined_by_a_program(tmp_path, capsys):
+    """[a; b] := | x <- 2 ; [x; 3 x] : a = 2, b = 6."""
+    lhs = f'<ml:matrix rows="2" cols="1">{_id("a")}{_id("b")}</ml:matrix>'
+    value = (
+        f'<ml:matrix rows="2" cols="1">{_id("x")}<ml:apply><ml:mult/><ml:real>3</ml:real>'
+        f"{_id('x')}</ml:apply></ml:matrix>"
+    )
+    program = f"<ml:program>{_local(_id('x'), _real(2))}{value}</ml:program>"
+    regions = (
+        _region(1, 1, f"<ml:define>{lhs}{program}</ml:define>")
+        + _eval(2, _id("a"))
+        + _eval(3, _id("b"))
+    )
+    results = _result(1) + _result(2, "<ml:real>2</ml:real>") + _result(3, "<ml:real>6</ml:real>")
+    src = _package(tmp_path / "ab.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "ab.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result

@@ -33,6 +33,10 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "reverse": ("reverse", None),
     "rank": ("rank", None), "polyroots": ("polyroots", None),
     "lu": ("lu", None), "rref": ("rref", None), "geninv": ("geninv", None),
+    "Var": ("Var", None), "Stdev": ("Stdev", None), "corr": ("corr", None),
+    "cvar": ("cvar", None), "slope": ("slope", None), "intercept": ("intercept", None),
+    "skew": ("skew", None), "kurt": ("kurt", None), "gmean": ("gmean", None),
+    "hmean": ("hmean", None), "Rank": ("Rank", None),
     "histogram": ("histogram", None), "concat": ("concat", None), "num2str": ("num2str", None),
     # probability distributions (workbook.distributions)
     "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),

@@ -1199,17 +1199,20 @@ class Translator:
         whole = self.new_sym("var", "parts", f"[...] := (region {region.id})", region.id)
         whole.generated = True
         try:
-            et = ExprTranslator(self)
-            body = et.value(rhs)
-            if et.ranges:
-                raise Untranslatable(
-                    f"uses the range variable {et.ranges[0].mathcad} outside a function"
-                )
+            if rhs.tag == "program":  # [a; b] := a program giving them
+                parts = self.program(rhs, {})
+            else:
+                et = ExprTranslator(self)
+                parts = {"body": et.value(rhs)}
+                if et.ranges:
+                    raise Untranslatable(
+                        f"uses the range variable {et.ranges[0].mathcad} outside a function"
+                    )
         except Untranslatable as why:
             for n in names:
                 self.define(_key(n), "var", region.id).broken = str(why)
             raise
-        self.out.items.append(Item("definition", region.id, sym=whole, body=body))
+        self.out.items.append(Item("definition", region.id, sym=whole, **parts))
         o = self.sheet_origin
         for c in range(cols):
             for r in range(rows):
