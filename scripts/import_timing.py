@@ -1,9 +1,10 @@
 """The timing table of docs/mathcad.md: importing each Mathcad worksheet against checking it.
 
 For every .xmcd or .mcdx file under the folders (default ../shared/mathcad and
-../shared/mathcad-prime beside the repository), prints the median wall time of
+../shared/mathcad-prime beside the repository), prints the median CPU time of
 ``workbook import`` and of ``workbook check`` of the imported worksheet (fresh processes,
-alternating), their ratio, and how many times the import built a ``Sheet`` (an engine load).
+alternating; CPU time, as the machine's cores are shared), their ratio, and how many
+times the import built a ``Sheet`` (an engine load).
 
     python scripts/import_timing.py [FOLDER ...] [--reps N]
 """
