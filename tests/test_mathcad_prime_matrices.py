@@ -379,3 +379,25 @@ def test_names_of_a_matrix_defined_by_a_program(tmp_path, capsys):
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
     result = _check(tmp_path / "ab.toml", capsys)
     assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result
+
+
+def test_an_element_defined_from_its_previous_value(tmp_path, capsys):
+    """v := [1; 2; 3]; v[1] := 10 v[1] (the right side reads the previous v, not the new one,
+    which was a circular definition): v = [1; 20; 3]."""
+    v = (
+        '<ml:matrix rows="3" cols="1"><ml:real>1</ml:real><ml:real>2</ml:real>'
+        "<ml:real>3</ml:real></ml:matrix>"
+    )
+    v1 = _index(_id("v"), _real(1))
+    regions = (
+        _region(1, 1, f"<ml:define>{_id('v')}{v}</ml:define>")
+        + _region(
+            2, 2, f"<ml:define>{v1}<ml:apply><ml:mult/>{_real(10)}{v1}</ml:apply></ml:define>"
+        )
+        + _eval(3, _id("v"))
+    )
+    results = _result(1) + _result(2) + _result(3, _stored_matrix([[1], [20], [3]]))
+    src = _package(tmp_path / "v.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    result = _check(tmp_path / "v.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from . import factorizations, samples
+from . import factorizations, norms, samples
 from .errors import DomainError, InputError
 from .excel_functions import stored
 from .limits import ELEMENT_WORK, charge_matrix_work
@@ -703,6 +703,78 @@ def register_entries() -> None:
     ):  # fmt: skip
         entry(name, len(inspect.signature(hook).parameters), rule, _hook(hook), excel, doc)
 
+    # norms, condition numbers, trace, diagonal, singular values (workbook.norms)
+    def r_matrix_norm(ctx, name, args):
+        need(args, 0, name, "a matrix")
+        return func(args[0].unit, name, args, None)
+
+    def r_cond(ctx, name, args):
+        square(args, name)
+        return func(ctx.dimensionless, name, args, None)
+
+    def r_trace(ctx, name, args):
+        square(args, name)
+        return func(args[0].unit, name, args, None)
+
+    def r_diag(ctx, name, args):
+        r, c = need(args, 0, name)
+        if c == 1:
+            return func(args[0].unit, name, args, (r, r))
+        return func(args[0].unit, name, args, (square(args, name), 1))
+
+    def r_svds(ctx, name, args):
+        r, c = need(args, 0, name, "a matrix")
+        return func(args[0].unit, name, args, (min(r, c), 1))
+
+    def norm_hook(kind: str):
+        return lambda m, shapes: norms.matrix_norm(m, kind)
+
+    def cond_hook(kind: str):
+        return lambda m, shapes: norms.condition(m, kind, SINGULAR_COND)
+
+    values = "has no spreadsheet formula here"
+    for kind, what in (
+        ("1", "largest column sum of |elements|"),
+        ("2", "largest singular value"),
+        ("i", "largest row sum of |elements|"),
+    ):
+        entry(
+            f"norm{kind}",
+            1,
+            r_matrix_norm,
+            norm_hook(kind),
+            not_live(f"norm{kind}() {values}"),
+            f"norm{kind}(M): the {what} of M",
+        )
+    for kind, what in (("1", "norm1"), ("2", "norm2"), ("e", "Frobenius norm"), ("i", "normi")):
+        entry(
+            f"cond{kind}",
+            1,
+            r_cond,
+            cond_hook(kind),
+            not_live(f"cond{kind}() {values}"),
+            f"cond{kind}(M): the condition number of M in the {what} (singular: an error)",
+        )
+    entry(
+        "tr",
+        1,
+        r_trace,
+        lambda m, shapes: norms.trace(m),
+        not_live(f"tr() {values}"),
+        "tr(M): the trace of a square matrix (the sum of its diagonal)",
+    )
+    entry(
+        "diag",
+        1,
+        r_diag,
+        lambda m, shapes: norms.diag(m),
+        not_live(f"diag() {values}"),
+        "diag(v): the diagonal matrix of a vector; diag(M): the diagonal of a square matrix",
+    )
+    entry("svds", 1, r_svds, lambda m, shapes: norms.singular_values(m),
+          not_live(f"svds() {values}"),
+          "svds(M): the singular values of M, largest first")  # fmt: skip
+
     def r_polyroots(columns: int):
         def rule(ctx, name, args):
             n = vector(args, 0, name)
@@ -778,7 +850,7 @@ def register_entries() -> None:
         return func(args[0].unit * args[1].unit, name, args, None)
 
     def r_norm(ctx, name, args):
-        vector(args, 0, name)
+        need(args, 0, name)  # a vector's length, a matrix's Frobenius norm
         return func(args[0].unit, name, args, None)
 
     def x_cross(args, shapes=None):
@@ -811,7 +883,8 @@ def register_entries() -> None:
         r_norm,
         lambda v, shapes: norm(v),
         call("SQRT", "SUMSQ({})"),
-        "length (Euclidean norm) of a vector",
+        "length (Euclidean norm) of a vector; of a matrix, the square root of the sum of the "
+        "squares of its elements (Frobenius)",
     )
 
     # Mathcad's |x|: one operator whose meaning follows the shape (known at load)

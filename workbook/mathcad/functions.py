@@ -37,6 +37,10 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "cvar": ("cvar", None), "slope": ("slope", None), "intercept": ("intercept", None),
     "skew": ("skew", None), "kurt": ("kurt", None), "gmean": ("gmean", None),
     "hmean": ("hmean", None), "Rank": ("Rank", None),
+    "norm1": ("norm1", None), "norm2": ("norm2", None), "normi": ("normi", None),
+    "cond1": ("cond1", None), "cond2": ("cond2", None), "conde": ("conde", None),
+    "condi": ("condi", None), "tr": ("tr", None), "diag": ("diag", None),
+    "svds": ("svds", None),
     "histogram": ("histogram", None), "concat": ("concat", None), "num2str": ("num2str", None),
     # probability distributions (workbook.distributions)
     "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),

@@ -1237,7 +1237,13 @@ class Translator:
                     + ("function" if previous.kind == "func" else "range variable")
                 )
             et = ExprTranslator(self)
-            value = et.value(rhs)  # the right side sees the previous definition
+            self.scope.pop(key)  # the right side sees the previous definition (if any)
+            if previous is not None:
+                self.scope[key] = previous
+            try:
+                value = et.value(rhs)
+            finally:
+                self.scope[key] = sym
             local = self.new_sym("local", sym.base, sym.mathcad)
             lines = []
             if previous is not None:
