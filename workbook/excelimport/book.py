@@ -84,9 +84,9 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
     for cell in cells:
         if _key(cell) in parsed and cell.array_master in (None, (cell.row, cell.col)):
             try:
-                FormulaTranslator(book, cell.sheet, record, tr.functions, book.names).translate(
-                    parsed[_key(cell)].tree
-                )
+                FormulaTranslator(
+                    book, cell.sheet, record, tr.functions, book.names, _block(cell)
+                ).translate(parsed[_key(cell)].tree)
             except FormulaProblem:
                 pass
     _name_cells(tr, cells, read, reserved)
@@ -95,6 +95,16 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
     _translate_functions(tr, reserved)
     _translate_cells(tr, cells, parsed)
     return tr
+
+
+def _block(cell: Cell) -> tuple[int, int] | None:
+    """(rows, columns) of the cells of the multi-cell array formula ``cell`` is in."""
+    if cell.array is None:
+        return None
+    from openpyxl.utils.cell import range_boundaries
+
+    c1, r1, c2, r2 = range_boundaries(cell.array)
+    return (r2 - r1 + 1, c2 - c1 + 1)
 
 
 def _key(cell: Cell) -> tuple[str, int, int]:
@@ -532,13 +542,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 def names(sheet, row, col, moving=moving):
                     return moving.get((sheet, row, col)) or name_of(sheet, row, col)
 
-            block = None
-            if cell.array is not None:
-                from openpyxl.utils.cell import range_boundaries
-
-                c1, r1, c2, r2 = range_boundaries(cell.array)
-                block = (r2 - r1 + 1, c2 - c1 + 1)
-            ft = FormulaTranslator(book, cell.sheet, names, tr.functions, book.names, block)
+            ft = FormulaTranslator(book, cell.sheet, names, tr.functions, book.names, _block(cell))
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:
                 d.note_link = True  # type: ignore[attr-defined]

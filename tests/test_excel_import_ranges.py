@@ -1,0 +1,133 @@
+"""`workbook import`: ranges that hold texts beside numbers given to VBA, SUMIF by a text
+criterion, MMULT in an array formula, and cells that read one cell of an array formula
+(workbooks the tests build, with the values Excel would cache, computed here by hand)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+xlsxwriter = pytest.importorskip("xlsxwriter")
+
+from workbook.cli import main  # noqa: E402
+
+MODULE = """Attribute VB_Name = "Loads"
+Option Explicit
+
+Function DeadLoad(loads As Range) As Double
+    Dim i As Long, t As Double
+    For i = 1 To loads.Rows.Count
+        If loads(i, 2) = "D" Then t = t + loads(i, 1)
+    Next i
+    DeadLoad = t
+End Function
+
+Function Factored(loads As Range, combo As Range) As Double
+    Dim i As Long, f As Double, t As Double
+    For i = 1 To loads.Rows.Count
+        Select Case loads(i, 2)
+            Case Is = "D"
+                f = combo(1, 1)
+            Case Is = "L"
+                f = combo(1, 2)
+            Case Else
+                f = 0
+        End Select
+        t = t + f * loads(i, 1)
+    Next i
+    Factored = t
+End Function
+
+Function Doubled(loads As Range) As Double
+    Doubled = loads(1, 2) * 2
+End Function
+"""
+
+LOADS = [(1.5, "D"), (2.0, "L"), (4.0, "d"), (3.0, "=B2")]  # B5 reads B2's text
+
+
+def build(folder):
+    path = folder / "loads.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("Loads")
+    ws.write_row(0, 0, ["Load", "Kind", "", "Kind sought"])
+    for i, (value, kind) in enumerate(LOADS, start=1):
+        ws.write_number(i, 0, value)
+        if kind.startswith("="):
+            ws.write_formula(i, 1, kind, None, "D")
+        else:
+            ws.write_string(i, 1, kind)
+    ws.write_string(1, 3, "D")  # D2: the criterion
+    ws.write_row(0, 6, ["dead", "live"])
+    ws.write_row(1, 6, [1.2, 1.6])  # G2:H2, the factors of one combination
+    # VBA compares texts with their case (Option Compare Binary): "d" is not "D"
+    ws.write_formula("E2", "=DeadLoad(A2:B5)", None, 1.5 + 3.0)
+    ws.write_formula("E3", "=Factored(A2:B5,G2:H2)", None, 1.2 * (1.5 + 3.0) + 1.6 * 2.0)
+    ws.write_formula("E4", "=Doubled(A2:B5)", None, "#VALUE!")
+    # SUMIF compares texts without case: "d" is "D"
+    ws.write_formula("E5", "=SUMIF(B2:B5,D2,A2:A5)", None, 1.5 + 4.0 + 3.0)
+    # MMULT of [[1, 2], [3, 4]] by [5, 6] shown in E8:E9, and cells that read its cells
+    for r, row in enumerate([[1, 2, 5], [3, 4, 6]], start=7):
+        ws.write_row(r, 0, row)
+    ws.write_array_formula("E8:E9", "{=MMULT(A8:B9,C8:C9)}", None, 17)
+    ws.write_number("E9", 39)  # the cached value of the array formula's second cell
+    ws.write_formula("F8", "=E9*2", None, 78)
+    ws.write_formula("F9", "=MAX(E8,0)", None, 17)  # one cell, not the whole product
+    wb.close()
+    bas = folder / "Loads.bas"
+    bas.write_text(MODULE, encoding="utf-8")
+    return path, bas
+
+
+@pytest.fixture(scope="module")
+def imported(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("ranges")
+    path, bas = build(folder)
+    out = folder / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    return out / "loads.toml"
+
+
+def test_every_cached_number_is_reproduced(imported, capsys):
+    capsys.readouterr()
+    assert main(["check", str(imported), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    # E2, E3, E5, F8, F9, the two cells of the MMULT and B5's text; E4 shows #VALUE! (not
+    # compared)
+    assert {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")} == {
+        "printed": 8,
+        "reproduced": 8,
+        "failed": 0,
+        "not_computable": 0,
+    }
+
+
+def test_arithmetic_on_a_text_of_a_range_is_an_error(imported):
+    import workbook
+
+    sheet = workbook.load(str(imported))
+    doubled = next(n for n, d in sheet.spec.definitions.items() if "Doubled(" in d.text)
+    with pytest.raises(workbook.WorkbookError, match="arithmetic on the text 'D'"):
+        sheet.evaluate(doubled)
+
+
+def test_a_cell_of_an_array_formula_is_read_as_its_element(imported):
+    text = imported.read_text(encoding="utf-8")
+    assert "_at(1)*2" in text and "max(" in text and "_at(0), 0)" in text
+
+
+def test_sumif_whose_criterion_is_a_pattern_is_listed(tmp_path):
+    path = tmp_path / "pattern.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("Loads")
+    for i, (value, kind) in enumerate([(1.0, "DL"), (2.0, "LL")]):
+        ws.write_number(i, 0, value)
+        ws.write_string(i, 1, kind)
+    ws.write_string("D1", "D*")
+    ws.write_formula("E1", "=SUMIF(B1:B2,D1,A1:A2)", None, 1.0)
+    wb.close()
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--out", str(out)]) == 0
+    head = (out / "pattern.toml").read_text(encoding="utf-8").split("[sheet]")[0]
+    assert "SUMIF whose criterion 'D*' is a pattern or an operator" in head
