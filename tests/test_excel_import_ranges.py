@@ -74,6 +74,13 @@ def build(folder):
     ws.write_number("E9", 39)  # the cached value of the array formula's second cell
     ws.write_formula("F8", "=E9*2", None, 78)
     ws.write_formula("F9", "=MAX(E8,0)", None, 17)  # one cell, not the whole product
+    ws.write_array_formula("G8:H9", "{=MINVERSE(A8:B9)}", None, -2)
+    for cell, value in (("H8", 1), ("G9", 1.5), ("H9", -0.5)):
+        ws.write_number(cell, value)
+    ws.write_formula("E6", '=COUNTIF(A2:A5,"<3")', None, 2)  # 1.5 and 2
+    ws.write_string("C11", "Shift")
+    ws.write_number("D11", 2)
+    ws.write_formula("E11", "=OFFSET(A2,D11,0)", None, 4.0)  # A4, where D11 is 2
     wb.close()
     bas = folder / "Loads.bas"
     bas.write_text(MODULE, encoding="utf-8")
@@ -93,11 +100,11 @@ def test_every_cached_number_is_reproduced(imported, capsys):
     capsys.readouterr()
     assert main(["check", str(imported), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
-    # E2, E3, E5, F8, F9, the two cells of the MMULT and B5's text; E4 shows #VALUE! (not
-    # compared)
+    # E2, E3, E5, E6, E11, F8, F9, the two cells of the MMULT, the four of the MINVERSE and
+    # B5's text; E4 shows #VALUE! (not compared)
     assert {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")} == {
-        "printed": 8,
-        "reproduced": 8,
+        "printed": 14,
+        "reproduced": 14,
         "failed": 0,
         "not_computable": 0,
     }
@@ -131,3 +138,19 @@ def test_sumif_whose_criterion_is_a_pattern_is_listed(tmp_path):
     assert main(["import", str(path), "--out", str(out)]) == 0
     head = (out / "pattern.toml").read_text(encoding="utf-8").split("[sheet]")[0]
     assert "SUMIF whose criterion 'D*' is a pattern or an operator" in head
+
+
+def test_offset_is_the_cell_it_reached_and_an_error_elsewhere(imported):
+    import workbook
+
+    sheet = workbook.load(str(imported))
+    name = next(n for n, d in sheet.spec.definitions.items() if "OFFSET" in d.note)
+    assert sheet.evaluate(name).magnitude == 4.0
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        sheet.with_inputs(Shift=1).evaluate(name)  # Excel would show A3: never A4's number
+
+
+def test_a_range_several_formulas_read_is_one_definition(imported):
+    text = imported.read_text(encoding="utf-8")
+    assert text.count("[definitions.range_Loads_A2_B5]") == 1
+    assert text.count("range_Loads_A2_B5") == 4  # its definition and the three calls

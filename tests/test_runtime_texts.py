@@ -123,3 +123,16 @@ out = "kind(loads)"
     shown = {c.value for ws in wb for row in ws.iter_rows() for c in row}
     assert '[[1.5, "D"], [2, "L"], [4, "D"]]' in shown
     assert "D" in shown
+
+
+def test_a_division_by_zero_of_an_element_is_not_a_finite_number(tmp_path):
+    s = sheet(
+        tmp_path,
+        '''"first(m)" = { program = """
+m[0, 0]
+""" }
+out = "first(loads)/0"
+''',
+    )
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        s.evaluate("out")

@@ -322,12 +322,47 @@ class Evaluator(Visitor):
         return lambda env: float(red(get(t.table, t.column)))
 
     def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
+        if ty.is_runtime(t.shape):
+            return self._runtime_piecewise(t)
         conds = [None if k is None else self.compile(k) for k in t.conditions]
         matrices, used = _matrix_names(t), frozenset(ty.parameters(t))
         split = _partition(conds, t.texts, matrices, used)
         keys = tuple(None if k is None else self.plan.keys.key(k) for k in t.conditions)
         split = self._kept(self.plan.keys.signature("pieces", keys), split)
         return _piecewise(t, conds, [self.compile(v) for v in t.values], split, matrices, used)
+
+    def _runtime_piecewise(self, t: tc.TPiecewise) -> Fn:
+        """``a if c otherwise b`` whose values are known when they run (elements of run-time
+        arrays): one point at a time, and each value given must be a number."""
+        conds = [None if k is None else self.compile(k) for k in t.conditions]
+        values = [self.compile(v) for v in t.values]
+        what, texts = _text(t), t.texts
+        matrices, used = _matrix_names(t), frozenset(ty.parameters(t))
+
+        def one(env):
+            for cond, val in zip(conds, values):
+                if cond is None or bool(cond(env)):
+                    return rt.number(val(env), what)
+            raise _NoPiece(env, texts)
+
+        def evaluate(env):
+            if any(np.ndim(env.get(k)) > 2 for k in matrices):
+                raise InputError(f"{what}: a matrix over a range where a number is wanted")
+            arrays = {
+                k: env[k]
+                for k in used
+                if k not in matrices and isinstance(env.get(k), np.ndarray) and env[k].ndim > 0
+            }
+            if not arrays:
+                return one(env)
+            grid = np.broadcast_shapes(*[a.shape for a in arrays.values()])
+            full = {k: np.broadcast_to(a, grid) for k, a in arrays.items()}
+            out = np.empty(grid)
+            for ix in np.ndindex(grid):
+                out[ix] = one({**env, **{k: float(a[ix]) for k, a in full.items()}})
+            return out
+
+        return evaluate
 
     def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
         from .matrix import build

@@ -272,9 +272,11 @@ def binary(op: str, a, b, what: str):
             raise InputError(f"{what}: arithmetic on {_text_shown(v)}")
     sa, sb = shape_of(a), shape_of(b)
     if sa is None and sb is None:
-        if op == "^":
-            return float(np.power(a, b))
-        return float(_ARITH[op](a, b))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            # x/0 is inf or nan, as in the rest of the engine (then refused as not finite)
+            if op == "^":
+                return float(np.power(a, b))
+            return float(_ARITH[op](np.float64(a), np.float64(b)))
     for v in (a, b):
         if is_array(v) and v.dtype == object:
             raise InputError(f"{what}: arithmetic on a nested array; use its elements")

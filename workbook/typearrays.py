@@ -143,7 +143,10 @@ class ArrayTyping:
             raise TemplateError(f"the condition of {ex.to_text(node)!r} is not a comparison")
         if value.boolean or other.boolean:
             raise TemplateError(f"{ex.to_text(node)!r} gives a comparison, not a value")
-        if value.shape is not None or other.shape is not None:
+        runtime = is_runtime(value.shape) or is_runtime(other.shape)
+        if not runtime and (value.shape is not None or other.shape is not None):
+            raise TemplateError(f"{ex.to_text(node)!r}: the values of a condition are numbers")
+        if runtime and any(v.shape is not None and not is_runtime(v.shape) for v in (value, other)):
             raise TemplateError(f"{ex.to_text(node)!r}: the values of a condition are numbers")
         if value.text != other.text:
             raise TemplateError(
@@ -164,6 +167,8 @@ class ArrayTyping:
             values=(value, other),
             texts=texts + (ex.to_text(node.other) + " otherwise",),
             text=value.text,
+            # a value known when it runs (an element of a run-time array): a number, checked
+            shape=RUNTIME if runtime else None,
         )
 
     # -- operators -------------------------------------------------------------------------

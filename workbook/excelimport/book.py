@@ -46,6 +46,7 @@ class Translation:
     cell_names: dict[tuple[str, int, int], str] = field(default_factory=dict)
     runs: dict[tuple[str, int, int], Run] = field(default_factory=dict)  # cell -> its run
     vectors: dict[str, str] = field(default_factory=dict)  # name -> vector literal
+    ranges: dict[str, str] = field(default_factory=dict)  # matrix literal of a range -> name
 
 
 def language_reserved() -> set[str]:
@@ -542,7 +543,9 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 def names(sheet, row, col, moving=moving):
                     return moving.get((sheet, row, col)) or name_of(sheet, row, col)
 
-            ft = FormulaTranslator(book, cell.sheet, names, tr.functions, book.names, _block(cell))
+            ft = FormulaTranslator(
+                book, cell.sheet, names, tr.functions, book.names, _block(cell), tr.ranges
+            )
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:
                 d.note_link = True  # type: ignore[attr-defined]

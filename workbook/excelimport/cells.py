@@ -99,9 +99,13 @@ class FormulaText:
 class FormulaTranslator:
     """Walks a formula tree; ``name_of(sheet, row, col)`` gives a cell's name."""
 
-    def __init__(self, book, sheet: str, name_of, functions: dict, names: dict, block=None) -> None:
+    def __init__(
+        self, book, sheet: str, name_of, functions: dict, names: dict, block=None, ranges=None
+    ) -> None:
         self.book = book
         self.block = block  # (rows, columns) of the cells of a multi-cell array formula
+        # {matrix literal: name}: a range that formulas read is one definition, named here
+        self.ranges = ranges
         self.sheet = sheet
         self.name_of = name_of
         self.functions = functions
@@ -109,15 +113,25 @@ class FormulaTranslator:
         self.out = FormulaText("")
 
     def translate(self, tree) -> FormulaText:
-        if tree[0] == "fn" and tree[1].upper() == "MMULT":
-            self.out.text = self.matrix_product(tree[2])
-        else:
-            self.out.text = self.value(tree)
+        self.out.text = self.value(tree)
         return self.out
 
+    def matrix_inverse(self, args) -> str:
+        """``MINVERSE(A)`` of a square range of at least 2x2, in an array formula of A's
+        shape."""
+        if len(args) != 1 or args[0][0] != "leaf" or args[0][1] != "Range":
+            raise FormulaProblem("MINVERSE of other than a range")
+        ref = self.ref_of(args[0][2])
+        n = ref.r2 - ref.r1 + 1
+        if n != ref.c2 - ref.c1 + 1 or n < 2:
+            raise FormulaProblem("MINVERSE of other than a square range of 2x2 or more")
+        if self.block != (n, n):
+            raise FormulaProblem(f"MINVERSE whose {n}x{n} inverse is not shown in as many cells")
+        return f"inverse({self.reference(args[0][2])})"
+
     def matrix_product(self, args) -> str:
-        """``MMULT(A, B)`` of two ranges, as the whole formula of an array formula whose
-        cells are the product's shape (each cell then shows its element, never another's)."""
+        """``MMULT(A, B)`` of two ranges, in an array formula whose cells are the product's
+        shape (each cell then shows its element, never another's)."""
         refs = [self.ref_of(a[2]) if a[0] == "leaf" and a[1] == "Range" else None for a in args]
         if len(args) != 2 or None in refs:
             raise FormulaProblem("MMULT of other than two ranges")
@@ -192,7 +206,24 @@ class FormulaTranslator:
             [self.name_of(ref.sheet, r, c) for c in range(ref.c1, ref.c2 + 1)]
             for r in range(ref.r1, ref.r2 + 1)
         ]
-        return "[" + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]"
+        return self.shared("[" + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]", ref)
+
+    def shared(self, literal: str, ref: Ref) -> str:
+        """The name of the definition of a range's matrix (one for every formula that reads
+        the same cells), or the literal itself when no names are kept."""
+        if self.ranges is None:
+            return literal
+        name = self.ranges.get(literal)
+        if name is None:
+            from openpyxl.utils import get_column_letter
+
+            sheet = re.sub(r"\W+", "", ref.sheet)[:12]
+            corner = f"{get_column_letter(ref.c1)}{ref.r1}_{get_column_letter(ref.c2)}{ref.r2}"
+            name = f"range_{sheet}_{corner}"
+            while name in self.ranges.values():
+                name += "_2"
+            self.ranges[literal] = name
+        return name
 
     def cells_of(self, node) -> list[str] | None:
         """The names of a range argument, in reading order (None if not a range)."""
@@ -248,6 +279,8 @@ class FormulaTranslator:
         short = name.split(".")[-1]
         if short.lower() in self.functions:
             return self.udf(short.lower(), args)
+        if upper == "OFFSET":
+            return self.offset(args)
         if upper in VOLATILE:
             raise FormulaProblem(
                 f"the volatile function {upper} (its value changes at every recalculation)"
@@ -276,11 +309,168 @@ class FormulaTranslator:
                 raise FormulaProblem(f"{upper} with {len(args)} arguments")
             out = text.format(*[self.value(a, 0) for a in args])
             return out if re.fullmatch(r"\w+\([^()]*\)", text) else f"({out})"
+        if upper == "MMULT":
+            return f"({self.matrix_product(args)})"
+        if upper == "MINVERSE":
+            return self.matrix_inverse(args)
         if upper == "SUMIF":
             return self.sum_if(args)
+        if upper == "COUNTIF":
+            return self.count_if(args)
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
+
+    def offset(self, args) -> str:
+        """``OFFSET(cell, rows, columns)``: the cell it reached when Excel computed it (from
+        Excel's cached values of the cells its offsets read), guarded: where the offsets
+        compute to other values the value is an error, never another cell's number. An
+        offset may be ``MATCH(x, range, 0)`` over a range of texts: its guard is x's value."""
+        if len(args) not in (3, 5) or args[0][0] != "leaf" or args[0][1] != "Range":
+            raise FormulaProblem("OFFSET of other than one cell by rows and columns")
+        if len(args) == 5 and any(self.static(a) != 1 for a in args[3:]):
+            raise FormulaProblem("OFFSET to a range of more than one cell")
+        ref = self.ref_of(args[0][2])
+        if not ref.single:
+            raise FormulaProblem("OFFSET of a range")
+        guards, moves = [], []
+        for a in args[1:3]:
+            value = self.static(a)
+            if value != int(value):
+                raise FormulaProblem("OFFSET by a fraction of a cell")
+            moves.append(int(value))
+            if not (a[0] == "leaf" and a[1] == "Number"):
+                guards.append(self.guard(a, value))
+        row, col = ref.r1 + moves[0], ref.c1 + moves[1]
+        if row < 1 or col < 1:
+            raise FormulaProblem("OFFSET outside the sheet (#REF! in Excel)")
+        target = self.book.cell(ref.sheet, row, col)
+        if guards and target is not None and isinstance(target.value, str):
+            raise FormulaProblem("OFFSET to a text, guarded")
+        self.out.refs.append(Ref(ref.sheet, row, col, row, col))
+        name = self.name_of(ref.sheet, row, col)
+        if not guards:
+            return name
+        return f"({name} if {' and '.join(guards)} otherwise 1/0)"
+
+    def guard(self, node, value: float) -> str:
+        """A condition that holds where ``node`` computes to ``value`` (Excel's)."""
+        if node[0] == "fn" and node[1].upper() == "MATCH":
+            lookup = node[2][0]
+            seen = self.static_any(lookup)
+            shown = f'"{seen}"' if isinstance(seen, str) else repr(float(seen))
+            return f"{self.value(lookup, 3)} == {shown}"
+        return f"{self.value(node, 3)} == {float(value)!r}"
+
+    def static_any(self, node):
+        """The value of a plain reference or literal from Excel's cached values (a text or a
+        number)."""
+        kind, name, payload = node
+        if kind == "leaf" and name == "String":
+            return payload.name
+        if kind == "leaf" and name == "Range":
+            ref = self.ref_of(payload)
+            if not ref.single:
+                raise FormulaProblem("a range where one cell is wanted")
+            cell = self.book.cell(ref.sheet, ref.r1, ref.c1)
+            value = None if cell is None else cell.value
+            if value is None or isinstance(value, bool):
+                return float(bool(value))
+            if isinstance(value, str):
+                if value.startswith("#"):
+                    raise FormulaProblem(f"reads {ref.sheet}!{cell.address}, an error value")
+                return value
+            return float(value)
+        return self.static(node)
+
+    def static(self, node) -> float:
+        """The number ``node`` computes to from Excel's cached values (an OFFSET's offsets):
+        numbers, cells, + - * / ^ and MATCH(x, range of texts, 0)."""
+        kind, name, payload = node
+        if kind == "leaf" and name == "Number":
+            word = payload.name.upper()
+            return 1.0 if word == "TRUE" else 0.0 if word == "FALSE" else float(payload.name)
+        if kind == "leaf" and name == "Range":
+            value = self.static_any(node)
+            if isinstance(value, str):
+                raise FormulaProblem("an offset that reads a text")
+            return value
+        if kind == "op" and name in ("+", "-", "*", "/", "^") and len(payload) == 2:
+            a, b = self.static(payload[0]), self.static(payload[1])
+            if name == "/" and b == 0:
+                raise FormulaProblem("an offset divided by zero")
+            return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else 0.0, "^": a**b}[name]
+        if kind == "op" and name in ("u-", "u+"):
+            v = self.static(payload[0])
+            return -v if name == "u-" else v
+        if kind == "fn" and name.upper() == "MATCH":
+            return self.match(payload)
+        raise FormulaProblem("an offset this translation does not compute")
+
+    def match(self, args) -> float:
+        """``MATCH(x, range, 0)``: the position of x in a row or column of constant texts
+        (texts equal but for case, as Excel); the texts are definitions that never change."""
+        if len(args) != 3 or self.static(args[2]) != 0:
+            raise FormulaProblem("MATCH other than an exact one")
+        rng = args[1]
+        if rng[0] != "leaf" or rng[1] != "Range":
+            raise FormulaProblem("MATCH in other than a range")
+        ref = self.ref_of(rng[2])
+        if ref.r1 != ref.r2 and ref.c1 != ref.c2:
+            raise FormulaProblem("MATCH in a block of rows and columns")
+        seen = self.static_any(args[0])
+        if not isinstance(seen, str) or re.search(r"[*?~]", seen):
+            raise FormulaProblem("MATCH of other than a text without a pattern")
+        k = 0
+        for r in range(ref.r1, ref.r2 + 1):
+            for c in range(ref.c1, ref.c2 + 1):
+                k += 1
+                cell = self.book.cell(ref.sheet, r, c)
+                if cell is None or cell.value is None:
+                    continue
+                if cell.formula is not None or not isinstance(cell.value, str):
+                    raise FormulaProblem("MATCH in a range that holds other than constant texts")
+                if cell.value.casefold() == seen.casefold():
+                    return float(k)
+        raise FormulaProblem("MATCH that finds nothing (#N/A in Excel)")
+
+    def count_if(self, args) -> str:
+        """``COUNTIF(range, "<>0")``: a comparison with a number, over cells that hold numbers
+        (constants or formulas); an empty or text cell, which Excel matches by rules of its
+        own, is refused."""
+        if len(args) != 2 or args[0][0] != "leaf" or args[0][1] != "Range":
+            raise FormulaProblem("COUNTIF of other than a range and a criterion")
+        op, number = self.numeric_criterion(args[1])
+        ref = self.ref_of(args[0][2])
+        items = []
+        for r in range(ref.r1, ref.r2 + 1):
+            for c in range(ref.c1, ref.c2 + 1):
+                cell = self.book.cell(ref.sheet, r, c)
+                if cell is None or cell.value is None or cell.value == "":
+                    raise FormulaProblem("COUNTIF over an empty cell")
+                if cell.formula is None and not isinstance(cell.value, (int, float)):
+                    raise FormulaProblem("COUNTIF over a cell that holds a text")
+                self.out.refs.append(Ref(ref.sheet, r, c, r, c))
+                items.append(f"(1 if {self.name_of(ref.sheet, r, c)} {op} {number!r} otherwise 0)")
+        return "(" + " + ".join(items) + ")"
+
+    def numeric_criterion(self, node) -> tuple[str, float]:
+        """(operator, number) of a criterion that compares with a number: "<>0", ">=2.5",
+        "=3" or 3, written in the formula."""
+        kind, name, payload = node
+        if kind == "leaf" and name == "Number" and payload.name.upper() not in ("TRUE", "FALSE"):
+            return "==", float(payload.name)
+        if kind != "leaf" or name != "String":
+            raise FormulaProblem("a criterion other than one written in the formula")
+        m = re.fullmatch(
+            r"(<>|<=|>=|=|<|>)?\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)", payload.name
+        )
+        if m is None:
+            raise FormulaProblem(
+                f"the criterion {payload.name!r} (a comparison with a number is translated)"
+            )
+        op = {"<>": "!=", "=": "==", None: "=="}.get(m.group(1), m.group(1))
+        return op, float(m.group(2))
 
     def sum_if(self, args) -> str:
         """``SUMIF(range, criterion, sum_range)`` whose criterion is a text cell (a load kind
@@ -383,7 +573,7 @@ class FormulaTranslator:
                         + "]"
                         for r in range(ref.r1, ref.r2 + 1)
                     ]
-                    texts.append("[" + ", ".join(rows) + "]")  # a range is a matrix
+                    texts.append(self.shared("[" + ", ".join(rows) + "]", ref))  # a matrix
                 else:
                     texts.append(self.value(a))
             else:

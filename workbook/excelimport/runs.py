@@ -42,11 +42,11 @@ def _leaves(tree) -> list:
     return [leaf for arg in payload for leaf in _leaves(arg)]
 
 
-def _calls(tree, name: str) -> bool:
+def _calls(tree, names: tuple[str, ...]) -> bool:
     kind, fname, payload = tree
     if kind == "leaf":
         return False
-    return (kind == "fn" and fname.upper() == name) or any(_calls(a, name) for a in payload)
+    return (kind == "fn" and fname.upper() in names) or any(_calls(a, names) for a in payload)
 
 
 def find_runs(book, cells, parsed, ref_of) -> list[Run]:
@@ -87,8 +87,8 @@ def find_runs(book, cells, parsed, ref_of) -> list[Run]:
 
 def _moving(run: Run, parsed, ref_of) -> bool:
     """Find the references that move with the row; False if the run cannot be one function."""
-    if _calls(parsed[(run.sheet, run.first, run.col)].tree, "SUMIF"):
-        return False  # its criterion is read when the formula is translated, row by row
+    if _calls(parsed[(run.sheet, run.first, run.col)].tree, ("SUMIF", "OFFSET", "MATCH")):
+        return False  # what they read is found when each cell's formula is translated
     a = _leaves(parsed[(run.sheet, run.first, run.col)].tree)
     b = _leaves(parsed[(run.sheet, run.first + 1, run.col)].tree)
     if len(a) != len(b):

@@ -157,6 +157,11 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             elements.append((Definition(d.name, d.cell, element=(d.name, 0)), cached))
         elif cached is not None:
             rows.append((d.name, "", cached, d.cell.ref))
+    exprs = " ".join(v["expr"] for v in definitions.values() if "expr" in v)
+    used = set(_WORD.findall(exprs))
+    for text, rname in tr.ranges.items():
+        if rname not in skip and rname in used:
+            definitions[rname] = {"expr": text, "note": "the cells of a range that formulas read"}
     # cells of an array formula: the function NAME_at(k) gives element k of NAME
     at_rows = []
     made = set()
@@ -165,12 +170,14 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         fn = f"{d.element[0]}_at"
         if fn not in made:
             made.add(fn)
-            n_rows, cols = masters[d.element[0]].block or (1, 1)
-            element = (
-                f"{d.element[0]}[k_at]"  # a row of cells shows a vector
-                if n_rows == 1
-                else f"{d.element[0]}[floor(k_at/{cols}), mod(k_at, {cols})]"
-            )
+            master = masters[d.element[0]]
+            n_rows, cols = master.block or (1, 1)
+            x = d.element[0]
+            element = f"{x}[floor(k_at/{cols}), mod(k_at, {cols})]"
+            if n_rows == 1 and not master.cell.formula.upper().startswith("MMULT("):
+                # a row of cells shows a VBA function's array: a vector (a 1-D array) or
+                # a matrix of one row (a 2-D array), known when it runs
+                element = f"({x}[k_at] if cols({x}) == 1 otherwise {x}[0, k_at])"
             definitions[f"{fn}(k_at)"] = {
                 "expr": element,
                 "note": f"the cells of the array formula {d.element[0]}, one by one",
@@ -340,6 +347,9 @@ def _drop_dependents(tr: Translation, name: str, skip: dict[str, str]) -> None:
         used = set(_WORD.findall(d.text or "")) | ({d.element[0]} if d.element else set())
         for u in used | {u[:-3] for u in used if u.endswith("_at")}:  # NAME_at(k) uses NAME
             users.setdefault(u, []).append(d.name)
+    for text, rname in tr.ranges.items():
+        for u in set(_WORD.findall(text)):
+            users.setdefault(u, []).append(rname)
     for info in tr.functions.values():
         if not info.problem:
             for u in set(_WORD.findall(info.program)):
