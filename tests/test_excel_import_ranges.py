@@ -39,6 +39,16 @@ Function Factored(loads As Range, combo As Range) As Double
     Factored = t
 End Function
 
+Function Dens(x As Double) As Double
+    Dim rho
+    If x < 0 Then
+        rho = CVErr(xlErrValue)
+    Else
+        rho = 2 * x
+    End If
+    Dens = rho + 1
+End Function
+
 Function Doubled(loads As Range) As Double
     Doubled = loads(1, 2) * 2
 End Function
@@ -81,6 +91,14 @@ def build(folder):
     ws.write_string("C11", "Shift")
     ws.write_number("D11", 2)
     ws.write_formula("E11", "=OFFSET(A2,D11,0)", None, 4.0)  # A4, where D11 is 2
+    for r, (key, value) in enumerate([(10, 1), (20, 2), (30, 3), (40, 4)], start=12):
+        ws.write_row(r, 0, [key, value])  # A13:B16
+    ws.write_string("C13", "Size")
+    ws.write_number("D13", 25)
+    ws.write_formula("E13", "=VLOOKUP(D13,A13:B16,2)", None, 2)  # the last key <= 25
+    ws.write_formula("E14", "=VLOOKUP(30,A13:B16,2,FALSE)", None, 3)
+    ws.write_formula("E17", "=Dens(D11)", None, 5)
+    ws.write_formula("E18", "=Dens(-1)", None, "#VALUE!")  # the error value in a local
     wb.close()
     bas = folder / "Loads.bas"
     bas.write_text(MODULE, encoding="utf-8")
@@ -98,13 +116,14 @@ def imported(tmp_path_factory):
 
 def test_every_cached_number_is_reproduced(imported, capsys):
     capsys.readouterr()
-    assert main(["check", str(imported), "--json"]) == 0
+    # exit 1: Dens(-1) has no value (a division by zero), as E18 holds #VALUE! in Excel
+    assert main(["check", str(imported), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # E2, E3, E5, E6, E11, F8, F9, the two cells of the MMULT, the four of the MINVERSE and
-    # B5's text; E4 shows #VALUE! (not compared)
+    # E2, E3, E5, E6, E11, E13, E14, E17, F8, F9, the two cells of the MMULT, the four of
+    # the MINVERSE and B5's text; E4 and E18 show #VALUE! (not compared)
     assert {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")} == {
-        "printed": 14,
-        "reproduced": 14,
+        "printed": 17,
+        "reproduced": 17,
         "failed": 0,
         "not_computable": 0,
     }
@@ -154,3 +173,28 @@ def test_a_range_several_formulas_read_is_one_definition(imported):
     text = imported.read_text(encoding="utf-8")
     assert text.count("[definitions.range_Loads_A2_B5]") == 1
     assert text.count("range_Loads_A2_B5") == 4  # its definition and the three calls
+
+
+def test_vlookup_is_guarded_by_its_keys_ascending(imported):
+    import workbook
+
+    sheet = workbook.load(str(imported))
+    name = next(n for n, d in sheet.spec.definitions.items() if "VLOOKUP(D13" in d.note)
+    assert sheet.evaluate(name).magnitude == 2
+    assert sheet.with_inputs(Size=40).evaluate(name).magnitude == 4
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        sheet.with_inputs(Size=5).evaluate(name)  # below the first key: #N/A in Excel
+    key = next(n for n, i in sheet.spec.inputs.items() if "A14" in i.note)
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        sheet.with_inputs(**{key: 35}).evaluate(name)  # keys not ascending: Excel's search
+
+
+def test_an_error_value_in_a_local_gives_no_value(imported):
+    import workbook
+
+    sheet = workbook.load(str(imported))
+    given = next(n for n, d in sheet.spec.definitions.items() if "=Dens(D11)" in d.note)
+    failing = next(n for n, d in sheet.spec.definitions.items() if "=Dens(-1)" in d.note)
+    assert sheet.evaluate(given).magnitude == 5
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        sheet.evaluate(failing)  # Excel shows #VALUE!: VBA stops at the error value's use

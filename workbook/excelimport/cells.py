@@ -18,6 +18,8 @@ _LINK = re.compile(
     r"(?:\[\d+\]|'[^']*\.xla[m]?'|[A-Za-z0-9_.\- ]+\.xla[m]?)!(?=[A-Za-z_][\w.]*\()", re.I
 )
 MAX_RANGE_CELLS = 100_000
+#: rows of a VLOOKUP table at most (a chain of as many conditions)
+MAX_LOOKUP_ROWS = 200
 #: a formula that is one cell's reference: =D63, =Sheet2!$B$4, ='Load table'!C7
 _PLAIN_REF = re.compile(r"(?:'?([^'!]+)'?!)?\$?([A-Za-z]{1,3})\$?(\d+)")
 
@@ -317,6 +319,8 @@ class FormulaTranslator:
             return self.sum_if(args)
         if upper == "COUNTIF":
             return self.count_if(args)
+        if upper == "VLOOKUP":
+            return self.vlookup(args)
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
@@ -433,6 +437,45 @@ class FormulaTranslator:
                 if cell.value.casefold() == seen.casefold():
                     return float(k)
         raise FormulaProblem("MATCH that finds nothing (#N/A in Excel)")
+
+    def vlookup(self, args) -> str:
+        """``VLOOKUP(x, table, k[, exact])`` over a first column of numbers: a chain of
+        conditions on x. The approximate match (the default) takes the last row whose first
+        cell is at most x, which is Excel's answer where that column ascends: the chain is
+        guarded by the column ascending, and x below the first row is an error (#N/A)."""
+        if len(args) not in (3, 4) or args[1][0] != "leaf" or args[1][1] != "Range":
+            raise FormulaProblem("VLOOKUP of other than a table range")
+        k = self.static(args[2]) if args[2][0] == "leaf" and args[2][1] == "Number" else None
+        exact = len(args) == 4 and self.static(args[3]) == 0
+        if k is None or k != int(k):
+            raise FormulaProblem("VLOOKUP of a column not written as a number")
+        ref = self.ref_of(args[1][2])
+        if ref.r2 - ref.r1 + 1 > MAX_LOOKUP_ROWS:
+            raise FormulaProblem(f"VLOOKUP in more than {MAX_LOOKUP_ROWS} rows")
+        col = ref.c1 + int(k) - 1
+        if not ref.c1 <= col <= ref.c2:
+            raise FormulaProblem("VLOOKUP of a column outside its table (#REF! in Excel)")
+        x = self.value(args[0], 3)
+        keys, values = [], []
+        for r in range(ref.r1, ref.r2 + 1):
+            cell = self.book.cell(ref.sheet, r, ref.c1)
+            if cell is None or cell.value is None or cell.formula is not None:
+                raise FormulaProblem("VLOOKUP whose first column holds other than constants")
+            if not isinstance(cell.value, (int, float)) or isinstance(cell.value, bool):
+                raise FormulaProblem("VLOOKUP whose first column holds texts")
+            self.out.refs.append(Ref(ref.sheet, r, ref.c1, r, ref.c1))
+            self.out.refs.append(Ref(ref.sheet, r, col, r, col))
+            keys.append(self.name_of(ref.sheet, r, ref.c1))
+            values.append(self.name_of(ref.sheet, r, col))
+        text = "1/0"
+        if exact:
+            for key, value in reversed(list(zip(keys, values))):
+                text = f"({value} if {x} == {key} otherwise {text})"
+            return text
+        for key, value in zip(keys, values):
+            text = f"({value} if {x} >= {key} otherwise {text})"
+        ascending = " and ".join(f"{a} <= {b}" for a, b in zip(keys, keys[1:])) or "1 == 1"
+        return f"({text} if {ascending} otherwise 1/0)"
 
     def count_if(self, args) -> str:
         """``COUNTIF(range, "<>0")``: a comparison with a number, over cells that hold numbers

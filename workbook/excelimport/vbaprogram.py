@@ -259,6 +259,13 @@ class Translator:
                 raise NotTranslated(f"assigns to the name of another function {target[1]}")
             if key in self.arrays and self.arrays[key].is_range:
                 raise NotTranslated(f"{target[1]} is a range given as an argument: writes cells")
+            callee = strip(rhs[1]) if rhs[0] == "call" else None
+            if callee is not None and callee[0] == "id" and callee[1].lower() == "cverr":
+                # an error value in a local: VBA stops at its next use (a type mismatch), so
+                # the function has no value from here (an error, where VBA might still give
+                # one if the local were never read again: never a number VBA would not give)
+                self.emit(indent, "return 1/0")
+                return i + 1
             value = self.value(rhs)
             if rhs[0] == "mem" and rhs[2].lower() in ("value", "value2"):
                 src = self._range_base(rhs[1])
