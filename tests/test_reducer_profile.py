@@ -432,3 +432,27 @@ def test_libreoffice_recalculates_the_live_profile(sheet, tmp_path):
         for h in ("x_t [mm]", "y_t [mm]", "a [deg]"):
             got = values[("Listing", f"{col[h]}{3 + i}")]
             assert got == pytest.approx(ref[h].iloc[i], rel=1e-9, abs=1e-12), (h, i)
+
+
+def test_tables_over_the_row_limit_are_refused_before_they_are_computed(sheet):
+    """n = 400 at its coarsest documented step writes; a finer step is refused by name."""
+    from workbook.errors import LimitError
+
+    reducer.validate(sheet.with_inputs(n=400, dphi="2 deg"))  # 72,400 rows: within the limit
+    with pytest.raises(LimitError, match=r"1,440,400 rows .*limit 75,000"):
+        reducer.validate(sheet.with_inputs(n=400, dphi="0.1 deg"))
+    f = sheet.with_inputs(n=400, dphi="0.1 deg").check().findings
+    assert any(x.topic == "inputs" and x.verdict == "fail" and "75,000" in x.what for x in f)
+
+
+def test_sign_changes_end_where_one_ulp_exceeds_the_tolerance(monkeypatch):
+    """Far out (phi ~ 35,640 deg, one ulp 7e-12 deg) the bisection stops at brentq's
+    tolerance of a few ulps instead of looping for ever; the root is the exact one."""
+    root = 35640.123456789
+
+    def linear(_sheet, name, k, phi):
+        return np.asarray(phi, dtype=float) - root
+
+    monkeypatch.setattr(reducer, "_f", linear)
+    (found,) = reducer._sign_changes(None, np.array([35640.0]), np.array([35640.25]))
+    assert found == pytest.approx(root, abs=1e-10)
