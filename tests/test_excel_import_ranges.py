@@ -198,3 +198,28 @@ def test_an_error_value_in_a_local_gives_no_value(imported):
     assert sheet.evaluate(given).magnitude == 5
     with pytest.raises(workbook.WorkbookError, match="not a finite number"):
         sheet.evaluate(failing)  # Excel shows #VALUE!: VBA stops at the error value's use
+
+
+def test_a_date_or_a_text_with_a_quote_is_listed_never_a_stand_in(tmp_path, capsys):
+    import datetime
+
+    path = tmp_path / "odd.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("Odd")
+    ws.write_datetime("A1", datetime.datetime(2024, 1, 31), wb.add_format({"num_format": "d"}))
+    ws.write_formula("B1", "=A1+1", None, 45323)
+    ws.write_string("A2", 'say "hi"')
+    ws.write_formula("B2", '=IF(A2="x",1,2)', None, 2)
+    ws.write_number("A3", 3)
+    ws.write_formula("B3", "=A3*2", None, 6)
+    wb.close()
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--out", str(out)]) == 0
+    text = (out / "odd.toml").read_text(encoding="utf-8")
+    head = text.split("[sheet]")[0]
+    assert "a datetime, not a number" in head and "a text with a quote" in head
+    assert 'value = "0"' not in text and 'expr = "\\"\\""' not in text  # no stand-ins
+    capsys.readouterr()
+    main(["check", str(out / "odd.toml"), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (1, 1, 0)  # B3 only

@@ -619,14 +619,15 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                     repr(float(cell.value)) if isinstance(cell.value, float) else str(cell.value),
                     note,
                 )
-            elif isinstance(cell.value, str):
+            elif isinstance(cell.value, str) and not ('"' in cell.value or "\\" in cell.value):
                 tr.texts[name] = (cell, cell.value)
-            else:
-                tr.inputs[name] = (
-                    cell,
-                    "0",
-                    f"{where} (a {type(cell.value).__name__}: not a number)",
+            else:  # never a stand-in value: the formulas that read it are left out
+                what = (
+                    "a text with a quote or a backslash"
+                    if isinstance(cell.value, str)
+                    else (f"a {type(cell.value).__name__}, not a number")
                 )
+                tr.listed.append((f"{cell.ref} ({name})", f"{what}: not translated"))
 
 
 def _addr(row: int, col: int) -> str:

@@ -91,7 +91,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
     for n, (cell, text) in tr.texts.items():
         if n not in skip:
             definitions[n] = {
-                "expr": f'"{text}"' if '"' not in text and "\\" not in text else '""',
+                "expr": f'"{text}"',
                 "note": f"{cell.ref} (text)",
             }
     for info in tr.functions.values():
