@@ -6,7 +6,9 @@ one of its derivatives is unbounded there). Such a zero just outside an interval
 inside a piece, past a break point) is what tanh-sinh's error estimate misses: it stops at
 its first levels with an estimate far below its error (1/sqrt(t + 1e-3) over [0, 0.79]:
 4.5e-11 for 6e-8). Sheet functions called with the variable in an argument are read with
-their parameters replaced by the arguments of the call.
+their parameters replaced by the arguments of the call; an inner integral whose bound
+depends on the variable contributes its integrand's singular sub-trees at that bound (the
+derivative of the integral in its bound is the integrand there).
 """
 
 from __future__ import annotations
@@ -29,6 +31,14 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
         t, depth = stack.pop()
         if isinstance(t, ty.TFunc):
             entry = REGISTRY.get(t.func)
+            if t.func == "integral" and len(t.args) == 4:
+                # d/db of integral(g, t, a, b) is g at t = b: g's singular points, at the
+                # bounds, are the inner integral's in the variable
+                inner, bound_var = t.args[0], t.args[1].name
+                for u in singular_arguments(typer, inner, bound_var):
+                    for end in t.args[2:]:
+                        _keep(_substitute(u, {bound_var: end}), var, found)
+                continue
             if entry is not None and entry.binds:
                 continue  # another built-in's own variable: its own business
             if t.func in ("sqrt", "ln", "log10") and len(t.args) == 1:
