@@ -233,3 +233,7 @@ def test_frame_library_programs_reproduce_every_stored_value(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (48, 48), result["failures"]
     text = toml.read_text(encoding="utf-8")
     assert '"result_875_2_1(index)" = { expr = "TT_7[index][2][1]"' in text
+    # found in the one typing pass: a trace the engine cannot draw (a vector where a number
+    # is wanted) and a function it refuses, each listed with the engine's reason
+    assert "#   region 39: a plot: trace 1: the engine cannot draw it: column" in text
+    assert "#   region 432: A_(...) := ...: the engine refuses it: " in text
