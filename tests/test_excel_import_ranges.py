@@ -49,6 +49,16 @@ Function Dens(x As Double) As Double
     Dens = rho + 1
 End Function
 
+Function Halve(x As Double) As Double
+    Dim lo, hi, mid
+    hi = x
+    Do While Abs(hi - lo) > 0.5
+        mid = (lo + hi) / 2
+        hi = mid
+    Loop
+    Halve = hi
+End Function
+
 Function Doubled(loads As Range) As Double
     Doubled = loads(1, 2) * 2
 End Function
@@ -99,6 +109,7 @@ def build(folder):
     ws.write_formula("E14", "=VLOOKUP(30,A13:B16,2,FALSE)", None, 3)
     ws.write_formula("E17", "=Dens(D11)", None, 5)
     ws.write_formula("E18", "=Dens(-1)", None, "#VALUE!")  # the error value in a local
+    ws.write_formula("E19", "=Halve(8)", None, 0.5)  # lo is read while Empty: 0
     wb.close()
     bas = folder / "Loads.bas"
     bas.write_text(MODULE, encoding="utf-8")
@@ -119,11 +130,11 @@ def test_every_cached_number_is_reproduced(imported, capsys):
     # exit 1: Dens(-1) has no value (a division by zero), as E18 holds #VALUE! in Excel
     assert main(["check", str(imported), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # E2, E3, E5, E6, E11, E13, E14, E17, F8, F9, the two cells of the MMULT, the four of
-    # the MINVERSE and B5's text; E4 and E18 show #VALUE! (not compared)
+    # E2, E3, E5, E6, E11, E13, E14, E17, E19, F8, F9, the two cells of the MMULT, the four
+    # of the MINVERSE and B5's text; E4 and E18 show #VALUE! (not compared)
     assert {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")} == {
-        "printed": 17,
-        "reproduced": 17,
+        "printed": 18,
+        "reproduced": 18,
         "failed": 0,
         "not_computable": 0,
     }

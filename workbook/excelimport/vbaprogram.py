@@ -421,13 +421,27 @@ class Translator:
                 self.emit(indent, f"{final} := {self.value(parse(value))}")
                 continue
             if bounds is None:
-                if self.types[key] in NUMBER_TYPES | {"boolean"}:
+                if self.types[key] in NUMBER_TYPES | {"boolean"} or (
+                    self.types[key] == "variant" and self._read_first(name)
+                ):
                     self.declared_numbers.append(key)
                 continue
             if not bounds.strip():  # Dim a(): dynamic, given by ReDim
                 self.arrays[key] = _Array(self.option_base, 0)
                 continue
             self.dimension(name, bounds, indent, zero_fill=True)
+
+    def _read_first(self, name: str) -> bool:
+        """The first line after the declarations that names the Variant ``name`` reads it
+        (``Do While Abs(P - ps) > 1e-5`` before ``ps = ...``): it is then Empty, which VBA
+        reads as 0. A Variant given a value first keeps what it is given (maybe an array)."""
+        word = re.compile(rf"\b{re.escape(name)}\b", re.I)
+        for _, line in self.proc.lines:
+            text = line.strip()
+            if re.match(r"(?:dim|static|const|redim)\b", text, re.I) or not word.search(text):
+                continue
+            return re.match(rf"{re.escape(name)}\s*=(?!=)", text, re.I) is None
+        return False
 
     def dimension(self, name: str, bounds: str, indent: int, zero_fill: bool) -> None:
         key = name.lower()
