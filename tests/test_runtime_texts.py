@@ -136,3 +136,31 @@ out = "first(loads)/0"
     )
     with pytest.raises(workbook.WorkbookError, match="not a finite number"):
         s.evaluate("out")
+
+
+def test_a_condition_over_a_range_gives_elements_of_run_time_arrays(tmp_path):
+    path = tmp_path / "table.toml"
+    path.write_text(
+        """
+[arguments]
+m = { plain = true }
+i = { plain = true }
+
+[definitions]
+loads = '[[1.5, "D"], [2, "L"], [4, "D"]]'
+"el(m, i)" = { program = \"\"\"
+m[i, 0]
+\"\"\" }
+"g(i)" = "el(loads, i) if i > 0 otherwise 0"
+"h(i)" = 'el(loads, i) if loads[i, 1] == "D" otherwise 0'
+
+[[tables]]
+name = "t"
+range = "i := 0 .. 2"
+columns = [{ expr = "g(i)" }, { expr = "h(i)" }]
+""",
+        encoding="utf-8",
+    )
+    table = workbook.load(str(path)).table("t")
+    assert list(table["g(i)"]) == [0.0, 2.0, 4.0]
+    assert list(table["h(i)"]) == [1.5, 0.0, 4.0]
