@@ -368,6 +368,7 @@ def polish_roots(of, result, shape, tol) -> int:
     used = ty.parameters(of.body) - {of.var}
     fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
     done = 0
+    f = of.over(shape)
     for i in rows:
         env = {**fixed, **{k: float(a[i]) for k, a in arrays.items()}}
 
@@ -375,6 +376,9 @@ def polish_roots(of, result, shape, tol) -> int:
             return form({**env, of.var: x})
 
         try:
+            probe = value[i] + np.array([-1.0, 1.0]) * max(0.1 * abs(value[i]), 1e-3)
+            if not _same_function(ctx, g, f, probe, i):
+                continue
             x = _checked_root(ctx, g, value[i], error[i], bool(noisy[i]))
         except (NoValue, Unconverged, ZeroDivisionError):
             continue
@@ -386,6 +390,23 @@ def polish_roots(of, result, shape, tol) -> int:
     result.value = value.reshape(np.shape(result.value))
     result.error = error.reshape(np.shape(result.error))
     return done
+
+
+def _same_function(ctx, g, f, xs: np.ndarray, row: int) -> bool:
+    """Whether EXPR's mpmath form computes what numpy computes at ``xs`` of ``row`` (to 1e-6
+    of their size; away from a root, where rounding is not all there is): not where the
+    numpy side reads values the mpmath form cannot see (a sweep's inputs varied per case)."""
+    with np.errstate(all="ignore"):
+        want = np.broadcast_to(np.asarray(f(xs, np.full(xs.size, row)), dtype=float), xs.shape)
+    keep = np.isfinite(want)
+    if not keep.any():
+        return False
+    try:
+        got = np.array([float(g(ctx.mpf(float(x)))) for x in xs[keep]])
+    except (NoValue, ZeroDivisionError):
+        return False
+    want = want[keep]
+    return bool(np.all(np.abs(got - want) <= 1e-6 * np.maximum(np.abs(want), np.abs(got)) + 1e-300))
 
 
 def _has_integral(evaluator, body) -> bool:
