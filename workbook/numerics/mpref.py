@@ -396,8 +396,14 @@ def _same_function(ctx, g, f, xs: np.ndarray, row: int) -> bool:
     """Whether EXPR's mpmath form computes what numpy computes at ``xs`` of ``row`` (to 1e-6
     of their size; away from a root, where rounding is not all there is): not where the
     numpy side reads values the mpmath form cannot see (a sweep's inputs varied per case)."""
-    with np.errstate(all="ignore"):
-        want = np.broadcast_to(np.asarray(f(xs, np.full(xs.size, row)), dtype=float), xs.shape)
+    from ..errors import WorkbookError
+
+    try:
+        with np.errstate(all="ignore"):
+            want = np.asarray(f(xs, np.full(xs.size, row)), dtype=float)
+    except WorkbookError:  # outside EXPR's domain there (a probe past a bound)
+        return False
+    want = np.broadcast_to(want, xs.shape)
     keep = np.isfinite(want)
     if not keep.any():
         return False
