@@ -531,7 +531,16 @@ class _TypeState:
             )
         t = self.number(s.value, s, f"the value of '{s.name}'")
         shape = self.t.shape_of(t)
-        if is_runtime(shape) or s.name in self.runtime:
+        given = self.local_shapes.get(s.name)
+        if (
+            is_runtime(shape)
+            or s.name in self.runtime
+            or (
+                # arrays of other sizes given to one local (Mathcad's and VBA's): its size is
+                # the last one given, known when it runs
+                shape is not None and given is not None and shape != given
+            )
+        ):
             # given a run-time array here, or elsewhere: it is one everywhere (next pass)
             self.runtime.add(s.name)
             shape = self.local_shapes[s.name] = RUNTIME
