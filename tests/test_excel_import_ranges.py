@@ -59,6 +59,16 @@ Function Halve(x As Double) As Double
     Halve = hi
 End Function
 
+Function Coef(n As Long) As Double
+    Dim c
+    If n = 1 Then
+        c = Array(1, 2, 3)
+    Else
+        c = Array(4, 5)
+    End If
+    Coef = c(UBound(c))
+End Function
+
 Function Doubled(loads As Range) As Double
     Doubled = loads(1, 2) * 2
 End Function
@@ -110,6 +120,8 @@ def build(folder):
     ws.write_formula("E17", "=Dens(D11)", None, 5)
     ws.write_formula("E18", "=Dens(-1)", None, "#VALUE!")  # the error value in a local
     ws.write_formula("E19", "=Halve(8)", None, 0.5)  # lo is read while Empty: 0
+    ws.write_formula("E20", "=Coef(1)", None, 3)  # arrays of two sizes in one local
+    ws.write_formula("E21", "=Coef(2)", None, 5)
     wb.close()
     bas = folder / "Loads.bas"
     bas.write_text(MODULE, encoding="utf-8")
@@ -130,11 +142,11 @@ def test_every_cached_number_is_reproduced(imported, capsys):
     # exit 1: Dens(-1) has no value (a division by zero), as E18 holds #VALUE! in Excel
     assert main(["check", str(imported), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # E2, E3, E5, E6, E11, E13, E14, E17, E19, F8, F9, the two cells of the MMULT, the four
-    # of the MINVERSE and B5's text; E4 and E18 show #VALUE! (not compared)
+    # E2, E3, E5, E6, E11, E13, E14, E17, E19, E20, E21, F8, F9, the two cells of the MMULT,
+    # the four of the MINVERSE and B5's text; E4 and E18 show #VALUE! (not compared)
     assert {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")} == {
-        "printed": 18,
-        "reproduced": 18,
+        "printed": 20,
+        "reproduced": 20,
         "failed": 0,
         "not_computable": 0,
     }
