@@ -61,6 +61,7 @@ class Builtin:
     # the unit rule when an argument is a run-time array (workbook.runtime); None: refused
     runtime: Callable[..., ty.T] | None = None
     texts: bool = False  # takes text arguments (the unit rule checks each; else numbers only)
+    sizes: bool = False  # reads only an array's size: the array may hold texts
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""

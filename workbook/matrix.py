@@ -436,7 +436,7 @@ def register_entries() -> None:
 
         return printed
 
-    def entry(name, arity, rule, numpy, excel, doc, runtime=None):
+    def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False):
         register(
             Builtin(
                 name,
@@ -448,6 +448,7 @@ def register_entries() -> None:
                 doc=doc,
                 arrays=True,
                 runtime=runtime,
+                sizes=sizes,
             )
         )
 
@@ -1074,6 +1075,7 @@ def register_entries() -> None:
             not_live(kind),
             doc,
             runtime=rt_with_origin("plain"),
+            sizes=True,
         )
 
     # reductions: max and min of numbers and of the elements of matrices; mean

@@ -35,9 +35,6 @@ Env = dict[str, object]
 Fn = Callable[[Env], object]
 
 _CMP = rt.COMPARE
-#: Built-ins of arrays that read only their sizes: an array that holds text may be given to
-#: them (every other built-in wants numbers).
-_SIZES = frozenset({"rows", "cols", "length", "last"})
 # Powers by products and square roots (x^1.5, x^3 and x^4 in Evaluator._power_by_parts):
 # several times faster than np.power, within 2 ulp (tests/test_numeric_golden.py, mpmath).
 _POWERS = {
@@ -252,7 +249,7 @@ class Evaluator(Visitor):
         if entry.arrays and any(ty.is_runtime(a.shape) for a in t.args):
             args, hook, what = [self.compile(a) for a in t.args], f, _text(t)
 
-            sizes = t.func in _SIZES
+            sizes = entry.sizes  # an array that holds texts may be given (else numbers)
 
             def runtime_call(env):
                 values = [rt.value(a(env)) for a in args]
