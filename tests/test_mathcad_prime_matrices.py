@@ -401,3 +401,27 @@ def test_an_element_defined_from_its_previous_value(tmp_path, capsys):
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
     result = _check(tmp_path / "v.toml", capsys)
     assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result
+
+
+def test_vectorize_over_a_vector_of_a_length_known_when_computed(tmp_path, capsys):
+    """v := lsolve(M, b) (its length not known at import); →(v·v + 1) is the language's
+    vectorize(v * v + 1): [5; 10]."""
+    m = (
+        '<ml:matrix rows="2" cols="2"><ml:real>1</ml:real><ml:real>0</ml:real>'
+        "<ml:real>0</ml:real><ml:real>1</ml:real></ml:matrix>"
+    )
+    b = '<ml:matrix rows="2" cols="1"><ml:real>2</ml:real><ml:real>3</ml:real></ml:matrix>'
+    square = f"<ml:apply><ml:mult/>{_id('v')}{_id('v')}</ml:apply>"
+    body = f"<ml:apply><ml:vectorize/><ml:apply><ml:plus/>{square}{_real(1)}</ml:apply></ml:apply>"
+    regions = (
+        _region(1, 1, f"<ml:define>{_id('M')}{m}</ml:define>")
+        + _region(2, 2, f"<ml:define>{_id('b')}{b}</ml:define>")
+        + _region(3, 3, f"<ml:define>{_id('v')}{_call('lsolve', _id('M'), _id('b'))}</ml:define>")
+        + _eval(4, body)
+    )
+    results = _result(1) + _result(2) + _result(3) + _result(4, _stored_matrix([[5], [10]]))
+    src = _package(tmp_path / "vec.mcdx", regions, results)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    assert "vectorize(" in (tmp_path / "vec.toml").read_text(encoding="utf-8")
+    result = _check(tmp_path / "vec.toml", capsys)
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result

@@ -369,6 +369,7 @@ class ExprTranslator(Visitor):
         one length known at import), as a vector of the elements' expressions."""
         o = self.tr.sheet_origin
         lengths: set[int] = set()
+        unknown: list[ex.Node] = []  # arrays whose length the import does not know
 
         def vector_length(node: ex.Node) -> int | None:
             if isinstance(node, ex.Matrix):
@@ -378,9 +379,8 @@ class ExprTranslator(Visitor):
             if isinstance(node, ex.Name) and self.tr.is_array(node.id):
                 n = self.tr.vector_length_of(node)
                 if n is None:
-                    raise Untranslatable(
-                        "a vectorised expression over a vector of a length not known at import"
-                    )
+                    unknown.append(node)
+                    return -1
                 return n
             return None
 
@@ -402,6 +402,8 @@ class ExprTranslator(Visitor):
                 scan(child)
 
         scan(tree)
+        if unknown:  # the language's vectorize, element by element when it is computed
+            return ex.Call("vectorize", (tree,))
         if not lengths:
             return tree  # no vector in it: vectorize changes nothing
         if len(lengths) > 1:
