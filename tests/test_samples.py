@@ -52,7 +52,7 @@ def test_reproduce_mathcads_stored_values(tmp_path):
             "V1": _vector(v1),
             "V2": _vector(v2),
             "c": "cvar(V1, V2)",
-            "a": "slope(V1, V2)",
+            "a": "fit_slope(V1, V2)",
             "r": "corr(V1, V2)",
             "R1": "Rank(V1)",
             "R2": "Rank(V2)",
@@ -107,7 +107,7 @@ def test_against_excels_formulas_in_mpmath(tmp_path):
         {
             "X": _vector(X), "Y": _vector(Y), "P": positive,
             "v": "Var(X)", "sd": "Stdev(X)", "r": "corr(X, Y)", "c": "cvar(X, Y)",
-            "a": "slope(X, Y)", "b": "intercept(X, Y)", "sk": "skew(X)", "ku": "kurt(X)",
+            "a": "fit_slope(X, Y)", "b": "fit_intercept(X, Y)", "sk": "skew(X)", "ku": "kurt(X)",
             "g": "gmean(P)", "h": "hmean(P)",
         },
     )  # fmt: skip
@@ -123,8 +123,8 @@ def test_units(tmp_path):
         {
             "x": "[1, 2, 4] * 1 m",
             "t": "[2, 3, 7] * 1 s",
-            "a": "slope(x, t)",
-            "b": "intercept(x, t)",
+            "a": "fit_slope(x, t)",
+            "b": "fit_intercept(x, t)",
             "c": "cvar(x, t)",
             "r": "corr(x, t)",
             "v": "Var(x)",
@@ -163,8 +163,9 @@ def test_excel_forms_recalculate_in_libreoffice(tmp_path):
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
     names = {
-        "v": "Var(x)", "s": "Stdev(x)", "r": "corr(x, y)", "c": "cvar(x, y)", "a": "slope(x, y)",
-        "b": "intercept(x, y)", "sk": "skew(x)", "ku": "kurt(x)", "g": "gmean(y)", "h": "hmean(y)",
+        "v": "Var(x)", "s": "Stdev(x)", "r": "corr(x, y)", "c": "cvar(x, y)",
+        "a": "fit_slope(x, y)", "b": "fit_intercept(x, y)", "sk": "skew(x)", "ku": "kurt(x)",
+        "g": "gmean(y)", "h": "hmean(y)",
     }  # fmt: skip
     sheet = _sheet(tmp_path, {"x": "[1, 2, 3, 4, 10]", "y": "[2, 4, 5, 4, 5]", **names})
     xlsx = tmp_path / "s.xlsx"

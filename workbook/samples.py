@@ -10,7 +10,6 @@ outside its domain, is an error, never a number.
 from __future__ import annotations
 
 import numpy as np
-import scipy.stats
 
 from .errors import DomainError, InputError
 
@@ -78,6 +77,8 @@ def skew(v) -> float:
     """The sample skewness, n / ((n - 1)(n - 2)) sum(((x - mean)/s)^3) (Excel's SKEW)."""
     x = _sample(v, "skew()", 3)
     _spread(x, "skew()")
+    import scipy.stats  # imported when used: loading a sheet imports no SciPy solver
+
     return float(scipy.stats.skew(x, bias=False))
 
 
@@ -85,6 +86,8 @@ def kurt(v) -> float:
     """The sample excess kurtosis (Excel's KURT)."""
     x = _sample(v, "kurt()", 4)
     _spread(x, "kurt()")
+    import scipy.stats
+
     return float(scipy.stats.kurtosis(x, fisher=True, bias=False))
 
 
@@ -93,6 +96,8 @@ def gmean(v) -> float:
     x = _sample(v, "gmean()")
     if np.any(x <= 0):
         raise DomainError("gmean(): the values must be positive")
+    import scipy.stats
+
     return float(scipy.stats.gmean(x))
 
 
@@ -101,6 +106,8 @@ def hmean(v) -> float:
     x = _sample(v, "hmean()")
     if np.any(x <= 0):
         raise DomainError("hmean(): the values must be positive")
+    import scipy.stats
+
     return float(scipy.stats.hmean(x))
 
 
@@ -108,4 +115,6 @@ def rank(v) -> np.ndarray:
     """The rank of each element of a vector, 1 for the smallest; equal values share the
     mean of their ranks (Excel's RANK.AVG, ascending)."""
     x = _sample(v, "Rank()")
+    import scipy.stats
+
     return scipy.stats.rankdata(x, method="average").reshape(-1, 1)

@@ -34,7 +34,7 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "rank": ("rank", None), "polyroots": ("polyroots", None),
     "lu": ("lu", None), "rref": ("rref", None), "geninv": ("geninv", None),
     "Var": ("Var", None), "Stdev": ("Stdev", None), "corr": ("corr", None),
-    "cvar": ("cvar", None), "slope": ("slope", None), "intercept": ("intercept", None),
+    "cvar": ("cvar", None), "slope": ("fit_slope", None), "intercept": ("fit_intercept", None),
     "skew": ("skew", None), "kurt": ("kurt", None), "gmean": ("gmean", None),
     "hmean": ("hmean", None), "Rank": ("Rank", None),
     "norm1": ("norm1", None), "norm2": ("norm2", None), "normi": ("normi", None),
