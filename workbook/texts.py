@@ -84,6 +84,5 @@ register(
         _num2str_excel,
         _no_sympy("num2str"),
         doc="num2str(x): the number x as a text, 15 significant digits (Mathcad's num2str)",
-        texts=True,
     )
 )
