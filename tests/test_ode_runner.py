@@ -90,6 +90,27 @@ def test_bench_rows_cover_every_method_against_a_tight_reference():
     assert rows[-1]["method"].startswith("reference")
 
 
+def test_bench_reference_is_checked_by_a_second_method():
+    """The reference row's error is its difference from a second method at rtol 1e-12; against
+    the closed form cos(t) it is not below the reference's true error and not above the sum of
+    both; errors at or below it are not claimed as resolved."""
+    f = lambda t, y: np.array([y[1], -y[0]])  # noqa: E731
+    rows = ode.bench_rows(f, 0.0, 6.0, [1.0, 0.0], name="osc", rtols=(1e-3, 1e-9))
+    ref = rows[-1]
+    assert ref["method"] == "reference DOP853 (checked by LSODA)"
+    ts = np.linspace(0.0, 6.0, 201)
+    true = {}
+    for method in ("DOP853", "LSODA"):
+        run = oderun.run_ode(
+            f, (0.0, 6.0), [1.0, 0.0], method=method, rtol=1e-12, atol=1e-14, t_eval=ts
+        )
+        true[method] = float(np.max(np.abs(run.y - np.array([np.cos(ts), -np.sin(ts)]))))
+    assert true["DOP853"] <= ref["error"] <= true["DOP853"] + true["LSODA"]
+    for r in rows[:-1]:
+        assert r["resolved"] == (r["error"] > ref["error"])
+    assert any(r["resolved"] for r in rows if r["rtol"] == 1e-3)
+
+
 def test_work_precision_skips_tighter_rtols_after_a_stall():
     """A method stopped by its step cap at one rtol is recorded as skipped at tighter ones;
     the others are run and their error falls with rtol (closed form of y' = -y)."""
