@@ -87,11 +87,22 @@ def test_round_of_a_ratio_times_a_step(sheet):
     assert sheet.evaluate("Lr").to("mm").magnitude == pytest.approx(15.0, rel=1e-15)
 
 
+def test_a_ratio_of_units_of_one_kind_is_its_plain_number(tmp_path):
+    """round(b/(1 mm)) with b in metres counts millimetres, as Mathcad does (the ratio m/mm is
+    the plain number 1000 times its magnitude); floor and trunc likewise."""
+    text = SHEET + 'B = "0.3047 m"\nm = "round(B/(1 mm))"\nk = "trunc(B/(1 cm))"\n'
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert sheet.evaluate("m").magnitude == 305.0
+    assert sheet.evaluate("k").magnitude == 30.0
+
+
 @pytest.mark.parametrize(
     "expr,message",
     [
         ("round(L)", "round() needs a plain number, got a value in mm"),
         ("trunc(phi)", "trunc() needs a plain number, got a value in deg"),
+        ("round(phi/(1 s)*(1 s))", "round() needs a plain number"),
+        ("floor(L/(1 mm)*(1 percent))", "floor() needs a plain number"),
         ("round(2.5, L)", "the number of decimals needs a dimensionless argument"),
     ],
 )
@@ -112,6 +123,8 @@ d = "round(1.005, 2)"
 v = "[1, 2, 3, 4, 10]"
 e = "stdev(v) + 10*var(v) + 100*median(v, 7)"
 f = "det(identity(3)*2) + sum(identity(2))"
+B = "0.3047 m"
+g = "round(B/(1 mm)) + trunc(B/(1 cm))"
 """
 
 
@@ -383,3 +396,46 @@ def test_statistics_are_live_and_formulas_agrees(stats, tmp_path):
             want = stats.evaluate(r[0].value).to(unit).magnitude
             assert float(got[r[1].coordinate]) == pytest.approx(want, rel=1e-13), r[0].value
     assert checked == 5
+
+
+# -- sec, csc, cot ------------------------------------------------------------------------------
+RECIPROCAL = """
+[inputs]
+a = "35 deg"
+x = "0.7"
+
+[definitions]
+s = "sec(a)"
+c = "csc(x)"
+k = "cot(a) + cot(x)"
+"""
+
+
+def test_reciprocal_trigonometry_against_mpmath_and_formulas(tmp_path):
+    """sec, csc and cot (Mathcad's) against mpmath at 30 digits; their Excel form 1/COS(...)
+    recalculated by the `formulas` package."""
+    import formulas
+    import openpyxl
+
+    sheet = workbook.load(write_template(tmp_path, RECIPROCAL))
+    mpmath.mp.dps = 30
+    a = mpmath.radians(35)
+    want = {
+        "s": mpmath.sec(a),
+        "c": mpmath.csc(mpmath.mpf("0.7")),
+        "k": mpmath.cot(a) + mpmath.cot(mpmath.mpf("0.7")),
+    }
+    for name, value in want.items():
+        assert sheet.evaluate(name).magnitude == pytest.approx(float(value), rel=4e-16), name
+    path = sheet.write_xlsx(tmp_path / "trig.xlsx")
+    ws = openpyxl.load_workbook(path)["Definitions"]
+    cells = {r[0].value: r[1] for r in ws.iter_rows(min_row=2) if r[0].value in want}
+    assert cells["s"].value.startswith("=1/COS(")
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    got = {
+        key.rpartition("!")[2].upper(): v.value[0, 0]
+        for key, v in solution.items()
+        if key.rpartition("!")[0].upper().endswith("DEFINITIONS'")
+    }
+    for name, cell in cells.items():
+        assert float(got[cell.coordinate]) == pytest.approx(float(want[name]), rel=1e-14), name

@@ -150,6 +150,37 @@ _TRIG = {"mathml_powered": True}
 _simple("sin", np.sin, "SIN", lambda sp, x: sp.sin(x), "sine (argument in radians)", **_TRIG)
 _simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG)
 _simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG)
+
+
+def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
+    """1/COS(x): Excel's SEC, CSC and COT are 2013 functions that older readers lack."""
+    return lambda args: (f"1/{excel}({args[0]})", PREC["/"])
+
+
+_simple(
+    "sec",
+    lambda x: 1 / np.cos(x),
+    _reciprocal("COS"),
+    lambda sp, x: sp.sec(x),
+    "secant, 1/cos(x)",
+    **_TRIG,
+)
+_simple(
+    "csc",
+    lambda x: 1 / np.sin(x),
+    _reciprocal("SIN"),
+    lambda sp, x: sp.csc(x),
+    "cosecant, 1/sin(x)",
+    **_TRIG,
+)
+_simple(
+    "cot",
+    lambda x: 1 / np.tan(x),
+    _reciprocal("TAN"),
+    lambda sp, x: sp.cot(x),
+    "cotangent, 1/tan(x)",
+    **_TRIG,
+)
 _simple(
     "asin",
     np.arcsin,
@@ -217,13 +248,21 @@ _simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_u
 
 
 # -- floor, ceil, round and trunc: of plain numbers only ----------------------------------------
+def _ratio_of_one_kind(unit) -> bool:
+    """A dimensionless unit none of whose factors is dimensionless itself (m/mm, not deg/s*s)."""
+    registry = unit._REGISTRY
+    return all(registry.Unit(name).dimensionality for name in unit._units)
+
+
 def _integer_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
     """floor, ceil, round and trunc take a plain number: rounding 1.5 m gives 2 m in metres
-    but 1.5 m in millimetres (Mathcad rounds the value in SI units), so a value with a unit,
-    or in a unit that is not the plain number itself (deg, %, mm/m), is refused."""
+    but 1.5 m in millimetres (Mathcad rounds the value in SI units), so a value with a unit is
+    refused, and so is one in a named dimensionless unit (deg, %), whose plain number is not
+    the one written. A ratio of units of one kind (b/mm with b in m) is its plain number, as
+    in Mathcad: round(b/mm) counts millimetres."""
     x = args[0]
     factor = None if x.unit.dimensionality else (1 * x.unit).to(ctx.dimensionless).magnitude
-    if factor != 1:
+    if factor != 1 and not (factor is not None and _ratio_of_one_kind(x.unit)):
         raise UnitError(
             f"{name}() needs a plain number, got a value in {pretty(x.unit)}: the result would "
             f"depend on the unit it is rounded in; round a ratio, {name}(x/step)*step"
