@@ -81,8 +81,8 @@ KNOWN_ELSEWHERE = {
     (
         "numerics/mpform.py",
         (
-            "abs", "acos", "asin", "atan", "ceil", "cos", "cosh", "exp", "floor", "ln", "log10",
-            "sign", "sin", "sinh", "sqrt", "tan", "tanh",
+            "abs", "acos", "asin", "atan", "ceil", "cos", "cosh", "cot", "csc", "exp", "floor",
+            "ln", "log10", "sec", "sign", "sin", "sinh", "sqrt", "tan", "tanh",
         ),
     ),
     # the functions singular where their argument is 0 (an integrand nearly singular beside

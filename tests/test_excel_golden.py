@@ -60,6 +60,7 @@ CASES = [
     ("inverse_trig", "asin(a/c) + acos(a/c) + atan(b/c)", None),
     ("sqrt_of_sum", "sqrt(a + b + c)", None),
     ("tangent", "tan(a/c) - tan(-x/4)", None),
+    ("reciprocal_trig", "2^sec(a/c) - csc(x/4)*cot(b/c)", None),  # 1/COS(...) under ^ and *
     ("sum_bound", "sum(u^2 - a*u, u, 1, 4)", None),  # unrolled: (1^2-a_*1)+...
     ("product_bound", "product(u + a, u, 1, 3)/x", None),
     ("pick_first", "pick(a)", None),

@@ -87,8 +87,8 @@ def test_num2str_is_written_as_its_value_with_a_comment(sheet, tmp_path):
     "line, message",
     [
         ('bad = "concat(\\"a\\", n)"', "concat(): argument 2 is not a text"),
-        ('bad = "num2str(\\"a\\")"', "argument of num2str(): text is not a number"),
-        ('bad = "num2str(mark)"', "'mark' is a choice (A, B), not a number"),
+        ('bad = "num2str(\\"a\\")"', "num2str(x): x must be a number"),
+        ('bad = "num2str(mark)"', "num2str(x): 'mark' is a choice, not a number"),
         ('bad = "num2str(L)"', "divide it by the unit"),
         ('bad = "num2str(n) + 1"', "text"),
     ],

@@ -38,6 +38,8 @@ def _concat(*texts):
 
 def _num2str_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
     (x,) = args
+    if getattr(x, "kind", None) == "choice":  # a word, typed as a plain number
+        raise TemplateError(f"num2str(x): '{x.name}' is a choice, not a number")
     if x.text or x.boolean or x.shape is not None:
         raise TemplateError("num2str(x): x must be a number")
     x = ctx.plain(x, "num2str(x): x (a value with a unit: divide it by the unit to write)")
@@ -84,5 +86,6 @@ register(
         _num2str_excel,
         _no_sympy("num2str"),
         doc="num2str(x): the number x as a text, 15 significant digits (Mathcad's num2str)",
+        texts=True,
     )
 )
