@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import zipfile
 from pathlib import Path
 
@@ -221,9 +222,11 @@ def test_small_prime_worksheets_reproduce(name, tmp_path, capsys):
 )
 def test_every_prime_worksheet_imports_and_none_is_wrong(name, tmp_path, capsys):
     """Every file imports (exit 0); every stored value is reproduced or not computable (its
-    region listed), none different."""
+    region listed), none different; no internal token of a name reaches the text."""
     assert main(["import", str(PRIME / name), "--out", str(tmp_path)]) == 0
-    result = _check(tmp_path / (Path(name).stem + ".toml"), capsys)
+    toml = tmp_path / (Path(name).stem + ".toml")
+    assert not re.search(r"\\u0000|\x00", toml.read_text(encoding="utf-8"))
+    result = _check(toml, capsys)
     assert result["reproduced"] + result["not_computable"] == result["printed"], result["failures"]
 
 

@@ -392,8 +392,9 @@ class ExprTranslator(Visitor):
             if isinstance(node, ex.Call):
                 for a in node.args:
                     if vector_length(a) is not None and node.func not in _ELEMENTWISE:
+                        called = self.tr.mathcad_name(node.func)
                         raise Untranslatable(
-                            f"a vectorised call of {node.func} (only functions of one "
+                            f"a vectorised call of {called} (only functions of one "
                             "number are applied element by element)"
                         )
             if isinstance(node, ex.Index):
@@ -560,6 +561,11 @@ class Translator:
 
     def sym_of(self, name: ex.Name) -> Sym:
         return next(s for s in self.out.syms if s.token() == name.id)
+
+    def mathcad_name(self, name: str) -> str:
+        """The name as Mathcad shows it, for a message (a symbol's token is an object id)."""
+        sym = next((s for s in self.out.syms if s.token() == name), None)
+        return name if sym is None else sym.mathcad
 
     def unit_sym(self, name: str) -> Sym:
         if name not in self.units:

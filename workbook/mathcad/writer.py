@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -168,8 +169,10 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             f"Not translated ({len({s.region for s in tr.skipped})} regions; their results "
             "count as not reproduced):"
         )
-        for s in tr.skipped:
-            doc.comment(f"  region {s.region}: {s.what}: {s.why}")
+        shown = {s.token(): s.mathcad for s in tr.syms}
+        for s in tr.skipped:  # a symbol's token in a reason is shown as Mathcad's name
+            why = re.sub("\x00\\d+", lambda m: shown.get(m.group(), "?"), s.why)
+            doc.comment(f"  region {s.region}: {s.what}: {why}")
     if tr.ignored:
         doc.comment()
         for line in _wrapped(
