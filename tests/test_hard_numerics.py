@@ -488,3 +488,30 @@ def test_a_nested_integral_sees_the_inner_integrands_singular_point_at_its_bound
     d = _MP(1e-3)
     exact = 2 * (_MP(2) / 3 * ((1 + d) ** 1.5 - d**1.5) - mpmath.sqrt(d))
     right(tmp_path, "integral(integral(1/sqrt(t + 1e-3), t, 0, u), u, 0, 1)", exact, rel=1e-12)
+
+
+@pytest.mark.parametrize("width", [1e-2, 1e-3, 1e-4])
+def test_a_narrow_peak_anywhere_in_the_bracket_is_integrated(tmp_path, width):
+    """exp(-((x - a)/w)^2) on [0, 10] for centres a across the bracket, near its ends too
+    (where a peak inside one end box was integrated to 0 or 1.8e-45), against erf in mpmath;
+    every value within its estimate."""
+    centres = np.concatenate([np.linspace(0, 10, 81), [0.035, 0.225, 0.35, 0.6, 1.025, 9.65]])
+    path = tmp_path / "peak.toml"
+    path.write_text(
+        '[arguments]\nx = { unit = "" }\na = { unit = "" }\n[definitions]\n'
+        f'"q(a)" = "integral(exp(-((x - a)/{width})^2), x, 0, 10)"\n',
+        encoding="utf-8",
+    )
+    s = workbook.load(path)
+    got = s.evaluate("q", centres).magnitude
+    estimate = max(float(np.max(r.error)) for _, r in s.evaluator.records if r.error.size)
+    w = mpmath.mpf(width)
+    exact = np.array(
+        [
+            float(w * mpmath.sqrt(mpmath.pi) / 2 * (mpmath.erf((10 - a) / w) + mpmath.erf(a / w)))
+            for a in centres
+        ]
+    )
+    error = np.abs(got - exact)
+    assert np.all(error <= 1e-9 * exact), centres[error > 1e-9 * exact]
+    assert np.max(error) <= 1.01 * estimate + 1e-300

@@ -6,8 +6,9 @@ the boxes end narrow where EXPR changes fast (a narrow peak, a steep step, a Lor
 and wide where it is flat. The ends of the boxes are break points for the adaptive rule,
 which then integrates smooth pieces instead of sampling past a feature between its nodes
 (``exp(-((x - 3.7)/0.01)^2)`` on [0, 10] was 2.4e-118 for 0.0177). A box at an end of the
-bracket is not halved below a sixteenth of it, nor a box where EXPR is unbounded (a
-singularity is tanh-sinh's, at a break point the tree gives).
+bracket is not halved below a sixteenth of it where EXPR is monotone in it (a steep end is
+tanh-sinh's), nor a box where EXPR is unbounded (a singularity is tanh-sinh's, at a break
+point the tree gives).
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ def breaks(g, h, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
             break
         c = 0.5 * (blo + bhi)
         with np.errstate(all="ignore"):
-            f, _ = g(blo, bhi, row)
+            f, d = g(blo, bhi, row)
             hc = np.abs(np.asarray(h(c, row), dtype=float))
         np.maximum.at(scale, row, np.where(np.isfinite(hc), hc, 0.0))
         spread = np.broadcast_to(np.asarray(f.hi - f.lo, dtype=float), row.shape)
@@ -62,6 +63,18 @@ def breaks(g, h, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
         np.maximum.at(widest, row, np.where(unbounded, 0.0, spread))
         level = np.maximum(scale, RELATIVE * widest)[row]
         halve = ~unbounded & (spread > SPREAD * level) & (w > 2 * floor)
+        # an end box at its floor is still halved where EXPR may turn inside it (its
+        # derivative's enclosure holds 0, or is unknown): a peak there, not a steep end that
+        # tanh-sinh takes (a peak at 0.035 of the bracket was integrated to 0 inside one end box)
+        stuck = ~unbounded & (spread > SPREAD * level) & at_end & ~halve & (w > 1e-9 * width0[row])
+        if stuck.any():
+            if d is None:
+                turns = np.ones(row.shape, dtype=bool)
+            else:
+                dlo = np.broadcast_to(np.asarray(d.lo, dtype=float), row.shape)
+                dhi = np.broadcast_to(np.asarray(d.hi, dtype=float), row.shape)
+                turns = ~(dlo > 0) & ~(dhi < 0)  # NaN bounds: may turn
+            halve |= stuck & turns
         crowded = np.bincount(row[halve], minlength=n)[row] > MAX_BOXES // 2
         halve &= ~crowded
         done_row.append(row[~halve])
