@@ -52,6 +52,10 @@ class Evaluator(Visitor):
     ``compile(t)`` returns a closure ``env -> magnitude``; one ``visit_<Node>`` per typed node.
     """
 
+    #: entries of the environment that references read besides the parameters (a sweep's
+    #: varied inputs); built-ins that bind a variable carry them through their rows
+    env_keys: tuple[str, ...] = ()
+
     def __init__(
         self,
         typer: tc.Typer,
@@ -141,6 +145,11 @@ class Evaluator(Visitor):
         return lambda env: env[n]
 
     def visit_TRef(self, t: tc.TRef) -> Fn:
+        return self.reference(t)
+
+    def reference(self, t: tc.TRef) -> Fn:
+        """How this evaluator reads a name in an environment; the interval and mpmath forms
+        of EXPR read names through it, so that they compute the function numpy computes."""
         name, kind, get = t.name, t.kind, self.scalar_value
         if kind == "solve" and self.typer.spec.solve_of(name).parameters:
             at = self.solve_at  # a [[solve]] block with parameters: solved at env's values
@@ -322,7 +331,7 @@ class Evaluator(Visitor):
         if ty.is_runtime(t.shape):
             return self._runtime_piecewise(t)
         conds = [None if k is None else self.compile(k) for k in t.conditions]
-        matrices, used = _matrix_names(t), frozenset(ty.parameters(t))
+        matrices, used = _matrix_names(t), frozenset(ty.parameters(t)) | set(self.env_keys)
         split = _partition(conds, t.texts, matrices, used)
         keys = tuple(None if k is None else self.plan.keys.key(k) for k in t.conditions)
         split = self._kept(self.plan.keys.signature("pieces", keys), split)
@@ -334,7 +343,7 @@ class Evaluator(Visitor):
         conds = [None if k is None else self.compile(k) for k in t.conditions]
         values = [self.compile(v) for v in t.values]
         what, texts = _text(t), t.texts
-        matrices, used = _matrix_names(t), frozenset(ty.parameters(t))
+        matrices, used = _matrix_names(t), frozenset(ty.parameters(t)) | set(self.env_keys)
 
         def one(env):
             for cond, val in zip(conds, values):

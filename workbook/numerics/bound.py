@@ -29,7 +29,7 @@ class Bound:
         self.body, self.fn, self.env = body, fn, env
         self.var, self.var_param = var.name, var
         self.unit_text = un.pretty(var.unit)
-        used = ty.parameters(body) - {self.var}
+        used = ty.parameters(body) - {self.var} | set(evaluator.env_keys)
         self.arrays = {k: np.asarray(env[k]) for k in used if k in env and np.ndim(env[k]) > 0}
         self.shape = np.broadcast_shapes(*(a.shape for a in self.arrays.values()))
 

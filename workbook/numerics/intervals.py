@@ -272,8 +272,10 @@ class Enclosure(Visitor):
         return param
 
     def visit_TRef(self, t):
-        name, kind, get = t.name, t.kind, self.evaluator.scalar_value
-        return lambda env: (Iv.point(get(name, kind)), None)
+        if t.kind == "solve" and self.evaluator.typer.spec.solve_of(t.name).parameters:
+            raise NoEnclosure(f"the solve block {t.name}")
+        read = self.evaluator.reference(t)  # a sweep's evaluator reads its cases in env
+        return lambda env: (Iv.point(read(env)), None)
 
     def visit_TScale(self, t):
         child, k = self.compile(t.child), t.factor
@@ -385,17 +387,19 @@ class Enclosure(Visitor):
         body = inner.in_call(f.body, f.params)
 
         def call(env):
-            return body([a(env) for a in args])
+            return body([a(env) for a in args], env)
 
         return call
 
     def in_call(self, body: ty.T, params) -> Callable:
-        """A function body of pairs: each parameter is a pair its argument computed."""
-        names = list(params)
+        """A function body of pairs: each parameter is a pair its argument computed; the
+        caller's entries that references read (a sweep's cases) go along."""
+        names, keys = list(params), self.evaluator.env_keys
         compiled = self.compile(body)
 
-        def run(pairs):
-            return compiled({_CALL: dict(zip(names, pairs))})
+        def run(pairs, env=None):
+            outer = {} if env is None else {k: env[k] for k in keys if k in env}
+            return compiled({**outer, _CALL: dict(zip(names, pairs))})
 
         return run
 

@@ -103,10 +103,10 @@ class MpForm(Visitor):
     def visit_TRef(self, t):
         if t.kind == "solve" and self.evaluator.typer.spec.solve_of(t.name).parameters:
             raise NoMpForm(f"the solve block {t.name}")
-        name, kind, get, mpf = t.name, t.kind, self.evaluator.scalar_value, self.ctx.mpf
+        read, mpf = self.evaluator.reference(t), self.ctx.mpf  # a sweep's cases are in env
 
         def ref(env):
-            v = get(name, kind)
+            v = read(env)
             return v if isinstance(v, str) else mpf(float(v))  # a choice: 'law == "stepped"'
 
         return ref
@@ -224,9 +224,11 @@ class MpForm(Visitor):
             raise NoMpForm(f"the recursive function {t.name}")
         f = typer.function(t.name)
         body = MpForm(self.evaluator, self.ctx, self.depth + 1).compile(f.body)
-        names = list(f.params)
+        names, keys = list(f.params), self.evaluator.env_keys  # a sweep's cases go along
         args = [self.compile(a) for a in t.args]
-        return lambda env: body({n: a(env) for n, a in zip(names, args)})
+        return lambda env: body(
+            {**{k: env[k] for k in keys if k in env}, **{n: a(env) for n, a in zip(names, args)}}
+        )
 
     def __getattr__(self, name):
         if name.startswith("visit_"):  # every other node kind: no mpmath form here

@@ -26,7 +26,7 @@ class CaseEvaluator(Evaluator):
         super().__init__(sheet.typer, sheet.scalar_value, sheet.describe_call)
         self.spec = sheet.spec
         self.swept = swept
-        self.keys = tuple("\x00" + n for n in sorted(swept))
+        self.env_keys = tuple("\x00" + n for n in sorted(swept))
         self._depends: dict[str, bool] = {}
 
     def depends(self, name: str) -> bool:
@@ -36,20 +36,20 @@ class CaseEvaluator(Evaluator):
             self._depends[name] = bool(deps & self.swept)
         return self._depends[name]
 
-    def visit_TRef(self, t):
+    def reference(self, t):
         """Swept inputs are read from the environment."""
         if t.kind == "input" and t.name in self.swept:
             key = "\x00" + t.name
             return lambda env: env[key]
         if t.kind == "definition" and self.depends(t.name):
             return self.compile(self.typer.scalar(t.name))
-        return super().visit_TRef(t)
+        return super().reference(t)
 
     def visit_TCall(self, t):
         f = self.function(t.name)
         params = self.typer.function(t.name).params
         args = [self.compile(a) for a in t.args]
-        keys = self.keys
+        keys = self.env_keys
 
         def call(env):
             inner = {p: a(env) for p, a in zip(params, args)}
