@@ -119,6 +119,7 @@ def test_validity_limit_warning_and_formulas_1_2(valve):
     assert eff[2] == pytest.approx(math.pi / 4 * (40**2 - 8**2))
 
 
+@pytest.mark.slow  # seconds of CPU: run by CI with the slow tests
 def test_wear_deeper_than_the_lift(valve):
     never = valve.with_inputs(w_b2="11 mm", w_n2="11 mm")
     assert float(mag(never.evaluate("TS2"), "mm^2*deg")) == 0.0

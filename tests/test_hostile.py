@@ -290,6 +290,7 @@ def test_limits_are_documented():
         assert f"{value:,}" in limits or str(value) in limits, value
 
 
+@pytest.mark.slow  # seconds of CPU: run by CI with the slow tests
 def test_solver_step_cap_stops_a_billion_steps():
     """A solver asked for 10^9 steps on a stiff problem with an explicit method stops at its
     documented budget (wall clock, then the step cap) with a reason, not after hours."""

@@ -178,6 +178,7 @@ def test_scene_parts_are_left_out_by_default(name):
     assert all("part" not in f for f in plain.spec.findings)
 
 
+@pytest.mark.slow  # seconds of CPU: run by CI with the slow tests
 def test_coupling_without_its_studies(tmp_path):
     out = tmp_path / "ac.xlsx"
     assert main(["run", "advance-coupling", "--out", str(out)]) == 0

@@ -332,6 +332,7 @@ def test_profile_has_z_lobes(sheet, sense, lobes):
     assert p["phi [deg]"].iloc[-1] == 360 * lobes
 
 
+@pytest.mark.slow  # seconds of CPU: run by CI with the slow tests
 def test_workbook_chart_has_equal_axes(sheet, tmp_path):
     spec = next(c for c in sheet.spec.charts if c.name == "tooth_profile")
     assert spec.equal_axes
@@ -434,6 +435,7 @@ def test_libreoffice_recalculates_the_live_profile(sheet, tmp_path):
             assert got == pytest.approx(ref[h].iloc[i], rel=1e-9, abs=1e-12), (h, i)
 
 
+@pytest.mark.slow  # seconds of CPU: run by CI with the slow tests
 def test_tables_over_the_row_limit_are_refused_before_they_are_computed(sheet):
     """n = 400 at its coarsest documented step writes; a finer step is refused by name."""
     from workbook.errors import LimitError
