@@ -7,6 +7,7 @@ from pathlib import Path
 
 import mpmath
 import pytest
+from test_hard_numerics import HARD_SHEET
 
 import workbook
 from workbook.numerics import bench, mpref
@@ -104,23 +105,13 @@ def test_a_reference_that_cannot_answer_raises_what_bench_prints():
         mpref.root_near(ctx, lambda x: x * x + 1, 0.5)
 
 
-HARD = """
-[sheet]
-title = "hard cases"
-[definitions]
-peak = "maximum(exp(-((x - 0.3)/1e-4)^2), x, 0, 1)"
-wave = "maximum(sin(100*x)*exp(-x), x, 0, 10)"
-narrow = "integral(exp(-((x - 3.7)/1e-2)^2), x, 0, 10)"
-step = "integral(tanh(1e3*x), x, -1, 2)"
-lorentz = "integral(1/(1 + ((x - 0.4)/1e-3)^2), x, 0, 1)"
-cusp = "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)"
-triple = "root(x^3 - 3*x^2 + 3*x - 1, x, 0, 1.7)"
-sqrt2 = "root(x^2 - 2, x, 0, 2)"
-where = "argmax(sin(100*x)*exp(-x), x, 0, 10)"
-near = "root(tan(x), x, 1.5)"
+HARD = (
+    HARD_SHEET
+    + """near = "root(tan(x), x, 1.5)"
 bump = "minimum(x^2 - 1/(1 + ((x - 0.61)/1e-5)^2), x, 0, 1)"
 nested = "integral(integral(1/sqrt(t + 1e-3), t, 0, u), u, 0, 1)"
 """
+)
 
 #: the one formula of the templates without an mpmath form: data interpolation, whose
 #: reference is QUADPACK in doubles (said on its line)

@@ -157,30 +157,19 @@ def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
     return lambda args: (f"1/{excel}({args[0]})", PREC["/"])
 
 
-_simple(
-    "sec",
-    lambda x: 1 / np.cos(x),
-    _reciprocal("COS"),
-    lambda sp, x: sp.sec(x),
-    "secant, 1/cos(x)",
-    **_TRIG,
-)
-_simple(
-    "csc",
-    lambda x: 1 / np.sin(x),
-    _reciprocal("SIN"),
-    lambda sp, x: sp.csc(x),
-    "cosecant, 1/sin(x)",
-    **_TRIG,
-)
-_simple(
-    "cot",
-    lambda x: 1 / np.tan(x),
-    _reciprocal("TAN"),
-    lambda sp, x: sp.cot(x),
-    "cotangent, 1/tan(x)",
-    **_TRIG,
-)
+for _name, _of, _excel, _what in (
+    ("sec", np.cos, "COS", "secant"),
+    ("csc", np.sin, "SIN", "cosecant"),
+    ("cot", np.tan, "TAN", "cotangent"),
+):
+    _simple(
+        _name,
+        lambda x, of=_of: 1 / of(x),
+        _reciprocal(_excel),
+        lambda sp, x, name=_name: getattr(sp, name)(x),
+        f"{_what}, 1/{_excel.lower()}(x)",
+        **_TRIG,
+    )
 _simple(
     "asin",
     np.arcsin,

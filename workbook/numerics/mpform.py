@@ -17,19 +17,12 @@ import operator
 from collections.abc import Callable
 
 from .. import typed as ty
+from ..runtime import COMPARE
 from ..visitor import Visitor
 
 #: a sheet function nested deeper than this is not expanded
 _MAX_DEPTH = 20
 
-_COMPARE = {
-    "<": operator.lt,
-    "<=": operator.le,
-    ">": operator.gt,
-    ">=": operator.ge,
-    "==": operator.eq,
-    "!=": operator.ne,
-}
 
 Mp = Callable[[dict], object]
 
@@ -141,7 +134,7 @@ class MpForm(Visitor):
 
     def visit_TCompare(self, t):
         parts = [self.compile(o) for o in t.operands]
-        ops = [_COMPARE[o] for o in t.ops]
+        ops = [COMPARE[o] for o in t.ops]
 
         def chain(env):
             vals = [p(env) for p in parts]
