@@ -405,3 +405,54 @@ def test_numerical_builtins_over_a_swept_input_agree_with_serial(tmp_path):
     assert t["m"].to_numpy() == pytest.approx(np.ones(4), rel=1e-9)
     assert t["w"].to_numpy() == pytest.approx(a, abs=1e-6)
     assert t["q"].to_numpy() == pytest.approx(np.full(4, 0.01 * math.sqrt(math.pi)), rel=1e-9)
+
+
+def _vectorisable_outputs(sheet, name: str) -> dict:
+    """The scalar definitions that depend on input ``name``, are numbers and that a
+    vectorised sweep of it computes."""
+    from workbook import expr as ex
+    from workbook import typecheck as tc
+    from workbook.errors import WorkbookError
+    from workbook.sweep.grid import as_varies
+    from workbook.sweep.outputs import as_outputs, type_output
+    from workbook.sweep.vector import vector_blockers
+
+    spec, keep = sheet.spec, {}
+    varies = as_varies(sheet, {name: [str(sheet.values[name])]})
+    for n, d in spec.definitions.items():
+        if d.is_function or name not in tc.dependencies(spec, ex.Name(n)):
+            continue
+        out = as_outputs(sheet, {n: n})
+        try:
+            type_output(sheet, out[0])
+        except WorkbookError:  # a text or a condition
+            continue
+        if not vector_blockers(sheet, out, varies):
+            keep[n] = n
+    return keep
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("template", workbook.list_templates())
+def test_vector_sweeps_of_every_input_agree_with_serial(template):
+    """Every template, every number input at 0.97, 1 and 1.03 times its value: the vectorised
+    sweep of every output it reaches equals the serial sweep (fresh sheets, one per case)."""
+    sheet = workbook.load(template)
+    compared = 0
+    for name, spec in sheet.spec.inputs.items():
+        if spec.options:
+            continue
+        outs = _vectorisable_outputs(sheet, name)
+        if not outs:
+            continue
+        q = sheet.values[name]
+        values = [f"{float(q.magnitude) * k!r} {q.units:~}" for k in (0.97, 1.0, 1.03)]
+        vector = sw.sweep(sheet, {name: values}, outs, mode="vector")
+        serial = sw.sweep(sheet, {name: values}, outs, mode="serial")
+        assert vector.mode == "vector"
+        assert list(vector.table["error"]) == list(serial.table["error"]), name
+        pd.testing.assert_frame_equal(
+            vector.table, serial.table, check_exact=False, rtol=1e-9, atol=1e-12
+        )
+        compared += len(outs)
+    assert compared > 0
