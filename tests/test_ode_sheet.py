@@ -55,6 +55,48 @@ def test_solution_against_the_closed_form_in_a_table(tmp_path):
     np.testing.assert_allclose(cells, table.iloc[:, 1], rtol=1e-12)
 
 
+COOLING = """
+[inputs]
+T0 = "80 degC"
+Ta = "20 degC"
+h = "0.05 1/s"
+
+[arguments]
+t = { unit = "s" }
+
+[definitions]
+T60 = { expr = "T(60 s)", unit = "K" }
+
+[[ode]]
+name = "cool"
+time = "t := 0 .. 120"
+rtol = 1e-10
+states = [
+  { name = "T", unit = "degC", initial = "T0", derivative = "-h*(T - Ta)", atol = "1e-9 K" },
+]
+
+[[tables]]
+name = "sol"
+range = "t := 0, 30 .. 120"
+columns = { T = "degF" }
+"""
+
+
+def test_a_temperature_state_changes_by_differences(tmp_path):
+    """Newton's cooling with T in degC: T' is in delta_degC/s (the derivative was converted to
+    degC/s, an internal error) and its atol a difference; T read in degF and K against the
+    closed form Ta + (T0 - Ta) exp(-h t)."""
+    path = tmp_path / "cool.toml"
+    path.write_text(COOLING, encoding="utf-8")
+    sheet = Sheet(load_spec(path))
+    celsius = 20 + 60 * np.exp(-0.05 * np.arange(0, 121, 30.0))
+    table = sheet.table("sol")
+    np.testing.assert_allclose(table.iloc[:, 1], celsius * 9 / 5 + 32, rtol=1e-10)
+    assert sheet.evaluate("T60").to("K").magnitude == pytest.approx(
+        20 + 60 * np.exp(-3.0) + 273.15, rel=1e-11
+    )
+
+
 def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):
     sheet = _sheet(
         tmp_path,

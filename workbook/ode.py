@@ -717,7 +717,9 @@ def type_ode(typer, spec: OdeSpec) -> TypedOde:
         scope[s.name] = u if shape is None else (u, shape)
     ders, atols = [], []
     for s, u, shape in zip(spec.states, units, shapes):
-        der = in_unit(s.derivative, u / time_unit, f"{s.name}' (ode '{spec.name}')", False)
+        # a state in degC changes by differences: T' is in delta_degC per time unit
+        step = un.difference_unit(u)
+        der = in_unit(s.derivative, step / time_unit, f"{s.name}' (ode '{spec.name}')", False)
         if der.shape != shape:
             raise TemplateError(
                 f"ode '{spec.name}': the derivative of '{s.name}' is {_shape_word(der.shape)}, "
@@ -727,7 +729,7 @@ def type_ode(typer, spec: OdeSpec) -> TypedOde:
             )
         ders.append(der)
         atols.append(
-            in_unit(s.atol, u, f"atol of {s.name} (ode '{spec.name}')", True) if s.atol else None
+            in_unit(s.atol, step, f"atol of {s.name} (ode '{spec.name}')", True) if s.atol else None
         )
     first = in_unit(spec.first, time_unit, f"time range of ode '{spec.name}'", True)
     last = in_unit(spec.last, time_unit, f"time range of ode '{spec.name}'", True)
