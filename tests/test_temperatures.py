@@ -291,3 +291,32 @@ def test_a_sweep_output_shown_in_degf_adds_the_offset(tmp_path):
         t2 = [60, 70, 80, 90, 100]
         want = [(q(20, "degC") + (q(t, "degC") - q(20, "degC")) / 2).to("degF").m for t in t2]
         np.testing.assert_allclose(got, want, rtol=1e-13)
+
+
+OVER_A_TEMPERATURE = """
+[inputs]
+c = "2 J/K"
+T1 = "20 degC"
+
+[arguments]
+T = { unit = "degC" }
+
+[definitions]
+"cp(T)" = { expr = "c*(1 + 0.001*(T - T1)/(1 K))", unit = "J/K" }
+"dcp(T)" = { expr = "diff(cp(T), T)", unit = "J/K^2" }
+Q = { expr = "integral(cp(T), T, 20 degC, 80 degC)", unit = "J" }
+Qf = { expr = "integral(cp(T), T, 68 degF, 176 degF)", unit = "J" }
+Tr = { expr = "root(cp(T) - 2.05 J/K, T, 0 degC, 100 degC)", unit = "degF" }
+d = { expr = "dcp(40 degC)", unit = "J/K^2" }
+"""
+
+
+def test_builtins_over_a_temperature_variable_step_by_differences(tmp_path):
+    """integral over T in degC has the unit of cp times delta_degC, diff is per delta_degC
+    (both were internal errors: 'offset units in higher order'); against closed forms."""
+    sheet = workbook.load(write_template(tmp_path, OVER_A_TEMPERATURE))
+    heat = 2 * (60 + 0.001 * 60**2 / 2)  # J, the integral of cp from 20 to 80 degC
+    assert sheet.evaluate("Q").to("J").magnitude == pytest.approx(heat, rel=1e-13)
+    assert sheet.evaluate("Qf").to("J").magnitude == pytest.approx(heat, rel=1e-12)
+    assert sheet.evaluate("Tr").to("degC").magnitude == pytest.approx(45, rel=1e-12)
+    assert sheet.evaluate("d").to("J/K^2").magnitude == pytest.approx(0.002, rel=1e-13)

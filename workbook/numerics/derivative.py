@@ -18,6 +18,7 @@ import weakref
 from dataclasses import dataclass, field
 
 from .. import typed as ty
+from .. import units as un
 from ..errors import LimitError, NotSymbolic, TemplateError, WorkbookError
 from ..limits import within_seconds
 from ..visitor import Visitor
@@ -102,7 +103,7 @@ def formula(typer, body: ty.T, var: ty.TParam, order: int) -> ty.T:
     rec = typer.derivatives.get(id(body))
     if rec is None or rec.body is not body or rec.order != order:
         # a call not met at load (a tree rebuilt by an analysis): no location known
-        rec = Pending(body, var, order, body.unit / var.unit**order)
+        rec = Pending(body, var, order, body.unit / un.difference_unit(var.unit) ** order)
     if rec.error is not None:
         raise rec.error
     if rec.tree is None:

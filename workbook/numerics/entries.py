@@ -99,7 +99,9 @@ def _integral_unit(ctx, name: str, args: tuple) -> ty.T:
     sheet_tolerance(ctx.spec.meta)
     a = _in_var_unit(ctx, a, var, name, "the lower bound A")
     b = _in_var_unit(ctx, b, var, name, "the upper bound B")
-    return ty.TFunc(body.unit * var.unit, func=name, args=(body, var, a, b))
+    # over a temperature in degC the variable's steps are differences (delta_degC)
+    step = un.difference_unit(var.unit)
+    return ty.TFunc(body.unit * step, func=name, args=(body, var, a, b))
 
 
 def _extremum_unit(ctx, name: str, args: tuple) -> ty.T:
@@ -138,7 +140,7 @@ def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
     why = ctx.symbolic_refusal(body)
     if why:
         raise TemplateError(f"diff(): {why}")
-    unit = body.unit / var.unit**order
+    unit = body.unit / un.difference_unit(var.unit) ** order  # per delta_degC, not per degC
     pending(ctx, body, var, order, unit)
     return ty.TFunc(unit, func=name, args=args)
 
