@@ -402,3 +402,20 @@ def test_a_zip_bomb_is_refused_before_it_inflates(tmp_path, capsys):
                 member.write(block)
     assert main(["import", str(bomb), "--out", str(tmp_path)]) == 2
     assert "inflates to" in capsys.readouterr().err
+
+
+def test_vba_rounding_goes_half_to_even_for_negative_numbers_too():
+    """CInt, CLng and Round of VBA (and the operands of \\ and Mod) round half to even:
+    -1.5 is -2 and -2.5 is -2 (the translation gave -1 for -1.5: an odd floor was found
+    only when positive); Python's round is the reference."""
+    import numpy as np
+
+    import workbook
+    from workbook.excelimport.vbaprogram import bankers
+
+    xs = np.arange(-7.5, 7.51, 0.25)
+    sheet = workbook.loads(
+        f'[arguments]\nx = {{ unit = "" }}\n[definitions]\n"r(x)" = "{bankers("x")}"\n'
+    )
+    got = sheet.evaluate("r", xs).magnitude
+    assert got.tolist() == [float(round(x)) for x in xs]

@@ -54,7 +54,8 @@ class FunctionInfo:
 def bankers(text: str) -> str:
     """VBA's rounding to an integer (half to even) as an expression of the language."""
     f = f"floor({text} + 0.5)"
-    return f"({f} - 1 if {f} == {text} + 0.5 and mod({f}, 2) == 1 otherwise {f})"
+    # an odd f at a half goes down: mod keeps the sign of f, so mod(-1, 2) is -1, not 1
+    return f"({f} - 1 if {f} == {text} + 0.5 and mod({f}, 2) != 0 otherwise {f})"
 
 
 @dataclass
