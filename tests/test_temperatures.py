@@ -320,3 +320,12 @@ def test_builtins_over_a_temperature_variable_step_by_differences(tmp_path):
     assert sheet.evaluate("Qf").to("J").magnitude == pytest.approx(heat, rel=1e-12)
     assert sheet.evaluate("Tr").to("degC").magnitude == pytest.approx(45, rel=1e-12)
     assert sheet.evaluate("d").to("J/K^2").magnitude == pytest.approx(0.002, rel=1e-13)
+
+
+def test_a_compound_unit_with_an_offset_temperature_is_a_unit_error():
+    """pint refuses degC inside a compound unit ('offset units in higher order'); the one
+    conversion of the engine says so as a UnitError (exit 2), not pint's error (exit 3)."""
+    r = un.registry()
+    src = r.Unit("joule") / r.Unit("kelvin") / r.Unit("degree_Celsius")
+    with pytest.raises(UnitError, match="inside a compound unit a temperature is a difference"):
+        un.factor(src, r.Unit("joule") / r.Unit("kelvin") ** 2)

@@ -160,7 +160,13 @@ def factor(src: pint.Unit, dst: pint.Unit) -> float:
             f"{pretty(src)} to {pretty(dst)} is not a scale factor (an absolute temperature "
             "with an offset)"
         )
-    return float(registry().Quantity(1.0, src).to(dst).magnitude)
+    try:
+        return float(registry().Quantity(1.0, src).to(dst).magnitude)
+    except pint.errors.PintError as err:  # degC inside a compound unit: pint refuses it
+        raise UnitError(
+            f"{pretty(src)} cannot be converted to {pretty(dst)}: {err}; inside a compound "
+            "unit a temperature is a difference (write delta_degC or K)"
+        ) from None
 
 
 def affine(src: pint.Unit, dst: pint.Unit) -> tuple[float, float]:
