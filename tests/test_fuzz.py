@@ -33,11 +33,13 @@ R1 = "20 mm"
 omega = "104.6 1/s"
 law = { value = "stepped", options = ["stepped", "harmonic"] }
 n = "3"
+Tc = "20 degC"
 
 [arguments]
 phi = { unit = "deg" }
 t = { unit = "s" }
 x = { unit = "" }
+Ta = { unit = "degC" }
 
 [definitions]
 "h(phi)" = "R1*sin(phi)"
@@ -46,8 +48,10 @@ k = "omega*R1"
 """
 
 NAMES = ["R1", "omega", "law", "n", "phi", "t", "x", "k", "pi", "h", "g", "sin", "nope", "__x"]
+NAMES += ["Tc", "Ta"]  # an absolute temperature, as an input and as a bound variable
 FUNCS = sorted(REGISTRY) + ["h", "g", "k", "R1", "log", "nope", "eval", "open"]
 ATOMS = ["0", "1", "2.5", "1e308", "1e-320", "-3", "0.0", "1e999", "10", '"stepped"', '"x"']
+ATOMS += ["20 degC", "5 delta_degC", "300 K", "2 mm"]
 OPS = ["+", "-", "*", "/", "^", "**", "<", "<=", ">", ">=", "==", "!=", " and ", " or ", "%", "//"]
 JUNK = ["(", ")", ",", ".", "[", "]", ":", "lambda", " if ", " else ", "'", "__", "@", "\\", "\n"]
 
@@ -88,8 +92,16 @@ def garbage():
 
 
 def check(sheet: Sheet, text: str) -> None:
-    scope = {"phi": sheet.spec.arguments["phi"].binding_unit, "x": sheet.typer.dimensionless}
-    values = {"phi": np.array([0.0, 30.0, 90.0, 180.0]), "x": np.array([-1.0, 0.0, 0.5, 2.0])}
+    scope = {
+        "phi": sheet.spec.arguments["phi"].binding_unit,
+        "x": sheet.typer.dimensionless,
+        "Ta": sheet.spec.arguments["Ta"].binding_unit,
+    }
+    values = {
+        "phi": np.array([0.0, 30.0, 90.0, 180.0]),
+        "x": np.array([-1.0, 0.0, 0.5, 2.0]),
+        "Ta": np.array([-40.0, 0.0, 20.0, 100.0]),
+    }
     try:
         node = ex.parse(text, what="fuzz")
         typed = sheet.typer.expression(node, scope, "fuzz")
