@@ -944,7 +944,7 @@ def _estimate_finding(sheet, name: str, sol: Solution):
     names = flat_names(sol.states, sol.sizes)
     units = [u for u, n in zip(typed.units, typed.sizes) for _ in range(1 if n is None else n)]
     k = est.worst
-    unit = un.pretty(units[k])
+    unit = un.pretty(un.difference_unit(units[k]))  # an error is a difference: delta_degC
     t_unit = un.pretty(typed.time_unit)
     what = (
         f"global error estimate: {names[k]} off by up to {est.errors[k]:.3g} {unit}".rstrip()
