@@ -1048,6 +1048,30 @@ def test_diff_of_functions_nested_in_themselves_is_bounded(tmp_path, monkeypatch
     assert float(sheet.evaluate("g", x=x).magnitude) == pytest.approx(expected, rel=1e-12)
 
 
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_a_time_limit_survives_an_alarm_swallowed_by_a_weakref_callback():
+    # SymPy's caches drop entries in weakref callbacks; an alarm landing there is printed and
+    # ignored by Python, and a single alarm let the diff run on for minutes
+    import weakref
+
+    from workbook.limits import within_seconds
+
+    class Cached:
+        pass
+
+    def busy(seconds: float) -> None:
+        start = time.monotonic()
+        while time.monotonic() - start < seconds:
+            pass
+
+    with pytest.raises(LimitError, match="spinning took more than 0.1 s"):
+        with within_seconds(0.1, "spinning"):
+            entry = Cached()
+            weakref.finalize(entry, busy, 0.3)  # the first alarm lands in this callback
+            del entry
+            busy(30.0)
+
+
 # -- --inputs bounded by what openpyxl parses ---------------------------------------------
 
 

@@ -265,11 +265,17 @@ def exhausted(exc: BaseException) -> LimitError:
     return LimitError("too large for memory (an array or a computation could not be allocated)")
 
 
+#: Seconds between repeated alarms once the time is up: an alarm that lands in a weakref
+#: callback or a ``__del__`` is printed and ignored by Python, so one alarm is not enough.
+ALARM_REPEAT_SECONDS = 0.05
+
+
 @contextlib.contextmanager
 def within_seconds(seconds: float, what: str):
     """Stop the block with a LimitError after ``seconds`` of wall-clock time (SIGALRM: pure
-    Python work such as SymPy's is interrupted between bytecodes). Only in the main thread of
-    a process where no other timer is set; elsewhere the block runs unbounded."""
+    Python work such as SymPy's is interrupted between bytecodes; the alarm repeats until the
+    block has stopped). Only in the main thread of a process where no other timer is set;
+    elsewhere the block runs unbounded."""
     if (
         threading.current_thread() is not threading.main_thread()
         or signal.getitimer(signal.ITIMER_REAL)[0] > 0
@@ -280,18 +286,28 @@ def within_seconds(seconds: float, what: str):
     class _Expired(Exception):
         pass
 
+    armed = [True]
+
     def expire(signum, frame):
-        raise _Expired
+        if armed[0]:
+            raise _Expired
 
     previous = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    signal.setitimer(signal.ITIMER_REAL, seconds, ALARM_REPEAT_SECONDS)
+    expired = False
     try:
-        yield
+        try:
+            yield
+        finally:
+            armed[0] = False  # an alarm raised before this line is caught just below
     except _Expired:
-        raise LimitError(f"{what} took more than {seconds:g} s") from None
+        expired = True
     finally:
+        armed[0] = False
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+    if expired:
+        raise LimitError(f"{what} took more than {seconds:g} s")
 
 
 _matrix_work: contextvars.ContextVar[list[float] | None] = contextvars.ContextVar(
