@@ -124,8 +124,10 @@ def test_bad_input_changes_nothing(previous):
 
 # -- Ctrl-C from outside ------------------------------------------------------------------------
 CHILD = r"""
-import sys, time
+import signal, sys, time
 from pathlib import Path
+# as at a terminal: a shell that starts the test run in the background ignores SIGINT in it
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from workbook import xlsx
 from workbook.cli import main
 
