@@ -1,6 +1,7 @@
 """Hostile worksheets: each is refused at load or stopped by a documented limit, with a message.
 
-Every case runs the real command line in a fresh interpreter with an address-space limit
+Every case runs the real command line in a fresh process (forked from one interpreter that
+imported the engine, tests/guard_server.py) with an address-space limit
 (RLIMIT_AS), a CPU-time limit and a wall-clock timeout. An audit hook (PEP 578) installed
 before the command runs records every file opened for writing, every file read outside the
 Python installation, the package and the case's folder, every import of a module that could
@@ -11,12 +12,10 @@ from __future__ import annotations
 
 import json
 import os
-import resource
-import subprocess
-import sys
 import time
 
 import pytest
+from guard_server import SERVER_INSTANCE
 
 from workbook import excelform, expr, numeric, ode, ranges, runtime, sheet, template, typecheck
 from workbook import limits as file_limits
@@ -28,66 +27,23 @@ MEMORY = 1536 * 2**20  # bytes of address space for one run
 CPU_SECONDS = 60
 WALL_SECONDS = 120  # generous: CI machines are shared; a refused case takes about 1 s of CPU
 
-GUARD = r"""
-import json, os, sys
-import numpy, pint, workbook, workbook.cli, workbook.sheet, workbook.template, workbook.units
-import workbook.typecheck, workbook.numeric, workbook.checks, workbook.blocks
-workbook.units.registry()
-roots = tuple(os.path.realpath(p) for p in {sys.prefix, sys.base_prefix, sys.exec_prefix,
-              os.path.dirname(os.path.dirname(workbook.__file__)), os.getcwd()})
-SYSTEM = {"subprocess", "socket", "ctypes", "pickle", "shutil", "multiprocessing", "pty",
-          "webbrowser", "http", "urllib", "ftplib", "smtplib", "telnetlib", "code", "pdb"}
-SPAWN = ("os.system", "os.exec", "os.posix_spawn", "os.spawn", "os.fork", "subprocess.Popen",
-         "os.remove", "os.rename", "os.rmdir", "os.unlink", "shutil.", "socket.")
-events = []
-def hook(event, args):
-    if event == "open":
-        path, mode, flags = args
-        if isinstance(path, int) or path is None:
-            return
-        path = os.fsdecode(path)
-        writing = (isinstance(mode, str) and any(c in mode for c in "wax+")) or (
-            isinstance(flags, int) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT))
-        real = os.path.realpath(path)
-        if writing or not real.startswith(roots):
-            events.append(f"open {path} {mode!r}")
-    elif event == "import" and args[0].split(".")[0] in SYSTEM:
-        events.append(f"import {args[0]}")
-    elif event.startswith(SPAWN):
-        events.append(event)
-sys.addaudithook(hook)
-from workbook.cli import main
-code = main(sys.argv[1:])
-print("AUDIT " + json.dumps(events))
-sys.exit(code)
-"""
-
-
-def _limits():
-    resource.setrlimit(resource.RLIMIT_AS, (MEMORY, MEMORY))
-    resource.setrlimit(resource.RLIMIT_CPU, (CPU_SECONDS, CPU_SECONDS))
-
 
 def guarded(tmp_path, text: str | bytes, *args: str):
+    """Run the command line on ``text`` (or ``args``) in a fresh guarded process."""
     path = tmp_path / "hostile.toml"
     if isinstance(text, bytes):
         path.write_bytes(text)
     else:
         path.write_text(text, encoding="utf-8")
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
     start = time.monotonic()
-    out = subprocess.run(
-        [sys.executable, "-c", GUARD, *(args or ("run", path.name))],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        timeout=WALL_SECONDS,
-        preexec_fn=_limits,
-        env=env,
+    out = SERVER_INSTANCE.run(
+        tmp_path,
+        list(args or ("run", path.name)),
+        memory=MEMORY,
+        cpu=CPU_SECONDS,
+        wall=WALL_SECONDS,
     )
     out.elapsed = time.monotonic() - start
-    audit = [line for line in out.stdout.splitlines() if line.startswith("AUDIT ")]
-    out.events = json.loads(audit[-1][6:]) if audit else None
     return out
 
 
