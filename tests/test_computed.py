@@ -22,7 +22,7 @@ STAGES_BEFORE = (
     "workbook/typearrays.py",
     "workbook/numeric.py",
     "workbook/numerics/",
-    "workbook/program.py",
+    "workbook/program/",
     "workbook/runtime.py",
     "workbook/sheet.py",
     "workbook/given_find.py",

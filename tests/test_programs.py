@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook import program as pg
+from workbook.program.run import MAX_STEPS
 from workbook.sheet import Sheet
 from workbook.template import load_spec
 
@@ -119,7 +119,7 @@ def test_a_while_that_never_ends_is_stopped_by_the_step_limit(tmp_path):
     with pytest.raises(workbook.WorkbookError, match=r"ran 1,000,000 statements") as info:
         sheet.evaluate("loop", 1)
     assert "in 'loop'" in str(info.value) and "limit exceeded" in str(info.value)
-    assert pg.MAX_STEPS == 1_000_000
+    assert MAX_STEPS == 1_000_000
 
 
 def test_text_values_conditions_and_comparisons(tmp_path):

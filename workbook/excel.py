@@ -287,7 +287,7 @@ class ExcelPrinter(Visitor):
         return text if shift == 0 else f"{text}+{shift}" if shift > 0 else f"{text}{shift}"
 
     def visit_TProgram(self, t, s):
-        from .program import excel_value
+        from .program.excel import excel_value
 
         return excel_value(t.program, lambda e, sub: self.print(e, sub), s), ATOM
 

@@ -402,7 +402,7 @@ class Evaluator(Visitor):
         )
 
     def visit_TProgram(self, t: tc.TProgram) -> Fn:
-        from .program import NoValue, compile_program
+        from .program.run import NoValue, compile_program
 
         run = compile_program(t.program, self.compile, t.name)
         params, is_text, name = t.params, t.text, t.name

@@ -194,7 +194,7 @@ class Definition:
     note: str = ""
     unit: pint.Unit | None = None  # display unit, optional
     line: int | None = None
-    program: Any = None  # workbook.program.Program: a body of statements
+    program: Any = None  # workbook.program.statements.Program: a body of statements
     ode: tuple[str, int] | None = None  # a state of an [[ode]]: (ode name, state index)
     limits: Limits | None = None  # what its values must meet (positive = true, min, max)
 
@@ -209,7 +209,7 @@ class Definition:
         if self.branches is not None:
             return [x for b in self.branches for x in (b.value, b.condition) if x is not None]
         if self.program is not None:
-            from .program import expressions
+            from .program.statements import expressions
 
             return list(expressions(self.program.body))
         return []  # an ODE state: its section's expressions are listed by the sheet
@@ -1032,9 +1032,9 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
         elif "pieces" in f:
             raw = raw["pieces"]
         elif "program" in raw:
-            from . import program
+            from .program.parse import parse as parse_program
 
-            body = program.parse(raw["program"], what=f"program of '{name}'")
+            body = parse_program(raw["program"], what=f"program of '{name}'")
             display = un.unit(unit_text, what=name) if unit_text is not None else None
             text = raw["program"].strip()
             return Definition(name, params, None, None, text, note, display, line, body)

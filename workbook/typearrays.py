@@ -281,7 +281,7 @@ class ArrayTyping:
 
     # -- definitions written as programs or as ODE states ----------------------------------
     def program_body(self, d, scope: dict[str, pint.Unit]) -> T:
-        from . import program as pg
+        from .program import typer as pg
 
         def type_expr(node, sc):
             return self.visit(node, sc)

@@ -1008,7 +1008,7 @@ def _closure(spec: SheetSpec, todo: list[str]) -> set[str]:
         local: set[str] = set(d.params)
         bodies = d.expressions()
         if d.program is not None:
-            from .program import names as program_names
+            from .program.statements import names as program_names
 
             todo.extend(program_names(d.program) - local)
             continue

@@ -147,7 +147,7 @@ class TProgram(T):
     typed program, ``params`` the names of the arguments it reads."""
 
     name: str = ""
-    program: object = None  # workbook.program.TypedProgram
+    program: object = None  # workbook.program.typer.TypedProgram
     params: tuple = ()
     matrices: tuple = ()  # the parameters that are vectors or matrices
 

@@ -1,0 +1,253 @@
+"""Running a typed program: one closure per program for the numeric back end."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from .. import runtime as rt
+from ..errors import LimitError, TemplateError
+from ..typed import is_runtime
+from .statements import (
+    Assign,
+    Break,
+    Continue,
+    For,
+    If,
+    Return,
+    SetItem,
+    Stmt,
+    Value,
+    While,
+    walk,
+)
+from .typer import TypedProgram
+
+#: Statements one call of a program may execute (a `while` that never ends stops here).
+MAX_STEPS = 1_000_000
+
+
+# -- running ----------------------------------------------------------------------------------
+class _Break(Exception):
+    pass
+
+
+class _Continue(Exception):
+    pass
+
+
+class _Return(Exception):
+    def __init__(self, value):
+        self.value = value
+
+
+class NoValue(Exception):
+    """The program ended without a value (the numeric back end names the function)."""
+
+
+_NONE = object()
+
+
+def compile_program(
+    typed: TypedProgram, compile_expr: Callable[[Any], Callable], name: str
+) -> Callable[[dict], Any]:
+    """A closure env -> value for scalar arguments (the back end loops over arrays)."""
+    from ..ranges import range_values
+
+    steps = [0]
+
+    def tick(s: Stmt):
+        steps[0] += 1
+        if steps[0] > MAX_STEPS:
+            raise LimitError(
+                f"the program of '{name}' ran {MAX_STEPS:,} statements without ending "
+                f"(line {s.line}: a loop that never ends?)",
+                definition=name,
+            )
+
+    def block(stmts):
+        compiled = [stmt(s) for s in stmts]
+
+        def run(env, last):
+            for c in compiled:
+                last = c(env, last)
+            return last
+
+        return run
+
+    def stmt(s: Stmt):
+        if isinstance(s, Assign):
+            f, n = compile_expr(s.value), s.name
+
+            def assign(env, last):
+                tick(s)
+                value = f(env)  # a matrix is copied: its elements may be set later
+                if isinstance(value, np.ndarray) and value.dtype == object:
+                    env[n] = value.copy()
+                else:
+                    env[n] = np.array(value, dtype=float) if np.ndim(value) else value
+                env.setdefault(_OWNED, set()).add(n)
+                return last
+
+            return assign
+        if isinstance(s, SetItem):
+            from ..matrix import element_index
+
+            f, n, origin, grow = compile_expr(s.value), s.name, s.origin, s.grow
+            idx = [compile_expr(i) for i in s.indices]
+            if is_runtime(grow):
+                what = f"program of '{name}', line {s.line}: {n}[...]"
+
+                def set_runtime(env, last):
+                    tick(s)
+                    _own(env, n)
+                    at = [i(env) for i in idx]
+                    env[n] = rt.set_item(env.get(n), at, f(env), origin=origin, what=what)
+                    return last
+
+                return set_runtime
+
+            def set_item(env, last):
+                tick(s)
+                _own(env, n)
+                if grow is not None:  # made, or grown with zeros, to its length at load
+                    old = env.get(n)
+                    if old is None or np.shape(old)[:2] != tuple(grow):
+                        target = np.zeros(grow)
+                        if old is not None:
+                            old = np.asarray(old, dtype=float).reshape(np.shape(old)[0], -1)
+                            target[: old.shape[0], : old.shape[1]] = old
+                        env[n] = target
+                target = env[n]
+                at = element_index(target.shape, [i(env) for i in idx], origin, f"{n}[...]")
+                target[at] = f(env)
+                return last
+
+            return set_item
+        if isinstance(s, Value):
+            f = compile_expr(s.value)
+
+            def value(env, last):
+                tick(s)
+                return _result(f(env))  # a local set after this line does not change it
+
+            return value
+        if isinstance(s, Return):
+            f = compile_expr(s.value)
+
+            def ret(env, last):
+                tick(s)
+                raise _Return(f(env))
+
+            return ret
+        if isinstance(s, Break):
+
+            def brk(env, last):
+                raise _Break
+
+            return brk
+        if isinstance(s, Continue):
+
+            def cont(env, last):
+                raise _Continue
+
+            return cont
+        if isinstance(s, If):
+            branches = [(compile_expr(c), block(b)) for c, b in s.branches]
+            other = block(s.otherwise) if s.otherwise is not None else None
+
+            def if_(env, last):
+                tick(s)
+                for c, b in branches:
+                    if bool(c(env)):
+                        return b(env, last)
+                return other(env, last) if other is not None else last
+
+            return if_
+        if isinstance(s, For):
+            first, last_ = compile_expr(s.first), compile_expr(s.last)
+            second = compile_expr(s.second) if s.second is not None else None
+            body, var = block(s.body), s.var
+
+            def for_(env, last):
+                where = f"program of '{name}', line {s.line}"
+                values = range_values(
+                    rt.number(first(env), where),
+                    rt.number(second(env), where) if second is not None else None,
+                    rt.number(last_(env), where),
+                    what=where,
+                )
+                for v in values:
+                    tick(s)
+                    env[var] = float(v)
+                    try:
+                        last = body(env, last)
+                    except _Break:
+                        break
+                    except _Continue:
+                        continue
+                return last
+
+            return for_
+        if isinstance(s, While):
+            cond, body = compile_expr(s.condition), block(s.body)
+
+            def while_(env, last):
+                while True:
+                    tick(s)
+                    if not bool(cond(env)):
+                        return last
+                    try:
+                        last = body(env, last)
+                    except _Break:
+                        return last
+                    except _Continue:
+                        continue
+
+            return while_
+        raise TypeError(s)  # pragma: no cover
+
+    main = block(typed.body)
+    # a local made by its elements when the program runs is the number 0 until its first
+    # element is set (Mathcad's start of a local): rows(v) is 0, so v[rows(v) + 1] appends
+    made = {s.name for s in walk(typed.body) if isinstance(s, SetItem) and is_runtime(s.grow)}
+
+    def run(env: dict):
+        steps[0] = 0
+        local = dict(env)
+        for n in made:
+            local.setdefault(n, 0.0)
+        try:
+            out = main(local, _NONE)
+        except _Return as r:
+            return _result(r.value)
+        except (_Break, _Continue):
+            raise TemplateError(f"'break'/'continue' outside a loop in '{name}'") from None
+        if out is _NONE:
+            raise NoValue(name)
+        return _result(out)
+
+    return run
+
+
+def _result(value):
+    """A program's value: an array is the program's own copy."""
+    if isinstance(value, np.ndarray):
+        return value.copy() if value.dtype == object else np.array(value)
+    return value
+
+
+#: Where a program run keeps the names of the locals it made (an argument's array is copied
+#: before its first element is set); not a valid name, so no local can meet it.
+_OWNED = "#owned"
+
+
+def _own(env: dict, name: str) -> None:
+    """Before the first element of ``name`` is set in this run: an array the run did not
+    make (an argument's, the caller's) is replaced by a copy of it."""
+    owned = env.setdefault(_OWNED, set())
+    if name not in owned and isinstance(env.get(name), np.ndarray):
+        env[name] = env[name].copy()
+    owned.add(name)
