@@ -168,6 +168,44 @@ def test_mistakes_say_what_to_write(tmp_path, expr, message):
         workbook.load(write_template(tmp_path, text))
 
 
+@pytest.mark.parametrize(
+    "text,tree",
+    [
+        ("85 %", ex.Quantity(85.0, "%")),
+        ("100% - p", ex.Binary("-", ex.Quantity(100.0, "%"), ex.Name("p"))),
+        ("15%/t", ex.Binary("/", ex.Quantity(15.0, "%"), ex.Name("t"))),
+        ("1 - 15 %", ex.Binary("-", ex.Number(1.0), ex.Quantity(15.0, "%"))),
+        ("7 % - 2", ex.Binary("-", ex.Quantity(7.0, "%"), ex.Number(2.0))),
+    ],
+)  # fmt: skip
+def test_a_number_then_percent_is_a_percentage(text, tree):
+    assert ex.parse(text) == tree
+    assert ex.parse(ex.to_text(tree)) == tree
+
+
+@pytest.mark.parametrize("text", ["7 % 2", "7 % (2)", "a % b", "7 % -2", "7 % +x"])
+def test_percent_between_two_values_is_refused_not_read_as_a_remainder(text):
+    with pytest.raises(WorkbookError, match=r"mod\(x, y\) is the remainder"):
+        ex.parse(text)
+
+
+def test_a_percentage_in_a_formula_is_live_in_excel(tmp_path):
+    text = (
+        '[inputs]\nP_in = "12 kW"\nloss = "4 %"\n\n[definitions]\n'
+        'P_out = { expr = "P_in*(100% - loss - 2.5 %)", unit = "kW" }\n'
+    )
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert math.isclose(sheet.evaluate("P_out").to("kW").magnitude, 12 * 0.935, rel_tol=1e-14)
+    path = sheet.write_xlsx(tmp_path / "p.xlsx")
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    values = [
+        float(r.value[0, 0])
+        for key, r in solution.items()
+        if key.upper().endswith("DEFINITIONS'!B2") or key.upper().endswith("DEFINITIONS!B2")
+    ]
+    assert values and math.isclose(values[0], 11.22, rel_tol=1e-12), values
+
+
 @pytest.mark.slow
 def test_libreoffice_recalculates_literals_constants_and_a_log_range(tmp_path):
     """The quantities, g, e and pi, and a logspace table, recalculated by LibreOffice."""

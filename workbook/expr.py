@@ -172,7 +172,7 @@ def _otherwise_as_else(source: str) -> str:
     return out
 
 
-_MAYBE_LITERAL = re.compile(r"[\d.]\s*[^\W\d]")
+_MAYBE_LITERAL = re.compile(r"[\d.]\s*(?:[^\W\d]|%)")
 #: Words that may follow a number without being its unit (``1 if x > 0 otherwise 0``).
 _NOT_UNITS = frozenset({"if", "else", "and", "or", "not", "in", "is", "for", "otherwise"})
 
@@ -213,6 +213,23 @@ def _quantity_literals(source: str) -> str:
             end = _unit_end(tokens, i + 1)
             spans.append((at(num.start), at(num.end), at(name.start), at(tokens[end - 1].end)))
             i = end
+        elif num.type == tokenize.NUMBER and name.string == "%" and name.start[0] == num.end[0]:
+            # a percentage (Mathcad's 15%); the language has no % operator, so '7 % 2' (a
+            # remainder in Python) stays an error that points to mod(x, y)
+            after = tokens[i + 2] if i + 2 < len(tokens) else None
+            signed = (  # '7 % -2', a remainder by -2 as Python reads it: left an error too
+                after is not None
+                and after.string in ("-", "+")
+                and i + 3 < len(tokens)
+                and tokens[i + 3].start == after.end
+                and after.start != name.end
+            )
+            if not signed and (
+                after is None
+                or not (after.type in (tokenize.NUMBER, tokenize.NAME) or after.string == "(")
+            ):
+                spans.append((at(num.start), at(num.end), at(name.start), at(name.end)))
+            i += 2
         else:
             i += 1
     out = source
@@ -292,6 +309,11 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
     if isinstance(node, ast.BinOp):
         if isinstance(node.op, ast.MatMult):
             return _quantity(node, text, what)
+        if isinstance(node.op, ast.Mod):
+            raise TemplateError(
+                f"{what}: % between two values is not an operator of the language in {text!r}: "
+                "mod(x, y) is the remainder, and a percentage is a number followed by % (15 %)"
+            )
         if type(node.op) not in _BINOPS:
             raise TemplateError(
                 f"{what}: operator {type(node.op).__name__} not allowed in {text!r} (use + - * / ^)"
