@@ -82,7 +82,7 @@ HOSTILE = {
     "keyword_argument": (define("max(a=1)"), "keyword arguments are not allowed"),
     "starred": (define("max(*R1)"), "starred arguments are not allowed"),
     "string_repeat": (define("'a' * 10**9"), "text can only be compared"),
-    "string_format": (define("'%s' % R1"), "operator Mod not allowed"),
+    "string_format": (define("'%s' % R1"), "% between two values is not an operator"),
     "fstring": (define("f'{R1.__class__}'"), "JoinedStr is not allowed"),
     "bytes": (define("b'abc'"), "is not allowed"),
     "tuple": (define("(1, 2)"), "Tuple is not allowed"),
