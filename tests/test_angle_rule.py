@@ -208,3 +208,43 @@ def test_a_program_loop_is_not_log_spaced(tmp_path):
 
     with pytest.raises(workbook.WorkbookError, match="for tables, charts and sweep outputs"):
         parse_range("k := logspace(1, 100, 3)")
+
+
+RATIOS = """
+[inputs]
+th = "45 deg"
+a = "20 mm"
+b = "10 mm"
+T = "10 degC"
+K = "100 K"
+p = "15 %"
+
+[definitions]
+"""
+
+
+@pytest.mark.parametrize(
+    "written,computed",
+    [
+        ("(20 mm / 10 mm) + th", "a/b + th"),
+        ("th - 20 mm/10 mm", "th - a/b"),
+        ("(10 degC / 100 K) - (0.5 - th)", "T/K - (0.5 - th)"),
+        ("max(4 m/2 m, th)", "max(a/b, th)"),
+        ("15 %*100 + th", "p*100 + th"),
+        ("-(20 mm/10 mm) + th", "-(a/b) + th"),
+    ],
+)
+def test_a_ratio_of_written_quantities_is_radians_as_a_ratio_of_inputs(tmp_path, written, computed):
+    # a ratio of literals was folded into a constant that looked bare, and was read as
+    # degrees next to an angle: (20 mm / 10 mm) + th was 47 deg, a/b + th 2 rad + 45 deg
+    text = RATIOS + f'w = "{written}"\nc = "{computed}"\n'
+    sheet = workbook.load(write_template(tmp_path, text))
+    w, c = sheet.evaluate("w"), sheet.evaluate("c")
+    assert math.isclose(w.to("rad").magnitude, c.to("rad").magnitude, rel_tol=1e-14)
+
+
+def test_bare_numbers_next_to_an_angle_are_still_degrees(tmp_path):
+    text = RATIOS + 'w = "2 + th"\nv = "(90/2) + th"\n'
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert math.isclose(sheet.evaluate("w").to("deg").magnitude, 47.0, rel_tol=1e-14)
+    assert math.isclose(sheet.evaluate("v").to("deg").magnitude, 90.0, rel_tol=1e-14)

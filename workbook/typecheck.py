@@ -382,7 +382,7 @@ class Typer(ArrayTyping, Visitor):
         if f == 1.0:
             return _with_unit(t, target)
         if isinstance(t, TConst) and t.unit.dimensionality:  # 20 mm in m: 0.02, as Excel shows
-            return TConst(target, value=t.value * f)
+            return TConst(target, value=t.value * f, derived=True)
         return TScale(target, child=t, factor=f, shape=t.shape)
 
     def _temperature(self, t: T, target: pint.Unit, kinds, where: str) -> T:
@@ -402,7 +402,7 @@ class Typer(ArrayTyping, Visitor):
             )
         f, offset = un.affine(t.unit, target)
         if isinstance(t, TConst):
-            return TConst(target, value=t.value * f + offset)
+            return TConst(target, value=t.value * f + offset, derived=True)
         scaled = _with_unit(t, target) if f == 1.0 else TScale(target, child=t, factor=f)
         if offset == 0.0:
             return scaled
@@ -483,7 +483,7 @@ class Typer(ArrayTyping, Visitor):
                 err.message += "; a space ends the unit of a number (2 m * x is 2 m times x)"
                 err.args = (err.message,)
             raise
-        return TConst(unit, value=node.value)
+        return TConst(unit, value=node.value, derived=True)
 
     def visit_Text(self, node: ex.Text, scope) -> T:
         return TText(self.dimensionless, value=node.value, text=True)
@@ -501,7 +501,7 @@ class Typer(ArrayTyping, Visitor):
         if node.op == "+":
             return child
         if isinstance(child, TConst):
-            return TConst(child.unit, value=-child.value)
+            return TConst(child.unit, value=-child.value, derived=child.derived)
         return TUnary(child.unit, op="-", child=child, shape=child.shape)
 
     def visit_Logic(self, node: ex.Logic, scope) -> T:
@@ -575,16 +575,18 @@ class Typer(ArrayTyping, Visitor):
             right = self.convert(right, left.unit, "sum")
             if isinstance(left, TConst) and isinstance(right, TConst):
                 v = left.value + right.value if op == "+" else left.value - right.value
-                return TConst(left.unit, value=v)
+                return TConst(left.unit, value=v, derived=_derived(left, right))
             return TBinary(left.unit, op=op, left=left, right=right)
         left, right = self.kelvin(left), self.kelvin(right)
         if op == "*":
             if isinstance(left, TConst) and isinstance(right, TConst):
-                return TConst(left.unit * right.unit, value=left.value * right.value)
+                v = left.value * right.value
+                return TConst(left.unit * right.unit, value=v, derived=_derived(left, right))
             return TBinary(left.unit * right.unit, op=op, left=left, right=right)
         if op == "/":
             if isinstance(left, TConst) and isinstance(right, TConst) and right.value != 0:
-                return TConst(left.unit / right.unit, value=left.value / right.value)
+                v = left.value / right.value
+                return TConst(left.unit / right.unit, value=v, derived=_derived(left, right))
             return TBinary(left.unit / right.unit, op=op, left=left, right=right)
         # power
         if not right.unit.dimensionless or right.unit.dimensionality:
@@ -608,7 +610,7 @@ class Typer(ArrayTyping, Visitor):
                 raise TemplateError(
                     f"{left.value:g}^{right.value:g} is not a finite number"
                 ) from None
-            return TConst(self.dimensionless, value=v)
+            return TConst(self.dimensionless, value=v, derived=_derived(left, right))
         return TBinary(self.dimensionless, op="^", left=left, right=right)
 
     def _temperature_sum(self, op: str, left: T, right: T) -> tuple[T, T, pint.Unit | None]:
@@ -973,8 +975,14 @@ def meeting(values) -> list[T]:
 def _with_unit(t: T, unit: pint.Unit) -> T:
     """Same node, relabelled with an equal unit (factor exactly 1)."""
     if isinstance(t, TConst):
-        return TConst(unit, value=t.value)
+        return TConst(unit, value=t.value, derived=t.derived or t.unit != unit)
     return TScale(unit, child=t, factor=1.0, shape=t.shape)
+
+
+def _derived(*consts: TConst) -> bool:
+    """A constant folded from these is derived when one of them is, or has a unit."""
+    dimensionless = un.registry().dimensionless
+    return any(c.derived or c.unit != dimensionless for c in consts)
 
 
 def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:

@@ -31,6 +31,9 @@ class T:
 @dataclass(frozen=True, eq=False)
 class TConst(T):
     value: float = 0.0
+    #: folded from quantities (``20 mm/10 mm``, ``15 %`` as a plain number): a plain number,
+    #: but not one written bare, so never read as degrees next to an angle
+    derived: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,8 +227,9 @@ _CHILDREN = _Children()
 
 
 def is_bare(t: T) -> bool:
-    """A plain number written in the expression (a literal, or literals folded)."""
-    return isinstance(t, TConst) and t.unit == un.registry().dimensionless
+    """A plain number written in the expression (a literal, or plain literals folded; not
+    a ratio of quantities)."""
+    return isinstance(t, TConst) and t.unit == un.registry().dimensionless and not t.derived
 
 
 def is_zero(t: T) -> bool:
