@@ -329,3 +329,23 @@ def test_a_compound_unit_with_an_offset_temperature_is_a_unit_error():
     src = r.Unit("joule") / r.Unit("kelvin") / r.Unit("degree_Celsius")
     with pytest.raises(UnitError, match="inside a compound unit a temperature is a difference"):
         un.factor(src, r.Unit("joule") / r.Unit("kelvin") ** 2)
+
+
+def test_a_written_negative_temperature_is_below_zero_and_a_negated_one_is_refused(tmp_path):
+    # -T1 was -25 degC (248.15 K) while -1*T1 was -298.15 K: the same formula, two numbers
+    from workbook.errors import UnitError
+
+    head = '[inputs]\nT1 = "25 degC"\n\n[definitions]\n'
+    sheet = workbook.load(
+        write_template(
+            tmp_path,
+            head + 'low = { expr = "max(T1 - 40 delta_degC, -10 degC)", unit = "degC" }\n'
+            'd = "-(T1 - 0 degC)"\nk = { expr = "-1*T1", unit = "K" }\n',
+        )
+    )
+    assert math.isclose(sheet.evaluate("low").magnitude, -10.0, rel_tol=1e-12)
+    assert sheet.evaluate("d").to("delta_degC").magnitude == pytest.approx(-25.0, rel=1e-12)
+    assert sheet.evaluate("k").magnitude == pytest.approx(-298.15, rel=1e-12)
+    for text in ("-T1", "2*(-T1)", "-(T1 + 5 delta_degC)"):
+        with pytest.raises(UnitError, match="negative of an absolute temperature"):
+            workbook.load(write_template(tmp_path, head + f'x = "{text}"\n'))

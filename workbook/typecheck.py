@@ -500,8 +500,15 @@ class Typer(ArrayTyping, Visitor):
         self._number(child, f"'{node.op}'")
         if node.op == "+":
             return child
-        if isinstance(child, TConst):
+        if isinstance(child, TConst):  # -10 degC written: a temperature below zero
             return TConst(child.unit, value=-child.value, derived=child.derived)
+        if un.temperature_kind(child.unit) == "absolute":
+            shown = un.pretty(child.unit)
+            raise UnitError(
+                f"the negative of an absolute temperature ({shown}) depends on its scale "
+                f"(the negative of 25 degC would be -25 degC, and -1 times it is -298.15 K, as "
+                f"products take kelvin); negate a difference, -(T - 0 {shown}), or a value in K"
+            )
         return TUnary(child.unit, op="-", child=child, shape=child.shape)
 
     def visit_Logic(self, node: ex.Logic, scope) -> T:
