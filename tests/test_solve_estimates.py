@@ -151,3 +151,20 @@ def test_inputs_of_a_block_with_parameters_are_used(tmp_path):
     text = FOUR_BAR.replace('d = "100 mm"', 'd = "100 mm"\nspare = "1 mm"')
     sheet = workbook.load(write_template(tmp_path, text))
     assert sheet.unused_inputs() == ["spare"]
+
+
+def test_the_estimate_of_an_unknown_in_degc_is_a_difference(tmp_path):
+    import openpyxl
+
+    text = (
+        '[inputs]\nT0 = "20 degC"\nk = "0.5 1/K"\n\n[[solve]]\nunknowns = { T = "30 degC" }\n'
+        'equations = ["k*(T - T0) == 2"]\n\n[definitions]\nTT = { expr = "T", unit = "degC" }\n'
+    )
+    sheet = workbook.load(write_template(tmp_path, text))
+    assert sheet.evaluate("T").magnitude == pytest.approx(24.0, rel=1e-12)
+    found = {f.topic: f for f in sheet.check().findings}
+    assert "degC (error estimate" in found["solve T"].what
+    assert found["solve T"].what.rstrip(")").endswith("delta_degC")
+    book = openpyxl.load_workbook(sheet.write_xlsx(tmp_path / "t.xlsx"))
+    notes = [c.value for row in book["Results"].iter_rows() for c in row if c.value]
+    assert any(str(v).startswith("error estimate") and " delta_degC," in str(v) for v in notes)

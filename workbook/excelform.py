@@ -379,11 +379,12 @@ class ExcelLayout:
         ws.write_number(row, 1, float(q.magnitude), self.fmt["number"])
         ws.write_comment(row, 1, "A value, not a formula: found by a [[solve]] block")
         ws.write_string(row, 2, un.pretty(q.units))
+        step = un.pretty(un.difference_unit(q.units))  # an error is a difference: delta_degC
         ws.write_string(
             row,
             4,
-            f"error estimate {solved.errors.get(unknown, float('nan')):.2g} "
-            f"{un.pretty(q.units)}, condition number {solved.condition:.3g}".replace(" ,", ","),
+            f"error estimate {solved.errors.get(unknown, float('nan')):.2g} {step}, "
+            f"condition number {solved.condition:.3g}".replace(" ,", ","),
         )
 
     def write_matrices(self, defs) -> None:

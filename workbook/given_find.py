@@ -248,7 +248,9 @@ def solve_findings(sheet) -> list:
         for name, q in block.unknowns.items():
             v, e = solved[name], solved.errors.get(name, float("nan"))
             unit = f" {un.pretty(q.units)}" if un.pretty(q.units) else ""
-            parts.append(f"{name} = {v:.10g}{unit} (error estimate {e:.2g}{unit})")
+            step = un.pretty(un.difference_unit(q.units))  # an error is a difference: delta_degC
+            step = f" {step}" if step else ""
+            parts.append(f"{name} = {v:.10g}{unit} (error estimate {e:.2g}{step})")
             rel = e / abs(v) if v else e
             worst = max(worst, rel) if np.isfinite(rel) else float("inf")
         what = "; ".join(parts)
