@@ -265,3 +265,13 @@ y_end = "y(2 min)"
     sheet = workbook.load(write_template(tmp_path, text))
     assert sheet.evaluate("y_q").magnitude == pytest.approx(math.exp(-10), rel=1e-4)
     assert sheet.evaluate("y_end").magnitude == pytest.approx(math.exp(-12), rel=1e-4)
+
+
+def test_python_syntax_warnings_do_not_reach_the_user():
+    # '1if' made Python print "<unknown>:1: SyntaxWarning: invalid decimal literal" on stderr
+    import warnings
+
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        assert ex.parse("1if a > 0 else 2") == ex.parse("1 if a > 0 else 2")
+    assert not [w for w in seen if issubclass(w.category, SyntaxWarning)], seen

@@ -10,6 +10,7 @@ from __future__ import annotations
 import ast
 import math
 import re
+import warnings
 from dataclasses import dataclass
 
 from .errors import LimitError, TemplateError
@@ -136,7 +137,9 @@ def parse(text: str, *, what: str = "expression") -> Node:
     if _MAYBE_LITERAL.search(source):
         source = _quantity_literals(source)
     try:
-        tree = ast.parse(source, mode="eval")
+        with warnings.catch_warnings():  # Python's own warnings (1if) are not the user's
+            warnings.simplefilter("ignore", SyntaxWarning)
+            tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
         col = f" at column {exc.offset}" if exc.offset else ""
         raise TemplateError(f"{what}: cannot parse {_short(text)!r}{col}: {exc.msg}") from None
