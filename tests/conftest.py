@@ -65,3 +65,16 @@ def write_template(tmp_path: Path, text: str, name: str = "t.toml") -> Path:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
     return path
+
+
+def fuzz_settings(examples: int):
+    """Hypothesis settings of the property tests: reproducible, no deadline, no database."""
+    from hypothesis import HealthCheck, settings
+
+    return settings(
+        max_examples=examples,
+        derandomize=True,
+        deadline=None,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+    )

@@ -15,7 +15,8 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from conftest import fuzz_settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from workbook import WorkbookError
@@ -115,13 +116,7 @@ def check(sheet: Sheet, text: str) -> None:
         pytest.fail(f"{type(exc).__name__} escaped for {text!r}: {exc}")
 
 
-FUZZ = settings(
-    max_examples=PER_TEST,
-    derandomize=True,
-    deadline=None,
-    database=None,
-    suppress_health_check=list(HealthCheck),
-)
+FUZZ = fuzz_settings(PER_TEST)
 
 
 @pytest.mark.slow
@@ -392,37 +387,27 @@ def check_template(folder, slots, items) -> None:
     assert time.monotonic() - start < CASE_SECONDS, text
 
 
-def _fuzz(examples: int):
-    return settings(
-        max_examples=examples,
-        derandomize=True,
-        deadline=None,
-        database=None,
-        suppress_health_check=list(HealthCheck),
-    )
-
-
-@_fuzz(FAST_EXAMPLES)
+@fuzz_settings(FAST_EXAMPLES)
 @given(text=quantity_texts())
 def test_quantity_text(text):
     check_quantity(text)
 
 
-@_fuzz(FAST_EXAMPLES)
+@fuzz_settings(FAST_EXAMPLES)
 @given(case=templates())
 def test_template_values(fuzz_folder, case):
     check_template(fuzz_folder, *case)
 
 
 @pytest.mark.slow
-@_fuzz(SLOW_EXAMPLES)
+@fuzz_settings(SLOW_EXAMPLES)
 @given(text=quantity_texts())
 def test_quantity_text_many(text):
     check_quantity(text)
 
 
 @pytest.mark.slow
-@_fuzz(SLOW_EXAMPLES)
+@fuzz_settings(SLOW_EXAMPLES)
 @given(case=templates())
 def test_template_values_many(fuzz_folder, case):
     check_template(fuzz_folder, *case)
@@ -477,7 +462,7 @@ def labels():
     return st.one_of(pieces, st.text(min_size=1, max_size=30))
 
 
-@_fuzz(FAST_EXAMPLES // 2)  # a workbook each: about 0.1 s
+@fuzz_settings(FAST_EXAMPLES // 2)  # a workbook each: about 0.1 s
 @given(texts=st.lists(labels(), min_size=4, max_size=4))
 def test_chart_labels_are_never_references(tmp_path_factory, texts):
     """A title, axis title or series name is shown as written: the chart refers to nothing but
@@ -528,7 +513,7 @@ def test_chart_labels_are_never_references(tmp_path_factory, texts):
             assert not text.startswith("=") and "!" not in text
 
 
-@_fuzz(FAST_EXAMPLES)
+@fuzz_settings(FAST_EXAMPLES)
 @given(cells=st.lists(labels(), min_size=1, max_size=8), dtype=st.sampled_from([object, "str"]))
 def test_csv_cells_never_run_and_never_forge_rows(tmp_path_factory, cells, dtype):
     """Every text cell reads back as written or behind one apostrophe (never starting with a
@@ -558,7 +543,7 @@ NAME_CHARS = st.sampled_from(
 )
 
 
-@_fuzz(FAST_EXAMPLES)
+@fuzz_settings(FAST_EXAMPLES)
 @given(name=st.lists(NAME_CHARS, min_size=1, max_size=8).map("".join))
 def test_names_with_control_characters(fuzz_folder, name):
     """A name with control characters, spaces or invisible characters in [inputs] or

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import pint
 import pytest
-from hypothesis import HealthCheck, given, settings
+from conftest import fuzz_settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 import workbook
@@ -164,29 +165,19 @@ def check(folder, case: Case) -> None:
     )
 
 
-def _settings(examples: int):
-    return settings(
-        max_examples=examples,
-        derandomize=True,
-        deadline=None,
-        database=None,
-        suppress_health_check=list(HealthCheck),
-    )
-
-
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     return tmp_path_factory.mktemp("units-oracle")
 
 
-@_settings(300)
+@fuzz_settings(300)
 @given(case=expressions)
 def test_the_engine_agrees_with_pint(folder, case):
     check(folder, case)
 
 
 @pytest.mark.slow
-@_settings(5000)
+@fuzz_settings(5000)
 @given(case=expressions)
 def test_the_engine_agrees_with_pint_many(folder, case):
     check(folder, case)
