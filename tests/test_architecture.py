@@ -98,3 +98,20 @@ def test_the_names_it_gives_exist():
                 break
             obj = getattr(obj, attr)
     assert not wrong, f"docs/architecture.md names what the code does not have: {wrong}"
+
+
+def test_the_load_walk_counts_moves_and_climbs_back_up():
+    # scripts/load_walk.py measures how often loading calls back into a module below on the
+    # stack; a declared check calling the Sheet is one such climb in concave-cam
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+    try:
+        import load_walk
+    finally:
+        sys.path.pop(0)
+    import workbook
+
+    workbook.load("concave-cam")
+    found = load_walk.walk(lambda: workbook.load("concave-cam"))
+    assert {"workbook.sheet", "workbook.typecheck", "workbook.template"} <= found.rooms
+    assert found.climbs <= found.moves
+    assert found.climbs_by_pair().get(("workbook.declared_checks", "workbook.sheet")) == 1
