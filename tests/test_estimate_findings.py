@@ -50,3 +50,21 @@ def test_the_findings_do_not_depend_on_what_was_written_before(tmp_path):
     before = sorted(_estimates(sheet))
     sheet.write_xlsx(tmp_path / "once.xlsx")
     assert sorted(_estimates(sheet)) == before
+
+
+def test_a_value_that_is_zero_is_not_measured_against_zero(tmp_path):
+    # the integral of a full period of a sine is 0 and a maximum of -(x - 0.3)^2 is 0: their
+    # estimates (rounding, and branch and bound's rtol times the function's size) were
+    # "relative inf" warnings
+    text = """
+[arguments]
+x = {}
+
+[definitions]
+period = "integral(1000*sin(x), x, 0, 2*pi)"
+top = "maximum(-(x - 0.3)^2*1000, x, -10, 10)"
+"""
+    sheet = workbook.loads(text, folder=tmp_path)
+    assert abs(sheet.evaluate("period").magnitude) < 1e-9
+    assert sheet.evaluate("top").magnitude == pytest.approx(0.0, abs=1e-6)
+    assert _estimates(sheet) == {}

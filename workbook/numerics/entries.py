@@ -194,11 +194,13 @@ def _solve(of, solve, *bounds) -> Result:
 
 
 def _joined_notes(parts: list[Result]) -> dict:
-    """The notes of the chunks of one call: the widest assumption of them all."""
+    """The notes of the chunks of one call: the widest assumption and the largest size of
+    EXPR of them all."""
     notes = dict(parts[0].notes)
-    widths = [r.notes["assumes"] for r in parts if "assumes" in r.notes]
-    if widths:
-        notes["assumes"] = max(widths)
+    for key in ("assumes", "scale"):
+        found = [r.notes[key] for r in parts if key in r.notes]
+        if found:
+            notes[key] = max(found)
     return notes
 
 

@@ -16,6 +16,11 @@ ESTIMATE_LIMIT = 100.0
 #: is 0 but for rounding), not an uncertainty worth a warning.
 ROUNDING = 100 * np.finfo(float).eps
 
+#: Extrema are certified to the tolerance relative to EXPR's size on the interval (a maximum
+#: that is 0 is found to within rtol times that size), so their estimates are measured
+#: against it; an integral's against its value (a small value by cancellation is warned of)
+CERTIFIED_TO_SCALE = frozenset({"maximum", "minimum"})
+
 #: The position of a smooth extremum is known only to about the square root of the rounding
 #: of its expression (docs/numerics.md): its estimate is information, not a warning.
 POSITIONS = frozenset({"argmax", "argmin"})
@@ -23,8 +28,9 @@ POSITIONS = frozenset({"argmax", "argmin"})
 
 def estimate_findings(sheet) -> list:
     """One warning per definition or column whose built-in's largest error estimate, relative
-    to its largest value, exceeds ESTIMATE_LIMIT times ``[sheet] tolerance``; computed from
-    what the sheet has evaluated so far (call it after the values)."""
+    to its largest value (for an extremum, or EXPR's size on the interval), exceeds ESTIMATE_LIMIT
+    times ``[sheet] tolerance``; computed from what the sheet has evaluated so far (call it
+    after the values)."""
     from ..findings import Finding
 
     rtol = sheet_tolerance(sheet.spec.meta).rtol
@@ -37,9 +43,12 @@ def estimate_findings(sheet) -> list:
         if where is None or builtin in POSITIONS or not np.size(result.error):
             continue
         size = float(np.max(np.abs(result.value), initial=0.0))
+        scale = float(result.notes.get("scale", 0.0))  # EXPR's size on the interval
         err = float(np.max(np.abs(result.error), initial=0.0))
-        if err <= ROUNDING * max(size, 1.0):  # a value at the rounding of numbers near 1
+        if err <= ROUNDING * max(size, scale, 1.0):  # the rounding of the numbers it adds
             continue
+        if builtin in CERTIFIED_TO_SCALE:
+            size = max(size, scale)
         relative = err / size if size > 0 else np.inf
         key = (where, builtin)
         if relative > worst.get(key, (-1.0,))[0]:

@@ -115,6 +115,7 @@ def extremum(
     # without enclosures nothing is known between the samples: the value rests on no feature
     # narrower than their spacing, which the result carries (``run`` prints it)
     notes = {} if enclose is not None else {"assumes": float(np.max((hi - lo) / k)), "unit": unit}
+    notes["scale"] = float(np.max(scale))  # the size of EXPR on [A, B] (a maximum may be 0)
     return Result(
         (sgn * best_v).reshape(shape),
         best_ve.reshape(shape),

@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, num, row_text, rows
+from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
 from .kronrod import gk21
 
 #: halvings of an interval before a row goes to tanh-sinh
@@ -107,7 +107,24 @@ def integrate(
         )
         value[pending], error[pending] = v, e
         evals = max(evals, ev)
-    return Result((sign * value).reshape(shape), error.reshape(shape), evaluations=evals)
+    notes = {"scale": _scale(f, lo, hi, args)}
+    return Result(
+        (sign * value).reshape(shape), error.reshape(shape), evaluations=evals, notes=notes
+    )
+
+
+#: interior points where the integrand's size is sampled (an end may be singular)
+_SCALE_AT = (np.arange(16) + 0.5) / 16
+
+
+def _scale(f, lo, hi, args) -> float:
+    """The integral's natural size: the width times the largest |f| at 16 interior points
+    (the integral of a full period of a sine is 0, its estimate is not measured against 0)."""
+    xs = lo[:, None] + (hi - lo)[:, None] * _SCALE_AT
+    with np.errstate(all="ignore"):
+        fs = np.abs(np.asarray(call(f, xs, [g[:, None] for g in args]), dtype=float))
+    fs = np.where(np.isfinite(fs), fs, 0.0)
+    return float(np.max((hi - lo) * fs.max(axis=1), initial=0.0))
 
 
 #: rows of one call searched for features; of a larger table, PROBE rows spread over it are,
