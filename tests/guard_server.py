@@ -14,7 +14,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -118,7 +117,6 @@ class GuardServer:
     def __init__(self) -> None:
         self._process: subprocess.Popen | None = None
         self._folder = Path(tempfile.mkdtemp(prefix="workbook-guard-"))
-        self._lock = threading.Lock()
         atexit.register(self.close)
 
     def close(self) -> None:
@@ -145,23 +143,22 @@ class GuardServer:
     def run(self, cwd: Path, args: list[str], *, memory: int, cpu: int, wall: float) -> Outcome:
         """Run ``workbook *args`` in ``cwd`` in a fresh guarded child; a case that outlasts
         ``wall`` seconds raises subprocess.TimeoutExpired."""
-        with self._lock:
-            server = self._start()
-            out, err = self._folder / "stdout", self._folder / "stderr"
-            request = dict(
-                cwd=str(cwd), args=args, memory=memory, cpu=cpu, wall=wall, stdout=str(out),
-                stderr=str(err),
-            )  # fmt: skip
-            server.stdin.write(json.dumps(request) + "\n")
-            server.stdin.flush()
-            reply = server.stdout.readline()
-            if not reply:
-                raise RuntimeError(f"the guard server ended (status {server.wait()})")
-            code = json.loads(reply)["returncode"]
-            if code is None:
-                raise subprocess.TimeoutExpired(args, wall)
-            stdout = out.read_text(encoding="utf-8", errors="replace")
-            stderr = err.read_text(encoding="utf-8", errors="replace")
+        server = self._start()
+        out, err = self._folder / "stdout", self._folder / "stderr"
+        request = dict(
+            cwd=str(cwd), args=args, memory=memory, cpu=cpu, wall=wall, stdout=str(out),
+            stderr=str(err),
+        )  # fmt: skip
+        server.stdin.write(json.dumps(request) + "\n")
+        server.stdin.flush()
+        reply = server.stdout.readline()
+        if not reply:
+            raise RuntimeError(f"the guard server ended (status {server.wait()})")
+        code = json.loads(reply)["returncode"]
+        if code is None:
+            raise subprocess.TimeoutExpired(args, wall)
+        stdout = out.read_text(encoding="utf-8", errors="replace")
+        stderr = err.read_text(encoding="utf-8", errors="replace")
         audit = [line for line in stdout.splitlines() if line.startswith("AUDIT ")]
         events = json.loads(audit[-1][6:]) if audit else None
         return Outcome(code, stdout, stderr, events)

@@ -28,9 +28,9 @@ POSITIONS = frozenset({"argmax", "argmin"})
 
 def estimate_findings(sheet) -> list:
     """One warning per definition or column whose built-in's largest error estimate, relative
-    to its largest value (for an extremum, or EXPR's size on the interval), exceeds ESTIMATE_LIMIT
-    times ``[sheet] tolerance``; computed from what the sheet has evaluated so far (call it
-    after the values)."""
+    to its largest value (an extremum's: to the larger of that and EXPR's size on the
+    interval), exceeds ESTIMATE_LIMIT times ``[sheet] tolerance``; computed from what the sheet
+    has evaluated so far (call it after the values)."""
     from ..findings import Finding
 
     rtol = sheet_tolerance(sheet.spec.meta).rtol

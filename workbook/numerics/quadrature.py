@@ -19,6 +19,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
+from .estimates import ESTIMATE_LIMIT
 from .kronrod import gk21
 
 #: halvings of an interval before a row goes to tanh-sinh
@@ -109,8 +110,6 @@ def integrate(
         evals = max(evals, ev)
     # the integrand's size, for the rows whose estimate the check would report against their
     # value (few or none: it costs 16 evaluations a row)
-    from .estimates import ESTIMATE_LIMIT
-
     suspect = error > ESTIMATE_LIMIT * tol.rtol * np.abs(value)
     notes = {"scale": _scale(f, lo[suspect], hi[suspect], [g[suspect] for g in args])}
     return Result(
