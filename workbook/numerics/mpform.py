@@ -9,6 +9,9 @@ interpolant, a program, a solve block, a probability distribution, a numerical b
 other than an inner integral or diff) raises :class:`NoMpForm` when compiled, naming it; a point
 where EXPR has no real value (a negative square root, a division by zero, no piece whose
 condition holds) raises :class:`NoValue` when evaluated.
+
+:func:`quad` is the integral in mpmath on pieces: the one of an inner integral here, and the
+reference's integral in :mod:`workbook.numerics.mpref` (which builds on this module).
 """
 
 from __future__ import annotations
@@ -22,6 +25,11 @@ from ..visitor import Visitor
 
 #: a sheet function nested deeper than this is not expanded
 _MAX_DEPTH = 20
+#: the relative estimate a piece of an integral is accepted at (fixed: an inner integral runs
+#: at the raised precision of the outer one's nodes, where mpmath's estimate stays near 1e-23)
+GOAL = "1e-20"
+#: pieces of one integral at most
+MAX_PIECES = 256
 
 
 Mp = Callable[[dict], object]
@@ -33,6 +41,10 @@ class NoMpForm(Exception):
 
 class NoValue(ArithmeticError):
     """EXPR has no real value at this point."""
+
+
+class Unconverged(ArithmeticError):
+    """The mpmath method did not reach its accuracy."""
 
 
 def _real(ctx, v):
@@ -67,6 +79,57 @@ def _functions(ctx) -> dict[str, Callable]:
         "floor": ctx.floor,
         "ceil": ctx.ceil,
     }
+
+
+# -- an integral in mpmath: EXPR's inner integral, and the reference's (mpref) ------------
+def quad(ctx, g, a, b, points, refine: bool = True) -> object:
+    """The integral of g over [a, b] (an mpf), split at ``points``; with ``refine``, also in
+    8 equal pieces, and a piece whose estimate is above GOAL of the scale is halved (an
+    inner integral is not refined: its error is part of the outer integrand's, which the
+    outer integral's estimate sees)."""
+    a, b = ctx.mpf(a), ctx.mpf(b)
+    if a == b:
+        return ctx.zero
+    sign = 1
+    if a > b:
+        a, b, sign = b, a, -1
+    edges = sorted({a, b, *(ctx.mpf(p) for p in points if a < p < b)})
+    if refine:
+        edges = sorted({*edges, *(a + (b - a) * k / 8 for k in range(1, 8))})
+    scale = (b - a) * max(_abs_or_zero(g, a + (b - a) * (k + 0.5) / 33) for k in range(33))
+    goal = ctx.mpf(GOAL)
+    pieces, total, done = list(zip(edges, edges[1:])), ctx.zero, 0
+    while pieces:
+        lo, hi = pieces.pop()
+        v, e = ctx.quad(lambda x, lo=lo, hi=hi: _inside(g, x, lo, hi), [lo, hi], error=True)
+        scale = max(scale, abs(v))
+        share = (hi - lo) / (b - a)
+        if not refine or e <= goal * max(scale, ctx.mpf(10) ** -300) * share:
+            total += v
+            done += 1
+            continue
+        if done + len(pieces) + 2 > MAX_PIECES:
+            raise Unconverged(
+                f"mpmath quad: estimate {float(e):.1e} on [{float(lo):.6g}, {float(hi):.6g}] "
+                f"after {MAX_PIECES} pieces"
+            )
+        mid = (lo + hi) / 2
+        pieces += [(lo, mid), (mid, hi)]
+    return sign * total
+
+
+def _inside(g, x, lo, hi):
+    """g at a node of a piece; 0 at a node that rounds to an end (a singular end's nodes
+    come closer to it than the precision: they weigh less than 1e-16 of an integrable
+    singularity's integral, below the reference's accuracy)."""
+    return 0 if x in (lo, hi) else g(x)
+
+
+def _abs_or_zero(g, x):
+    try:
+        return abs(g(x))
+    except (NoValue, ZeroDivisionError):
+        return 0
 
 
 class MpForm(Visitor):
@@ -189,8 +252,6 @@ class MpForm(Visitor):
         return lambda env: _real(ctx, f(a(env)))
 
     def _integral(self, t):
-        from .mpref import quad
-
         body, var = self.compile(t.args[0]), t.args[1].name
         lo, hi = self.compile(t.args[2]), self.compile(t.args[3])
         ctx = self.ctx

@@ -4,9 +4,11 @@ Inside :func:`workbook.numerics.reference_methods`, root, integral and the extre
 each row by these methods, EXPR evaluated by :mod:`workbook.numerics.mpform` (every
 operation in mpmath, not numpy):
 
-- integral: ``mpmath.quad`` (tanh-sinh) at 32 digits on pieces: the kinks the tree shows,
-  the narrow and steep features its interval enclosures locate, and 8 equal pieces; a piece
-  whose estimate is above 1e-26 of the integral's scale is halved (256 pieces at most);
+- integral: ``mpmath.quad`` (tanh-sinh) at 32 digits on pieces
+  (:func:`workbook.numerics.mpform.quad`, which EXPR's inner integrals use too): the kinks
+  the tree shows, the narrow and steep features its interval enclosures locate, and 8 equal
+  pieces; a piece whose estimate is above 1e-26 of the integral's scale is halved (256
+  pieces at most);
 - root in a bracket: bisection at 60 digits (to 1e-40 relative) on [A, B] or, where EXPR
   has the same sign at both ends, on the one of 64 sample intervals with a sign change; a
   bracket whose ends end far from 0 is a pole or a jump, not a root;
@@ -30,7 +32,7 @@ import mpmath
 import numpy as np
 
 from ._common import reference_note
-from .mpform import NoMpForm, NoValue, mp_form
+from .mpform import NoMpForm, NoValue, Unconverged, mp_form, quad
 from .reference import ReferenceFailed
 
 #: digits of the integral's and the extrema's reference
@@ -39,18 +41,9 @@ DIGITS = 32
 ROOT_DIGITS = 60
 #: rows of one call computed at most (spread over it)
 ROWS = 16
-#: the relative estimate a piece of an integral is accepted at (fixed: an inner integral runs
-#: at the raised precision of the outer one's nodes, where mpmath's estimate stays near 1e-23)
-GOAL = "1e-20"
-#: pieces of one integral at most
-MAX_PIECES = 256
 #: points of the extremum's sampling, and the local extrema polished
 DENSE = 4000
 CANDIDATES = 8
-
-
-class Unconverged(ArithmeticError):
-    """The mpmath method did not reach its accuracy."""
 
 
 def context(digits: int):
@@ -60,57 +53,7 @@ def context(digits: int):
     return ctx
 
 
-# -- the methods on one row: g(x) is EXPR at an mpf x ------------------------------------------
-def quad(ctx, g, a, b, points, refine: bool = True) -> object:
-    """The integral of g over [a, b] (an mpf), split at ``points``; with ``refine``, also in
-    8 equal pieces, and a piece whose estimate is above GOAL of the scale is halved (an
-    inner integral is not refined: its error is part of the outer integrand's, which the
-    outer integral's estimate sees)."""
-    a, b = ctx.mpf(a), ctx.mpf(b)
-    if a == b:
-        return ctx.zero
-    sign = 1
-    if a > b:
-        a, b, sign = b, a, -1
-    edges = sorted({a, b, *(ctx.mpf(p) for p in points if a < p < b)})
-    if refine:
-        edges = sorted({*edges, *(a + (b - a) * k / 8 for k in range(1, 8))})
-    scale = (b - a) * max(_abs_or_zero(g, a + (b - a) * (k + 0.5) / 33) for k in range(33))
-    goal = ctx.mpf(GOAL)
-    pieces, total, done = list(zip(edges, edges[1:])), ctx.zero, 0
-    while pieces:
-        lo, hi = pieces.pop()
-        v, e = ctx.quad(lambda x, lo=lo, hi=hi: _inside(g, x, lo, hi), [lo, hi], error=True)
-        scale = max(scale, abs(v))
-        share = (hi - lo) / (b - a)
-        if not refine or e <= goal * max(scale, ctx.mpf(10) ** -300) * share:
-            total += v
-            done += 1
-            continue
-        if done + len(pieces) + 2 > MAX_PIECES:
-            raise Unconverged(
-                f"mpmath quad: estimate {float(e):.1e} on [{float(lo):.6g}, {float(hi):.6g}] "
-                f"after {MAX_PIECES} pieces"
-            )
-        mid = (lo + hi) / 2
-        pieces += [(lo, mid), (mid, hi)]
-    return sign * total
-
-
-def _inside(g, x, lo, hi):
-    """g at a node of a piece; 0 at a node that rounds to an end (a singular end's nodes
-    come closer to it than the precision: they weigh less than 1e-16 of an integrable
-    singularity's integral, below the reference's accuracy)."""
-    return 0 if x in (lo, hi) else g(x)
-
-
-def _abs_or_zero(g, x):
-    try:
-        return abs(g(x))
-    except (NoValue, ZeroDivisionError):
-        return 0
-
-
+# -- the methods on one row: g(x) is EXPR at an mpf x (the integral: mpform.quad) ---------------
 def _bisect(ctx, g, lo, hi, glo):
     """A sign change of g in [lo, hi] to 1e-40 relative; refused when it is a pole or a jump."""
     scale = max(abs(glo), abs(g(hi)))
@@ -227,6 +170,11 @@ def _rows(n: int) -> np.ndarray:
     return np.arange(n) if n <= ROWS else np.unique(np.linspace(0, n - 1, ROWS).astype(np.intp))
 
 
+def _flat(of, shape) -> dict[str, np.ndarray]:
+    """The arrays of the call's environment (``of.arrays``), each flat over ``shape``."""
+    return {k: np.broadcast_to(a, shape).reshape(-1) for k, a in of.arrays.items()}
+
+
 def _prepared(of, name: str, digits: int, *bounds):
     """(ctx, form, shape, flat bounds, row environments) or None without an mpmath form."""
     from .. import typed as ty
@@ -241,7 +189,7 @@ def _prepared(of, name: str, digits: int, *bounds):
         reference_note(f"scipy ({err}: no mpmath form)", min(n, SCIPY_ROWS), n)
         return None
     flat = [np.broadcast_to(np.asarray(b, dtype=float), shape).reshape(-1) for b in bounds]
-    arrays = of._flat(shape)
+    arrays = _flat(of, shape)
     used = ty.parameters(of.body) - {of.var}
     fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
     rows = _rows(n)
@@ -282,13 +230,17 @@ def root(of, a, b=None) -> np.ndarray | None:
 
 
 def _feature_points(of, shape, lo, hi, rows) -> dict[int, list[float]]:
-    """Row -> the ends of the boxes where EXPR's enclosures show a narrow or steep feature."""
-    from .quadrature import _features
+    """Row -> the ends of the boxes where EXPR's enclosures show a narrow or steep feature
+    (every row computed is searched: there are at most ROWS)."""
+    from .features import breaks
 
     enclose = of.enclosure(shape)
     if enclose is None:
         return {}
-    found = _features(of.over(shape), enclose, (rows.astype(float),), lo[rows], hi[rows])
+    f, at = of.over(shape), rows.astype(float)
+    found = breaks(
+        lambda p, q, r: enclose(p, q, at[r]), lambda x, r: f(x, at[r]), lo[rows], hi[rows]
+    )
     return {int(r): [float(p[k]) for p in found] for k, r in enumerate(rows)}
 
 
@@ -364,7 +316,7 @@ def polish_roots(of, result, shape, tol) -> int:
         form = mp_form(of.evaluator, ctx, of.body)
     except NoMpForm:
         return 0
-    arrays = of._flat(shape)
+    arrays = _flat(of, shape)
     used = ty.parameters(of.body) - {of.var}
     fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
     done = 0
