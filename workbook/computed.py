@@ -3,14 +3,19 @@ once after the sheet is loaded and checked.
 
 :func:`compute` is the one stage between evaluation and writing. It evaluates the scalar
 definitions (each with its typed tree in the unit it is shown in), the [[solve]] unknowns,
-the tables (range tables as :class:`workbook.sheet.TableData`, block and family tables as
-DataFrames), the data of every chart series, the check report (printed values, findings,
-estimate warnings) and, when asked, the workbook's Excel form
-(:class:`workbook.excelform.ExcelForm`: every cell with its formula or value, helper cells,
-live-form notes, charts and defined names, checked by :mod:`workbook.livecheck`). The
-renderers (:mod:`workbook.xlsx`, :mod:`workbook.report`, :mod:`workbook.notebook`, the CSV
-writer) read a :class:`ComputedSheet`: they neither type nor evaluate, and the Sheet is not
-changed by them.
+the tables (range tables as :class:`TableData` of :class:`Column`, block and family tables
+as DataFrames), the data of every chart series (and the x column of each over a range), the
+check report (printed values, findings, estimate warnings) and, when asked, the workbook's
+Excel form (:class:`workbook.excelform.ExcelForm`: every cell with its formula or value,
+helper cells, live-form notes, charts and defined names, checked by
+:mod:`workbook.livecheck`). The renderers (:mod:`workbook.xlsx`, :mod:`workbook.report`,
+:mod:`workbook.notebook`, the CSV writer) read a :class:`ComputedSheet`: they neither type
+nor evaluate, and the Sheet is not changed by them.
+
+This module imports no Sheet (it reads the one it is given; :mod:`workbook.sheet` builds on
+it, with the Column and TableData it fills), and the Excel form reads what it needs of the
+charts from the ComputedSheet: the package's import graph has no cycle
+(tests/test_layers.py).
 
 A value that cannot be computed is kept as its error: the report and the notebook show it,
 the workbook raises it where it would have been written.
@@ -25,7 +30,6 @@ import numpy as np
 
 from . import expr as ex
 from . import units as un
-from .sheet import Column, TableData
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -34,8 +38,33 @@ if TYPE_CHECKING:
     from .checks import Report
     from .excelform import ExcelForm
     from .sheet import Sheet
-    from .template import ChartSpec, SeriesSpec, SheetSpec
+    from .template import ChartSpec, ColumnSpec, SeriesSpec, SheetSpec
     from .typed import T
+
+
+@dataclass
+class Column:
+    """One evaluated table column: values in ``unit``."""
+
+    title: str
+    unit: pint.Unit
+    values: np.ndarray
+    typed: T | None  # None for the range variable itself
+    text: str
+    failed: dict[int, str] = field(default_factory=dict)  # row -> why it has no value (NaN)
+
+    def excel_error(self, row: int) -> str:
+        """The Excel error value of a failed row: #DIV/0! for a division by zero, else #NUM!."""
+        return "#DIV/0!" if "division by zero" in self.failed[row] else "#NUM!"
+
+
+@dataclass
+class TableData:
+    name: str
+    title: str
+    var: str
+    var_unit: pint.Unit
+    columns: list[Column]  # the first is the range variable
 
 
 @dataclass(frozen=True)
@@ -87,6 +116,8 @@ class ComputedSheet:
     # range tables as TableData, block and family tables as DataFrames, or the error
     tables: dict[str, Any] = field(default_factory=dict)
     series: dict[tuple[str, int], Series | BaseException] = field(default_factory=dict)
+    # the x column of each series over a range (None: x is the range variable itself)
+    x_columns: dict[tuple[str, int], ColumnSpec | None] = field(default_factory=dict)
     report: Report | BaseException | None = None
     excel: ExcelForm | None = None
 
@@ -171,6 +202,8 @@ def _compute(sheet: Sheet, out: ComputedSheet, report, check: bool, excel: bool)
         out.tables[t.name] = _table(sheet, t)
     for chart in spec.charts:
         for i, s in enumerate(chart.series):
+            if s.table is None:
+                out.x_columns[(chart.name, i)] = x_column(chart, s, s.range or chart.range)
             out.series[(chart.name, i)] = _series(sheet, out.tables, chart, s)
     if out.report is None and check:
         try:

@@ -29,7 +29,6 @@ from . import typed as tc
 from . import units as un
 from . import verdicts as V
 from .checks import tolerances
-from .computed import x_column
 from .constants import CONSTANTS, shadowed
 from .errors import LimitError, WorkbookError
 from .excel import ExcelPrinter, NotLive
@@ -792,7 +791,7 @@ class ExcelLayout:
                     f"'{s.x_column}' or '{s.y_column}'"
                 ) from None
         rng = s.range or chart.range
-        x = x_column(chart, s, rng)
+        x = self.computed.x_columns[(chart.name, index)]
         wanted = [s.y] if x is None else [x, s.y]
         keys = [(rng.text, c.text, self._unit_key(c, rng, chart)) for c in wanted]
         # a table already written over the same range with these columns (same sheet, same rows)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +13,7 @@ from . import expr as ex
 from . import runtime as rt
 from . import typecheck as tc
 from . import units as un
+from .computed import Column, TableData, compute
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
 from .fields import nearest
 from .limits import exhausted, matrix_work
@@ -34,31 +34,6 @@ from .uses import names_used
 
 #: Values of a table with ``vary`` (curves x columns x points), checked before any is computed.
 MAX_FAMILY_CELLS = 1_000_000
-
-
-@dataclass
-class Column:
-    """One evaluated table column: values in ``unit``."""
-
-    title: str
-    unit: pint.Unit
-    values: np.ndarray
-    typed: tc.T | None  # None for the range variable itself
-    text: str
-    failed: dict[int, str] = field(default_factory=dict)  # row -> why it has no value (NaN)
-
-    def excel_error(self, row: int) -> str:
-        """The Excel error value of a failed row: #DIV/0! for a division by zero, else #NUM!."""
-        return "#DIV/0!" if "division by zero" in self.failed[row] else "#NUM!"
-
-
-@dataclass
-class TableData:
-    name: str
-    title: str
-    var: str
-    var_unit: pint.Unit
-    columns: list[Column]  # the first is the range variable
 
 
 class Sheet:
@@ -105,7 +80,7 @@ class Sheet:
             from .given_find import typed_equations
 
             try:
-                self._check_not_circular(block)
+                self.check_not_circular(block)
                 typed_equations(self.typer, block)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=block.line, definition=block.what) from None
@@ -152,10 +127,11 @@ class Sheet:
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
 
-    def _check_not_circular(self, block) -> None:
+    def check_not_circular(self, block) -> None:
         """Refuse a [[solve]] block whose equations use a definition that needs one of its
         unknowns: solving needs the definition, which needs the solution (it recursed until
-        Python's limit, reported as "nested too deeply")."""
+        Python's limit, reported as "nested too deeply"). Load time, and the Mathcad
+        importer's check of a translated block."""
         nodes = [n for lhs, rhs, _ in block.equations for n in (lhs, rhs)]
         nodes += [c for c, _ in block.conditions]
         used = sorted({n for node in nodes for n in ex.names(node)} - set(block.unknowns))
@@ -170,6 +146,9 @@ class Sheet:
                     f"use {name}, which needs the unknown {x}; write the equation with {x} "
                     f"itself, or make {name} a function of it)"
                 )
+
+    #: the former private name, until the Mathcad engine calls the public one
+    _check_not_circular = check_not_circular
 
     def _check_vary(self, t, name: str, values) -> None:
         where = dict(file=self.file, line=t.line, definition=f"table {t.name}")
@@ -714,7 +693,6 @@ class Sheet:
         evaluator first (one that disagrees is written as the engine's value, and appended
         to ``refusals`` when given)."""
         from .atomic import check_target
-        from .computed import compute
         from .xlsx import write_workbook
 
         check_target(Path(path), force=force)  # before any work
@@ -726,7 +704,6 @@ class Sheet:
     def report(self, path=None, pdf: bool = False, **options) -> Path:
         """Write the calculation as a document: ``path`` (default ``reports/NAME.html``) and,
         with ``pdf``, the PDF beside it (needs Chromium). Returns the HTML path."""
-        from .computed import compute
         from .report import report_targets, write_report
 
         path, _ = report_targets(self.name, path, pdf=pdf, force=options.get("force", False))
