@@ -14,7 +14,7 @@ import math
 
 from . import typed as ty
 from .findings import Finding
-from .typecheck import angle_in
+from .unitrules import angle_in
 
 TRIGONOMETRIC = ("sin", "cos", "tan")
 

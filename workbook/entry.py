@@ -18,7 +18,8 @@ Arity = int | tuple[int, int | None] | None
 
 
 class UnitContext(Protocol):
-    """What a unit rule may ask of the typer."""
+    """What a unit rule may ask of the typer: the unit rules of typed trees
+    (:class:`workbook.unitrules.UnitRules`, a base of the typer)."""
 
     dimensionless: pint.Unit
 
@@ -27,8 +28,6 @@ class UnitContext(Protocol):
     def plain(self, t: ty.T, where: str) -> ty.T: ...
 
     def meeting(self, values) -> list[ty.T]: ...
-
-    def symbolic_refusal(self, t: ty.T) -> str | None: ...
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,7 @@ from .template import (
     select_parts,
 )
 from .typed import TConst
+from .unitrules import is_scaled_angle
 from .uses import names_used
 
 #: Values of a table with ``vary`` (curves x columns x points), checked before any is computed.
@@ -470,7 +471,7 @@ class Sheet:
                 raise TemplateError(
                     f"{what}: range bound has units but '{rng.var}' has no declared unit"
                 )
-            if spec is not None and not (tc.is_bare(t) and not tc.is_angle(spec.unit)):
+            if spec is not None and not (tc.is_bare(t) and not is_scaled_angle(spec.unit)):
                 # the typer's one conversion, as for an argument of a call: a bare number is
                 # in the declared unit (0, 5 .. 90 degrees), an expression with pi or a plain
                 # number computed is in radians (a plain argument's bounds are plain numbers)

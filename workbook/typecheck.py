@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import contextlib
 import copy
-import functools
-import math
 import re
 
 import pint
@@ -51,7 +49,11 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     is_zero,
     shape_text,
 )
+from .unitrules import UnitRules, angle_in, meeting  # noqa: F401 - angle_in: the importer's name
 from .visitor import Visitor
+
+#: Most elements of one matrix written out.
+MAX_ELEMENTS = 10_000
 
 #: Longest chain of definitions typed inside one another (a -> b -> c ...).
 MAX_CHAIN = 100
@@ -65,7 +67,7 @@ def _fresh(err: WorkbookError) -> WorkbookError:
     return out
 
 
-class Typer(ArrayTyping, Visitor):
+class Typer(ArrayTyping, UnitRules, Visitor):
     """Types the definitions of one sheet (lazily, each once, with cycle detection).
 
     ``visit(node, scope)`` types an expression node (one ``visit_<Node>`` per kind of
@@ -304,7 +306,7 @@ class Typer(ArrayTyping, Visitor):
                 body = self.visit(d.body, scope)
                 if body.boolean:
                     raise TemplateError("the value is a comparison, not a number")
-                return body if body.text else self._not_text(body, f"'{d.name}'")
+                return body if body.text else self.not_text(body, f"'{d.name}'")
             return self._piecewise(d, scope)
         except WorkbookError as err:
             raise err.located(file=str(self.spec.path), line=d.line, definition=d.name) from None
@@ -331,7 +333,7 @@ class Typer(ArrayTyping, Visitor):
             typed = meeting(typed)  # "90 if ...", "theta otherwise": 90 is 90 deg
         for b, v in zip(d.branches, typed):
             if not v.text:
-                self._not_text(v, f"piece {b.text!r}")
+                self.not_text(v, f"piece {b.text!r}")
             if first_unit is None:
                 first_unit = v.unit
             elif not v.text:
@@ -353,110 +355,6 @@ class Typer(ArrayTyping, Visitor):
             texts=tuple(texts),
             text=bool(is_text),
         )
-
-    def convert(self, t: T, target: pint.Unit, where: str, *, angle: bool = False) -> T:
-        """``t`` in the unit ``target`` (an explicit factor), or a UnitError naming ``where``.
-
-        ``angle``: ``t`` is used as an angle (the argument of sin, cos...). A bare number
-        wanted as an angle in degrees (any angle unit) is in that unit: a bound 180, ``f(90)``,
-        a shown ``90`` are 180, 90 and 90 degrees, not radians."""
-        if t.unit == target:
-            return t
-        if is_bare(t) and is_angle(target):
-            return TConst(target, value=t.value)
-        if not angle:
-            self._no_bare_ratio(t, target, where)
-        if t.text:
-            raise TemplateError(f"{where}: text where a number is wanted")
-        if is_zero(t):  # a literal 0 is zero in any unit: h > 0, "0 otherwise"
-            return TConst(target, value=0.0)
-        if t.unit.dimensionality != target.dimensionality:
-            raise UnitError(
-                f"{where}: {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}) cannot be converted "
-                f"to {un.dims(target)} ({un.pretty(target) or '1'})"
-            )
-        kinds = (un.temperature_kind(t.unit), un.temperature_kind(target))
-        if "absolute" in kinds:
-            return self._temperature(t, target, kinds, where)
-        f = un.factor(t.unit, target)
-        if f == 1.0:
-            return _with_unit(t, target)
-        if isinstance(t, TConst) and t.unit.dimensionality:  # 20 mm in m: 0.02, as Excel shows
-            return TConst(target, value=t.value * f, derived=True)
-        return TScale(target, child=t, factor=f, shape=t.shape)
-
-    def _temperature(self, t: T, target: pint.Unit, kinds, where: str) -> T:
-        """An absolute temperature in another scale: ``t*factor + offset`` (20 degC is
-        293.15 K); a difference is never shown as an absolute temperature, nor the reverse."""
-        if "difference" in kinds:
-            shown = (un.pretty(t.unit), un.pretty(target))
-            if kinds[0] == "difference":
-                raise UnitError(
-                    f"{where}: a temperature difference ({shown[0]}) cannot be shown as an "
-                    f"absolute temperature ({shown[1]}); show it in "
-                    f"{un.pretty(un.difference_unit(target))} or K"
-                )
-            raise UnitError(
-                f"{where}: an absolute temperature ({shown[0]}) cannot be shown as a "
-                f"difference ({shown[1]}); a difference is written T - T0, or show it in K"
-            )
-        f, offset = un.affine(t.unit, target)
-        if isinstance(t, TConst):
-            return TConst(target, value=t.value * f + offset, derived=True)
-        scaled = _with_unit(t, target) if f == 1.0 else TScale(target, child=t, factor=f)
-        if offset == 0.0:
-            return scaled
-        op = "+" if offset > 0 else "-"
-        const = TConst(target, value=abs(offset))
-        return TBinary(target, op=op, left=scaled, right=const, shape=t.shape)
-
-    def kelvin(self, t: T) -> T:
-        """An absolute temperature with an offset (degC, degF) in kelvin, as a product, a
-        quotient, a power or a built-in takes it (Mathcad's rule: 2*T is 2*293.15 K at
-        20 degC); any other value as it is."""
-        if un.temperature_kind(t.unit) != "absolute":
-            return t
-        return self.convert(t, un.registry().kelvin, "an absolute temperature in kelvin")
-
-    def meeting(self, values) -> list[T]:
-        """Bare numbers among ``values`` next to an angle in degrees take its unit."""
-        return meeting(values)
-
-    def symbolic_refusal(self, t: T) -> str | None:
-        """Why ``t`` has no symbolic form (``diff`` refuses it at load), or None; no SymPy."""
-        from .symbolic import refusal
-
-        return refusal(self, t)
-
-    def plain(self, t: T, where: str) -> T:
-        """Convert to a plain number (radians for angles); refuse dimensioned values."""
-        if t.boolean:
-            raise TemplateError(f"{where}: a comparison cannot be used as a number")
-        if t.unit.dimensionality:
-            raise UnitError(
-                f"{where} needs a dimensionless argument, got {un.dims(t.unit)} "
-                f"({un.pretty(t.unit)})"
-            )
-        return self.convert(t, self.dimensionless, where, angle=True)
-
-    def _number(self, t: T, where: str) -> T:
-        if t.boolean:
-            raise TemplateError(f"{where}: a comparison cannot be used as a number")
-        return self._not_text(t, where)
-
-    def _not_text(self, t: T, where: str) -> T:
-        """Refuse text and choice inputs where a number is needed (found by the fuzz test)."""
-        if t.text:
-            raise TemplateError(
-                f"{where}: text is not a number (text can only be compared with == and !=)"
-            )
-        if isinstance(t, TRef) and t.kind == "choice":
-            opts = ", ".join(self.spec.inputs[t.name].options)
-            raise TemplateError(
-                f"{where}: '{t.name}' is a choice ({opts}), not a number; "
-                f'compare it: {t.name} == "..."'
-            )
-        return t
 
     def visit_Number(self, node: ex.Number, scope) -> T:
         return TConst(self.dimensionless, value=node.value)
@@ -497,7 +395,7 @@ class Typer(ArrayTyping, Visitor):
             if not child.boolean:
                 raise TemplateError("'not' needs a comparison")
             return TUnary(child.unit, op="not", child=child, boolean=True)
-        self._number(child, f"'{node.op}'")
+        self.as_number(child, f"'{node.op}'")
         if node.op == "+":
             return child
         if isinstance(child, TConst):  # -10 degC written: a temperature below zero
@@ -560,119 +458,12 @@ class Typer(ArrayTyping, Visitor):
         raise self._unknown("name", name, scope)
 
     def visit_Binary(self, node: ex.Binary, scope) -> T:
-        left = self._number(self.visit(node.left, scope), f"'{node.op}'")
-        right = self._number(self.visit(node.right, scope), f"'{node.op}'")
+        left = self.as_number(self.visit(node.left, scope), f"'{node.op}'")
+        right = self.as_number(self.visit(node.right, scope), f"'{node.op}'")
         op = node.op
         if left.shape is not None or right.shape is not None:
             return self.matrix_binary(op, left, right)
         return self.scalar_binary(op, left, right)
-
-    def scalar_binary(self, op: str, left: T, right: T) -> T:
-        """``left op right`` of numbers: the unit rules of the operators (constants folded)."""
-        if op in "+-":
-            left, right = meeting((left, right))
-            if is_zero(left) and not is_zero(right):
-                left = TConst(right.unit, value=0.0)
-            if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
-                self._mismatch(op, left, right)
-            if not is_zero(left) and not is_zero(right):
-                left, right, unit = self._temperature_sum(op, left, right)
-                if unit is not None:
-                    return TBinary(unit, op=op, left=left, right=right)
-            right = self.convert(right, left.unit, "sum")
-            if isinstance(left, TConst) and isinstance(right, TConst):
-                v = left.value + right.value if op == "+" else left.value - right.value
-                return TConst(left.unit, value=v, derived=_derived(left, right))
-            return TBinary(left.unit, op=op, left=left, right=right)
-        left, right = self.kelvin(left), self.kelvin(right)
-        if op == "*":
-            if isinstance(left, TConst) and isinstance(right, TConst):
-                v = left.value * right.value
-                return TConst(left.unit * right.unit, value=v, derived=_derived(left, right))
-            return TBinary(left.unit * right.unit, op=op, left=left, right=right)
-        if op == "/":
-            if isinstance(left, TConst) and isinstance(right, TConst) and right.value != 0:
-                v = left.value / right.value
-                return TConst(left.unit / right.unit, value=v, derived=_derived(left, right))
-            return TBinary(left.unit / right.unit, op=op, left=left, right=right)
-        # power
-        if not right.unit.dimensionless or right.unit.dimensionality:
-            raise UnitError(f"an exponent must be dimensionless, got {un.dims(right.unit)}")
-        right = self.convert(right, self.dimensionless, "exponent")
-        if left.unit.dimensionality:
-            if not isinstance(right, TConst):
-                raise UnitError(
-                    f"{un.dims(left.unit)} raised to a variable power has no fixed unit; "
-                    "make the base dimensionless (e.g. divide by a reference value)"
-                )
-            n = right.value
-            if abs(n) > 1000:
-                raise UnitError(f"exponent {n:g} of a dimensioned value is out of range")
-            return TBinary(left.unit**n, op="^", left=left, right=right)
-        left = self.convert(left, self.dimensionless, "base of a power")
-        if isinstance(left, TConst) and isinstance(right, TConst):
-            try:
-                v = math.pow(left.value, right.value)
-            except (OverflowError, ValueError):
-                raise TemplateError(
-                    f"{left.value:g}^{right.value:g} is not a finite number"
-                ) from None
-            return TConst(self.dimensionless, value=v, derived=_derived(left, right))
-        return TBinary(self.dimensionless, op="^", left=left, right=right)
-
-    def _temperature_sum(self, op: str, left: T, right: T) -> tuple[T, T, pint.Unit | None]:
-        """Sums and differences of temperatures as pint and Mathcad Prime read them: absolute
-        minus absolute is a difference (delta_degC), absolute plus or minus a difference is
-        absolute, two absolute temperatures are not added. Returns the operands converted
-        and the unit of the result, or the operands and None when no temperature rule applies
-        (K and degR alone are both absolute and difference, as in pint)."""
-        kinds = (un.temperature_kind(left.unit), un.temperature_kind(right.unit))
-        if "absolute" not in kinds and kinds not in (
-            ("difference", "kelvin"),
-            ("kelvin", "difference"),
-        ):
-            return left, right, None
-        shown = f"{un.pretty(left.unit)} {op} {un.pretty(right.unit)}"
-        if kinds == ("difference", "absolute") and op == "-":
-            raise UnitError(
-                f"{shown}: a temperature difference minus an absolute temperature is not a "
-                "temperature; write the absolute one first (T - dT)"
-            )
-        if kinds[1] == "difference":  # T + dT, T - dT: in the scale of T
-            return left, self.convert(right, un.difference_unit(left.unit), "sum"), left.unit
-        if kinds[0] == "difference":  # dT + T: in the scale of T
-            return self.convert(left, un.difference_unit(right.unit), "sum"), right, right.unit
-        if op == "+":
-            raise UnitError(
-                f"{shown}: two absolute temperatures cannot be added (20 degC + 20 degC is "
-                "not 40 degC); add a difference (T + 5 delta_degC; T1 + (T2 - T1)/2 is their "
-                "mean), or convert both to K"
-            )
-        # absolute - absolute: a difference, in the scale of the left one
-        return left, self.convert(right, left.unit, "difference"), un.difference_unit(left.unit)
-
-    def _no_bare_ratio(self, t: T, target: pint.Unit, where: str) -> None:
-        """An angle in degrees divided by a plain number (theta/90) is a plain number of
-        degrees: used as a plain number (or in mm...) it would silently be in radians."""
-        u = angle_in(t.unit)
-        if not u or angle_in(target):
-            return
-        ratio = _bare_ratio(t)
-        if ratio is None:
-            return
-        raise UnitError(
-            f"{where}: an angle in {u} divided by the plain number {ratio:g} is a plain number "
-            f"of {u}, not a ratio (at 90 {u}, theta/90 is 0.01745 as a plain number); divide "
-            f'by an angle (an input right = "90 {u}", then theta/right), or declare the '
-            f"argument plain = true (plain numbers, as Mathcad)"
-        )
-
-    def _mismatch(self, op, left, right):
-        verb = "add" if op == "+" else "subtract"
-        raise UnitError(
-            f"cannot {verb} {un.dims(right.unit)} ({un.pretty(right.unit) or '1'}) "
-            f"{'to' if op == '+' else 'from'} {un.dims(left.unit)} ({un.pretty(left.unit) or '1'})"
-        )
 
     def visit_Compare(self, node: ex.Compare, scope) -> T:
         ops = list(node.operands)
@@ -699,7 +490,7 @@ class Typer(ArrayTyping, Visitor):
         first = next((t for t in typed if not is_zero(t)), typed[0])
         out = []
         for t in typed:
-            self._number(t, "comparison")
+            self.as_number(t, "comparison")
             if t.unit.dimensionality != first.unit.dimensionality and not is_zero(t):
                 raise UnitError(
                     f"cannot compare {un.dims(first.unit)} ({un.pretty(first.unit)}) "
@@ -724,7 +515,7 @@ class Typer(ArrayTyping, Visitor):
         args = [self.visit(a, scope) for a in node.args] if known else []  # unknown: say so first
         if not (entry is not None and entry.texts and not local):
             for a in args:
-                self._number(a, f"argument of {name}()")
+                self.as_number(a, f"argument of {name}()")
         if name in self.spec.definitions:
             d = self.spec.definitions[name]
             if not d.is_function:
@@ -834,9 +625,9 @@ class Typer(ArrayTyping, Visitor):
                 args.append(TParam(unit, name=var.id))
             elif i == expr_at:
                 body = self.visit(a, {**scope, var.id: unit})
-                args.append(self._number(body, f"argument {i + 1} of {name}()"))
+                args.append(self.as_number(body, f"argument {i + 1} of {name}()"))
             else:
-                args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
+                args.append(self.as_number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         self.scope = scope
         typed = entry.unit_rule(self, name, tuple(args))
         body = args[expr_at]
@@ -859,7 +650,7 @@ class Typer(ArrayTyping, Visitor):
                     a.id in scope or a.id in self.spec.definitions
                 )  # a vector of the sheet or of a program, named
                 if col is None and (defined or not isinstance(a, ex.Name)):
-                    typed = self._number(self.visit(a, scope), f"argument {i + 1} of {name}()")
+                    typed = self.as_number(self.visit(a, scope), f"argument {i + 1} of {name}()")
                     if typed.shape is not None:  # a vector of the sheet or of a program
                         args.append(typed)
                         continue
@@ -871,7 +662,7 @@ class Typer(ArrayTyping, Visitor):
                     )
                 args.append(TRef(col.unit, name=a.id, kind="data"))
             else:
-                args.append(self._number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
+                args.append(self.as_number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         self.scope = scope
         return entry.unit_rule(self, name, tuple(args))
 
@@ -896,6 +687,199 @@ class Typer(ArrayTyping, Visitor):
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
         return self.convert(a, unit, where)  # f(90) of an argument in deg is 90 deg
+
+    # -- vectors, matrices, indexing, inline conditions, programs and ODE states ----------
+    def visit_Matrix(self, node: ex.Matrix, scope) -> T:
+        r, c = len(node.rows), len(node.rows[0])
+        if r * c > MAX_ELEMENTS:
+            raise TemplateError(f"a matrix of {r * c} elements (limit {MAX_ELEMENTS})")
+        typed = [[self.visit(e, scope) for e in row] for row in node.rows]
+        first = None
+        nested = any(e.shape is not None for row in typed for e in row)
+        # text beside numbers (a table of load kinds): its elements are looked at when it runs
+        texts = any(e.text for row in typed for e in row)
+        for i, row in enumerate(typed):
+            for j, e in enumerate(row):
+                where = f"element [{i}, {j}] of the matrix"
+                if e.boolean:
+                    raise TemplateError(f"{where} is a comparison; elements are numbers or text")
+                if e.text:
+                    continue
+                self.as_number(e, where)
+                if first is None and not is_zero(e):
+                    first = (e, i, j)
+        unit = first[0].unit if first else self.dimensionless
+        rows = []
+        for i, row in enumerate(typed):
+            out = []
+            for j, e in enumerate(row):
+                if e.text:
+                    out.append(e)
+                    continue
+                if not is_zero(e) and e.unit.dimensionality != unit.dimensionality:
+                    f, fi, fj = first
+                    raise UnitError(
+                        f"a matrix has one unit: element [{i}, {j}] is {un.dims(e.unit)} "
+                        f"({un.pretty(e.unit) or '1'}), element [{fi}, {fj}] is "
+                        f"{un.dims(unit)} ({un.pretty(unit) or '1'}); split it into "
+                        "matrices of one dimension each"
+                    )
+                out.append(self.convert(e, unit, f"element [{i}, {j}] of the matrix"))
+            rows.append(tuple(out))
+        # an array of arrays (Mathcad's nested array): its shape is looked at when it runs
+        return TMatrix(unit, rows=tuple(rows), shape=RUNTIME if nested or texts else (r, c))
+
+    def visit_Index(self, node: ex.Index, scope) -> T:
+        target = self.visit(node.target, scope)
+        if target.shape is None:
+            raise ShapeError(
+                f"{ex.to_text(node.target)} is not a vector or matrix; it cannot be indexed"
+            )
+        n = len(node.indices)
+        if is_runtime(target.shape):  # its shape, and the element's, are known when it runs
+            if n > 2:
+                raise TemplateError(f"{ex.to_text(node)}: at most two indices, M[i, j]")
+            words = ("row", "column") if n == 2 else ("element",)
+            idx = tuple(
+                self.typed_index(i, scope, None, w, ex.to_text(node))
+                for i, w in zip(node.indices, words)
+            )
+            return TIndex(
+                target.unit, target=target, indices=idx, origin=self.spec.origin, shape=RUNTIME
+            )
+        r, c = target.shape
+        if n == 1 and c != 1:
+            raise TemplateError(
+                f"{ex.to_text(node.target)} is a {shape_text(target.shape)}: "
+                "write M[i, j] (one index is for a vector)"
+            )
+        idx = []
+        for k, (i, size) in enumerate(zip(node.indices, (r, c) if n == 2 else (r,))):
+            word = ("row", "column")[k] if n == 2 else "element"
+            idx.append(self.typed_index(i, scope, size, word, ex.to_text(node)))
+        return TIndex(target.unit, target=target, indices=tuple(idx), origin=self.spec.origin)
+
+    def typed_index(self, i: ex.Node, scope, size: int | None, word: str, what: str) -> T:
+        """An index: a plain number; a constant one is checked against ``size`` here (None:
+        a run-time array, checked when it runs)."""
+        origin = self.spec.origin
+        t = self.plain(self.as_number(self.visit(i, scope), "an index"), f"the {word} index")
+        if t.shape is not None and not is_runtime(t.shape):
+            raise TemplateError(f"the {word} index is a matrix; an index is a number")
+        if isinstance(t, TConst) and size is not None:
+            v = t.value
+            if v != int(v) or not origin <= v < origin + size:
+                raise TemplateError(
+                    f"{what}: {word} index {v:g} is out of range "
+                    f"({size} {word}s: {origin} .. {origin + size - 1} with origin {origin})"
+                )
+        return t
+
+    def visit_IfElse(self, node: ex.IfElse, scope) -> T:
+        value = self.visit(node.value, scope)
+        other = self.visit(node.other, scope)
+        cond = self.visit(node.condition, scope)
+        if not cond.boolean:
+            raise TemplateError(f"the condition of {ex.to_text(node)!r} is not a comparison")
+        if value.boolean or other.boolean:
+            raise TemplateError(f"{ex.to_text(node)!r} gives a comparison, not a value")
+        runtime = is_runtime(value.shape) or is_runtime(other.shape)
+        if not runtime and (value.shape is not None or other.shape is not None):
+            raise TemplateError(f"{ex.to_text(node)!r}: the values of a condition are numbers")
+        if runtime and any(v.shape is not None and not is_runtime(v.shape) for v in (value, other)):
+            raise TemplateError(f"{ex.to_text(node)!r}: the values of a condition are numbers")
+        if value.text != other.text:
+            raise TemplateError(
+                f"{ex.to_text(node)!r} gives text on one side, a number on the other"
+            )
+        unit = value.unit
+        if not value.text:
+            self.as_number(value, "a value")
+            self.as_number(other, "a value")
+            if is_zero(value) and not is_zero(other):
+                unit = other.unit
+            value = self.convert(value, unit, "the value if the condition holds")
+            other = self.convert(other, unit, f"the value otherwise ({ex.to_text(node.other)})")
+        texts = (ex.to_text(node.value) + " if " + ex.to_text(node.condition),)
+        return TPiecewise(
+            unit,
+            conditions=(cond, None),
+            values=(value, other),
+            texts=texts + (ex.to_text(node.other) + " otherwise",),
+            text=value.text,
+            # a value known when it runs (an element of a run-time array): a number, checked
+            shape=RUNTIME if runtime else None,
+        )
+
+    def vectorize(self, node: ex.Call, scope) -> T:
+        """``vectorize(EXPR)``: ``* / ^`` inside work element by element."""
+        if len(node.args) != 1:
+            raise TemplateError(f"vectorize() takes 1 argument, got {len(node.args)}")
+        self._elementwise += 1
+        try:
+            return self.visit(node.args[0], scope)
+        finally:
+            self._elementwise -= 1
+
+    def program_body(self, d, scope: dict[str, pint.Unit]) -> T:
+        from .program import typer as pg
+
+        def type_expr(node, sc):
+            return self.visit(node, sc)
+
+        def convert(t, unit, where):
+            if t.text:
+                raise TemplateError(f"{where}: text where a number is wanted")
+            return self.convert(t, unit, where)
+
+        typing = pg.ExprTyping(
+            type_expr=type_expr,
+            convert=convert,
+            is_boolean=lambda t: t.boolean,
+            is_text=lambda t: t.text,
+            is_zero=is_zero,
+            unit_of=lambda t: t.unit,
+            shape_of=lambda t: t.shape,
+            scope_entry=lambda unit, shape: unit if shape is None else (unit, shape),
+            index=lambda i, sc, size, word: self.typed_index(i, sc, size, word, "an element"),
+            origin=self.spec.origin,
+        )
+        reserved = frozenset(self.spec.inputs) | frozenset(self.spec.definitions)
+        typed = pg.type_program(d.program, dict(scope), typing, reserved=reserved - set(scope))
+        return TProgram(
+            typed.unit,
+            name=d.name,
+            program=typed,
+            params=tuple(d.params),
+            matrices=tuple(p for p in d.params if isinstance(scope[p], tuple)),
+            text=typed.text,
+            shape=typed.shape,
+        )
+
+    def ode_body(self, d, scope: dict[str, pint.Unit]) -> T:
+        name, k = d.ode
+        typed = self.ode(name)
+        (var,) = d.params
+        t = TParam(scope[var], name=var)
+        shape = typed.shapes[k] if typed.shapes else None
+        return TOde(typed.units[k], ode=name, state=k, name=d.name, args=(t,), shape=shape)
+
+    def ode(self, name: str):
+        """The typed section ``[[ode]] name`` (units checked once)."""
+        from .ode import type_ode
+
+        cache = self.__dict__.setdefault("_odes", {})
+        if name not in cache:
+            spec = self.spec.odes[name]
+            key = f"ode {name}"
+            if key in self._stack:
+                raise TemplateError(f"ode '{name}' refers to its own solution")
+            self._stack.append(key)
+            try:
+                cache[name] = type_ode(self, spec)
+            finally:
+                self._stack.pop()
+        return cache[name]
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}
@@ -928,68 +912,6 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     if col.unit is not None:
         t = typer.convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
-
-
-def is_angle(unit: pint.Unit) -> bool:
-    """An angle unit other than the radian (deg, grad, arcmin...)."""
-    if unit.dimensionality:
-        return False
-    factor, root = un.registry().get_root_units(unit)
-    return factor != 1 and root == un.registry().radian
-
-
-@functools.lru_cache(maxsize=256)
-def _angle_in(text: str) -> str:
-    reg = un.registry()
-    for name in re.findall(r"[A-Za-z_]+", text):
-        if is_angle(reg.Unit(name)):
-            return un.pretty(reg.Unit(name))
-    return ""
-
-
-def angle_in(unit: pint.Unit) -> str:
-    """The angle unit other than the radian that ``unit`` has as a factor ('deg' for mm*deg),
-    or '' (also when the angles cancel: deg*min/revolution is a time)."""
-    reg = un.registry()
-    if "radian" not in str(reg.get_root_units(unit)[1]):
-        return ""
-    return _angle_in(str(unit))
-
-
-def _bare_ratio(t: T) -> float | None:
-    """The plain number that divides an angle in degrees somewhere in ``t`` (None: none)."""
-    if isinstance(t, TBinary) and t.op == "/":
-        for angle, bare in ((t.left, t.right), (t.right, t.left)):
-            if is_bare(bare) and not is_bare(angle) and angle_in(angle.unit):
-                return bare.value
-    if isinstance(t, TCall):
-        return None  # a function's body is checked where it is typed
-    for c in children(t):
-        found = _bare_ratio(c)
-        if found is not None:
-            return found
-    return None
-
-
-def meeting(values) -> list[T]:
-    """Bare numbers among values that meet an angle (deg, ...) take its unit: theta <= 90."""
-    angle = next((v.unit for v in values if not is_bare(v) and is_angle(v.unit)), None)
-    if angle is None:
-        return list(values)
-    return [TConst(angle, value=v.value) if is_bare(v) else v for v in values]
-
-
-def _with_unit(t: T, unit: pint.Unit) -> T:
-    """Same node, relabelled with an equal unit (factor exactly 1)."""
-    if isinstance(t, TConst):
-        return TConst(unit, value=t.value, derived=t.derived or t.unit != unit)
-    return TScale(unit, child=t, factor=1.0, shape=t.shape)
-
-
-def _derived(*consts: TConst) -> bool:
-    """A constant folded from these is derived when one of them is, or has a unit."""
-    dimensionless = un.registry().dimensionless
-    return any(c.derived or c.unit != dimensionless for c in consts)
 
 
 def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
