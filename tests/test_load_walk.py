@@ -43,3 +43,27 @@ def test_the_walk_sees_a_callback_as_a_climb():
     # an [[ode]] section's expressions are typed by the typer, asked from ode.py: one climb
     found = _walk("advance-coupling")
     assert ("workbook.ode", "workbook.typecheck") in found.climbs_by_pair()
+
+
+def test_the_readers_of_measured_data_and_solve_blocks_return_what_they_read(tmp_path):
+    # they used to claim names and find lines through callbacks of the template reader
+    (tmp_path / "pump.csv").write_text("Q,H\n0,10\n10,8\n20,5\n")
+    text = """
+[data.pump]
+file = "pump.csv"
+columns = { Q = "m^3/h", H = "m" }
+
+[inputs]
+q = "12 m^3/h"
+
+[[solve]]
+unknowns = { x = "1 m" }
+equations = ["x^2 == 2 m^2"]
+
+[definitions]
+head = "linterp(Q, H, q)"
+"""
+    workbook.loads(text, folder=tmp_path)
+    found = load_walk.walk(lambda: workbook.loads(text, folder=tmp_path))
+    assert {"workbook.measured", "workbook.given_find"} <= found.rooms
+    assert not found.climbs, sorted(found.climbs)

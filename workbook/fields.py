@@ -117,3 +117,11 @@ class Fields:
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
             raise self._type_error(key, "a list of tables [{ ... }, ...]")
         return value
+
+
+def value_line(text: str, value: str) -> int | None:
+    """Line number (1-based) of the first line of ``text`` holding ``value``, or None."""
+    for number, line in enumerate(text.splitlines(), start=1):
+        if value in line:
+            return number
+    return None

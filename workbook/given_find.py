@@ -26,6 +26,7 @@ from . import expr as ex
 from . import typed as ty
 from . import units as un
 from .errors import TemplateError, UnitError, WorkbookError
+from .fields import value_line
 
 #: most unknowns of one block
 MAX_UNKNOWNS = 50
@@ -48,8 +49,9 @@ class SolveSpec:
         return f"solve {', '.join(self.unknowns)}"
 
 
-def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
-    """The [[solve]] blocks of a template (names claimed; equations parsed, not typed)."""
+def read_solves(raw: list, text: str) -> list[SolveSpec]:
+    """The [[solve]] blocks of a template (equations parsed, not typed); ``text`` is the
+    template's, for the lines of errors (the reader of the template claims the unknowns)."""
     out = []
     for i, block in enumerate(raw):
         if not isinstance(block, dict) or not (
@@ -67,10 +69,10 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
         if method not in METHODS:
             raise TemplateError(
                 f"[[solve]] method {str(method)!r}: one of {', '.join(METHODS)}",
-                line=find_value_line(str(method)),
+                line=value_line(text, str(method)),
             )
         unknowns, equations = block["unknowns"], block["equations"]
-        line = find_value_line(str(equations[0])) if equations else None
+        line = value_line(text, str(equations[0])) if equations else None
         what = f"solve {', '.join(map(str, unknowns))}"
         try:
             if not isinstance(unknowns, dict) or not unknowns or len(unknowns) > MAX_UNKNOWNS:
@@ -89,7 +91,6 @@ def read_solves(raw: list, find_value_line, claim) -> list[SolveSpec]:
                 )
             guesses = {}
             for name, guess in unknowns.items():
-                claim(name, "solve", line)
                 guesses[name] = un.quantity(str(guess), None, what=name)
             eqs = tuple(_equation(e) for e in equations)
             conditions = block.get("conditions", [])

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,24 +40,20 @@ class DataColumn:
     line: int | None
 
 
-def read_data(
-    raw: dict,
-    path: Path,
-    find_line: Callable[[str, str | None], int | None],
-    claim: Callable[[str, str, int | None], None],
-) -> dict[str, DataColumn]:
-    """Every column of every [data] table, by column name (each name claimed once)."""
-    out: dict[str, DataColumn] = {}
+def read_data(raw: dict, path: Path, lines: dict[str, int | None]) -> list[DataColumn]:
+    """Every column of every [data] table, in the order written; ``lines`` gives the line of
+    each table (the reader of the template claims the column names)."""
+    out: list[DataColumn] = []
     for table, spec in raw.items():
-        line = find_line(table, "data") or find_line("file", f"data.{table}")
+        line = lines.get(table)
         try:
-            out.update(_table(table, spec, path, line, claim))
+            out.extend(_table(table, spec, path, line))
         except WorkbookError as err:
             raise err.located(line=line, definition=f"data.{table}") from None
     return out
 
 
-def _table(table: str, spec, path: Path, line, claim) -> dict[str, DataColumn]:
+def _table(table: str, spec, path: Path, line) -> list[DataColumn]:
     if not isinstance(spec, dict) or "file" not in spec or "columns" not in spec:
         raise TemplateError(
             f'[data.{table}] needs file = "name.csv" and columns = {{ X = "unit", ... }}'
@@ -84,9 +79,8 @@ def _table(table: str, spec, path: Path, line, claim) -> dict[str, DataColumn]:
         raise LimitError(
             f"[data.{table}]: {file.name} has {len(rows) - 1} rows (limit {MAX_POINTS})"
         )
-    out = {}
+    out = []
     for name, unit_text in columns.items():
-        claim(name, f"data.{table}", line)
         if name not in header:
             raise TemplateError(
                 f"[data.{table}]: {file.name} has no column '{name}' (columns: {', '.join(header)})"
@@ -106,5 +100,5 @@ def _table(table: str, spec, path: Path, line, claim) -> dict[str, DataColumn]:
                 raise TemplateError(f"[data.{table}]: {file.name}, data row {k}: {v} is not finite")
             values.append(v)
         unit = un.unit(str(unit_text), what=f"data.{table}.{name}")
-        out[name] = DataColumn(name, table, unit, np.asarray(values), file, line)
+        out.append(DataColumn(name, table, unit, np.asarray(values), file, line))
     return out

@@ -24,7 +24,7 @@ from . import expr as ex
 from . import units as un
 from .declared_checks import read_check
 from .errors import InputError, LimitError, TemplateError, UnitError, WorkbookError
-from .fields import Fields, nearest
+from .fields import Fields, nearest, value_line
 from .ranges import RangeSpec, parse_range
 from .registry import REGISTRY
 
@@ -703,11 +703,17 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     from .given_find import read_solves
     from .measured import read_data
 
-    measured = read_data(
-        _table(data, "data"), path, lambda key, sec: find_line(text, key, sec), claim
-    )
+    tables = _table(data, "data")
+    lines = {t: find_line(text, t, "data") or find_line(text, "file", f"data.{t}") for t in tables}
+    measured = {}
+    for col in read_data(tables, path, lines):
+        claim(col.name, f"data.{col.table}", col.line)
+        measured[col.name] = col
 
-    solves = read_solves(_list(data, "solve"), lambda v: _value_line(text, v), claim)
+    solves = read_solves(_list(data, "solve"), text)
+    for block in solves:
+        for name in block.unknowns:
+            claim(name, "solve", block.line)
     for block in solves:  # Mathcad's th(a) := Find(x): each unknown a function of the parameters
         for p in block.parameters:
             if p not in arguments:
@@ -743,7 +749,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             f.text("block"), f.text("title"), f.text("part", None)
         except WorkbookError as err:
             raise err.located(
-                line=_value_line(text, str(raw.get("block", "[[findings]]")))
+                line=value_line(text, str(raw.get("block", "[[findings]]")))
             ) from None
     _check_sheet_names(tables)
     names_seen = set()
@@ -876,7 +882,7 @@ def _part_of(raw: dict, parts: dict[str, PartSpec], section: str, text: str, lin
         known = ", ".join(parts) or "none declared"
         raise TemplateError(
             f"[[{section}]] part = {part!r} is not declared in [parts] (parts: {known})",
-            line=line or _value_line(text, f"part = {part!r}".replace("'", '"')),
+            line=line or value_line(text, f"part = {part!r}".replace("'", '"')),
         )
     return part
 
@@ -1235,7 +1241,7 @@ def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
 def _printed_spec(raw: dict, path: Path, text: str) -> PrintedSpec:
     if "file" not in raw:
         raise TemplateError('[[printed]] needs file = "...csv"')
-    line = _value_line(text, str(raw["file"]))
+    line = value_line(text, str(raw["file"]))
     try:
         return _printed_fields(raw, path, text)
     except WorkbookError as err:
@@ -1260,7 +1266,7 @@ def _printed_fields(raw: dict, path: Path, text: str) -> PrintedSpec:
     if rel.is_absolute() or ".." in rel.parts:
         raise TemplateError(  # a worksheet reads only files in its own folder
             f"[[printed]] file {str(raw['file'])!r} must be a file name beside the template",
-            line=_value_line(text, str(raw["file"])),
+            line=value_line(text, str(raw["file"])),
         )
     role = f.text("role", "check")
     if role not in ("check", "information"):
@@ -1291,7 +1297,7 @@ def _relation_spec(raw: dict, text: str) -> RelationSpec:
     rel = raw.get("relation")
     if not isinstance(rel, str):
         raise TemplateError('[[relations]] needs relation = "v1 = omega * d(h1)/d(phi)"')
-    line = _value_line(text, rel)
+    line = value_line(text, rel)
     try:
         f = Fields(raw, RELATION_KEYS, f"relation {rel!r}")
         f.text("part", None), f.text("range"), f.text("unit")
@@ -1318,13 +1324,6 @@ def _relation_spec(raw: dict, text: str) -> RelationSpec:
         rng,
         line,
     )
-
-
-def _value_line(text: str, value: str) -> int | None:
-    for number, line in enumerate(text.splitlines(), start=1):
-        if value in line:
-            return number
-    return None
 
 
 def column_node(spec: SheetSpec, col, var: str) -> ex.Node:
