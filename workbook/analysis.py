@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import typecheck as tc
+from . import typed as ty
 from . import units as un
 from .blocks import Finding
 from .errors import WorkbookError
@@ -357,10 +357,10 @@ class PiecewiseResult:
     error: str = ""
 
 
-def _piece_names(t: tc.TPiecewise) -> list[str]:
+def _piece_names(t: ty.TPiecewise) -> list[str]:
     names = []
     for v, text in zip(t.values, t.texts):
-        names.append(v.name if isinstance(v, tc.TCall) else text.split(" if ")[0].strip())
+        names.append(v.name if isinstance(v, ty.TCall) else text.split(" if ")[0].strip())
     return names
 
 
@@ -385,7 +385,7 @@ def _analyse_piecewise(sheet, name, res: PiecewiseResult, var_unit: str):
     from . import symbolic
 
     body = sheet.typer.function(name).body
-    if not isinstance(body, tc.TPiecewise):
+    if not isinstance(body, ty.TPiecewise):
         res.error = "not a piecewise body"
         return
     var = res.var
@@ -455,9 +455,9 @@ def _piece_derivative(sheet, body, exprs, k, order, x, p) -> float:
 
     val = body.values[k]
     if (
-        isinstance(val, tc.TCall)
+        isinstance(val, ty.TCall)
         and len(val.args) == 1
-        and isinstance(val.args[0], tc.TParam)
+        and isinstance(val.args[0], ty.TParam)
         and val.args[0].name == str(x)
     ):
         return float(_derivative_fn(sheet, val.name, str(x), order)(float(p)))
@@ -559,28 +559,28 @@ def join_findings(sheet) -> list[Finding]:
 
 
 # -- domains --------------------------------------------------------------------------------
-def _pure(t: tc.T) -> bool:
+def _pure(t: ty.T) -> bool:
     """True if the tree calls no solver block (cheap to evaluate on a grid)."""
-    if isinstance(t, (tc.TBlock,)) or type(t).__name__ == "TAggregate":
+    if isinstance(t, (ty.TBlock,)) or type(t).__name__ == "TAggregate":
         return False
     return all(_pure(c) for c in children(t))
 
 
-def restricted(t: tc.T):
+def restricted(t: ty.T):
     """Yield (kind, argument node, test) for every sub-expression with a restricted domain."""
     for item in _restricted(t):
         if _pure(item[1]):
             yield item
 
 
-def _restricted(t: tc.T):
-    if isinstance(t, tc.TFunc):
+def _restricted(t: ty.T):
+    if isinstance(t, ty.TFunc):
         for d in REGISTRY[t.func].domain:
             yield d.kind, t.args[d.arg], d.bad, d.shown
-    elif isinstance(t, tc.TBinary):
+    elif isinstance(t, ty.TBinary):
         if t.op == "/":
             yield "division by zero", t.right, lambda v: v == 0, "1/({})"
-        elif t.op == "^" and isinstance(t.right, tc.TConst):
+        elif t.op == "^" and isinstance(t.right, ty.TConst):
             n = t.right.value
             if not float(n).is_integer():
                 shown = "({})^" + f"{n:g}"
@@ -598,11 +598,11 @@ class TypedText(Visitor):
     ``visit(t)`` returns (text, precedence level of :data:`workbook.expr.PREC`).
     """
 
-    def text(self, t: tc.T, parent: int = 0) -> str:
+    def text(self, t: ty.T, parent: int = 0) -> str:
         s, p = self.visit(t)
         return f"({s})" if p < parent else s
 
-    def visit_TConst(self, t: tc.TConst) -> tuple[str, int]:
+    def visit_TConst(self, t: ty.TConst) -> tuple[str, int]:
         v = t.value
         s = repr(int(v)) if float(v).is_integer() and abs(v) < 1e15 else f"{v:.6g}"
         return s, PREC["atom"]
@@ -612,36 +612,36 @@ class TypedText(Visitor):
 
     visit_TRef = visit_TParam
 
-    def visit_TText(self, t: tc.TText) -> tuple[str, int]:
+    def visit_TText(self, t: ty.TText) -> tuple[str, int]:
         return f'"{t.value}"', PREC["atom"]
 
-    def visit_TScale(self, t: tc.TScale) -> tuple[str, int]:
+    def visit_TScale(self, t: ty.TScale) -> tuple[str, int]:
         return self.visit(t.child)
 
-    def visit_TUnary(self, t: tc.TUnary) -> tuple[str, int]:
+    def visit_TUnary(self, t: ty.TUnary) -> tuple[str, int]:
         if t.op == "not":
             return "not " + self.text(t.child, PREC["not"]), PREC["not"]
         return "-" + self.text(t.child, PREC["neg"]), PREC["neg"]
 
-    def visit_TBinary(self, t: tc.TBinary) -> tuple[str, int]:
+    def visit_TBinary(self, t: ty.TBinary) -> tuple[str, int]:
         op = {"@": "*", "@^": "^"}.get(t.op, t.op)  # matrix product and power
         p = PREC[op]
         if op == "^":
             return f"{self.text(t.left, p + 1)}^{self.text(t.right, p)}", p
         return f"{self.text(t.left, p)} {op} {self.text(t.right, p + 1)}", p
 
-    def visit_TCompare(self, t: tc.TCompare) -> tuple[str, int]:
+    def visit_TCompare(self, t: ty.TCompare) -> tuple[str, int]:
         p = PREC["cmp"]
         parts = [self.text(t.operands[0], p + 1)]
         for op, o in zip(t.ops, t.operands[1:]):
             parts += [op, self.text(o, p + 1)]
         return " ".join(parts), p
 
-    def visit_TLogic(self, t: tc.TLogic) -> tuple[str, int]:
+    def visit_TLogic(self, t: ty.TLogic) -> tuple[str, int]:
         p = PREC[t.op]
         return f" {t.op} ".join(self.text(v, p + 1) for v in t.values), p
 
-    def visit_TFunc(self, t: tc.TFunc) -> tuple[str, int]:
+    def visit_TFunc(self, t: ty.TFunc) -> tuple[str, int]:
         return f"{t.func}({', '.join(self.text(a) for a in t.args)})", PREC["atom"]
 
     def visit_TCall(self, t) -> tuple[str, int]:
@@ -649,53 +649,53 @@ class TypedText(Visitor):
 
     visit_TBlock = visit_TCall
 
-    def visit_TAggregate(self, t: tc.TAggregate) -> tuple[str, int]:
+    def visit_TAggregate(self, t: ty.TAggregate) -> tuple[str, int]:
         return f"{t.func}_over({t.table}, {t.column})", PREC["atom"]
 
-    def visit_TPiecewise(self, t: tc.TPiecewise) -> tuple[str, int]:
+    def visit_TPiecewise(self, t: ty.TPiecewise) -> tuple[str, int]:
         return "; ".join(t.texts), PREC["or"] - 1
 
-    def visit_TMatrix(self, t: tc.TMatrix) -> tuple[str, int]:
+    def visit_TMatrix(self, t: ty.TMatrix) -> tuple[str, int]:
         rows = ["[" + ", ".join(self.text(e) for e in row) + "]" for row in t.rows]
         return "[" + ", ".join(rows) + "]", PREC["atom"]
 
-    def visit_TIndex(self, t: tc.TIndex) -> tuple[str, int]:
+    def visit_TIndex(self, t: ty.TIndex) -> tuple[str, int]:
         inner = ", ".join(self.text(i) for i in t.indices)
         return f"{self.text(t.target, PREC['atom'])}[{inner}]", PREC["atom"]
 
-    def visit_TProgram(self, t: tc.TProgram) -> tuple[str, int]:
+    def visit_TProgram(self, t: ty.TProgram) -> tuple[str, int]:
         return f"the program of {t.name}", PREC["atom"]
 
-    def visit_TOde(self, t: tc.TOde) -> tuple[str, int]:
+    def visit_TOde(self, t: ty.TOde) -> tuple[str, int]:
         return f"{t.name}({', '.join(self.text(a) for a in t.args)})", PREC["atom"]
 
 
-def typed_text(t: tc.T, parent: int = 0) -> str:
+def typed_text(t: ty.T, parent: int = 0) -> str:
     """The typed tree back as worksheet text (unit conversions are implicit)."""
     return TypedText().text(t, parent)
 
 
-def _squares(t: tc.T):
+def _squares(t: ty.T):
     """Bases of a product of squares (k^2*sin(x)^2 -> [k, sin(x)]), else None."""
-    if isinstance(t, tc.TScale) and t.factor == 1.0:
+    if isinstance(t, ty.TScale) and t.factor == 1.0:
         return _squares(t.child)
-    if isinstance(t, tc.TBinary) and t.op == "^" and isinstance(t.right, tc.TConst):
+    if isinstance(t, ty.TBinary) and t.op == "^" and isinstance(t.right, ty.TConst):
         return [t.left] if t.right.value == 2 else None
-    if isinstance(t, tc.TBinary) and t.op == "*":
+    if isinstance(t, ty.TBinary) and t.op == "*":
         a, b = _squares(t.left), _squares(t.right)
         return a + b if a is not None and b is not None else None
     return None
 
 
-def meaning(kind: str, node: tc.T) -> str:
+def meaning(kind: str, node: ty.T) -> str:
     """What leaving the domain means in the sheet's terms: 1 - X^2 < 0 is |X| > 1."""
     if not (kind.startswith("sqrt") or kind.startswith("power")):
         return ""
-    t = node.child if isinstance(node, tc.TScale) and node.factor == 1.0 else node
+    t = node.child if isinstance(node, ty.TScale) and node.factor == 1.0 else node
     if (
-        isinstance(t, tc.TBinary)
+        isinstance(t, ty.TBinary)
         and t.op == "-"
-        and isinstance(t.left, tc.TConst)
+        and isinstance(t.left, ty.TConst)
         and t.left.value == 1
     ):
         bases = _squares(t.right)
@@ -718,7 +718,7 @@ def _runs(x: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
     return out
 
 
-def explain_domain(evaluator, typed: tc.TypedFunction, env: dict, units: dict | None = None) -> str:
+def explain_domain(evaluator, typed: ty.TypedFunction, env: dict, units: dict | None = None) -> str:
     """Which sub-expression leaves its domain, and for which argument values ('' if unknown)."""
     parts = []
     try:

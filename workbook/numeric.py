@@ -126,28 +126,28 @@ class Evaluator(Visitor):
             self._functions[name] = fn
         return self._functions[name]
 
-    def compile(self, t: tc.T) -> Fn:
+    def compile(self, t: ty.T) -> Fn:
         """A closure computing ``t`` from an environment of parameter values."""
         fn = self.visit(t)
         key = self.plan.shared(t)
         return fn if key is None else self._kept(key, fn)
 
-    def visit_TConst(self, t: tc.TConst) -> Fn:
+    def visit_TConst(self, t: ty.TConst) -> Fn:
         v = t.value
         return lambda env: v
 
-    def visit_TText(self, t: tc.TText) -> Fn:
+    def visit_TText(self, t: ty.TText) -> Fn:
         v = t.value
         return lambda env: v
 
-    def visit_TParam(self, t: tc.TParam) -> Fn:
+    def visit_TParam(self, t: ty.TParam) -> Fn:
         n = t.name
         return lambda env: env[n]
 
-    def visit_TRef(self, t: tc.TRef) -> Fn:
+    def visit_TRef(self, t: ty.TRef) -> Fn:
         return self.reference(t)
 
-    def reference(self, t: tc.TRef) -> Fn:
+    def reference(self, t: ty.TRef) -> Fn:
         """How this evaluator reads a name in an environment; the interval and mpmath forms
         of EXPR read names through it, so that they compute the function numpy computes."""
         name, kind, get = t.name, t.kind, self.scalar_value
@@ -156,10 +156,10 @@ class Evaluator(Visitor):
             return lambda env: at(name, env)
         return lambda env: get(name, kind)
 
-    def visit_TScale(self, t: tc.TScale) -> Fn:
+    def visit_TScale(self, t: ty.TScale) -> Fn:
         f = t.factor
         c = t.child
-        if f != 1.0 and isinstance(c, tc.TBinary) and c.op == "*":
+        if f != 1.0 and isinstance(c, ty.TBinary) and c.op == "*":
             # a unit factor joins the constant side of a product: (omega*R)*x*f = x*(omega*R*f)
             for const, other in ((c.left, c.right), (c.right, c.left)):
                 if _constant(const):
@@ -172,7 +172,7 @@ class Evaluator(Visitor):
             return lambda env: rt.scale(rt.value(child(env)), f)
         return lambda env: child(env) * f
 
-    def visit_TUnary(self, t: tc.TUnary) -> Fn:
+    def visit_TUnary(self, t: ty.TUnary) -> Fn:
         child = self.compile(t.child)
         if t.op == "not":
             return lambda env: np.logical_not(child(env))
@@ -181,7 +181,7 @@ class Evaluator(Visitor):
             return lambda env: rt.negate(child(env), what)
         return lambda env: -child(env)
 
-    def visit_TBinary(self, t: tc.TBinary) -> Fn:
+    def visit_TBinary(self, t: ty.TBinary) -> Fn:
         left, right = self.compile(t.left), self.compile(t.right)
         if ty.is_runtime(t.shape):
             op, what = t.op, _text(t)
@@ -189,7 +189,7 @@ class Evaluator(Visitor):
         if t.left.shape is not None or t.right.shape is not None:
             return _matrix_binary(t, left, right)
         if t.op == "^":
-            if isinstance(t.right, tc.TConst):
+            if isinstance(t.right, ty.TConst):
                 n = t.right.value
                 if n in (1.5, 3.0, 4.0):
                     return self._power_by_parts(t, n)
@@ -201,7 +201,7 @@ class Evaluator(Visitor):
         op = _ARITH[t.op]
         return lambda env: op(left(env), right(env))
 
-    def _power_by_parts(self, t: tc.TBinary, n: float) -> Fn:
+    def _power_by_parts(self, t: ty.TBinary, n: float) -> Fn:
         """x^1.5 = x*sqrt(x), x^3 = x*x^2, x^4 = (x^2)^2: the sqrt(x) or x^2 written
         elsewhere in the sheet is then computed once (and a product is cheaper than a power)."""
         base = self.compile(t.left)
@@ -214,7 +214,7 @@ class Evaluator(Visitor):
             return lambda env: base(env) * square(env)
         return lambda env: np.square(square(env))
 
-    def visit_TCompare(self, t: tc.TCompare) -> Fn:
+    def visit_TCompare(self, t: ty.TCompare) -> Fn:
         parts = [self.compile(o) for o in t.operands]
         if any(ty.is_runtime(o.shape) for o in t.operands):
             ops_text, what = t.ops, _text(t)
@@ -238,7 +238,7 @@ class Evaluator(Visitor):
 
         return chain
 
-    def visit_TLogic(self, t: tc.TLogic) -> Fn:
+    def visit_TLogic(self, t: ty.TLogic) -> Fn:
         parts = [self.compile(v) for v in t.values]
         join = np.logical_and if t.op == "and" else np.logical_or
 
@@ -250,7 +250,7 @@ class Evaluator(Visitor):
 
         return logic
 
-    def visit_TFunc(self, t: tc.TFunc) -> Fn:
+    def visit_TFunc(self, t: ty.TFunc) -> Fn:
         entry = REGISTRY[t.func]
         f = entry.numpy
         if entry.binds and len(t.args) > max(entry.binds):
@@ -287,7 +287,7 @@ class Evaluator(Visitor):
             return lambda env: f(a0(env), a1(env))
         return lambda env: f(*[a(env) for a in args])
 
-    def _binding(self, t: tc.TFunc, entry) -> Fn:
+    def _binding(self, t: ty.TFunc, entry) -> Fn:
         """A built-in binding a variable: its hook gets EXPR as a function of the variable
         (a :class:`workbook.numerics.bound.Bound`: ``of(value)``, and the row-wise form
         SciPy's vectorised solvers call)."""
@@ -309,7 +309,7 @@ class Evaluator(Visitor):
 
         return call
 
-    def visit_TCall(self, t: tc.TCall) -> Fn:
+    def visit_TCall(self, t: ty.TCall) -> Fn:
         f = self.function(t.name)
         params = self.typer.function(t.name).params
         args = [self.compile(a) for a in t.args]
@@ -318,16 +318,16 @@ class Evaluator(Visitor):
             return lambda env: f({p0: a0(env)})
         return lambda env: f({p: a(env) for p, a in zip(params, args)})
 
-    def visit_TBlock(self, t: tc.TBlock) -> Fn:
+    def visit_TBlock(self, t: ty.TBlock) -> Fn:
         return self._block(t)
 
-    def visit_TAggregate(self, t: tc.TAggregate) -> Fn:
+    def visit_TAggregate(self, t: ty.TAggregate) -> Fn:
         get, red = self.column_values, (np.max if t.func == "max" else np.min)
         if get is None:
             raise InputError(f"{t.func}_over({t.table}, {t.column}) needs a sheet's tables")
         return lambda env: float(red(get(t.table, t.column)))
 
-    def visit_TPiecewise(self, t: tc.TPiecewise) -> Fn:
+    def visit_TPiecewise(self, t: ty.TPiecewise) -> Fn:
         if ty.is_runtime(t.shape):
             return self._runtime_piecewise(t)
         conds = [None if k is None else self.compile(k) for k in t.conditions]
@@ -337,7 +337,7 @@ class Evaluator(Visitor):
         split = self._kept(self.plan.keys.signature("pieces", keys), split)
         return _piecewise(t, conds, [self.compile(v) for v in t.values], split, matrices, used)
 
-    def _runtime_piecewise(self, t: tc.TPiecewise) -> Fn:
+    def _runtime_piecewise(self, t: ty.TPiecewise) -> Fn:
         """``a if c otherwise b`` whose values are known when they run (elements of run-time
         arrays): one point at a time, and each value given must be a number."""
         conds = [None if k is None else self.compile(k) for k in t.conditions]
@@ -370,18 +370,18 @@ class Evaluator(Visitor):
 
         return evaluate
 
-    def visit_TMatrix(self, t: tc.TMatrix) -> Fn:
+    def visit_TMatrix(self, t: ty.TMatrix) -> Fn:
         from .matrix import build
 
         rows = [[self.compile(e) for e in row] for row in t.rows]
         if ty.is_runtime(t.shape):  # an array of arrays
             return lambda env: rt.build([[e(env) for e in row] for row in rows])
-        if all(isinstance(e, tc.TConst) for row in t.rows for e in row):
+        if all(isinstance(e, ty.TConst) for row in t.rows for e in row):
             value = np.array([[e.value for e in row] for row in t.rows])
             return lambda env: value
         return lambda env: build([[e(env) for e in row] for row in rows])
 
-    def visit_TIndex(self, t: tc.TIndex) -> Fn:
+    def visit_TIndex(self, t: ty.TIndex) -> Fn:
         from .analysis import typed_text
         from .matrix import index
 
@@ -401,7 +401,7 @@ class Evaluator(Visitor):
             target(env), i0(env), j0(env), origin=origin, shape=shape, what=what
         )
 
-    def visit_TProgram(self, t: tc.TProgram) -> Fn:
+    def visit_TProgram(self, t: ty.TProgram) -> Fn:
         from .program.run import NoValue, compile_program
 
         run = compile_program(t.program, self.compile, t.name)
@@ -441,7 +441,7 @@ class Evaluator(Visitor):
 
         return program
 
-    def visit_TOde(self, t: tc.TOde) -> Fn:
+    def visit_TOde(self, t: ty.TOde) -> Fn:
         time = self.compile(t.args[0])
         k, name = t.state, t.ode
         solution = self.ode_solution
@@ -472,7 +472,7 @@ class Evaluator(Visitor):
             raise cache[name]
         return cache[name]
 
-    def _block(self, t: tc.TBlock) -> Fn:
+    def _block(self, t: ty.TBlock) -> Fn:
         from . import blocks
 
         blk = blocks.get(t.ref, "function")
@@ -539,26 +539,26 @@ def _recursion_bounded(name: str, fn: Fn) -> Fn:
     return run
 
 
-def _text(t: tc.T) -> str:
+def _text(t: ty.T) -> str:
     """The source text of a typed node, for run-time errors."""
     from .analysis import typed_text
 
     return typed_text(t)
 
 
-def _constant(t: tc.T) -> bool:
+def _constant(t: ty.T) -> bool:
     """True if ``t`` does not depend on the environment (no parameter in it)."""
-    if isinstance(t, tc.TParam):
+    if isinstance(t, ty.TParam):
         return False
     return all(_constant(c) for c in children(t))
 
 
-def _matrix_names(t: tc.T) -> frozenset:
+def _matrix_names(t: ty.T) -> frozenset:
     """The parameters and program locals that are vectors or matrices, read in ``t``."""
     out, todo = set(), [t]
     while todo:
         n = todo.pop()
-        if isinstance(n, tc.TParam) and n.shape is not None:
+        if isinstance(n, ty.TParam) and n.shape is not None:
             out.add(n.name)
         todo.extend(ty.children(n))
     return frozenset(out)
@@ -621,7 +621,7 @@ def _partition(
 
 
 def _piecewise(
-    t: tc.TPiecewise,
+    t: ty.TPiecewise,
     conds: list,
     values: list,
     split: Fn,
@@ -648,7 +648,7 @@ def _piecewise(
     return evaluate
 
 
-def _matrix_binary(t: tc.TBinary, left: Fn, right: Fn) -> Fn:
+def _matrix_binary(t: ty.TBinary, left: Fn, right: Fn) -> Fn:
     """An operator with a vector or matrix operand (matrix axes first, see workbook.matrix)."""
     from . import matrix as mx
 
@@ -805,7 +805,7 @@ def _explain_of(run, env) -> str:
     return explain(env) if explain is not None else ""
 
 
-def _explain(evaluator: Evaluator, f: tc.TypedFunction, env) -> str:
+def _explain(evaluator: Evaluator, f: ty.TypedFunction, env) -> str:
     """Which sub-expression left its domain, and for which arguments (workbook.analysis)."""
     try:
         from . import units as un

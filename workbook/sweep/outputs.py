@@ -10,7 +10,7 @@ import numpy as np
 import pint
 
 from .. import expr as ex
-from .. import typecheck as tc
+from .. import typed as ty
 from .. import units as un
 from ..errors import InputError, TemplateError, WorkbookError
 
@@ -104,7 +104,7 @@ class TypedOutput:
     """An output typed against the sheet, with the unit and factor it is shown in."""
 
     out: Output
-    t: tc.T
+    t: ty.T
     unit: object  # pint.Unit shown
     factor: float  # typed magnitude -> shown unit
     var_unit: object | None = None
@@ -122,7 +122,7 @@ def type_output(sheet, out: Output) -> TypedOutput:
             )
         scope = {out.range.var: spec.binding_unit}
     t = sheet.typer.expression(out.node, scope, what)
-    if isinstance(t, tc.TText) or getattr(t, "text", False) or getattr(t, "boolean", False):
+    if isinstance(t, ty.TText) or getattr(t, "text", False) or getattr(t, "boolean", False):
         # a text (a design check's "OK") failed every case with a raw ValueError, exit 0
         raise TemplateError(f"{what}: the output must be a number, not a text or a condition")
     if out.reduction in ("argmax", "argmin"):
