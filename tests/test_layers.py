@@ -53,9 +53,6 @@ allow_indirect_imports = true
 #: Each one goes through a module outside the compute stage and the renderers, whose edits are
 #: made elsewhere; remove its entry once it is broken.
 ALLOWED_CYCLES: tuple[frozenset[str], ...] = (
-    # diff's unit rule asks the symbolic layer why it refuses EXPR; the symbolic layer reads
-    # the registry, which registers the numerical built-ins' entries
-    frozenset({"workbook.numerics.entries", "workbook.registry", "workbook.symbolic"}),
     # the Mathcad importer: the translation asks the engine for a unit or a value at import
     # (engine.AtImport, engine.Unknown), the engine and the writer use the translation's names
     frozenset({"workbook.mathcad.engine", "workbook.mathcad.translate", "workbook.mathcad.writer"}),

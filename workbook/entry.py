@@ -19,7 +19,8 @@ Arity = int | tuple[int, int | None] | None
 
 class UnitContext(Protocol):
     """What a unit rule may ask of the typer: the unit rules of typed trees
-    (:class:`workbook.unitrules.UnitRules`, a base of the typer)."""
+    (:class:`workbook.unitrules.UnitRules`, a base of the typer), and for ``diff`` whether a
+    typed body has a symbolic form."""
 
     dimensionless: pint.Unit
 
@@ -28,6 +29,8 @@ class UnitContext(Protocol):
     def plain(self, t: ty.T, where: str) -> ty.T: ...
 
     def meeting(self, values) -> list[ty.T]: ...
+
+    def symbolic_refusal(self, t: ty.T) -> str | None: ...
 
 
 @dataclass(frozen=True)

@@ -263,6 +263,12 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         return self.function(name).unit if d.is_function else self.scalar(name).unit
 
     # -- internals ----------------------------------------------------------------
+    def symbolic_refusal(self, t: T) -> str | None:
+        """Why ``t`` has no symbolic form (``diff`` refuses it at load), or None; no SymPy."""
+        from .symbolic import refusal
+
+        return refusal(self, t)
+
     def where(self) -> dict:
         """File, line and definition being typed (for an error found later, at first use)."""
         name = self._stack[-1] if self._stack else None

@@ -118,7 +118,6 @@ def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
     """diff's unit, EXPR's over X's to the N: no SymPy at load. What can be refused without
     SymPy is refused here (the order, a variable not in scope, EXPR with a part that has no
     formula); the derivative itself is found at first use (workbook.numerics.derivative)."""
-    from ..symbolic import refusal
     from .derivative import pending
 
     body, var, *rest = args
@@ -138,7 +137,7 @@ def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
             f"diff(): the derivative is a function of {var.name}, which is not an argument "
             f'here: make {var.name} an argument of the definition ("NAME({var.name})")'
         )
-    why = refusal(ctx, body)
+    why = ctx.symbolic_refusal(body)
     if why:
         raise TemplateError(f"diff(): {why}")
     unit = body.unit / un.difference_unit(var.unit) ** order  # per delta_degC, not per degC
