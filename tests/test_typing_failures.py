@@ -58,3 +58,14 @@ def test_a_remembered_error_is_raised_as_it_was_made(monkeypatch, tmp_path):
         "no formula calls f() with a vector or matrix; with numbers: P is not a vector or "
         "matrix; it cannot be indexed; with arrays: unknown name 'nosuch' (did you mean cosh?)"
     )
+
+
+def test_an_error_caught_to_add_context_is_raised_as_a_new_value():
+    from workbook.errors import UnitError
+
+    err = UnitError("cannot add", file="a.toml", line=3, definition="y")
+    new = err.reworded("f(x): cannot add")
+    assert type(new) is UnitError
+    assert (new.file, new.line, new.definition) == ("a.toml", 3, "y")
+    assert str(new) == "a.toml:3, in 'y': unit error: f(x): cannot add"
+    assert (err.message, err.args) == ("cannot add", ("cannot add",))

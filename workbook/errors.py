@@ -6,6 +6,8 @@ the command line can print one actionable paragraph instead of a traceback.
 
 from __future__ import annotations
 
+import copy
+
 
 class WorkbookError(Exception):
     """Base class: a user-facing error with a location."""
@@ -32,6 +34,16 @@ class WorkbookError(Exception):
         self.line = self.line or line
         self.definition = self.definition or definition
         return self
+
+    def reworded(self, message: str) -> WorkbookError:
+        """A copy of this error (its type, location and fields) with ``message`` for its own:
+        an error caught to add what the caller knows is raised again as a new value, and the
+        one caught (perhaps remembered) is left as it was."""
+        out = copy.copy(self)
+        out.__dict__ = dict(self.__dict__)
+        out.message = message
+        out.args = (message,)
+        return out
 
     def __str__(self) -> str:
         where = []

@@ -2,14 +2,13 @@
 
 Every node gets the pint unit its value is in; every place where two units must
 agree (sums, comparisons, piecewise branches, function arguments) gets an
-explicit conversion factor. Both back ends (numpy and Excel) read this typed
-tree, so the unit logic lives only here.
+explicit conversion factor (the rules: :mod:`workbook.unitrules`). Both back ends (numpy
+and Excel) read this typed tree, so no back end converts a unit.
 """
 
 from __future__ import annotations
 
 import contextlib
-import copy
 import re
 
 import pint
@@ -57,14 +56,6 @@ MAX_ELEMENTS = 10_000
 
 #: Longest chain of definitions typed inside one another (a -> b -> c ...).
 MAX_CHAIN = 100
-
-
-def _fresh(err: WorkbookError) -> WorkbookError:
-    """A copy of ``err`` with its own attributes (``copy.copy`` of an exception may share
-    them with the original)."""
-    out = copy.copy(err)
-    out.__dict__ = dict(err.__dict__)
-    return out
 
 
 class Typer(ArrayTyping, UnitRules, Visitor):
@@ -150,12 +141,10 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         except WorkbookError as err:
             if at_numbers.message in err.message:  # the same mistake either way
                 raise at_numbers from None
-            err.message = (
+            raise err.reworded(
                 f"no formula calls {name}() with a vector or matrix; with numbers: "
                 f"{at_numbers.message}; with arrays: {err.message}"
-            )
-            err.args = (err.message,)
-            raise
+            ) from None
 
     def specialized(self, name: str, shapes: tuple) -> TypedFunction:
         """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for
@@ -188,13 +177,14 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         it happened in the chain: that chain is over the limit from any start."""
         failed = self._failed.get(key)
         if failed is not None:
-            raise _fresh(failed)
+            raise failed.reworded(failed.message)
         reads = self._assumption_reads
         try:
             yield
         except WorkbookError as err:
             if self._assumption_reads == reads:
-                self._failed[key] = _fresh(err)  # callers may rewrite the one they catch
+                # a copy: callers may locate the one they catch
+                self._failed[key] = err.reworded(err.message)
             raise
 
     def _settled(self, d: Definition, key: str, units, scope, shapes) -> TypedFunction:
@@ -384,8 +374,8 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             unit = un.unit(node.unit, what=f"the quantity {shown!r}")
         except WorkbookError as err:
             if re.search(r"[*/]", node.unit):
-                err.message += "; a space ends the unit of a number (2 m * x is 2 m times x)"
-                err.args = (err.message,)
+                hint = "; a space ends the unit of a number (2 m * x is 2 m times x)"
+                raise err.reworded(err.message + hint) from None
             raise
         return TConst(unit, value=node.value, derived=True)
 
@@ -592,13 +582,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             given = ", ".join(
                 f"{p} a {shape_text(sh)}" for p, sh in zip(d.params, shapes) if sh is not None
             )
-            err.message = f"{ex.to_text(node)} (with {given}): {err.message}"
-            err.args = (err.message,)
+            message = f"{ex.to_text(node)} (with {given}): {err.message}"
             caller = self._stack[-1] if self._stack else None
             if caller is not None and caller != err.definition:
-                err.message += f" (called in '{caller}')"
-                err.args = (err.message,)
-            raise
+                message += f" (called in '{caller}')"
+            raise err.reworded(message) from None
 
     def _scalar_args(self, name: str, args) -> None:
         for a in args:

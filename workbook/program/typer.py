@@ -114,8 +114,7 @@ class _TypeState:
         try:
             return self.t.type_expr(e, self.scope)
         except WorkbookError as err:
-            err.message = f"{self.where(s)}: {err.message}"
-            raise
+            raise err.reworded(f"{self.where(s)}: {err.message}") from None
 
     def cond(self, e, s: Stmt):
         t = self.expr(e, s)
