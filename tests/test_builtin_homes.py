@@ -28,12 +28,14 @@ from workbook.report.mathml import MathML
 
 PACKAGE = Path(__file__).resolve().parents[1] / "workbook"
 
-# The modules of registry entries; and the importers' maps of Mathcad's and Excel's names to
-# the language's (data about those products, checked against the registry below).
+# The modules of registry entries (matrix.py: what the matrix entries compute, by name); and
+# the importers' maps of Mathcad's and Excel's names to the language's (data about those
+# products, checked against the registry below).
 HOMES = {
     "builtins.py",
     "distributions.py",
     "matrix.py",
+    "matrix_entries.py",
     "numerics/entries.py",
     "mathcad/functions.py",
     "excelimport/functions.py",
