@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 from . import excel_names
-from . import typed as tc
+from . import typed as ty
 from .errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
 from .expr import PREC
 from .registry import CONSTANTS, REGISTRY
@@ -63,9 +63,9 @@ class BoundBody:
 
     printer: ExcelPrinter
     subst: dict
-    typed: tc.T  # EXPR's typed tree
+    typed: ty.T  # EXPR's typed tree
     var: str  # the variable it binds
-    var_param: tc.T  # the variable as typed
+    var_param: ty.T  # the variable as typed
     rest: tuple  # the other arguments, typed
     helpers: object  # the context's helper cells (None outside one)
     scope: tuple  # the printed values of the variables around the call
@@ -78,7 +78,7 @@ class BoundBody:
     def __call__(self, value: str) -> str:
         return self.printer.print(self.typed, {**self.subst, self.var: value})
 
-    def tree(self, tree: tc.T) -> tuple[str, int]:
+    def tree(self, tree: ty.T) -> tuple[str, int]:
         return self.printer.visit(tree, self.subst)
 
 
@@ -121,11 +121,11 @@ class ExcelPrinter(Visitor):
         return self._context.helpers
 
     def visit(self, t, *args):
-        if tc.is_runtime(getattr(t, "shape", None)):
+        if ty.is_runtime(getattr(t, "shape", None)):
             raise NotLive("an array whose size is known only when its program runs")
         return super().visit(t, *args)
 
-    def formula(self, t: tc.T, subst: dict[str, str]) -> Formula:
+    def formula(self, t: ty.T, subst: dict[str, str]) -> Formula:
         """The live formula of ``t`` (NotLive when it has none); ``.array`` says whether it
         computes with arrays."""
         self._array = False
@@ -138,7 +138,7 @@ class ExcelPrinter(Visitor):
         out.array = self._array
         return out
 
-    def print(self, t: tc.T, subst: dict[str, str]) -> str:
+    def print(self, t: ty.T, subst: dict[str, str]) -> str:
         return self.visit(t, subst)[0]
 
     def _wrap(self, t, subst, level: int) -> str:
@@ -215,7 +215,7 @@ class ExcelPrinter(Visitor):
         expr_at, var_at = entry.binds
         body, var = t.args[expr_at], t.args[var_at].name
         rest = [a for i, a in enumerate(t.args) if i not in (expr_at, var_at)]
-        consts = [a.value if isinstance(a, tc.TConst) else None for a in rest]
+        consts = [a.value if isinstance(a, ty.TConst) else None for a in rest]
 
         printed = BoundBody(
             self, s, body, var, t.args[var_at], tuple(rest), self.helpers, tuple(s.values())
@@ -230,7 +230,7 @@ class ExcelPrinter(Visitor):
         f = self.typer.function(t.name)
         if t.name in self.typer.recursive:  # Excel has no recursion
             raise NotLive(f"{t.name.split('@')[0]}() calls itself; its values are numbers")
-        if any(f.shapes) and isinstance(f.body, tc.TProgram):  # loops over a matrix: no formula
+        if any(f.shapes) and isinstance(f.body, ty.TProgram):  # loops over a matrix: no formula
             raise NotLive(
                 f"{t.name.split('@')[0]}() is called with a vector or matrix; "
                 "its values are written as numbers"
@@ -267,7 +267,7 @@ class ExcelPrinter(Visitor):
 
     def visit_TMatrix(self, t, s):
         self._array = True
-        if not all(isinstance(e, tc.TConst) for row in t.rows for e in row):
+        if not all(isinstance(e, ty.TConst) for row in t.rows for e in row):
             raise NotLive("a matrix written with formulas inside an expression (name it)")
         rows = (",".join(number(e.value) for e in row) for row in t.rows)
         return "{" + ";".join(rows) + "}", ATOM
@@ -280,7 +280,7 @@ class ExcelPrinter(Visitor):
         return f"INDEX({target}, {idx[0]}, {idx[1]})", ATOM
 
     def _index(self, i, origin: int, s) -> str:
-        if isinstance(i, tc.TConst):
+        if isinstance(i, ty.TConst):
             return number(i.value + 1 - origin)
         shift = 1 - origin
         text = self._wrap(i, s, ADD)

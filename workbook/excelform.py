@@ -25,7 +25,7 @@ from xlsxwriter.utility import xl_rowcol_to_cell
 from . import expr as ex
 from . import runtime as rt
 from . import style
-from . import typed as tc
+from . import typed as ty
 from . import units as un
 from . import verdicts as V
 from .checks import tolerances
@@ -396,7 +396,7 @@ class ExcelLayout:
         self.on_matrices = getattr(self, "on_matrices", set()) | {d.name for d in defs}
         for d in defs:
             t = self.sheet.typer.scalar(d.name)
-            if tc.is_runtime(t.shape):
+            if ty.is_runtime(t.shape):
                 row = self._write_runtime(ws, row, d, t)
                 continue
             r, c = t.shape
@@ -418,7 +418,7 @@ class ExcelLayout:
         for d in defs:
             shape = self._shape(d.name)
             if shape is not None and (
-                not tc.is_runtime(shape) or self._runtime_value(d.name) is not None
+                not ty.is_runtime(shape) or self._runtime_value(d.name) is not None
             ):
                 arrays.append(d)
         return arrays, [d for d in defs if d not in arrays]
@@ -432,7 +432,7 @@ class ExcelLayout:
             return None
         return v if rt.is_array(v) else None
 
-    def _write_runtime(self, ws, row: int, d, t: tc.T) -> int:
+    def _write_runtime(self, ws, row: int, d, t: ty.T) -> int:
         """An array whose size is known only when its program ran: its values (a nested
         array, whose elements are arrays, as a line of text), with a comment."""
         value = self._runtime_value(d.name)
@@ -491,16 +491,16 @@ class ExcelLayout:
         except WorkbookError:
             return None
 
-    def _write_block(self, ws, top: int, t: tc.T, value, what: str) -> None:
+    def _write_block(self, ws, top: int, t: ty.T, value, what: str) -> None:
         r, c = t.shape
         fmt = self.fmt["number"]
         body = t
-        while isinstance(body, tc.TScale) and body.factor == 1.0:
+        while isinstance(body, ty.TScale) and body.factor == 1.0:
             body = body.child
-        if isinstance(body, tc.TMatrix):  # written out: one cell per element
+        if isinstance(body, ty.TMatrix):  # written out: one cell per element
             for i, row in enumerate(body.rows):
                 for j, e in enumerate(row):
-                    if isinstance(e, tc.TConst):
+                    if isinstance(e, ty.TConst):
                         ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
                     else:
                         self._write_cell(ws, top + i, 1 + j, e, {}, float(value[i, j]), fmt, what)
@@ -521,7 +521,7 @@ class ExcelLayout:
                     ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
         self.formula_cells += 1
 
-    def _write_cell(self, ws, row, col, t: tc.T, subst, value: float, fmt, what: str) -> bool:
+    def _write_cell(self, ws, row, col, t: ty.T, subst, value: float, fmt, what: str) -> bool:
         try:
             refused = self.refused.get((ws.name, row, col))
             if refused is not None:
@@ -544,7 +544,7 @@ class ExcelLayout:
             self._live_note(ws, row, col, t, {}, value, what)
         return True
 
-    def _live_note(self, ws, row, col, t: tc.T, env: dict, values, what: str, rows=0) -> None:
+    def _live_note(self, ws, row, col, t: ty.T, env: dict, values, what: str, rows=0) -> None:
         """A comment on a live formula that holds an approximate live form (an integral), and
         a line of the Checks sheet's list of live forms."""
         from .numerics.live import difference
@@ -1208,11 +1208,11 @@ class HelperCells:
 
     SHEET = "Solver steps"
 
-    def __init__(self, writer, what: str, typed: tc.T | None = None):
+    def __init__(self, writer, what: str, typed: ty.T | None = None):
         self.writer, self.what, self.typed = writer, what, typed
         self._chains: dict | None = None
 
-    def chain(self, expr: tc.T) -> dict:
+    def chain(self, expr: ty.T) -> dict:
         """The engine's steps of the live form of ``expr`` in this definition (or NotLive)."""
         if self.typed is None:
             raise NotLive("no helper cells here")
@@ -1220,7 +1220,7 @@ class HelperCells:
             self._chains = _recorded_chains(self.writer, self.typed, {})
         return _one_chain(self._chains, expr, ())
 
-    def value(self, t: tc.T, env: dict) -> float:
+    def value(self, t: ty.T, env: dict) -> float:
         """The engine's value of a typed tree (for a helper cell's cached value)."""
         return float(self.writer.sheet.evaluator.compile(t)(env))
 
@@ -1257,7 +1257,7 @@ class RowSteps:
         self.blocks: list[RowBlock] = []
         self._chains: dict | None = None
 
-    def chain(self, expr: tc.T) -> dict:
+    def chain(self, expr: ty.T) -> dict:
         """The engine's steps of the live form of ``expr`` (a root's, an extremum's), every
         row (or NotLive)."""
         if self._chains is None:
@@ -1302,7 +1302,7 @@ class RowSteps:
             w.formula_cells += self.n * len(b.headers)
 
 
-def _recorded_chains(writer, typed: tc.T, env: dict) -> dict:
+def _recorded_chains(writer, typed: ty.T, env: dict) -> dict:
     """The steps of every live root and extremum met evaluating ``typed`` in ``env`` with
     the live forms (workbook.numerics), by id of their EXPR."""
     from .numerics import live_forms, recording_chains
@@ -1319,7 +1319,7 @@ def _recorded_chains(writer, typed: tc.T, env: dict) -> dict:
     return found
 
 
-def _one_chain(found: dict, expr: tc.T, shape: tuple) -> dict:
+def _one_chain(found: dict, expr: ty.T, shape: tuple) -> dict:
     """The one chain of ``expr`` in ``found``, each array of ``shape`` or one value."""
     got = found.get(id(expr), [])
     arrays = []

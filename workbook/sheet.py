@@ -12,6 +12,7 @@ import pint
 from . import expr as ex
 from . import runtime as rt
 from . import typecheck as tc
+from . import typed as ty
 from . import units as un
 from .computed import Column, TableData, compute
 from .errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
@@ -257,7 +258,7 @@ class Sheet:
         except (RecursionError, MemoryError) as exc:
             raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
 
-    def scalar_typed(self, name: str) -> tc.T:
+    def scalar_typed(self, name: str) -> ty.T:
         """The typed tree of scalar definition ``name`` in the unit it is shown in: a
         dimensionless product of units (``kg*mm/m^2/Pa/s^2``) becomes a plain number."""
         t = self.typer.scalar(name)
@@ -454,11 +455,11 @@ class Sheet:
         except WorkbookError as err:
             raise self._locate(err, what) from None
 
-    def range_bounds(self, rng: RangeSpec, what: str = "range") -> list[tc.T | None]:
+    def range_bounds(self, rng: RangeSpec, what: str = "range") -> list[ty.T | None]:
         """The typed first, second (or None) and last value of a range, in the range
         variable's declared unit (a plain number is taken as already in it)."""
         spec = self.spec.arguments.get(rng.var)
-        out: list[tc.T | None] = []
+        out: list[ty.T | None] = []
         for node, unit in zip((rng.first, rng.second, rng.last), rng.units):
             if node is None:
                 out.append(None)
@@ -471,7 +472,7 @@ class Sheet:
                 raise TemplateError(
                     f"{what}: range bound has units but '{rng.var}' has no declared unit"
                 )
-            if spec is not None and not (tc.is_bare(t) and not is_scaled_angle(spec.unit)):
+            if spec is not None and not (ty.is_bare(t) and not is_scaled_angle(spec.unit)):
                 # the typer's one conversion, as for an argument of a call: a bare number is
                 # in the declared unit (0, 5 .. 90 degrees), an expression with pi or a plain
                 # number computed is in radians (a plain argument's bounds are plain numbers)
@@ -498,7 +499,7 @@ class Sheet:
         """A bare function name as a column means that function of the range variable."""
         return column_node(self.spec, col, var)
 
-    def typed_column(self, col: ColumnSpec, var: str, what: str) -> tc.T:
+    def typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
         try:
             t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
             if col.unit is not None:
@@ -526,7 +527,7 @@ class Sheet:
             fn = self.evaluator.compile(t)
         except (RecursionError, MemoryError) as exc:  # functions inlined into one another
             raise self._locate(exhausted(exc), what) from None
-        if tc.is_runtime(t.shape):  # a run-time value: each row's must be a number
+        if ty.is_runtime(t.shape):  # a run-time value: each row's must be a number
             run = fn
             where = f"column '{col.text}'"
             fn = lambda env: np.array(  # noqa: E731
