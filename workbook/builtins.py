@@ -388,7 +388,7 @@ def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
     return ty.TFunc(body.unit, func=name, args=(body, var, a, b), shape=body.shape)
 
 
-def _bound(value, which: str) -> int:
+def sum_index(value, which: str) -> int:
     x = float(np.asarray(value, dtype=float).flat[0])
     if not math.isfinite(x) or x != math.floor(x):
         raise InputError(f"sum(): the {which} index must be an integer, got {x:g}")
@@ -428,7 +428,7 @@ def _sum_excel(body, args=None, consts=None, *, shapes=None) -> tuple[str, int]:
     lo, hi = consts
     if lo is None or hi is None:
         raise NotLive("sum() with bounds that are not constants has no live formula")
-    lo, hi = _bound(lo, "first"), _bound(hi, "last")
+    lo, hi = sum_index(lo, "first"), sum_index(hi, "last")
     if hi < lo:
         return "0", PREC["atom"]
     if hi - lo + 1 > MAX_EXCEL_TERMS:

@@ -641,9 +641,9 @@ __all__ = ["Translation", "translate_book", "Procedure"]
 
 def translate_vba(code: str, module: str = "Module1") -> dict[str, FunctionInfo]:
     """The Functions of VBA source text, translated (each with its program or its problem)."""
-    from .vba import _module
+    from .vba import module_of
 
-    tr = Translation(Path(module + ".bas"), Book(Path(module + ".bas")), [_module(module, code)])
+    tr = Translation(Path(module + ".bas"), Book(Path(module + ".bas")), [module_of(module, code)])
     reserved = language_reserved()
     _collect_functions(tr, reserved)
     _name_params(tr, reserved)

@@ -70,7 +70,7 @@ def read_modules(path: Path) -> list[Module]:
             except UnicodeDecodeError:
                 continue
         m = re.search(r'^Attribute VB_Name = "([^"]+)"', text, re.M)
-        return [_module(m.group(1) if m else path.stem, text)]
+        return [module_of(m.group(1) if m else path.stem, text)]
     try:
         from oletools.olevba import VBA_Parser
     except ImportError:  # pragma: no cover - a runtime dependency
@@ -96,7 +96,7 @@ def read_modules(path: Path) -> list[Module]:
                     f"(limit {MAX_MODULE_CHARS:,})"
                 )
             m = re.search(r'^Attribute VB_Name = "([^"]+)"', text, re.M)
-            out.append(_module(m.group(1) if m else stream.split("/")[-1], text))
+            out.append(module_of(m.group(1) if m else stream.split("/")[-1], text))
     except LimitError:
         raise
     except Exception as exc:  # noqa: BLE001 - a damaged VBA project
@@ -106,7 +106,7 @@ def read_modules(path: Path) -> list[Module]:
     return out
 
 
-def _module(name: str, code: str) -> Module:
+def module_of(name: str, code: str) -> Module:
     document = code.lstrip().startswith("VERSION") or bool(
         re.search(r"^Attribute VB_(Base|GlobalNameSpace|Creatable|PredeclaredId)\b", code, re.M)
     )

@@ -701,12 +701,12 @@ def _integral_excel(body, args, consts) -> tuple[str, int]:
 
 
 def _product_excel(body, args, consts) -> tuple[str, int]:
-    from ..builtins import MAX_EXCEL_TERMS, _bound
+    from ..builtins import MAX_EXCEL_TERMS, sum_index
 
     lo, hi = consts
     if lo is None or hi is None:
         raise NotLive("product() with bounds that are not constants has no live formula")
-    lo, hi = _bound(lo, "first"), _bound(hi, "last")
+    lo, hi = sum_index(lo, "first"), sum_index(hi, "last")
     if hi < lo:
         return "1", ATOM
     if hi - lo + 1 > MAX_EXCEL_TERMS:

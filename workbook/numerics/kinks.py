@@ -57,7 +57,7 @@ class Kinks(Visitor):
                 if n.name in aliases or (subst is not None and n.name not in subst):
                     return None
             stack.extend(ty.children(n))
-        return t if not subst else _substitute(t, subst)
+        return t if not subst else substitute(t, subst)
 
     def _pair(self, x: ty.T, y: ty.T, aliases, subst) -> None:
         for lin, other in ((x, y), (y, x)):
@@ -135,7 +135,7 @@ class Kinks(Visitor):
             self.visit(f.body, inner, values)
 
 
-def _substitute(t: ty.T, subst: dict[str, ty.T]) -> ty.T:
+def substitute(t: ty.T, subst: dict[str, ty.T]) -> ty.T:
     """``t`` with parameters replaced by typed trees (their units are the parameters')."""
     if isinstance(t, ty.TParam):
         return subst.get(t.name, t)
@@ -143,10 +143,10 @@ def _substitute(t: ty.T, subst: dict[str, ty.T]) -> ty.T:
     for field in dataclasses.fields(t):
         v = getattr(t, field.name)
         if isinstance(v, ty.T):
-            changes[field.name] = _substitute(v, subst)
+            changes[field.name] = substitute(v, subst)
         elif isinstance(v, tuple) and any(isinstance(x, ty.T) for x in v):
             changes[field.name] = tuple(
-                _substitute(x, subst) if isinstance(x, ty.T) else x for x in v
+                substitute(x, subst) if isinstance(x, ty.T) else x for x in v
             )
     return dataclasses.replace(t, **changes) if changes else t
 

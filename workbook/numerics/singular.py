@@ -14,7 +14,7 @@ derivative of the integral in its bound is the integrand there).
 from __future__ import annotations
 
 from .. import typed as ty
-from .kinks import _substitute
+from .kinks import substitute
 
 #: a sheet function nested deeper than this is not read
 _MAX_DEPTH = 20
@@ -37,7 +37,7 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
                 inner, bound_var = t.args[0], t.args[1].name
                 for u in singular_arguments(typer, inner, bound_var):
                     for end in t.args[2:]:
-                        _keep(_substitute(u, {bound_var: end}), var, found)
+                        _keep(substitute(u, {bound_var: end}), var, found)
                 continue
             if entry is not None and entry.binds:
                 continue  # another built-in's own variable: its own business
@@ -50,7 +50,7 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
                 _keep(t.left, var, found)
         elif isinstance(t, ty.TCall) and depth < _MAX_DEPTH and t.name not in typer.recursive:
             f = typer.function(t.name)
-            stack.append((_substitute(f.body, dict(zip(f.params, t.args))), depth + 1))
+            stack.append((substitute(f.body, dict(zip(f.params, t.args))), depth + 1))
             continue  # its arguments are inside the substituted body
         stack.extend((c, depth) for c in ty.children(t))
     return found
