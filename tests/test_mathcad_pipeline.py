@@ -77,3 +77,44 @@ def test_a_worksheet_the_engine_takes_is_loaded_once(tmp_path, capsys, counted):
     assert counted == {"sheets": 1, "translations": 1}
     result = _check(tmp_path, capsys, "clean")
     assert (result["printed"], result["reproduced"]) == (1, 1), result
+
+
+def test_a_range_over_a_value_the_engine_computes(tmp_path, capsys):
+    """L := 3.4 m; n := round(L/m) + 1; i := 0 .. n-1 and i*2 listed over it: the range's
+    values (0, 1, 2, 3) are computed by the engine, with any of its built-ins (round)."""
+    n = _apply("plus", _call("round", _apply("div", _id("L"), _id("m"))), _real(1))
+    rng = f"<ml:range>{_real(0)}{_apply('minus', _id('n'), _real(1))}</ml:range>"
+    listed = "<ml:matrix rows='4' cols='1'>" + "".join(_real(v) for v in (0, 2, 4, 6))
+    text = _import(
+        tmp_path,
+        capsys,
+        "ranged",
+        _define(1, _id("L"), _length(3.4)),
+        _define(2, _id("n"), n),
+        _define(3, _id("i"), rng),
+        _eval(4, _apply("mult", _id("i"), _real(2)), listed + "</ml:matrix>"),
+    )
+    assert "not translated" not in text.lower().split("[sheet]")[0], text
+    result = _check(tmp_path, capsys, "ranged")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (4, 4, 0), result
+
+
+def test_a_chain_of_definitions_is_typed_once(tmp_path, capsys, monkeypatch):
+    """x1 := x0/2, x2 := x1/2, ... (is an angle divided? the engine tells, for each link):
+    what the engine typed once stands in as an input of its unit, so the worksheets written to
+    type the chain hold a few definitions each, not the whole chain before."""
+    from workbook.mathcad import writer
+
+    rendered = []
+    document = writer.document
+
+    def counted(tr, *a, **k):
+        rendered.append(len(tr.items))
+        return document(tr, *a, **k)
+
+    monkeypatch.setattr(writer, "document", counted)
+    links = [_define(k + 1, _id(f"x{k}"), _apply("div", _id(f"x{k - 1}"), _real(2)))
+             for k in range(1, 60)]  # fmt: skip
+    _import(tmp_path, capsys, "chain", _define(0, _id("x0"), _length(1.0)), *links)
+    at_import = rendered[:-1]  # the last: the whole worksheet, typed once
+    assert len(at_import) >= 59 and max(at_import) <= 2, rendered

@@ -8,6 +8,8 @@ typed by their calls), then computes every chart series as ``workbook run`` will
 the engine refuses gives its region and the engine's reason; what needs a refused definition
 is not typed (it is left out with it). :func:`leave_out` marks the refused regions
 untranslated in the translation, and everything that uses them, with the reason.
+:class:`AtImport` gives the unit and the value of an expression while the translation is
+built (a range's values, a guess, a size), with the same typer and evaluator.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from pathlib import Path
 from .. import expr as ex
 from .. import typecheck as tc
 from ..errors import WorkbookError
-from .translate import Item, Skipped, Translation, _uses
+from .translate import Item, Skipped, Translation, _rename, _uses
 from .writer import Rendered
 
 
@@ -238,3 +240,185 @@ def _defined(item: Item) -> list:
     if item.kind == "solve":
         return [sym for sym, _ in item.solve[0]]
     return [item.sym] if item.sym is not None else []
+
+
+class Unknown(Exception):
+    """What an expression needs is not known at import, or the engine refuses it."""
+
+
+class AtImport:
+    """The unit and the value of an expression of the translation so far, as the engine
+    gives them: the inputs, units and definitions it needs (nothing else) are written as a
+    worksheet in memory by the writer, typed by the language's typer and computed by its
+    evaluator. A name that is not known at import is :class:`Unknown`: an argument of a
+    function (typed by its calls at the end), a local of a program, a function of the sheet
+    (its arguments' units are not known yet), an unknown of a solve block, a definition the
+    translation left out or written as a program; a range variable is known by its unit only
+    (``ranges=True``).
+
+    A definition the engine typed once (or computed) stands in the next worksheet as an input
+    of that unit (or value), and one it refused is refused again without typing: a chain of
+    definitions each asked about (``x2 := x1/2`` divides an angle?) is typed once, not once
+    per link."""
+
+    def __init__(self, translator) -> None:
+        self.translator = translator
+        self.out = translator.out
+        self.items: dict[str, Item] = {}
+        self.syms: dict[str, object] = {}
+        self.order: dict[int, int] = {}  # id of a symbol -> its place in the translation
+        self.seen = (0, 0)
+        # token of a scalar definition -> (its value or None, its unit); None: refused
+        self.known: dict[str, tuple | None] = {}
+
+    def _update(self) -> None:
+        """The symbols and their items so far (the translation only grows)."""
+        items, syms = self.out.items, self.out.syms
+        for item in items[self.seen[0] :]:
+            if item.sym is not None:
+                self.items[item.sym.token()] = item
+        for k, sym in enumerate(syms[self.seen[1] :], self.seen[1]):
+            self.syms[sym.token()] = sym
+            self.order[id(sym)] = k
+        self.seen = (len(items), len(syms))
+
+    def _needs(self, node: ex.Node, ranges: bool, values: bool):
+        """The items and symbols ``node`` needs (a definition known before as an input in
+        its place), and the range variables it uses."""
+        self._update()
+        items: list[Item] = []
+        syms: set = set()
+        range_syms: list = []
+        stack, seen = list(ex.names(node)), set()
+        while stack:
+            name = stack.pop()
+            if name in seen or not name.startswith("\x00"):  # a built-in: the engine's
+                continue
+            seen.add(name)
+            sym = self.syms.get(name)
+            if sym is None or sym.broken:
+                raise Unknown(name)
+            if sym.kind == "unit":
+                syms.add(sym)
+                continue
+            if sym.kind == "param":  # a bound variable (a free one the typer refuses)
+                if not sym.unit and (sym.hint is not None or sym.hint_sym is not None):
+                    raise Unknown(name)  # its unit is given at the end
+                syms.add(sym)
+                continue
+            item = self.items.get(name)
+            if item is None:
+                raise Unknown(name)
+            if item.kind == "range" and ranges and sym.is_range:
+                syms.add(sym)
+                range_syms.append(sym)
+                continue
+            if item.kind == "definition" and name in self.known:
+                known = self.known[name]
+                if known is None:
+                    raise Unknown(name)
+                if known[0] is not None or not values:
+                    items.append(Item("input", sym=sym, value=_quantity_text(*known)))
+                    syms.add(sym)
+                    continue
+            if item.kind == "input" or (item.kind == "definition" and item.program is None):
+                items.append(item)
+                syms.add(sym)
+                trees = [item.body] if item.body is not None else []
+                trees += [t for piece in item.pieces or [] for t in piece if t is not None]
+                for tree in trees:
+                    stack += ex.names(tree)
+                continue
+            raise Unknown(name)
+        return items, syms, range_syms
+
+    def _sizes(self, node: ex.Node) -> ex.Node:
+        """``node`` with rows(M), cols(M) and length(v) of a matrix written out in the
+        translation (by name) as numbers. Kept from the tree, not computed: an element of M may
+        call a function of the sheet, whose arguments' units are only known at the end."""
+        if isinstance(node, ex.Call) and node.func in ("rows", "cols", "length"):
+            if len(node.args) == 1:
+                tree = self.translator.written_out(node.args[0]) or node.args[0]
+                if isinstance(tree, ex.Matrix):
+                    rows, cols = len(tree.rows), len(tree.rows[0])
+                    if node.func != "length" or cols == 1:
+                        return ex.Number(float(cols if node.func == "cols" else rows))
+        return ex.map_children(node, self._sizes)
+
+    def _typed(self, node: ex.Node, what: str, ranges: bool, values: bool):
+        """(spec, typer, typed tree, token of each name) of ``node`` in a worksheet of what it
+        needs."""
+        from ..template import spec_from_data
+        from .writer import document
+
+        node = self._sizes(node)
+        items, syms, range_syms = self._needs(node, ranges, values)
+        part = Translation(items=items, syms=sorted(syms, key=lambda s: self.order[id(s)]))
+        try:
+            doc, _ = document(part, "at-import", Path("at-import.xmcd"))
+            spec = spec_from_data(doc.data, Path("at-import.toml"), "at-import")
+            input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+            typer = tc.Typer(spec, input_units)
+            mapping = {s.token(): s.final for s in part.syms}
+            scope = {s.final: spec.arguments[s.final].binding_unit for s in range_syms}
+            t = typer.expression(_rename(node, mapping), scope, what)
+        except (WorkbookError, RecursionError) as err:
+            if isinstance(node, ex.Name) and node.id in self.items:
+                self.known.setdefault(node.id, None)  # refused wherever it is used
+            raise Unknown(str(err)) from None
+        tokens = {s.final: s.token() for s in part.syms}
+        for name, typed in typer.scalars.items():
+            if _number(typed):
+                self.known.setdefault(tokens[name], (None, typed.unit))
+        return spec, typer, t, tokens
+
+    def unit(self, node: ex.Node):
+        """The pint unit of ``node`` (of each element of a vector or matrix; a range variable
+        by its unit), or None: not known at import, a text, a condition or an array of
+        arrays."""
+        try:
+            t = self._typed(node, "an expression at import", True, False)[2]
+        except Unknown:
+            return None
+        return None if t.text or t.boolean or tc.is_runtime(t.shape) else t.unit
+
+    def quantity(self, node: ex.Node):
+        """The value of ``node`` (a number) as a pint quantity; :class:`Unknown` if it is not
+        one known at import."""
+        import numpy as np
+
+        from .. import units as un
+        from ..limits import matrix_work
+        from ..sheet import Sheet
+
+        spec, typer, t, tokens = self._typed(node, "an expression at import", False, True)
+        if not _number(t):
+            raise Unknown("not a number")
+        try:
+            sheet = Sheet(spec, typer=typer)  # the evaluator of what it needs
+            with matrix_work():
+                value = sheet.evaluator.compile(t)({})
+        except (WorkbookError, RecursionError) as err:
+            raise Unknown(str(err)) from None
+        if isinstance(value, str) or np.ndim(value) != 0:
+            raise Unknown("not a number")
+        for name, typed in typer.scalars.items():  # the definitions computed on the way
+            if _number(typed):
+                try:
+                    v = sheet.scalar_value(name, "definition")  # remembered: not computed again
+                except WorkbookError:
+                    continue
+                if isinstance(v, float):
+                    self.known[tokens[name]] = (v, typed.unit)
+        return un.registry().Quantity(float(value), t.unit)
+
+
+def _number(t) -> bool:
+    """Is the typed tree ``t`` one number (not a vector, a text or a condition)?"""
+    return t.shape is None and not t.text and not t.boolean
+
+
+def _quantity_text(value: float | None, unit) -> str:
+    """An input's value: ``value`` (1 if None) in ``unit``."""
+    number = repr(float(1.0 if value is None else value))
+    return number if str(unit) in ("", "dimensionless") else f"{number} {unit}"

@@ -250,10 +250,7 @@ class ExprTranslator(Visitor):
         number in radians Mathcad divides."""
         if not isinstance(other, ex.Number) or isinstance(node, ex.Number):
             return node
-        try:
-            unit = _Units(self.tr).visit(node)
-        except Exception:  # noqa: BLE001 - unknown: left as written
-            return node
+        unit = self.tr.at_import().unit(node)
         from ..typecheck import angle_in
 
         if unit is None or not angle_in(unit):
@@ -525,7 +522,7 @@ MAX_WRITTEN_ELEMENTS = 10_000
 def _whole_at_import(tr: Translator, node: MNode, what: str) -> int:
     """A size Mathcad gives as an expression: a whole number of at least 1 known at import."""
     try:
-        value = float(_Values(tr).quantity(node).to("").magnitude)
+        value = float(tr.quantity(node).to("").magnitude)
     except Exception:  # noqa: BLE001 - not a value known at import, or not a plain number
         raise Untranslatable(f"{what} whose size is not a number known at import") from None
     if not (math.isfinite(value) and value == int(value) and value >= 1):
@@ -552,6 +549,25 @@ class Translator:
         self.shown: dict[str, tuple[str, list]] = {}  # a name -> (unit, values Mathcad stored)
         # local functions of programs, written out at each call: token -> (parameters, body)
         self.inline: dict[str, tuple[list[str], ex.Node]] = {}
+        self._at_import = None
+
+    def at_import(self):
+        """The engine's unit and value of an expression of the translation so far."""
+        if self._at_import is None:
+            from .engine import AtImport
+
+            self._at_import = AtImport(self)
+        return self._at_import
+
+    def quantity(self, node: MNode, why: str = "a value that is not known at import"):
+        """The value (a pint quantity) of a Mathcad expression of numbers, units, inputs and
+        definitions, as the engine computes it."""
+        from .engine import Unknown
+
+        try:
+            return self.at_import().quantity(ExprTranslator(self).visit(node))
+        except Unknown:
+            raise Untranslatable(why) from None
 
     # -- symbols --------------------------------------------------------------
     def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym:
@@ -820,7 +836,12 @@ class Translator:
     def argument_units(self) -> None:
         """Mathcad's functions are untyped: an argument takes the unit of the values the
         worksheet calls the function with (the first call whose unit is known)."""
-        units = _Units(self)
+        at = self.at_import()
+
+        def unit_of(node: ex.Node) -> str | None:
+            u = at.unit(node)
+            return None if u is None else ("" if u.dimensionless else str(u))
+
         for item in self.out.items:
             if item.kind != "function" or item.sym is None or item.sym.kind == "helper":
                 continue
@@ -829,14 +850,14 @@ class Translator:
                     continue
                 for args in self.calls.get(item.sym, []):
                     if k < len(args):
-                        unit = units.of(args[k])
+                        unit = unit_of(args[k])
                         if unit is not None:
                             param.unit = unit
                             break
         for sym in self.out.syms:  # variables bound by root, integral, diff
             if sym.kind == "param" and not sym.unit:
                 if sym.hint is not None:
-                    sym.unit = units.of(sym.hint) or ""
+                    sym.unit = unit_of(sym.hint) or ""
                 elif sym.hint_sym is not None:
                     sym.unit = sym.hint_sym.unit
 
@@ -943,7 +964,7 @@ class Translator:
             return
         if key == ("TOL", "") and _quantity_text(rhs) is not None:
             try:
-                tol = float(_Values(self).quantity(rhs).magnitude)
+                tol = float(self.quantity(rhs).magnitude)
                 self.out.solve_tolerance = max(self.out.solve_tolerance, tol)
             except Exception:  # noqa: BLE001 - a TOL that is not a number: the default
                 pass
@@ -1544,16 +1565,10 @@ class Translator:
         method = _METHODS.get(method, "")
         if len(eqs) != len(args) and not (0 < len(eqs) < len(args) and method):
             raise Untranslatable(f"a solve block of {len(eqs)} equations in {len(args)} unknowns")
-        values = _Values(self)
         local, unknowns = {}, []
         for a in args:
             key = _key(a)
-            try:
-                q = values.visit(et.visit(a))  # the guess: the value before the block
-            except Untranslatable:
-                raise
-            except Exception:  # noqa: BLE001 - pint's errors alike
-                raise Untranslatable(f"the guess of {nm.mathcad_text(*key)} is not known") from None
+            q = self.guess(et, a)  # the value before the block
             sym = self.new_sym("var", nm.identifier(*key), nm.mathcad_text(*key), self.given[0])
             local[key] = sym
             magnitude = float(q.magnitude)
@@ -1580,6 +1595,17 @@ class Translator:
             return names[0]
         return ex.Matrix(tuple((n,) for n in names))
 
+    def guess(self, et: ExprTranslator, name: MNode):
+        """The value of the name ``name`` before a solve block (its guess), as the engine
+        computes it."""
+        from .engine import Unknown
+
+        try:
+            return self.at_import().quantity(et.visit(name))
+        except Unknown:
+            what = nm.mathcad_text(*_key(name))
+            raise Untranslatable(f"the guess of {what} is not known") from None
+
     def extremum(self, et: ExprTranslator, args: list[MNode], largest: bool) -> ex.Node:
         """Maximize(f, x) / Minimize(f, x) from the guess x (and the inequalities of an open
         Given block): the stationary point of f nearest the guess where f curves down (up),
@@ -1596,12 +1622,7 @@ class Translator:
             if fsym is None or fsym.kind != "func" or fsym.broken:
                 raise Untranslatable(f"{what} of something that is not a function of the sheet")
             key = _key(args[1])
-            try:
-                q = _Values(self).visit(et.visit(args[1]))  # the guess: the value before
-            except Untranslatable:
-                raise
-            except Exception:  # noqa: BLE001 - pint's errors alike
-                raise Untranslatable(f"the guess of {nm.mathcad_text(*key)} is not known") from None
+            q = self.guess(et, args[1])  # the value before
             guess = et.visit(args[1])
             region = given[0] if given else self.region
             slope = self._derivative(fsym, fsym, "slope", region, guess)
@@ -1833,100 +1854,6 @@ def _symbolic_result(node: MNode) -> MNode:
     return node
 
 
-class _Units(Visitor):
-    """The unit of an expression at import (pint text), or None where it is not known
-    (parameters, calls of the worksheet's functions): a guess for argument units only; the
-    engine checks every unit when it loads the result."""
-
-    def __init__(self, tr: Translator):
-        self.tr = tr
-        self.items = {i.sym.token(): i for i in tr.out.items if i.sym is not None}
-        self.units = {s.token(): s.unit for s in tr.out.syms if s.kind == "unit"}
-        self.memo: dict[str, object] = {}
-
-    def of(self, node: ex.Node) -> str | None:
-        try:
-            u = self.visit(node)
-        except (_Unknown, Exception):  # noqa: BLE001 - unknown: the engine decides
-            return None
-        if u is None:
-            return None
-        return "" if u.dimensionless else str(u)
-
-    def _reg(self):
-        from .. import units as un
-
-        return un.registry()
-
-    def visit_Number(self, n):
-        return self._reg().dimensionless
-
-    def visit_Name(self, n):
-        if n.id == "pi":
-            return self._reg().dimensionless
-        if n.id in self.units:
-            return self._reg().Unit(self.units[n.id])
-        item = self.items.get(n.id)
-        if item is None:
-            raise _Unknown
-        if n.id not in self.memo:
-            self.memo[n.id] = None  # a cycle is unknown
-            self.memo[n.id] = self._item_unit(item)
-        if self.memo[n.id] is None:
-            raise _Unknown
-        return self.memo[n.id]
-
-    def _item_unit(self, item: Item):
-        if item.kind == "input":
-            return self._reg().Quantity(item.value).units
-        if item.kind == "definition" and item.body is not None:
-            return self.visit(item.body)
-        if item.kind == "range" and item.sym.unit is not None:
-            return self._reg().Unit(item.sym.unit)
-        return None
-
-    def visit_Unary(self, n):
-        return self.visit(n.operand)
-
-    def visit_Binary(self, n):
-        a = self.visit(n.left)
-        if n.op in "+-":
-            return a
-        b = self.visit(n.right)
-        if n.op == "*":
-            return a * b
-        if n.op == "/":
-            return a / b
-        if isinstance(n.right, ex.Number):
-            return a**n.right.value
-        raise _Unknown
-
-    def visit_Matrix(self, n):
-        """A matrix has one unit: that of its first element whose unit is known."""
-        for row in n.rows:
-            for e in row:
-                if not (isinstance(e, ex.Number) and e.value == 0):
-                    return self.visit(e)
-        return self._reg().dimensionless
-
-    def visit_Index(self, n):
-        return self.visit(n.target)
-
-    def visit_Call(self, n):
-        if n.func in ("abs", "mag", "min", "max", "mod"):
-            return self.visit(n.args[0])
-        if n.func == "sqrt":
-            return self.visit(n.args[0]) ** 0.5
-        plain = ("sin", "cos", "tan", "exp", "ln", "log10", "asin", "acos", "atan")
-        if n.func in plain + ("floor", "ceil", "round", "trunc"):
-            return self._reg().dimensionless
-        raise _Unknown
-
-
-class _Unknown(Exception):
-    pass
-
-
 def _has_matrix(tree: ex.Node) -> bool:
     """Is a vector or matrix written inside ``tree``?"""
     return any(isinstance(n, ex.Matrix) for n in ex.walk(tree))
@@ -2084,10 +2011,10 @@ def _quantity_text(node: MNode) -> str | None:
 def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNode):
     """Mathcad's values of a range first, second .. last (up to last, not beyond), and the
     range's unit; the bounds must be values known at import (numbers, inputs, definitions)."""
-    ev = _Values(tr)
+    why = "a range whose bounds are not values known at import"
     try:
-        a, c = ev.quantity(first), ev.quantity(last)
-        b = ev.quantity(second) if second is not None else None
+        a, c = tr.quantity(first, why), tr.quantity(last, why)
+        b = tr.quantity(second, why) if second is not None else None
         unit = c.units if a.magnitude == 0 and not a.dimensionless else a.units
         if a.magnitude == 0 and a.dimensionless:
             unit = c.units
@@ -2112,90 +2039,6 @@ def _range_values(tr: Translator, first: MNode, second: MNode | None, last: MNod
         raise Untranslatable("a range of more than 100,000 values")
     dimensionless = unit == "" or not str(unit) or unit.dimensionless
     return [a + k * step for k in range(n + 1)], ("" if dimensionless else str(unit))
-
-
-class _Values(Visitor):
-    """The value (a pint quantity) of an expression of numbers, units, inputs and scalar
-    definitions, at import: used for the values of a range only."""
-
-    _FUNCS = {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp",
-              "ln", "log10", "sqrt", "abs", "floor", "ceil"}  # fmt: skip
-
-    def __init__(self, tr: Translator):
-        from .. import units as un
-
-        self.ureg = un.registry()
-        self.items = {i.sym.token(): i for i in tr.out.items if i.sym is not None}
-        self.units = {s.token(): s.unit for s in tr.out.syms if s.kind == "unit"}
-        self.tr = tr
-        self.depth = 0
-
-    def quantity(self, node: MNode):
-        return self.visit(ExprTranslator(self.tr).visit(node))
-
-    def visit_Number(self, n):
-        return self.ureg.Quantity(n.value)
-
-    def visit_Name(self, n):
-        if n.id == "pi":
-            return self.ureg.Quantity(math.pi)
-        if n.id in self.units:
-            return self.ureg.Quantity(1.0, self.units[n.id])
-        item = self.items.get(n.id)
-        self.depth += 1
-        if item is None or self.depth > 200:
-            raise Untranslatable("a range whose bounds are not values known at import")
-        if item.kind == "input":
-            return self.ureg.Quantity(item.value)
-        if item.kind == "definition" and item.body is not None:
-            return self.visit(item.body)
-        raise Untranslatable("a range whose bounds are not values known at import")
-
-    def _size(self, func: str, node: ex.Node) -> int:
-        """rows, cols or length of a matrix written out, or of a name defined as one."""
-        self.depth += 1
-        while isinstance(node, ex.Name) and self.depth <= 200:
-            item = self.items.get(node.id)
-            if item is None or item.kind != "definition" or item.body is None:
-                break
-            node = item.body
-            self.depth += 1
-        if not isinstance(node, ex.Matrix):
-            raise Untranslatable("a range whose bounds are not values known at import")
-        rows, cols = len(node.rows), len(node.rows[0])
-        if func == "length" and cols != 1:
-            raise Untranslatable("length() of a matrix")
-        return cols if func == "cols" else rows
-
-    def visit_Unary(self, n):
-        v = self.visit(n.operand)
-        return -v if n.op == "-" else v
-
-    def visit_Binary(self, n):
-        a, b = self.visit(n.left), self.visit(n.right)
-        if n.op == "^":
-            return a ** float(b.to("").magnitude)
-        return {"+": a.__add__, "-": a.__sub__, "*": a.__mul__, "/": a.__truediv__}[n.op](b)
-
-    def visit_Call(self, n):
-        import numpy as np
-
-        if n.func in ("rows", "cols", "length") and len(n.args) == 1:
-            return self.ureg.Quantity(float(self._size(n.func, n.args[0])))
-        if n.func in ("min", "max"):
-            vals = [self.visit(a) for a in n.args]
-            return (min if n.func == "min" else max)(vals)
-        if n.func not in self._FUNCS or len(n.args) != 1:
-            raise Untranslatable("a range whose bounds are not values known at import")
-        v = self.visit(n.args[0])
-        if n.func == "sqrt":
-            return v**0.5
-        if n.func == "abs":
-            return abs(v)
-        name = {"ln": "log", "asin": "arcsin", "acos": "arccos", "atan": "arctan"}.get(
-            n.func, n.func
-        )
-        return self.ureg.Quantity(float(getattr(np, name)(v.to("").magnitude)))
 
 
 # -- Mathcad's comparisons are numbers (1 or 0), its numbers conditions (true where not 0) --
