@@ -270,6 +270,8 @@ class AtImport:
         self.seen = (0, 0)
         # token of a scalar definition -> (its value or None, its unit); None: refused
         self.known: dict[str, tuple | None] = {}
+        # what a worksheet holds -> (spec, typer, identifier of each token, its Sheet or None)
+        self.worksheets: dict[frozenset, list] = {}
 
     def _update(self) -> None:
         """The symbols and their items so far (the translation only grows)."""
@@ -346,38 +348,47 @@ class AtImport:
         return ex.map_children(node, self._sizes)
 
     def _typed(self, node: ex.Node, what: str, ranges: bool, values: bool):
-        """(spec, typer, typed tree, token of each name) of ``node`` in a worksheet of what it
-        needs."""
+        """(key of the worksheet of what ``node`` needs, typed tree, token of each identifier);
+        the worksheet is written, read and given a typer once for the same needs."""
         from ..template import spec_from_data
         from .writer import document
 
         node = self._sizes(node)
         items, syms, range_syms = self._needs(node, ranges, values)
-        part = Translation(items=items, syms=sorted(syms, key=lambda s: self.order[id(s)]))
+        key = frozenset(id(s) for s in syms) | {
+            (id(i.sym), i.value if i.kind == "input" else id(i)) for i in items
+        }
         try:
-            doc, _ = document(part, "at-import", Path("at-import.xmcd"))
-            spec = spec_from_data(doc.data, Path("at-import.toml"), "at-import")
-            input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-            typer = tc.Typer(spec, input_units)
-            mapping = {s.token(): s.final for s in part.syms}
-            scope = {s.final: spec.arguments[s.final].binding_unit for s in range_syms}
+            if key not in self.worksheets:  # the same needs (a range over n, again): reused
+                part = Translation(items=items, syms=sorted(syms, key=lambda s: self.order[id(s)]))
+                doc, _ = document(part, "at-import", Path("at-import.xmcd"))
+                spec = spec_from_data(doc.data, Path("at-import.toml"), "at-import")
+                input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+                mapping = {s.token(): s.final for s in part.syms}
+                self.worksheets[key] = [spec, tc.Typer(spec, input_units), mapping, None]
+            spec, typer, mapping, _ = self.worksheets[key]
+            finals = [mapping[s.token()] for s in range_syms]
+            scope = {f: spec.arguments[f].binding_unit for f in finals}
             t = typer.expression(_rename(node, mapping), scope, what)
         except (WorkbookError, RecursionError) as err:
             if isinstance(node, ex.Name) and node.id in self.items:
                 self.known.setdefault(node.id, None)  # refused wherever it is used
             raise Unknown(str(err)) from None
-        tokens = {s.final: s.token() for s in part.syms}
+        tokens = {final: token for token, final in mapping.items()}
         for name, typed in typer.scalars.items():
             if _number(typed):
                 self.known.setdefault(tokens[name], (None, typed.unit))
-        return spec, typer, t, tokens
+        return key, t, tokens
 
     def unit(self, node: ex.Node):
         """The pint unit of ``node`` (of each element of a vector or matrix; a range variable
         by its unit), or None: not known at import, a text, a condition or an array of
         arrays."""
+        known = self.known.get(node.id) if isinstance(node, ex.Name) else None
+        if known is not None:
+            return known[1]
         try:
-            t = self._typed(node, "an expression at import", True, False)[2]
+            t = self._typed(node, "an expression at import", True, False)[1]
         except Unknown:
             return None
         return None if t.text or t.boolean or tc.is_runtime(t.shape) else t.unit
@@ -391,11 +402,18 @@ class AtImport:
         from ..limits import matrix_work
         from ..sheet import Sheet
 
-        spec, typer, t, tokens = self._typed(node, "an expression at import", False, True)
+        known = self.known.get(node.id) if isinstance(node, ex.Name) else None
+        if known is not None and known[0] is not None:
+            return un.registry().Quantity(*known)
+        key, t, tokens = self._typed(node, "an expression at import", False, True)
         if not _number(t):
             raise Unknown("not a number")
+        worksheet = self.worksheets[key]
+        spec, typer = worksheet[:2]
         try:
-            sheet = Sheet(spec, typer=typer)  # the evaluator of what it needs
+            if worksheet[3] is None:  # the evaluator of what it needs
+                worksheet[3] = Sheet(spec, typer=typer)
+            sheet = worksheet[3]
             with matrix_work():
                 value = sheet.evaluator.compile(t)({})
         except (WorkbookError, RecursionError) as err:
