@@ -188,12 +188,24 @@ def test_loop_gives_listed_values(sheet, dr, expected):
 
 
 def test_loop_steps_from_e_without_drift(sheet):
-    r, k = R.loop(6.0, 0.1, mm(sheet.evaluate("r0_grid")), mm(sheet.evaluate("r0")))
+    s = sheet.with_inputs(dr="0.1 mm")
+    k, r = s.evaluate("loop_k").magnitude, mm(s.evaluate("r0_loop"))
     assert k == 323 and r == 6.0 + 323 * 0.1
     drifted = 6.0
     for _ in range(323):
         drifted += 0.1  # what r0 += dr does
     assert drifted != r  # the accumulated sum has drifted; e + k*dr has not
+
+
+def test_loop_is_the_templates_program(sheet):
+    """The loop is the template's program loop_k; a run over the cap is not stepped: loop_k
+    gives the steps it would need (the refusal names them)."""
+    assert sheet.spec.definitions["loop_k"].program
+    assert sheet.evaluate("loop_k").magnitude == 3225
+    s = sheet.with_inputs(alpha_max="0.5 deg")
+    assert s.evaluate("loop_k").magnitude == 277_449 > s.evaluate("loop_cap").magnitude
+    with pytest.raises(LimitError, match="277,449 steps of dr = 0.01 mm .*cap 100,000"):
+        s.evaluate("r0_loop")
 
 
 def test_largest_pressure_angle_at_r0_is_alpha_max(sheet):

@@ -3,20 +3,19 @@
 Scene r0-synthesis: Parkhomenko, Porotnikov, Kucher (DonNTU) describe a VBA macro that finds
 r0 by stepping r0 = e + dr, e + 2 dr, ... until the pressure angle stays within alpha_max at
 every angle of the rise. The rise laws, the required S0, its maximum over the continuous angle
-(``maximum``/``argmax``), r0 and the checks are the template's (templates/r0-synthesis.toml).
-Here:
+(``maximum``/``argmax``), r0, the macro's loop (the program ``loop_k``) and the checks are the
+template's (templates/r0-synthesis.toml). Here:
 
-* :func:`loop_r0` is the macro's loop (r0 = e + k*dr, not r0 += dr, so no drift): on the grid,
-  |alpha| <= alpha_max at every angle exactly when S0 = sqrt(r0^2 - e^2) reaches the grid's
-  largest required S0 (``S0_grid``), so the loop steps k until it does; it refuses the cases
-  the macro got wrong silently;
-* the study that times the loop against the direct solution, whose error is measured against
-  the same solution at the reference tolerance of ``workbook bench``.
+* :func:`loop_refusals`, the refusals of the loop: the language has no error of a sheet's own
+  wording (a piecewise definition with no piece names its conditions, a declared limit its
+  value), and these messages name the step dr, the loop's r0 and the direct r0 and say what
+  to change;
+* the study that times the template's loop against the direct solution, whose error is
+  measured against the same solution at the reference tolerance of ``workbook bench``.
 """
 
 from __future__ import annotations
 
-import math
 import time
 import timeit
 
@@ -25,40 +24,33 @@ import numpy as np
 from ..errors import InputError, LimitError
 from . import bench_block, block, cached, table_block
 
-LOOP_CAP = 100_000  # iterations of the r0 loop
-
 
 def _mm(sheet, name: str, **args):
     out = sheet.evaluate(name, **args).to("mm").magnitude
     return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
 
 
-@block(args={"e": "mm", "dr": "mm", "r0_grid": "mm", "r0": "mm"}, returns="mm", vectorized=False)
-def loop_r0(e, dr, r0_grid, r0):
-    """r0 by the paper's VBA loop: e + k*dr until |alpha| <= alpha_max on the grid."""
-    return loop(e, dr, r0_grid, r0)[0]
-
-
-def loop(e: float, dr: float, r0_grid: float, r0: float, cap: int = LOOP_CAP) -> tuple[float, int]:
-    """(r0, k) of the loop r0 = e + k*dr; ``r0`` is the direct answer (for the messages)."""
-    if not dr > 0:
-        raise InputError(f"the loop step dr = {dr:g} mm must be positive")
+@block(
+    args={"e": "mm", "dr": "mm", "r0_grid": "mm", "r0": "mm", "k": "", "cap": ""},
+    returns="",
+    vectorized=False,
+)
+def loop_refusals(e, dr, r0_grid, r0, k, cap):
+    """The steps k of the template's loop r0 = e + k*dr, or the reason the loop has no
+    answer (``r0`` is the direct answer, for the messages)."""
     if r0_grid <= e:
         raise InputError(
             "alpha_max does not bound r0: the pressure angle stays below it for every r0 > e "
             "(the required S0 is at most 0 at every angle of the grid), so choose r0 from "
             "other limits (roller, strength, undercutting)"
         )
-    need = max(1, math.ceil((r0_grid - e) / dr - 1e-9))
-    if need > cap:  # a hopeless run stops before it starts
+    k = int(k)
+    if k > cap:  # loop_k gives the steps it would need, without taking them
         raise LimitError(
-            f"the loop would need {need:,} steps of dr = {dr:g} mm to reach r0 = "
-            f"{e + need * dr:.6g} mm (cap {cap:,}); use a larger dr or the direct r0"
+            f"the loop would need {k:,} steps of dr = {dr:g} mm to reach r0 = "
+            f"{e + k * dr:.6g} mm (cap {int(cap):,}); use a larger dr or the direct r0"
         )
-    for k in range(1, cap + 1):
-        r = e + k * dr  # e + k*dr: r0 += dr would drift in floating point
-        if r >= r0_grid:  # |alpha| <= alpha_max at every angle of the grid
-            break
+    r = e + k * dr  # the loop's answer, for the messages
     if k == 1:
         raise InputError(
             f"the loop accepted its first candidate r0 = e + dr = {r:.6g} mm: dr = {dr:g} mm "
@@ -72,7 +64,7 @@ def loop(e: float, dr: float, r0_grid: float, r0: float, cap: int = LOOP_CAP) ->
             "exceeds alpha_max between the grid points; use a grid that holds the critical "
             "angle (an odd number of angles for the stepped law: phi_rise/2 on the grid)"
         )
-    return r, k
+    return k
 
 
 # -- error against run time -------------------------------------------------------------------
@@ -94,11 +86,17 @@ def _timed(func, min_time=0.02):
 
 def run_bench(sheet, drs=BENCH_DR, grids=BENCH_GRIDS):
     """Loop error and run time against the direct answer, for every (dr, grid): the loop's
-    time is the grid's required S0 (the template's, at every angle) and the stepping."""
+    time is a fresh sheet's ``loop_k``, the template's program, with what it needs: the grid's
+    required S0 (the template's, at every angle) and the stepping."""
     import pandas as pd
 
-    def row(e, r0, t_direct, dr, n):
-        (r, k), t = _timed(lambda: loop(e, dr, _mm(sheet.with_inputs(n_grid=n), "r0_grid"), r0))
+    def row(r0, t_direct, dr, n):
+        def fresh():
+            return sheet.with_inputs(n_grid=n, dr=f"{dr!r} mm")
+
+        _, t = _timed(lambda: fresh().evaluate("loop_k"))
+        s = fresh()  # r0_loop: the loop's steps and its refusals
+        k, r = int(s.evaluate("loop_k").magnitude), _mm(s, "r0_loop")
         return {
             **{"dr [mm]": dr, "angles": n, "steps": k, "r0 loop [mm]": r, "r0 direct [mm]": r0},
             **{"loop error [mm]": r - r0, "loop time [s]": t, "direct time [s]": t_direct},
@@ -106,9 +104,8 @@ def run_bench(sheet, drs=BENCH_DR, grids=BENCH_GRIDS):
         }
 
     def build():
-        e = _mm(sheet, "e")
         r0, t_direct = _timed(lambda: _mm(sheet.with_inputs(), "r0"), min_time=0.05)
-        return pd.DataFrame([row(e, r0, t_direct, dr, n) for dr in drs for n in grids])
+        return pd.DataFrame([row(r0, t_direct, dr, n) for dr in drs for n in grids])
 
     return cached(sheet, ("bench", tuple(drs), tuple(grids)), build).copy()
 
