@@ -447,6 +447,24 @@ def test_tables_over_the_row_limit_are_refused_before_they_are_computed(sheet):
     assert any(x.topic == "inputs" and x.verdict == "fail" and "75,000" in x.what for x in f)
 
 
+@pytest.mark.parametrize("sense, table", [("same", "rollers"), ("opposite", "profile")])
+def test_row_count_is_the_templates(sheet, sense, table):
+    """The template's rows: the longer of the table of every roller and the closed profile."""
+    s = sheet.with_inputs(sense=sense)
+    rows = s.evaluate("rows").magnitude
+    assert rows == len(s.table(table)) == max(len(s.table("rollers")), len(s.table("profile")))
+    assert rows == {"same": 12 * 181, "opposite": 13 * 180 + 1}[sense]
+
+
+def test_polar_angles_of_the_undercut_are_the_templates(sheet):
+    s = sheet.with_inputs(rp="7.6 mm")
+    uc = reducer.undercut(s)
+    for c in uc["cusps"][:4]:
+        x, y = (s.evaluate(n, 0, c["phi"]).to("mm").magnitude for n in ("x_k", "y_k"))
+        assert c["psi"] == pytest.approx(math.degrees(math.atan2(y, x)), abs=1e-12)
+    assert uc["loops"][0]["psi"] == pytest.approx(180 / 11, abs=1e-12)
+
+
 def test_sign_changes_end_where_one_ulp_exceeds_the_tolerance(monkeypatch):
     """Far out (phi ~ 35,640 deg, one ulp 7e-12 deg) the bisection stops at brentq's
     tolerance of a few ulps instead of looping for ever; the root is the exact one."""

@@ -9,7 +9,9 @@ formula of a fixed shape:
   point of a closed multi-lobed curve: a k-d tree over a dense trace, then Newton's method on
   the template's exact derivatives), also for the printed variants;
 * undercut: the cusps and loops of the practical profile, as many as the values make;
-* the table of every roller (two arguments), the findings' prose and the CAD export.
+* the table of every roller (two arguments, k and phi: a range table has one), the findings'
+  prose and the CAD export (docs/reducer-profile.md says why each stays);
+* the refusals of :func:`validate`, in words the language has not (its own: "no piece applies").
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ import numpy as np
 from ..errors import InputError, LimitError
 from . import Finding, cached, export_block, findings_block, table_block
 
-#: The closure check passes when the traces agree to this distance (mm).
+#: The closure finding passes when the traces agree to this distance (mm); no [[checks]] line:
+#: the distance is this block's, not an expression of the sheet.
 CLOSURE_TOL_MM = 1e-9
 #: Rows of the table of every roller and of the closed profile: at most this many (n = 400
 #: rollers at dphi = 2 deg, 72,400 rows, write in about 52 s of CPU).
@@ -46,7 +49,8 @@ def _mag(sheet, name: str, unit: str = "") -> float:
 
 def validate(sheet) -> None:
     """Refuse inputs for which the mechanism does not exist, with a message saying why, and
-    inputs whose tables would exceed ``MAX_ROWS``."""
+    inputs whose tables would exceed ``MAX_ROWS`` (the template's ``rows``). The template's
+    Z, turns and rp_packing have no piece for the first two, a message naming the condition."""
     n = _mag(sheet, "n")
     if abs(n - round(n)) > 1e-9:
         raise InputError(f"n = {n:g}: the number of rollers must be a whole number", definition="n")
@@ -59,9 +63,7 @@ def validate(sheet) -> None:
             "choose e1 < r2",
             definition="e1",
         )
-    dphi = _mag(sheet, "dphi", "deg")
-    per_turn = math.floor(360 / dphi) + 1
-    rows = max(round(n) * per_turn, math.floor(_mag(sheet, "period", "deg") / dphi) + 1)
+    rows, dphi = int(_mag(sheet, "rows")), _mag(sheet, "dphi", "deg")  # the template's count
     if rows > MAX_ROWS:
         raise LimitError(
             f"n = {n:g} rollers at dphi = {dphi:g} deg make tables of {rows:,} rows (the "
@@ -72,15 +74,8 @@ def validate(sheet) -> None:
         )
 
 
-def _period(sheet) -> float:
-    """Eccentric angle (deg) after which roller 0 has traced the whole closed profile."""
-    validate(sheet)
-    return _mag(sheet, "period", "deg")
-
-
 def _grid(sheet, table: str) -> np.ndarray:
-    """The eccentric angles (deg) of the template's table ``table``."""
-    validate(sheet)
+    """The eccentric angles (deg) of the template's range table ``table``."""
     return sheet.range_values(sheet.table_spec(table).range, f"table {table}")
 
 
@@ -101,7 +96,7 @@ def distance_to_trace(sheet, px, py):
     """
     from scipy.spatial import cKDTree
 
-    period = _period(sheet)
+    period = _mag(sheet, "period", "deg")
 
     def build():
         s = np.arange(0.0, period, _SAMPLE_DEG)
@@ -128,6 +123,7 @@ def distance_to_trace(sheet, px, py):
 
 def closure(sheet) -> dict:
     """Largest distance of the traces of rollers 1..n-1 (one eccentric turn) from roller 0's."""
+    validate(sheet)
     K, PHI = _rollers(sheet)
     K, PHI = K[K > 0], PHI[K > 0]
     d, _ = distance_to_trace(sheet, _f(sheet, "x_t", K, PHI), _f(sheet, "y_t", K, PHI))
@@ -143,11 +139,12 @@ def undercut(sheet) -> dict:
     range fixed by the inputs, so it is done here (on the template's offset_margin), every
     tooth at once.
     """
+    validate(sheet)
     return cached(sheet, "reducer undercut", lambda: _undercut(sheet))
 
 
 def _undercut(sheet) -> dict:
-    L = _period(sheet)
+    L = _mag(sheet, "period", "deg")
     s = np.arange(0.0, L, _SAMPLE_DEG)
     g = _f(sheet, "offset_margin", 0, s)
     out = {"cusps": [], "loops": [], "teeth": 0}
@@ -164,11 +161,10 @@ def _undercut(sheet) -> dict:
     if not pairs:
         return out
     c = np.array(pairs)  # teeth x 2
-    xs, ys = (_f(sheet, n, 0, c) for n in ("x_k", "y_k"))
+    xs, ys, psis = (_f(sheet, n, 0, c) for n in ("x_k", "y_k", "psi_k"))
     for tooth in range(len(pairs)):
         for side in (0, 1):
-            x, y = float(xs[tooth, side]), float(ys[tooth, side])
-            psi = math.degrees(math.atan2(y, x))
+            x, y, psi = float(xs[tooth, side]), float(ys[tooth, side]), float(psis[tooth, side])
             phi = float(c[tooth, side]) % L
             out["cusps"].append({"tooth": tooth + 1, "phi": phi, "psi": psi, "x": x, "y": y})
     for tooth, loop in enumerate(_loop_crossings(sheet, c[:, 0], c[:, 1], L), start=1):
@@ -238,11 +234,11 @@ def _loop_crossings(sheet, c1: np.ndarray, c2: np.ndarray, L: float) -> list[dic
     out: list[dict | None] = [None] * len(c1)
     if s1.size:
         x, y = _offset(sheet, s1)[:2]
+        psi = _f(sheet, "psi_k", 0, s1)
         for n, k in enumerate(np.nonzero(found)[0]):
-            psi = math.degrees(math.atan2(float(y[n]), float(x[n])))
             out[k] = {
                 **{"phi1": float(s1[n]) % L, "phi2": float(s2[n]) % L},
-                **{"psi": psi, "x": float(x[n]), "y": float(y[n])},
+                **{"psi": float(psi[n]), "x": float(x[n]), "y": float(y[n])},
             }
     return out
 
