@@ -1,7 +1,10 @@
-"""Random programs without loops (locals, if / else if / otherwise blocks, returns, one-line
-``return X if C``): the engine's value against a plain Python run of the same program, and
-the live nested IF the workbook writes, recalculated by an independent Excel evaluator (the
-`formulas` package), against the same run. Slow: each example writes and reads a workbook."""
+"""Random programs against a plain Python run of the same program.
+
+Without loops (locals, if / else if / otherwise blocks, returns, one-line ``return X if C``):
+the engine's value, and the live nested IF the workbook writes, recalculated by an independent
+Excel evaluator (the `formulas` package). With ``for`` loops (nested, stepped up and down,
+``break`` and ``continue``): the engine's value, the loops run as Mathcad's (never beyond the
+last value). Slow: the first writes and reads a workbook an example."""
 
 from __future__ import annotations
 
@@ -28,6 +31,14 @@ Term = tuple[str, Callable[[dict], float]]
 class _Return(Exception):
     def __init__(self, value: float):
         self.value = value
+
+
+class _Break(Exception):
+    pass
+
+
+class _Continue(Exception):
+    pass
 
 
 def _expr(rng: random.Random, names: list[str], depth: int = 0) -> Term:
@@ -191,3 +202,104 @@ def test_a_program_the_engine_python_and_its_live_formula_agree(tmp_path_factory
     got = _recalculated(path)
     recalculated = np.array([float(got[c]) for c in cells])
     np.testing.assert_allclose(recalculated, expected, rtol=1e-9, atol=1e-12, err_msg=text)
+
+
+def _mathcad_loop(first: int, second: int | None, last: int) -> list[int]:
+    """Mathcad's values of ``for k in first, second .. last``: never beyond ``last``."""
+    step = (second - first) if second is not None else (1 if last >= first else -1)
+    return list(range(first, last + (1 if step > 0 else -1), step))
+
+
+def _loops(rng: random.Random, names: list[str], depth: int, lines: list[str]) -> list:
+    """The steps of a block at ``depth`` (0: the program's top level), its lines appended."""
+    steps: list = []
+    pad = "    " * depth
+    for _ in range(rng.randint(1, 3)):
+        k = rng.random()
+        if k < 0.45 or depth >= 2:
+            n = rng.choice([m for m in names if m not in ("k", "m")])
+            text, f = _expr(rng, names)
+            lines.append(f"{pad}{n} := {text}")
+            steps.append(("assign", n, f))
+        elif k < 0.6 and depth > 0:
+            cond, fc = _condition(rng, names)
+            word = rng.choice(["break", "continue"])
+            lines.append(f"{pad}{word} if {cond}")
+            steps.append((word, fc))
+        elif k < 0.7:
+            cond, fc = _condition(rng, names)
+            text, f = _expr(rng, names)
+            lines.append(f"{pad}return {text} if {cond}")
+            steps.append(("return if", fc, f))
+        else:
+            var = ("k", "m")[depth]
+            first, last = rng.randint(-3, 3), rng.randint(-3, 6)
+            second = None
+            if rng.random() < 0.4:
+                second = first + rng.choice([1, 2, 3]) * (1 if last >= first else -1)
+            bounds = f"{first} .. {last}" if second is None else f"{first}, {second} .. {last}"
+            lines.append(f"{pad}for {var} in {bounds}")
+            body = _loops(rng, [*names, var], depth + 1, lines)
+            steps.append(("for", var, _mathcad_loop(first, second, last), body))
+    return steps
+
+
+def _loop_program(rng: random.Random) -> tuple[str, Callable[[float], float]]:
+    lines: list[str] = []
+    names: list[str] = []
+    steps: list = []
+    for n in LOCALS[: rng.randint(1, 2)]:
+        text, f = _expr(rng, names)
+        lines.append(f"{n} := {text}")
+        steps.append(("assign", n, f))
+        names.append(n)
+    steps += _loops(rng, names, 0, lines)
+    text, f = _expr(rng, names)
+    lines.append(text)
+    steps.append(("value", f))
+
+    def run(s: float) -> float:
+        env: dict = {"s": s}
+
+        def block(todo):
+            for step in todo:
+                kind = step[0]
+                if kind == "assign":
+                    env[step[1]] = step[2](env)
+                elif kind == "value":
+                    env["value"] = step[1](env)
+                elif kind in ("break", "continue") and step[1](env):
+                    raise _Break() if kind == "break" else _Continue()
+                elif kind == "return if" and step[1](env):
+                    raise _Return(step[2](env))
+                elif kind == "for":
+                    for v in step[2]:
+                        env[step[1]] = float(v)
+                        try:
+                            block(step[3])
+                        except _Continue:
+                            continue
+                        except _Break:
+                            break
+
+        try:
+            block(steps)
+        except _Return as done:
+            return done.value
+        return env["value"]
+
+    return "\n".join(lines), run
+
+
+@fuzz_settings(200)
+@given(st.randoms(use_true_random=False))
+def test_a_program_with_loops_the_engine_and_python_agree(rng):
+    text, run = _loop_program(rng)
+    sheet = workbook.loads(
+        '[arguments]\ns = { unit = "" }\n[definitions]\n'
+        f'"p(s)" = {{ program = """\n{text}\n""" }}\n\n'
+        '[[tables]]\nname = "t"\nrange = "s := -3, -2.5 .. 3"\ncolumns = { p = "" }\n'
+    )
+    expected = np.array([run(float(x)) for x in XS])
+    engine = np.asarray(sheet.table("t").iloc[:, 1], dtype=float)
+    np.testing.assert_allclose(engine, expected, rtol=1e-12, atol=1e-12, err_msg=text)

@@ -244,3 +244,22 @@ def test_a_vector_is_made_and_grown_by_its_elements(tmp_path):
     ]:
         with pytest.raises(workbook.WorkbookError, match=re.escape(message)):
             _sheet(tmp_path, '[arguments]\nx = { unit = "" }\n[definitions]\n' + prog("f(x)", body))
+
+
+def test_a_for_loop_never_goes_beyond_its_last_value(tmp_path):
+    """A loop runs as Mathcad's for: first, first + step, ... up to the last value, not beyond
+    it; a range variable of a table ends with its last value (the paper's listings)."""
+    sheet = _sheet(
+        tmp_path,
+        HEAD
+        + "[definitions]\n"
+        + prog("odd(x)", "t := 0\nfor k in 1, 3 .. x\n    t := t + k\nt")
+        + prog("down(x)", "t := 0\nfor k in x, x - 3 .. 0\n    t := 10*t + k\nt")
+        + prog("tenths(x)", "n := 0\nfor k in 0, 0.1 .. x\n    n := n + 1\nn")
+        + '\n[[tables]]\nname = "t"\nrange = "x := 1, 3 .. 10"\ncolumns = { odd = "" }\n',
+    )
+    assert sheet.evaluate("odd", 10).magnitude == 1 + 3 + 5 + 7 + 9
+    assert sheet.evaluate("odd", 9).magnitude == 1 + 3 + 5 + 7 + 9
+    assert sheet.evaluate("down", 10).magnitude == 10_741  # 10, 7, 4, 1
+    assert sheet.evaluate("tenths", 1).magnitude == 11  # 1 is on the step, within rounding
+    assert list(sheet.table("t").iloc[:, 0]) == [1, 3, 5, 7, 9, 10]

@@ -118,7 +118,23 @@ def _bound_node(text: str, what: str) -> tuple[ex.Node, pint.Unit | None]:
 
 
 def range_values(first: float, second: float | None, last: float, *, what: str = "range"):
-    """Values of a range; the last value is always included (as the paper's listings show)."""
+    """Values of a range variable; the last value is always included (as the paper's listings
+    show: ``0, 5 .. 22`` is 0, 5, 10, 15, 20, 22)."""
+    import numpy as np
+
+    values, on_step = _steps(first, second, last, what)
+    return values if on_step else np.append(values, last)
+
+
+def loop_values(first: float, second: float | None, last: float, *, what: str = "loop"):
+    """Values of a program's ``for`` loop, as Mathcad runs it: first, first + step, ... never
+    beyond the last value (``for k in 1, 3 .. 10`` is 1, 3, 5, 7, 9)."""
+    return _steps(first, second, last, what)[0]
+
+
+def _steps(first: float, second: float | None, last: float, what: str):
+    """(first + k*step up to ``last``, whether ``last`` is one of them); refuses a zero step,
+    a step away from ``last`` and more than MAX_RANGE_POINTS values."""
     import numpy as np
 
     for v in (first, last) + ((second,) if second is not None else ()):
@@ -141,10 +157,9 @@ def range_values(first: float, second: float | None, last: float, *, what: str =
     count = math.floor(span) + 1
     values = first + step * np.arange(count, dtype=float)  # first + k*step: no drift
     if abs(values[-1] - last) > 1e-9 * max(1.0, abs(step)):
-        values = np.append(values, last)
-    else:
-        values[-1] = last
-    return values
+        return values, False
+    values[-1] = last
+    return values, True
 
 
 def split_top(text: str, sep: str) -> list[str]:

@@ -54,7 +54,7 @@ def compile_program(
     typed: TypedProgram, compile_expr: Callable[[Any], Callable], name: str
 ) -> Callable[[dict], Any]:
     """A closure env -> value for scalar arguments (the back end loops over arrays)."""
-    from ..ranges import range_values
+    from ..ranges import loop_values
 
     steps = [0]
 
@@ -173,7 +173,7 @@ def compile_program(
 
             def for_(env, last):
                 where = f"program of '{name}', line {s.line}"
-                values = range_values(
+                values = loop_values(
                     rt.number(first(env), where),
                     rt.number(second(env), where) if second is not None else None,
                     rt.number(last_(env), where),

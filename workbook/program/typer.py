@@ -381,7 +381,7 @@ def growth(program: Program, origin: int) -> dict[str, _Growth]:
                 values = None
                 if None not in bounds and (st.second is None or second is not None):
                     try:
-                        values = [float(v) for v in _range_values(bounds[0], second, bounds[1])]
+                        values = [float(v) for v in _loop_values(bounds[0], second, bounds[1])]
                     except TemplateError:
                         values = None
                 stop = any(isinstance(x, (Break, Continue, Return)) for x in walk(st.body))
@@ -403,10 +403,10 @@ def _number(node) -> float | None:
     return None
 
 
-def _range_values(first, second, last):
-    from ..ranges import range_values
+def _loop_values(first, second, last):
+    from ..ranges import loop_values
 
-    return range_values(first, second, last, what="loop")
+    return loop_values(first, second, last, what="loop")
 
 
 def _grown_used_whole(program: Program, grown: dict, growing: set[str]) -> None:
