@@ -167,13 +167,20 @@ def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) ->
         elif item.sym is not None:
             item.sym.broken = item.sym.broken or why
             skip(item.region, what.get(item.region, "a region"), why)
-    by_token = {s.token(): s for s in tr.syms}
+    place = {s.token(): k for k, s in enumerate(tr.syms)}
+
+    def first_broken(trees):
+        """The first name (in the translation's order, so every import names the same one)
+        the trees use that is left out, or None."""
+        at = [place[n] for t in trees for n in ex.names(t) if n in place]
+        broken = [k for k in at if tr.syms[k].broken]
+        return tr.syms[min(broken)] if broken else None
+
     changed = True
     while changed:  # in Mathcad's order what an item uses is before it; cycles are settled
         changed = False
         for item in tr.items:
-            used = [by_token[n] for t in _trees(item) for n in ex.names(t) if n in by_token]
-            broken = next((s for s in used if s.broken), None)
+            broken = first_broken(_trees(item))
             if broken is None:
                 continue
             if item.kind == "chart":
@@ -188,8 +195,7 @@ def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) ->
             continue
         for x, y, rng, _, n in list(item.chart):
             trees = [x, y, *(t for t in rng.range if t is not None)]
-            used = [by_token[m] for t in trees for m in ex.names(t) if m in by_token]
-            broken = next((s for s in used if s.broken), None)
+            broken = first_broken(trees)
             if broken is not None:
                 _drop_trace(tr, item.region, n, _uses(broken), skip)
     for res in tr.results:  # stored values of what is left out: kept, listed as values
