@@ -46,20 +46,9 @@ HOMES = {
 KNOWN_ELSEWHERE = {
     # Mathcad's operators that bind a variable, as the importer translates them
     ("mathcad/translate.py", ("diff", "integral", "product", "sum")),
-    # the importer's own unit guesser and value reader (to give way to the language's typer)
-    ("mathcad/translate.py", ("abs", "mag", "max", "min", "mod")),
-    ("mathcad/translate.py", ("acos", "asin", "atan", "cos", "exp", "ln", "log10", "sin", "tan")),
-    ("mathcad/translate.py", ("ceil", "floor", "round", "trunc")),
-    # the sizes the import-time value reader takes of a matrix written out
-    ("mathcad/translate.py", ("cols", "length", "rows")),
-    ("mathcad/translate.py", ("acos", "asin", "atan", "ln")),
-    (
-        "mathcad/translate.py",
-        (
-            "abs", "acos", "asin", "atan", "ceil", "cos", "cosh", "exp", "floor", "ln", "log10",
-            "sin", "sinh", "sqrt", "tan", "tanh",
-        ),
-    ),
+    # the sizes read from a matrix written out while importing (its elements may call
+    # functions whose units are settled only at the end of the translation)
+    ("mathcad/engine.py", ("cols", "length", "rows")),
     # the built-ins vectorize applies element by element (could be read from the registry:
     # the entries of plain numbers)
     (

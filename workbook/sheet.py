@@ -149,9 +149,6 @@ class Sheet:
                     f"itself, or make {name} a function of it)"
                 )
 
-    #: the former private name, until the Mathcad engine calls the public one
-    _check_not_circular = check_not_circular
-
     def _check_vary(self, t, name: str, values) -> None:
         where = dict(file=self.file, line=t.line, definition=f"table {t.name}")
         if name not in self.spec.inputs:

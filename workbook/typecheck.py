@@ -20,16 +20,14 @@ from .fields import nearest
 from .registry import CONSTANTS, REGISTRY
 from .template import Definition, SheetSpec, column_node
 from .typearrays import ArrayTyping
-from .typed import (  # noqa: F401 - the typed nodes are part of this module's interface
+from .typed import (
     RUNTIME,
     T,
     TAggregate,
-    TBinary,
     TBlock,
     TCall,
     TCompare,
     TConst,
-    TFunc,
     TIndex,
     TLogic,
     TMatrix,
@@ -38,17 +36,14 @@ from .typed import (  # noqa: F401 - the typed nodes are part of this module's i
     TPiecewise,
     TProgram,
     TRef,
-    TScale,
     TText,
     TUnary,
     TypedFunction,
-    children,
-    is_bare,
     is_runtime,
     is_zero,
     shape_text,
 )
-from .unitrules import UnitRules, angle_in, meeting  # noqa: F401 - angle_in: the importer's name
+from .unitrules import UnitRules, meeting
 from .visitor import Visitor
 
 #: Most elements of one matrix written out.

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from .. import expr as ex
 from .. import typecheck as tc
+from .. import typed as ty
 from ..errors import WorkbookError
 from .translate import Item, Skipped, Translation, _rename, _uses
 from .writer import Rendered
@@ -64,7 +65,7 @@ def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
         try:
             from ..given_find import typed_equations
 
-            sheet._check_not_circular(block)
+            sheet.check_not_circular(block)
             typed_equations(typer, block)
         except WorkbookError as err:
             refuse(err, rendered.region_of.get(block.unknowns[0]), block.unknowns)
@@ -397,7 +398,7 @@ class AtImport:
             t = self._typed(node, "an expression at import", True, False)[1]
         except Unknown:
             return None
-        return None if t.text or t.boolean or tc.is_runtime(t.shape) else t.unit
+        return None if t.text or t.boolean or ty.is_runtime(t.shape) else t.unit
 
     def quantity(self, node: ex.Node):
         """The value of ``node`` (a number) as a pint quantity; :class:`Unknown` if it is not
