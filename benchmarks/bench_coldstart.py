@@ -34,8 +34,8 @@ t = [time.perf_counter()]
 import numpy, pint, xlsxwriter
 t.append(time.perf_counter())
 bare = set(sys.modules)
-import workbook, workbook.cli, workbook.sheet, workbook.xlsx
-from workbook import units
+import workbook, workbook.cli, workbook.engine.sheet, workbook.outputs.xlsx
+from workbook.language import units
 units.registry()
 t.append(time.perf_counter())
 sheet = workbook.load(sys.argv[1], parts=sys.argv[3:] or None)

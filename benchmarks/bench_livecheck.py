@@ -1,4 +1,4 @@
-"""Ratio 6: the independent check of the live formulas (workbook.livecheck). Writing a
+"""Ratio 6: the independent check of the live formulas (workbook.compute.livecheck). Writing a
 workbook with the check against writing the same workbook without it (``verify=False``),
 alternately, in one process; medians. Two sheets: one whose formulas all need the check (a
 table of N rows with an integral and a nested integral in its columns, scalar integrals) and

@@ -60,10 +60,10 @@ class Raw:
     """Everything the raw xlsxwriter side needs, prepared outside the timing."""
 
     def __init__(self, sheet):
-        from workbook import units as un
-        from workbook.excel import ExcelPrinter, excel_name
-        from workbook.excelform import ROW_TOKEN
-        from workbook.units import header
+        from workbook.compute.excel import ExcelPrinter, excel_name
+        from workbook.compute.excelform import ROW_TOKEN
+        from workbook.language import units as un
+        from workbook.language.units import header
 
         data = sheet.table_data("big")
         printer = ExcelPrinter(sheet.typer)
@@ -89,7 +89,7 @@ class Raw:
         """``classic``: skip xlsxwriter's formula rewriting as the engine does (information)."""
         import xlsxwriter
 
-        from workbook.xlsx import _classic_formulas_as_they_are
+        from workbook.outputs.xlsx import _classic_formulas_as_they_are
 
         wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
         bold = wb.add_format({"bold": True})

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import workbook
 
 #: modules that only pass a call on (visitor dispatch): not rooms of the walk
-TRANSPARENT = frozenset({"workbook.visitor"})
+TRANSPARENT = frozenset({"workbook.language.visitor"})
 
 
 @dataclass

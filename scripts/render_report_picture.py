@@ -32,7 +32,7 @@ def main(argv: list[str] | None = None) -> int:
         print("needs pdftoppm: apt-get install poppler-utils", file=sys.stderr)
         return 2
     import workbook
-    from workbook.report import write_report
+    from workbook.outputs.report import write_report
 
     with tempfile.TemporaryDirectory(prefix="report-picture-") as tmp:
         html, pdf = write_report(workbook.load(args.name), Path(tmp) / "r.html", pdf=True)

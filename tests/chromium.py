@@ -13,7 +13,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from workbook.report.pdf import chromium, chromium_args
+from workbook.outputs.report.pdf import chromium, chromium_args
 
 # Runs after the document is laid out: every element must end inside the text block
 # (182 mm, the A4 width less the margins), and every fraction must be stacked

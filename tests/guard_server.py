@@ -19,9 +19,11 @@ from pathlib import Path
 
 SERVER = r"""
 import json, os, resource, sys, time, traceback
-import numpy, pint, workbook, workbook.cli, workbook.sheet, workbook.template, workbook.units
-import workbook.typecheck, workbook.numeric, workbook.checks, workbook.blocks
-workbook.units.registry()
+import numpy, pint, workbook
+import workbook.cli, workbook.engine.sheet, workbook.language.template, workbook.language.units
+import workbook.language.typecheck, workbook.engine.numeric
+import workbook.compute.checks, workbook.blocks
+workbook.language.units.registry()
 from workbook.cli import main
 SYSTEM = {"subprocess", "socket", "ctypes", "pickle", "shutil", "multiprocessing", "pty",
           "webbrowser", "http", "urllib", "ftplib", "smtplib", "telnetlib", "code", "pdb"}

@@ -11,7 +11,7 @@ import re
 
 from lxml import html as lxml_html
 
-from workbook.report.mathml import GREEK
+from workbook.outputs.report.mathml import GREEK
 
 _LATIN = {v: k for k, v in GREEK.items()}
 _OPS = {

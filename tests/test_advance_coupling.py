@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook import ode, oderun
 from workbook.blocks import coupling as cp
-from workbook.declared_checks import check_findings
+from workbook.compute.declared_checks import check_findings
+from workbook.engine import ode, oderun
 from workbook.errors import WorkbookError
 
 # the reference example's dimensions (SI)

@@ -204,7 +204,7 @@ def test_log_spaced_range_mistakes(tmp_path, range_text, message):
 
 
 def test_a_program_loop_is_not_log_spaced(tmp_path):
-    from workbook.ranges import parse_range
+    from workbook.language.ranges import parse_range
 
     with pytest.raises(workbook.WorkbookError, match="for tables, charts and sweep outputs"):
         parse_range("k := logspace(1, 100, 3)")

@@ -12,8 +12,8 @@ import openpyxl
 import pytest
 
 from workbook import WorkbookError
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.engine.sheet import Sheet
+from workbook.language.template import load_spec
 
 SHEET = """
 [sheet]

@@ -25,8 +25,8 @@ def _named(cell: str) -> set[str]:
 
 
 def modules() -> list[str]:
-    """Every module of the package as a path under workbook/ ("sheet.py", "numerics/roots.py");
-    a subpackage as its folder ("numerics/")."""
+    """Every module of the package as a path under workbook/ ("engine/sheet.py",
+    "numerics/roots.py"); a subpackage as its folder ("numerics/")."""
     out = []
     for path in sorted(PACKAGE.rglob("*.py")):
         rel = path.relative_to(PACKAGE).as_posix()
@@ -112,6 +112,13 @@ def test_the_load_walk_counts_moves_and_climbs_back_up():
 
     workbook.load("concave-cam")
     found = load_walk.walk(lambda: workbook.load("concave-cam"))
-    assert {"workbook.sheet", "workbook.typecheck", "workbook.template"} <= found.rooms
+    assert {
+        "workbook.engine.sheet",
+        "workbook.language.typecheck",
+        "workbook.language.template",
+    } <= found.rooms
     assert found.climbs <= found.moves
-    assert found.climbs_by_pair().get(("workbook.declared_checks", "workbook.sheet")) == 1
+    assert (
+        found.climbs_by_pair().get(("workbook.compute.declared_checks", "workbook.engine.sheet"))
+        == 1
+    )

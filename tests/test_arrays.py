@@ -9,8 +9,8 @@ import pytest
 import scipy.linalg as sl
 
 import workbook
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.engine.sheet import Sheet
+from workbook.language.template import load_spec
 
 RNG = np.random.default_rng(7)
 A = RNG.normal(size=(4, 4))

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from recalc import cell_values, recalculate, soffice
 
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.engine.sheet import Sheet
+from workbook.language.template import load_spec
 
 pytestmark = [
     pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed"),

@@ -1,7 +1,7 @@
 """Nothing lost: an error or Ctrl-C while computing or writing leaves the previous file as it was.
 
 Outputs are written to a temporary file beside the target and moved into place only when
-complete (workbook/atomic.py). These tests force failures in the middle of writing, in the
+complete (workbook/outputs/atomic.py). These tests force failures in the middle of writing, in the
 process (monkeypatching a writer method to raise) and from outside (SIGINT to a subprocess).
 """
 
@@ -18,8 +18,9 @@ from pathlib import Path
 import pytest
 from conftest import SINE
 
-from workbook import excelform, xlsx
 from workbook.cli import main
+from workbook.compute import excelform
+from workbook.outputs import xlsx
 
 TEMPLATE = (
     SINE
@@ -128,7 +129,7 @@ import signal, sys, time
 from pathlib import Path
 # as at a terminal: a shell that starts the test run in the background ignores SIGINT in it
 signal.signal(signal.SIGINT, signal.default_int_handler)
-from workbook import xlsx
+from workbook.outputs import xlsx
 from workbook.cli import main
 
 stage = sys.argv[1]
@@ -142,13 +143,13 @@ def pause(original):
 if stage == "writing":
     xlsx._replay = pause(xlsx._replay)  # the file is being written
 else:
-    import workbook.sheet
-    original = workbook.sheet.Sheet.check
+    import workbook.engine.sheet
+    original = workbook.engine.sheet.Sheet.check
     def slow_check(self):
         Path("ready").write_text("computing")
         time.sleep(60)
         return original(self)
-    workbook.sheet.Sheet.check = slow_check
+    workbook.engine.sheet.Sheet.check = slow_check
 sys.exit(main(["run", "s.toml", "--out", "out.xlsx"]))
 """
 

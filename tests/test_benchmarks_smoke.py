@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook import typecheck as tc
 from workbook.errors import LimitError
+from workbook.language import typecheck as tc
 
 BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
 sys.path.insert(0, str(BENCH))

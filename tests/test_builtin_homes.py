@@ -16,15 +16,15 @@ import pytest
 from test_builtins import DOC, documented
 
 import workbook
-from workbook import symbolic
-from workbook import typed as ty
-from workbook.builtins import Builtin, excel_call, plain_in, register
-from workbook.excel import ExcelPrinter
-from workbook.excel_functions import stored
+from workbook.compute.excel import ExcelPrinter
+from workbook.engine import symbolic
+from workbook.functions.builtins import Builtin, excel_call, plain_in, register
+from workbook.functions.excel_functions import stored
+from workbook.functions.registry import REGISTRY
+from workbook.language import typed as ty
 from workbook.mathcad.functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS
 from workbook.numerics.derivative import sympy_functions
-from workbook.registry import REGISTRY
-from workbook.report.mathml import MathML
+from workbook.outputs.report.mathml import MathML
 
 PACKAGE = Path(__file__).resolve().parents[1] / "workbook"
 
@@ -32,10 +32,10 @@ PACKAGE = Path(__file__).resolve().parents[1] / "workbook"
 # the importers' maps of Mathcad's and Excel's names to the language's (data about those
 # products, checked against the registry below).
 HOMES = {
-    "builtins.py",
-    "distributions.py",
-    "matrix.py",
-    "matrix_entries.py",
+    "functions/builtins.py",
+    "functions/distributions.py",
+    "functions/matrix.py",
+    "functions/matrix_entries.py",
     "numerics/entries.py",
     "mathcad/functions.py",
     "excelimport/functions.py",
@@ -81,7 +81,7 @@ KNOWN_ELSEWHERE = {
     ("numerics/singular.py", ("ln", "log10", "sqrt")),
     # the trigonometric functions whose argument the angle warnings look at (a slip of theta
     # in degrees times pi/180, a bare number of degrees read as radians)
-    ("angle_slips.py", ("cos", "sin", "tan")),
+    ("engine/angle_slips.py", ("cos", "sin", "tan")),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),
 }  # fmt: skip
@@ -237,7 +237,7 @@ def test_a_new_builtin_needs_only_its_entry_and_its_docs_line(tmp_path, acotan):
     ]
     assert cells and all("_xlfn.ACOT(" in c for c in cells)
     # MathML of the report
-    assert "<mi>acotan</mi>" in MathML().box(workbook.expr.parse("acotan(x)")).xml
+    assert "<mi>acotan</mi>" in MathML().box(workbook.language.expr.parse("acotan(x)")).xml
     # the docs check: the entry is missing from the reference until its line is written
     text = DOC.read_text(encoding="utf-8")
     assert sorted(documented(text)) != sorted(REGISTRY)

@@ -9,17 +9,18 @@ import mpmath
 import numpy as np
 import pytest
 
-from workbook import WorkbookError, symbolic
-from workbook import typed as ty
-from workbook.analysis import typed_text
-from workbook.builtins import Builtin, register
-from workbook.excel import ExcelPrinter
-from workbook.numeric import Evaluator
-from workbook.registry import REGISTRY
-from workbook.sheet import Sheet
-from workbook.symbolic import SympyConverter
-from workbook.template import load_spec
-from workbook.visitor import UnhandledNode
+from workbook import WorkbookError
+from workbook.compute.excel import ExcelPrinter
+from workbook.engine import symbolic
+from workbook.engine.analysis import typed_text
+from workbook.engine.numeric import Evaluator
+from workbook.engine.sheet import Sheet
+from workbook.engine.symbolic import SympyConverter
+from workbook.functions.builtins import Builtin, register
+from workbook.functions.registry import REGISTRY
+from workbook.language import typed as ty
+from workbook.language.template import load_spec
+from workbook.language.visitor import UnhandledNode
 
 DOC = Path(__file__).parent.parent / "docs" / "language.md"
 
@@ -100,7 +101,7 @@ def test_sum_excel_formula_against_the_formulas_package(tmp_path):
     total = printer.formula(sheet.typer.scalar("total"), {})
     assert float(formulas.Parser().ast(total)[1].compile()()) == 35.0
     # bounds that are not constants: no live formula, the writer writes numbers
-    from workbook.excel import NotLive
+    from workbook.compute.excel import NotLive
 
     with pytest.raises(NotLive, match="not constants"):
         printer.formula(sheet.typer.function("g").body, {"x": "33"})

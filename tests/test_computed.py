@@ -11,29 +11,29 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook.atomic import write_csv
-from workbook.computed import ComputedSheet, compute
-from workbook.report import render
-from workbook.xlsx import write_workbook
+from workbook.compute.computed import ComputedSheet, compute
+from workbook.outputs.atomic import write_csv
+from workbook.outputs.report import render
+from workbook.outputs.xlsx import write_workbook
 
 #: the modules that type, evaluate or print formulas: a renderer calls none of them
 STAGES_BEFORE = (
-    "workbook/typecheck.py",
-    "workbook/typearrays.py",
-    "workbook/numeric.py",
+    "workbook/language/typecheck.py",
+    "workbook/language/typearrays.py",
+    "workbook/engine/numeric.py",
     "workbook/numerics/",
     "workbook/program/",
-    "workbook/runtime.py",
-    "workbook/sheet.py",
-    "workbook/given_find.py",
-    "workbook/ode.py",
-    "workbook/oderun.py",
-    "workbook/symbolic.py",
-    "workbook/analysis.py",
-    "workbook/declared_checks.py",
-    "workbook/excel.py",
-    "workbook/excelform.py",
-    "workbook/livecheck.py",
+    "workbook/engine/runtime.py",
+    "workbook/engine/sheet.py",
+    "workbook/language/given_find.py",
+    "workbook/engine/ode.py",
+    "workbook/engine/oderun.py",
+    "workbook/engine/symbolic.py",
+    "workbook/engine/analysis.py",
+    "workbook/compute/declared_checks.py",
+    "workbook/compute/excel.py",
+    "workbook/compute/excelform.py",
+    "workbook/compute/livecheck.py",
     "workbook/blocks/",
 )
 
@@ -143,14 +143,18 @@ def test_the_count_sees_evaluation():
     sheet = workbook.load("concave-cam")
     found = calls_into_stages(lambda: compute(sheet.with_inputs(R3="41 mm"), excel=True))
     modules = {key.split(":")[0] for key in found}
-    assert {"workbook/numeric.py", "workbook/sheet.py", "workbook/excelform.py"} <= modules
+    assert {
+        "workbook/engine/numeric.py",
+        "workbook/engine/sheet.py",
+        "workbook/compute/excelform.py",
+    } <= modules
 
 
 def test_the_computed_sheet_holds_values_not_the_engine(concave):
     """No Sheet, typer or evaluator inside: a renderer has nothing to evaluate with."""
-    from workbook.numeric import Evaluator
-    from workbook.sheet import Sheet
-    from workbook.typecheck import Typer
+    from workbook.engine.numeric import Evaluator
+    from workbook.engine.sheet import Sheet
+    from workbook.language.typecheck import Typer
 
     computed = compute(concave)
     assert isinstance(computed, ComputedSheet)

@@ -12,7 +12,7 @@ from conftest import write_template
 
 import workbook
 from workbook.errors import TemplateError
-from workbook.registry import CONSTANTS
+from workbook.functions.registry import CONSTANTS
 
 SHEET = """
 [sheet]

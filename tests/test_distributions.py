@@ -13,8 +13,8 @@ from conftest import write_template
 
 import workbook
 from workbook import WorkbookError
-from workbook.distributions import NAMES
-from workbook.registry import REGISTRY
+from workbook.functions.distributions import NAMES
+from workbook.functions.registry import REGISTRY
 
 mp = mpmath.mp
 
@@ -231,7 +231,7 @@ def test_excel_forms_agree_with_the_formulas_package(golden):
 
 def test_degrees_of_freedom_excel_would_truncate(golden):
     formulas = pytest.importorskip("formulas")
-    from workbook.excel import ExcelPrinter
+    from workbook.compute.excel import ExcelPrinter
 
     """Excel truncates degrees of freedom: from a cell, a fraction gives #N/A (never the value
     of another distribution); a constant fraction is written as the value."""

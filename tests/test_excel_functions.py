@@ -12,9 +12,9 @@ import xlsxwriter
 from openpyxl.utils.formulas import FORMULAE
 
 import workbook
-from workbook import excel_names
-from workbook.excel_functions import CLASSIC, FUNCTIONS, stored
-from workbook.excel_names import BUILTIN_NAMES, ExcelNames
+from workbook.functions import excel_names
+from workbook.functions.excel_functions import CLASSIC, FUNCTIONS, stored
+from workbook.functions.excel_names import BUILTIN_NAMES, ExcelNames
 
 
 @pytest.fixture(scope="module")

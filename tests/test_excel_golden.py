@@ -19,8 +19,8 @@ from conftest import write_template
 from recalc import formula_values
 
 import workbook
-from workbook.distributions import NAMES as DISTRIBUTIONS
-from workbook.registry import REGISTRY
+from workbook.functions.distributions import NAMES as DISTRIBUTIONS
+from workbook.functions.registry import REGISTRY
 
 REL = 1e-13
 

@@ -16,8 +16,8 @@ from conftest import write_template
 
 import workbook
 from workbook.errors import WorkbookError
-from workbook.factorizations import geninv, lu, rref
-from workbook.matrix import SINGULAR_COND
+from workbook.functions.factorizations import geninv, lu, rref
+from workbook.functions.matrix import SINGULAR_COND
 
 PRIME = Path(__file__).resolve().parents[1].parent / "shared" / "mathcad-prime"
 needs_corpus = pytest.mark.skipif(not PRIME.is_dir(), reason=f"{PRIME} is absent")

@@ -214,7 +214,7 @@ columns = ["q", "r"]
 def test_a_failed_value_is_computed_once(tmp_path, monkeypatch):
     """A table whose every row needs a [[solve]] that fails asks for it at every halving of
     its rows; the failure is remembered, so the block is solved once."""
-    from workbook import given_find
+    from workbook.language import given_find
 
     calls = []
     solve_block = given_find.solve_block

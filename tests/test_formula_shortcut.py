@@ -10,7 +10,7 @@ import zipfile
 import pytest
 
 import workbook
-from workbook import xlsx
+from workbook.outputs import xlsx
 
 FAST = ["concave-cam"]  # the others write for seconds each: run with the slow tests
 TEMPLATES = [

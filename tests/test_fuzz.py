@@ -20,10 +20,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from workbook import WorkbookError
-from workbook import expr as ex
-from workbook.registry import REGISTRY
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.engine.sheet import Sheet
+from workbook.functions.registry import REGISTRY
+from workbook.language import expr as ex
+from workbook.language.template import load_spec
 
 EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "12000"))
 PER_TEST = EXAMPLES // 2
@@ -138,8 +138,8 @@ def test_budget_is_at_least_ten_thousand():
 
 
 # -- quantity and unit text; template value types --------------------------------------------
-# Every text a user types as a value or unit goes through one reader (workbook.quantity); every
-# table of a template through checked fields. Generated texts and TOML values must give a
+# Every text a user types as a value or unit goes through one reader (workbook.language.quantity);
+# every table of a template through checked fields. Generated texts and TOML values must give a
 # quantity or a WorkbookError, quickly: never another exception, never a long computation.
 
 QUANTITY_TOKENS = [
@@ -217,7 +217,7 @@ def quantity_texts():
 def check_quantity(text: str) -> None:
     import time
 
-    from workbook import units as un
+    from workbook.language import units as un
 
     start = time.monotonic()
     for read in (lambda: un.quantity(text, what="q"), lambda: un.unit(text, what="u")):
@@ -369,7 +369,7 @@ def template_text(slots, items) -> str:
 def check_template(folder, slots, items) -> None:
     import time
 
-    from workbook.template import load_spec as load
+    from workbook.language.template import load_spec as load
 
     text = template_text(slots, items)
     path = folder / "fuzz.toml"
@@ -473,8 +473,8 @@ def test_chart_labels_are_never_references(tmp_path_factory, texts):
     import openpyxl
     import xlsxwriter
 
-    from workbook import style
-    from workbook.xlsx import chart_label
+    from workbook.outputs import style
+    from workbook.outputs.xlsx import chart_label
 
     texts = [t.replace("\x00", "") or "x" for t in texts]  # no cell or XML holds NUL
     path = tmp_path_factory.mktemp("labels") / "c.xlsx"
@@ -522,7 +522,7 @@ def test_csv_cells_never_run_and_never_forge_rows(tmp_path_factory, cells, dtype
 
     import pandas as pd
 
-    from workbook.atomic import write_csv
+    from workbook.outputs.atomic import write_csv
 
     cells = [c.replace("\x00", "") for c in cells]
     path = tmp_path_factory.mktemp("csv") / "t.csv"

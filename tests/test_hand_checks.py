@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook import analysis
+from workbook.engine import analysis
 from workbook.errors import DomainError
 
 R1, R2, R3, RP, A, OMEGA = 20.0, 10.0, 50.0, 10.0, 20.0, 104.6  # mm, 1/s

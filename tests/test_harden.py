@@ -16,9 +16,9 @@ import pytest
 
 import workbook
 from workbook import WorkbookError
-from workbook import excel_names as xn
-from workbook import units as un
 from workbook.errors import InputError, LimitError
+from workbook.functions import excel_names as xn
+from workbook.language import units as un
 
 CODE = "import sys; from workbook.cli import main; sys.exit(main())"
 
@@ -418,7 +418,7 @@ def test_csv_and_export_overwrite_only_with_force(tmp_path):
 def test_every_sheet_key_the_engine_reads_is_a_known_key():
     import re
 
-    from workbook.template import SHEET_KEYS
+    from workbook.language.template import SHEET_KEYS
 
     source = Path(workbook.__file__).parent
     read = {
@@ -578,7 +578,7 @@ def test_every_text_cell_of_a_csv_is_escaped_whatever_its_dtype(tmp_path, dtype)
     # pandas 3 gives text columns the dtype str: escaping only dtype object wrote them raw
     import pandas as pd
 
-    from workbook.atomic import write_csv
+    from workbook.outputs.atomic import write_csv
 
     texts = [*CSV_PAYLOADS, "plain", "x=1"]
     frame = pd.DataFrame({"=label": pd.Series(texts, dtype=dtype), "n": range(len(texts))})
@@ -803,7 +803,7 @@ columns = { y = "" }
 
 def test_a_family_table_is_checked_before_its_curves_are_computed(tmp_path):
     # 50 curves x 2e6 rows built 1.66 GB before the row check refused the table
-    from workbook.sheet import MAX_FAMILY_CELLS
+    from workbook.engine.sheet import MAX_FAMILY_CELLS
 
     values = "[" + ", ".join(f'"{k}"' for k in range(1, 51)) + "]"
     path = write(tmp_path / "f.toml", FAMILY.replace("LAST", "39999").replace("VALUES", values))
@@ -935,7 +935,7 @@ def test_two_references_to_one_file_are_not_a_cycle(tmp_path):
 @pytest.mark.parametrize("error", [MemoryError, RecursionError])
 def test_memory_and_recursion_errors_name_the_definition(tmp_path, monkeypatch, error):
     # they fell through to the command line's last resort: no file, line or definition
-    from workbook import numeric
+    from workbook.engine import numeric
 
     text = '[inputs]\nR = "1 mm"\n[definitions]\na = "2*R"\nb = "3*a"\n'
     sheet = workbook.load(write(tmp_path / "m.toml", text))
@@ -992,8 +992,8 @@ def test_a_sweep_of_a_text_output_is_refused_at_load(tmp_path):
 )
 def test_a_product_of_two_numbers_shows_its_operator(text):
     # 2*10^e was typeset with an invisible times: it read "210^e" in the concave-cam report
-    from workbook import expr as ex
-    from workbook.report.mathml import MathML
+    from workbook.language import expr as ex
+    from workbook.outputs.report.mathml import MathML
 
     xml = MathML().box(ex.parse(text)).xml
     opening = r"(?:<(?:mrow|msup|msub|msubsup|mfrac|mstyle|mpadded)(?:\s[^>]*)?>)*"
@@ -1002,8 +1002,8 @@ def test_a_product_of_two_numbers_shows_its_operator(text):
 
 
 def test_a_number_before_a_name_keeps_the_invisible_times():
-    from workbook import expr as ex
-    from workbook.report.mathml import MathML
+    from workbook.language import expr as ex
+    from workbook.outputs.report.mathml import MathML
 
     for text in ("2*a", "0.5*x^2", "2*(a + b)", "2*sin(x)"):
         assert "<mo>\u2062</mo>" in MathML().box(ex.parse(text)).xml, text
@@ -1137,7 +1137,7 @@ def test_a_row_vector_at_the_last_column_is_written_whole_or_refused(tmp_path, n
 
 def test_a_report_names_a_huge_array_instead_of_showing_it(tmp_path):
     # a 2,000,001-element vector made a 90 MB report page
-    from workbook.report import mathml as mm
+    from workbook.outputs.report import mathml as mm
 
     big = mm.matrix_box(np.zeros((mm.MAX_SHOWN_ELEMENTS + 1, 1)), "mm").xml
     assert "<mtable>" not in big and f"a vector of {mm.MAX_SHOWN_ELEMENTS + 1:,}" in big

@@ -17,8 +17,10 @@ import time
 import pytest
 from guard_server import SERVER_INSTANCE
 
-from workbook import excelform, expr, numeric, ode, ranges, runtime, sheet, template, typecheck
 from workbook import limits as file_limits
+from workbook.compute import excelform
+from workbook.engine import numeric, ode, runtime, sheet
+from workbook.language import expr, ranges, template, typecheck
 from workbook.numerics import derivative
 from workbook.sweep.driver import MAX_SWEEP_POINTS
 from workbook.sweep.grid import MAX_CASES
@@ -252,7 +254,7 @@ def test_solver_step_cap_stops_a_billion_steps():
     documented budget (wall clock, then the step cap) with a reason, not after hours."""
     import numpy as np
 
-    from workbook.oderun import run_ode
+    from workbook.engine.oderun import run_ode
 
     def stiff(t, y):  # y' = -1e6 (y - cos t): RK45 needs ~1e6 steps per unit of time
         return -1e6 * (y - np.cos(t))

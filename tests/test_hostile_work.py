@@ -21,12 +21,13 @@ import pytest
 from test_hostile import guarded
 
 import workbook
-from workbook import excelform, limits
+from workbook import limits
 from workbook.cli import main
+from workbook.compute import excelform
 from workbook.errors import LimitError
-from workbook.excel_names import ExcelNames, needs_change
+from workbook.functions.excel_names import ExcelNames, needs_change
+from workbook.language.template import _scan_for_line, find_line
 from workbook.mathcad import writer
-from workbook.template import _scan_for_line, find_line
 
 # -- matrix work ------------------------------------------------------------------------------
 
@@ -84,7 +85,7 @@ def test_matrix_work_of_formulas_and_decompositions_is_counted(tmp_path, monkeyp
 
 def test_a_matrix_product_agrees_with_mpmath():
     # the product is numpy's BLAS matmul over the table's range axes (it was an einsum loop)
-    from workbook import matrix as mx
+    from workbook.functions import matrix as mx
 
     rng = np.random.default_rng(5)
     a, b = rng.normal(size=(4, 3, 6)), rng.normal(size=(3, 5, 6))  # 6 range points

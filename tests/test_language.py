@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 
 import workbook
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.engine.sheet import Sheet
+from workbook.language.template import load_spec
 
 DOC = Path(__file__).parent.parent / "docs" / "language.md"
 BLOCKS = re.findall(r"```toml\n(.*?)```", DOC.read_text(encoding="utf-8"), flags=re.S)

@@ -38,8 +38,8 @@ exclude_type_checking_imports = true
 [[tool.importlinter.contracts]]
 name = "the Excel form does not import the printer"
 type = "forbidden"
-source_modules = ["workbook.excelform"]
-forbidden_modules = ["workbook.excel"]
+source_modules = ["workbook.compute.excelform"]
+forbidden_modules = ["workbook.compute.excel"]
 allow_indirect_imports = true
 """,
         encoding="utf-8",

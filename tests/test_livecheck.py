@@ -1,5 +1,6 @@
 """Live formulas against the engine: the nested integral's live form, and the independent
-check (workbook.livecheck, the `formulas` package) that writes a disagreeing cell as a value."""
+check (workbook.compute.livecheck, the `formulas` package) that writes a disagreeing cell as a
+value."""
 
 import math
 
@@ -7,7 +8,7 @@ import openpyxl
 import pytest
 
 import workbook
-from workbook import livecheck
+from workbook.compute import livecheck
 from workbook.numerics import gauss
 
 # A beam's double integration and relatives: each value known in closed form.

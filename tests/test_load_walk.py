@@ -21,14 +21,14 @@ finally:
 MOST_CLIMBS = 6
 #: modules that hold only rules on typed trees: a call from them into the typer is a callback
 RULES = (
-    "workbook.builtins",
-    "workbook.matrix_entries",
+    "workbook.functions.builtins",
+    "workbook.functions.matrix_entries",
     "workbook.numerics.entries",
-    "workbook.typearrays",
+    "workbook.language.typearrays",
 )
 #: the one question a rule asks the typer: whether diff's body has a symbolic form (the
 #: functions it calls are looked up in the typer)
-ASKED = {("workbook.numerics.entries", "workbook.typecheck", "Typer.symbolic_refusal")}
+ASKED = {("workbook.numerics.entries", "workbook.language.typecheck", "Typer.symbolic_refusal")}
 TEMPLATES = sorted(workbook.list_templates())
 
 
@@ -44,7 +44,7 @@ def test_loading_a_template_climbs_back_up_at_most_six_times(name):
     found = _walk(name)
     assert len(found.climbs) <= MOST_CLIMBS, sorted(found.climbs)
     back_into_typer = [
-        c for c in found.climbs - ASKED if c[0] in RULES and c[1] == "workbook.typecheck"
+        c for c in found.climbs - ASKED if c[0] in RULES and c[1] == "workbook.language.typecheck"
     ]
     assert not back_into_typer
 
@@ -52,7 +52,7 @@ def test_loading_a_template_climbs_back_up_at_most_six_times(name):
 def test_the_walk_sees_a_callback_as_a_climb():
     # an [[ode]] section's expressions are typed by the typer, asked from ode.py: one climb
     found = _walk("advance-coupling")
-    assert ("workbook.ode", "workbook.typecheck") in found.climbs_by_pair()
+    assert ("workbook.engine.ode", "workbook.language.typecheck") in found.climbs_by_pair()
 
 
 def test_the_readers_of_measured_data_and_solve_blocks_return_what_they_read(tmp_path):
@@ -75,5 +75,5 @@ head = "linterp(Q, H, q)"
 """
     workbook.loads(text, folder=tmp_path)
     found = load_walk.walk(lambda: workbook.loads(text, folder=tmp_path))
-    assert {"workbook.measured", "workbook.given_find"} <= found.rooms
+    assert {"workbook.language.measured", "workbook.language.given_find"} <= found.rooms
     assert not found.climbs, sorted(found.climbs)

@@ -10,8 +10,8 @@ import struct
 
 import pytest
 
-from workbook import units as un
 from workbook.cli import main
+from workbook.language import units as un
 from workbook.mathcad.functions import MATHCAD_FUNCTIONS
 from workbook.mathcad.names import identifier
 from workbook.mathcad.units import FORMULA_UNITS

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 from test_mathcad_programs import _apply, _call, _check, _define, _eval, _id, _import, _real
 
-from workbook import sheet as sheet_module
+from workbook.engine import sheet as sheet_module
 from workbook.mathcad import translate
 
 

@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_mathcad_maps import _apply, _eval, _id, _real, _region, _worksheet
 
-from workbook import expr as ex
 from workbook.cli import main
+from workbook.language import expr as ex
 
 NAMES = st.sampled_from(["x", "y", "a_1", "L", "phi"])
 NUMBERS = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, allow_infinity=False)

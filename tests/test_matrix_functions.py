@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from workbook.engine.sheet import Sheet
 from workbook.errors import TemplateError, UnitError
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.language.template import load_spec
 
 DATA = Path(__file__).parent / "data" / "matrix_functions.toml"
 L, TH = 0.25, math.radians(35)

@@ -12,8 +12,8 @@ import pytest
 from conftest import write_template
 
 import workbook
-from workbook.builtins import _round_numpy
 from workbook.errors import WorkbookError
+from workbook.functions.builtins import _round_numpy
 
 SHEET = """
 [inputs]
@@ -231,7 +231,7 @@ def test_sort_over_a_range_sorts_each_point(arrays):
 
 
 def test_run_time_arrays(arrays):
-    from workbook import runtime as rt
+    from workbook.engine import runtime as rt
 
     grown = rt.value(arrays.evaluate("grown", 6.0).magnitude)
     assert grown.ravel().tolist() == sorted(float(7 * i % 5) for i in range(1, 7))

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 import workbook
-from workbook import analysis
+from workbook.engine import analysis
 from workbook.errors import DomainError
 
 ROOT = Path(__file__).resolve().parents[1]

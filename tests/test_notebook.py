@@ -5,7 +5,7 @@ import pytest
 from conftest import write_template
 
 import workbook
-from workbook import notebook
+from workbook.outputs import notebook
 
 
 def test_the_html_shows_inputs_definitions_and_tables(concave):

@@ -16,8 +16,8 @@ import pytest
 from conftest import write_template
 
 import workbook
-from workbook.distributions import NAMES as DISTRIBUTIONS
-from workbook.registry import REGISTRY
+from workbook.functions.distributions import NAMES as DISTRIBUTIONS
+from workbook.functions.registry import REGISTRY
 
 mp = mpmath.mp
 

@@ -9,7 +9,7 @@ from conftest import DATA, write_template
 from scipy.integrate import solve_ivp
 
 import workbook
-from workbook import ode
+from workbook.engine import ode
 from workbook.errors import DomainError
 
 

@@ -1,5 +1,5 @@
-"""The ODE runner (workbook.oderun) and the solving of [[ode]] sections (workbook.ode) against
-closed forms and scipy."""
+"""The ODE runner (workbook.engine.oderun) and the solving of [[ode]] sections (workbook.engine.ode)
+against closed forms and scipy."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from workbook import ode, oderun
+from workbook.engine import ode, oderun
 from workbook.errors import DomainError, LimitError
 
 

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook.checks import run_checks
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.compute.checks import run_checks
+from workbook.engine.sheet import Sheet
+from workbook.language.template import load_spec
 
 HEAD = """
 [inputs]
@@ -212,7 +212,7 @@ def test_vector_state_shapes_and_method_names_are_checked_at_load(tmp_path):
 
 
 def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
-    from workbook import ode as wo
+    from workbook.engine import ode as wo
 
     path = tmp_path / "m.toml"
     path.write_text(MASS, encoding="utf-8")

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import workbook
+from workbook.engine.sheet import Sheet
+from workbook.language.template import load_spec
 from workbook.program.run import MAX_STEPS
-from workbook.sheet import Sheet
-from workbook.template import load_spec
 
 
 def _sheet(tmp_path, text: str) -> Sheet:
@@ -227,7 +227,7 @@ def test_a_vector_is_made_and_grown_by_its_elements(tmp_path):
     np.testing.assert_allclose(sheet.evaluate("grid", 1).magnitude, i + 10 * j + 1)
     assert sheet.evaluate("fib", 1).magnitude == 34
     assert sheet.evaluate("count", 2).magnitude == 10
-    # a length known only when the program runs: a run-time array (workbook.runtime)
+    # a length known only when the program runs: a run-time array (workbook.engine.runtime)
     late = _sheet(
         tmp_path,
         '[arguments]\nx = { unit = "" }\n[definitions]\n'

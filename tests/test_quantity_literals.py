@@ -12,10 +12,10 @@ from conftest import write_template
 from recalc import formula_values
 
 import workbook
-from workbook import expr as ex
-from workbook import units as un
 from workbook.errors import WorkbookError
-from workbook.report.mathml import MathML
+from workbook.language import expr as ex
+from workbook.language import units as un
+from workbook.outputs.report.mathml import MathML
 
 
 @pytest.mark.parametrize(

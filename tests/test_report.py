@@ -13,12 +13,12 @@ import report_parse as rp
 from conftest import SINE_TABLE, write_template
 
 import workbook
-from workbook import expr as ex
-from workbook import units as un
 from workbook.cli import main
-from workbook.computed import compute
-from workbook.report import render
-from workbook.report.mathml import MathML, name_box
+from workbook.compute.computed import compute
+from workbook.language import expr as ex
+from workbook.language import units as un
+from workbook.outputs.report import render
+from workbook.outputs.report.mathml import MathML, name_box
 
 # -- the printer ---------------------------------------------------------------------------
 
@@ -83,7 +83,7 @@ def test_the_formula_shown_is_the_formula_written(text):
 
 
 def test_every_builtin_is_written_as_its_registry_entry_says():
-    from workbook.registry import REGISTRY
+    from workbook.functions.registry import REGISTRY
 
     for name, entry in REGISTRY.items():
         a = entry.arity
@@ -391,7 +391,7 @@ def test_a_failed_write_keeps_the_old_file(tmp_path, monkeypatch):
     def boom(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr("workbook.report.render", boom)
+    monkeypatch.setattr("workbook.outputs.report.render", boom)
     with pytest.raises(KeyboardInterrupt):
         sheet.with_inputs(R="30 mm").report(out)
     assert out.read_text(encoding="utf-8") == before
@@ -409,9 +409,9 @@ def test_charts_leave_pyplot_alone_and_run_does_not_draw(tmp_path):
         "import sys, workbook\n"
         "from workbook.cli import main\n"
         f"main(['run', 'concave-cam', '--out', {str(tmp_path / 'c.xlsx')!r}])\n"
-        "print(sorted(m for m in ('matplotlib', 'workbook.report') if m in sys.modules))\n"
-        "from workbook.computed import compute\n"
-        "from workbook.report import render\n"
+        "print(sorted(m for m in ('matplotlib', 'workbook.outputs.report') if m in sys.modules))\n"
+        "from workbook.compute.computed import compute\n"
+        "from workbook.outputs.report import render\n"
         "assert render(compute(workbook.load('concave-cam'))).count('<svg') == 2\n"
         "print('matplotlib.pyplot' in sys.modules)\n"
     )

@@ -10,9 +10,9 @@ import pytest
 from chromium import measure, pdf_pages, pdf_text, screenshots
 
 import workbook
-from workbook.computed import compute
-from workbook.report import write_report
-from workbook.report.pdf import chromium
+from workbook.compute.computed import compute
+from workbook.outputs.report import write_report
+from workbook.outputs.report.pdf import chromium
 
 if chromium() is None and os.environ.get("CI"):
     raise RuntimeError("CI must run the report tests in Chromium: install chromium")

@@ -1,4 +1,4 @@
-"""Arrays whose size is known only when the program runs (workbook.runtime): growth, nested
+"""Arrays whose size is known only when the program runs (workbook.engine.runtime): growth, nested
 arrays, Mathcad's rules on shapes, and the errors that replace a guess."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import workbook
-from workbook import runtime as rt
+from workbook.engine import runtime as rt
 from workbook.errors import InputError, WorkbookError
 
 SHEET = '''

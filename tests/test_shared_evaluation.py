@@ -1,5 +1,5 @@
 """Definitions computed once per evaluation: nested calls, and sub-expressions shared by
-the columns of a table (workbook.subtrees, workbook.numeric)."""
+the columns of a table (workbook.language.subtrees, workbook.engine.numeric)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import time
 import numpy as np
 import pytest
 
-from workbook.excel import ExcelPrinter
-from workbook.registry import REGISTRY
-from workbook.sheet import Sheet
+from workbook.compute.excel import ExcelPrinter
+from workbook.engine.sheet import Sheet
+from workbook.functions.registry import REGISTRY
+from workbook.language.template import load_spec
 from workbook.sweep import sweep
-from workbook.template import load_spec
 
 LEVELS = 40
 # Without sharing, f40 is 2^40 calls of f0: a run that never ends. The bound below only turns

@@ -69,8 +69,8 @@ def test_run_prints_the_unknowns_as_results(tmp_path):
 def test_the_results_sheet_and_the_report_show_the_block(tmp_path):
     import openpyxl
 
-    from workbook.computed import compute
-    from workbook.report import write_report
+    from workbook.compute.computed import compute
+    from workbook.outputs.report import write_report
 
     sheet = workbook.load(write_template(tmp_path, SHEET))
     sheet.write_xlsx(tmp_path / "s.xlsx")

@@ -410,9 +410,9 @@ def test_numerical_builtins_over_a_swept_input_agree_with_serial(tmp_path):
 def _vectorisable_outputs(sheet, name: str) -> dict:
     """The scalar definitions that depend on input ``name``, are numbers and that a
     vectorised sweep of it computes."""
-    from workbook import expr as ex
-    from workbook import typecheck as tc
     from workbook.errors import WorkbookError
+    from workbook.language import expr as ex
+    from workbook.language import typecheck as tc
     from workbook.sweep.grid import as_varies
     from workbook.sweep.outputs import as_outputs, type_output
     from workbook.sweep.vector import vector_blockers

@@ -1,4 +1,4 @@
-"""workbook.symbolic: the typed tree as SymPy, derivatives, exact numbers."""
+"""workbook.engine.symbolic: the typed tree as SymPy, derivatives, exact numbers."""
 
 import math
 
@@ -8,8 +8,8 @@ import pytest
 import sympy as sp
 
 import workbook
-from workbook import symbolic
-from workbook.analysis import true_pi_sheet
+from workbook.engine import symbolic
+from workbook.engine.analysis import true_pi_sheet
 
 
 def test_exact_numbers():

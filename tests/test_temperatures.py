@@ -21,8 +21,8 @@ from conftest import write_template
 from recalc import formula_values
 
 import workbook
-from workbook import units as un
 from workbook.errors import UnitError
+from workbook.language import units as un
 
 UNITS = ["K", "degC", "degF", "degR", "delta_degC", "delta_degF"]
 LEFT, RIGHT = 300.0, 20.0  # magnitudes of the two operands

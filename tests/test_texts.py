@@ -10,7 +10,7 @@ from conftest import write_template
 
 import workbook
 from workbook import WorkbookError
-from workbook.texts import number_text
+from workbook.functions.texts import number_text
 
 SHEET = r"""
 [inputs]
@@ -65,7 +65,7 @@ def test_num2str_writes_15_significant_digits(x, text):
 
 def test_concat_is_live_in_excel(sheet, tmp_path):
     formulas = pytest.importorskip("formulas")
-    from workbook.excel import ExcelPrinter
+    from workbook.compute.excel import ExcelPrinter
 
     printer = ExcelPrinter(sheet.typer, {"n": "3"})
     for name in ("quoted", "joined"):

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import pytest
 
-from workbook import typecheck
+from workbook.engine.sheet import Sheet
 from workbook.errors import LimitError, WorkbookError
-from workbook.sheet import Sheet
-from workbook.template import load_spec
+from workbook.language import typecheck
+from workbook.language.template import load_spec
 
 HEAD = '[inputs]\nR1 = "20 mm"\n\n[arguments]\nx = { unit = "" }\n\n[definitions]\n'
 

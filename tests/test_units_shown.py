@@ -10,7 +10,7 @@ import pytest
 from conftest import write_template
 
 import workbook
-from workbook import units as un
+from workbook.language import units as un
 
 SHEET = """
 [sheet]

@@ -36,7 +36,7 @@ def template_path(name_or_path: str | Path) -> Path:
         return path
     found = list_templates()
     if text not in found:
-        from .fields import nearest
+        from .language.fields import nearest
 
         hint = nearest(text, found)
         if Path(text + ".toml").is_file():
@@ -50,8 +50,8 @@ def load(name_or_path: str | Path, parts=None):
 
     ``parts`` chooses the template's optional parts to compute and write: None (only what is
     in no part), a part name, several names, or ``"all"``."""
-    from .sheet import Sheet
-    from .template import load_spec
+    from .engine.sheet import Sheet
+    from .language.template import load_spec
 
     path = template_path(name_or_path)
     return Sheet(load_spec(path), parts=parts)
@@ -61,9 +61,9 @@ def loads(text: str, name: str = "sheet", folder: str | Path = ".", parts=None):
     """A :class:`Sheet` from template text (TOML), its units checked, as :func:`load` gives
     from a file. Messages name ``FOLDER/NAME.toml`` (no file is read or written), and files
     the text names ([data] CSV) are read from ``folder``."""
+    from .engine.sheet import Sheet
     from .errors import LimitError
-    from .sheet import Sheet
-    from .template import MAX_TEMPLATE_BYTES, parse_spec
+    from .language.template import MAX_TEMPLATE_BYTES, parse_spec
 
     if len(text.encode("utf-8")) > MAX_TEMPLATE_BYTES:
         raise LimitError(f"template text is larger than {MAX_TEMPLATE_BYTES:,} bytes")
@@ -72,7 +72,7 @@ def loads(text: str, name: str = "sheet", folder: str | Path = ".", parts=None):
 
 def __getattr__(name):
     if name == "Sheet":
-        from .sheet import Sheet
+        from .engine.sheet import Sheet
 
         return Sheet
     raise AttributeError(name)

@@ -203,10 +203,10 @@ def cmd_run(args) -> int:
     are checked and all contents computed before any file is replaced. Findings with verdict
     warning or fail are printed; exit 1 (after writing) when one fails. Printed values that an
     override (--set) no longer reproduces are counted in the summary, not an error."""
-    from .atomic import Outputs, write_csv
-    from .computed import compute
+    from .compute.computed import compute
     from .errors import InputError
-    from .xlsx import write_workbook
+    from .outputs.atomic import Outputs, write_csv
+    from .outputs.xlsx import write_workbook
 
     if args.out and Path(args.out).suffix.lower() != ".xlsx":
         raise InputError(
@@ -245,7 +245,7 @@ def cmd_run(args) -> int:
     if exporter is not None:
         print(f"wrote {args.export}")
     n_checked = sum(r.role == "check" for r in report.rows)
-    from .verdicts import REPRODUCED
+    from .compute.verdicts import REPRODUCED
 
     n_ok = sum(r.role == "check" and r.verdict in REPRODUCED for r in report.rows)
     summary = f"{len(sheet.spec.tables)} tables, {len(sheet.spec.charts)} charts"
@@ -274,7 +274,7 @@ def _estimates_after_writing(sheet, report) -> None:
 def _print_scalars(sheet) -> None:
     """The scalar results, one a line (the first MAX_SUMMARY_SCALARS of them)."""
     from .errors import WorkbookError
-    from .units import pretty
+    from .language.units import pretty
 
     unknowns = [  # [[solve]] results (a block with parameters is a function)
         n for block in sheet.spec.solves if not block.parameters for n in block.unknowns
@@ -302,7 +302,7 @@ def _print_scalars(sheet) -> None:
 
 def _print_findings(report) -> int:
     """Print the findings with verdict warning or fail (stderr); EXIT_CHECK if one fails."""
-    from .verdicts import FINDING_FAILED, FINDING_FLAGGED
+    from .compute.verdicts import FINDING_FAILED, FINDING_FLAGGED
 
     for f in report.findings:
         if f.verdict in FINDING_FLAGGED:
@@ -312,8 +312,8 @@ def _print_findings(report) -> int:
 
 
 def cmd_report(args) -> int:
-    from .computed import compute
-    from .report import regenerate_command, report_targets, write_report
+    from .compute.computed import compute
+    from .outputs.report import regenerate_command, report_targets, write_report
 
     sheet = load_sheet(args, args.part or None)
     command = regenerate_command(sheet, parse_sets(args.set))
@@ -386,7 +386,7 @@ def cmd_bench(args) -> int:
 
     tables = []
     if sheet.spec.odes:
-        from .ode import sheet_bench
+        from .engine.ode import sheet_bench
 
         tables.append(pd.DataFrame(sheet_bench(sheet, quick=args.quick)))
     if ref:
@@ -402,8 +402,8 @@ def cmd_sweep(args) -> int:
     """``workbook sweep NAME --vary R3=40mm..60mm:21 [--output NAME=EXPR] [--out FILE]``."""
     import math
 
-    from .atomic import check_target
     from .errors import InputError
+    from .outputs.atomic import check_target
     from .sweep import Progress, parse_output_option, parse_vary, sweep, write
 
     sheet = load_sheet(args)
@@ -472,7 +472,7 @@ def main(argv: list[str] | None = None) -> int:
         import warnings
 
         warnings.simplefilter("ignore", RuntimeWarning)
-    from .atomic import Terminated, sigterm_as_interrupt
+    from .outputs.atomic import Terminated, sigterm_as_interrupt
 
     try:
         with sigterm_as_interrupt():

@@ -1,6 +1,6 @@
 """Read the inputs back from the Inputs sheet of a generated (and edited) workbook.
 
-The Inputs sheet (written by :mod:`workbook.xlsx`) holds Name, Value, Unit, Note from row 2.
+The Inputs sheet (written by :mod:`workbook.outputs.xlsx`) holds Name, Value, Unit, Note from row 2.
 A user edits values (and may change a unit: ``45`` ``mm`` -> ``4.5`` ``cm``) in Excel or
 LibreOffice; :func:`read_inputs` reads them with openpyxl and checks them exactly as
 ``--set`` does (unknown names, units, bounds, choices).
@@ -18,7 +18,7 @@ MAX_INPUT_ROWS = 10_000
 
 def read_inputs(sheet, path) -> dict:
     """Inputs of ``path`` as ``{name: checked value}`` (quantities in the input's unit)."""
-    from .sheet import coerce_input
+    from .engine.sheet import coerce_input
 
     rows = _rows(Path(path))
     values = {}
@@ -66,7 +66,7 @@ def with_inputs_from(sheet, path):
 
 
 def _unit_text(q) -> str:
-    from . import units as un
+    from .language import units as un
 
     return un.pretty(q.units) or str(q.units)
 
@@ -147,7 +147,7 @@ def _raw(spec, value, unit: str, where: str):
     time, a boolean or an error value is refused naming the cell (a date would otherwise be
     read as its year or serial number).
     """
-    from .quantity import check_unit_text, split_quantity
+    from .language.quantity import check_unit_text, split_quantity
 
     if spec.options:
         if not isinstance(value, str):

@@ -82,7 +82,7 @@ def starter(name: str, file: str) -> str:
 
 def write_starter(name: str, out: str | Path | None = None, *, force: bool = False) -> Path:
     """Write the starter worksheet ``NAME.toml`` (or ``out``); returns its path."""
-    from .atomic import replacing
+    from .outputs.atomic import replacing
 
     if not name or any(c in name for c in '/\\:*?"<>|') or name.startswith("."):
         raise InputError(f"'{name}' is not a usable worksheet name (letters, digits, - and _)")

@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from ..compute.findings import Finding
 from ..errors import TemplateError
-from ..findings import Finding
 
 __all__ = [
     "Block",

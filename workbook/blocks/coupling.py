@@ -16,7 +16,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from .. import ode, oderun
+from ..engine import ode, oderun
 from . import Finding, bench_block, cached, findings_block, table_block
 
 

@@ -424,7 +424,7 @@ def export_profile_csv(sheet, path, *, allow_invalid: bool = False, header: bool
     """
     from pathlib import Path
 
-    from ..atomic import check_target, replacing
+    from ..outputs.atomic import check_target, replacing
 
     profile = sheet.table("profile").iloc[:-1]
     if _mag(sheet, "regular") != 1 and not allow_invalid:

@@ -25,8 +25,8 @@ SG_ORDER = 3
 def measured_points(sheet):
     """The measured lift of the template's [data.measured_lift] (phi in deg, h in mm), checked
     for what the Savitzky-Golay filter needs: enough points, increasing in equal steps."""
-    from .. import units as un
     from ..errors import InputError
+    from ..language import units as un
 
     phi, h = (sheet.spec.data[n] for n in ("phi_m", "h_m"))
     where = f"{phi.file.name} ([data.measured_lift])"
@@ -44,7 +44,7 @@ def _measured(sheet):
     def make():
         from scipy.signal import savgol_coeffs, savgol_filter
 
-        from .. import units as un
+        from ..language import units as un
 
         phi, h = measured_points(sheet)
         dphi = float(phi[1] - phi[0])

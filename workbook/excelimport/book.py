@@ -50,7 +50,7 @@ class Translation:
 
 
 def language_reserved() -> set[str]:
-    from ..registry import REGISTRY
+    from ..functions.registry import REGISTRY
 
     return {n.lower() for n in REGISTRY} | KEYWORDS
 
@@ -273,7 +273,7 @@ def _label(book: Book, sheet: str, row: int, col: int) -> str | None:
 def proposed_unit(label: str | None, number_format: str) -> str | None:
     """A unit named by the label (``Span (mm)``) or the number format (``0.0 "kN"``) that
     pint reads; proposed in a note, never applied."""
-    from .. import units as un
+    from ..language import units as un
 
     found = []
     if label:

@@ -255,8 +255,8 @@ def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
     """{definition: why} of what the engine refuses at load (empty when the worksheet loads):
     every definition is typed, so one load finds them all."""
     import workbook
-    from workbook import typecheck as tc
-    from workbook.template import load_spec
+    from workbook.language import typecheck as tc
+    from workbook.language.template import load_spec
 
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{name}.toml"

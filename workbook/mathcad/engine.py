@@ -2,7 +2,7 @@
 refuses left out of the translation.
 
 :func:`refusals` builds the worksheet's spec from the document's data (no TOML text, no file)
-and types every element with one :class:`~workbook.typecheck.Typer` in the order the engine
+and types every element with one :class:`~workbook.language.typecheck.Typer` in the order the engine
 checks a worksheet at load (solve blocks, definitions, table columns, chart series, functions
 typed by their calls), then computes every chart series as ``workbook run`` will. An element
 the engine refuses gives its region and the engine's reason; what needs a refused definition
@@ -16,10 +16,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .. import expr as ex
-from .. import typecheck as tc
-from .. import typed as ty
 from ..errors import WorkbookError
+from ..language import expr as ex
+from ..language import typecheck as tc
+from ..language import typed as ty
 from .translate import Item, Skipped, Translation, _rename, _uses
 from .writer import Rendered
 
@@ -27,8 +27,8 @@ from .writer import Rendered
 def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
     """Region id (or ``"REGION/trace N"`` for one trace of a plot) -> why the engine refuses
     it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``."""
-    from ..sheet import Sheet
-    from ..template import spec_from_data
+    from ..engine.sheet import Sheet
+    from ..language.template import spec_from_data
 
     path = folder / f"{rendered.name}.toml"
     spec = spec_from_data(data, path, rendered.name)
@@ -63,7 +63,7 @@ def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
         if needs_refused(*tc.solve_expressions(block)):
             continue
         try:
-            from ..given_find import typed_equations
+            from ..language.given_find import typed_equations
 
             sheet.check_not_circular(block)
             typed_equations(typer, block)
@@ -357,7 +357,7 @@ class AtImport:
     def _typed(self, node: ex.Node, what: str, ranges: bool, values: bool):
         """(key of the worksheet of what ``node`` needs, typed tree, token of each identifier);
         the worksheet is written, read and given a typer once for the same needs."""
-        from ..template import spec_from_data
+        from ..language.template import spec_from_data
         from .writer import document
 
         node = self._sizes(node)
@@ -405,9 +405,9 @@ class AtImport:
         one known at import."""
         import numpy as np
 
-        from .. import units as un
+        from ..engine.sheet import Sheet
+        from ..language import units as un
         from ..limits import matrix_work
-        from ..sheet import Sheet
 
         known = self.known.get(node.id) if isinstance(node, ex.Name) else None
         if known is not None and known[0] is not None:

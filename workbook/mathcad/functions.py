@@ -42,7 +42,7 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "condi": ("condi", None), "tr": ("tr", None), "diag": ("diag", None),
     "svds": ("svds", None),
     "histogram": ("histogram", None), "concat": ("concat", None), "num2str": ("num2str", None),
-    # probability distributions (workbook.distributions)
+    # probability distributions (workbook.functions.distributions)
     "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),
     "dt": ("dt", None), "pt": ("pt", None), "qt": ("qt", None),
     "dchisq": ("dchisq", None), "pchisq": ("pchisq", None), "qchisq": ("qchisq", None),
@@ -80,6 +80,6 @@ OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpos
 
 def language_functions() -> set[str]:
     """The built-in function names of the language (its registry)."""
-    from ..registry import REGISTRY
+    from ..functions.registry import REGISTRY
 
     return set(REGISTRY)

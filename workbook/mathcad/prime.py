@@ -417,7 +417,7 @@ def _constant(text: str, subscript: str, attrs: dict, line) -> MNode:
     if key not in _CONSTANTS:
         named = dict(attrs, subscript=subscript) if subscript else attrs
         return MNode("id", named, text, [], line)
-    from .. import units as un
+    from ..language import units as un
 
     q = un.registry().Quantity(1, _CONSTANTS[key]).to_base_units()
     node = MNode("real", {}, repr(float(q.magnitude)), [], line)
@@ -535,7 +535,7 @@ def _attach_result(evaluation: MNode, stored) -> None:
 def _override_quantity(node: MNode) -> tuple[float, str]:
     """(scale factor, pint unit text) of the unit typed after ``=`` (``kN/m``, ``10^3``,
     ``10^-34 kg*m^2/s``)."""
-    from .. import units as un
+    from ..language import units as un
 
     text = _unit_expression(node)
     try:

@@ -9,7 +9,7 @@ try/catch) is untranslatable.
 
 from __future__ import annotations
 
-from .. import expr as ex
+from ..language import expr as ex
 from . import names as nm
 from .reader import MNode
 from .symbols import Sym, Untranslatable, matrix_size, what

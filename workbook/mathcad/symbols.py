@@ -7,7 +7,7 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from .. import expr as ex
+from ..language import expr as ex
 
 if TYPE_CHECKING:
     from .reader import MNode

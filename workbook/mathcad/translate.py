@@ -1,6 +1,6 @@
 """Translating a Mathcad worksheet (regions in reading order) into the worksheet language.
 
-Mathcad's math trees become the language's expression trees (:mod:`workbook.expr`), names
+Mathcad's math trees become the language's expression trees (:mod:`workbook.language.expr`), names
 go through :mod:`.names`, units through :mod:`.units`, built-in functions through
 :mod:`.functions`. Every result Mathcad stored becomes a printed value. What the language
 cannot express is kept as a list of untranslated regions (id, what, why); a definition
@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .. import expr as ex
-from ..visitor import Visitor
+from ..language import expr as ex
+from ..language.visitor import Visitor
 from . import names as nm
 from .functions import (
     MATHCAD_FUNCTIONS,
@@ -251,7 +251,7 @@ class ExprTranslator(Visitor):
         if not isinstance(other, ex.Number) or isinstance(node, ex.Number):
             return node
         unit = self.tr.at_import().unit(node)
-        from ..unitrules import angle_in
+        from ..language.unitrules import angle_in
 
         if unit is None or not angle_in(unit):
             return node

@@ -8,8 +8,8 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .. import expr as ex
 from ..errors import InputError
+from ..language import expr as ex
 from .functions import language_functions
 from .tomldoc import Document, is_one_line, one_line
 from .translate import Item, Skipped, Sym, Translation, _rename
@@ -34,7 +34,7 @@ class Rendered:
 
 def pretty_unit(text: str) -> str:
     """Unit text in pint's short form (``kN / m ** 2``); as it is if pint cannot read it."""
-    from .. import units as un
+    from ..language import units as un
 
     try:
         return format(un.registry().Unit(text), "~")
@@ -347,7 +347,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
 def _list_unknown_units(tr: Translation) -> None:
     """A stored result in a unit the engine does not know costs that result (listed, not
     computable), never the check of the whole worksheet."""
-    from .. import units as un
+    from ..language import units as un
 
     for res in tr.results:
         if not res.unit or not res.rows:
@@ -498,7 +498,7 @@ def write(rendered: Rendered, out_dir: Path, *, force: bool) -> list[Path]:
         existing = [p for p in targets if p.exists()]
         if existing:
             raise InputError(f"{existing[0]} exists; use --force to replace it")
-    from ..atomic import replacing
+    from ..outputs.atomic import replacing
 
     for path, text in zip(targets, [rendered.toml, *rendered.csv.values()]):
         with replacing(path) as tmp:

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import typed as ty
 from ..errors import WorkbookError
+from ..language import typed as ty
 from ._common import current, reference_methods, sheet_tolerance
 
 #: built-ins whose values come from an iterative method with an error estimate

@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .. import typed as ty
-from .. import units as un
+from ..language import typed as ty
+from ..language import units as un
 from ._common import Result, Tolerance, current, defined, num, sheet_tolerance
 
 

@@ -4,7 +4,7 @@ At load the typer gives ``diff`` its unit (EXPR's over X's to the N) and keeps a
 :class:`Pending` record of the call; nothing is differentiated yet, and SymPy is not imported.
 The first back end that needs the derivative (a value, a formula, a check) calls
 :func:`formula`: EXPR's typed tree is printed as SymPy
-(:class:`workbook.symbolic.SympyConverter`, inputs and definitions kept as symbols),
+(:class:`workbook.engine.symbolic.SympyConverter`, inputs and definitions kept as symbols),
 differentiated, and read back into a typed tree whose leaves are EXPR's own parameters and
 references; it is kept for every later use. Every back end then treats the derivative as any
 other formula: numpy evaluates it, Excel gets it as a live formula.
@@ -17,11 +17,11 @@ import math
 import weakref
 from dataclasses import dataclass, field
 
-from .. import typed as ty
-from .. import units as un
 from ..errors import LimitError, NotSymbolic, TemplateError, WorkbookError
+from ..language import typed as ty
+from ..language import units as un
+from ..language.visitor import Visitor
 from ..limits import within_seconds
-from ..visitor import Visitor
 
 
 def sympy_functions() -> dict[str, str]:
@@ -29,9 +29,9 @@ def sympy_functions() -> dict[str, str]:
     read from the registry: an entry whose SymPy form, given symbols, is one SymPy function of
     exactly those symbols (``Abs(x)``, ``atan2(y, x)``). Plain built-ins come before those of
     vectors (``abs`` before ``mag``, whose SymPy form is ``Abs`` too)."""
-    # workbook.registry.REGISTRY is this dict; it imports this module's entry, so the dict is
-    # read from its home. By the time a derivative is read back every entry is registered.
-    from ..entry import ENTRIES
+    # workbook.functions.registry.REGISTRY is this dict; it imports this module's entry, so the dict
+    # is read from its home. By the time a derivative is read back every entry is registered.
+    from ..functions.entry import ENTRIES
 
     return _sympy_functions(tuple(ENTRIES.values()))  # read again when an entry is added
 

@@ -1,10 +1,10 @@
 """Registry entries of the numerical built-ins: root, integral, maximum/minimum/argmax/argmin,
-product, diff, and linterp/cspline over [data] columns (one :class:`workbook.builtins.Builtin`
-each; ``sum`` is in builtins.py).
+product, diff, and linterp/cspline over [data] columns (one
+:class:`workbook.functions.builtins.Builtin` each; ``sum`` is in builtins.py).
 
 Each binds its variable (``binds=(0, 1)``): the unit rule checks the bounds or the guess
 against the variable's unit at load; the numpy hook receives EXPR as a
-:class:`workbook.numeric.Bound` and solves every row of a table in one vectorised call of
+:class:`workbook.engine.numeric.Bound` and solves every row of a table in one vectorised call of
 :mod:`workbook.numerics`. SciPy is imported only when a hook runs.
 """
 
@@ -14,11 +14,11 @@ import math
 
 import numpy as np
 
-from .. import typed as ty
-from .. import units as un
-from ..entry import Builtin, register
 from ..errors import NotLive, NotSymbolic, TemplateError, UnitError, WorkbookError
-from ..expr import PREC
+from ..functions.entry import Builtin, register
+from ..language import typed as ty
+from ..language import units as un
+from ..language.expr import PREC
 from ._common import (
     NumericsError,
     Result,
@@ -701,7 +701,7 @@ def _integral_excel(body, args, consts) -> tuple[str, int]:
 
 
 def _product_excel(body, args, consts) -> tuple[str, int]:
-    from ..builtins import MAX_EXCEL_TERMS, sum_index
+    from ..functions.builtins import MAX_EXCEL_TERMS, sum_index
 
     lo, hi = consts
     if lo is None or hi is None:
@@ -742,7 +742,7 @@ def _no_sympy(name: str):
     def convert(sp, body, var, *rest):
         raise NotSymbolic(why)
 
-    convert.refusal = why  # read by workbook.symbolic.refusal, without SymPy
+    convert.refusal = why  # read by workbook.engine.symbolic.refusal, without SymPy
     return convert
 
 

@@ -19,8 +19,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .. import typed as ty
-from ..visitor import Visitor
+from ..language import typed as ty
+from ..language.visitor import Visitor
 
 _INF = np.inf
 _EPS = float(np.finfo(float).eps)

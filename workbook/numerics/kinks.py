@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from .. import typed as ty
-from ..visitor import Visitor
+from ..language import typed as ty
+from ..language.visitor import Visitor
 
 
 class Kinks(Visitor):
@@ -165,7 +165,7 @@ def switching(body: ty.T, var: str) -> list[ty.T]:
     sides of a comparison (a piecewise condition). Their zeros are found numerically
     (:func:`workbook.numerics.features.kink_points`); the linear cases are also found
     above, exactly."""
-    from ..registry import REGISTRY
+    from ..functions.registry import REGISTRY
 
     found: list[ty.T] = []
     stack = [body]

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import typed as ty
+from ..language import typed as ty
 from ._common import live_forms
 
 #: built-ins whose Excel form is live but approximate

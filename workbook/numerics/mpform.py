@@ -19,9 +19,9 @@ from __future__ import annotations
 import operator
 from collections.abc import Callable
 
-from .. import typed as ty
-from ..runtime import COMPARE
-from ..visitor import Visitor
+from ..engine.runtime import COMPARE
+from ..language import typed as ty
+from ..language.visitor import Visitor
 
 #: a sheet function nested deeper than this is not expanded
 _MAX_DEPTH = 20

@@ -177,7 +177,7 @@ def _flat(of, shape) -> dict[str, np.ndarray]:
 
 def _prepared(of, name: str, digits: int, *bounds):
     """(ctx, form, shape, flat bounds, row environments) or None without an mpmath form."""
-    from .. import typed as ty
+    from ..language import typed as ty
     from .reference import ROWS as SCIPY_ROWS
 
     ctx = context(digits)
@@ -300,7 +300,7 @@ def polish_roots(of, result, shape, tol) -> int:
     tolerance. Rows without an mpmath form,
     or where no sign change is found, keep their value and estimate. Returns the number of
     rows changed."""
-    from .. import typed as ty
+    from ..language import typed as ty
 
     value = np.ravel(result.value).copy()
     error = np.ravel(result.error).copy()
@@ -369,7 +369,7 @@ def _same_function(ctx, g, f, xs: np.ndarray, row: int) -> bool:
 
 def _has_integral(evaluator, body) -> bool:
     """Whether EXPR calls integral, also through the sheet's functions."""
-    from .. import typed as ty
+    from ..language import typed as ty
 
     stack, seen = [body], set()
     while stack:

@@ -13,7 +13,7 @@ derivative of the integral in its bound is the integrand there).
 
 from __future__ import annotations
 
-from .. import typed as ty
+from ..language import typed as ty
 from .kinks import substitute
 
 #: a sheet function nested deeper than this is not read
@@ -23,7 +23,7 @@ _MAX_DEPTH = 20
 def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
     """Typed sub-trees of ``body`` that depend on ``var`` and whose zeros are singular points
     of EXPR (a denominator, a power's base, the argument of sqrt, ln, log10)."""
-    from ..registry import REGISTRY
+    from ..functions.registry import REGISTRY
 
     found: list[ty.T] = []
     stack = [(body, 0)]

@@ -2,7 +2,7 @@
 
 One statement a line; a block is the lines indented under its header (as in Python).
 The text is split into statements here and every expression goes through
-:func:`workbook.expr.parse`, so nothing is ever evaluated by Python::
+:func:`workbook.language.expr.parse`, so nothing is ever evaluated by Python::
 
     a := x^2                      # a local (Mathcad's a <- x^2; '←' is read too)
     v := [0, 0, 0]                # a local vector; v[i] := ... sets an element

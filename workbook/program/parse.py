@@ -7,8 +7,8 @@ import re
 import tokenize
 from dataclasses import dataclass
 
-from .. import expr as ex
 from ..errors import LimitError, TemplateError
+from ..language import expr as ex
 from .statements import (
     Assign,
     Break,
@@ -163,7 +163,7 @@ _FOR = re.compile(r"^([A-Za-z][A-Za-z0-9_]*)\s+(?:in|∈)\s+(.+)$")
 
 
 def _for(text: str, body, number: int, where: str) -> For:
-    from ..ranges import parse_range
+    from ..language.ranges import parse_range
 
     m = _FOR.match(text)
     if not m:

@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from .. import runtime as rt
+from ..engine import runtime as rt
 from ..errors import LimitError, TemplateError
-from ..typed import is_runtime
+from ..language.typed import is_runtime
 from .statements import (
     Assign,
     Break,
@@ -54,7 +54,7 @@ def compile_program(
     typed: TypedProgram, compile_expr: Callable[[Any], Callable], name: str
 ) -> Callable[[dict], Any]:
     """A closure env -> value for scalar arguments (the back end loops over arrays)."""
-    from ..ranges import loop_values
+    from ..language.ranges import loop_values
 
     steps = [0]
 
@@ -93,7 +93,7 @@ def compile_program(
 
             return assign
         if isinstance(s, SetItem):
-            from ..matrix import element_index
+            from ..functions.matrix import element_index
 
             f, n, origin, grow = compile_expr(s.value), s.name, s.origin, s.grow
             idx = [compile_expr(i) for i in s.indices]

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .. import expr as ex
+from ..language import expr as ex
 
 
 # -- statements (E is ex.Node after parsing, a typed node after typing) -----------------------

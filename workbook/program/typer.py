@@ -7,9 +7,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from .. import expr as ex
 from ..errors import TemplateError
-from ..typed import RUNTIME, is_runtime
+from ..language import expr as ex
+from ..language.typed import RUNTIME, is_runtime
 from .statements import (
     Assign,
     Break,
@@ -88,7 +88,7 @@ def type_program(
 class _TypeState:
     def __init__(self, scope, hints, typing: ExprTyping, reserved, grown=None, runtime=()):
         self.grown: dict[str, _Growth] = grown or {}
-        # locals whose shape is known only when the program runs (workbook.runtime): grown
+        # locals whose shape is known only when the program runs (workbook.engine.runtime): grown
         # at indices not known at load, given arrays as elements, or given values of
         # different shapes where one is such an array
         self.runtime: set[str] = set(runtime)
@@ -404,7 +404,7 @@ def _number(node) -> float | None:
 
 
 def _loop_values(first, second, last):
-    from ..ranges import loop_values
+    from ..language.ranges import loop_values
 
     return loop_values(first, second, last, what="loop")
 

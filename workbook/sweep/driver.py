@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import units as un
 from ..errors import InputError, LimitError
+from ..language import units as un
 from .grid import Vary, as_varies, grid
 from .outputs import Output, as_outputs, type_output
 from .runners import make_tasks, run_case, run_tasks

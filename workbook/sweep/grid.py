@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import units as un
 from ..errors import InputError
+from ..language import units as un
 
 _VARY = re.compile(r"^\s*(.+?)\s*\.\.\s*(.+?)\s*:\s*(\d+)\s*$")
 MAX_CASES = 100_000  # 100,000 cases of a formula: 12 s to an xlsx; 10^6 took 148 s

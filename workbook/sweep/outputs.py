@@ -9,10 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 import pint
 
-from .. import expr as ex
-from .. import typed as ty
-from .. import units as un
 from ..errors import InputError, TemplateError, WorkbookError
+from ..language import expr as ex
+from ..language import typed as ty
+from ..language import units as un
 
 REDUCTIONS = ("max", "min", "mean", "argmax", "argmin")
 _REDUCE = re.compile(r"^\s*(max|min|mean|argmax|argmin)\s+of\s+(.+?)\s+over\s+(.+?)\s*$", re.S)
@@ -32,7 +32,7 @@ class Output:
     @classmethod
     def parse(cls, name: str, text: str, unit: str | None = None) -> Output:
         """Read ``text`` as an expression or a reduction over a range."""
-        from ..ranges import parse_range
+        from ..language.ranges import parse_range
 
         if not ex.is_identifier(name):
             raise InputError(f"sweep output name {name!r} is not a valid name (letters, digits, _)")

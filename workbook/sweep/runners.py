@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import units as un
 from ..errors import InputError, WorkbookError
+from ..language import units as un
 from .outputs import Output, evaluate_outputs
 
 _SHEETS: dict[tuple[str, str], object] = {}
@@ -50,7 +50,7 @@ def _prime(sheet) -> tuple[str, str]:
     """Put ``sheet``'s template into this process's cache (forked workers inherit it)."""
     import hashlib
 
-    from ..sheet import Sheet
+    from ..engine.sheet import Sheet
 
     path = str(Path(sheet.spec.path).resolve())
     text = sheet.spec.text

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import expr as ex
-from .. import typecheck as tc
-from .. import units as un
+from ..engine.numeric import Evaluator
 from ..errors import InputError, WorkbookError
-from ..numeric import Evaluator
+from ..language import expr as ex
+from ..language import typecheck as tc
+from ..language import units as un
 from .grid import Vary
 from .outputs import Output, reduce_values, type_output
 
@@ -104,8 +104,8 @@ def _coerced(sheet, vary: Vary) -> dict:
     """Each value of ``vary`` -> (its magnitude in the input's unit, None) or (None, the
     error): all values converted in one array when every one is valid (a sweep of 100,000
     values converted one by one spent 4 s in pint), else one by one for their errors."""
-    from ..sheet import coerce_input
-    from ..template import check_input_value
+    from ..engine.sheet import coerce_input
+    from ..language.template import check_input_value
 
     spec = sheet.spec.inputs[vary.name]
     Q = un.registry().Quantity

@@ -8,14 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import style
 from ..errors import InputError
+from ..outputs import style
 from .driver import SweepResult
 
 
 def write(result: SweepResult, path: Path, *, force: bool = False, command: str = "") -> Path:
     """Write the sweep: ``.csv`` (the table) or ``.xlsx`` (table, chart, about), atomically."""
-    from ..atomic import check_target, replacing, write_csv
+    from ..outputs.atomic import check_target, replacing, write_csv
 
     path = Path(path)
     kind = "csv" if path.suffix.lower() == ".csv" else "xlsx"
@@ -33,8 +33,8 @@ def write(result: SweepResult, path: Path, *, force: bool = False, command: str 
 def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
     import xlsxwriter
 
+    from ..outputs.xlsx import chart_label, write_labels
     from ..version import __version__
-    from ..xlsx import chart_label, write_labels
 
     df = result.table
     wb = xlsxwriter.Workbook(

@@ -1,0 +1,438 @@
+"""Every live formula of a workbook checked against the engine before the workbook is written.
+
+The writer records each cell it writes (:class:`CellLog`, through :class:`RecordingSheet`):
+formulas with their cached values (the engine's), numbers, texts and defined names. Each
+formula that is not :func:`plain` is then computed by an evaluator independent of the engine,
+the ``formulas`` package (its own parser and its own implementation of Excel's functions and
+array rules), from the cached values of the cells and names it reads; a formula whose value
+differs from its cached value beyond :data:`RELATIVE` is refused (a live approximate form too:
+an integral's 20-point Gauss-Legendre sum of an integrand with an end-point singularity), and
+the writer writes that cell as a number with a comment saying why. Checked cell by cell from
+cached inputs, a chain of formulas agrees with the engine wherever each link does.
+
+A table column (or a column of helper cells) is one formula with the row number filled in: it
+is compiled once and computed at :data:`ROWS_CHECKED` rows spread over the column, first and
+last included; when one row disagrees, the whole column is refused.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: largest relative difference between a live formula and the engine's value
+RELATIVE = 1e-9
+#: rows of a table column computed by the check (spread evenly, first and last included)
+ROWS_CHECKED = 9
+#: a row number no written cell has (a table ends 3 rows above Excel's last row, which the
+#: evaluator would read as a whole column): it stands for a column's row
+SENTINEL = 1_048_575
+
+_REF = re.compile(
+    r"^(?:'?(?P<sheet>.+?)'?!)?\$?(?P<c0>[A-Z]{1,3})\$?(?P<r0>\d+)"
+    r"(?::\$?(?P<c1>[A-Z]{1,3})\$?(?P<r1>\d+))?$"
+)
+_NAME_REF = re.compile(r"^=?(?:'?(?P<sheet>.+?)'?!)(?P<cells>.+)$")
+
+
+def _col_index(letters: str) -> int:
+    n = 0
+    for ch in letters:
+        n = n * 26 + ord(ch) - 64
+    return n - 1
+
+
+@dataclass
+class Formula:
+    """One formula written into a block of cells (one cell unless an array formula)."""
+
+    sheet: str
+    row: int
+    col: int
+    text: str
+    last_row: int
+    last_col: int
+
+
+@dataclass
+class Column:
+    """One formula written down a column: ``pieces`` joined by a row number (1-based)."""
+
+    sheet: str
+    col: int
+    first: int
+    n: int
+    pieces: list[str]
+
+
+@dataclass
+class Refusal:
+    """A live formula that disagrees with the engine: where, and the two values."""
+
+    sheet: str
+    row: int
+    col: int
+    formula: str
+    independent: object
+    engine: object
+    rows: int = 1  # a column: the rows refused from ``row`` down
+
+    @property
+    def where(self) -> str:
+        """The cell (or the column's cells) in Excel's notation."""
+        from xlsxwriter.utility import xl_rowcol_to_cell
+
+        cells = xl_rowcol_to_cell(self.row, self.col)
+        if self.rows > 1:
+            cells += ":" + xl_rowcol_to_cell(self.row + self.rows - 1, self.col)
+        return f"'{self.sheet}'!{cells}"
+
+    @property
+    def disagreement(self) -> str:
+        """One line: the two values."""
+        return (
+            f"its live formula computes {_shown(self.independent)} (the formulas package), "
+            f"the engine {_shown(self.engine)}"
+        )
+
+    @property
+    def why(self) -> str:
+        """The cell comment of the value written instead of the formula."""
+        return (
+            f"A value, not a formula: the live formula {_short(self.formula)} computes "
+            f"{_shown(self.independent)} in an independent evaluation of its Excel formula "
+            f"(the formulas package), the engine {_shown(self.engine)}; the engine's value is "
+            "written."
+        )
+
+
+def _short(formula: str, limit: int = 160) -> str:
+    formula = re.sub(r"\{[^{}]*\}", "{...}", formula)  # array constants: a node row
+    return formula if len(formula) <= limit else formula[: limit - 3] + "..."
+
+
+def _shown(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.10g}"
+    return str(value)
+
+
+@dataclass
+class CellLog:
+    """What a writer wrote: values by (sheet, row, col), formulas, columns, defined names."""
+
+    values: dict[tuple[str, int, int], object] = field(default_factory=dict)
+    formulas: dict[tuple[str, int, int], Formula] = field(default_factory=dict)
+    columns: list[Column] = field(default_factory=list)
+    names: dict[str, str] = field(default_factory=dict)  # NAME (upper) -> "=Sheet!$B$3"
+    in_columns: set[tuple[str, int, int]] = field(default_factory=set)
+
+    def column(self, sheet: str, col: int, first: int, n: int, pieces: list[str]) -> Column:
+        """Register a formula written down a column (its cells are checked as one)."""
+        c = Column(sheet, col, first, n, pieces)
+        self.columns.append(c)
+        self.in_columns.update((sheet, first + i, col) for i in range(n))
+        return c
+
+
+class RecordingSheet:
+    """An Excel sheet being laid out (:class:`workbook.compute.excelform.FormSheet`) that records
+    what is written into a :class:`CellLog`, and writes a refused formula as its cached value
+    with a comment."""
+
+    def __init__(self, ws, log: CellLog, refused: dict[tuple[str, int, int], str]):
+        self._ws, self._log, self._refused = ws, log, refused
+        self.name = ws.name
+
+    def __getattr__(self, name):
+        return getattr(self._ws, name)
+
+    def _value(self, row: int, col: int, value) -> None:
+        self._log.values[(self.name, row, col)] = value
+
+    def write_number(self, row, col, number, fmt=None):
+        self._value(row, col, float(number))
+        return self._ws.write_number(row, col, number, fmt)
+
+    def write_string(self, row, col, text, fmt=None):
+        self._value(row, col, text)
+        return self._ws.write_string(row, col, text, fmt)
+
+    def write_boolean(self, row, col, value, fmt=None):
+        self._value(row, col, bool(value))
+        return self._ws.write_boolean(row, col, value, fmt)
+
+    def write_formula(self, row, col, formula, fmt=None, value=0):
+        why = self._refused.get((self.name, row, col))
+        if why is not None:
+            self._write_cached(row, col, value, fmt)
+            self._ws.write_comment(row, col, why)
+            return 0
+        self._value(row, col, value)
+        self._log.formulas[(self.name, row, col)] = Formula(self.name, row, col, formula, row, col)
+        return self._ws.write_formula(row, col, formula, fmt, value)
+
+    def write_array_formula(
+        self, first_row, first_col, last_row, last_col, formula, fmt=None, value=0
+    ):
+        why = self._refused.get((self.name, first_row, first_col))
+        if why is not None:
+            self._write_cached(first_row, first_col, value, fmt)
+            self._ws.write_comment(first_row, first_col, why)
+            return 0
+        self._value(first_row, first_col, value)
+        self._log.formulas[(self.name, first_row, first_col)] = Formula(
+            self.name, first_row, first_col, formula, last_row, last_col
+        )
+        return self._ws.write_array_formula(
+            first_row, first_col, last_row, last_col, formula, fmt, value
+        )
+
+    def write_formula_column(self, first, col, pieces, values, fmt=None, array=False, label=""):
+        """A formula down a column (``pieces`` joined by each row's number), checked as one
+        (:meth:`CellLog.column`); the caller lays a refused column out as values."""
+        self._log.column(self.name, col, first, len(values), pieces)
+        name = self.name
+        self._log.values.update(((name, first + i, col), v) for i, v in enumerate(values))
+        return self._ws.write_formula_column(first, col, pieces, values, fmt, array, label)
+
+    def _write_cached(self, row, col, value, fmt) -> None:
+        if isinstance(value, str):
+            self.write_string(row, col, value, fmt)
+        elif isinstance(value, (bool, np.bool_)):
+            self.write_boolean(row, col, value, fmt)
+        else:
+            self.write_number(row, col, float(value), fmt)
+
+
+@dataclass
+class Outcome:
+    """What the check found: refused formulas, and how many formulas it computed."""
+
+    refusals: list[Refusal]
+    checked: int  # formula cells computed
+    unchecked: dict[str, int]  # why not computed (a function the evaluator lacks) -> cells
+    plain: int = 0  # formula cells of scalar arithmetic only, left out (see plain())
+
+    def refused(self) -> dict[tuple[str, int, int], str]:
+        """(sheet, row, col) -> comment, for the writer's second pass."""
+        out = {}
+        for r in self.refusals:
+            for i in range(r.rows):
+                out[(r.sheet, r.row + i, r.col)] = r.why
+        return out
+
+
+class _Inputs:
+    """Values of the references a compiled formula reads, from the log."""
+
+    def __init__(self, log: CellLog):
+        self.log = log
+        self.sheets = {}
+        for sheet, _, _ in log.values:
+            self.sheets.setdefault(sheet.upper(), sheet)
+
+    def value(self, key: str, here: str, depth: int = 0):
+        m = _REF.match(key)
+        if m is None:
+            ref = self.log.names.get(key.upper())
+            if ref is None or depth > 4:
+                raise KeyError(key)
+            n = _NAME_REF.match(ref)
+            if n is None:
+                raise KeyError(key)
+            return self.value(f"{n['sheet']}!{n['cells'].replace('$', '')}", here, depth + 1)
+        sheet = self.sheets.get((m["sheet"] or here).upper().strip("'"), m["sheet"] or here)
+        r0, c0 = int(m["r0"]) - 1, _col_index(m["c0"])
+        if m["c1"] is None:
+            return self._cell(sheet, r0, c0)
+        r1, c1 = int(m["r1"]) - 1, _col_index(m["c1"])
+        out = np.empty((r1 - r0 + 1, c1 - c0 + 1), dtype=object)
+        for i in range(r1 - r0 + 1):
+            for j in range(c1 - c0 + 1):
+                out[i, j] = self._cell(sheet, r0 + i, c0 + j)
+        return out
+
+    def _cell(self, sheet: str, row: int, col: int):
+        import schedula
+        from formulas.tokens.operand import NUM
+
+        v = self.log.values.get((sheet, row, col), schedula.EMPTY)
+        if isinstance(v, float) and not math.isfinite(v):
+            return NUM
+        return v
+
+
+#: a cell or range reference, optionally on another sheet (not inside a name such as R1_)
+_CELLS = re.compile(
+    r"(?<![\w.$'])((?:'[^']+'|[A-Za-z_][\w.]*)!)?(\$?[A-Z]{1,3}\$?\d+(?::\$?[A-Z]{1,3}\$?\d+)?)"
+    r"(?![\w.(!])"
+)
+
+
+_NUMBER = re.compile(r"(?<![\w.$])\d+(?:\.\d*)?(?:E[+-]?\d+)?(?![\w.(])")
+_CONSTANTS = re.compile(r'(\{[^{}]*\}|"(?:[^"]|"")*")')  # array constants and texts
+
+
+def _generic(text: str) -> tuple[str, list[str]]:
+    """The formula with its cell references and numbers (outside array constants and texts)
+    replaced by names _REF_0_, _REF_1_, ...; and what they stand for: formulas that differ
+    only in the cells they read or in a constant (a sample's position) share one
+    compilation."""
+    refs: list[str] = []
+
+    def ref(m: re.Match) -> str:
+        refs.append((m[1] or "") + m[2].replace("$", ""))
+        return f"_REF_{len(refs) - 1}_"
+
+    def number(m: re.Match) -> str:
+        refs.append(m[0])
+        return f"_REF_{len(refs) - 1}_"
+
+    parts = _CONSTANTS.split(text)
+    for i in range(0, len(parts), 2):  # the odd parts are constants, kept as they are
+        parts[i] = _NUMBER.sub(number, _CELLS.sub(ref, parts[i]))
+    return "".join(parts), refs
+
+
+def _compile(text: str):
+    import formulas
+
+    return formulas.Parser().ast(text)[1].compile()
+
+
+def plain(text: str, sheet: str, arrays: frozenset[str] = frozenset()) -> bool:
+    """A formula the default check leaves out: scalar arithmetic only (no array constant, no
+    range, no defined name of a vector or matrix (``arrays``, upper case), no function but
+    :data:`SCALAR`), which the engine and the printer compute by the same operations in the
+    same order (tests/test_excel_golden.py checks the printer's scalar forms against the same
+    evaluator); and a helper cell of a root's bisection or an extremum's golden-section
+    steps, whose cached value is the engine's own step of the same form (the cell that reads
+    the last step is checked)."""
+    if sheet in HELPER_SHEETS:
+        return True
+    if "{" in text or ":" in text:
+        return False
+    for name, call in re.findall(r"([A-Za-z_][\w.]*)\s*(\(?)", _CONSTANTS.sub("", text)):
+        if call and name.upper() not in SCALAR:
+            return False
+        if not call and name.upper() in arrays:
+            return False
+    return True
+
+
+#: Excel functions of numbers that return a number (any other function is checked)
+SCALAR = frozenset(
+    "ABS ACOS AND ASIN ATAN ATAN2 COS COSH EXP IF INT LN LOG10 MAX MIN MOD NA NOT OR PI "
+    "POWER ROUND SIGN SIN SINH SQRT TAN TANH TRUNC".split()
+)
+#: Excel sheets of helper cells (a root's bisection, an extremum's samples)
+HELPER_SHEETS = ("Solver steps", "Solver rows")
+
+
+def _first(result):
+    a = np.asarray(result, dtype=object)
+    return a.ravel()[0] if a.size else None
+
+
+def _agrees(got, cached, scale: float) -> bool:
+    if isinstance(cached, (str, bool, np.bool_)):
+        return not isinstance(got, (float, int)) and str(got) == str(cached) or got == cached
+    cached = float(cached)
+    if isinstance(got, (bool, np.bool_)) or not isinstance(got, (int, float, np.number)):
+        return not math.isfinite(cached)  # an Excel error where the engine has none is wrong
+    got = float(got)
+    if not math.isfinite(cached) or not math.isfinite(got):
+        return False
+    return abs(got - cached) <= RELATIVE * max(abs(cached), abs(got), scale)
+
+
+def check(log: CellLog, everything: bool = False) -> Outcome:
+    """Compute the formulas of ``log`` independently (every one with ``everything``, else
+    all but the :func:`plain` ones); the ones that disagree with the engine's (cached)
+    values."""
+    inputs = _Inputs(log)
+    refusals: list[Refusal] = []
+    unchecked: dict[str, int] = {}
+    checked = 0
+    compiled: dict[str, object] = {}
+
+    def run(text: str, here: str, row_of=None):
+        generic, refs = _generic(text)
+        fn = compiled.get(generic)
+        if fn is None:
+            fn = compiled[generic] = _compile(generic)
+        args = []
+        for key in fn.inputs:
+            if key.startswith("_REF_"):
+                key = refs[int(key[5:-1])]
+                if key[0].isdigit():
+                    args.append(float(key))
+                    continue
+            if row_of is not None:
+                key = key.replace(str(SENTINEL), str(row_of))
+            args.append(inputs.value(key, here))
+        return fn(*args)
+
+    def skipped(err: Exception, cells: int) -> None:
+        why = f"{type(err).__name__}: {err}".splitlines()[0][:120]
+        unchecked[why] = unchecked.get(why, 0) + cells
+
+    plain_cells = 0
+    arrays = frozenset(name for name, ref in log.names.items() if ":" in ref)
+    for key, f in log.formulas.items():
+        if key in log.in_columns:
+            continue
+        if not everything and plain(f.text, f.sheet, arrays):
+            plain_cells += 1
+            continue
+        try:
+            got = np.asarray(run(f.text, f.sheet), dtype=object)
+        except Exception as err:  # noqa: BLE001 - a formula the evaluator cannot compute
+            skipped(err, 1)
+            continue
+        checked += 1
+        rows, cols = f.last_row - f.row + 1, f.last_col - f.col + 1
+        if got.ndim < 2:
+            got = got.reshape(1, -1) if got.ndim == 1 else got.reshape(1, 1)
+        for i in range(rows):
+            for j in range(cols):
+                cached = log.values.get((f.sheet, f.row + i, f.col + j))
+                try:
+                    value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
+                except IndexError:
+                    value = None
+                if cached is not None and not _agrees(value, cached, 0.0):
+                    refusals.append(Refusal(f.sheet, f.row, f.col, f.text, value, cached))
+                    break
+            else:
+                continue
+            break
+
+    for c in log.columns:
+        template = str(SENTINEL).join(c.pieces)
+        if not everything and plain(template, c.sheet, arrays):
+            plain_cells += c.n
+            continue
+        cached_all = [log.values.get((c.sheet, c.first + i, c.col)) for i in range(c.n)]
+        # a value near zero in a column (a difference of near terms) is compared at the
+        # column's scale: its rounding is not the formula's error
+        numbers = [abs(v) for v in cached_all if isinstance(v, float) and math.isfinite(v)]
+        scale = max(numbers, default=0.0)
+        rows = sorted({round(k * (c.n - 1) / (ROWS_CHECKED - 1)) for k in range(ROWS_CHECKED)})
+        for i in rows if c.n > 1 else [0]:
+            row = c.first + i
+            try:
+                got = _first(run(template, c.sheet, row + 1))
+            except Exception as err:  # noqa: BLE001 - a formula the evaluator cannot compute
+                skipped(err, c.n)
+                break
+            checked += 1
+            if not _agrees(got, cached_all[i], scale):
+                text = str(row + 1).join(c.pieces)
+                refusals.append(Refusal(c.sheet, c.first, c.col, text, got, cached_all[i], c.n))
+                break
+    return Outcome(refusals, checked, unchecked, plain_cells)

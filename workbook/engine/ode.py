@@ -1,0 +1,972 @@
+"""Ordinary differential equations of a worksheet: ``[[ode]]`` sections.
+
+A section declares states (unit, initial value, derivative expression), the time range and the
+method; the engine types the expressions like any definition, integrates once with
+:func:`run_ode` (a wall-clock budget and a step cap, dense output) and each state becomes a
+function of time, ``x(t)``, usable in tables and charts::
+
+    [[ode]]
+    name = "fall"
+    time = "t := 0 .. t_end"             # t is declared in [arguments] with its unit
+    method = "auto"                      # auto | RK45 | DOP853 | Radau | BDF | LSODA
+    rtol = 1e-8
+    atol = 1e-10
+    states = [
+      { name = "x", unit = "m", initial = "x0", derivative = "v" },
+      { name = "v", unit = "m/s", initial = "0 m/s", derivative = "-g - c/m*v" },
+    ]
+
+``method``, ``rtol``, ``atol`` and ``max_time`` may also be expressions of the sheet (a text
+definition or choice input for the method), and a state may have its own ``atol``.
+
+This module holds the sections' side on plain magnitudes (states in their declared units,
+time in its unit): reading a section, typing it, choosing a method, solving it, a sheet's run
+with other settings (:func:`run_sheet`, for studies) and error against run time; the runs
+themselves are :mod:`workbook.engine.oderun`. scipy is imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import DomainError, LimitError, TemplateError
+from ..language import expr as ex
+from .oderun import OdeRun, run_ode, work_precision
+
+METHODS = ("auto", "RK45", "DOP853", "Radau", "BDF", "LSODA")
+#: "auto" takes an implicit method when max(-Re lambda) * span of the Jacobian at the start
+#: exceeds this: an explicit method would then need more than about STIFF_INDEX/3.3 steps for
+#: stability alone, whatever the tolerance.
+STIFF_INDEX = 500.0
+#: A state whose magnitude exceeds this (in its declared unit) stops the run: it blows up.
+BLOWUP = 1e100
+MAX_TIME = 30.0  # wall-clock budget of one run, seconds
+MAX_STEPS = 1_000_000
+MAX_STATES = 1000
+
+
+Setting = float | ex.Node  # a number, or an expression of the sheet
+
+
+@dataclass(frozen=True)
+class StateSpec:
+    name: str
+    unit: str
+    initial: ex.Node
+    derivative: ex.Node
+    initial_text: str
+    derivative_text: str
+    atol: ex.Node | None = None  # this state's absolute tolerance (in its unit)
+
+
+@dataclass(frozen=True)
+class OdeSpec:
+    name: str
+    var: str
+    first: ex.Node
+    last: ex.Node
+    time_text: str
+    states: tuple[StateSpec, ...]
+    method: str | ex.Node = "auto"  # one of METHODS, or an expression giving one
+    rtol: Setting = 1e-6
+    atol: Setting = 1e-9
+    max_time: Setting = MAX_TIME
+    max_steps: int = MAX_STEPS
+    note: str = ""
+    line: int | None = None
+
+    def expressions(self) -> list[ex.Node]:
+        """Every expression of the section (what it depends on)."""
+        out = [self.first, self.last]
+        out += [x for s in self.states for x in (s.initial, s.derivative, s.atol) if x]
+        settings = (self.method, self.rtol, self.atol, self.max_time)
+        return out + [x for x in settings if isinstance(x, ex.Node)]
+
+
+_KEYS = {"name", "time", "states", "method", "rtol", "atol", "max_time", "max_steps", "note"}
+_STATE_KEYS = {"name", "unit", "initial", "derivative", "atol", "note"}
+
+
+def parse_spec(raw: dict, *, where: str, line: int | None = None) -> OdeSpec:
+    """Read one ``[[ode]]`` table (raises TemplateError naming the key)."""
+    from ..language.ranges import parse_range
+
+    if not isinstance(raw, dict):
+        raise TemplateError(f"{where}: an [[ode]] entry is a table", line=line)
+    extra = set(raw) - _KEYS
+    if extra:
+        raise TemplateError(
+            f"{where}: unknown key(s) {', '.join(sorted(extra))} "
+            f"(known: {', '.join(sorted(_KEYS))})",
+            line=line,
+        )
+    name = raw.get("name")
+    if not isinstance(name, str) or not ex.is_identifier(name):
+        raise TemplateError(f'{where}: name = "..." (a plain name) is required', line=line)
+    where = f"ode '{name}'"
+    if "time" not in raw:
+        raise TemplateError(f'{where}: time = "t := 0 .. t_end" is required', line=line)
+    rng = parse_range(raw["time"], what=f"{where}: time")
+    if rng.second is not None:
+        raise TemplateError(f"{where}: time is 'VAR := FIRST .. LAST' (no step)", line=line)
+    method = raw.get("method", "auto")
+    if not isinstance(method, str):
+        raise TemplateError(f"{where}: method is one of {', '.join(METHODS)}", line=line)
+    if method not in METHODS:
+        method = ex.parse(method, what=f"{where}: method")
+    rtol, atol = _setting(raw, "rtol", 1e-6, where), _setting(raw, "atol", 1e-9, where)
+    if isinstance(rtol, float) and rtol < 1e-13:
+        raise TemplateError(f"{where}: rtol {rtol:g} is below what doubles resolve (1e-13)")
+    max_time = _setting(raw, "max_time", MAX_TIME, where)
+    max_steps = int(_positive(raw, "max_steps", MAX_STEPS, where))
+    # a worksheet may lower its budget, never raise it past the engine's
+    if isinstance(max_time, float):
+        _within_budget(where, "max_time", max_time, line)
+    _within_budget(where, "max_steps", max_steps, line)
+    states = raw.get("states")
+    if not isinstance(states, list) or not states:
+        raise TemplateError(
+            f'{where}: states = [{{ name = "x", unit = "m", initial = "...", '
+            'derivative = "..." }, ...] is required',
+            line=line,
+        )
+    if len(states) > MAX_STATES:
+        raise LimitError(f"{where}: {len(states)} states (limit {MAX_STATES})", line=line)
+    out, seen = [], set()
+    for k, s in enumerate(states):
+        sw = f"{where}, state {k + 1}"
+        if not isinstance(s, dict):
+            raise TemplateError(f"{sw}: a state is a table {{ name = ..., ... }}", line=line)
+        extra = set(s) - _STATE_KEYS
+        missing = {"name", "initial", "derivative"} - set(s)
+        if extra or missing:
+            raise TemplateError(
+                f"{sw}: keys are name, unit, initial, derivative (and atol, note); "
+                + (f"unknown: {', '.join(sorted(extra))}" if extra else "")
+                + (f"missing: {', '.join(sorted(missing))}" if missing else ""),
+                line=line,
+            )
+        sname = s["name"]
+        if not isinstance(sname, str) or not ex.is_identifier(sname) or sname in seen:
+            raise TemplateError(f"{sw}: name {sname!r} is not a new plain name", line=line)
+        seen.add(sname)
+        unit = s.get("unit", "")
+        if not isinstance(unit, str):
+            raise TemplateError(f'{sw}: unit is text like "m/s"', line=line)
+        init, der = s["initial"], s["derivative"]
+        init = repr(init) if isinstance(init, (int, float)) and not isinstance(init, bool) else init
+        der = repr(der) if isinstance(der, (int, float)) and not isinstance(der, bool) else der
+        out.append(
+            StateSpec(
+                sname,
+                unit,
+                ex.parse(init, what=f"{sw}: initial"),
+                ex.parse(der, what=f"{sw}: derivative"),
+                init,
+                der,
+                _expression(s["atol"], f"{sw}: atol") if "atol" in s else None,
+            )
+        )
+    if rng.var in seen:
+        raise TemplateError(f"{where}: the time variable '{rng.var}' is also a state", line=line)
+    return OdeSpec(
+        name,
+        rng.var,
+        rng.first,
+        rng.last,
+        rng.text,
+        tuple(out),
+        method,
+        rtol,
+        atol,
+        max_time,
+        max_steps,
+        str(raw.get("note", "")),
+        line,
+    )
+
+
+def _expression(v, what: str) -> ex.Node:
+    """A setting given as a number or as an expression text."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+        raise TemplateError(f"{what}: a number or an expression, got {v!r}")
+    return ex.parse(v if isinstance(v, str) else repr(v), what=what)
+
+
+def _setting(raw: dict, key: str, default: float, where: str) -> Setting:
+    """A positive number, or an expression of the sheet (checked when it is evaluated)."""
+    if isinstance(raw.get(key), str):
+        return ex.parse(raw[key], what=f"{where}: {key}")
+    return _positive(raw, key, default, where)
+
+
+def _within_budget(where: str, key: str, value: float, line: int | None = None) -> None:
+    """Refuse a worksheet's ``max_time`` or ``max_steps`` above the engine's
+    (:data:`MAX_TIME`, :data:`MAX_STEPS`)."""
+    limit = {"max_time": MAX_TIME, "max_steps": MAX_STEPS}[key]
+    if value > limit:
+        shown = f"{value:g} s (limit {limit:g} s)" if key == "max_time" else f"{value:,.0f}"
+        if key == "max_steps":
+            shown += f" (limit {limit:,})"
+        raise LimitError(
+            f"{where}: {key} = {shown}: a worksheet may lower the budget of a run, not raise it",
+            line=line,
+        )
+
+
+def _positive(raw: dict, key: str, default: float, where: str) -> float:
+    v = raw.get(key, default)
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not (v > 0 and math.isfinite(v)):
+        raise TemplateError(f"{where}: {key} must be a positive number, got {v!r}")
+    return float(v)
+
+
+# -- stiffness and the choice of method -------------------------------------------------------
+def jacobian(fun: Callable, t: float, y: np.ndarray) -> np.ndarray:
+    """Forward-difference Jacobian of fun(t, y) with respect to y."""
+    y = np.asarray(y, dtype=float)
+    f0 = np.asarray(fun(t, y), dtype=float)
+    jac = np.empty((len(f0), len(y)))
+    for k in range(len(y)):
+        h = math.sqrt(np.finfo(float).eps) * max(1.0, abs(y[k]))
+        yk = y.copy()
+        yk[k] += h
+        jac[:, k] = (np.asarray(fun(t, yk), dtype=float) - f0) / h
+    return jac
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The method "auto" chose, and why (said as a finding)."""
+
+    method: str
+    reason: str
+    eigenvalues: np.ndarray
+    index: float  # max(-Re lambda) * span
+
+
+def choose_method(
+    fun: Callable, t0: float, t1: float, y0, rtol: float, time_unit: str = ""
+) -> Choice:
+    """Explicit unless the Jacobian at the start says the run is stiff (see STIFF_INDEX)."""
+    jac = jacobian(fun, t0, y0)
+    if not np.all(np.isfinite(jac)):
+        return Choice(
+            "LSODA",
+            "the Jacobian at the start is not finite; LSODA switches "
+            "between explicit and implicit steps as it goes",
+            np.array([]),
+            math.nan,
+        )
+    lam = np.linalg.eigvals(jac)
+    span = abs(t1 - t0)
+    decay = float(np.max(-lam.real, initial=0.0))
+    index = decay * span
+    unit = f" 1/{time_unit}" if time_unit else ""
+    fastest = lam[np.argmax(-lam.real)] if lam.size else 0.0
+    where = (
+        f"the Jacobian at t = {t0:g} has its fastest decaying eigenvalue {_complex(fastest)}{unit}"
+    )
+    if index > STIFF_INDEX:
+        method = "Radau" if len(y0) <= 200 else "BDF"
+        reason = (
+            f"{where}; times the span {span:g} that is {index:.3g} > {STIFF_INDEX:g}: stiff "
+            f"(an explicit method would need about {index / 3.3:.3g} steps for stability alone)"
+        )
+        return Choice(method, reason, lam, index)
+    method = "DOP853" if rtol < 1e-6 else "RK45"
+    reason = (
+        f"{where}; times the span {span:g} that is {index:.3g} <= {STIFF_INDEX:g}: not stiff, "
+        f"an explicit method ({'8th order for rtol < 1e-6' if method == 'DOP853' else '5th order'})"
+    )
+    return Choice(method, reason, lam, index)
+
+
+#: An explicit run of "auto" looks at the Jacobian after this many steps and at each doubling
+#: (10, 20, 40, ...): a stiff stretch makes an explicit method take many steps, so it is seen,
+#: and a run that is not stiff pays for a few Jacobians only.
+WATCH_FIRST = 10
+
+
+def stiffness_watch(fun: Callable, t1: float, time_unit: str = "") -> Callable:
+    """A ``watch`` for :func:`run_ode`: stiff when, at the current point, the fastest decay rate
+    times the remaining span exceeds STIFF_INDEX and the step is held by stability (step times
+    that rate above 1; an explicit step that follows the solution is shorter)."""
+    due = [WATCH_FIRST]
+    unit = f" {time_unit}" if time_unit else ""
+    rate = f" 1/{time_unit}" if time_unit else ""
+
+    def watch(solver, nsteps: int) -> str | None:
+        if nsteps < due[0]:
+            return None
+        due[0] *= 2
+        jac = jacobian(fun, solver.t, solver.y)
+        if not np.all(np.isfinite(jac)):
+            return None
+        lam = np.linalg.eigvals(jac)
+        decay = float(np.max(-lam.real, initial=0.0))
+        index, h = decay * abs(t1 - solver.t), float(solver.step_size or 0.0)
+        if index > STIFF_INDEX and h * decay > 1.0:
+            fastest = lam[np.argmax(-lam.real)]
+            return (
+                f"at t = {solver.t:.6g}{unit}, after {nsteps} steps, the Jacobian's fastest "
+                f"decaying eigenvalue is {_complex(fastest)}{rate}"
+                f"; times the remaining span that is {index:.3g} > {STIFF_INDEX:g}, and the "
+                f"step {h:.3g}{unit} is held by stability: stiff"
+            )
+        return None
+
+    return watch
+
+
+def auto_run(fun: Callable, t0: float, t1: float, y0, time_unit: str = "", **options):
+    """The run of method "auto": the method the Jacobian at the start says, and an explicit run
+    watched along the way (:func:`stiffness_watch`); when it turns stiff, an implicit method
+    runs again from the start within what is left of the budget. (run, Choice saying what was
+    used and why)."""
+    choice = choose_method(fun, t0, t1, y0, options.get("rtol", 1e-6), time_unit)
+    if choice.method not in ("RK45", "DOP853"):
+        return run_ode(fun, (t0, t1), y0, method=choice.method, **options), choice
+    first = run_ode(
+        fun,
+        (t0, t1),
+        y0,
+        method=choice.method,
+        watch=stiffness_watch(fun, t1, time_unit),
+        **options,
+    )
+    if first.stop_reason != "stiff":
+        return first, choice
+    method = "Radau" if len(y0) <= 200 else "BDF"
+    budget = dict(options)
+    budget["max_time"] = max(options.get("max_time", MAX_TIME) - first.elapsed, 1e-3)
+    budget["max_steps"] = max(options.get("max_steps", MAX_STEPS) - first.nsteps, 1)
+    run = run_ode(fun, (t0, t1), y0, method=method, **budget)
+    run.elapsed += first.elapsed  # what the result cost, the explicit start included
+    run.nfev += first.nfev
+    reason = (
+        f"{choice.reason}; {first.method} then stopped: {first.notes[-1]}; {method} from the start "
+        f"({first.nsteps} explicit steps, {first.elapsed:.3g} s, before it)"
+    )
+    return run, Choice(method, reason, choice.eigenvalues, choice.index)
+
+
+def _complex(z) -> str:
+    z = complex(z)
+    if abs(z.imag) <= 1e-12 * max(1.0, abs(z.real)):
+        return f"{z.real:.4g}"
+    return f"{z.real:.4g} {'+' if z.imag >= 0 else '-'} {abs(z.imag):.4g}i"
+
+
+# -- a run ------------------------------------------------------------------------------------
+@dataclass
+class Solution:
+    """The states as functions of time over [t0, t1] (dense output), and how they were got."""
+
+    name: str
+    states: tuple[str, ...]
+    t0: float
+    t1: float
+    method: str
+    choice: Choice | None
+    run: OdeRun
+    notes: list[str] = field(default_factory=list)
+    sizes: tuple = ()  # per state: None (a number) or n (a vector of n)
+    rerun: Callable | None = (
+        None  # (rtol, atol, max_time) -> OdeRun: the same run, other tolerances
+    )
+    atol: np.ndarray | None = None  # per number of the state vector
+    _estimate: ErrorEstimate | None = None
+
+    def estimate(self) -> ErrorEstimate:
+        """The global error estimate of the states (computed once): the difference from a run
+        of the same method at tolerances REFERENCE_FACTOR tighter, at every step of this run."""
+        if self._estimate is None:
+            self._estimate = estimate_error(self)
+        return self._estimate
+
+    def __call__(self, k: int, t) -> np.ndarray | float:
+        """State k at time(s) t (magnitudes in the time unit); outside the span is an error.
+        A vector state of n elements gives shape (n, 1) + shape of t."""
+        arr = np.asarray(t, dtype=float)
+        lo, hi = min(self.t0, self.t1), max(self.t0, self.t1)
+        tol = 1e-12 * max(1.0, abs(hi - lo))
+        bad = (arr < lo - tol) | (arr > hi + tol) | ~np.isfinite(arr)
+        if np.any(bad):
+            first = float(np.atleast_1d(arr)[np.atleast_1d(bad)][0])
+            raise DomainError(
+                f"{self.states[k]}({first:g}) is outside the time range of ode '{self.name}' "
+                f"[{self.t0:g}, {self.t1:g}]",
+                definition=self.states[k],
+            )
+        sizes = self.sizes or (None,) * len(self.states)
+        first = sum(1 if n is None else n for n in sizes[:k])
+        # scipy's dense output takes one time or a line of them: a grid of the numerical
+        # built-ins (rows x samples) is read as a line and given its shape back
+        flat = np.clip(arr, lo, hi).reshape(-1) if arr.ndim else np.clip(arr, lo, hi)
+        y = np.asarray(self.run.sol(flat))
+        y = y.reshape(y.shape[:1] + arr.shape)
+        if sizes[k] is not None:
+            return y[first : first + sizes[k]].reshape((sizes[k], 1) + arr.shape)
+        out = y[first]
+        return float(out) if arr.ndim == 0 else out
+
+    def finding(self) -> str:
+        r = self.run
+        head = f"ode '{self.name}': {self.method}"
+        if self.choice is not None:
+            head += f" (auto: {self.choice.reason})"
+        return (
+            f"{head}; rtol {r.rtol:g}, atol {r.atol:g}: {r.nsteps} steps, {r.nfev} evaluations, "
+            f"{r.elapsed:.3g} s"
+        )
+
+
+def solve(
+    fun: Callable,
+    t0: float,
+    t1: float,
+    y0,
+    *,
+    name: str,
+    states: tuple[str, ...],
+    method: str = "auto",
+    rtol: float = 1e-6,
+    atol: float | np.ndarray = 1e-9,
+    max_time: float = MAX_TIME,
+    max_steps: int = MAX_STEPS,
+    time_unit: str = "",
+    sizes: tuple = (),
+) -> Solution:
+    """Integrate y' = fun(t, y) from t0 to t1; a run that does not finish is a LimitError
+    (budget, step cap) or a DomainError (blow-up, solver failure) that says where and why."""
+    y0 = np.asarray(y0, dtype=float)
+    if not np.all(np.isfinite(y0)):
+        raise DomainError(f"ode '{name}': an initial value is not a finite number")
+    if t1 == t0:
+        raise TemplateError(f"ode '{name}': the time range is empty ({t0:g} .. {t1:g})")
+    choice = None
+    f0 = np.asarray(fun(t0, y0), dtype=float)
+    if f0.shape != y0.shape or not np.all(np.isfinite(f0)):
+        raise DomainError(f"ode '{name}': a derivative is not a finite number at the start")
+    options = dict(
+        rtol=rtol,
+        atol=atol,
+        max_time=max_time,
+        max_steps=max_steps,
+        dense_output=True,
+        blowup=BLOWUP,
+    )
+    if method == "auto":
+        run, choice = auto_run(fun, t0, t1, y0, time_unit, **options)
+        method = choice.method
+    else:
+        run = run_ode(fun, (t0, t1), y0, method=method, **options)
+    if not run.ok:
+        _refuse(run, name, flat_names(states, sizes), time_unit)
+
+    def rerun(r: float, a, seconds: float) -> OdeRun:
+        return run_ode(
+            fun, (t0, t1), y0, method=method, rtol=r, atol=a, max_time=seconds,
+            max_steps=max_steps, dense_output=True, blowup=BLOWUP,
+        )  # fmt: skip
+
+    return Solution(
+        name,
+        tuple(states),
+        float(t0),
+        float(t1),
+        method,
+        choice,
+        run,
+        sizes=tuple(sizes),
+        rerun=rerun,
+        atol=np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy(),
+    )
+
+
+#: The reference of a state's error estimate runs at tolerances this much tighter (rtol at
+#: least 1e-13); an estimate above ESTIMATE_LIMIT times the tolerance is a warning (a local
+#: tolerance commonly gives global errors up to some tens of times it; more means they grew).
+REFERENCE_FACTOR = 1000.0
+ESTIMATE_LIMIT = 100.0
+#: The reference run's wall-clock budget: this many times the run's own time, at least
+#: REFERENCE_SECONDS (and at most MAX_TIME); a reference that needs more gives no estimate.
+REFERENCE_SLOWER = 20.0
+REFERENCE_SECONDS = 5.0
+#: Where a state passes through zero its error is measured against this fraction of its largest
+#: size over the run (a velocity crossing zero is not judged by its rtol near zero alone).
+SIZE_FLOOR = 0.01
+
+
+@dataclass(frozen=True)
+class ErrorEstimate:
+    """Per number of the state vector: the largest |y - y_ref| over the run's steps, where, and
+    that error over the run's tolerance there (atol + rtol*|y_ref|, |y_ref| at least SIZE_FLOOR
+    of its largest value); or why there is none."""
+
+    errors: np.ndarray
+    times: np.ndarray
+    ratios: np.ndarray
+    reference: str  # how the reference ran
+    failed: str = ""  # why there is no estimate
+
+    @property
+    def worst(self) -> int:
+        return int(np.argmax(self.ratios)) if self.ratios.size else -1
+
+
+def estimate_error(sol: Solution) -> ErrorEstimate:
+    """The difference between a solution and a run at tolerances REFERENCE_FACTOR tighter."""
+    r = sol.run
+    rtol = max(r.rtol / REFERENCE_FACTOR, 1e-13)
+    atol = sol.atol / REFERENCE_FACTOR
+    budget = min(MAX_TIME, max(REFERENCE_SECONDS, REFERENCE_SLOWER * r.elapsed))
+    ref = sol.rerun(rtol, atol, budget)
+    how = f"{ref.method} at rtol {rtol:g}, atol {np.max(atol):g}"
+    if not ref.ok:
+        empty = np.empty(0)
+        return ErrorEstimate(empty, empty, empty, how, f"the reference run {ref.summary()}")
+    y_ref = np.asarray(ref.sol(r.t)).reshape(r.y.shape)
+    diff = np.abs(r.y - y_ref)
+    size = np.maximum(np.abs(y_ref), SIZE_FLOOR * np.max(np.abs(y_ref), axis=1, keepdims=True))
+    scale = (atol * REFERENCE_FACTOR)[:, None] + r.rtol * size
+    ratio = diff / scale
+    at = np.argmax(ratio, axis=1)
+    rows = np.arange(len(at))
+    return ErrorEstimate(diff[rows, at], r.t[at], ratio[rows, at], how)
+
+
+def flat_names(states, sizes) -> list[str]:
+    """A name per number of the state vector: x, or q[0], q[1], ... of a vector state."""
+    sizes = sizes or (None,) * len(states)
+    out = []
+    for s, n in zip(states, sizes):
+        out += [s] if n is None else [f"{s}[{i}]" for i in range(n)]
+    return out
+
+
+def _refuse(run, name: str, states, time_unit: str) -> None:
+    at = f"t = {run.t_reached:.6g}{' ' + time_unit if time_unit else ''} of {run.t_final:g}"
+    if run.stop_reason in ("time budget", "step cap"):
+        budget = "its time budget" if run.stop_reason == "time budget" else "its step cap"
+        advice = (
+            f"{run.method} is an implicit method already: a looser rtol, or a shorter time range"
+            if run.method in ("Radau", "BDF", "LSODA")
+            else 'a stiff system wants method = "Radau" or "BDF" (or "auto")'
+        )
+        raise LimitError(
+            f"ode '{name}' ({run.method}) stopped at {at}: {run.notes[-1]}; "
+            f"{run.nsteps} steps. {budget.capitalize()} is max_time/max_steps in [[ode]]; "
+            + advice,
+            definition=name,
+        )
+    if run.stop_reason == "blow-up":
+        note = run.notes[-1]
+        k = int(note.split()[1])
+        note = note.replace(f"state {k} ", f"state '{states[k]}' ", 1)
+        raise DomainError(f"ode '{name}' stopped at {at}: {note}", definition=name)
+    big = ""
+    if run.y.size and np.max(np.abs(run.y[:, -1])) > 1e6:
+        big = " (the states grow without bound: the solution blows up)"
+    raise DomainError(
+        f"ode '{name}' ({run.method}) stopped at {at}: {run.stop_reason}{big}", definition=name
+    )
+
+
+# -- error against run time -------------------------------------------------------------------
+def bench_rows(
+    fun: Callable,
+    t0: float,
+    t1: float,
+    y0,
+    *,
+    name: str,
+    atol_ratio: float = 1e-3,
+    rtols=(1e-3, 1e-6, 1e-9),
+    methods=("RK45", "DOP853", "Radau", "BDF", "LSODA"),
+    max_time: float = 10.0,
+    points: int = 201,
+) -> list[dict]:
+    """Every method at every rtol against a tight reference (DOP853 or Radau at rtol 1e-12,
+    the one "auto" would take), itself checked by a second method at the same tolerance:
+    the largest error over ``points`` times, relative to the largest magnitude of each
+    state, and the run time. The reference row's error is the two references' difference;
+    an error at or below it is marked as not resolved by the reference."""
+    y0 = np.asarray(y0, dtype=float)
+    ref_method = choose_method(fun, t0, t1, y0, 1e-12).method
+    check_method = "LSODA" if ref_method != "LSODA" else "Radau"
+    ts = np.linspace(t0, t1, points)
+    ref, second = (
+        run_ode(fun, (t0, t1), y0, method=m, rtol=1e-12, atol=1e-14, t_eval=ts, max_time=60.0)
+        for m in (ref_method, check_method)
+    )
+    for run in (ref, second):
+        if not run.ok:
+            raise LimitError(
+                f"ode '{name}': the reference run ({run.method}) did not finish: {run.summary()}"
+            )
+    scale = np.maximum(np.max(np.abs(ref.y), axis=1), 1e-300)[:, None]
+    ref_error = float(np.max(np.abs(second.y - ref.y) / scale))
+
+    def case(method: str, rtol: float):
+        return run_ode(
+            fun,
+            (t0, t1),
+            y0,
+            method=method,
+            rtol=rtol,
+            atol=rtol * atol_ratio * scale[:, 0],
+            t_eval=ts,
+            max_time=max_time,
+        )
+
+    def error(run) -> float:
+        return float(np.max(np.abs(run.y - ref.y) / scale))
+
+    rows = work_precision(case, error, methods, rtols, case=name)
+    out = [
+        {
+            "ode": name,
+            "method": r.method,
+            "rtol": r.rtol,
+            "error": r.error,
+            "seconds": r.elapsed,
+            "evaluations": r.nfev,
+            "steps": r.nsteps,
+            "stop": r.stop_reason,
+            "resolved": bool(r.error > ref_error),
+        }
+        for r in rows
+    ]
+    out.append(
+        {
+            "ode": name,
+            "method": f"reference {ref_method} (checked by {check_method})",
+            "rtol": 1e-12,
+            "error": ref_error,
+            "seconds": ref.elapsed,
+            "evaluations": ref.nfev,
+            "steps": ref.nsteps,
+            "stop": ref.stop_reason,
+            "resolved": False,
+        }
+    )
+    return out
+
+
+# -- an [[ode]] of a sheet ----------------------------------------------------------------------
+@dataclass(frozen=True)
+class TypedOde:
+    """The typed expressions of one section: derivatives in state unit per time unit,
+    initial values and tolerances in the state's unit, the time bounds in the time variable's
+    unit; settings given as expressions typed (None: the section's number)."""
+
+    spec: OdeSpec
+    time_unit: object  # pint.Unit
+    units: tuple  # pint.Unit of each state
+    derivatives: tuple  # typed nodes
+    initials: tuple
+    first: object
+    last: object
+    atols: tuple = ()  # typed node or None, per state
+    settings: dict = field(default_factory=dict)  # "method", "rtol", "atol", "max_time"
+    shapes: tuple = ()  # per state: None (a number) or (n, 1) (a vector)
+
+    @property
+    def sizes(self) -> tuple:
+        """Per state: None (a number) or its number of elements."""
+        shapes = self.shapes or (None,) * len(self.units)
+        return tuple(None if s is None else s[0] for s in shapes)
+
+
+def type_ode(typer, spec: OdeSpec) -> TypedOde:
+    """Type a section's expressions (units are checked here, at load)."""
+    from ..errors import WorkbookError
+    from ..language import units as un
+
+    time_unit = typer.spec.arguments[spec.var].unit
+    dimensionless = un.registry().dimensionless
+    units = []
+    for s in spec.states:
+        try:
+            units.append(un.unit(s.unit, what=f"ode '{spec.name}', state '{s.name}'"))
+        except WorkbookError as err:
+            raise err.located(line=spec.line, definition=s.name) from None
+    scope = {spec.var: time_unit}
+
+    def in_unit(node, unit, what: str, plain_ok: bool):
+        t = typer.expression(node, scope if not plain_ok else {}, what)
+        if plain_ok and t.unit == dimensionless and not t.boolean and not t.text:
+            return t  # a plain number is taken in the declared unit (as range bounds)
+        try:
+            return typer.convert(t, unit, what)
+        except WorkbookError as err:
+            raise err.located(line=spec.line, definition=what) from None
+
+    inits = [
+        in_unit(s.initial, u, f"initial {s.name} (ode '{spec.name}')", True)
+        for s, u in zip(spec.states, units)
+    ]
+    shapes = tuple(_state_shape(spec, s, t) for s, t in zip(spec.states, inits))
+    for s, u, shape in zip(spec.states, units, shapes):
+        scope[s.name] = u if shape is None else (u, shape)
+    ders, atols = [], []
+    for s, u, shape in zip(spec.states, units, shapes):
+        # a state in degC changes by differences: T' is in delta_degC per time unit
+        step = un.difference_unit(u)
+        der = in_unit(s.derivative, step / time_unit, f"{s.name}' (ode '{spec.name}')", False)
+        if der.shape != shape:
+            raise TemplateError(
+                f"ode '{spec.name}': the derivative of '{s.name}' is {_shape_word(der.shape)}, "
+                f"its initial value {_shape_word(shape)}",
+                line=spec.line,
+                definition=s.name,
+            )
+        ders.append(der)
+        atols.append(
+            in_unit(s.atol, step, f"atol of {s.name} (ode '{spec.name}')", True) if s.atol else None
+        )
+    first = in_unit(spec.first, time_unit, f"time range of ode '{spec.name}'", True)
+    last = in_unit(spec.last, time_unit, f"time range of ode '{spec.name}'", True)
+    settings = {}
+    for key, unit in (("rtol", dimensionless), ("atol", dimensionless), ("max_time", "s")):
+        node = getattr(spec, key)
+        if isinstance(node, ex.Node):
+            unit = un.unit(unit) if isinstance(unit, str) else unit
+            settings[key] = in_unit(node, unit, f"{key} of ode '{spec.name}'", True)
+    if isinstance(spec.method, ex.Node):
+        settings["method"] = _typed_method(typer, spec)
+    return TypedOde(
+        spec,
+        time_unit,
+        tuple(units),
+        tuple(ders),
+        tuple(inits),
+        first,
+        last,
+        tuple(atols),
+        settings,
+        shapes,
+    )
+
+
+def _state_shape(spec: OdeSpec, s: StateSpec, initial) -> tuple | None:
+    """A state is a number or a vector (a column), as its initial value."""
+    if initial.shape is not None and initial.shape[1] != 1:
+        raise TemplateError(
+            f"ode '{spec.name}': the initial value of '{s.name}' is a "
+            f"{initial.shape[0]}x{initial.shape[1]} matrix; a state is a number or a vector",
+            line=spec.line,
+            definition=s.name,
+        )
+    return initial.shape
+
+
+def _shape_word(shape) -> str:
+    return "a number" if shape is None else f"a vector of {shape[0]}"
+
+
+def _typed_method(typer, spec: OdeSpec):
+    """The method as an expression: a text definition or a choice input."""
+    from ..language.typed import TRef
+
+    node = spec.method
+    known = set(typer.spec.inputs) | set(typer.spec.definitions)
+    if isinstance(node, ex.Name) and node.id not in known:
+        raise TemplateError(
+            f"ode '{spec.name}': method {node.id!r} is not one of {', '.join(METHODS)}, nor a "
+            "text definition or choice input of the sheet",
+            line=spec.line,
+        )
+    t = typer.expression(node, {}, f"method of ode '{spec.name}'")
+    if not (t.text or (isinstance(t, TRef) and t.kind == "choice")):
+        raise TemplateError(
+            f"ode '{spec.name}': method must give text, one of {', '.join(METHODS)}",
+            line=spec.line,
+        )
+    return t
+
+
+@dataclass(frozen=True)
+class Settings:
+    """A section's method and tolerances, evaluated on its sheet."""
+
+    method: str
+    rtol: float
+    atol: np.ndarray  # per state, in the states' units
+    max_time: float
+    max_steps: int
+
+
+def settings(typed: TypedOde, compile_expr: Callable) -> Settings:
+    """Evaluate the method, rtol, atol (per state) and budget of a section."""
+    spec, done = typed.spec, typed.settings
+
+    def value(key: str):
+        return compile_expr(done[key])({}) if key in done else getattr(spec, key)
+
+    method, rtol, max_time = value("method"), float(value("rtol")), float(value("max_time"))
+    if method not in METHODS:
+        raise DomainError(
+            f"ode '{spec.name}': method {method!r} is not one of {', '.join(METHODS)}",
+            definition=spec.name,
+        )
+    for key, v, low in (("rtol", rtol, 1e-13), ("max_time", max_time, 0.0)):
+        if not (math.isfinite(v) and v > low):
+            raise DomainError(f"ode '{spec.name}': {key} = {v:g} is not above {low:g}")
+    _within_budget(f"ode '{spec.name}'", "max_time", max_time)
+    atol = float(value("atol"))
+    per_state = [compile_expr(a)({}) if a is not None else atol for a in typed.atols]
+    per_state = per_state or [atol] * len(spec.states)
+    atols = np.concatenate(
+        [np.full(1 if n is None else n, float(v)) for v, n in zip(per_state, typed.sizes)]
+    )
+    if not np.all((atols > 0) & np.isfinite(atols)):
+        raise DomainError(f"ode '{spec.name}': an atol is not a positive number")
+    return Settings(method, rtol, atols, max_time, spec.max_steps)
+
+
+def problem(typed: TypedOde, compile_expr: Callable):
+    """(fun, t0, t1, y0) of a section, compiled with the numpy back end."""
+    spec = typed.spec
+    ders = [compile_expr(d) for d in typed.derivatives]
+    var = spec.var
+    parts, first = [], 0  # (name, first index, size or None)
+    for s, n in zip(spec.states, typed.sizes):
+        parts.append((s.name, first, n))
+        first += 1 if n is None else n
+
+    def fun(t, y):
+        env = {var: float(t)}
+        for name, k, n in parts:
+            env[name] = float(y[k]) if n is None else y[k : k + n].reshape(n, 1)
+        return np.concatenate([np.asarray(d(env), dtype=float).reshape(-1) for d in ders])
+
+    y0 = np.concatenate(
+        [np.asarray(compile_expr(i)({}), dtype=float).reshape(-1) for i in typed.initials]
+    )
+    t0, t1 = float(compile_expr(typed.first)({})), float(compile_expr(typed.last)({}))
+    return fun, t0, t1, y0
+
+
+def solve_typed(typed: TypedOde, compile_expr: Callable) -> Solution:
+    """Compile the derivatives with the numpy back end and integrate."""
+    from ..language import units as un
+
+    spec = typed.spec
+    fun, t0, t1, y0 = problem(typed, compile_expr)
+    st = settings(typed, compile_expr)
+    return solve(
+        fun,
+        t0,
+        t1,
+        y0,
+        name=spec.name,
+        states=tuple(s.name for s in spec.states),
+        method=st.method,
+        rtol=st.rtol,
+        atol=st.atol,
+        max_time=st.max_time,
+        max_steps=st.max_steps,
+        time_unit=un.pretty(typed.time_unit),
+        sizes=typed.sizes,
+    )
+
+
+def run_sheet(
+    sheet,
+    name: str,
+    *,
+    t_eval=None,
+    max_time: float | None = None,
+    max_steps: int | None = None,
+    label: str | None = None,
+    jac=None,
+) -> OdeRun:
+    """One bounded run of the sheet's ``[[ode]] name`` with its own method and tolerances
+    (give other ones with ``sheet.with_inputs``), timed: a run that stops early is returned,
+    not raised (a study records it). ``t_eval`` in the time unit (default: the steps);
+    ``jac(t, y)``: the Jacobian for the implicit methods, when the caller knows it (a linear
+    system's matrix), else they estimate it by differences."""
+    typed = sheet.typer.ode(name)
+    fun, t0, t1, y0 = problem(typed, sheet.evaluator.compile)
+    st = settings(typed, sheet.evaluator.compile)
+    fun(t0, y0)  # what the derivatives share is computed before the clock starts
+    options = dict(
+        rtol=st.rtol,
+        atol=st.atol,
+        t_eval=t_eval,
+        max_time=st.max_time if max_time is None else max_time,
+        max_steps=st.max_steps if max_steps is None else max_steps,
+        label=label,
+        jac=jac,
+    )
+    if st.method == "auto":
+        return auto_run(fun, t0, t1, y0, **options)[0]
+    return run_ode(fun, (t0, t1), y0, method=st.method, **options)
+
+
+def sheet_findings(sheet) -> list:
+    """One finding per [[ode]]: the method, and why "auto" chose it; a run that failed."""
+    from ..compute.findings import Finding
+    from ..errors import WorkbookError
+
+    out = []
+    for name in sheet.spec.odes:
+        try:
+            sol = sheet.evaluator.ode_solution(name)
+        except WorkbookError as err:
+            out.append(Finding(f"ode {name}", "the run did not finish", None, "", "fail", str(err)))
+            continue
+        out.append(
+            Finding(f"ode {name}", f"solved with {sol.method}", None, "", "info", sol.finding())
+        )
+        out.append(_estimate_finding(sheet, name, sol))
+    return out
+
+
+def _estimate_finding(sheet, name: str, sol: Solution):
+    """The states' global error estimate: a warning when one exceeds ESTIMATE_LIMIT times its
+    tolerance (or when there is no estimate), else for information."""
+    from ..compute.findings import Finding
+    from ..language import units as un
+
+    est = sol.estimate()
+    topic = f"ode {name}"
+    if est.failed:
+        return Finding(topic, "no global error estimate", None, "", "warning", est.failed)
+    typed = sheet.typer.ode(name)
+    names = flat_names(sol.states, sol.sizes)
+    units = [u for u, n in zip(typed.units, typed.sizes) for _ in range(1 if n is None else n)]
+    k = est.worst
+    unit = un.pretty(un.difference_unit(units[k]))  # an error is a difference: delta_degC
+    t_unit = un.pretty(typed.time_unit)
+    what = (
+        f"global error estimate: {names[k]} off by up to {est.errors[k]:.3g} {unit}".rstrip()
+        + f" at t = {est.times[k]:.6g} {t_unit}".rstrip()
+        + f", {est.ratios[k]:.3g} times its tolerance (rtol {sol.run.rtol:g}, atol "
+        f"{sol.atol[k]:g})"
+    )
+    note = f"the difference from a run of {est.reference}, at each step"
+    if est.ratios[k] > ESTIMATE_LIMIT:
+        note += (
+            f"; over {ESTIMATE_LIMIT:g} times the tolerance: the values of this ode are less "
+            "accurate than asked (tighten rtol and atol, or the solution is growing fast)"
+        )
+        return Finding(topic, what, None, "", "warning", note)
+    return Finding(topic, what, None, "", "info", note)
+
+
+def sheet_bench(sheet, quick: bool = False) -> list[dict]:
+    """Error against run time of every method on each [[ode]] of the sheet."""
+    rows = []
+    for name in sheet.spec.odes:
+        fun, t0, t1, y0 = problem(sheet.typer.ode(name), sheet.evaluator.compile)
+        rtols = (1e-3, 1e-6) if quick else (1e-3, 1e-6, 1e-9)
+        rows += bench_rows(fun, t0, t1, y0, name=name, rtols=rtols)
+    return rows

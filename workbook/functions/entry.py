@@ -1,0 +1,98 @@
+"""One built-in function: the :class:`Builtin` record, the registry it is kept in, and
+:func:`register` (the fields are described in :mod:`workbook.functions.builtins`; the complete
+registry, every module's entries registered, is :data:`workbook.functions.registry.REGISTRY`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+import pint
+
+from ..errors import TemplateError
+from ..language import typed as ty
+
+Arity = int | tuple[int, int | None] | None
+
+
+class UnitContext(Protocol):
+    """What a unit rule may ask of the typer: the unit rules of typed trees
+    (:class:`workbook.language.unitrules.UnitRules`, a base of the typer), and for ``diff`` whether
+    a typed body has a symbolic form."""
+
+    dimensionless: pint.Unit
+
+    def convert(self, t: ty.T, target: pint.Unit, where: str) -> ty.T: ...
+
+    def plain(self, t: ty.T, where: str) -> ty.T: ...
+
+    def meeting(self, values) -> list[ty.T]: ...
+
+    def symbolic_refusal(self, t: ty.T) -> str | None: ...
+
+
+@dataclass(frozen=True)
+class Domain:
+    """A restricted domain of argument ``arg``: ``bad(values)`` marks values outside it."""
+
+    kind: str  # "sqrt of a negative number"
+    bad: Callable[[np.ndarray], np.ndarray]
+    shown: str  # "sqrt({})", filled with the argument's text
+    arg: int = 0
+
+
+@dataclass(frozen=True)
+class Builtin:
+    """One built-in function (see the module docstring for the meaning of each field)."""
+
+    name: str
+    arity: Arity
+    unit_rule: Callable[..., ty.T]
+    numpy: Callable[..., Any]
+    excel: Callable[..., tuple[str, int]]
+    sympy: Callable[..., Any]
+    domain: tuple[Domain, ...] = ()
+    doc: str = ""
+    binds: tuple[int, int] | None = None
+    data_args: tuple[int, ...] = ()  # arguments that name columns of [data] tables
+    mathml: str = ""
+    mathml_powered: bool = False
+    arrays: bool = (
+        False  # takes vectors/matrices: the hooks get ``shapes=`` (workbook.functions.matrix)
+    )
+    # the unit rule when an argument is a run-time array (workbook.engine.runtime); None: refused
+    runtime: Callable[..., ty.T] | None = None
+    texts: bool = False  # takes text arguments (the unit rule checks each; else numbers only)
+    sizes: bool = False  # reads only an array's size: the array may hold texts
+
+    def check_arity(self, n: int) -> None:
+        """Raise a TemplateError if ``n`` arguments do not fit."""
+        a = self.arity
+        if a is None:
+            if n < 1:
+                raise TemplateError(f"{self.name}() needs at least one argument")
+            return
+        if isinstance(a, int):
+            if n != a:
+                raise TemplateError(f"{self.name}() takes {a} argument(s), got {n}")
+            return
+        lo, hi = a
+        if n < lo or (hi is not None and n > hi):
+            span = f"{lo} or more" if hi is None else f"{lo} to {hi}"
+            raise TemplateError(f"{self.name}() takes {span} arguments, got {n}")
+
+
+# Every built-in function by name, filled as the modules that define entries are imported.
+# Read it as workbook.functions.registry.REGISTRY, which imports all of them first (a module
+# reading it from here could see only some).
+ENTRIES: dict[str, Builtin] = {}
+
+
+def register(entry: Builtin) -> Builtin:
+    """Add a built-in; a name can be registered once."""
+    if entry.name in ENTRIES:
+        raise ValueError(f"built-in {entry.name}() is registered twice")
+    ENTRIES[entry.name] = entry
+    return entry

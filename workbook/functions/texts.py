@@ -1,0 +1,91 @@
+"""Built-ins of texts, as Mathcad names them: ``concat(S1, S2, ...)`` joins texts and
+``num2str(x)`` writes a number as a text (15 significant digits, ``1e-05`` for small ones)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import NotLive, NotSymbolic, TemplateError
+from ..language import typed as ty
+from ..language.expr import PREC
+from .entry import Builtin, UnitContext, register
+
+
+def _no_sympy(name: str):
+    why = f"{name}() gives a text, which has no derivative"
+
+    def convert(sp, *args):
+        raise NotSymbolic(why)
+
+    convert.refusal = why  # read by workbook.engine.symbolic.refusal, without SymPy
+    return convert
+
+
+def _concat_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    for k, a in enumerate(args, 1):
+        if not a.text or a.shape is not None:
+            raise TemplateError(
+                f"concat(): argument {k} is not a text; num2str(x) writes a number as one"
+            )
+    return ty.TFunc(ctx.dimensionless, func=name, args=tuple(args), text=True)
+
+
+def _concat(*texts):
+    if all(isinstance(t, str) for t in texts):
+        return "".join(texts)
+    return np.frompyfunc(lambda *parts: "".join(parts), len(texts), 1)(*texts)
+
+
+def _num2str_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    (x,) = args
+    if getattr(x, "kind", None) == "choice":  # a word, typed as a plain number
+        raise TemplateError(f"num2str(x): '{x.name}' is a choice, not a number")
+    if x.text or x.boolean or x.shape is not None:
+        raise TemplateError("num2str(x): x must be a number")
+    x = ctx.plain(x, "num2str(x): x (a value with a unit: divide it by the unit to write)")
+    return ty.TFunc(ctx.dimensionless, func=name, args=(x,), text=True)
+
+
+def number_text(x: float) -> str:
+    """A number as num2str writes it: 15 significant digits, no trailing zeros."""
+    return f"{float(x):.15g}"
+
+
+def _num2str(x):
+    if np.ndim(x) == 0:
+        return number_text(x)
+    return np.frompyfunc(number_text, 1, 1)(np.asarray(x, dtype=float))
+
+
+def _concat_excel(args: list[str]) -> tuple[str, int]:
+    return f"CONCATENATE({', '.join(args)})", PREC["atom"]
+
+
+def _num2str_excel(args: list[str]) -> tuple[str, int]:
+    raise NotLive("num2str: Excel writes numbers as texts with its own digits")
+
+
+register(
+    Builtin(
+        "concat",
+        (1, None),
+        _concat_unit,
+        _concat,
+        _concat_excel,
+        _no_sympy("concat"),
+        doc="concat(S1, S2, ...): the texts joined (Mathcad's concat)",
+        texts=True,
+    )
+)
+register(
+    Builtin(
+        "num2str",
+        1,
+        _num2str_unit,
+        _num2str,
+        _num2str_excel,
+        _no_sympy("num2str"),
+        doc="num2str(x): the number x as a text, 15 significant digits (Mathcad's num2str)",
+        texts=True,
+    )
+)

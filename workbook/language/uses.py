@@ -1,0 +1,79 @@
+"""What a sheet's outputs use: the one place that lists the expressions a sheet shows.
+
+Tables, charts, printed values (and, for the hand checks, relations, findings, checks,
+[[solve]] blocks and [[ode]] sections) are the outputs; :func:`names_used` follows their
+expressions through the definitions to the inputs and blocks they need. The writer writes only
+those (``excelform.needed_names``), ``Sheet`` reports the inputs nothing uses, and the analysis
+finds the ranges that show a function.
+"""
+
+from __future__ import annotations
+
+from ..compute.declared_checks import placeholders
+from ..errors import WorkbookError
+from . import expr as ex
+from . import typecheck as tc
+from .printed import read_printed
+from .ranges import RangeSpec
+from .template import SheetSpec, column_node
+
+
+def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
+    """Each range of a table or chart series, with the expressions shown over it."""
+    out = []
+    for t in spec.tables:
+        if t.range is not None:
+            out.append((t.range, [column_node(spec, c, t.range.var) for c in t.columns]))
+    for c in spec.charts:
+        for s in c.series:
+            rng = s.range or c.range
+            if s.table is not None or rng is None:
+                continue
+            nodes = [column_node(spec, s.y, rng.var)]
+            x = s.x or c.x
+            if x is not None:
+                nodes.append(column_node(spec, x, rng.var))
+            out.append((rng, nodes))
+    return out
+
+
+def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> list[ex.Node]:
+    """Expressions the outputs evaluate: columns, series and their range bounds, printed
+    values, the names ``reads`` that blocks evaluated through the sheet (``Sheet.reads``); with
+    ``hand_checks`` also the columns of block tables and the relations (what the checks read)."""
+    roots: list[ex.Node] = [ex.Name(n) for n in sorted(reads)]
+    for t in spec.tables:
+        if t.range is None and hand_checks:
+            roots += [c.node for c in t.columns]
+    for rng, nodes in ranged_outputs(spec):
+        roots += nodes
+        roots += [n for n in (rng.first, rng.second, rng.last, rng.points) if n is not None]
+    for p in spec.printed:
+        roots += [ex.Name(n) for n in printed_names(p)]
+    if hand_checks:  # the check report solves every [[solve]] block and [[ode]]
+        for block in spec.solves:
+            roots += tc.solve_expressions(block)
+        for o in spec.odes.values():
+            roots += [ex.Name(s.name) for s in o.states]
+        for r in spec.relations:
+            roots += [ex.Name(r.child), ex.Name(r.parent), r.factor]
+        for c in spec.checks:
+            roots += [n for n in (c.value, c.ok) if n is not None]
+            roots += [ex.Name(n) for n in c.inputs]
+            for piece in (c.what, c.note):
+                roots += [ex.parse(text) for text, _ in placeholders(piece)]
+    return roots
+
+
+def names_used(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> set[str]:
+    """Inputs, definitions and blocks the outputs (and ``reads``) need, transitively."""
+    roots = output_roots(spec, hand_checks=hand_checks, reads=reads)
+    return tc.dependencies_of_all(spec, roots)  # one closure: linear in the definitions
+
+
+def printed_names(p) -> set[str]:
+    """Names of a printed-values file (none if it cannot be read: the checks report that)."""
+    try:
+        return {row.name for row in read_printed(p)}
+    except WorkbookError:
+        return set()

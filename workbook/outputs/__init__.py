@@ -1,0 +1,1 @@
+"""The renderers: functions of a computed sheet that write files (xlsx, report, notebook)."""

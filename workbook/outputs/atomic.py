@@ -1,0 +1,197 @@
+"""Write output files so that an error or Ctrl-C never leaves a half-written file."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import tempfile
+import threading
+import zipfile
+from pathlib import Path
+
+from ..errors import InputError
+from ..limits import writable_target
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (what ``timeout``, ``kill`` and service managers send), handled as Ctrl-C: the
+    temporary files are removed and no output file is changed."""
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """Within the block, SIGTERM raises :class:`Terminated` in the main thread (by default it
+    ends the process at once, leaving ``.NAME.partial`` folders beside the targets). A process
+    forked meanwhile (a sweep's worker) still ends at once on SIGTERM."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pid = os.getpid()
+
+    def on_term(signum, frame):
+        if os.getpid() != pid:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTERM)
+            return
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, on_term)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None:
+    """Refuse a directory, a missing parent folder, a FIFO or device, an existing file of
+    another kind; an existing CSV is overwritten only with ``force``."""
+    writable_target(path)
+    if path.is_dir():
+        raise InputError(
+            f"output path {path} is a directory; give a file name like {path}/report.{kind}"
+        )
+    if not path.parent.exists():
+        raise InputError(f"output folder {path.parent} does not exist")
+    if path.exists() and not force and kind == "xlsx" and not _is_xlsx(path):
+        raise InputError(f"{path} exists and is not an xlsx workbook; use --force to overwrite it")
+    if path.exists() and not force and kind == "csv":  # a CSV cannot be recognised as ours
+        raise InputError(f"{path} exists; use --force to overwrite it")
+
+
+def _is_xlsx(path: Path) -> bool:
+    try:
+        with zipfile.ZipFile(path) as z:
+            return "[Content_Types].xml" in z.namelist()
+    except (zipfile.BadZipFile, OSError):
+        return False
+
+
+def _mode_for(path: Path) -> int:
+    """Keep an existing file's permissions; a new file gets the usual 0666 less the umask."""
+    try:
+        return path.stat().st_mode & 0o7777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
+def os_error(path: Path, exc: OSError) -> InputError:
+    """An error of the file system (disk full, read-only, name too long) as an input error."""
+    return InputError(f"cannot write {path}: {exc.strerror or exc}")
+
+
+@contextlib.contextmanager
+def replacing(path: Path):
+    """Yield a temporary path beside ``path``; move it into place only if the block succeeds.
+
+    ``path`` must be new or a regular file: moving a file over a device or FIFO would replace
+    the node itself."""
+    writable_target(path)
+    try:
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{path.name[:100]}.", suffix=".partial", dir=path.parent
+        )
+    except OSError as exc:
+        raise os_error(path, exc) from None
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.chmod(tmp_path, _mode_for(path))
+        os.replace(tmp_path, path)
+    except BaseException as exc:  # includes KeyboardInterrupt: the old file stays as it was
+        with contextlib.suppress(OSError):
+            tmp_path.unlink()
+        if isinstance(exc, OSError):
+            raise os_error(path, exc) from None
+        raise
+
+
+class Outputs:
+    """Several output files written as one: each is written to a temporary folder beside its
+    target, and all are moved into place only when every one is complete (an error in the
+    last leaves every earlier target as it was).
+
+        with Outputs(force=False) as outs:
+            tmp = outs.add(Path("a.xlsx"), "xlsx")   # checked now, before anything is written
+            ...write tmp...
+    """
+
+    def __init__(self, *, force: bool = False):
+        self.force = force
+        self.items: list[tuple[Path, Path]] = []  # (target, temporary path)
+
+    def add(self, path: Path, kind: str) -> Path:
+        """Check ``path`` as a target of ``kind`` and return the temporary path to write."""
+        path = Path(path)
+        check_target(path, kind=kind, force=self.force)
+        if any(os.path.abspath(t) == os.path.abspath(path) for t, _ in self.items):
+            raise InputError(f"{path} is named twice as an output")
+        try:
+            folder = tempfile.mkdtemp(
+                prefix=f".{path.name[:100]}.", suffix=".partial", dir=path.parent
+            )
+        except OSError as exc:
+            raise os_error(path, exc) from None
+        self.items.append((path, Path(folder) / path.name))
+        return self.items[-1][1]
+
+    def __enter__(self) -> Outputs:
+        return self
+
+    def __exit__(self, kind, exc, tb) -> None:
+        try:
+            if kind is None:
+                for target, tmp in self.items:
+                    if not tmp.exists():
+                        raise RuntimeError(f"{target} was not written")
+                for target, tmp in self.items:
+                    try:
+                        os.chmod(tmp, _mode_for(target))
+                        os.replace(tmp, target)
+                    except OSError as err:
+                        raise os_error(target, err) from None
+        finally:
+            for _, tmp in self.items:
+                with contextlib.suppress(OSError):
+                    for leftover in tmp.parent.iterdir():
+                        leftover.unlink()
+                with contextlib.suppress(OSError):
+                    tmp.parent.rmdir()
+
+
+def write_csv(frame, path: Path) -> None:
+    """A table (pandas DataFrame) as CSV; every text cell and header that a spreadsheet would
+    run as a formula gets a leading apostrophe (:func:`csv_text`). Cells are escaped by their
+    value, whatever the column's dtype (pandas gives text columns ``object``, ``str`` or
+    ``category``); only columns of numbers are left as they are."""
+    frame = frame.rename(columns=lambda c: csv_text(str(c)))
+    for name in frame.columns:
+        if frame[name].dtype.kind not in "biufcmM":  # not numbers, booleans or times
+            frame[name] = frame[name].map(_csv_cell).astype(object)
+    try:
+        frame.to_csv(path, index=False, lineterminator="\r\n")
+    except OSError as exc:
+        raise os_error(path, exc) from None
+
+
+def _csv_cell(value):
+    return csv_text(value) if isinstance(value, str) else value
+
+
+# The characters that make a spreadsheet read a cell as a formula (with the full-width forms
+# some spreadsheets also accept), and the ones that may come before them unnoticed.
+_FORMULA_STARTS = frozenset("=+-@\uff1d\uff0b\uff0d\uff20")
+_CONTROL_STARTS = frozenset("\t\r\n")
+
+
+def csv_text(text: str) -> str:
+    """``text`` safe for a CSV cell that a spreadsheet opens: a text whose first character
+    that is not a space is = + - @ (or their full-width forms), or that starts with a tab, CR
+    or LF, gets a leading apostrophe."""
+    first = text.lstrip(" \t\r\n\u00a0\u3000")[:1]
+    if text[:1] in _CONTROL_STARTS or first in _FORMULA_STARTS:
+        return "'" + text
+    return text
