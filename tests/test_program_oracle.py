@@ -170,6 +170,20 @@ def _program(rng: random.Random) -> tuple[str, Callable[[float], float]]:
     return "\n".join(lines), run
 
 
+def _checked(text: str, run: Callable[[float], float]):
+    """The sheet of the program ``p(s)`` tabulated over XS, its values checked against a
+    Python run; (the sheet, the values of the run)."""
+    sheet = workbook.loads(
+        '[arguments]\ns = { unit = "" }\n[definitions]\n'
+        f'"p(s)" = {{ program = """\n{text}\n""" }}\n\n'
+        '[[tables]]\nname = "t"\nrange = "s := -3, -2.5 .. 3"\ncolumns = { p = "" }\n'
+    )
+    expected = np.array([run(float(x)) for x in XS])
+    engine = np.asarray(sheet.table("t").iloc[:, 1], dtype=float)
+    np.testing.assert_allclose(engine, expected, rtol=1e-12, atol=1e-12, err_msg=text)
+    return sheet, expected
+
+
 def _recalculated(path: Path) -> dict[str, object]:
     """Cell -> value of the Listing sheet, recalculated by the formulas package."""
     import formulas
@@ -186,15 +200,7 @@ def _recalculated(path: Path) -> dict[str, object]:
 @given(st.randoms(use_true_random=False))
 def test_a_program_the_engine_python_and_its_live_formula_agree(tmp_path_factory, rng):
     text, run = _program(rng)
-    body = "\n".join("    " + line if line.strip() else line for line in text.splitlines())
-    sheet = workbook.loads(
-        '[arguments]\ns = { unit = "" }\n[definitions]\n'
-        f'"p(s)" = {{ program = """\n{body}\n""" }}\n\n'
-        '[[tables]]\nname = "t"\nrange = "s := -3, -2.5 .. 3"\ncolumns = { p = "" }\n'
-    )
-    expected = np.array([run(float(x)) for x in XS])
-    engine = np.asarray(sheet.table("t").iloc[:, 1], dtype=float)
-    np.testing.assert_allclose(engine, expected, rtol=1e-12, atol=1e-12, err_msg=text)
+    sheet, expected = _checked(text, run)
     path = sheet.write_xlsx(tmp_path_factory.mktemp("program") / "p.xlsx")
     listing = openpyxl.load_workbook(path)["Listing"]
     cells = [f"B{3 + k}" for k in range(len(XS))]
@@ -294,12 +300,4 @@ def _loop_program(rng: random.Random) -> tuple[str, Callable[[float], float]]:
 @fuzz_settings(200)
 @given(st.randoms(use_true_random=False))
 def test_a_program_with_loops_the_engine_and_python_agree(rng):
-    text, run = _loop_program(rng)
-    sheet = workbook.loads(
-        '[arguments]\ns = { unit = "" }\n[definitions]\n'
-        f'"p(s)" = {{ program = """\n{text}\n""" }}\n\n'
-        '[[tables]]\nname = "t"\nrange = "s := -3, -2.5 .. 3"\ncolumns = { p = "" }\n'
-    )
-    expected = np.array([run(float(x)) for x in XS])
-    engine = np.asarray(sheet.table("t").iloc[:, 1], dtype=float)
-    np.testing.assert_allclose(engine, expected, rtol=1e-12, atol=1e-12, err_msg=text)
+    _checked(*_loop_program(rng))
