@@ -28,7 +28,8 @@ FOLDERS = [ROOT.parent / "shared" / "mathcad", ROOT.parent / "shared" / "mathcad
 #: The import, run with Sheet construction counted (printed on the last line of stderr).
 COUNT_LOADS = """
 import sys
-from workbook import cli, sheet
+from workbook import cli
+from workbook.engine import sheet
 n = [0]
 init = sheet.Sheet.__init__
 def counted(self, *a, **k):
