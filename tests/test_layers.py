@@ -48,15 +48,9 @@ allow_indirect_imports = true
 
 
 # -- no import cycle among the package's modules ------------------------------------------------
-#: Cycles allowed for now, each as the set of modules it goes through: a strongly connected
-#: component of the import graph is allowed when its modules are all in one of these sets.
-#: Each one goes through a module outside the compute stage and the renderers, whose edits are
-#: made elsewhere; remove its entry once it is broken.
-ALLOWED_CYCLES: tuple[frozenset[str], ...] = (
-    # the Mathcad importer: the translation asks the engine for a unit or a value at import
-    # (engine.AtImport, engine.Unknown), the engine and the writer use the translation's names
-    frozenset({"workbook.mathcad.engine", "workbook.mathcad.translate", "workbook.mathcad.writer"}),
-)
+#: Cycles allowed, each as the set of modules it goes through: a strongly connected component
+#: of the import graph is allowed when its modules are all in one of these sets. None is.
+ALLOWED_CYCLES: tuple[frozenset[str], ...] = ()
 
 
 def _graph(package: str):

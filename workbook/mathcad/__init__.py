@@ -113,7 +113,7 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
         regions = regions_with_references(ws)
     name = sheet_name(src)
     out_dir = Path(out_dir)
-    translator = Translator()
+    translator = Translator(engine.AtImport)
     tr = translator.run(ws, regions)
     doc, rendered = writer.document(tr, name, src)
     refused = engine.refusals(doc.data, rendered, out_dir)

@@ -20,6 +20,7 @@ from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
+from .symbols import Unknown
 from .translate import Item, Skipped, Translation, _rename, _uses
 from .writer import Rendered
 
@@ -247,10 +248,6 @@ def _defined(item: Item) -> list:
     if item.kind == "solve":
         return [sym for sym, _ in item.solve[0]]
     return [item.sym] if item.sym is not None else []
-
-
-class Unknown(Exception):
-    """What an expression needs is not known at import, or the engine refuses it."""
 
 
 class AtImport:

@@ -17,6 +17,10 @@ class Untranslatable(Exception):
     """A construct the language cannot express (yet): the message says what and why."""
 
 
+class Unknown(Exception):
+    """What an expression needs is not known at import, or the engine refuses it."""
+
+
 @dataclass(eq=False)
 class Sym:
     """A name of the generated worksheet; its final identifier is chosen at the end."""

@@ -10,7 +10,9 @@ that uses an untranslated one is untranslated too.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from ..language import expr as ex
 from ..language.visitor import Visitor
@@ -23,7 +25,7 @@ from .functions import (
     language_functions,
 )
 from .reader import MNode, Region, Worksheet
-from .symbols import Sym, Untranslatable, matrix_size, whole_number
+from .symbols import Sym, Unknown, Untranslatable, matrix_size, whole_number
 from .symbols import key as _key
 from .symbols import what as _what
 from .units import FORMULA_UNITS, result_unit
@@ -531,9 +533,12 @@ def _whole_at_import(tr: Translator, node: MNode, what: str) -> int:
 
 
 class Translator:
-    """Regions in order -> a :class:`Translation`."""
+    """Regions in order -> a :class:`Translation`. ``at_import(translator)`` makes what gives
+    the unit and value of an expression of the translation so far (the engine's
+    :class:`workbook.mathcad.engine.AtImport`; passed in, as the engine builds on this module)."""
 
-    def __init__(self):
+    def __init__(self, at_import: Callable[[Translator], Any]):
+        self._make_at_import = at_import
         self.scope: dict[tuple[str, str], Sym] = {}
         self.units: dict[str, Sym] = {}
         self.out = Translation()
@@ -554,16 +559,12 @@ class Translator:
     def at_import(self):
         """The engine's unit and value of an expression of the translation so far."""
         if self._at_import is None:
-            from .engine import AtImport
-
-            self._at_import = AtImport(self)
+            self._at_import = self._make_at_import(self)
         return self._at_import
 
     def quantity(self, node: MNode, why: str = "a value that is not known at import"):
         """The value (a pint quantity) of a Mathcad expression of numbers, units, inputs and
         definitions, as the engine computes it."""
-        from .engine import Unknown
-
         try:
             return self.at_import().quantity(ExprTranslator(self).visit(node))
         except Unknown:
@@ -1598,8 +1599,6 @@ class Translator:
     def guess(self, et: ExprTranslator, name: MNode):
         """The value of the name ``name`` before a solve block (its guess), as the engine
         computes it."""
-        from .engine import Unknown
-
         try:
             return self.at_import().quantity(et.visit(name))
         except Unknown:
