@@ -34,7 +34,7 @@ k = "3"
 
 
 def _a_by_hand(x):
-    f = 3 * x**2 + mpmath.atan2(x, 2)
+    f = 3 * x**2 + mpmath.atan2(2, x)  # atan2(x, 2): x first
     p = mpmath.sqrt(x) if x > 0.5 else -x
     return (
         f

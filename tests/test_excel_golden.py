@@ -41,7 +41,7 @@ CASES = [
     ("mul_of_neg", "a*-b", None),
     ("min_max", "min(a, b, -x) + max(a, -x)", None),
     ("min_neg", "-min(a, b)", None),
-    ("atan2_order", "atan2(a, b)", None),  # worksheet atan2(y, x); Excel ATAN2(x, y)
+    ("atan2_order", "atan2(a, b)", None),  # x first in both: ATAN2(a, b)
     ("atan2_quadrant", "atan2(-a, -b)", None),
     ("unit_sum", "R1 + L2", "mm"),  # a factor 1000 on the metre input
     ("unit_product", "omega*R1", "m/s"),

@@ -56,7 +56,7 @@ FUNCTIONS = {
     "asin": ("asin(u)", mpmath.asin, (-1, 1)),
     "acos": ("acos(u)", mpmath.acos, (-1, 1)),
     "atan": ("atan(u)", mpmath.atan, (-50, 50)),
-    "atan2": ("atan2(u, v)", mpmath.atan2, (-3, 3), (-3, 3)),
+    "atan2": ("atan2(u, v)", lambda x, y: mpmath.atan2(y, x), (-3, 3), (-3, 3)),  # x first
     "sinh": ("sinh(u)", mpmath.sinh, (-20, 20)),
     "cosh": ("cosh(u)", mpmath.cosh, (-20, 20)),
     "tanh": ("tanh(u)", mpmath.tanh, (-5, 5)),

@@ -56,6 +56,7 @@ def quantity(text: str):
 
 
 ABSOLUTE = {"T1", "T2", "10 degC", "32 degF"}  # temperatures on a scale with an offset
+DELTAS = {"dT", "dF", "4 delta_degC"}  # temperature differences
 
 
 @dataclass(frozen=True)
@@ -86,8 +87,16 @@ def _grow(children):
             if op in "+-" and (a.bare or b.bare):  # a bare number next to an angle is degrees
                 return None
             bare = a.bare and b.bare
+            # kelvin in a sum with an absolute temperature is a difference (Mathcad's rule,
+            # where pint reads K as absolute): compared in test_temperatures_mathcad.py
+            mathcad = op in "+-" and a.absolute != b.absolute and not {a.text, b.text} & DELTAS
             return joined(
-                f"({a.text} {op} {b.text})", f"({a.python} {op} {b.python})", a, b, bare=bare
+                f"({a.text} {op} {b.text})",
+                f"({a.python} {op} {b.python})",
+                a,
+                b,
+                bare=bare,
+                kelvin=mathcad,
             )
 
         return st.tuples(children, children).map(make)

@@ -19,7 +19,7 @@ EXCEL: dict[str, tuple[str, tuple[int, ...]]] = {
     "ASIN": ("asin({0})", (1,)),
     "ACOS": ("acos({0})", (1,)),
     "ATAN": ("atan({0})", (1,)),
-    "ATAN2": ("atan2({1}, {0})", (2,)),  # Excel: ATAN2(x, y)
+    "ATAN2": ("atan2({0}, {1})", (2,)),  # x first in both
     "SINH": ("sinh({0})", (1,)),
     "COSH": ("cosh({0})", (1,)),
     "TANH": ("tanh({0})", (1,)),

@@ -99,9 +99,9 @@ def _sign_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
 
 
 def _atan2_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
-    y, x = args
-    x = ctx.convert(x, y.unit, "atan2(y, x): x and y")
-    return ty.TFunc(ctx.dimensionless, func=name, args=(y, x))
+    x, y = args
+    y = ctx.convert(y, x.unit, "atan2(x, y): x and y")
+    return ty.TFunc(ctx.dimensionless, func=name, args=(x, y))
 
 
 # -- Excel -------------------------------------------------------------------------------------
@@ -112,10 +112,6 @@ def excel_call(function: str) -> Callable[[list[str]], tuple[str, int]]:
         return f"{function}({', '.join(args)})", PREC["atom"]
 
     return printed
-
-
-def _excel_atan2(args: list[str]) -> tuple[str, int]:
-    return f"ATAN2({args[1]}, {args[0]})", PREC["atom"]  # Excel's ATAN2 takes (x, y)
 
 
 def _excel_ceil(args: list[str]) -> tuple[str, int]:
@@ -196,10 +192,10 @@ _simple(
 )
 _simple(
     "atan2",
-    np.arctan2,
-    _excel_atan2,
-    lambda sp, y, x: sp.atan2(y, x),
-    "angle of the point (x, y): atan2(y, x)",
+    lambda x, y: np.arctan2(y, x),
+    "ATAN2",  # x first, as Mathcad's atan2 and Excel's ATAN2
+    lambda sp, x, y: sp.atan2(y, x),
+    "angle of the point (x, y), x first: atan2(x, y)",
     rule=_atan2_unit,
     arity=2,
 )

@@ -6,14 +6,15 @@
     file = "pump.csv"                       # a header row of column names, then numbers
     columns = { Q = "m^3/h", H = "m" }      # the unit of each column used
 
-Each column becomes a name that ``linterp(X, Y, x)`` and ``cspline(X, Y, x)`` read; the
-file is read when the sheet is loaded, so a missing file, a missing column or a value that
+Each column becomes a name that ``linterp(X, Y, x)`` and ``cspline(X, Y, x)`` read, and,
+anywhere else, a vector of its values in its unit (Mathcad's READPRN columns); the file is read when the sheet is loaded, so a missing file, a missing column or a value that
 is not a number is an error naming the file and line.
 """
 
 from __future__ import annotations
 
 import csv
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +24,7 @@ import pint
 
 from ..errors import LimitError, TemplateError, WorkbookError
 from . import units as un
+from .typed import TConst, TMatrix
 
 #: most points of one data file
 MAX_POINTS = 1_000_000
@@ -38,6 +40,18 @@ class DataColumn:
     values: np.ndarray
     file: Path
     line: int | None
+
+    @functools.cached_property
+    def vector(self) -> TMatrix:
+        """The typed vector of the values (built once, however often the column is used)."""
+        rows = tuple((TConst(self.unit, value=float(v)),) for v in self.values)
+        return TMatrix(self.unit, rows=rows, shape=(len(rows), 1))
+
+
+def column_vector(col: DataColumn) -> TMatrix:
+    """The column as a vector written out (its values in its unit): every vector built-in
+    takes it, and the workbook writes it as an array of numbers."""
+    return col.vector
 
 
 def read_data(raw: dict, path: Path, lines: dict[str, int | None]) -> list[DataColumn]:

@@ -112,6 +112,7 @@ def check_unit_text(text: str, *, what: str = "unit", quantity: str | None = Non
             _exponent(tokens, i, shown, what)
         elif tok[0].isdigit():
             exponent = prev in ("**", "^") or (prev in ("-", "+", "(") and _after_power(tokens, i))
+            exponent = exponent or _denominator_of_power(tokens, i)  # the 2 of m^(1/2)
             one_over = tok == "1" and i == 0 and len(tokens) > 1 and tokens[1] == "/"
             if not (exponent or one_over):
                 raise InputError(
@@ -133,10 +134,10 @@ def check_unit_text(text: str, *, what: str = "unit", quantity: str | None = Non
             if depth < 0:
                 raise InputError(f"{what}: unbalanced parentheses in {shown!r}")
         elif tok not in ("*", "/"):
-            if tok in names:
+            if tok == prev:  # "MPa MPa": pint reads a space as a product
                 raise InputError(
-                    f"{what}: unit {tok!r} is written twice in {shown!r}; write the power "
-                    f"({tok}^2) if it is meant"
+                    f"{what}: unit {tok!r} is written twice in {shown!r} (a space between two "
+                    f"units multiplies them); write it once, or {tok}^2 if the square is meant"
                 )
             names.append(tok)
     if depth:
@@ -152,6 +153,20 @@ def _after_power(tokens: list[str], i: int) -> bool:
     return j >= 0 and tokens[j] in ("**", "^")
 
 
+def _denominator_of_power(tokens: list[str], i: int) -> bool:
+    """True when token ``i`` is the ``b`` of a fractional power ``^(a/b)`` (m^(1/2))."""
+    return (
+        i >= 3
+        and tokens[i - 1] == "/"
+        and tokens[i - 2][0].isdigit()
+        and tokens[i - 3] in ("(", "-", "+")
+        and "(" in tokens[i - 4 : i - 2] + tokens[i - 3 : i - 2]
+        and _after_power(tokens, i - 2)
+        and i + 1 < len(tokens)
+        and tokens[i + 1] == ")"
+    )
+
+
 def _exponent(tokens: list[str], i: int, shown: str, what: str) -> None:
     j, sign = i + 1, 1.0
     while j < len(tokens) and tokens[j] in ("(", "-", "+"):
@@ -161,7 +176,15 @@ def _exponent(tokens: list[str], i: int, shown: str, what: str) -> None:
     if j >= len(tokens) or not tokens[j][0].isdigit():
         raise InputError(f"{what}: {shown!r}: a power needs a number (m^2, s^-1)")
     value = sign * float(tokens[j])
-    if j + 1 < len(tokens) and tokens[j + 1] in ("**", "^"):
+    if j + 2 < len(tokens) and tokens[j + 1] == "/" and _denominator_of_power(tokens, j + 2):
+        if float(tokens[j + 2]) == 0:
+            raise InputError(f"{what}: {shown!r}: a power divides by zero")
+        value /= float(tokens[j + 2])
+        j += 2
+    k, opened = j + 1, tokens[i + 1 : j].count("(")
+    while k < len(tokens) and tokens[k] == ")" and opened:  # m^(2)^2 is m^(2^2) to pint
+        k, opened = k + 1, opened - 1
+    if k < len(tokens) and tokens[k] in ("**", "^"):
         # kg^9**9**9 is kg to the power 9**(9**9): each power alone is small, pint would
         # compute the tower (minutes of CPU and unbounded memory)
         raise LimitError(

@@ -18,6 +18,7 @@ from ..functions.registry import CONSTANTS, REGISTRY
 from . import expr as ex
 from . import units as un
 from .fields import nearest
+from .measured import column_vector
 from .template import Definition, SheetSpec, column_node
 from .typearrays import ArrayTyping
 from .typed import (
@@ -420,12 +421,8 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     f"write {name}({', '.join(block.parameters)})"
                 )
             return TRef(block.unknowns[name].units, name=name, kind="solve")
-        if name in self.spec.data:
-            col = self.spec.data[name]
-            raise TemplateError(
-                f"'{name}' is a column of the data table '{col.table}': use it in "
-                f"linterp(X, Y, x) or cspline(X, Y, x)"
-            )
+        if name in self.spec.data:  # a vector of the measured values, in the column's unit
+            return column_vector(self.spec.data[name])
         if name in self.spec.inputs:
             u = self.input_units[name]
             if u is None:

@@ -15,6 +15,7 @@ import re
 from typing import TYPE_CHECKING
 
 import pint
+from pint.util import to_units_container
 
 from ..errors import TemplateError, UnitError
 from . import units as un
@@ -51,7 +52,7 @@ class UnitRules:
                 f"{where}: {un.dims(t.unit)} ({un.pretty(t.unit) or '1'}) cannot be converted "
                 f"to {un.dims(target)} ({un.pretty(target) or '1'})"
             )
-        kinds = (un.temperature_kind(t.unit), un.temperature_kind(target))
+        kinds = (sum_kind(t.unit), sum_kind(target))
         if "absolute" in kinds:
             return self._temperature(t, target, kinds, where)
         f = un.factor(t.unit, target)
@@ -76,6 +77,11 @@ class UnitRules:
                 f"{where}: an absolute temperature ({shown[0]}) cannot be shown as a "
                 f"difference ({shown[1]}); a difference is written T - T0, or show it in K"
             )
+        kelvin = un.registry().kelvin
+        if kinds[0] == "kelvin" and un.temperature_kind(t.unit) is None:  # q/h in kW*K/W
+            t = self.convert(t, kelvin, where)  # pint converts no compound unit to degC
+        if kinds[1] == "kelvin" and un.temperature_kind(target) is None:
+            return self.convert(self.convert(t, kelvin, where), target, where)
         f, offset = un.affine(t.unit, target)
         if isinstance(t, TConst):
             return TConst(target, value=t.value * f + offset, derived=True)
@@ -182,12 +188,14 @@ class UnitRules:
         return TBinary(self.dimensionless, op="^", left=left, right=right)
 
     def _temperature_sum(self, op: str, left: T, right: T) -> tuple[T, T, pint.Unit | None]:
-        """Sums and differences of temperatures as pint and Mathcad Prime read them: absolute
-        minus absolute is a difference (delta_degC), absolute plus or minus a difference is
-        absolute, two absolute temperatures are not added. Returns the operands converted
-        and the unit of the result, or the operands and None when no temperature rule applies
-        (K and degR alone are both absolute and difference, as in pint)."""
-        kinds = (un.temperature_kind(left.unit), un.temperature_kind(right.unit))
+        """Sums and differences of temperatures as Mathcad reads them: absolute minus
+        absolute is a difference (delta_degC); absolute plus or minus anything else in kelvin
+        (a difference, K, degR, q/h in K, 88 % of a difference) is absolute, in the scale of
+        the absolute one (22 degC - 12.5 K is 9.5 degC); two absolute temperatures are not
+        added, and a difference minus an absolute temperature is refused. Returns the
+        operands converted and the unit of the result, or the operands and None when no
+        temperature rule applies (see :func:`sum_kind`)."""
+        kinds = (sum_kind(left.unit), sum_kind(right.unit))
         if "absolute" not in kinds and kinds not in (
             ("difference", "kelvin"),
             ("kelvin", "difference"),
@@ -199,16 +207,25 @@ class UnitRules:
                 f"{shown}: a temperature difference minus an absolute temperature is not a "
                 "temperature; write the absolute one first (T - dT)"
             )
-        if kinds[1] == "difference":  # T + dT, T - dT: in the scale of T
+        if kinds[0] == "absolute" and kinds[1] != "absolute":  # T + dT, T - 5 K: in T's scale
             return left, self.convert(right, un.difference_unit(left.unit), "sum"), left.unit
-        if kinds[0] == "difference":  # dT + T: in the scale of T
+        if kinds[0] != "absolute" and kinds[1] == "absolute" and op == "+":  # 5 K + T
             return self.convert(left, un.difference_unit(right.unit), "sum"), right, right.unit
+        if kinds[1] == "difference":  # K + dT: in kelvin, as pint
+            return left, self.convert(right, left.unit, "sum"), left.unit
+        if kinds[0] == "difference":  # dT + K
+            return self.convert(left, right.unit, "sum"), right, right.unit
         if op == "+":
             raise UnitError(
                 f"{shown}: two absolute temperatures cannot be added (20 degC + 20 degC is "
                 "not 40 degC); add a difference (T + 5 delta_degC; T1 + (T2 - T1)/2 is their "
                 "mean), or convert both to K"
             )
+        if kinds[0] == "kelvin":  # 300 K - 20 degC: kelvin minus kelvin, a difference in K
+            kelvin = un.registry().kelvin
+            if un.temperature_kind(left.unit) != "kelvin":  # q/h in kW*K/W: in K first
+                left = self.convert(left, kelvin, "difference")
+            return left, self.convert(right, left.unit, "difference"), left.unit
         # absolute - absolute: a difference, in the scale of the left one
         return left, self.convert(right, left.unit, "difference"), un.difference_unit(left.unit)
 
@@ -234,6 +251,20 @@ class UnitRules:
             f"cannot {verb} {un.dims(right.unit)} ({un.pretty(right.unit) or '1'}) "
             f"{'to' if op == '+' else 'from'} {un.dims(left.unit)} ({un.pretty(left.unit) or '1'})"
         )
+
+
+def sum_kind(unit: pint.Unit) -> str | None:
+    """What a value in ``unit`` is in a sum with a temperature: ``"absolute"`` (degC,
+    degF), ``"difference"`` (delta_degC, or a unit made with one: 88 % of a difference),
+    ``"kelvin"`` (K, degR, or any other unit of a temperature: q/h in kW*K/W); None for
+    units that are not temperatures."""
+    kind = un.temperature_kind(unit)
+    if kind is not None:
+        return kind
+    if unit.dimensionality != un.registry().kelvin.dimensionality:
+        return None
+    names = [str(n) for n in to_units_container(unit)]
+    return "difference" if any(n.startswith("delta_") for n in names) else "kelvin"
 
 
 def is_scaled_angle(unit: pint.Unit) -> bool:

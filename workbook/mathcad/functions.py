@@ -1,9 +1,8 @@
 """Mathcad's built-in functions, as data: each maps one to one onto a language built-in.
 
 ``name: (language name, argument order)``; the order lists Mathcad's argument positions in
-the order the language takes them (Mathcad's ``atan2(x, y)`` is the language's
-``atan2(y, x)``). A Mathcad function whose language name is not (yet) a built-in of the
-language is reported as not translated, never dropped.
+the order the language takes them (None: Mathcad's order, as ``atan2(x, y)``, x first in
+both). A Mathcad function whose language name is not (yet) a built-in of the language is reported as not translated, never dropped.
 """
 
 from __future__ import annotations
@@ -11,7 +10,7 @@ from __future__ import annotations
 MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "sin": ("sin", None), "cos": ("cos", None), "tan": ("tan", None),
     "asin": ("asin", None), "acos": ("acos", None), "atan": ("atan", None),
-    "atan2": ("atan2", (1, 0)), "angle": ("atan2", (1, 0)),
+    "atan2": ("atan2", None), "angle": ("atan2", None),
     "sinh": ("sinh", None), "cosh": ("cosh", None), "tanh": ("tanh", None),
     "exp": ("exp", None), "ln": ("ln", None), "log": ("log10", None),
     "sqrt": ("sqrt", None), "abs": ("abs", None), "sign": ("sign", None),

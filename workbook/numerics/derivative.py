@@ -33,14 +33,23 @@ def sympy_functions() -> dict[str, str]:
     # is read from its home. By the time a derivative is read back every entry is registered.
     from ..functions.entry import ENTRIES
 
-    return _sympy_functions(tuple(ENTRIES.values()))  # read again when an entry is added
+    table = _sympy_functions(tuple(ENTRIES.values()))  # read again when an entry is added
+    return {name: entry for name, (entry, _) in table.items()}
+
+
+def _sympy_function(name: str) -> tuple[str, tuple[int, ...]] | None:
+    """The built-in written as SymPy's function ``name`` and, for each of its arguments, the
+    position of that argument in SymPy's (``atan2(x, y)`` is SymPy's ``atan2(y, x)``)."""
+    from ..functions.entry import ENTRIES
+
+    return _sympy_functions(tuple(ENTRIES.values())).get(name)
 
 
 @functools.lru_cache(maxsize=4)
-def _sympy_functions(entries: tuple) -> dict[str, str]:
+def _sympy_functions(entries: tuple) -> dict[str, tuple[str, tuple[int, ...]]]:
     import sympy as sp
 
-    out: dict[str, str] = {}
+    out: dict[str, tuple[str, tuple[int, ...]]] = {}
     for entry in sorted(entries, key=lambda b: b.arrays):  # a stable sort
         if entry.binds or entry.data_args:
             continue
@@ -51,8 +60,9 @@ def _sympy_functions(entries: tuple) -> dict[str, str]:
             except Exception:  # noqa: BLE001 - a hook that refuses symbols names no function
                 continue
             simple = isinstance(e, sp.Basic) and not isinstance(e, (sp.Add, sp.Mul, sp.Pow))
-            if simple and not e.is_Atom and e.args == tuple(symbols):
-                out.setdefault(type(e).__name__, entry.name)
+            if simple and not e.is_Atom and sorted(e.args, key=str) == list(symbols):
+                order = tuple(e.args.index(s) for s in symbols)
+                out.setdefault(type(e).__name__, (entry.name, order))
     return out
 
 
@@ -218,13 +228,15 @@ class _Back(Visitor):
         return method(e)
 
     def _function(self, e):
-        name = sympy_functions().get(type(e).__name__)
-        if name is None:
+        found = _sympy_function(type(e).__name__)
+        if found is None:
             raise TemplateError(
                 f"diff(): the derivative contains {type(e).__name__} ({e}), which has no "
                 "formula in the worksheet language"
             )
-        args = tuple(self.visit(a) for a in e.args)
+        name, order = found
+        ordered = e.args if order == tuple(range(len(order))) else [e.args[i] for i in order]
+        args = tuple(self.visit(a) for a in ordered)  # Max(a, b, c): every argument
         if name in ("min", "max") and len(args) > 2:
             out = args[0]
             for a in args[1:]:

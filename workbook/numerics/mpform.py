@@ -234,7 +234,7 @@ class MpForm(Visitor):
             pick = min if t.func == "min" else max
             return lambda env: pick(p(env) for p in parts)
         if t.func == "atan2" and len(args) == 2:
-            y, x = (self.compile(a) for a in args)
+            x, y = (self.compile(a) for a in args)  # atan2(x, y), x first
             return lambda env: ctx.atan2(y(env), x(env))
         f = self.plain.get(t.func)
         if f is None or len(args) != 1:

@@ -1,0 +1,158 @@
+"""Sums of temperatures by the rule table of docs/language.md (Temperatures), against
+Mathcad's reading: every temperature is a number of kelvin (an absolute one from its zero, a
+difference by its size), a sum is the sum of those kelvin, and the result is shown in the scale
+of the absolute operand. The engine's numbers, the workbook's formulas recalculated by the
+`formulas` package, and (slow) LibreOffice's recalculation are all compared with that model.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import formulas
+import openpyxl
+import pytest
+from conftest import write_template
+
+import workbook
+from workbook.errors import UnitError
+from workbook.language import units as un
+from workbook.language.unitrules import sum_kind
+
+UNITS = ["K", "degC", "degF", "degR", "delta_degC", "delta_degF"]
+LEFT, RIGHT = 300.0, 20.0
+ETA = 0.88  # eta = "88 %"
+
+
+def _name(prefix: str, unit: str) -> str:
+    return f"{prefix}_{unit}"
+
+
+# (formula, its kelvin under Mathcad's reading, its kind in a sum)
+def _operand(prefix: str, magnitude: float, unit: str, scaled: bool = False):
+    q = un.registry().Quantity(magnitude, unit)
+    kind = un.temperature_kind(q.units)
+    kelvin = float(q.to("K").magnitude)  # an absolute one from 0 K, a difference by its size
+    if not scaled:
+        return _name(prefix, unit), kelvin, kind
+    # eta*B: an absolute temperature in a product is in kelvin; a difference stays one
+    return f"eta*{_name(prefix, unit)}", ETA * kelvin, (
+        "difference" if kind == "difference" else "kelvin"
+    )
+
+
+LEFTS = [_operand("A", LEFT, u) for u in UNITS] + [("P/G", 20.0, "kelvin")]
+RIGHTS = (
+    [_operand("B", RIGHT, u) for u in UNITS]
+    + [_operand("B", RIGHT, u, scaled=True) for u in UNITS]
+    + [("P/G", 20.0, "kelvin")]
+)
+CASES = [(op, a, b) for op, a, b in itertools.product("+-", LEFTS, RIGHTS)]
+
+
+def expected_kind(op: str, left: str, right: str) -> str | None:
+    """The rule table: None when refused, else "absolute" or "difference" (any value that is
+    not on a scale with an offset: a difference, K, degR, a compound unit of kelvin)."""
+    if (left, right) == ("absolute", "absolute"):
+        return None if op == "+" else "difference"
+    if left == "difference" and right == "absolute" and op == "-":
+        return None
+    if left == "absolute" or (right == "absolute" and op == "+"):
+        return "absolute"
+    return "difference"
+
+
+INPUTS = (
+    "".join(f'{_name("A", u)} = "{LEFT} {u}"\n' for u in UNITS)
+    + "".join(f'{_name("B", u)} = "{RIGHT} {u}"\n' for u in UNITS)
+    + 'eta = "88 %"\nP = "2 kW"\nG = "100 W/K"\n'
+)
+
+
+def _sheet(tmp_path, definitions: str):
+    text = f'[sheet]\ntitle = "sums"\n\n[inputs]\n{INPUTS}\n[definitions]\n{definitions}'
+    return workbook.load(write_template(tmp_path, text))
+
+
+def _in_kelvin(q) -> float:
+    return float(q.to("K").magnitude)
+
+
+def test_the_kelvin_valued_operands_are_kelvin_or_differences():
+    reg = un.registry()
+    assert sum_kind(reg.Unit("kW*K/W")) == "kelvin"
+    assert sum_kind(reg.Unit("percent*delta_degC")) == "difference"
+    assert sum_kind(reg.Unit("degC")) == "absolute"
+    assert sum_kind(reg.Unit("m")) is None
+
+
+@pytest.mark.parametrize(
+    "op,a,b", CASES, ids=[f"{a[0]}{op}{b[0]}".replace("*", "x") for op, a, b in CASES]
+)
+def test_a_sum_of_temperatures_is_mathcads(tmp_path, op, a, b):
+    (left, lk, lkind), (right, rk, rkind) = a, b
+    kind = expected_kind(op, lkind, rkind)
+    formula = f"{left} {op} {right}"
+    if kind is None:
+        with pytest.raises(UnitError, match="absolute temperature"):
+            _sheet(tmp_path, f'r = "{formula}"\n')
+        return
+    got = _sheet(tmp_path, f'r = "{formula}"\n').evaluate("r")
+    want = lk + rk if op == "+" else lk - rk
+    assert (sum_kind(got.units) == "absolute") == (kind == "absolute"), got
+    if kind == "absolute":  # in the scale of the absolute operand
+        scale = left if lkind == "absolute" else right
+        assert str(got.units) == str(un.unit(scale.split("_", 1)[1]))
+    assert math.isclose(_in_kelvin(got), want, rel_tol=1e-12, abs_tol=1e-9), (formula, got)
+
+
+ACCEPTED = [
+    (f"r{i}", f"{a[0]} {op} {b[0]}")
+    for i, (op, a, b) in enumerate(CASES)
+    if expected_kind(op, a[2], b[2]) is not None
+]
+
+
+@pytest.fixture(scope="module")
+def book(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("sums")
+    sheet = _sheet(tmp, "".join(f'{n} = "{f}"\n' for n, f in ACCEPTED))
+    return sheet, sheet.write_xlsx(tmp / "sums.xlsx")
+
+
+def _result_rows(path) -> dict[str, int]:
+    results = openpyxl.load_workbook(path)["Results"]
+    return {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
+
+
+def test_the_workbook_recalculates_to_the_engine(book):
+    """The `formulas` package (an independent Excel evaluator) recalculates every sum of the
+    workbook to the engine's number in the definition's unit."""
+    sheet, path = book
+    rows = _result_rows(path)
+    solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
+    values = {}
+    for key, ranges in solution.items():
+        book_sheet, _, cell = key.rpartition("!")
+        if book_sheet.split("]", 1)[-1].strip("'").upper() == "RESULTS" and ":" not in cell:
+            values[cell.upper()] = ranges.value[0, 0]
+    for name, formula in ACCEPTED:
+        want = float(sheet.evaluate(name).magnitude)
+        got = float(values[f"B{rows[name]}"])
+        assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (name, formula, got, want)
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculates_the_sums(book, tmp_path):
+    from recalc import cell_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    sheet, path = book
+    rows = _result_rows(path)
+    values = cell_values(recalculate(path, tmp_path))
+    for name, formula in ACCEPTED:
+        want = float(sheet.evaluate(name).magnitude)
+        got = float(values[("Results", f"B{rows[name]}")])
+        assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (name, formula, got, want)
