@@ -66,9 +66,7 @@ def _mathcad_sum(op: str, a: str, b: str) -> bool:
     return op in "+-" and kinds == {"absolute", "kelvin"}
 
 
-COMBINATIONS = [
-    c for c in itertools.product("+-*/", UNITS, UNITS) if not _mathcad_sum(*c)
-]
+COMBINATIONS = [c for c in itertools.product("+-*/", UNITS, UNITS) if not _mathcad_sum(*c)]
 
 
 @pytest.mark.parametrize("op,a,b", COMBINATIONS, ids=[f"{a}{o}{b}" for o, a, b in COMBINATIONS])

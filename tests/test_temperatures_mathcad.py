@@ -37,8 +37,10 @@ def _operand(prefix: str, magnitude: float, unit: str, scaled: bool = False):
     if not scaled:
         return _name(prefix, unit), kelvin, kind
     # eta*B: an absolute temperature in a product is in kelvin; a difference stays one
-    return f"eta*{_name(prefix, unit)}", ETA * kelvin, (
-        "difference" if kind == "difference" else "kelvin"
+    return (
+        f"eta*{_name(prefix, unit)}",
+        ETA * kelvin,
+        ("difference" if kind == "difference" else "kelvin"),
     )
 
 

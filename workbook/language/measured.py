@@ -7,7 +7,8 @@
     columns = { Q = "m^3/h", H = "m" }      # the unit of each column used
 
 Each column becomes a name that ``linterp(X, Y, x)`` and ``cspline(X, Y, x)`` read, and,
-anywhere else, a vector of its values in its unit (Mathcad's READPRN columns); the file is read when the sheet is loaded, so a missing file, a missing column or a value that
+anywhere else, a vector of its values in its unit (Mathcad's READPRN columns); the file is read
+when the sheet is loaded, so a missing file, a missing column or a value that
 is not a number is an error naming the file and line.
 """
 

@@ -2,7 +2,8 @@
 
 ``name: (language name, argument order)``; the order lists Mathcad's argument positions in
 the order the language takes them (None: Mathcad's order, as ``atan2(x, y)``, x first in
-both). A Mathcad function whose language name is not (yet) a built-in of the language is reported as not translated, never dropped.
+both). A Mathcad function whose language name is not (yet) a built-in of the language is
+reported as not translated, never dropped.
 """
 
 from __future__ import annotations
