@@ -50,8 +50,13 @@ class ArrayTyping:
                 )
             if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
                 self.mismatch(op, left, right)
+            if not is_zero(left) and not is_zero(right):  # T - 20 degC: differences
+                left, right, unit = self.temperature_sum(op, left, right)
+                if unit is not None:
+                    return TBinary(unit, op=op, left=left, right=right, shape=ls or rs)
             right = self.convert(right, left.unit, "sum")
             return TBinary(left.unit, op=op, left=left, right=right, shape=ls or rs)
+        left, right = self.kelvin(left), self.kelvin(right)  # 2*T: in kelvin, as numbers
         if op == "*":
             unit = left.unit * right.unit
             if ls is None or rs is None:

@@ -143,7 +143,7 @@ class UnitRules:
             if right.unit.dimensionality != left.unit.dimensionality and not is_zero(right):
                 self.mismatch(op, left, right)
             if not is_zero(left) and not is_zero(right):
-                left, right, unit = self._temperature_sum(op, left, right)
+                left, right, unit = self.temperature_sum(op, left, right)
                 if unit is not None:
                     return TBinary(unit, op=op, left=left, right=right)
             right = self.convert(right, left.unit, "sum")
@@ -187,7 +187,7 @@ class UnitRules:
             return TConst(self.dimensionless, value=v, derived=derived_from(left, right))
         return TBinary(self.dimensionless, op="^", left=left, right=right)
 
-    def _temperature_sum(self, op: str, left: T, right: T) -> tuple[T, T, pint.Unit | None]:
+    def temperature_sum(self, op: str, left: T, right: T) -> tuple[T, T, pint.Unit | None]:
         """Sums and differences of temperatures as Mathcad reads them: absolute minus
         absolute is a difference (delta_degC); absolute plus or minus anything else in kelvin
         (a difference, K, degR, q/h in K, 88 % of a difference) is absolute, in the scale of
