@@ -255,6 +255,10 @@ def _unit_end(tokens, i: int) -> int:
         tok = tokens[j]
         if tok.string == "**" and joined(j + 1):
             k = j + 1
+            fraction = _fraction_end(tokens, k, joined)  # m^(1/2)
+            if fraction:
+                j = fraction
+                continue
             if tokens[k].string in "-+" and joined(k + 1):
                 k += 1
             if tokens[k].type != tokenize.NUMBER:
@@ -271,6 +275,27 @@ def _unit_end(tokens, i: int) -> int:
             j, depth = j + 1, depth - 1
         else:
             break
+    return j
+
+
+def _fraction_end(tokens, k: int, joined) -> int:
+    """Index after a power written as a fraction, ``(1/2)`` or ``(-3/2)`` at ``tokens[k]``,
+    joined with no space; 0 when there is none."""
+    import tokenize
+
+    want = ["(", "-", tokenize.NUMBER, "/", tokenize.NUMBER, ")"]
+    j = k
+    for w in want:
+        if j >= len(tokens) or (j > k and not joined(j)):
+            return 0
+        tok = tokens[j]
+        if w == "-":
+            if tok.string in ("-", "+"):
+                j += 1
+            continue
+        if tok.type != w if isinstance(w, int) else tok.string != w:
+            return 0
+        j += 1
     return j
 
 
