@@ -234,7 +234,7 @@ def test_run_prints_matrices_and_texts(tmp_path, capsys):
     data = Path(__file__).parent / "data" / "arrays.toml"
     assert main(["run", str(data), "--out", str(tmp_path / "a.xlsx")]) == 0
     out = capsys.readouterr().out
-    assert "K = [[8., 2.], [4., 6.]] kN/m" in out
+    assert "  K = [ 8  2 ] kN/m\n      [ 4  6 ]\n" in out  # aligned rows, not numpy's text
     assert 'verdict = "OK"' in out
 
 

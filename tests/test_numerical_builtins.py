@@ -245,7 +245,7 @@ def test_interpolation_against_scipy_and_numpy(tmp_path):
     [
         (PUMP, '"linterp(Q, H, T)"', UnitError, "x is [time] (s), but the data column Q"),
         (PUMP, '"linterp(Q, eta, T)"', TemplateError, "must be a column of a [data] table"),
-        (PUMP, '"2*Q"', TemplateError, "'Q' is a column of the data table 'pump'"),
+        (PUMP, '"Q + 1 m"', UnitError, "cannot add [length] (m) to"),  # Q: a vector
         (PUMP.replace("20,29.5", "5,29.5"), '"linterp(Q, H, 0)"', NumericsError, "increasing"),
         (
             PUMP.replace("31.2", "high"),

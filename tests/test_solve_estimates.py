@@ -167,4 +167,4 @@ def test_the_estimate_of_an_unknown_in_degc_is_a_difference(tmp_path):
     assert found["solve T"].what.rstrip(")").endswith("delta_degC")
     book = openpyxl.load_workbook(sheet.write_xlsx(tmp_path / "t.xlsx"))
     notes = [c.value for row in book["Results"].iter_rows() for c in row if c.value]
-    assert any(str(v).startswith("error estimate") and " delta_degC," in str(v) for v in notes)
+    assert any(str(v).startswith("error estimate") and " Δ°C," in str(v) for v in notes)

@@ -69,9 +69,52 @@ def test_run_and_the_workbook_show_the_declared_units(tmp_path):
         assert line in done.stdout, done.stdout
     results = openpyxl.load_workbook(tmp_path / "shown.xlsx")["Results"]
     units = {r[0]: r[2] for r in results.iter_rows(min_row=2, values_only=True) if r[0]}
-    assert units["torque"] == "N*m" and units["flow"] == "L/min" and units["energy"] == "kW*h"
+    # the Results sheet is for people: the units typeset, in the declared order
+    assert units["torque"] == "N·m" and units["flow"] == "L/min" and units["energy"] == "kW·h"
+    assert units["conduct"] == "W/(m·K)"
     inputs = openpyxl.load_workbook(tmp_path / "shown.xlsx")["Inputs"]
     shown = [c for r in inputs.iter_rows(values_only=True) for c in r if isinstance(c, str)]
     assert "L/s" in shown and "W/(m*K)" in shown
     sheet = workbook.load(path)
     assert sheet.evaluate("energy").to("J").magnitude == pytest.approx(3.6e6)
+
+
+@pytest.mark.parametrize(
+    "text,shown",
+    [
+        ("N*m", "N·m"),
+        ("m*N", "m·N"),
+        ("W/(m^2*K)", "W/(m²·K)"),
+        ("degC", "°C"),
+        ("delta_degC", "Δ°C"),
+        ("delta_degF", "Δ°F"),
+        ("ohm", "Ω"),
+        ("kohm", "kΩ"),
+        ("um", "µm"),
+        ("L/s", "L/s"),
+        ("mL", "mL"),
+        ("deg", "°"),
+        ("percent", "%"),
+        ("m/s^2", "m/s²"),
+        ("1/s", "1/s"),
+        ("kg^12", "kg¹²"),
+        ("m^0.5/s", "m^0.5/s"),
+        ("J/(kg*K)", "J/(kg·K)"),
+        ("", ""),
+    ],
+)
+def test_typeset_is_what_a_person_writes_and_reads_back(text, shown):
+    assert un.typeset(un.unit(text)) == shown
+    if shown:
+        assert un.unit(shown) == un.unit(text)  # the workbook's text reads back as the unit
+
+
+def test_typeset_does_not_change_how_units_are_spelt():
+    """typeset and the report's reading of unit text are pure: the spelling pretty() keeps
+    (the worksheet's L for pint's l) is not changed by them."""
+    before = un.pretty(un.unit("L/s"))
+    for text in ("l/s", "liter/s", "W/(m*K)"):
+        un.typeset(un.unit("m"))
+        assert un.shown_factors(text) is not None
+    assert un.pretty(un.unit("L/s")) == before
+    assert un.shown_factors("pieces") is None  # a label is not a unit

@@ -67,6 +67,12 @@ def _parser() -> argparse.ArgumentParser:
         default=[],
         help="also write table TABLE as CSV beside the workbook (repeatable)",
     )
+    run.add_argument(
+        "--first",
+        metavar="N",
+        type=int,
+        help="print only the first N results (default: every result; all are on the Results sheet)",
+    )
     chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
     sheet_args(chk)
     part_args(chk, "all")
@@ -195,9 +201,6 @@ def cmd_list(args) -> int:
     return EXIT_OK
 
 
-MAX_SUMMARY_SCALARS = 20  # scalar results printed by `run` (all are on the Results sheet)
-
-
 def cmd_run(args) -> int:
     """Compute, then write the workbook and every --csv and --export file as one: all targets
     are checked and all contents computed before any file is replaced. Findings with verdict
@@ -254,7 +257,7 @@ def cmd_run(args) -> int:
     print(f"wrote {out}: {summary}")
     for r in refusals:  # a live formula that an independent evaluation does not confirm
         print(f"written as a value: {r.where}: {r.disagreement}")
-    _print_scalars(sheet)
+    _print_scalars(sheet, args.first)
     for name in sheet.left_out:
         part = sheet.full_spec.parts[name]
         print(f"left out part {name} ({part.title}): add it with --part {name}")
@@ -271,33 +274,67 @@ def _estimates_after_writing(sheet, report) -> None:
     report.findings += [f for f in estimate_findings(sheet) if (f.topic, f.what) not in known]
 
 
-def _print_scalars(sheet) -> None:
-    """The scalar results, one a line (the first MAX_SUMMARY_SCALARS of them)."""
-    from .errors import WorkbookError
+def _print_scalars(sheet, first: int | None = None) -> None:
+    """Every result, one a line (the first ``first`` of them when given); a vector or matrix
+    as aligned rows of numbers, its unit after the first row."""
+    from .errors import InputError, WorkbookError
     from .language.units import pretty
 
+    if first is not None and first < 0:
+        raise InputError(f"--first {first}: give a number of results, 0 or more")
     unknowns = [  # [[solve]] results (a block with parameters is a function)
         n for block in sheet.spec.solves if not block.parameters for n in block.unknowns
     ]
     names = unknowns + [n for n, d in sheet.spec.definitions.items() if not d.is_function]
-    for name in names[:MAX_SUMMARY_SCALARS]:
+    shown = names if first is None else names[:first]
+    for name in shown:
         try:
             q = sheet.evaluate(name) if name in unknowns else sheet.scalar_quantity(name)
             if isinstance(q, str):  # a text: "OK"
                 print(f'  {name} = "{q}"')
                 continue
-            if getattr(q.magnitude, "ndim", 0):  # a vector or matrix, one row a line
-                import numpy as np
-
-                rows = np.array2string(q.magnitude, precision=6, separator=", ")
-                print(f"  {name} = {rows.replace(chr(10), '')} {pretty(q.units)}".rstrip())
+            if getattr(q.magnitude, "ndim", 0):  # a vector or matrix: aligned rows
+                print("\n".join(matrix_lines(f"  {name} = ", q.magnitude, pretty(q.units))))
                 continue
             value = float(q.magnitude) + 0.0  # -0 shows as 0
             print(f"  {name} = {value:.6g} {pretty(q.units)}".rstrip())
         except WorkbookError as err:
             print(f"  {name}: error: {err.message}")
-    if len(names) > MAX_SUMMARY_SCALARS:
-        print(f"  ... and {len(names) - MAX_SUMMARY_SCALARS} more on the Results sheet")
+    if len(shown) < len(names):
+        print(f"  ... and {len(names) - len(shown)} more on the Results sheet")
+
+
+def matrix_lines(lead: str, values, unit: str) -> list[str]:
+    """A vector or matrix as text for people: one bracketed line a row, the columns aligned
+    (numbers on their right edge, 6 significant digits), the unit after the first row::
+
+        M = [ 4     1 ] N/mm
+            [ 2  -3.5 ]
+    """
+    import numpy as np
+
+    arr = np.asarray(values, dtype=object)
+    if arr.ndim == 1:
+        arr = arr.reshape(-1, 1)
+    cells = [[_element_text(v) for v in row] for row in arr]
+    widths = [max(len(r[j]) for r in cells) for j in range(arr.shape[1])] if cells else []
+    pad = " " * len(lead)
+    out = []
+    for i, row in enumerate(cells):
+        text = "[ " + "  ".join(c.rjust(w) for c, w in zip(row, widths)) + " ]"
+        out.append((lead if i == 0 else pad) + text + (f" {unit}" if i == 0 and unit else ""))
+    return out or [f"{lead}[ ] {unit}".rstrip()]
+
+
+def _element_text(v) -> str:
+    import numpy as np
+
+    if isinstance(v, str):
+        return f'"{v}"'
+    if np.ndim(v):  # an array inside an array
+        r, c = np.shape(v) if np.ndim(v) == 2 else (np.size(v), 1)
+        return f"{{{r}x{c}}}"
+    return f"{float(v) + 0.0:.6g}"
 
 
 def _print_findings(report) -> int:

@@ -287,7 +287,7 @@ class ExcelLayout:
             value = q if t.text or isinstance(q, str) else float(q.magnitude)
             with self.printer.context(helpers=HelperCells(self, d.name, t)):
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
-            ws.write_string(row, 2, un.pretty(t.unit))
+            ws.write_string(row, 2, un.typeset(t.unit))
             ws.write_string(row, 3, d.text)
             ws.write_string(row, 4, d.note)
             self._define(ws, row, d.name, f"=Definitions!$B${row + 1}")
@@ -346,7 +346,7 @@ class ExcelLayout:
             except WorkbookError as err:
                 ws.write_string(row, 1, f"error: {err.message}", self.fmt["fail"])
                 continue
-            unit = un.pretty(t.unit)
+            unit = un.typeset(t.unit)
             ws.write_string(row, 2, unit)
             value = q if t.text or isinstance(q, str) else float(q.magnitude)
             if d.name in done:
@@ -376,8 +376,8 @@ class ExcelLayout:
         q, solved = found.value, found.solution
         ws.write_number(row, 1, float(q.magnitude), self.fmt["number"])
         ws.write_comment(row, 1, "A value, not a formula: found by a [[solve]] block")
-        ws.write_string(row, 2, un.pretty(q.units))
-        step = un.pretty(un.difference_unit(q.units))  # an error is a difference: delta_degC
+        ws.write_string(row, 2, un.typeset(q.units))
+        step = un.typeset(un.difference_unit(q.units))  # an error is a difference: delta_degC
         ws.write_string(
             row,
             4,
@@ -402,7 +402,7 @@ class ExcelLayout:
             self._check_block(d, row + 1, r, c)
             value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
             ws.write_string(row, 0, d.name, self.fmt["header"])
-            ws.write_string(row, 1, f"{un.pretty(t.unit) or '1'}   {d.text}   {d.note}".strip())
+            ws.write_string(row, 1, f"{un.typeset(t.unit) or '1'}   {d.text}   {d.note}".strip())
             top = row + 1
             self._write_block(ws, top, t, value, d.name)
             last = f"{_col_letter(c)}${top + r}"
@@ -439,7 +439,7 @@ class ExcelLayout:
         if value.dtype != object:
             self._check_block(d, row + 1, r, c)
         ws.write_string(row, 0, d.name, self.fmt["header"])
-        ws.write_string(row, 1, f"{un.pretty(t.unit) or '1'}   {d.text}   {d.note}".strip())
+        ws.write_string(row, 1, f"{un.typeset(t.unit) or '1'}   {d.text}   {d.note}".strip())
         top = row + 1
         if value.dtype == object:
             text = _nested_text(value)
@@ -599,7 +599,7 @@ class ExcelLayout:
             )
         self._count_table_cells(spec, n, len(data.columns))
         ws.write_string(start, 0, spec.title, self.fmt["title"])
-        heads = [un.header(c.title, c.unit) for c in data.columns]
+        heads = [un.header(c.title, c.unit, typeset_unit=True) for c in data.columns]
         write_labels(ws, start + 1, 0, heads, self.fmt["header"])
         first = start + 2
         self._write_range_column(ws, spec, first, data.columns[0].values)

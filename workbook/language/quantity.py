@@ -26,6 +26,10 @@ _TOKEN = re.compile(
 )
 
 
+#: typeset unit text read as written (W/(m²·K), as the report and the workbook show it)
+_TYPESET = str.maketrans({"·": "*", "⋅": "*"})
+
+
 def split_quantity(text: str, *, what: str = "value") -> tuple[float | int, str]:
     """Split ``"45.5 mm"`` into ``(45.5, "mm")``; the unit text is checked (may be empty).
 
@@ -88,7 +92,7 @@ def check_unit_text(text: str, *, what: str = "unit", quantity: str | None = Non
         raise LimitError(
             f"{what}: unit text is {len(text):,} characters long (limit {MAX_QUANTITY_TEXT})"
         )
-    text = text.strip()
+    text = text.strip().translate(_TYPESET)
     if not text:
         return ""
     tokens, pos = [], 0

@@ -287,11 +287,82 @@ def _remember_spelling(text: str) -> None:
                 _SPELLING[name] = token
 
 
+#: How a unit is typeset for people where pint's symbol is not what a person writes (pint's
+#: liter is l, its degree deg); every other unit by pint's symbol (°C, Δ°C, Ω, µm).
+_TYPESET_SYMBOLS = {
+    "liter": "L",
+    "degree": "°",
+    "percent": "%",
+}
+_SUPERSCRIPTS = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def typeset_factors(u: pint.Unit) -> tuple[list[tuple[str, float]], list[tuple[str, float]]]:
+    """The factors of ``u`` above and below the fraction bar, each ``(symbol, power)`` with a
+    positive power, in the order written (a pure function of the unit)."""
+    top: list[tuple[str, float]] = []
+    bottom: list[tuple[str, float]] = []
+    for name, power in to_units_container(u).items():
+        (top if power > 0 else bottom).append((_typeset_symbol(name), abs(float(power))))
+    return top, bottom
+
+
+@functools.lru_cache(maxsize=512)
+def _typeset_symbol(name: str) -> str:
+    if name in _TYPESET_SYMBOLS:
+        return _TYPESET_SYMBOLS[name]
+    symbol = registry().get_symbol(name)
+    for full, shown in _TYPESET_SYMBOLS.items():  # a prefixed liter: mL
+        if name.endswith(full) and symbol.endswith(registry().get_symbol(full)):
+            prefix = symbol[: len(symbol) - len(registry().get_symbol(full))]
+            return prefix + shown
+    return symbol
+
+
+def shown_factors(text: str) -> tuple[list[tuple[str, float]], list[tuple[str, float]]] | None:
+    """:func:`typeset_factors` of a unit text as shown (``W/(m*K)``, ``delta_degC``), or None
+    when the text is not a unit (a label). Reading it here never changes how units are
+    spelt (:func:`pretty`)."""
+    try:
+        u = _unit_of(check_unit_text(text.strip()))
+    except Exception:  # noqa: BLE001 - a label, or text pint cannot read
+        return None
+    if u == registry().dimensionless:
+        return None
+    return typeset_factors(u)
+
+
+def superscript(power: float) -> str:
+    """``²`` for 2, ``""`` for 1; a power that is not an integer as ``^0.5``."""
+    if power == 1:
+        return ""
+    if float(power).is_integer():
+        return str(int(power)).translate(_SUPERSCRIPTS)
+    return f"^{power:g}"
+
+
+def typeset(u: pint.Unit) -> str:
+    """A unit as a person writes it: ``W/(m²·K)``, ``Δ°C``, ``µm``, ``kN·m``, ``1/s`` ('' for
+    dimensionless). The text is read back by the unit reader as the same unit."""
+    if u == registry().dimensionless:
+        return ""
+    top, bottom = typeset_factors(u)
+
+    def part(factors: list[tuple[str, float]]) -> str:
+        return "·".join(symbol + superscript(p) for symbol, p in factors)
+
+    out = part(top) or "1"
+    if bottom:
+        out += "/" + (part(bottom) if len(bottom) == 1 else f"({part(bottom)})")
+    return out
+
+
 def close(a: float, b: float, rel: float = 1e-12) -> bool:
     return math.isclose(a, b, rel_tol=rel, abs_tol=0.0)
 
 
-def header(title: str, unit) -> str:
-    """A column header with its unit: ``"h1 [mm]"`` (the title alone when dimensionless)."""
-    u = pretty(unit)
+def header(title: str, unit, *, typeset_unit: bool = False) -> str:
+    """A column header with its unit: ``"h1 [mm]"`` (the title alone when dimensionless);
+    ``typeset_unit``: the unit typeset for people (``"h [W/(m²·K)]"``, see :func:`typeset`)."""
+    u = typeset(unit) if typeset_unit else pretty(unit)
     return f"{title} [{u}]" if u else title

@@ -299,7 +299,7 @@ class Document:
             values = [u.value for u in found]
             solved = found[0].solution
             shown = "; ".join(
-                f"{n} = {num_html(float(q.magnitude))} {escape(un.pretty(q.units))}".rstrip()
+                f"{n} = {num_html(float(q.magnitude))} {escape(un.typeset(q.units))}".rstrip()
                 + f" (error estimate {solved.errors.get(n, float('nan')):.2g})"
                 for n, q in zip(block.unknowns, values)
             )
@@ -329,7 +329,7 @@ class Document:
         error = ""
         if d.is_function:
             unit = self.sheet.function_units.get(d.name)
-            unit = "" if unit is None else un.pretty(unit)
+            unit = "" if unit is None else un.typeset(unit)
             if unit:
                 notes.append(f"in {unit}")
             shown = self._shown_in(d.name)

@@ -165,11 +165,17 @@ def number_box(value: float, digits: int = PRECISION) -> Box:
     return Box(f"<mrow>{xml}</mrow>", width, prec, numeric=True)
 
 
-def unit_box(text: str) -> Box:
-    """A unit as printed by :func:`workbook.language.units.pretty` (``m/s^2``, ``1/s``, ``N*m``) in
-    upright letters: ``m/s²``."""
+def unit_box(text: str, typeset: bool = True) -> Box:
+    """A unit as printed by :func:`workbook.language.units.pretty` (``m/s^2``, ``1/s``, ``N*m``)
+    typeset in upright letters by :func:`workbook.language.units.typeset_factors`: ``m/s²``,
+    ``W/(m²·K)``, ``°C``, ``Δ°C``, ``Ω``, ``µm``. A text that is not a unit (a label), or
+    ``typeset=False`` (a quantity inside a formula, shown with the names written), keeps its
+    names: ``W/(m²·K)``, ``degC``."""
     if not text:
         return Box("", 0.0)
+    shown = _typeset_unit(text) if typeset else None
+    if shown is not None:
+        return shown
     num, _, den = text.partition("/")
     if den.startswith("(") and den.endswith(")"):
         den = den[1:-1]
@@ -193,7 +199,43 @@ def unit_box(text: str) -> Box:
     xml = top
     if den:
         bottom, w2 = factors(den)
+        if re.search(r"[*·\s]", den.strip()):  # W/(m²·K): the bar divides the whole product
+            bottom, w2 = f"<mo>(</mo>{bottom}<mo>)</mo>", w2 + 0.6
         xml += f"<mo lspace='0' rspace='0'>/</mo>{bottom}"
+        width += w2 + 0.4
+    return Box(f"<mrow class='unit'>{xml}</mrow>", width)
+
+
+def _typeset_unit(text: str) -> Box | None:
+    """The unit ``text`` typeset, or None when it is not a unit the reader knows."""
+    from ...language import units as un
+
+    found = un.shown_factors(text)
+    if found is None:
+        return None
+    top, bottom = found
+
+    def factors(part: list[tuple[str, float]]) -> tuple[str, float]:
+        out, width = [], 0.0
+        for i, (sym, power) in enumerate(part):
+            if i:
+                out.append(f"<mo lspace='0.1em' rspace='0.1em'>{_TIMES}</mo>")
+                width += 0.3
+            mi = f"<mi mathvariant='normal'>{escape(sym)}</mi>"
+            width += 0.55 * len(sym)
+            if power != 1:
+                shown = f"{power:g}"
+                mi = f"<msup>{mi}<mn>{escape(shown)}</mn></msup>"
+                width += 0.4 * len(shown)
+            out.append(mi)
+        return "".join(out), width
+
+    xml, width = factors(top) if top else ("<mn>1</mn>", 0.5)
+    if bottom:
+        below, w2 = factors(bottom)
+        if len(bottom) > 1:  # W/(m²·K): the bar divides by the whole product
+            below, w2 = f"<mo>(</mo>{below}<mo>)</mo>", w2 + 0.6
+        xml += f"<mo lspace='0' rspace='0'>/</mo>{below}"
         width += w2 + 0.4
     return Box(f"<mrow class='unit'>{xml}</mrow>", width)
 
@@ -207,7 +249,9 @@ def quantity_box(value: float, unit: str, digits: int = PRECISION, attrs: str = 
         return Box(f"<mrow {attrs}>{num.xml}</mrow>", num.width, num.prec, numeric=True)
     u = unit_box(unit)
     xml = f"<mrow {attrs}>{num.xml}<mspace width='0.25em'/>{u.xml}</mrow>"
-    return Box(xml, num.width + 0.25 + u.width, min(num.prec, PREC["*"]), numeric=True)
+    # a negative value keeps its sign's precedence: 22 °C − (−8 °C), 2·(−3 mm)
+    prec = PREC["neg"] if num.prec == PREC["neg"] else min(num.prec, PREC["*"])
+    return Box(xml, num.width + 0.25 + u.width, prec, numeric=True)
 
 
 #: Elements of one vector or matrix shown in the report (a 2,000,001-element vector made a
@@ -291,7 +335,7 @@ class MathML(Visitor):
     def visit_Quantity(self, node: ex.Quantity) -> Box:
         """``20 mm`` as written: the number, then its unit in upright letters."""
         num = self.visit_Number(ex.Number(node.value))
-        u = unit_box(node.unit)
+        u = unit_box(node.unit, typeset=False)
         xml = f"<mrow class='literal'>{num.xml}<mspace width='0.2em'/>{u.xml}</mrow>"
         return Box(xml, num.width + 0.2 + u.width, PREC["*"], numeric=True)
 
