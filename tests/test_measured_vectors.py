@@ -124,3 +124,20 @@ bad = "sum(x) + 1 m"
 """
     with pytest.raises(workbook.WorkbookError, match="cannot add"):
         workbook.load(write_template(tmp_path, text))
+
+
+@pytest.mark.slow
+def test_libreoffice_recalculates_the_regression(sheet, tmp_path):
+    from recalc import cell_values, recalculate, soffice
+
+    if soffice() is None:
+        pytest.skip("LibreOffice is not installed")
+    sh, tmp = sheet
+    path = sh.write_xlsx(tmp / "pt100-lo.xlsx")
+    results = openpyxl.load_workbook(path)["Results"]
+    rows = {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
+    values = cell_values(recalculate(path, tmp_path))
+    for name in ("n", "slope", "R20", "alpha", "r", "R_sum", "R_mean", "R_max", "R_3", "worst"):
+        want = float(sh.evaluate(name).magnitude)
+        got = float(values[("Results", f"B{rows[name]}")])
+        assert math.isclose(got, want, rel_tol=1e-11, abs_tol=1e-12), name
