@@ -45,14 +45,20 @@ def test_x_comes_first_in_every_quadrant(sheet):
     assert sh.evaluate("mixed").to("rad").magnitude == pytest.approx(math.atan2(0.5, 1.0))
 
 
-def test_the_workbook_writes_atan2_x_first_and_recalculates(sheet):
+def test_the_workbook_writes_atan2_x_first(sheet):
     sh, tmp = sheet
     path = sh.write_xlsx(tmp / "atan2.xlsx")
-    results = openpyxl.load_workbook(path)["Results"]
-    rows = {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
     book = openpyxl.load_workbook(path)
     cells = [str(getattr(c.value, "text", c.value)) for ws in book for row in ws for c in row]
     assert any(c.startswith("=ATAN2(px_1, py_1)") for c in cells), cells  # x first
+
+
+@pytest.mark.slow
+def test_the_workbook_recalculates_atan2_to_the_engine(sheet):
+    sh, tmp = sheet
+    path = sh.write_xlsx(tmp / "atan2-recalc.xlsx")
+    results = openpyxl.load_workbook(path)["Results"]
+    rows = {r[0].value: r[0].row for r in results.iter_rows(min_row=2) if r[0].value}
     solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
     values = {}
     for key, ranges in solution.items():
@@ -84,3 +90,17 @@ def test_an_excel_atan2_is_imported_in_its_order(tmp_path):
     assert float(imported.evaluate(name).magnitude) == pytest.approx(
         math.atan2(-91.7, 40.0), rel=1e-14
     ), text
+
+
+@pytest.mark.slow
+def test_a_symbolic_derivative_that_keeps_atan2_keeps_its_order(tmp_path):
+    """SymPy's atan2 takes y first: a derivative read back from it is the language's
+    atan2(x, y) again (d/dx of x*atan2(x, 1) holds atan2(x, 1) itself)."""
+    text = (
+        '[arguments]\nx = { unit = "" }\n\n[definitions]\n"f(x)" = "x*atan2(x, 1)"\n'
+        '"g(x)" = "diff(f(x), x)"\n'
+    )
+    sheet = workbook.load(write_template(tmp_path, text))
+    for x in (-2.0, -0.3, 0.7, 5.0):
+        want = float(mpmath.diff(lambda t: t * mpmath.atan2(1, t), x))
+        assert float(sheet.evaluate("g", x).magnitude) == pytest.approx(want, rel=1e-13)
