@@ -275,8 +275,12 @@ def _symbol(name: str) -> str:
 
 
 def _remember_spelling(text: str) -> None:
-    """Note how each unit name of a unit text the reader accepted is spelt (see pretty)."""
+    """Note how each unit name of a unit text the reader accepted is spelt (see pretty). A
+    typeset name (``Δ°C``, ``m²``, copied from a report) is not a spelling: pretty keeps the
+    text a worksheet types, and :func:`typeset` shows those."""
     for token in re.findall(r"[^\W\d][\w°µμΩ%]*|[°%Ω]", text):
+        if not token.isascii():
+            continue
         try:
             items = list(to_units_container(_unit_of(token)).items())
         except Exception:  # noqa: BLE001 - a name pint reads only in context
