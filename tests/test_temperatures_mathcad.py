@@ -179,3 +179,44 @@ def test_libreoffice_recalculates_the_sums(tmp_path):
         want = float(sheet.evaluate(name).magnitude)
         got = float(values[("Results", f"B{rows[name]}")])
         assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (name, formula, got, want)
+
+
+def test_a_wall_and_a_heater_in_degc_with_kelvin_rises(tmp_path):
+    """Heat transfer as a course writes it: surface temperatures from a heat flux over a film
+    coefficient (K), an outlet temperature from a power over m*cp (W/(kg/s*J/(kg*K)) = K),
+    88 % of a rise; each against the same arithmetic on plain numbers in kelvin."""
+    text = """
+[inputs]
+T_in = "22 degC"
+T_out = "-8 degC"
+h_i = "8 W/(m^2*K)"
+h_o = "23 W/(m^2*K)"
+L = "0.2 m"
+k = "0.8 W/(m*K)"
+P = "3 kW"
+m_dot = "0.05 kg/s"
+cp = "4.18 kJ/(kg*K)"
+eta = "88 %"
+
+[definitions]
+R = "1/h_i + L/k + 1/h_o"
+q = { expr = "(T_in - T_out)/R", unit = "W/m^2" }
+T_si = "T_in - q/h_i"
+T_so = { expr = "T_out + q/h_o", unit = "degF" }
+T_2 = "T_in + P/(m_dot*cp)"
+T_3 = "T_in + eta*(T_2 - T_in)"
+"""
+    sheet = workbook.load(write_template(tmp_path, text))
+    t_in, t_out = 22 + 273.15, -8 + 273.15
+    r = 1 / 8 + 0.2 / 0.8 + 1 / 23
+    q = (t_in - t_out) / r
+    want = {
+        "T_si": (t_in - q / 8, "degC"),
+        "T_so": (t_out + q / 23, "degF"),
+        "T_2": (t_in + 3000 / (0.05 * 4180), "degC"),
+        "T_3": (t_in + 0.88 * 3000 / (0.05 * 4180), "degC"),
+    }
+    for name, (kelvin, unit) in want.items():
+        got = sheet.evaluate(name)
+        assert str(got.units) == str(un.unit(unit)), (name, got)
+        assert _in_kelvin(got) == pytest.approx(kelvin, rel=1e-13), name
