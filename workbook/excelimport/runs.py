@@ -12,8 +12,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .cells import Ref
-
 MIN_RUN = 3
 ROW = "i_row"
 
@@ -110,7 +108,3 @@ def _moving(run: Run, parsed, ref_of) -> bool:
         moving[(ra.sheet, ra.r1, ra.c1)] = (ra.sheet, ra.c1, ra.r1 - run.first)
     run.moving = moving
     return True
-
-
-def column_ref(sheet: str, col: int, first: int, count: int) -> Ref:
-    return Ref(sheet, first, col, first + count - 1, col)

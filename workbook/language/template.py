@@ -106,12 +106,6 @@ _PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
 
 
 @dataclass
-class Located:
-    file: str
-    line: int | None
-
-
-@dataclass
 class InputSpec:
     name: str
     value: pint.Quantity | str

@@ -33,23 +33,6 @@ def pieces_value(f, points: np.ndarray, n: int, args=()) -> np.ndarray:
     return (((right - left)[..., None] * w * fx).sum(axis=-1)).sum(axis=0)
 
 
-def smallest_rule(
-    f, points, target, tolerance: float, args=(), most: int = 64
-) -> tuple[int, float]:
-    """The fewest nodes per piece (doubling from 4) whose value is within ``tolerance`` of
-    ``target`` (the engine's value); returns (n, largest difference). Beyond ``most`` nodes
-    the best found is returned with its difference."""
-    n, best = 4, (4, np.inf)
-    while n <= most:
-        diff = float(np.max(np.abs(pieces_value(f, points, n, args) - target)))
-        if diff < best[1]:
-            best = (n, diff)
-        if diff <= tolerance:
-            return n, diff
-        n *= 2
-    return best
-
-
 def _literal(values: np.ndarray, separator: str) -> str:
     return "{" + separator.join(repr(float(v)).upper() for v in values) + "}"
 

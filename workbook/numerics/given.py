@@ -185,9 +185,3 @@ def _corners(n: int) -> list[list[float]]:
     """The 2^n sign patterns of a diagonal (at most 16: the first four unknowns)."""
     m = min(n, 4)
     return [[(1 if (k >> i) & 1 else -1) if i < m else 0 for i in range(n)] for k in range(2**m)]
-
-
-def _unpack_r(packed: np.ndarray, n: int) -> np.ndarray:
-    out = np.zeros((n, n))
-    out[np.triu_indices(n)] = packed
-    return out
