@@ -21,13 +21,17 @@ from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
 from .symbols import Unknown
-from .translate import Item, Skipped, Translation, _rename, _uses
+from .translate import Item, Result, Skipped, Translation, _rename, _uses
 from .writer import Rendered
 
 
-def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
+def refusals(
+    data: dict, rendered: Rendered, folder: Path, results: list[Result] = ()
+) -> dict[str, str]:
     """Region id (or ``"REGION/trace N"`` for one trace of a plot) -> why the engine refuses
-    it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``."""
+    it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``. A stored
+    result (of ``results``) whose unit does not fit what the translation computes gets its
+    ``misfit``: its values stay, not computable, and the rest is still compared."""
     from ..engine.sheet import Sheet
     from ..language.template import spec_from_data
 
@@ -130,7 +134,42 @@ def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
                     sheet.column(col, rng.var, values, f"chart {c.name}")
         except WorkbookError as err:
             refused[f"{region}/trace {n}"] = f"the engine cannot draw it: {err.message}"
+    for res in results:
+        if res.sym is not None and res.rows and not res.misfit and res.sym.final not in bad:
+            res.misfit = _misfit(spec, typer, res)
     return refused
+
+
+def _misfit(spec, typer, res: Result) -> str:
+    """Why the stored values of ``res`` cannot be compared with the translation's (a unit of
+    another dimension), or ''."""
+    import pint
+
+    from ..language import units as un
+
+    if all(isinstance(v, str) for _, v in res.rows):
+        return ""
+    name = res.sym.final
+    try:
+        printed = un.unit(res.unit or "")
+        if name in spec.inputs:
+            ours = spec.inputs[name].unit
+            if ours is None:
+                return ""
+        elif name not in spec.definitions:
+            return ""  # not defined: not computable as it is
+        elif spec.definitions[name].is_function:
+            ours = typer.function(name).unit
+        else:
+            ours = typer.scalar(name).unit
+    except (WorkbookError, pint.PintError, AttributeError, TypeError):
+        return ""  # the check says why
+    if ours.dimensionality == printed.dimensionality:
+        return ""
+    return (
+        f"Mathcad stored it in {un.pretty(printed) or 'a plain number'} "
+        f"({un.dims(printed)}), the translation computes {un.dims(ours)}"
+    )
 
 
 def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) -> None:

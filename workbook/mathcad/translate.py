@@ -63,6 +63,9 @@ class Result:
     # where Mathcad's value is round-off of a larger size (a difference whose terms cancel, a
     # stored 0 among large elements): the absolute tolerance, and why
     round_off: tuple[float, str] | None = None
+    #: why the stored values do not fit what the translation computes (a unit of another
+    #: dimension): each stays a value, listed as not computable with this reason
+    misfit: str = ""
 
 
 @dataclass

@@ -50,7 +50,12 @@ def pretty_quantity(text: str) -> str:
 def _assign(tr: Translation) -> None:
     """Choose every symbol's identifier: unique, not a built-in, arguments apart from the
     names of inputs and definitions (shared by arguments of the same unit)."""
+    from ..functions.registry import CONSTANTS
+
     reserved = set(language_functions()) | {"pi"}
+    # a name left out (untranslated) is never a constant's: its stored results would read
+    # the constant (Mathcad's own e is written exp(1))
+    constants = set(CONSTANTS)
     taken: dict[str, Sym] = {}
     lower: set[str] = set()
     # (base, candidates) -> the first number not tried by a claim that shares nothing: the
@@ -58,7 +63,8 @@ def _assign(tr: Translation) -> None:
     untried: dict[tuple[str, int], int] = {}
 
     def claim(sym: Sym, share=None, alt=True) -> None:
-        base = sym.base if sym.base not in reserved else sym.base + "_"
+        off = reserved | constants if sym.broken else reserved
+        base = sym.base if sym.base not in off else sym.base + "_"
         # an argument named like a variable gets a trailing _ first (x and x_), then numbers
         candidates = [base] + ([base + "_"] if share is not None and alt else [])
         if sym.kind == "unit":  # a unit whose name the worksheet uses: kN_unit
@@ -304,6 +310,13 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             # under a name no worksheet defines: counted, and not computable (never compared)
             rows.append([f"unreadable result of region {res.region}", "", "(unreadable)", ""])
             continue
+        if res.misfit:  # under a name no worksheet defines: each value not computable
+            rows.append([f"# region {res.region}: {res.name}: not computable: {res.misfit}"])
+            for at, value in res.rows:
+                at_text = "" if at is None else repr(float(at))
+                val = value if isinstance(value, str) else repr(float(value))
+                rows.append([f"not computable result of region {res.region}", at_text, val, ""])
+            continue
         rows.append([f"# region {res.region}: {res.name}"])
         for at, value in res.rows:
             at_text = "" if at is None else repr(float(at))
@@ -350,10 +363,10 @@ def _list_unknown_units(tr: Translation) -> None:
     from ..language import units as un
 
     for res in tr.results:
-        if not res.unit or not res.rows:
+        if not res.unit or not res.rows or res.misfit:
             continue
         try:
-            un.registry().Unit(res.unit)
+            un.unit(res.unit)  # the language's reading: its names and its powers
         except Exception:  # noqa: BLE001 - pint's parse and definition errors alike
             tr.skipped.append(
                 Skipped(
@@ -362,7 +375,7 @@ def _list_unknown_units(tr: Translation) -> None:
                     f"its unit {res.unit!r} is not a unit the engine knows",
                 )
             )
-            res.rows = []
+            res.misfit = f"its unit {res.unit!r} is not a unit the engine knows"
 
 
 def _csv_text(rows: list[list[str]]) -> str:

@@ -1,0 +1,117 @@
+"""Builders of small Mathcad 15 worksheets (.xmcd XML) for the importer's tests, and the
+import and check steps the tests run on them."""
+
+from __future__ import annotations
+
+import json
+
+from workbook.cli import main
+
+ML = "http://schemas.mathsoft.com/math30"
+UNITS = "http://schemas.mathsoft.com/units10"
+
+
+def real(v) -> str:
+    return f"<ml:real>{v}</ml:real>"
+
+
+def ident(name, sub=None) -> str:
+    s = f' subscript="{sub}"' if sub else ""
+    return f"<ml:id{s}>{name}</ml:id>"
+
+
+def apply(op, *args) -> str:
+    return f"<ml:apply><ml:{op}/>{''.join(args)}</ml:apply>"
+
+
+def call(name, *args) -> str:
+    return f"<ml:apply>{ident(name)}{''.join(args)}</ml:apply>"
+
+
+def index(target, *at) -> str:
+    inner = at[0] if len(at) == 1 else f"<ml:sequence>{''.join(at)}</ml:sequence>"
+    return f"<ml:apply><ml:indexer/>{target}{inner}</ml:apply>"
+
+
+def matrix(*cells, cols=1) -> str:
+    """A matrix of ``cells`` as Mathcad stores them: column by column."""
+    rows = len(cells) // cols
+    return f'<ml:matrix rows="{rows}" cols="{cols}">{"".join(cells)}</ml:matrix>'
+
+
+def local(lhs, rhs) -> str:
+    return f"<ml:localDefine>{lhs}{rhs}</ml:localDefine>"
+
+
+def if_then(cond, body) -> str:
+    return f"<ml:ifThen>{cond}{body}</ml:ifThen>"
+
+
+def otherwise(body) -> str:
+    return f"<ml:otherwise>{body}</ml:otherwise>"
+
+
+def for_loop(var, first, last, body) -> str:
+    return f"<ml:for>{ident(var)}<ml:range>{first}{last}</ml:range>{body}</ml:for>"
+
+
+def program(*lines) -> str:
+    return f"<ml:program>{''.join(lines)}</ml:program>"
+
+
+def united(value, *units: tuple[str, int]) -> str:
+    """A stored value with units: ``united(2, ("m", 1), ("s", -2))``."""
+    refs = "".join(
+        f'<u:unitReference unit="{u}"' + (f' power-numerator="{p}"' if p != 1 else "") + "/>"
+        for u, p in units
+    )
+    return (
+        f'<ml:unitedValue>{real(value)}<u:unitMonomial xmlns:u="{UNITS}">{refs}'
+        "</u:unitMonomial></ml:unitedValue>"
+    )
+
+
+def at(rid: int) -> str:
+    return f'region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}"'
+
+
+def define(rid: int, lhs: str, rhs: str) -> str:
+    body = f'<ml:define xmlns:ml="{ML}">{lhs}{rhs}</ml:define>'
+    return f"<region {at(rid)}><math>{body}</math></region>"
+
+
+def function(rid: int, name: str, params: list[str], body: str) -> str:
+    bound = "".join(ident(p) for p in params)
+    lhs = f"<ml:function>{ident(name)}<ml:boundVars>{bound}</ml:boundVars></ml:function>"
+    return define(rid, lhs, body)
+
+
+def evaluate(rid: int, body: str, result: str) -> str:
+    return (
+        f'<region {at(rid)}><math><ml:eval xmlns:ml="{ML}">{body}'
+        f"<ml:result>{result}</ml:result></ml:eval></math></region>"
+    )
+
+
+def worksheet(*regions: str, origin: int = 0) -> str:
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n<worksheet '
+        'xmlns="http://schemas.mathsoft.com/worksheet30" '
+        f'xmlns:ml="{ML}"><settings><calculation><builtInVariables array-origin="{origin}"/>'
+        f"</calculation></settings><regions>{''.join(regions)}</regions></worksheet>"
+    )
+
+
+def import_sheet(tmp_path, capsys, name: str, *regions: str, origin: int = 0) -> str:
+    """Write the worksheet, import it (exit 0), and give the written TOML's text."""
+    src = tmp_path / f"{name}.xmcd"
+    src.write_text(worksheet(*regions, origin=origin), encoding="utf-8")
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    return (tmp_path / f"{name}.toml").read_text(encoding="utf-8")
+
+
+def check_sheet(tmp_path, capsys, name: str) -> dict:
+    """``workbook check NAME.toml --json`` (exit 0 or 1), its JSON."""
+    assert main(["check", str(tmp_path / f"{name}.toml"), "--json"]) in (0, 1)
+    return json.loads(capsys.readouterr().out)
