@@ -115,3 +115,43 @@ def check_sheet(tmp_path, capsys, name: str) -> dict:
     """``workbook check NAME.toml --json`` (exit 0 or 1), its JSON."""
     assert main(["check", str(tmp_path / f"{name}.toml"), "--json"]) in (0, 1)
     return json.loads(capsys.readouterr().out)
+
+
+# Mathcad Prime (.mcdx): a zip package of XML parts
+
+PRIME_WS = (
+    '<worksheet xmlns="http://schemas.mathsoft.com/worksheet50" '
+    'xmlns:ml="http://schemas.mathsoft.com/math50" '
+    'xmlns:u="http://schemas.mathsoft.com/units10"><regions>{}</regions></worksheet>'
+)
+PRIME_RESULTS = (
+    '<resultsList xmlns="http://schemas.mathsoft.com/result10" '
+    'xmlns:ml="http://schemas.mathsoft.com/math50" '
+    'xmlns:u="http://schemas.mathsoft.com/units10">{}</resultsList>'
+)
+
+
+def prime_region(rid: int, ref: int, body: str) -> str:
+    return f'<region region-id="{rid}"><math resultRef="{ref}">{body}</math></region>'
+
+
+def prime_result(ref: int, value: str = "") -> str:
+    inner = f"<ml:result>{value}</ml:result>" if value else ""
+    return f'<resultData result-id="{ref}" calculation-status="Synchronized">{inner}</resultData>'
+
+
+def prime_package(path, regions: str, results: str, extra: dict | None = None):
+    """Write a Prime package of ``regions`` and stored ``results`` at ``path``."""
+    import zipfile
+
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("mathcad/worksheet.xml", PRIME_WS.format(regions))
+        z.writestr("mathcad/result.xml", PRIME_RESULTS.format(results))
+        z.writestr(
+            "mathcad/settings/calculation.xml",
+            '<calculation xmlns="http://schemas.ptc.com/mathcad/settings/calculation10">'
+            '<builtInVariables array-origin="0" convergence-tolerance="0.001"/></calculation>',
+        )
+        for name, data in (extra or {}).items():
+            z.writestr(name, data)
+    return path

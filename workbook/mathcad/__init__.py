@@ -111,6 +111,9 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
     else:
         ws = read(src)
         regions = regions_with_references(ws)
+    from .structure import check_regions
+
+    check_regions(src, regions)
     name = sheet_name(src)
     out_dir = Path(out_dir)
     translator = Translator(engine.AtImport)

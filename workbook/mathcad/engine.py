@@ -73,7 +73,8 @@ def refusals(
             sheet.check_not_circular(block)
             typed_equations(typer, block)
         except WorkbookError as err:
-            refuse(err, rendered.region_of.get(block.unknowns[0]), block.unknowns)
+            unknowns = list(block.unknowns)  # a dict of the unknowns, in order
+            refuse(err, rendered.region_of.get(unknowns[0]), unknowns)
     later = []
     for name, d in spec.definitions.items():
         if name in bad or needs_refused(ex.Name(name)):

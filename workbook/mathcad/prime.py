@@ -160,6 +160,9 @@ def _xml(data: bytes, path: Path, part: str):
     count = sum(1 for _ in root.iter())
     if count > MAX_ELEMENTS:
         raise LimitError(f"{path}: {count:,} XML elements in {part} (limit {MAX_ELEMENTS:,})")
+    from .structure import refuse_xinclude
+
+    refuse_xinclude(root, path, part)
     return root
 
 
