@@ -155,3 +155,20 @@ def prime_package(path, regions: str, results: str, extra: dict | None = None):
         for name, data in (extra or {}).items():
             z.writestr(name, data)
     return path
+
+
+def math_region(rid: int, body: str) -> str:
+    """A math region of one expression (``Given``, an equation of a solve block)."""
+    return f"<region {at(rid)}><math>{body}</math></region>"
+
+
+def shown(body: str, result: str) -> str:
+    """The right side of ``x := body =`` (a definition whose value Mathcad shows)."""
+    return f"<ml:eval>{body}<ml:result>{result}</ml:result></ml:eval>"
+
+
+def derivative(var: str, body: str, degree: str | None = None) -> str:
+    """Mathcad's d/dvar body (with ``degree``, the n-th derivative's order element)."""
+    lam = f"<ml:lambda><ml:boundVars>{ident(var)}</ml:boundVars>{body}</ml:lambda>"
+    order = f"<ml:degree>{degree}</ml:degree>" if degree is not None else ""
+    return f"<ml:apply><ml:derivative/>{lam}{order}</ml:apply>"

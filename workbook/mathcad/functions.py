@@ -74,6 +74,13 @@ REFUSED: dict[str, str] = {
 #: shows it, but no file is written.
 WRITERS: frozenset[str] = frozenset({"WRITEPRN", "APPENDPRN", "WRITECSV", "WRITE", "APPEND"})
 
+#: Mathcad functions whose indices count from ORIGIN (the language's count from the sheet's
+#: origin): where the worksheet sets another ORIGIN than the one at its first index, a call
+#: is refused rather than read off by one
+ORIGIN_FUNCTIONS: frozenset[str] = frozenset(
+    {"submatrix", "last", "csort", "rsort", "lookup", "hlookup", "vlookup", "match"}
+)
+
 #: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
 OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpose": "transpose"}
 

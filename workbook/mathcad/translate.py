@@ -20,6 +20,7 @@ from . import names as nm
 from .functions import (
     MATHCAD_FUNCTIONS,
     OPERATOR_FUNCTIONS,
+    ORIGIN_FUNCTIONS,
     REFUSED,
     WRITERS,
     language_functions,
@@ -158,6 +159,8 @@ class ExprTranslator(Visitor):
             return ex.Name("pi")
         if not sub and text == "e":
             return ex.Call("exp", (ex.Number(1.0),))
+        if not sub and text == "ORIGIN":  # the ORIGIN in force where Mathcad reads it
+            return ex.Number(float(self.tr.origin))
         # Mathcad Prime labels each name: one labelled a variable is never a unit
         if not sub and text in FORMULA_UNITS and node.attrs.get("labels") in (None, "UNIT"):
             return ex.Name(self.tr.unit_sym(text).token())
@@ -291,7 +294,10 @@ class ExprTranslator(Visitor):
         if tag == "derivative":
             if bounds is not None:
                 raise Untranslatable("a derivative with bounds")
-            return self._builtin(name, tag, [body, var])
+            order = _derivative_order(next((a for a in args if a.tag == "degree"), None))
+            if order == 1:
+                return self._builtin(name, tag, [body, var])
+            return self._builtin(name, tag, [body, var, ex.Number(float(order))])
         if bounds is None and tag in ("summation", "product"):
             a, b = self._range_bounds(bvars[0], tag)
             return self._builtin(name, tag, [body, var, a, b])
@@ -466,6 +472,11 @@ class ExprTranslator(Visitor):
                 return self._builtin("sort", "sort", [inner])
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
             args = args[0].children  # min of a literal vector: min of its elements
+        if text in ORIGIN_FUNCTIONS and not key[1] and self.tr.origin != self.tr.sheet_origin:
+            raise Untranslatable(
+                f"{text}() where ORIGIN is {self.tr.origin}, and the worksheet's origin (ORIGIN "
+                f"at its first index) is {self.tr.sheet_origin}: its indices would be off"
+            )
         if text in MATHCAD_FUNCTIONS and not key[1]:
             name, order = MATHCAD_FUNCTIONS[text]
             if order is not None:
@@ -1562,7 +1573,14 @@ class Translator:
     def solve_block(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         if not args or any(a.tag != "id" for a in args):
             raise Untranslatable("Find of something that is not a list of names")
-        eqs = [c for c in self.constraints if c.children[0].tag == "equal"]
+        # Mathcad's chain a = b = c (a comparison whose left side is one, without brackets)
+        # is two equations, a = b and b = c
+        eqs = [
+            pair
+            for c in self.constraints
+            if c.children[0].tag == "equal"
+            for pair in _equal_chain(c)
+        ]
         ineqs = [c for c in self.constraints if c.children[0].tag != "equal"]
         if any(c.children[0].tag not in _INEQUALITY for c in ineqs):
             raise Untranslatable("a solve block with a condition that is not < <= > >=")
@@ -1580,8 +1598,8 @@ class Translator:
             unknowns.append((sym, f"{magnitude!r}{unit}"))
         inner = ExprTranslator(self, {**et.local, **local})
         equations = []
-        for c in eqs:
-            left, right = inner.value(c.children[1]), inner.value(c.children[2])
+        for lhs, rhs in eqs:
+            left, right = inner.value(lhs), inner.value(rhs)
             equations.append(ex.Compare(("==",), (left, right)))
         conditions = [inner.visit(c) for c in ineqs]  # checked at the root found
         if inner.ranges:
@@ -1730,6 +1748,41 @@ _ELEMENTWISE = frozenset(
 )  # fmt: skip
 
 
+def _derivative_order(degree: MNode | None) -> int:
+    """The order of Mathcad's derivative from its ``degree`` (none, or an empty placeholder
+    as Prime writes it: the first); an order that is not a whole number written in the
+    worksheet (1 to 5, as Mathcad's numerical derivative allows) is refused, never read as
+    the first."""
+    if degree is None:
+        return 1
+    kids = degree.children
+    if kids and all(c.tag == "placeholder" for c in kids):
+        return 1
+    if not kids:  # the order as the element's text
+        text = degree.text
+    elif len(kids) == 1 and kids[0].tag == "real":
+        text = kids[0].text
+    else:
+        text = ""
+    try:
+        value = float(text.strip())
+    except ValueError:
+        value = 0.5
+    if value.is_integer() and 1 <= value <= 5:
+        return int(value)
+    raise Untranslatable("a derivative whose order is not a whole number from 1 to 5 written in it")
+
+
+def _equal_chain(node: MNode) -> list[tuple[MNode, MNode]]:
+    """The equations of Mathcad's ``a = b = c`` (stored as ``(a = b) = c``): ``[(a, b), (b,
+    c)]``; of ``a = b``, ``[(a, b)]``."""
+    left, right = node.children[1], node.children[2]
+    if left.tag == "apply" and len(left.children) == 3 and left.children[0].tag == "equal":
+        inner = _equal_chain(left)
+        return [*inner, (inner[-1][1], right)]
+    return [(left, right)]
+
+
 def _rename(node: ex.Node, mapping: dict[str, str]) -> ex.Node:
     """The tree with names (and called functions) replaced as mapped."""
     if isinstance(node, ex.Name):
@@ -1808,6 +1861,8 @@ _INEQUALITY = {"lessThan", "greaterThan", "lessOrEqual", "greaterOrEqual"}
 def _has_index(node: MNode) -> bool:
     if node.tag in ("indexer", "matcol"):
         return True
+    if node.tag == "id" and node.text.strip() in ORIGIN_FUNCTIONS:
+        return True  # a function whose indices count from ORIGIN
     return any(_has_index(c) for c in node.children)
 
 

@@ -330,7 +330,8 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         title = "Mathcad results" + (" over " + arg if arg else "")
         if from_solve:
             title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
-        absolute = ABS_TOLERANCE
+        # Mathcad's solver stops within TOL: a value it found near 0 is as close as TOL
+        absolute = tr.solve_tolerance if from_solve else ABS_TOLERANCE
         if own:
             absolute, why = round_off[own]
             title += f" of {why}: their round-off"
