@@ -82,7 +82,14 @@ ORIGIN_FUNCTIONS: frozenset[str] = frozenset(
 )
 
 #: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
-OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpose": "transpose"}
+OPERATOR_FUNCTIONS: dict[str, str] = {
+    "sqrt": "sqrt", "absval": "abs", "transpose": "transpose",
+    "determinant": "det",  # |M| written as the determinant operator
+    "polyroots": "polyroots",  # the keyword form (its method: the roots are the same)
+}  # fmt: skip
+
+#: Mathcad operators of two operands written as elements, and their built-in
+OPERATOR_FUNCTIONS_2: dict[str, str] = {"crossProduct": "cross"}
 
 
 def language_functions() -> set[str]:

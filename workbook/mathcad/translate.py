@@ -20,6 +20,7 @@ from . import names as nm
 from .functions import (
     MATHCAD_FUNCTIONS,
     OPERATOR_FUNCTIONS,
+    OPERATOR_FUNCTIONS_2,
     ORIGIN_FUNCTIONS,
     REFUSED,
     WRITERS,
@@ -194,6 +195,11 @@ class ExprTranslator(Visitor):
             return self._absval(self.value(args[0]))
         if tag in OPERATOR_FUNCTIONS and len(args) == 1:
             return self._builtin(OPERATOR_FUNCTIONS[tag], tag, [self.value(args[0])])
+        if tag in OPERATOR_FUNCTIONS_2 and len(args) == 2:
+            pair = [self.value(a) for a in args]
+            return self._builtin(OPERATOR_FUNCTIONS_2[tag], tag, pair)
+        if tag == "matrow" and len(args) == 2:
+            return self._row(args)
         if tag == "id":
             if _is_if(node):
                 cond, a, b = _if_args(node)
@@ -368,6 +374,16 @@ class ExprTranslator(Visitor):
                 else ex.Binary("+", last, ex.Number(float(o - 1)))
             )
         return ex.Call("submatrix", (m, ex.Number(float(o)), last, j, j))
+
+    def _row(self, args: list[MNode]) -> ex.Node:
+        """Prime's row M<i> (a row of one row): submatrix(M, i, i, first column, last)."""
+        m, i = self.value(args[0]), self.value(args[1])
+        shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
+        if shift:
+            i = ex.Binary("+", i, ex.Number(float(shift)))
+        o = self.tr.sheet_origin
+        last = ex.Binary("+", ex.Call("cols", (m,)), ex.Number(float(o - 1)))
+        return ex.Call("submatrix", (m, i, i, ex.Number(float(o)), last))
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.value(node.children[0])])
@@ -963,7 +979,10 @@ class Translator:
                         self.stored_but_broken(region, evaluation, "an element assignment")
                 raise
             if evaluation is not None:
-                self.evaluation(region, evaluation, self.scope[_key(target)])
+                key = _key(target)
+                # v[k] := expr = shows the element (one number): the value of expr
+                element = not _shows_array(evaluation) and not _mentions(rhs, key)
+                self.evaluation(region, evaluation, None if element else self.scope[key])
             return
         if lhs.tag == "matrix" and evaluation is None:
             self.destructure(region, lhs, rhs)
@@ -1746,6 +1765,23 @@ _ELEMENTWISE = frozenset(
     {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "ln",
      "log10", "sqrt", "abs", "floor", "ceil", "round", "trunc", "sign", "atan2", "mod"}
 )  # fmt: skip
+
+
+def _shows_array(evaluation: MNode) -> bool:
+    """Whether the result Mathcad stored for ``evaluation`` is a vector or matrix."""
+    result = evaluation.find("result")
+    return result is None or any(_has_tag(c, "matrix") for c in result.children)
+
+
+def _has_tag(node: MNode, tag: str) -> bool:
+    return node.tag == tag or any(_has_tag(c, tag) for c in node.children)
+
+
+def _mentions(node: MNode, key: tuple[str, str]) -> bool:
+    """Whether the Mathcad name ``key`` occurs in ``node``."""
+    if node.tag == "id" and _key(node) == key:
+        return True
+    return any(_mentions(c, key) for c in node.children)
 
 
 def _derivative_order(degree: MNode | None) -> int:
