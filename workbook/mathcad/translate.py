@@ -486,6 +486,8 @@ class ExprTranslator(Visitor):
             if values is not None:  # sorted: Prime's order of eigenvalues does not matter
                 inner = self._builtin("eigenvals", "eigenvals", [self.value(values)])
                 return self._builtin("sort", "sort", [inner])
+        if text == "histogram" and not key[1] and len(args) == 2:
+            return self._histogram(args)
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
             args = args[0].children  # min of a literal vector: min of its elements
         if text in ORIGIN_FUNCTIONS and not key[1] and self.tr.origin != self.tr.sheet_origin:
@@ -505,6 +507,37 @@ class ExprTranslator(Visitor):
         raise Untranslatable(
             f"{nm.mathcad_text(*key)}() is neither defined before nor a known built-in"
         )
+
+    def _histogram(self, args: list[MNode]) -> ex.Node:
+        """Mathcad's histogram(intervals, data) counts every element of data, a matrix too:
+        a matrix of columns known at import is the stack of its columns (the counts do not
+        depend on the order of the values)."""
+        n, data = self.value(args[0]), self.value(args[1])
+        if not isinstance(n, ex.Number):  # a count of intervals: a number the engine sees
+            try:
+                n = ex.Number(float(_whole_at_import(self.tr, args[0], "histogram()")))
+            except Untranslatable:
+                pass  # intervals given as a vector, or a count not known at import
+        try:
+            columns = self.tr.quantity(
+                MNode("apply", {}, "", [MNode("id", {}, "cols", []), args[1]])
+            )
+            columns = int(float(columns.to("").magnitude))
+        except Exception:  # noqa: BLE001 - not known at import: the data as it is
+            columns = 1
+        if 1 < columns <= MAX_STACKED_COLUMNS:
+            o = self.tr.sheet_origin
+            last = ex.Binary("+", ex.Call("rows", (data,)), ex.Number(float(o - 1)))
+            data = ex.Call(
+                "stack",
+                tuple(
+                    ex.Call(
+                        "submatrix", (data, ex.Number(float(o)), last, ex.Number(j), ex.Number(j))
+                    )
+                    for j in (float(o + k) for k in range(columns))
+                ),
+            )
+        return self._builtin("histogram", "histogram", [n, data])
 
     def _matrix_of_function(self, args: list[MNode]) -> ex.Node:
         """Mathcad's matrix(m, n, f): the m x n matrix of f(i, j), i and j counted from 0
@@ -1886,6 +1919,9 @@ def _is_indexer(node: MNode) -> bool:
 #: condition), the root nearest the guess that meets the conditions is the one it reports in
 #: the worksheets measured; the others (linear, quasi-Newton): the default method
 _METHODS = {"levenberg": "levenberg-marquardt", "conjugate": "nearest"}
+
+#: at most this many columns of a matrix are stacked for histogram()
+MAX_STACKED_COLUMNS = 1000
 
 #: steps of the range of a quick plot (an x that the worksheet has not defined)
 QUICK_PLOT_STEPS = 200
