@@ -67,6 +67,14 @@ REFUSED: dict[str, str] = {
     name: "gives eigenvectors whose sign is that of Mathcad's solver, which the language "
     "cannot reproduce (the language's eigenvec has the largest component positive)"
     for name in ("eigenvec", "eigenvecs")
+} | {
+    # Mathcad's generator is its own, seeded by the worksheet's seed setting: no generator
+    # of the language gives its numbers, so a stored random value is never compared
+    name: "gives random numbers of Mathcad's own generator (seeded by the worksheet's seed "
+    "setting); a stored random value is not reproducible"
+    for name in ("rnd", "runif", "rnorm", "rbeta", "rbinom", "rcauchy", "rchisq", "rexp",
+                 "rF", "rgamma", "rgeom", "rhypergeom", "rlnorm", "rlogis", "rnbinom",
+                 "rpois", "rt", "rweibull", "rsample")
 }  # fmt: skip
 
 #: Mathcad functions that write a value to a file (``WRITEPRN("f", M)``, or
