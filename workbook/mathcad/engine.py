@@ -21,7 +21,8 @@ from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
 from .symbols import Unknown
-from .translate import Item, Result, Skipped, Translation, _rename, _uses
+from .translation import Item, Result, Skipped, Translation, uses
+from .trees import rename
 from .writer import Rendered
 
 
@@ -229,9 +230,9 @@ def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) ->
                 continue  # a trace's own names are looked at below
             for sym in _defined(item):
                 if not sym.broken:
-                    sym.broken = _uses(broken)
+                    sym.broken = uses(broken)
                     changed = True
-                    skip(item.region, what.get(item.region, "a region"), _uses(broken))
+                    skip(item.region, what.get(item.region, "a region"), uses(broken))
     for item in tr.items:  # a trace over a name left out: that trace is left out
         if item.kind != "chart" or not item.chart:
             continue
@@ -239,7 +240,7 @@ def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) ->
             trees = [x, y, *(t for t in rng.range if t is not None)]
             broken = first_broken(trees)
             if broken is not None:
-                _drop_trace(tr, item.region, n, _uses(broken), skip)
+                _drop_trace(tr, item.region, n, uses(broken), skip)
     for res in tr.results:  # stored values of what is left out: kept, listed as values
         if res.sym in sound and res.sym.broken:
             res.rows = [(None, v) for _, v in res.rows]
@@ -413,7 +414,7 @@ class AtImport:
             spec, typer, mapping, _ = self.worksheets[key]
             finals = [mapping[s.token()] for s in range_syms]
             scope = {f: spec.arguments[f].binding_unit for f in finals}
-            t = typer.expression(_rename(node, mapping), scope, what)
+            t = typer.expression(rename(node, mapping), scope, what)
         except (WorkbookError, RecursionError) as err:
             if isinstance(node, ex.Name) and node.id in self.items:
                 self.known.setdefault(node.id, None)  # refused wherever it is used

@@ -580,9 +580,9 @@ def _in_unit(value: MNode, factor: float, unit: str) -> MNode:
     if scaled.tag == "unitedValue":
         inner = scaled.children[0]
         mono = scaled.find("unitMonomial")
-        from .translate import _unit_monomial
+        from .trees import unit_monomial
 
-        residual = _unit_monomial(mono) if mono is not None else ""
+        residual = unit_monomial(mono) if mono is not None else ""
     if inner.tag == "matrix" and any(c.tag == "unitedValue" for c in inner.children):
         return MNode("unreadable", {"why": "a matrix result with a unit per element"}, "", [])
     text = f"({unit}) * ({residual})" if residual else unit

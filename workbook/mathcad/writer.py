@@ -11,8 +11,10 @@ from pathlib import Path
 from ..errors import InputError
 from ..language import expr as ex
 from .functions import language_functions
+from .symbols import Sym
 from .tomldoc import Document, is_one_line, one_line
-from .translate import Item, Skipped, Sym, Translation, _rename
+from .translation import Item, Skipped, Translation
+from .trees import rename
 
 #: Relative tolerance of the printed values: Mathcad stores full doubles.
 REL_TOLERANCE = 1e-9
@@ -104,7 +106,7 @@ def _assign(tr: Translation) -> None:
 
 
 def _text(node: ex.Node, mapping: dict[str, str]) -> str:
-    return ex.to_text(_rename(node, mapping))
+    return ex.to_text(rename(node, mapping))
 
 
 def _wrapped(text: str, width: int = 96) -> list[str]:
