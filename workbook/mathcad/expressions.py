@@ -403,6 +403,10 @@ class ExprTranslator(Visitor):
             if values is not None:  # sorted: Prime's order of eigenvalues does not matter
                 inner = self._builtin("eigenvals", "eigenvals", [self.value(values)])
                 return self._builtin("sort", "sort", [inner])
+        if text == "rkfixed" and not key[1]:
+            from .odes import rkfixed
+
+            return rkfixed(self, args)
         if text == "histogram" and not key[1] and len(args) == 2:
             return self._histogram(args)
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
