@@ -39,12 +39,13 @@ def rkfixed(et: ExprTranslator, args: list[MNode]) -> ex.Node:
     y0, x1, x2, n = (et.value(a) for a in args[:4])
     if et.ranges:
         raise Untranslatable("rkfixed() over a range variable")
-    try:
-        start = tr.quantity(args[0])
-    except Exception:  # noqa: BLE001 - not known at import
-        raise Untranslatable("rkfixed() of an initial value not known at import") from None
-    if getattr(start.magnitude, "ndim", 0) == 0:
-        y0 = ex.Matrix(((y0,),))  # a scalar: a state vector of one
+    if not _is_vector(tr, y0):
+        try:
+            start = tr.quantity(args[0])
+        except Exception:  # noqa: BLE001 - not known at import
+            raise Untranslatable("rkfixed() of an initial value not known at import") from None
+        if getattr(start.magnitude, "ndim", 0) == 0:
+            y0 = ex.Matrix(((y0,),))  # a scalar: a state vector of one
     names = {w: tr.new_sym("local", w, w) for w in ("h", "y", "x", "out", "k", "j")}
     slopes = [tr.new_sym("local", f"k{i}", f"k{i}") for i in range(1, 5)]
     h, y, x, out, k, j = (ex.Name(names[w].token()) for w in ("h", "y", "x", "out", "k", "j"))
@@ -95,3 +96,11 @@ def rkfixed(et: ExprTranslator, args: list[MNode]) -> ex.Node:
     tr.out.items.append(Item("definition", tr.region, sym=helper, program=lines))
     tr.calls.setdefault(dsym, []).append((x1, y0))
     return ex.Name(helper.token())
+
+
+def _is_vector(tr, tree: ex.Node) -> bool:
+    """Whether the initial value is a vector as the import sees it (written, or a name of
+    one)."""
+    if isinstance(tree, ex.Matrix):
+        return True
+    return isinstance(tree, ex.Name) and tr.is_array(tree.id)
