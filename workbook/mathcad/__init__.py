@@ -119,8 +119,9 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
     translator = Translator(engine.AtImport)
     tr = translator.run(ws, regions)
     doc, rendered = writer.document(tr, name, src)
+    listed = {id(r) for r in tr.results if r.misfit}  # listed by the writer already
     refused = engine.refusals(doc.data, rendered, out_dir, tr.results)
-    misfits = [r for r in tr.results if r.misfit]
+    misfits = [r for r in tr.results if r.misfit and id(r) not in listed]
     for res in misfits:
         tr.skipped.append(Skipped(res.region, f"the result of {res.name}", res.misfit))
     if refused:

@@ -115,6 +115,7 @@ class Translator(ResultsMixin, SolveMixin):
     def run(self, ws: Worksheet, regions: list[Region]) -> Translation:
         self.origin = ws.origin
         self.sheet_origin = self.out.origin = tt.first_index_origin(ws.origin, regions)
+        self.out.generator = ws.generator
         # Mathcad evaluates global definitions (≡) first, top to bottom, then the others
         first = [r for r in regions if r.math is not None and r.math.tag == "globalDefine"]
         regions = first + [r for r in regions if r not in first]

@@ -62,6 +62,7 @@ class Translation:
     title: str = ""
     ignored: list[str] = field(default_factory=list)  # regions that show and define nothing
     origin: int = 0
+    generator: str = ""  # "Mathcad Prime" for a .mcdx
     solve_tolerance: float = 1e-3  # Mathcad's TOL (its default, or the largest the sheet sets)
 
 

@@ -15,6 +15,7 @@ from .symbols import Sym
 from .tomldoc import Document, is_one_line, one_line
 from .translation import Item, Skipped, Translation
 from .trees import rename
+from .units import PRIME_UNITS_OFF
 
 #: Relative tolerance of the printed values: Mathcad stores full doubles.
 REL_TOLERANCE = 1e-9
@@ -367,6 +368,11 @@ def _list_unknown_units(tr: Translation) -> None:
 
     for res in tr.results:
         if not res.unit or not res.rows or res.misfit:
+            continue
+        off = [w for u, w in PRIME_UNITS_OFF.items() if re.search(rf"\b{u}\b", res.unit)]
+        if off and tr.generator == "Mathcad Prime":
+            tr.skipped.append(Skipped(res.region, f"the result of {res.name}", off[0]))
+            res.misfit = off[0]
             continue
         try:
             un.unit(res.unit)  # the language's reading: its names and its powers
