@@ -20,6 +20,9 @@ from mathcad_xml import (
     import_sheet,
     index,
     matrix,
+    prime_package,
+    prime_region,
+    prime_result,
     real,
     shown,
 )
@@ -157,3 +160,22 @@ def test_rkfixed_reproduces_mathcad_stored_matrix(tmp_path, capsys):
     main(["check", str(tmp_path / "ode-runge-kutta-spline.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert result["failed"] == 0 and result["reproduced"] >= 122, result["failures"][:3]
+
+
+def test_prime_divides_a_number_by_a_vector_element_by_element(tmp_path, capsys):
+    """Prime's T := 2 pi / w of a vector w stores the vector of quotients: vectorize."""
+    w = [1.5, 2.0, 4.0]
+    vec = matrix(*(real(v) for v in w))
+    body = apply("div", apply("mult", real(2), "<ml:id>π</ml:id>"), "<ml:id>w</ml:id>")
+    regions = prime_region(1, 1, f"<ml:define><ml:id>w</ml:id>{vec}</ml:define>") + prime_region(
+        2, 2, f"<ml:define><ml:id>T</ml:id><ml:eval>{body}</ml:eval></ml:define>"
+    )
+    stored = matrix(*(real(2 * math.pi / v) for v in w))
+    src = prime_package(
+        tmp_path / "periods.mcdx", regions, prime_result(1) + prime_result(2, stored)
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    main(["check", str(tmp_path / "periods.toml"), "--json"])
+    result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]

@@ -96,6 +96,10 @@ class ExprTranslator(Visitor):
             left, right = self.value(args[0]), self.value(args[1])
             if tag == "div":
                 left, right = self._radians(left, right), self._radians(right, left)
+                if self._prime_number_over_vector(left, right):
+                    # Prime divides a number by a vector element by element (it stores the
+                    # vector of quotients); Mathcad 15 refuses it
+                    return ex.Call("vectorize", (ex.Binary("/", left, right),))
             return ex.Binary(tt.BINARY[tag], left, right)
         if tag in tt.COMPARE and len(args) == 2:
             return self._compare(tag, args)
@@ -135,6 +139,14 @@ class ExprTranslator(Visitor):
         if tag in ("Maximize", "Minimize"):
             return self.tr.extremum(self, args, tag == "Maximize")
         raise Untranslatable(f"{_what(tag)} is not in the language yet")
+
+    def _prime_number_over_vector(self, left: ex.Node, right: ex.Node) -> bool:
+        """A number of the sheet divided by a vector of the sheet, in a Prime worksheet."""
+        if self.tr.out.generator != "Mathcad Prime" or self.local:
+            return False
+        vector = isinstance(right, ex.Name) and self.tr.is_array(right.id)
+        number = not tt.has_matrix(left) and not any(self.tr.is_array(n) for n in ex.names(left))
+        return vector and number
 
     def value(self, node: MNode) -> ex.Node:
         """``node`` where Mathcad uses a number: a comparison (Mathcad's 1 or 0) is
