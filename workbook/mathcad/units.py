@@ -21,6 +21,7 @@ FORMULA_UNITS: dict[str, str] = {
     "yr": "year", "wk": "week",
     # force
     "N": "newton", "kN": "kilonewton", "MN": "meganewton", "dyne": "dyne", "kgf": "kilogram_force",
+    "N·m": "newton * meter", "kN·m": "kilonewton * meter",  # moments, one name in Mathcad
     "lbf": "pound_force", "kip": "kip", "tonf": "ton_force",
     # pressure, stress
     "Pa": "pascal", "kPa": "kilopascal", "MPa": "megapascal", "GPa": "gigapascal",
