@@ -26,13 +26,9 @@ from .trees import rename
 from .writer import Rendered
 
 
-def refusals(
-    data: dict, rendered: Rendered, folder: Path, results: list[Result] = ()
-) -> dict[str, str]:
+def refusals(data: dict, rendered: Rendered, folder: Path, results=()) -> dict[str, str]:
     """Region id (or ``"REGION/trace N"`` for one trace of a plot) -> why the engine refuses
-    it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``. A stored
-    result (of ``results``) whose unit does not fit what the translation computes gets its
-    ``misfit``: its values stay, not computable, and the rest is still compared."""
+    it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``."""
     from ..engine.sheet import Sheet
     from ..language.template import spec_from_data
 
@@ -136,10 +132,16 @@ def refusals(
                     sheet.column(col, rng.var, values, f"chart {c.name}")
         except WorkbookError as err:
             refused[f"{region}/trace {n}"] = f"the engine cannot draw it: {err.message}"
+    _mark_misfits(spec, typer, results, bad)
+    return refused
+
+
+def _mark_misfits(spec, typer, results: list[Result], bad: set[str]) -> None:
+    """Give each stored result (of ``results``) whose unit does not fit what the translation
+    computes its ``misfit``: its values stay, not computable, and the rest is compared."""
     for res in results:
         if res.sym is not None and res.rows and not res.misfit and res.sym.final not in bad:
             res.misfit = _misfit(spec, typer, res)
-    return refused
 
 
 def _misfit(spec, typer, res: Result) -> str:

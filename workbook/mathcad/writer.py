@@ -313,12 +313,8 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             # under a name no worksheet defines: counted, and not computable (never compared)
             rows.append([f"unreadable result of region {res.region}", "", "(unreadable)", ""])
             continue
-        if res.misfit:  # under a name no worksheet defines: each value not computable
-            rows.append([f"# region {res.region}: {res.name}: not computable: {res.misfit}"])
-            for at, value in res.rows:
-                at_text = "" if at is None else repr(float(at))
-                val = value if isinstance(value, str) else repr(float(value))
-                rows.append([f"not computable result of region {res.region}", at_text, val, ""])
+        if res.misfit:
+            rows += _misfit_rows(res)
             continue
         rows.append([f"# region {res.region}: {res.name}"])
         for at, value in res.rows:
@@ -333,8 +329,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         title = "Mathcad results" + (" over " + arg if arg else "")
         if from_solve:
             title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
-        # Mathcad's solver stops within TOL: a value it found near 0 is as close as TOL
-        absolute = tr.solve_tolerance if from_solve else ABS_TOLERANCE
+        absolute = tr.solve_tolerance if from_solve else ABS_TOLERANCE  # TOL near 0 too
         if own:
             absolute, why = round_off[own]
             title += f" of {why}: their round-off"
@@ -359,6 +354,17 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         doc.pair("rel_tolerance", tr.solve_tolerance if from_solve else REL_TOLERANCE)
         doc.pair("tolerance", absolute)
     return doc, out
+
+
+def _misfit_rows(res) -> list[list[str]]:
+    """The stored values of a result that does not fit the translation, under a name no
+    worksheet defines: each counted, and not computable."""
+    rows = [[f"# region {res.region}: {res.name}: not computable: {res.misfit}"]]
+    for at, value in res.rows:
+        at_text = "" if at is None else repr(float(at))
+        val = value if isinstance(value, str) else repr(float(value))
+        rows.append([f"not computable result of region {res.region}", at_text, val, ""])
+    return rows
 
 
 def _list_unknown_units(tr: Translation) -> None:
