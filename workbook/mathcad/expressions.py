@@ -311,7 +311,9 @@ class ExprTranslator(Visitor):
         if shift:
             i = ex.Binary("+", i, ex.Number(float(shift)))
         o = self.tr.sheet_origin
-        last = ex.Binary("+", ex.Call("cols", (m,)), ex.Number(float(o - 1)))
+        last = ex.Call("cols", (m,))
+        if o != 1:
+            last = ex.Binary("-" if o < 1 else "+", last, ex.Number(float(abs(o - 1))))
         return ex.Call("submatrix", (m, i, i, ex.Number(float(o)), last))
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
