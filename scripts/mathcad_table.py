@@ -1,12 +1,13 @@
 """The table of docs/mathcad.md: each Mathcad worksheet imported, then checked.
 
-For every .xmcd or .mcdx file under the folder (default ../shared/mathcad beside the repository; a
-file that is only referenced by another one is skipped), runs ``workbook import`` and
-``workbook check --json`` and prints a Markdown table: results Mathcad stored, reproduced,
-failed, not computable, and the reasons for those not reproduced (from the untranslated list
-of the worksheet).
+For every .xmcd or .mcdx file under each folder (default: the Mathcad 15 and Prime folders of
+../shared beside the repository, corpus-more's included; a file that is only referenced by
+another one is skipped), runs ``workbook import`` and ``workbook check --json`` and prints a
+Markdown table per folder: both exit codes, results Mathcad stored, reproduced, failed, not
+computable, and the most common reasons for those not reproduced (from the untranslated list
+of the worksheet), then one summary row per folder.
 
-    python scripts/mathcad_table.py [FOLDER]
+    python scripts/mathcad_table.py [FOLDER ...]
 """
 
 from __future__ import annotations
@@ -89,45 +90,82 @@ def _short(reason: str) -> str:
     return reason[:150]
 
 
-def main() -> int:
-    folder = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT.parent / "shared" / "mathcad"
+FOLDERS = (
+    "mathcad",
+    "mathcad-prime",
+    "corpus-more/mathcad15-a",
+    "corpus-more/mathcad15-b",
+    "corpus-more/prime-a",
+)
+
+
+def table(folder: Path, tmp: str) -> tuple[list[str], Counter]:
+    """The rows of one folder's table and its sums."""
     skip = referenced(folder)
     rows = []
-    sums = Counter()
+    sums: Counter = Counter()
+    for path in sorted([*folder.rglob("*.xmcd"), *folder.rglob("*.mcdx")]):
+        if path.resolve() in skip:
+            continue
+        name = path.relative_to(folder).as_posix()
+        sums.update(files=1)
+        imp = run(["import", str(path), "--out", tmp, "--force"])
+        if imp.returncode != 0:
+            sums.update(errors=1)
+            msg = imp.stderr.strip().splitlines()[-1:] or [""]
+            rows.append(f"| {name} | {imp.returncode} | | import failed: {msg[0][:120]} |||||")
+            continue
+        toml = Path(tmp) / (path.stem + ".toml")
+        chk = run(["check", str(toml), "--json"])
+        if chk.returncode not in (0, 1):
+            sums.update(errors=1)
+            msg = chk.stderr.strip().splitlines()[-1:] or [""]
+            rows.append(f"| {name} | 0 | {chk.returncode} | check failed: {msg[0][:120]} |||||")
+            continue
+        res = json.loads(chk.stdout)
+        n, ok = res["printed"], res["reproduced"]
+        pct = f"{100 * ok / n:.0f} %" if n else "-"
+        why = "; ".join(f"{c} × {r}" for r, c in reasons(toml, res["failures"]).most_common(6))
+        good, total = evaluations(toml, res["failures"])
+        sums.update(
+            good=good, total=total, n=n, ok=ok, failed=res["failed"], nc=res["not_computable"]
+        )
+        rows.append(
+            f"| {name} | 0 | {chk.returncode} | {good} of {total} | {n} | {ok} | "
+            f"{res['failed']} | {res['not_computable']} | {pct} | {why or '-'} |"
+        )
+    return rows, sums
+
+
+def main() -> int:
+    shared = ROOT.parent / "shared"
+    folders = [Path(a) for a in sys.argv[1:]] or [shared / f for f in FOLDERS]
+    header = (
+        "| file | import exit | check exit | evaluations reproduced | values stored | "
+        "reproduced | failed | not computable | share of values | why not (most common) |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"
+    )
+    summary = []
     with tempfile.TemporaryDirectory() as tmp:
-        for path in sorted([*folder.rglob("*.xmcd"), *folder.rglob("*.mcdx")]):
-            if path.resolve() in skip:
+        for folder in folders:
+            if not folder.is_dir():
                 continue
-            name = path.relative_to(folder).as_posix()
-            imp = run(["import", str(path), "--out", tmp, "--force"])
-            if imp.returncode != 0:
-                rows.append(f"| {name} | import failed: {imp.stderr.strip()[:120]} | | | | | |")
-                continue
-            toml = Path(tmp) / (path.stem + ".toml")
-            chk = run(["check", str(toml), "--json"])
-            res = json.loads(chk.stdout)
-            n, ok = res["printed"], res["reproduced"]
-            pct = f"{100 * ok / n:.0f} %" if n else "-"
-            why = "; ".join(f"{c} × {r}" for r, c in reasons(toml, res["failures"]).most_common())
-            good, total = evaluations(toml, res["failures"])
-            sums.update(
-                good=good, total=total, n=n, ok=ok, failed=res["failed"], nc=res["not_computable"]
+            rows, sums = table(folder, tmp)
+            pct = f"{100 * sums['ok'] / sums['n']:.1f} %" if sums["n"] else "-"
+            print(f"\n### {folder.name}\n\n{header}")
+            print("\n".join(rows))
+            line = (
+                f"{sums['good']} of {sums['total']} | {sums['n']} | {sums['ok']} | "
+                f"{sums['failed']} | {sums['nc']} | {pct}"
             )
-            rows.append(
-                f"| {name} | {good} of {total} | {n} | {ok} | {res['failed']} | "
-                f"{res['not_computable']} | {pct} | {why or '-'} |"
-            )
+            print(f"| all | | | {line} | |")
+            summary.append(f"| {folder.name} | {sums['files']} | {sums['errors']} | {line} |")
     print(
-        "| file | evaluations reproduced | values stored | reproduced | failed | not computable "
-        "| share of values | why not |"
+        "\n| folder | files | import or check errors | evaluations reproduced | values stored "
+        "| reproduced | failed | not computable | share of values |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
     )
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
-    print("\n".join(rows))
-    pct = f"{100 * sums['ok'] / sums['n']:.0f} %" if sums["n"] else "-"
-    print(
-        f"| all | {sums['good']} of {sums['total']} | {sums['n']} | {sums['ok']} | "
-        f"{sums['failed']} | {sums['nc']} | {pct} | |"
-    )
+    print("\n".join(summary))
     return 0
 
 

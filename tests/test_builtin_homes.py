@@ -45,14 +45,14 @@ HOMES = {
 # new list, or a built-in added to one of these, fails: (module, the built-ins listed).
 KNOWN_ELSEWHERE = {
     # Mathcad's operators that bind a variable, as the importer translates them
-    ("mathcad/translate.py", ("diff", "integral", "product", "sum")),
+    ("mathcad/trees.py", ("diff", "integral", "product", "sum")),
     # the sizes read from a matrix written out while importing (its elements may call
     # functions whose units are settled only at the end of the translation)
     ("mathcad/engine.py", ("cols", "length", "rows")),
     # the built-ins vectorize applies element by element (could be read from the registry:
     # the entries of plain numbers)
     (
-        "mathcad/translate.py",
+        "mathcad/expressions.py",
         (
             "abs", "acos", "asin", "atan", "atan2", "ceil", "cos", "cosh", "exp", "floor", "ln",
             "log10", "mod", "round", "sign", "sin", "sinh", "sqrt", "tan", "tanh", "trunc",

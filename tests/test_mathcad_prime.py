@@ -9,49 +9,19 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from mathcad_xml import prime_package as _package
+from mathcad_xml import prime_region as _region
+from mathcad_xml import prime_result as _result
 
 from workbook.cli import main
 
 PRIME = Path(__file__).resolve().parents[1].parent / "shared" / "mathcad-prime"
 needs_corpus = pytest.mark.skipif(not PRIME.is_dir(), reason=f"{PRIME} is absent")
 
-WS = (
-    '<worksheet xmlns="http://schemas.mathsoft.com/worksheet50" '
-    'xmlns:ml="http://schemas.mathsoft.com/math50" '
-    'xmlns:u="http://schemas.mathsoft.com/units10"><regions>{}</regions></worksheet>'
-)
-RESULTS = (
-    '<resultsList xmlns="http://schemas.mathsoft.com/result10" '
-    'xmlns:ml="http://schemas.mathsoft.com/math50" '
-    'xmlns:u="http://schemas.mathsoft.com/units10">{}</resultsList>'
-)
 SPAN = (
     '<Span xmlns="http://schemas.microsoft.com/winfx/2006/xaml/presentation" '
     'xmlns:pw="clr-namespace:Ptc.Wpf;assembly=Ptc.Core">{}<pw:Subscript>{}</pw:Subscript></Span>'
 )
-
-
-def _region(rid: int, ref: int, body: str) -> str:
-    return f'<region region-id="{rid}"><math resultRef="{ref}">{body}</math></region>'
-
-
-def _result(ref: int, value: str = "") -> str:
-    inner = f"<ml:result>{value}</ml:result>" if value else ""
-    return f'<resultData result-id="{ref}" calculation-status="Synchronized">{inner}</resultData>'
-
-
-def _package(path: Path, regions: str, results: str, extra: dict | None = None) -> Path:
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("mathcad/worksheet.xml", WS.format(regions))
-        z.writestr("mathcad/result.xml", RESULTS.format(results))
-        z.writestr(
-            "mathcad/settings/calculation.xml",
-            '<calculation xmlns="http://schemas.ptc.com/mathcad/settings/calculation10">'
-            '<builtInVariables array-origin="0" convergence-tolerance="0.001"/></calculation>',
-        )
-        for name, data in (extra or {}).items():
-            z.writestr(name, data)
-    return path
 
 
 def _check(toml: Path, capsys) -> dict:

@@ -7,7 +7,9 @@ from __future__ import annotations
 import zipfile
 from pathlib import Path
 
-from test_mathcad_prime import RESULTS, WS, _check, _id, _region, _result
+from mathcad_xml import PRIME_RESULTS as RESULTS
+from mathcad_xml import PRIME_WS as WS
+from test_mathcad_prime import _check, _id, _region, _result
 
 from workbook.cli import main
 

@@ -6,87 +6,24 @@ from __future__ import annotations
 
 import json
 
+from mathcad_xml import ML  # noqa: F401 - for the tests that import it from here
+from mathcad_xml import apply as _apply
+from mathcad_xml import call as _call
+from mathcad_xml import define as _define
+from mathcad_xml import evaluate as _eval
+from mathcad_xml import for_loop as _for
+from mathcad_xml import function as _function
+from mathcad_xml import ident as _id
+from mathcad_xml import if_then as _if
+from mathcad_xml import index as _index
+from mathcad_xml import local as _local
+from mathcad_xml import matrix as _matrix
+from mathcad_xml import otherwise as _otherwise
+from mathcad_xml import program as _program
+from mathcad_xml import real as _real
+from mathcad_xml import worksheet as _worksheet
+
 from workbook.cli import main
-
-ML = "http://schemas.mathsoft.com/math30"
-
-
-def _real(v) -> str:
-    return f"<ml:real>{v}</ml:real>"
-
-
-def _id(name, sub=None) -> str:
-    s = f' subscript="{sub}"' if sub else ""
-    return f"<ml:id{s}>{name}</ml:id>"
-
-
-def _apply(op, *args) -> str:
-    return f"<ml:apply><ml:{op}/>{''.join(args)}</ml:apply>"
-
-
-def _call(name, *args) -> str:
-    return f"<ml:apply>{_id(name)}{''.join(args)}</ml:apply>"
-
-
-def _index(target, *at) -> str:
-    inner = at[0] if len(at) == 1 else f"<ml:sequence>{''.join(at)}</ml:sequence>"
-    return f"<ml:apply><ml:indexer/>{target}{inner}</ml:apply>"
-
-
-def _matrix(*cells, cols=1) -> str:
-    rows = len(cells) // cols
-    return f'<ml:matrix rows="{rows}" cols="{cols}">{"".join(cells)}</ml:matrix>'
-
-
-def _local(lhs, rhs) -> str:
-    return f"<ml:localDefine>{lhs}{rhs}</ml:localDefine>"
-
-
-def _if(cond, body) -> str:
-    return f"<ml:ifThen>{cond}{body}</ml:ifThen>"
-
-
-def _otherwise(body) -> str:
-    return f"<ml:otherwise>{body}</ml:otherwise>"
-
-
-def _for(var, first, last, body) -> str:
-    return f"<ml:for>{_id(var)}<ml:range>{first}{last}</ml:range>{body}</ml:for>"
-
-
-def _program(*lines) -> str:
-    return f"<ml:program>{''.join(lines)}</ml:program>"
-
-
-def _at(rid: int) -> str:
-    return f'region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}"'
-
-
-def _define(rid: int, lhs: str, rhs: str) -> str:
-    body = f'<ml:define xmlns:ml="{ML}">{lhs}{rhs}</ml:define>'
-    return f"<region {_at(rid)}><math>{body}</math></region>"
-
-
-def _function(rid: int, name: str, params: list[str], body: str) -> str:
-    bound = "".join(_id(p) for p in params)
-    lhs = f"<ml:function>{_id(name)}<ml:boundVars>{bound}</ml:boundVars></ml:function>"
-    return _define(rid, lhs, body)
-
-
-def _eval(rid: int, body: str, result: str) -> str:
-    return (
-        f'<region {_at(rid)}><math><ml:eval xmlns:ml="{ML}">{body}'
-        f"<ml:result>{result}</ml:result></ml:eval></math></region>"
-    )
-
-
-def _worksheet(*regions: str, origin: int = 0) -> str:
-    return (
-        '<?xml version="1.0" encoding="UTF-8"?>\n<worksheet '
-        'xmlns="http://schemas.mathsoft.com/worksheet30" '
-        f'xmlns:ml="{ML}"><settings><calculation><builtInVariables array-origin="{origin}"/>'
-        f"</calculation></settings><regions>{''.join(regions)}</regions></worksheet>"
-    )
 
 
 def _import(tmp_path, capsys, name: str, *regions: str, origin: int = 0) -> str:

@@ -100,7 +100,7 @@ def _reference_path(path: Path, href: str) -> Path:
 def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = False):
     """Translate ``src`` and write ``out_dir/NAME.toml`` and its printed values."""
     from . import engine, writer
-    from .translate import Translator
+    from .translate import Skipped, Translator
 
     src = Path(src)
     if src.suffix.lower() == ".mcdx":
@@ -111,14 +111,22 @@ def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = Fal
     else:
         ws = read(src)
         regions = regions_with_references(ws)
+    from .structure import check_regions
+
+    check_regions(src, regions)
     name = sheet_name(src)
     out_dir = Path(out_dir)
     translator = Translator(engine.AtImport)
     tr = translator.run(ws, regions)
     doc, rendered = writer.document(tr, name, src)
-    refused = engine.refusals(doc.data, rendered, out_dir)
+    listed = {id(r) for r in tr.results if r.misfit}  # listed by the writer already
+    refused = engine.refusals(doc.data, rendered, out_dir, tr.results)
+    misfits = [r for r in tr.results if r.misfit and id(r) not in listed]
+    for res in misfits:
+        tr.skipped.append(Skipped(res.region, f"the result of {res.name}", res.misfit))
     if refused:
         engine.leave_out(tr, refused, _descriptions(translator, regions))
+    if refused or misfits:
         doc, rendered = writer.document(tr, name, src)
     rendered.toml = doc.text()
     if refused:  # what is left loads as it is: anything else is a bug of the import

@@ -21,11 +21,12 @@ from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
 from .symbols import Unknown
-from .translate import Item, Skipped, Translation, _rename, _uses
+from .translation import Item, Result, Skipped, Translation, uses
+from .trees import rename
 from .writer import Rendered
 
 
-def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
+def refusals(data: dict, rendered: Rendered, folder: Path, results=()) -> dict[str, str]:
     """Region id (or ``"REGION/trace N"`` for one trace of a plot) -> why the engine refuses
     it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``."""
     from ..engine.sheet import Sheet
@@ -69,7 +70,8 @@ def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
             sheet.check_not_circular(block)
             typed_equations(typer, block)
         except WorkbookError as err:
-            refuse(err, rendered.region_of.get(block.unknowns[0]), block.unknowns)
+            unknowns = list(block.unknowns)  # a dict of the unknowns, in order
+            refuse(err, rendered.region_of.get(unknowns[0]), unknowns)
     later = []
     for name, d in spec.definitions.items():
         if name in bad or needs_refused(ex.Name(name)):
@@ -130,7 +132,48 @@ def refusals(data: dict, rendered: Rendered, folder: Path) -> dict[str, str]:
                     sheet.column(col, rng.var, values, f"chart {c.name}")
         except WorkbookError as err:
             refused[f"{region}/trace {n}"] = f"the engine cannot draw it: {err.message}"
+    _mark_misfits(spec, typer, results, bad)
     return refused
+
+
+def _mark_misfits(spec, typer, results: list[Result], bad: set[str]) -> None:
+    """Give each stored result (of ``results``) whose unit does not fit what the translation
+    computes its ``misfit``: its values stay, not computable, and the rest is compared."""
+    for res in results:
+        if res.sym is not None and res.rows and not res.misfit and res.sym.final not in bad:
+            res.misfit = _misfit(spec, typer, res)
+
+
+def _misfit(spec, typer, res: Result) -> str:
+    """Why the stored values of ``res`` cannot be compared with the translation's (a unit of
+    another dimension), or ''."""
+    import pint
+
+    from ..language import units as un
+
+    if all(isinstance(v, str) for _, v in res.rows):
+        return ""
+    name = res.sym.final
+    try:
+        printed = un.unit(res.unit or "")
+        if name in spec.inputs:
+            ours = spec.inputs[name].unit
+            if ours is None:
+                return ""
+        elif name not in spec.definitions:
+            return ""  # not defined: not computable as it is
+        elif spec.definitions[name].is_function:
+            ours = typer.function(name).unit
+        else:
+            ours = typer.scalar(name).unit
+    except (WorkbookError, pint.PintError, AttributeError, TypeError):
+        return ""  # the check says why
+    if ours.dimensionality == printed.dimensionality:
+        return ""
+    return (
+        f"Mathcad stored it in {un.pretty(printed) or 'a plain number'} "
+        f"({un.dims(printed)}), the translation computes {un.dims(ours)}"
+    )
 
 
 def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) -> None:
@@ -189,9 +232,9 @@ def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) ->
                 continue  # a trace's own names are looked at below
             for sym in _defined(item):
                 if not sym.broken:
-                    sym.broken = _uses(broken)
+                    sym.broken = uses(broken)
                     changed = True
-                    skip(item.region, what.get(item.region, "a region"), _uses(broken))
+                    skip(item.region, what.get(item.region, "a region"), uses(broken))
     for item in tr.items:  # a trace over a name left out: that trace is left out
         if item.kind != "chart" or not item.chart:
             continue
@@ -199,7 +242,7 @@ def leave_out(tr: Translation, refused: dict[str, str], what: dict[str, str]) ->
             trees = [x, y, *(t for t in rng.range if t is not None)]
             broken = first_broken(trees)
             if broken is not None:
-                _drop_trace(tr, item.region, n, _uses(broken), skip)
+                _drop_trace(tr, item.region, n, uses(broken), skip)
     for res in tr.results:  # stored values of what is left out: kept, listed as values
         if res.sym in sound and res.sym.broken:
             res.rows = [(None, v) for _, v in res.rows]
@@ -373,7 +416,7 @@ class AtImport:
             spec, typer, mapping, _ = self.worksheets[key]
             finals = [mapping[s.token()] for s in range_syms]
             scope = {f: spec.arguments[f].binding_unit for f in finals}
-            t = typer.expression(_rename(node, mapping), scope, what)
+            t = typer.expression(rename(node, mapping), scope, what)
         except (WorkbookError, RecursionError) as err:
             if isinstance(node, ex.Name) and node.id in self.items:
                 self.known.setdefault(node.id, None)  # refused wherever it is used

@@ -67,6 +67,14 @@ REFUSED: dict[str, str] = {
     name: "gives eigenvectors whose sign is that of Mathcad's solver, which the language "
     "cannot reproduce (the language's eigenvec has the largest component positive)"
     for name in ("eigenvec", "eigenvecs")
+} | {
+    # Mathcad's generator is its own, seeded by the worksheet's seed setting: no generator
+    # of the language gives its numbers, so a stored random value is never compared
+    name: "gives random numbers of Mathcad's own generator (seeded by the worksheet's seed "
+    "setting); a stored random value is not reproducible"
+    for name in ("rnd", "runif", "rnorm", "rbeta", "rbinom", "rcauchy", "rchisq", "rexp",
+                 "rF", "rgamma", "rgeom", "rhypergeom", "rlnorm", "rlogis", "rnbinom",
+                 "rpois", "rt", "rweibull", "rsample")
 }  # fmt: skip
 
 #: Mathcad functions that write a value to a file (``WRITEPRN("f", M)``, or
@@ -74,8 +82,22 @@ REFUSED: dict[str, str] = {
 #: shows it, but no file is written.
 WRITERS: frozenset[str] = frozenset({"WRITEPRN", "APPENDPRN", "WRITECSV", "WRITE", "APPEND"})
 
+#: Mathcad functions whose indices count from ORIGIN (the language's count from the sheet's
+#: origin): where the worksheet sets another ORIGIN than the one at its first index, a call
+#: is refused rather than read off by one
+ORIGIN_FUNCTIONS: frozenset[str] = frozenset(
+    {"submatrix", "last", "csort", "rsort", "lookup", "hlookup", "vlookup", "match"}
+)
+
 #: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
-OPERATOR_FUNCTIONS: dict[str, str] = {"sqrt": "sqrt", "absval": "abs", "transpose": "transpose"}
+OPERATOR_FUNCTIONS: dict[str, str] = {
+    "sqrt": "sqrt", "absval": "abs", "transpose": "transpose",
+    "determinant": "det",  # |M| written as the determinant operator
+    "polyroots": "polyroots",  # the keyword form (its method: the roots are the same)
+}  # fmt: skip
+
+#: Mathcad operators of two operands written as elements, and their built-in
+OPERATOR_FUNCTIONS_2: dict[str, str] = {"crossProduct": "cross"}
 
 
 def language_functions() -> set[str]:

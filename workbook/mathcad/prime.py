@@ -160,6 +160,9 @@ def _xml(data: bytes, path: Path, part: str):
     count = sum(1 for _ in root.iter())
     if count > MAX_ELEMENTS:
         raise LimitError(f"{path}: {count:,} XML elements in {part} (limit {MAX_ELEMENTS:,})")
+    from .structure import refuse_xinclude
+
+    refuse_xinclude(root, path, part)
     return root
 
 
@@ -577,9 +580,9 @@ def _in_unit(value: MNode, factor: float, unit: str) -> MNode:
     if scaled.tag == "unitedValue":
         inner = scaled.children[0]
         mono = scaled.find("unitMonomial")
-        from .translate import _unit_monomial
+        from .trees import unit_monomial
 
-        residual = _unit_monomial(mono) if mono is not None else ""
+        residual = unit_monomial(mono) if mono is not None else ""
     if inner.tag == "matrix" and any(c.tag == "unitedValue" for c in inner.children):
         return MNode("unreadable", {"why": "a matrix result with a unit per element"}, "", [])
     text = f"({unit}) * ({residual})" if residual else unit

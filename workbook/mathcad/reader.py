@@ -122,6 +122,9 @@ def parse_bytes(data: bytes, path: Path) -> Worksheet:
     count = sum(1 for _ in root.iter())
     if count > MAX_ELEMENTS:
         raise LimitError(f"{path}: {count} XML elements (limit {MAX_ELEMENTS})")
+    from .structure import refuse_xinclude
+
+    refuse_xinclude(root, path)
     return _worksheet(root, path)
 
 

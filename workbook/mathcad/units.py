@@ -21,6 +21,7 @@ FORMULA_UNITS: dict[str, str] = {
     "yr": "year", "wk": "week",
     # force
     "N": "newton", "kN": "kilonewton", "MN": "meganewton", "dyne": "dyne", "kgf": "kilogram_force",
+    "N·m": "newton * meter", "kN·m": "kilonewton * meter",  # moments, one name in Mathcad
     "lbf": "pound_force", "kip": "kip", "tonf": "ton_force",
     # pressure, stress
     "Pa": "pascal", "kPa": "kilopascal", "MPa": "megapascal", "GPa": "gigapascal",
@@ -75,3 +76,13 @@ def result_unit(name: str) -> str:
         if parts and all(p.isalpha() and len(p) >= 4 for p in parts):
             return " * ".join(parts)
     return name
+
+
+#: Units whose size in Mathcad Prime is not pint's, as measured from a stored result: a value
+#: Prime stored in one of them is listed as not computable with the reason, never compared
+#: (kitchen-materials.mcdx stores pi/4 (9.5 in)^2 (3.25 in) as 0.9972601194974439 gal, a
+#: gallon of 3.785411968 L, where the US gallon of 231 in^3 is 3.785411784 L)
+PRIME_UNITS_OFF: dict[str, str] = {
+    "gallon": "Prime's gallon (3.785411968 L, measured from a stored volume) is not pint's "
+    "US gallon of 231 in^3 (3.785411784 L)",
+}

@@ -11,8 +11,11 @@ from pathlib import Path
 from ..errors import InputError
 from ..language import expr as ex
 from .functions import language_functions
+from .symbols import Sym
 from .tomldoc import Document, is_one_line, one_line
-from .translate import Item, Skipped, Sym, Translation, _rename
+from .translation import Item, Skipped, Translation
+from .trees import rename
+from .units import PRIME_UNITS_OFF
 
 #: Relative tolerance of the printed values: Mathcad stores full doubles.
 REL_TOLERANCE = 1e-9
@@ -50,7 +53,12 @@ def pretty_quantity(text: str) -> str:
 def _assign(tr: Translation) -> None:
     """Choose every symbol's identifier: unique, not a built-in, arguments apart from the
     names of inputs and definitions (shared by arguments of the same unit)."""
+    from ..functions.registry import CONSTANTS
+
     reserved = set(language_functions()) | {"pi"}
+    # a name left out (untranslated) is never a constant's: its stored results would read
+    # the constant (Mathcad's own e is written exp(1))
+    constants = set(CONSTANTS)
     taken: dict[str, Sym] = {}
     lower: set[str] = set()
     # (base, candidates) -> the first number not tried by a claim that shares nothing: the
@@ -58,7 +66,8 @@ def _assign(tr: Translation) -> None:
     untried: dict[tuple[str, int], int] = {}
 
     def claim(sym: Sym, share=None, alt=True) -> None:
-        base = sym.base if sym.base not in reserved else sym.base + "_"
+        off = reserved | constants if sym.broken else reserved
+        base = sym.base if sym.base not in off else sym.base + "_"
         # an argument named like a variable gets a trailing _ first (x and x_), then numbers
         candidates = [base] + ([base + "_"] if share is not None and alt else [])
         if sym.kind == "unit":  # a unit whose name the worksheet uses: kN_unit
@@ -98,7 +107,7 @@ def _assign(tr: Translation) -> None:
 
 
 def _text(node: ex.Node, mapping: dict[str, str]) -> str:
-    return ex.to_text(_rename(node, mapping))
+    return ex.to_text(rename(node, mapping))
 
 
 def _wrapped(text: str, width: int = 96) -> list[str]:
@@ -304,6 +313,9 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             # under a name no worksheet defines: counted, and not computable (never compared)
             rows.append([f"unreadable result of region {res.region}", "", "(unreadable)", ""])
             continue
+        if res.misfit:
+            rows += _misfit_rows(res)
+            continue
         rows.append([f"# region {res.region}: {res.name}"])
         for at, value in res.rows:
             at_text = "" if at is None else repr(float(at))
@@ -317,7 +329,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         title = "Mathcad results" + (" over " + arg if arg else "")
         if from_solve:
             title += f" that depend on a solve block (Mathcad's TOL = {tr.solve_tolerance:g})"
-        absolute = ABS_TOLERANCE
+        absolute = tr.solve_tolerance if from_solve else ABS_TOLERANCE  # TOL near 0 too
         if own:
             absolute, why = round_off[own]
             title += f" of {why}: their round-off"
@@ -344,16 +356,32 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
     return doc, out
 
 
+def _misfit_rows(res) -> list[list[str]]:
+    """The stored values of a result that does not fit the translation, under a name no
+    worksheet defines: each counted, and not computable."""
+    rows = [[f"# region {res.region}: {res.name}: not computable: {res.misfit}"]]
+    for at, value in res.rows:
+        at_text = "" if at is None else repr(float(at))
+        val = value if isinstance(value, str) else repr(float(value))
+        rows.append([f"not computable result of region {res.region}", at_text, val, ""])
+    return rows
+
+
 def _list_unknown_units(tr: Translation) -> None:
     """A stored result in a unit the engine does not know costs that result (listed, not
     computable), never the check of the whole worksheet."""
     from ..language import units as un
 
     for res in tr.results:
-        if not res.unit or not res.rows:
+        if not res.unit or not res.rows or res.misfit:
+            continue
+        off = [w for u, w in PRIME_UNITS_OFF.items() if re.search(rf"\b{u}\b", res.unit)]
+        if off and tr.generator == "Mathcad Prime":
+            tr.skipped.append(Skipped(res.region, f"the result of {res.name}", off[0]))
+            res.misfit = off[0]
             continue
         try:
-            un.registry().Unit(res.unit)
+            un.unit(res.unit)  # the language's reading: its names and its powers
         except Exception:  # noqa: BLE001 - pint's parse and definition errors alike
             tr.skipped.append(
                 Skipped(
@@ -362,7 +390,7 @@ def _list_unknown_units(tr: Translation) -> None:
                     f"its unit {res.unit!r} is not a unit the engine knows",
                 )
             )
-            res.rows = []
+            res.misfit = f"its unit {res.unit!r} is not a unit the engine knows"
 
 
 def _csv_text(rows: list[list[str]]) -> str:
