@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cmath
 import math
 from pathlib import Path
 from typing import Any
@@ -345,8 +346,8 @@ class Sheet:
         if isinstance(value, str):
             pass  # a text: "OK"
         elif np.ndim(value) == 0:
-            value = float(value)
-            if not math.isfinite(value):
+            value = complex(value) if np.iscomplexobj(value) else float(value)
+            if not cmath.isfinite(value):
                 raise DomainError(
                     f"{name} is not a finite number ({value}); its formula is {d.text}",
                     file=self.file,

@@ -66,6 +66,7 @@ from ..errors import InputError, LimitError, NotLive, TemplateError, UnitError
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.units import pretty
+from .complexes import im_call
 from .entry import (  # noqa: F401 - the entry record is part of this module's interface
     Arity,
     Builtin,
@@ -150,9 +151,24 @@ def mathml_fence(left: str, right: str) -> str:
 
 
 _TRIG = {"mathml_powered": True}
-_simple("sin", np.sin, "SIN", lambda sp, x: sp.sin(x), "sine (argument in radians)", **_TRIG)
-_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG)
-_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG)
+
+
+def _complex(function: str) -> dict:
+    """The fields of a built-in over the complex plane, Excel's ``function`` its live form."""
+    return {"complex": "complex", "complex_excel": im_call(function)}
+
+
+_simple(
+    "sin",
+    np.sin,
+    "SIN",
+    lambda sp, x: sp.sin(x),
+    "sine (argument in radians)",
+    **_TRIG,
+    **_complex("IMSIN"),
+)
+_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG, **_complex("IMCOS"))
+_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_complex("IMTAN"))
 
 
 def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
@@ -203,8 +219,24 @@ _simple(
     rule=_atan2_unit,
     arity=2,
 )
-_simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine", **_TRIG)
-_simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine", **_TRIG)
+_simple(
+    "sinh",
+    np.sinh,
+    "SINH",
+    lambda sp, x: sp.sinh(x),
+    "hyperbolic sine",
+    **_TRIG,
+    **_complex("IMSINH"),
+)
+_simple(
+    "cosh",
+    np.cosh,
+    "COSH",
+    lambda sp, x: sp.cosh(x),
+    "hyperbolic cosine",
+    **_TRIG,
+    **_complex("IMCOSH"),
+)
 _simple("tanh", np.tanh, "TANH", lambda sp, x: sp.tanh(x), "hyperbolic tangent", **_TRIG)
 _simple(
     "sqrt",
@@ -215,9 +247,18 @@ _simple(
     _sqrt_unit,
     (_SQRT,),
     mathml="<msqrt>{0}</msqrt>",
+    **_complex("IMSQRT"),
 )
-_simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential")
-_simple("ln", np.log, "LN", lambda sp, x: sp.log(x), "natural logarithm", domain=_log_domain("ln"))
+_simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", **_complex("IMEXP"))
+_simple(
+    "ln",
+    np.log,
+    "LN",
+    lambda sp, x: sp.log(x),
+    "natural logarithm",
+    domain=_log_domain("ln"),
+    **_complex("IMLN"),
+)
 _simple(
     "log10",
     np.log10,
@@ -225,6 +266,7 @@ _simple(
     lambda sp, x: sp.log(x, 10),
     "logarithm base 10",
     domain=_log_domain("log10"),
+    **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
 )
 _simple(
@@ -232,9 +274,11 @@ _simple(
     np.abs,
     "ABS",
     lambda sp, x: sp.Abs(x),
-    "absolute value",
+    "absolute value (of a complex number: its modulus)",
     same_unit,
     mathml=mathml_fence("|", "|"),
+    complex="real",
+    complex_excel=im_call("IMABS"),
 )
 _simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
 

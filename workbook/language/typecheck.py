@@ -9,6 +9,7 @@ and Excel) read this typed tree, so no back end converts a unit.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import re
 
 import pint
@@ -141,10 +142,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 f"{at_numbers.message}; with arrays: {err.message}"
             ) from None
 
-    def specialized(self, name: str, shapes: tuple) -> TypedFunction:
+    def specialized(self, name: str, shapes: tuple, complexes: tuple = ()) -> TypedFunction:
         """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for
-        all numbers), each in the unit declared in [arguments]; typed once per shapes."""
-        key = specialization_key(name, shapes)
+        all numbers), complex where ``complexes`` says so, each in the unit declared in
+        [arguments]; typed once per shapes."""
+        key = specialization_key(name, shapes, complexes)
         if key in self._assumed:  # a call inside its own body: recursion
             d = self._definition(name)
             if d.program is None and d.branches is None:  # nothing can end it
@@ -157,7 +159,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             d = self._definition(name)
             shapes = tuple(shapes) or (None,) * len(d.params)
             units = tuple(self.spec.arguments[p].binding_unit for p in d.params)
-            scope = {p: u if sh is None else (u, sh) for p, u, sh in zip(d.params, units, shapes)}
+            kinds = complexes or (False,) * len(d.params)
+            scope = {
+                p: (u, sh, "complex") if c else u if sh is None else (u, sh)
+                for p, u, sh, c in zip(d.params, units, shapes, kinds)
+            }
             with self._remembered(key):
                 self.functions[key] = self._settled(d, key, units, scope, shapes)
         return self.functions[key]
@@ -350,6 +356,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
     def visit_Number(self, node: ex.Number, scope) -> T:
         return TConst(self.dimensionless, value=node.value)
 
+    def visit_Imaginary(self, node: ex.Imaginary, scope) -> T:
+        return TConst(self.dimensionless, value=complex(0.0, node.value))
+
     def visit_Quantity(self, node: ex.Quantity, scope) -> T:
         """``20 mm``: a constant in its unit, read by the reader of input values. A name joined
         to the unit (``2 m*x``) that is also a name of this sheet is refused: write a space."""
@@ -408,9 +417,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
     def _name(self, name: str, scope) -> T:
         if name in scope:
-            if isinstance(scope[name], tuple):  # a program's local vector: (unit, shape)
-                unit, shape = scope[name]
-                return TParam(unit, name=name, shape=shape)
+            if isinstance(scope[name], tuple):  # (unit, shape), and "complex" for a complex one
+                unit, shape, *kind = scope[name]
+                return TParam(unit, name=name, shape=shape, complex=bool(kind))
             return TParam(scope[name], name=name)
         block = self.spec.solve_of(name)
         if block is not None:
@@ -439,7 +448,14 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     f"write {name}({', '.join(d.params)})"
                 )
             body = self.scalar(name)
-            return TRef(body.unit, name=name, kind="definition", shape=body.shape, text=body.text)
+            return TRef(
+                body.unit,
+                name=name,
+                kind="definition",
+                shape=body.shape,
+                text=body.text,
+                complex=body.complex,
+            )
         if name in self.spec.arguments:
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
         if name in CONSTANTS:  # the sheet's own pi, e or g came first
@@ -477,6 +493,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                             f"{', '.join(opts)}"
                         )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
+        if any(t.complex for t in typed) and set(node.ops) - {"==", "!="}:
+            raise TemplateError(
+                f"{ex.to_text(node)!r}: complex numbers have no order; compare abs(z), Re(z) "
+                "or Im(z)"
+            )
         typed = meeting(typed)
         first = next((t for t in typed if not is_zero(t)), typed[0])
         out = []
@@ -517,12 +538,23 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     f"({', '.join(d.params)}), got {len(args)}"
                 )
             shapes = tuple(a.shape for a in args)
-            f = self._called(node, shapes) if any(shapes) else self.specialized(name, ())
+            complexes = tuple(a.complex for a in args)
+            if any(shapes) or any(complexes):
+                f = self._called(node, shapes, complexes)
+            else:
+                f = self.specialized(name, ())
             conv = tuple(
                 self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
                 for i, (a, u) in enumerate(zip(args, f.param_units))
             )
-            return TCall(f.unit, name=f.name, args=conv, shape=f.body.shape, text=f.body.text)
+            return TCall(
+                f.unit,
+                name=f.name,
+                args=conv,
+                shape=f.body.shape,
+                text=f.body.text,
+                complex=f.body.complex,
+            )
         if name in self.spec.blocks:
             from .. import blocks
 
@@ -557,25 +589,35 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     "not supported"
                 )
             return entry.runtime(self, name, tuple(args))
+        if not entry.complex and any(a.complex for a in args):
+            raise TemplateError(
+                f"{name}() takes real numbers, and an argument is complex: pass Re(z), Im(z), "
+                "abs(z) or arg(z)"
+            )
         typed = entry.unit_rule(self, name, tuple(args))
+        if entry.complex == "real" and typed.complex:  # abs(z): the modulus is real
+            typed = dataclasses.replace(typed, complex=False)
         return typed if entry.arrays else self.elementwise_call(name, entry, tuple(args), typed)
 
-    def _called(self, node: ex.Call, shapes: tuple) -> TypedFunction:
-        """The specialization of a function called with vectors or matrices; an error in its
-        body for these shapes names the call as well as the definition."""
+    def _called(self, node: ex.Call, shapes: tuple, complexes: tuple = ()) -> TypedFunction:
+        """The specialization of a function called with vectors or matrices, or with complex
+        values; an error in its body for these arguments names the call as well as the
+        definition."""
         name = node.func
         d = self.spec.definitions[name]
-        if d.ode is not None or d.branches is not None:
+        if any(shapes) and (d.ode is not None or d.branches is not None):
             what = "the solution of an ode" if d.ode is not None else "defined by pieces"
             raise TemplateError(
                 f"{ex.to_text(node)}: {name}() is {what}; its arguments are numbers "
                 "(pass elements, v[i])"
             )
         try:
-            return self.specialized(name, shapes)
+            return self.specialized(name, shapes, complexes)
         except WorkbookError as err:
             given = ", ".join(
-                f"{p} a {shape_text(sh)}" for p, sh in zip(d.params, shapes) if sh is not None
+                f"{p} a {'complex ' if c else ''}{shape_text(sh) if sh is not None else 'number'}"
+                for p, sh, c in zip(d.params, shapes, complexes or (False,) * len(shapes))
+                if sh is not None or c
             )
             message = f"{ex.to_text(node)} (with {given}): {err.message}"
             caller = self._stack[-1] if self._stack else None
@@ -753,6 +795,8 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         a run-time array, checked when it runs)."""
         origin = self.spec.origin
         t = self.plain(self.as_number(self.visit(i, scope), "an index"), f"the {word} index")
+        if t.complex:
+            raise TemplateError(f"{what}: the {word} index is complex; an index is a number")
         if t.shape is not None and not is_runtime(t.shape):
             raise TemplateError(f"the {word} index is a matrix; an index is a number")
         if isinstance(t, TConst) and size is not None:
@@ -814,7 +858,13 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         from ..program import typer as pg
 
         def type_expr(node, sc):
-            return self.visit(node, sc)
+            t = self.visit(node, sc)
+            if t.complex:
+                raise TemplateError(
+                    f"{ex.to_text(node)!r}: complex values in a program are not supported; "
+                    "compute them in definitions"
+                )
+            return t
 
         def convert(t, unit, where):
             if t.text:
@@ -874,12 +924,14 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 AGGREGATES = {"max_over": "max", "min_over": "min"}
 
 
-def specialization_key(name: str, shapes: tuple) -> str:
+def specialization_key(name: str, shapes: tuple, complexes: tuple = ()) -> str:
     """The name of function ``name`` typed for arguments of ``shapes`` (``dist@2x1,2x1``;
-    ``1`` for a number); ``name`` itself for numbers only."""
-    if not any(shapes):
+    ``1`` for a number, ``c`` after a complex one: ``par@1c,1c``); ``name`` itself for real
+    numbers only."""
+    if not any(shapes) and not any(complexes):
         return name
-    return name + "@" + ",".join(_shape_key(s) for s in shapes)
+    kinds = complexes or (False,) * len(shapes)
+    return name + "@" + ",".join(_shape_key(s) + ("c" if c else "") for s, c in zip(shapes, kinds))
 
 
 def _shape_key(shape) -> str:
