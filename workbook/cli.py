@@ -292,6 +292,11 @@ def _print_scalars(sheet) -> None:
                 rows = np.array2string(q.magnitude, precision=6, separator=", ")
                 print(f"  {name} = {rows.replace(chr(10), '')} {pretty(q.units)}".rstrip())
                 continue
+            if isinstance(q.magnitude, complex):  # a + bi
+                from .functions.complexes import readable
+
+                print(f"  {name} = {readable(q.magnitude)} {pretty(q.units)}".rstrip())
+                continue
             value = float(q.magnitude) + 0.0  # -0 shows as 0
             print(f"  {name} = {value:.6g} {pretty(q.units)}".rstrip())
         except WorkbookError as err:

@@ -35,7 +35,7 @@ from ..outputs.xlsx import chart_label, write_labels
 from ..version import __version__
 from . import verdicts as V
 from .checks import tolerances
-from .excel import ExcelPrinter, NotLive
+from .excel import ExcelPrinter, NotLive, cell_value
 from .livecheck import RELATIVE, ROWS_CHECKED, CellLog, RecordingSheet
 
 MAX_ROWS = 1_048_576  # rows of an Excel sheet
@@ -348,7 +348,7 @@ class ExcelLayout:
                 continue
             unit = un.pretty(t.unit)
             ws.write_string(row, 2, unit)
-            value = q if t.text or isinstance(q, str) else float(q.magnitude)
+            value = q if t.text or isinstance(q, str) else cell_value(t, q.magnitude)
             if d.name in done:
                 ref = self.names[d.name]
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)

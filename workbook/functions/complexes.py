@@ -46,6 +46,33 @@ def _part(x: float) -> str:
     return text
 
 
+def parse_text(text: str) -> complex | None:
+    """Excel's complex text (``3+4i``, ``-i``, ``2.5j``, ``7``) as a complex number; None for
+    a text that is not one."""
+    body = text.strip().replace(" ", "")
+    if body[-1:] in ("i", "j"):
+        body = body[:-1]
+        if body == "" or body[-1] in "+-":
+            body += "1"
+        body += "j"
+    try:
+        return complex(body)
+    except ValueError:
+        return None
+
+
+def readable(z: complex, digits: int = 6) -> str:
+    """``z`` as a person writes it: ``10 - 16.1230i``, ``2i``, ``-7`` (``digits``
+    significant digits in each part)."""
+    z = complex(z)
+    re, im = f"{z.real + 0.0:.{digits}g}", f"{abs(z.imag):.{digits}g}"
+    if z.imag == 0:
+        return re
+    if z.real == 0:
+        return ("-" if z.imag < 0 else "") + im + "i"
+    return f"{re} {'-' if z.imag < 0 else '+'} {im}i"
+
+
 def power(base: str, exponent: str, real_exponent: bool) -> str:
     """``base^exponent`` over the complex plane: IMPOWER takes a real exponent; a complex
     one is exp(exponent * ln(base))."""
