@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import cmath
-import math
 from pathlib import Path
 from typing import Any
 

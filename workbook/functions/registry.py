@@ -1,9 +1,10 @@
 """The complete registry of built-in functions: the plain ones of
 :mod:`workbook.functions.builtins`, the distributions of :mod:`workbook.functions.distributions`,
-the numerical ones of
-:mod:`workbook.numerics.entries`, the complex ones of :mod:`workbook.functions.complexes`, the texts of :mod:`workbook.functions.texts` and the vector and
-matrix ones of :mod:`workbook.functions.matrix_entries`. Every back end reads built-ins from here,
-and the built-in constants (pi, e, g) as :data:`CONSTANTS` (:mod:`workbook.functions.constants`)."""
+the numerical ones of :mod:`workbook.numerics.entries`, the complex ones of
+:mod:`workbook.functions.complexes`, the texts of :mod:`workbook.functions.texts` and the vector
+and matrix ones of :mod:`workbook.functions.matrix_entries`. Every back end reads built-ins from
+here, and the built-in constants (pi, e, g) as :data:`CONSTANTS`
+(:mod:`workbook.functions.constants`)."""
 
 from __future__ import annotations
 
