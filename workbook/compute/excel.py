@@ -12,6 +12,8 @@ import dataclasses
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
 from ..functions import complexes, excel_names
 from ..functions.registry import CONSTANTS, REGISTRY
@@ -43,7 +45,7 @@ def cell_value(t: ty.T, magnitude) -> float | str:
     text (``3+4i``), which the IM* functions read."""
     if t.complex:
         return complexes.excel_text(complex(magnitude))
-    return float(magnitude)
+    return float(np.real(magnitude))  # a real element of a complex matrix
 
 
 _CMP = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "=", "!=": "<>"}

@@ -499,6 +499,7 @@ register(
         doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A); "
         "sum(v): the sum of the elements of a vector or matrix",
         binds=(0, 1),
+        complex="complex",
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
         arrays=True,
     )

@@ -278,6 +278,8 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
         known.update(dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS]))
         hint = nearest(name, known)
+        if kind == "name" and un.is_unit_name(name):  # mm is not Im(): a unit is meant
+            hint = nearest(name, {k: v for k, v in known.items() if k not in REGISTRY})
         if kind == "name" and not hint and un.is_unit_name(name):
             hint = f" (a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")
@@ -589,11 +591,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     "not supported"
                 )
             return entry.runtime(self, name, tuple(args))
-        if not entry.complex and any(a.complex for a in args):
-            raise TemplateError(
-                f"{name}() takes real numbers, and an argument is complex: pass Re(z), Im(z), "
-                "abs(z) or arg(z)"
-            )
+        _real_only(name, entry, args)
         typed = entry.unit_rule(self, name, tuple(args))
         if entry.complex == "real" and typed.complex:  # abs(z): the modulus is real
             typed = dataclasses.replace(typed, complex=False)
@@ -660,6 +658,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             else:
                 args.append(self.as_number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         self.scope = scope
+        _real_only(name, entry, args)
         typed = entry.unit_rule(self, name, tuple(args))
         body = args[expr_at]
         if body.shape is not None and typed.shape is None:  # never a matrix taken as a number
@@ -922,6 +921,15 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}
+
+
+def _real_only(name: str, entry, args) -> None:
+    """Refuse complex arguments of a built-in of real numbers (its entry says which take them)."""
+    if not entry.complex and any(a.complex for a in args):
+        raise TemplateError(
+            f"{name}() takes real numbers, and an argument is complex: pass Re(z), Im(z), "
+            "abs(z) or arg(z)"
+        )
 
 
 def specialization_key(name: str, shapes: tuple, complexes: tuple = ()) -> str:
