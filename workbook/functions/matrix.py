@@ -175,9 +175,12 @@ def _real(values, what: str, kind: str = "eigenvalues"):
 
 
 def _order(lam):
-    """Ascending eigenvalues; complex ones by real part, then imaginary part."""
+    """Ascending eigenvalues; complex ones by real part (equal to 10 digits of the largest
+    modulus: a conjugate pair's rounding does not split it), then imaginary part."""
     if np.iscomplexobj(lam):
-        return np.lexsort((lam.imag, lam.real), axis=-1)
+        scale = np.max(np.abs(lam), axis=-1, keepdims=True)
+        real = np.round(lam.real / np.where(scale > 0, scale, 1.0), 10)
+        return np.lexsort((lam.imag, real), axis=-1)
     return np.argsort(lam, axis=-1)
 
 

@@ -217,6 +217,12 @@ def _quantity_literals(source: str) -> str:
         num, name = tokens[i], tokens[i + 1]
         if num.type == tokenize.NUMBER and name.string in ("i", "j") and name.start == num.end:
             # 4i, as Mathcad writes the imaginary unit: Python's 4j (j alone stays a name)
+            unit = tokens[i + 2] if i + 2 < len(tokens) else None
+            if unit is not None and unit.type == tokenize.NAME and unit.string not in _NOT_UNITS:
+                end = _unit_end(tokens, i + 2)  # 4i ohm: refused with what to write
+                spans.append((at(num.start), at(name.end), at(unit.start), at(tokens[end - 1].end)))
+                i = end
+                continue
             spans.append((at(num.start), at(num.end), at(name.start), at(name.end)))
             i += 2
         elif (
@@ -253,7 +259,10 @@ def _quantity_literals(source: str) -> str:
         if unit in ("i", "j") and u0 == n1:
             out = f"{out[:n0]}{out[n0:n1]}j{out[u1:]}"
             continue
-        out = f"{out[:n0]}({out[n0:n1]} @ {unit!r}){out[u1:]}"
+        number = out[n0:n1]
+        if number[-1] in "ij":  # 4i ohm
+            number = number[:-1] + "j"
+        out = f"{out[:n0]}({number} @ {unit!r}){out[u1:]}"
     return out
 
 
