@@ -293,7 +293,7 @@ class ExcelLayout:
         for row, d in enumerate(defs, start=1):
             t, q = self._scalar(d.name)
             ws.write_string(row, 0, d.name)
-            value = q if t.text or isinstance(q, str) else float(q.magnitude)
+            value = q if t.text or isinstance(q, str) else cell_value(t, q.magnitude)
             with self.printer.context(helpers=HelperCells(self, d.name, t)):
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             ws.write_string(row, 2, un.pretty(t.unit))

@@ -362,9 +362,11 @@ _IM_CALL = re.compile(r"(?<![\w.])(?:_xlfn\.)?(?:IM[A-Z0-9]+|COMPLEX)\(")
 
 def _complex_error(text: str, got) -> bool:
     """An Excel error value computed for a formula of complex numbers: not checkable."""
+    from formulas.tokens.operand import XlError
+
     if not _IM_CALL.search(text):
         return False
-    return got is None or not isinstance(got, (str, int, float, np.number, bool, np.bool_))
+    return got is None or isinstance(got, XlError)
 
 
 def _complex_agree(got: str, cached: str) -> bool:

@@ -239,7 +239,24 @@ _simple(
     **_TRIG,
     **_complex("IMCOSH"),
 )
-_simple("tanh", np.tanh, "TANH", lambda sp, x: sp.tanh(x), "hyperbolic tangent", **_TRIG)
+_IMSINH, _IMCOSH = im_call("IMSINH"), im_call("IMCOSH")
+
+
+def _excel_complex_tanh(args: list[str]) -> tuple[str, int]:
+    """Excel has no IMTANH: sinh/cosh."""
+    return f"IMDIV({_IMSINH(args)[0]}, {_IMCOSH(args)[0]})", PREC["atom"]
+
+
+_simple(
+    "tanh",
+    np.tanh,
+    "TANH",
+    lambda sp, x: sp.tanh(x),
+    "hyperbolic tangent",
+    **_TRIG,
+    complex="complex",
+    complex_excel=_excel_complex_tanh,
+)
 _simple(
     "sqrt",
     np.sqrt,
