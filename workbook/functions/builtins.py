@@ -66,7 +66,7 @@ from ..errors import InputError, LimitError, NotLive, TemplateError, UnitError
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.units import pretty
-from .complexes import im_call
+from .complexes import classic, im_call
 from .entry import (  # noqa: F401 - the entry record is part of this module's interface
     Arity,
     Builtin,
@@ -160,6 +160,11 @@ def _complex(function: str) -> dict:
     return {"complex": "complex", "complex_excel": im_call(function)}
 
 
+def _classic(name: str) -> dict:
+    """The same, the live form made of the classic IM* functions (tan, sinh, cosh)."""
+    return {"complex": "complex", "complex_excel": classic(name)}
+
+
 _simple(
     "sin",
     np.sin,
@@ -170,7 +175,7 @@ _simple(
     **_complex("IMSIN"),
 )
 _simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG, **_complex("IMCOS"))
-_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_complex("IMTAN"))
+_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_classic("tan"))
 
 
 def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
@@ -228,7 +233,7 @@ _simple(
     lambda sp, x: sp.sinh(x),
     "hyperbolic sine",
     **_TRIG,
-    **_complex("IMSINH"),
+    **_classic("sinh"),
 )
 _simple(
     "cosh",
@@ -237,16 +242,8 @@ _simple(
     lambda sp, x: sp.cosh(x),
     "hyperbolic cosine",
     **_TRIG,
-    **_complex("IMCOSH"),
+    **_classic("cosh"),
 )
-_IMSINH, _IMCOSH = im_call("IMSINH"), im_call("IMCOSH")
-
-
-def _excel_complex_tanh(args: list[str]) -> tuple[str, int]:
-    """Excel has no IMTANH: sinh/cosh."""
-    return f"IMDIV({_IMSINH(args)[0]}, {_IMCOSH(args)[0]})", PREC["atom"]
-
-
 _simple(
     "tanh",
     np.tanh,
@@ -255,7 +252,7 @@ _simple(
     "hyperbolic tangent",
     **_TRIG,
     complex="complex",
-    complex_excel=_excel_complex_tanh,
+    complex_excel=classic("tanh"),
 )
 _simple(
     "sqrt",

@@ -105,6 +105,38 @@ def im_call(function: str):
     return printed
 
 
+def _exps(z: str) -> tuple[str, str]:
+    return f"IMEXP({z})", f"IMEXP(IMSUB(0, {z}))"
+
+
+def _sinh(z: str) -> str:
+    return "IMDIV(IMSUB({}, {}), 2)".format(*_exps(z))
+
+
+def _cosh(z: str) -> str:
+    return "IMDIV(IMSUM({}, {}), 2)".format(*_exps(z))
+
+
+#: the forms of tan, sinh, cosh and tanh by the classic IM* functions: Excel's IMTAN, IMSINH
+#: and IMCOSH (2013) are #NAME? in LibreOffice's reading of an xlsx file, and it has no IMTANH
+BY_CLASSIC = {
+    "tan": lambda z: f"IMDIV(IMSIN({z}), IMCOS({z}))",
+    "sinh": _sinh,
+    "cosh": _cosh,
+    "tanh": lambda z: f"IMDIV({_sinh(z)}, {_cosh(z)})",
+}
+
+
+def classic(name: str):
+    """The Excel form of ``name`` (tan, sinh, cosh, tanh) of a complex argument."""
+    form = BY_CLASSIC[name]
+
+    def printed(args: list[str]) -> tuple[str, int]:
+        return form(args[0]), ATOM
+
+    return printed
+
+
 # -- the unit rules -----------------------------------------------------------------------------
 def _part_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
     """Re(z), Im(z): real, in z's unit."""
