@@ -11,7 +11,7 @@ import pytest
 
 import workbook
 from workbook.compute.livecheck import _agrees, _complex_error
-from workbook.errors import DomainError, TemplateError, UnitError
+from workbook.errors import DomainError, TemplateError, UnitError, WorkbookError
 from workbook.functions.complexes import excel_text, parse_text, readable
 from workbook.language import expr as ex
 
@@ -412,3 +412,34 @@ def test_the_report_shows_a_plus_bi(ac):
     html = render(workbook.compute.computed.compute(ac))
     assert "<mi>i</mi>" in html
     assert "16.123" in html and "(10 + 3.14159i" not in html
+
+
+PIECES = """[arguments]
+x = { unit = "" }
+
+[definitions]
+"f(x)" = ["x + 1i if x > 0", "x otherwise"]
+
+[[tables]]
+name = "t"
+range = "x := -2 .. 2"
+columns = { "f(x)" = "" }
+"""
+
+
+def test_a_piecewise_function_with_a_complex_piece(tmp_path):
+    import openpyxl
+
+    path = tmp_path / "p.toml"
+    path.write_text(PIECES, encoding="utf-8")
+    sheet = workbook.load(path)
+    got = sheet.table("t").iloc[:, 1].to_numpy(dtype=complex)
+    assert list(got) == [-2, -1, 0, 1 + 1j, 2 + 1j]
+    limited = _sheet(tmp_path, 'z = { expr = "3 + 4i", positive = true }\n')
+    with pytest.raises(WorkbookError, match="'z' is complex: its limits"):
+        limited.evaluate("z")
+    book = sheet.write_xlsx(tmp_path / "p.xlsx")
+    ws = openpyxl.load_workbook(book)["Listing"]
+    cached = openpyxl.load_workbook(book, data_only=True)["Listing"]
+    assert all(ws.cell(r, 2).value.startswith("=IF(") for r in range(3, 8))  # live, not refused
+    assert [cached.cell(r, 2).value for r in range(3, 8)] == ["-2", "-1", "0", "1+i", "2+i"]

@@ -341,7 +341,7 @@ def _first(result):
 
 
 def _agrees(got, cached, scale: float) -> bool:
-    if isinstance(cached, str) and isinstance(got, str) and _complex_agree(got, cached):
+    if isinstance(cached, str) and _complex_agree(got, cached):
         return True
     if isinstance(cached, (str, bool, np.bool_)):
         return not isinstance(got, (float, int)) and str(got) == str(cached) or got == cached
@@ -369,10 +369,15 @@ def _complex_error(text: str, got) -> bool:
     return got is None or isinstance(got, XlError)
 
 
-def _complex_agree(got: str, cached: str) -> bool:
-    """Two complex texts (Excel's ``3+4i``) of the same number to :data:`RELATIVE` (the
-    evaluator may write more digits, or ``j``)."""
-    a, b = parse_text(got), parse_text(cached)
+def _complex_agree(got, cached: str) -> bool:
+    """A complex text (Excel's ``3+4i``) and a complex text or a number (a real branch of a
+    complex value) of the same number to :data:`RELATIVE` (the evaluator may write more
+    digits, or ``j``)."""
+    from formulas.tokens.operand import XlError
+
+    if isinstance(got, (bool, np.bool_, XlError)) or not isinstance(got, (str, int, float)):
+        return False
+    a, b = parse_text(str(got)), parse_text(cached)
     if a is None or b is None:
         return False
     return abs(a - b) <= RELATIVE * max(abs(a), abs(b))

@@ -66,7 +66,7 @@ from ..errors import InputError, LimitError, NotLive, TemplateError, UnitError
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.units import pretty
-from .complexes import classic, im_call
+from .complexes import classic, im_call, im_cosh, im_sinh, im_tan, im_tanh
 from .entry import (  # noqa: F401 - the entry record is part of this module's interface
     Arity,
     Builtin,
@@ -160,9 +160,9 @@ def _complex(function: str) -> dict:
     return {"complex": "complex", "complex_excel": im_call(function)}
 
 
-def _classic(name: str) -> dict:
+def _classic(form) -> dict:
     """The same, the live form made of the classic IM* functions (tan, sinh, cosh)."""
-    return {"complex": "complex", "complex_excel": classic(name)}
+    return {"complex": "complex", "complex_excel": classic(form)}
 
 
 _simple(
@@ -175,7 +175,7 @@ _simple(
     **_complex("IMSIN"),
 )
 _simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG, **_complex("IMCOS"))
-_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_classic("tan"))
+_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_classic(im_tan))
 
 
 def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
@@ -233,7 +233,7 @@ _simple(
     lambda sp, x: sp.sinh(x),
     "hyperbolic sine",
     **_TRIG,
-    **_classic("sinh"),
+    **_classic(im_sinh),
 )
 _simple(
     "cosh",
@@ -242,7 +242,7 @@ _simple(
     lambda sp, x: sp.cosh(x),
     "hyperbolic cosine",
     **_TRIG,
-    **_classic("cosh"),
+    **_classic(im_cosh),
 )
 _simple(
     "tanh",
@@ -252,7 +252,7 @@ _simple(
     "hyperbolic tangent",
     **_TRIG,
     complex="complex",
-    complex_excel=classic("tanh"),
+    complex_excel=classic(im_tanh),
 )
 _simple(
     "sqrt",

@@ -109,27 +109,26 @@ def _exps(z: str) -> tuple[str, str]:
     return f"IMEXP({z})", f"IMEXP(IMSUB(0, {z}))"
 
 
-def _sinh(z: str) -> str:
+# tan, sinh, cosh and tanh by the classic IM* functions: Excel's IMTAN, IMSINH and IMCOSH
+# (2013) are #NAME? in LibreOffice's reading of an xlsx file, and Excel has no IMTANH
+def im_sinh(z: str) -> str:
     return "IMDIV(IMSUB({}, {}), 2)".format(*_exps(z))
 
 
-def _cosh(z: str) -> str:
+def im_cosh(z: str) -> str:
     return "IMDIV(IMSUM({}, {}), 2)".format(*_exps(z))
 
 
-#: the forms of tan, sinh, cosh and tanh by the classic IM* functions: Excel's IMTAN, IMSINH
-#: and IMCOSH (2013) are #NAME? in LibreOffice's reading of an xlsx file, and it has no IMTANH
-BY_CLASSIC = {
-    "tan": lambda z: f"IMDIV(IMSIN({z}), IMCOS({z}))",
-    "sinh": _sinh,
-    "cosh": _cosh,
-    "tanh": lambda z: f"IMDIV({_sinh(z)}, {_cosh(z)})",
-}
+def im_tan(z: str) -> str:
+    return f"IMDIV(IMSIN({z}), IMCOS({z}))"
 
 
-def classic(name: str):
-    """The Excel form of ``name`` (tan, sinh, cosh, tanh) of a complex argument."""
-    form = BY_CLASSIC[name]
+def im_tanh(z: str) -> str:
+    return f"IMDIV({im_sinh(z)}, {im_cosh(z)})"
+
+
+def classic(form):
+    """The Excel form of a built-in of a complex argument from ``form`` (im_tan, ...)."""
 
     def printed(args: list[str]) -> tuple[str, int]:
         return form(args[0]), ATOM
