@@ -233,15 +233,18 @@ class _Children(Visitor):
 
 _CHILDREN = _Children()
 
-#: the nodes whose value is complex when one of their children is (the others say so)
-_OF_CHILDREN = (TScale, TUnary, TBinary, TFunc, TMatrix)
-
-
 def _derived_complex(t: T) -> bool:
+    """Whether ``t`` is complex, from its children (every typed node asks once, when made)."""
     if isinstance(t, TConst):
         return isinstance(t.value, complex)
-    if isinstance(t, _OF_CHILDREN):
-        return any(c.complex for c in _CHILDREN.visit(t))
+    if isinstance(t, TBinary):
+        return t.left.complex or t.right.complex
+    if isinstance(t, (TScale, TUnary)):
+        return t.child is not None and t.child.complex
+    if isinstance(t, TFunc):
+        return any(a.complex for a in t.args)
+    if isinstance(t, TMatrix):
+        return any(e.complex for row in t.rows for e in row)
     if isinstance(t, TIndex):
         return t.target.complex
     if isinstance(t, TPiecewise):
