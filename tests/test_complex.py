@@ -407,11 +407,18 @@ def test_run_prints_a_plus_bi(ac, tmp_path, capsys):
 
 
 def test_the_report_shows_a_plus_bi(ac):
+    from workbook.outputs.report import mathml as mm
     from workbook.outputs.report import render
 
+    box = mm.quantity_box(10 - 16.123j, "ohm")
+    assert box.xml.count("<mo stretchy='false'>(</mo>") == 1  # (10 − 16.123i) Ω
+    assert "<mn>10</mn>" in box.xml and "<mo>\u2212</mo>" in box.xml and "<mi>i</mi>" in box.xml
+    assert mm.complex_box(2j).xml == "<mrow><mn>2</mn></mrow><mi>i</mi>"
+    assert mm.complex_box(-1j).xml == "<mrow><mo>\u2212</mo><mi>i</mi></mrow>"
+    written = mm.MathML().box(ex.parse("R + 1i*omega")).xml
+    assert "<mrow><mn>1</mn><mi>i</mi></mrow><mo>\u22c5</mo><mi>ω</mi>" in written  # 1i⋅ω
     html = render(workbook.compute.computed.compute(ac))
-    assert "<mi>i</mi>" in html
-    assert "16.123" in html and "(10 + 3.14159i" not in html
+    assert "16.123" in html and "<mi>i</mi>" in html
 
 
 PIECES = """[arguments]

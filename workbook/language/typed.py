@@ -233,6 +233,7 @@ class _Children(Visitor):
 
 _CHILDREN = _Children()
 
+
 def _derived_complex(t: T) -> bool:
     """Whether ``t`` is complex, from its children (every typed node asks once, when made)."""
     if isinstance(t, TConst):

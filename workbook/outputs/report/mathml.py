@@ -365,6 +365,7 @@ class MathML(Visitor):
                 and _leftmost(node.right) not in ("e", "E")  # 2e would read as a number
                 and not _starts_with_number(right.xml)  # 2⁢10^e would read as 210^e
                 and not (isinstance(node.left, ex.Number) and node.left.value == 0)  # 0⋅α
+                and not isinstance(node.left, ex.Imaginary)  # 1i⋅ω, as Mathcad shows it
             ):
                 sign = Box("<mo>\u2062</mo>", 0.1)  # 2a: invisible times after a number
             else:
