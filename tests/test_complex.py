@@ -450,3 +450,22 @@ def test_a_piecewise_function_with_a_complex_piece(tmp_path):
     cached = openpyxl.load_workbook(book, data_only=True)["Listing"]
     assert all(ws.cell(r, 2).value.startswith("=IF(") for r in range(3, 8))  # live, not refused
     assert [cached.cell(r, 2).value for r in range(3, 8)] == ["-2", "-1", "0", "1+i", "2+i"]
+
+
+def test_a_chart_of_complex_values_is_refused(tmp_path):
+    text = """[arguments]
+fr = { unit = "Hz" }
+
+[definitions]
+"Zf(fr)" = "1 ohm + 1i*fr*1 ohm*s"
+
+[[charts]]
+name = "c"
+range = "fr := 1 Hz .. 5 Hz"
+x = { expr = "fr", title = "f" }
+series = [ { y = "Zf(fr)", unit = "ohm", name = "Z" }, { y = "abs(Zf(fr))", unit = "ohm" } ]
+"""
+    path = tmp_path / "ch.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(WorkbookError, match="a series of complex values has no points"):
+        workbook.load(path).write_xlsx(tmp_path / "ch.xlsx")
