@@ -469,3 +469,20 @@ series = [ { y = "Zf(fr)", unit = "ohm", name = "Z" }, { y = "abs(Zf(fr))", unit
     path.write_text(text, encoding="utf-8")
     with pytest.raises(WorkbookError, match="a series of complex values has no points"):
         workbook.load(path).write_xlsx(tmp_path / "ch.xlsx")
+
+
+def test_polar_form_on_request(tmp_path, capsys):
+    from workbook.cli import main
+    from workbook.outputs.report import render
+
+    path = tmp_path / "p.toml"
+    path.write_text(AC.replace("[inputs]", '[sheet]\ncomplex = "polar"\n\n[inputs]'), "utf-8")
+    main(["run", str(path), "--out", str(tmp_path / "o.xlsx")])
+    z = _ac_reference()[0]
+    r, phi = abs(z), math.degrees(cmath.phase(z))
+    assert f"Z = {r:.6g}\u2220{phi:.6g}\u00b0 Ω" in capsys.readouterr().out
+    html = render(workbook.compute.computed.compute(workbook.load(path)))
+    assert f"<mn>{r:.6g}</mn></mrow><mo>\u2220</mo>" in html
+    path.write_text(AC.replace("[inputs]", '[sheet]\ncomplex = "round"\n\n[inputs]'), "utf-8")
+    with pytest.raises(TemplateError, match='complex is "rectangular"'):
+        workbook.load(path)

@@ -295,7 +295,8 @@ def _print_scalars(sheet) -> None:
             if isinstance(q.magnitude, complex):  # a + bi
                 from .functions.complexes import readable
 
-                print(f"  {name} = {readable(q.magnitude)} {pretty(q.units)}".rstrip())
+                shown = readable(q.magnitude, polar=sheet.spec.polar)
+                print(f"  {name} = {shown} {pretty(q.units)}".rstrip())
                 continue
             value = float(q.magnitude) + 0.0  # -0 shows as 0
             print(f"  {name} = {value:.6g} {pretty(q.units)}".rstrip())

@@ -124,9 +124,7 @@ def _excel_ceil(args: list[str]) -> tuple[str, int]:
 
 
 # -- the classic built-ins -----------------------------------------------------------------------
-_SQRT = Domain(
-    "sqrt of a negative number (its complex root: sqrt(x + 0i))", lambda v: v < 0, "sqrt({})"
-)
+_SQRT = Domain("sqrt of a negative number", lambda v: v < 0, "sqrt({})")
 
 
 def _inverse_domain(name: str) -> tuple[Domain, ...]:

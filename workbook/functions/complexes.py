@@ -61,10 +61,13 @@ def parse_text(text: str) -> complex | None:
         return None
 
 
-def readable(z: complex, digits: int = 6) -> str:
+def readable(z: complex, digits: int = 6, polar: bool = False) -> str:
     """``z`` as a person writes it: ``10 - 16.1230i``, ``2i``, ``-7`` (``digits``
-    significant digits in each part)."""
+    significant digits in each part), or with ``polar`` as ``18.9883∠-58.1915°``."""
     z = complex(z)
+    if polar:
+        r, phi = abs(z), math.degrees(math.atan2(z.imag, z.real)) + 0.0
+        return f"{r:.{digits}g}\u2220{phi:.{digits}g}\u00b0"
     re, im = f"{z.real + 0.0:.{digits}g}", f"{abs(z.imag):.{digits}g}"
     if z.imag == 0:
         return re

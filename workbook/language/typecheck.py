@@ -278,8 +278,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
         known.update(dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS]))
         hint = nearest(name, known)
-        if kind == "name" and un.is_unit_name(name):  # mm is not Im(): a unit is meant
-            hint = nearest(name, {k: v for k, v in known.items() if k not in REGISTRY})
+        if kind == "name":  # a value is meant: the sheet's names first (R1 is R_1, not Re())
+            values = nearest(name, {k: v for k, v in known.items() if k not in REGISTRY})
+            hint = values if values or un.is_unit_name(name) else hint
         if kind == "name" and not hint and un.is_unit_name(name):
             hint = f" (a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")

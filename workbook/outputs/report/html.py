@@ -362,7 +362,7 @@ class Document:
                 result = Box(_named("result-matrix", d.name, box.xml), box.width)
             else:
                 attrs = f"class='result' data-name='{escape(d.name)}'"
-                result = mm.quantity_box(r[0], r[1], attrs=attrs)
+                result = mm.quantity_box(r[0], r[1], attrs=attrs, polar=self.spec.polar)
             pieces.append(_fit(_eq_box(_EQ, result)))
         blocks = [
             self.spec.blocks[n]

@@ -168,6 +168,14 @@ def number_box(value: float | complex, digits: int = PRECISION) -> Box:
     return Box(f"<mrow>{xml}</mrow>", width, prec, numeric=True)
 
 
+def polar_box(z: complex, digits: int = PRECISION) -> Box:
+    """``r∠phi°`` (``5∠53.1301°``): the modulus, then the angle in degrees."""
+    r = number_box(abs(z), digits)
+    phi = number_box(math.degrees(math.atan2(z.imag, z.real)) + 0.0, digits)
+    xml = f"<mrow>{r.xml}<mo>\u2220</mo>{phi.xml}<mo>\u00b0</mo></mrow>"
+    return Box(xml, r.width + phi.width + 1.4, PREC["+"], numeric=True)
+
+
 def complex_box(z: complex, digits: int = PRECISION) -> Box:
     """``a + bi`` (``3 + 4i``, ``−2i``, ``7``): a sum for the precedence of what is around it."""
     i = Box("<mi>i</mi>", 0.4)
@@ -218,10 +226,14 @@ def unit_box(text: str) -> Box:
     return Box(f"<mrow class='unit'>{xml}</mrow>", width)
 
 
-def quantity_box(value: float, unit: str, digits: int = PRECISION, attrs: str = "") -> Box:
+def quantity_box(
+    value: float, unit: str, digits: int = PRECISION, attrs: str = "", polar: bool = False
+) -> Box:
     """A value with its unit, as substituted or as a result: ``20 mm``; ``attrs`` are
-    extra attributes of its element (a result is marked ``class='result'``)."""
-    num = number_box(value, digits)
+    extra attributes of its element (a result is marked ``class='result'``); a complex
+    value with ``polar`` as r∠phi."""
+    polar = polar and isinstance(value, complex)
+    num = polar_box(value, digits) if polar else number_box(value, digits)
     attrs = attrs or "class='value'"
     if unit and num.prec < PREC["*"]:  # (3 + 4i) ohm
         num = Box(_parens(num).xml, num.width + 0.7, ATOM, numeric=True)
