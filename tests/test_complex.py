@@ -486,3 +486,12 @@ def test_polar_form_on_request(tmp_path, capsys):
     path.write_text(AC.replace("[inputs]", '[sheet]\ncomplex = "round"\n\n[inputs]'), "utf-8")
     with pytest.raises(TemplateError, match='complex is "rectangular"'):
         workbook.load(path)
+
+
+def test_the_largest_value_of_a_complex_column_is_refused(tmp_path):
+    text = AC.replace("[[tables]]", 'top = "max_over(sweep, Zf)"\n\n[[tables]]')
+    text = text.replace('columns = { "Zf(fr)" = "ohm"', 'columns = { Zf = "ohm"')
+    path = tmp_path / "m.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(TemplateError, match="the column is complex"):
+        workbook.load(path).check_units()

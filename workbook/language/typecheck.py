@@ -712,8 +712,13 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 f"{name}(): table '{tname}' has no column '{cname}' (columns: "
                 f"{', '.join(c.text for c in table.columns)})"
             )
-        unit = column_type(self, col, table.range.var, f"{name}({tname}, {cname})").unit
-        return TAggregate(unit, func=AGGREGATES[name], table=tname, column=cname)
+        typed = column_type(self, col, table.range.var, f"{name}({tname}, {cname})")
+        if typed.complex:
+            raise TemplateError(
+                f"{name}({tname}, {cname}): the column is complex, and complex numbers have no "
+                "order; make a column of abs(z) or Re(z)"
+            )
+        return TAggregate(typed.unit, func=AGGREGATES[name], table=tname, column=cname)
 
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
