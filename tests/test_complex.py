@@ -495,3 +495,12 @@ def test_the_largest_value_of_a_complex_column_is_refused(tmp_path):
     path.write_text(text, encoding="utf-8")
     with pytest.raises(TemplateError, match="the column is complex"):
         workbook.load(path).check_units()
+
+
+def test_a_sweep_of_a_complex_output_is_refused(ac):
+    from workbook.sweep import sweep
+
+    with pytest.raises(TemplateError, match="the output is complex"):
+        sweep(ac, {"R": "5 ohm..10 ohm:3"}, {"Zo": "Z"})
+    result = sweep(ac, {"R": "5 ohm..10 ohm:3"}, {"m": "abs(Z)"})
+    assert result.table.iloc[2, 1] == pytest.approx(abs(_ac_reference()[0]), rel=1e-12)
