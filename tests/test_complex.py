@@ -504,3 +504,13 @@ def test_a_sweep_of_a_complex_output_is_refused(ac):
         sweep(ac, {"R": "5 ohm..10 ohm:3"}, {"Zo": "Z"})
     result = sweep(ac, {"R": "5 ohm..10 ohm:3"}, {"m": "abs(Z)"})
     assert result.table.iloc[2, 1] == pytest.approx(abs(_ac_reference()[0]), rel=1e-12)
+
+
+def test_a_printed_value_of_a_complex_definition_says_to_check_its_parts(tmp_path):
+    csv = "name,argument,value,unit\nZ,,10,ohm\nI_mag,,12122.87,mA\n"
+    (tmp_path / "printed.csv").write_text(csv, encoding="utf-8")
+    path = tmp_path / "p.toml"
+    path.write_text(AC + '\n[[printed]]\nfile = "printed.csv"\ntolerance = 0.01\n', "utf-8")
+    rows = {r.name: r for r in workbook.load(path).check().rows}
+    assert rows["Z"].verdict == "error" and 'Z_re = "Re(Z)"' in rows["Z"].note
+    assert rows["I_mag"].verdict == "pass"
