@@ -18,6 +18,7 @@ from ..errors import LimitError, ShapeError, TemplateError, UnitError, WorkbookE
 from ..functions.registry import CONSTANTS, REGISTRY
 from . import expr as ex
 from . import units as un
+from .complextyping import no_order, real_in_program, real_index, real_only, value_kind
 from .fields import nearest
 from .template import Definition, SheetSpec, column_node
 from .typearrays import ArrayTyping
@@ -451,14 +452,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     f"write {name}({', '.join(d.params)})"
                 )
             body = self.scalar(name)
-            return TRef(
-                body.unit,
-                name=name,
-                kind="definition",
-                shape=body.shape,
-                text=body.text,
-                complex=body.complex,
-            )
+            return TRef(body.unit, name=name, kind="definition", **value_kind(body))
         if name in self.spec.arguments:
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
         if name in CONSTANTS:  # the sheet's own pi, e or g came first
@@ -496,11 +490,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                             f"{', '.join(opts)}"
                         )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
-        if any(t.complex for t in typed) and set(node.ops) - {"==", "!="}:
-            raise TemplateError(
-                f"{ex.to_text(node)!r}: complex numbers have no order; compare abs(z), Re(z) "
-                "or Im(z)"
-            )
+        no_order(node, typed)
         typed = meeting(typed)
         first = next((t for t in typed if not is_zero(t)), typed[0])
         out = []
@@ -550,14 +540,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
                 for i, (a, u) in enumerate(zip(args, f.param_units))
             )
-            return TCall(
-                f.unit,
-                name=f.name,
-                args=conv,
-                shape=f.body.shape,
-                text=f.body.text,
-                complex=f.body.complex,
-            )
+            return TCall(f.unit, name=f.name, args=conv, **value_kind(f.body))
         if name in self.spec.blocks:
             from .. import blocks
 
@@ -592,7 +575,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     "not supported"
                 )
             return entry.runtime(self, name, tuple(args))
-        _real_only(name, entry, args)
+        real_only(name, entry, args)
         typed = entry.unit_rule(self, name, tuple(args))
         if entry.complex == "real" and typed.complex:  # abs(z): the modulus is real
             typed = dataclasses.replace(typed, complex=False)
@@ -659,7 +642,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             else:
                 args.append(self.as_number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         self.scope = scope
-        _real_only(name, entry, args)
+        real_only(name, entry, args)
         typed = entry.unit_rule(self, name, tuple(args))
         body = args[expr_at]
         if body.shape is not None and typed.shape is None:  # never a matrix taken as a number
@@ -800,8 +783,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         a run-time array, checked when it runs)."""
         origin = self.spec.origin
         t = self.plain(self.as_number(self.visit(i, scope), "an index"), f"the {word} index")
-        if t.complex:
-            raise TemplateError(f"{what}: the {word} index is complex; an index is a number")
+        real_index(t, what, word)
         if t.shape is not None and not is_runtime(t.shape):
             raise TemplateError(f"the {word} index is a matrix; an index is a number")
         if isinstance(t, TConst) and size is not None:
@@ -863,13 +845,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         from ..program import typer as pg
 
         def type_expr(node, sc):
-            t = self.visit(node, sc)
-            if t.complex:
-                raise TemplateError(
-                    f"{ex.to_text(node)!r}: complex values in a program are not supported; "
-                    "compute them in definitions"
-                )
-            return t
+            return real_in_program(self.visit(node, sc), node)
 
         def convert(t, unit, where):
             if t.text:
@@ -927,15 +903,6 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
 
 AGGREGATES = {"max_over": "max", "min_over": "min"}
-
-
-def _real_only(name: str, entry, args) -> None:
-    """Refuse complex arguments of a built-in of real numbers (its entry says which take them)."""
-    if not entry.complex and any(a.complex for a in args):
-        raise TemplateError(
-            f"{name}() takes real numbers, and an argument is complex: pass Re(z), Im(z), "
-            "abs(z) or arg(z)"
-        )
 
 
 def specialization_key(name: str, shapes: tuple, complexes: tuple = ()) -> str:
