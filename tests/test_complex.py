@@ -84,6 +84,8 @@ CASES = [
     ("arg(-1 - 1i)", cmath.phase(-1 - 1j)),
     ("Re(3 - 4i)*Im(2 + 7i)", 21.0),
     ("conj(3 + 4i)", 3 - 4j),
+    ("sum(k*1i + 1, k, 1, 4)", 4 + 10j),
+    ("sum([1i, 2, 3 + 1i])", 5 + 2j),
 ]
 MPMATH = [
     ("exp(1i*pi/3)", lambda: mpmath.exp(1j * mpmath.pi / 3)),

@@ -30,6 +30,7 @@ k4 = "sin(1 + 2i*R/R) + cos(1 - 1i) + tan(0.5 + 0.5i) + sinh(1i) + cosh(2 - 1i) 
 k5 = { expr = "Re(Z) + Im(Z) + abs(Z) - conj(Z)", unit = "ohm" }
 k6 = "arg(1i*R/R) + arg(-R/R + 0i)"
 k7 = "-Z/(2 ohm)"
+k8 = "sum(k*1i*R/R + 1, k, 1, 4)"
 Y = "[[1/R + 1i/(omega*L), -1/R], [-1/R, 1/R + 1i*omega*C]]"
 """
 

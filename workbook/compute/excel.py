@@ -239,7 +239,7 @@ class ExcelPrinter(Visitor):
             if entry.complex_excel is None or any(a.shape is not None for a in t.args):
                 raise NotLive(f"{t.func}() of complex values has no live formula")
             return entry.complex_excel([self.print(a, s) for a in t.args])
-        if bound and t.complex:
+        if bound and t.complex and entry.complex_excel is None:
             raise NotLive(f"{t.func}() of complex values has no live formula")
         if entry.arrays and not bound and any(a.shape is not None for a in t.args):
             self._array = True

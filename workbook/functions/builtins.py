@@ -495,6 +495,8 @@ def _sum_excel(body, args=None, consts=None, *, shapes=None) -> tuple[str, int]:
     if hi - lo + 1 > MAX_EXCEL_TERMS:
         raise NotLive(f"sum() of {hi - lo + 1} terms (written out up to {MAX_EXCEL_TERMS})")
     terms = [body(str(i) if i >= 0 else f"({i})") for i in range(lo, hi + 1)]
+    if body.typed.complex:  # complex terms: Excel's IMSUM of them
+        return f"IMSUM({', '.join(terms)})", PREC["atom"]
     return "(" + ")+(".join(terms) + ")", PREC["+"]
 
 
@@ -514,6 +516,7 @@ register(
         "sum(v): the sum of the elements of a vector or matrix",
         binds=(0, 1),
         complex="complex",
+        complex_excel=_sum_excel,
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
         arrays=True,
     )
