@@ -516,3 +516,10 @@ def test_a_printed_value_of_a_complex_definition_says_to_check_its_parts(tmp_pat
     rows = {r.name: r for r in workbook.load(path).check().rows}
     assert rows["Z"].verdict == "error" and 'Z_re = "Re(Z)"' in rows["Z"].note
     assert rows["I_mag"].verdict == "pass"
+
+
+def test_a_complex_argument_of_sin_is_no_angle_slip(tmp_path):
+    head = '[arguments]\nphi = { unit = "deg" }\n\n'
+    sheet = _sheet(tmp_path, '"f(phi)" = "sin(phi)"\nx = "sin(10 + 2i)"\ny = "sin(10)"\n', head)
+    warned = [f.what for f in sheet.check().findings if f.topic == "angles"]
+    assert any("'y'" in w for w in warned) and not any("'x'" in w for w in warned)
