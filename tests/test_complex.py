@@ -523,3 +523,11 @@ def test_a_complex_argument_of_sin_is_no_angle_slip(tmp_path):
     sheet = _sheet(tmp_path, '"f(phi)" = "sin(phi)"\nx = "sin(10 + 2i)"\ny = "sin(10)"\n', head)
     warned = [f.what for f in sheet.check().findings if f.topic == "angles"]
     assert any("'y'" in w for w in warned) and not any("'x'" in w for w in warned)
+
+
+@pytest.mark.parametrize("text", ["3 + 4i ohm", "4i", "2.5j V"])
+def test_a_complex_input_value_says_what_to_write(tmp_path, text):
+    path = tmp_path / "i.toml"
+    path.write_text(f'[inputs]\nZ = "{text}"\n[definitions]\nx = "Z"\n', encoding="utf-8")
+    with pytest.raises(WorkbookError, match="is a complex number.*R \\+ X\\*1i"):
+        workbook.load(path)
