@@ -161,6 +161,7 @@ Zp = "par(Z, 1i*omega*L)"
 Zr = "par(R, R)"
 P = "polar(V, 30 deg)"
 S = { expr = "V*conj(I)", unit = "W" }
+Y = "[[1/R + 1/(1i*omega*L), -1/R], [-1/R, 1/R + 1i*omega*C]]"
 
 [[tables]]
 name = "sweep"
@@ -405,6 +406,7 @@ def test_run_prints_a_plus_bi(ac, tmp_path, capsys):
     main(["run", str(ac.spec.path), "--out", str(tmp_path / "o.xlsx")])
     out = capsys.readouterr().out
     assert "Z = 10 - 16.123i Ω" in out
+    assert "Y = [[0.1 - 0.063662i, -0.1], [-0.1, 0.1 + 0.0314159i]] 1/Ω" in out
     assert "I_mag = 12122.9 mA" in out
 
 

@@ -31,7 +31,6 @@ k5 = { expr = "Re(Z) + Im(Z) + abs(Z) - conj(Z)", unit = "ohm" }
 k6 = "arg(1i*R/R) + arg(-R/R + 0i)"
 k7 = "-Z/(2 ohm)"
 k8 = "sum(k*1i*R/R + 1, k, 1, 4)"
-Y = "[[1/R + 1i/(omega*L), -1/R], [-1/R, 1/R + 1i*omega*C]]"
 """
 
 

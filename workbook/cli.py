@@ -289,7 +289,11 @@ def _print_scalars(sheet) -> None:
             if getattr(q.magnitude, "ndim", 0):  # a vector or matrix, one row a line
                 import numpy as np
 
-                rows = np.array2string(q.magnitude, precision=6, separator=", ")
+                from .functions.complexes import readable
+
+                rows = np.array2string(  # complex elements as a + bi
+                    q.magnitude, precision=6, separator=", ", formatter={"complex_kind": readable}
+                )
                 print(f"  {name} = {rows.replace(chr(10), '')} {pretty(q.units)}".rstrip())
                 continue
             if isinstance(q.magnitude, complex):  # a + bi
