@@ -196,14 +196,14 @@ class ExcelPrinter(Visitor):
         return "-" + self._wrap(t.child, s, ATOM - 1), ADD
 
     def visit_TBinary(self, t, s):
+        if t.complex:
+            return self._complex_binary(t, s), ATOM
         if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
             self._array = True
             if t.op == "@":
                 return f"MMULT({self.print(t.left, s)}, {self.print(t.right, s)})", ATOM
             if t.op == "@^":
                 return _matrix_power(self.print(t.left, s), int(t.right.value)), ATOM
-        if t.complex:
-            return self._complex_binary(t, s), ATOM
         if t.op == "^":
             return f"{self._wrap(t.left, s, POW)}^{self._wrap(t.right, s, POW)}", POW
         level = ADD if t.op in "+-" else MUL

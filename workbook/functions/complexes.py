@@ -62,7 +62,7 @@ def parse_text(text: str) -> complex | None:
 
 
 def readable(z: complex, digits: int = 6, polar: bool = False) -> str:
-    """``z`` as a person writes it: ``10 - 16.1230i``, ``2i``, ``-7`` (``digits``
+    """``z`` as a person writes it: ``10 - 16.123i``, ``2i``, ``-7`` (``digits``
     significant digits in each part), or with ``polar`` as ``18.9883∠-58.1915°``."""
     z = complex(z)
     if polar:
@@ -99,8 +99,7 @@ def _number(x: float) -> str:
 
 def im_call(function: str):
     """The Excel function ``function`` of the printed arguments (the IM* functions)."""
-
-    name = stored(function)  # IMTAN, IMSINH, IMCOSH are newer: _xlfn.IMTAN
+    name = stored(function)  # a newer one with its stored prefix
 
     def printed(args: list[str]) -> tuple[str, int]:
         return f"{name}({', '.join(args)})", ATOM
