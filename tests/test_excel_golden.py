@@ -59,6 +59,8 @@ CASES = [
     ("hyperbolic", "sinh(a/b) + cosh(a/b) - tanh(a/b)", None),
     ("inverse_trig", "asin(a/c) + acos(a/c) + atan(b/c)", None),
     ("sqrt_of_sum", "sqrt(a + b + c)", None),
+    # complex numbers: the parts and angle of IM* results are numbers
+    ("complex_parts", "Re(polar(a, x/4)) + Im(conj(a - b*1i)) + arg(-a + x*1i)", None),
     ("tangent", "tan(a/c) - tan(-x/4)", None),
     ("reciprocal_trig", "2^sec(a/c) - csc(x/4)*cot(b/c)", None),  # 1/COS(...) under ^ and *
     ("sum_bound", "sum(u^2 - a*u, u, 1, 4)", None),  # unrolled: (1^2-a_*1)+...
@@ -155,7 +157,7 @@ def test_every_plain_builtin_is_printed_here():
     distributions by tests/test_distributions.py)."""
     plain = {n for n, b in REGISTRY.items() if not (b.binds or b.arrays or b.data_args)}
     plain -= DISTRIBUTIONS | {n for n, b in REGISTRY.items() if b.texts}  # test_texts.py
-    called = {n for _, text, _ in CASES for n in re.findall(r"([a-z_][a-z0-9_]*)\(", text)}
+    called = {n for _, text, _ in CASES for n in re.findall(r"([A-Za-z_]\w*)\(", text)}
     assert plain - called == set()
 
 

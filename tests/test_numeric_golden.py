@@ -73,6 +73,12 @@ FUNCTIONS = {
     "mod": ("mod(u, v)", lambda u, v: _remainder(u, v), (-20, 20), (0.3, 7)),
     "round": ("round(u, 2)", lambda u: _round(u, 2), (-50, 50)),
     "trunc": ("trunc(u)", lambda u: _sign(u) * mpmath.floor(abs(u)), (-5, 5)),
+    # of complex numbers u + v i (a real part of the complex results, as ulps are of reals)
+    "Re": ("Re(u + v*1i)", lambda u, v: mpmath.re(mpmath.mpc(u, v)), (-5, 5), (-5, 5)),
+    "Im": ("Im(u + v*1i)", lambda u, v: mpmath.im(mpmath.mpc(u, v)), (-5, 5), (-5, 5)),
+    "arg": ("arg(u + v*1i)", lambda u, v: mpmath.arg(mpmath.mpc(u, v)), (-5, 5), (-5, 5)),
+    "conj": ("Im(conj(u - v*1i))", lambda u, v: v, (-5, 5), (-5, 5)),
+    "polar": ("Im(polar(u, v))", lambda u, v: u * mpmath.sin(v), (0, 5), (-3, 3)),
 }
 
 # operator -> (worksheet expression, mpmath reference, domains, exact: correctly rounded)

@@ -296,6 +296,12 @@ def _print_scalars(sheet, first: int | None = None) -> None:
             if getattr(q.magnitude, "ndim", 0):  # a vector or matrix: aligned rows
                 print("\n".join(matrix_lines(f"  {name} = ", q.magnitude, pretty(q.units))))
                 continue
+            if isinstance(q.magnitude, complex):  # a + bi
+                from .functions.complexes import readable
+
+                shown = readable(q.magnitude, polar=sheet.spec.polar)
+                print(f"  {name} = {shown} {pretty(q.units)}".rstrip())
+                continue
             value = float(q.magnitude) + 0.0  # -0 shows as 0
             print(f"  {name} = {value:.6g} {pretty(q.units)}".rstrip())
         except WorkbookError as err:
@@ -334,6 +340,10 @@ def _element_text(v) -> str:
     if np.ndim(v):  # an array inside an array
         r, c = np.shape(v) if np.ndim(v) == 2 else (np.size(v), 1)
         return f"{{{r}x{c}}}"
+    if np.iscomplexobj(v):  # a + bi
+        from .functions.complexes import readable
+
+        return readable(complex(v))
     return f"{float(v) + 0.0:.6g}"
 
 

@@ -319,6 +319,15 @@ def _check_row(sheet, spec: PrintedSpec, row: PrintedRow) -> CheckRow:
                 line=row.line,
                 definition=row.name,
             )
+        if isinstance(q.magnitude, complex):
+            raise TemplateError(
+                f"'{row.name}' is complex and a printed value is one real number: check its "
+                f'parts through definitions (e.g. {row.name}_re = "Re({row.name})", or '
+                f"abs({row.name}), arg({row.name}))",
+                file=str(spec.file),
+                line=row.line,
+                definition=row.name,
+            )
         computed = float(q.to(un.unit(row.unit)).magnitude)
     except pint.DimensionalityError:
         raise UnitError(

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import InputError
 from ..language import expr as ex
 from ..language import units as un
 
@@ -271,6 +272,11 @@ def _series(sheet: Sheet, tables: dict, chart: ChartSpec, s: SeriesSpec) -> Seri
             return Series(x, np.asarray(df[s.y_column], dtype=float))
         data = _series_table(sheet, tables, chart, s)
         x = data.columns[1].values if len(data.columns) == 3 else data.columns[0].values
+        if any(c.typed is not None and c.typed.complex for c in data.columns):
+            raise InputError(
+                f"chart {chart.name}: a series of complex values has no points; plot abs(z), "
+                "arg(z), Re(z) or Im(z)"
+            )
         return Series(x, data.columns[-1].values, data)
     except Exception as err:  # noqa: BLE001 - kept; the workbook raises it, the report shows it
         return err

@@ -12,8 +12,10 @@ import dataclasses
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
-from ..functions import excel_names
+from ..functions import complexes, excel_names
 from ..functions.registry import CONSTANTS, REGISTRY
 from ..language import typed as ty
 from ..language.expr import PREC
@@ -36,6 +38,14 @@ def number(value: float) -> str:
     if float(value).is_integer() and abs(value) < 1e15:
         return str(int(value))
     return repr(float(value)).replace("e", "E")
+
+
+def cell_value(t: ty.T, magnitude) -> float | str:
+    """The value a cell of ``t`` holds: a number, or for a complex value Excel's complex
+    text (``3+4i``), which the IM* functions read."""
+    if t.complex:
+        return complexes.excel_text(complex(magnitude))
+    return float(np.real(magnitude))  # a real element of a complex matrix
 
 
 _CMP = {"<": "<", "<=": "<=", ">": ">", ">=": ">=", "==": "=", "!=": "<>"}
@@ -146,6 +156,8 @@ class ExcelPrinter(Visitor):
         return f"({text})" if own <= level else text
 
     def visit_TConst(self, t, s):
+        if t.complex:
+            return complexes.constant(t.value), ATOM
         text = number(t.value)
         return text, (ADD if text.startswith("-") else ATOM)
 
@@ -171,15 +183,21 @@ class ExcelPrinter(Visitor):
     def visit_TScale(self, t, s):
         if t.factor == 1.0:
             return self.visit(t.child, s)
+        if t.complex:
+            return f"IMPRODUCT({self.print(t.child, s)}, {number(t.factor)})", ATOM
         return f"{self._wrap(t.child, s, MUL - 1)}*{number(t.factor)}", MUL
 
     def visit_TUnary(self, t, s):
         if t.op == "not":
             return f"NOT({self.print(t.child, s)})", ATOM
+        if t.complex:
+            return f"IMSUB(0, {self.print(t.child, s)})", ATOM
         # Excel's negation binds tighter than ^: -x^2 is (-x)^2 there, so bracket all but atoms.
         return "-" + self._wrap(t.child, s, ATOM - 1), ADD
 
     def visit_TBinary(self, t, s):
+        if t.complex:
+            return self._complex_binary(t, s), ATOM
         if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
             self._array = True
             if t.op == "@":
@@ -193,7 +211,18 @@ class ExcelPrinter(Visitor):
         right = self._wrap(t.right, s, level)  # a-(b-c), a/(b*c)
         return f"{left}{t.op}{right}", level
 
+    def _complex_binary(self, t, s) -> str:
+        """An operator over the complex plane: IMSUM, IMSUB, IMPRODUCT, IMDIV, IMPOWER."""
+        if t.shape is not None or t.left.shape is not None or t.right.shape is not None:
+            raise NotLive("a vector or matrix of complex values has no live formula here")
+        left, right = self.print(t.left, s), self.print(t.right, s)
+        if t.op == "^":
+            return complexes.power(left, right, not t.right.complex)
+        return f"{complexes.OPERATORS[t.op]}({left}, {right})"
+
     def visit_TCompare(self, t, s):
+        if any(o.complex for o in t.operands):
+            raise NotLive("a comparison of complex values has no live formula here")
         parts = [self._wrap(o, s, CMP) for o in t.operands]
         pairs = [f"{a}{_CMP[op]}{b}" for a, op, b in zip(parts, t.ops, parts[1:])]
         if len(pairs) == 1:
@@ -206,6 +235,12 @@ class ExcelPrinter(Visitor):
     def visit_TFunc(self, t, s):
         entry = REGISTRY[t.func]
         bound = entry.binds is not None and len(t.args) > max(entry.binds)  # sum(EXPR, I, A, B)
+        if not bound and any(a.complex for a in t.args):
+            if entry.complex_excel is None or any(a.shape is not None for a in t.args):
+                raise NotLive(f"{t.func}() of complex values has no live formula")
+            return entry.complex_excel([self.print(a, s) for a in t.args])
+        if bound and t.complex and entry.complex_excel is None:
+            raise NotLive(f"{t.func}() of complex values has no live formula")
         if entry.arrays and not bound and any(a.shape is not None for a in t.args):
             self._array = True
             shapes = tuple(a.shape for a in t.args)
@@ -266,6 +301,8 @@ class ExcelPrinter(Visitor):
         return tail, ATOM
 
     def visit_TMatrix(self, t, s):
+        if t.complex:
+            raise NotLive("a matrix of complex values is written as values")
         self._array = True
         if not all(isinstance(e, ty.TConst) for row in t.rows for e in row):
             raise NotLive("a matrix written with formulas inside an expression (name it)")

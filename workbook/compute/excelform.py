@@ -25,6 +25,7 @@ from ..engine import runtime as rt
 from ..errors import LimitError, WorkbookError
 from ..functions.constants import CONSTANTS, shadowed
 from ..functions.excel_names import ExcelNames
+from ..functions.matrix import numbers
 from ..language import expr as ex
 from ..language import typed as ty
 from ..language import units as un
@@ -35,7 +36,7 @@ from ..outputs.xlsx import chart_label, write_labels
 from ..version import __version__
 from . import verdicts as V
 from .checks import tolerances
-from .excel import ExcelPrinter, NotLive
+from .excel import ExcelPrinter, NotLive, cell_value
 from .livecheck import RELATIVE, ROWS_CHECKED, CellLog, RecordingSheet
 
 MAX_ROWS = 1_048_576  # rows of an Excel sheet
@@ -154,6 +155,14 @@ class ColumnCells:
     first_row: int  # 0-based
     last_row: int
     title: str
+
+
+def _write_value(ws, row: int, col: int, value: float | str, fmt) -> None:
+    """A value cell: a number, or a text (a complex number as Excel's text)."""
+    if isinstance(value, str):
+        ws.write_string(row, col, value, fmt)
+    else:
+        ws.write_number(row, col, value, fmt)
 
 
 def _col_letter(col: int) -> str:
@@ -284,7 +293,7 @@ class ExcelLayout:
         for row, d in enumerate(defs, start=1):
             t, q = self._scalar(d.name)
             ws.write_string(row, 0, d.name)
-            value = q if t.text or isinstance(q, str) else float(q.magnitude)
+            value = q if t.text or isinstance(q, str) else cell_value(t, q.magnitude)
             with self.printer.context(helpers=HelperCells(self, d.name, t)):
                 self._write_cell(ws, row, 1, t, {}, value, self.fmt["number"], d.name)
             ws.write_string(row, 2, un.typeset(t.unit))
@@ -348,7 +357,7 @@ class ExcelLayout:
                 continue
             unit = un.typeset(t.unit)
             ws.write_string(row, 2, unit)
-            value = q if t.text or isinstance(q, str) else float(q.magnitude)
+            value = q if t.text or isinstance(q, str) else cell_value(t, q.magnitude)
             if d.name in done:
                 ref = self.names[d.name]
                 ws.write_formula(row, 1, f"={ref}", self.fmt["number"], value)
@@ -400,7 +409,7 @@ class ExcelLayout:
                 continue
             r, c = t.shape
             self._check_block(d, row + 1, r, c)
-            value = np.asarray(self.sheet.scalar_value(d.name, "definition"), dtype=float)
+            value = numbers(self.sheet.scalar_value(d.name, "definition"))
             ws.write_string(row, 0, d.name, self.fmt["header"])
             ws.write_string(row, 1, f"{un.typeset(t.unit) or '1'}   {d.text}   {d.note}".strip())
             top = row + 1
@@ -499,17 +508,18 @@ class ExcelLayout:
         if isinstance(body, ty.TMatrix):  # written out: one cell per element
             for i, row in enumerate(body.rows):
                 for j, e in enumerate(row):
+                    v = cell_value(e, value[i, j])
                     if isinstance(e, ty.TConst):
-                        ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
+                        _write_value(ws, top + i, 1 + j, v, fmt)
                     else:
-                        self._write_cell(ws, top + i, 1 + j, e, {}, float(value[i, j]), fmt, what)
+                        self._write_cell(ws, top + i, 1 + j, e, {}, v, fmt, what)
             return
         try:
             formula = self.printer.formula(t, {})
         except NotLive as why:
             for i in range(r):
                 for j in range(c):
-                    ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
+                    _write_value(ws, top + i, 1 + j, cell_value(t, value[i, j]), fmt)
             ws.write_comment(top, 1, f"Values, not formulas: {why}")
             self.not_live.append(what)
             return
@@ -690,17 +700,21 @@ class ExcelLayout:
                 if i in col.failed:  # an error value, as Excel computes one
                     error = col.excel_error(i)
                     ws.write_formula(first + i, j, _ERROR_FORMULAS[error], fmt, error)
-                elif isinstance(v, str):
-                    ws.write_string(first + i, j, v, fmt)
                 else:
-                    ws.write_number(first + i, j, float(v), fmt)
+                    _write_value(
+                        ws, first + i, j, v if isinstance(v, str) else cell_value(col.typed, v), fmt
+                    )
             ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
             self.not_live.append(f"{table}.{col.text}")
             _failed_comments(ws, first, j, col)
             return False
         steps.write()
         pieces = template.split(ROW_TOKEN)
-        values = col.values.tolist()
+        values = (
+            [cell_value(col.typed, v) for v in col.values]
+            if col.typed.complex
+            else col.values.tolist()
+        )
         for i in col.failed:  # the cached value of a failed row is Excel's error value
             values[i] = col.excel_error(i)
         _failed_comments(ws, first, j, col)

@@ -604,6 +604,8 @@ class TypedText(Visitor):
 
     def visit_TConst(self, t: ty.TConst) -> tuple[str, int]:
         v = t.value
+        if isinstance(v, complex):  # 3+4i, as written
+            return f"({v.real:.6g}{v.imag:+.6g}i)", PREC["atom"]
         s = repr(int(v)) if float(v).is_integer() and abs(v) < 1e15 else f"{v:.6g}"
         return s, PREC["atom"]
 

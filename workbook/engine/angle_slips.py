@@ -83,7 +83,7 @@ def _trig_calls(t: ty.T):
 def _bare(t: ty.T) -> float | None:
     while isinstance(t, ty.TScale) and t.factor == 1.0:
         t = t.child
-    return t.value if ty.is_bare(t) else None
+    return t.value if ty.is_bare(t) and not t.complex else None  # sin(2 + 1i) is no angle
 
 
 def _degrees_times_pi_over_180(t: ty.T) -> bool:

@@ -640,7 +640,7 @@ def _piecewise(
                     return val(env)
             raise _NoPiece(env, texts)
         shape, pieces = split(env)
-        out = np.empty(shape, dtype=object if t.text else float)
+        out = np.empty(shape, dtype=object if t.text else complex if t.complex else float)
         for i, take, sub in pieces:
             out[take] = values[i](sub)
         return out
@@ -745,6 +745,11 @@ def outside_limits(d, unit, values) -> tuple[np.ndarray, str]:
     from ..language import units as un
 
     lo, hi, positive = d.limits.magnitudes(unit, d.unit, f"'{d.name}'")
+    if np.iscomplexobj(values):
+        raise InputError(
+            f"'{d.name}' is complex: its limits (min, max, positive) compare real numbers; "
+            f"declare them on abs({d.name}) or Re({d.name})"
+        )
     v = np.asarray(values, dtype=float)
     bad = (v < lo) | (v > hi)
     if positive:

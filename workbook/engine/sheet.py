@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import math
+import cmath
 from pathlib import Path
 from typing import Any
 
@@ -11,6 +11,7 @@ import pint
 
 from ..compute.computed import Column, TableData, compute
 from ..errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
+from ..functions.matrix import numbers
 from ..functions.registry import CONSTANTS
 from ..language import expr as ex
 from ..language import typecheck as tc
@@ -248,7 +249,7 @@ class Sheet:
             out = self.evaluator.function(name)(env)
             if f.body.text or isinstance(out, str):  # a text, or an array's element that is one
                 return out if np.ndim(out) == 0 else np.asarray(out, dtype=object)
-            q = Q(np.asarray(out, dtype=float) if np.ndim(out) else float(out), f.unit)
+            q = Q(numbers(out) if np.ndim(out) else numbers(out).item(), f.unit)
             return q.to("") if un.is_compound_ratio(f.unit) else q
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
@@ -345,8 +346,8 @@ class Sheet:
         if isinstance(value, str):
             pass  # a text: "OK"
         elif np.ndim(value) == 0:
-            value = float(value)
-            if not math.isfinite(value):
+            value = complex(value) if np.iscomplexobj(value) else float(value)
+            if not cmath.isfinite(value):
                 raise DomainError(
                     f"{name} is not a finite number ({value}); its formula is {d.text}",
                     file=self.file,
@@ -555,7 +556,7 @@ class Sheet:
         if t.text:
             out = np.broadcast_to(np.asarray(out, dtype=object), values.shape).copy()
             return Column(col.title, t.unit, out, t, col.text)
-        out = np.broadcast_to(np.asarray(out, dtype=float), values.shape).copy()
+        out = np.broadcast_to(numbers(out), values.shape).copy()
         bad = ~np.isfinite(out)
         for i in np.flatnonzero(bad).tolist()[: MAX_FAILED_ROWS + 1]:
             failed.setdefault(

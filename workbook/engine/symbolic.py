@@ -44,6 +44,8 @@ def _sympy():
 def exact_number(value: float):
     """A float as an exact SymPy number: a short fraction (times pi), else its decimal."""
     sp = _sympy()
+    if isinstance(value, complex):  # a + b*I
+        return exact_number(value.real) + sp.I * exact_number(value.imag)
     v = float(value)
     if not math.isfinite(v):
         raise NotSymbolic(f"{v} is not a finite number")

@@ -416,7 +416,9 @@ def _unique(base: str, taken: set[str]) -> str:
 
 
 def _name_params(tr: Translation, reserved: set[str]) -> None:
-    taken = set(reserved) | {n.lower() for n in tr.cell_names.values()}
+    # a parameter may take a built-in's name (Re, a Reynolds number, beside Re(z)): inside
+    # the function it is the value, and a call of that name is still the built-in
+    taken = set(KEYWORDS) | {n.lower() for n in tr.cell_names.values()}
     taken |= {i.final.lower() for i in tr.functions.values()}
     for info in tr.functions.values():
         used: set[str] = set()

@@ -66,6 +66,7 @@ from ..errors import InputError, LimitError, NotLive, TemplateError, UnitError
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.units import pretty
+from .complexes import classic, im_call, im_cosh, im_sinh, im_tan, im_tanh
 from .entry import (  # noqa: F401 - the entry record is part of this module's interface
     Arity,
     Builtin,
@@ -146,9 +147,29 @@ def mathml_fence(left: str, right: str) -> str:
 
 
 _TRIG = {"mathml_powered": True}
-_simple("sin", np.sin, "SIN", lambda sp, x: sp.sin(x), "sine (argument in radians)", **_TRIG)
-_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG)
-_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG)
+
+
+def _complex(function: str) -> dict:
+    """The fields of a built-in over the complex plane, Excel's ``function`` its live form."""
+    return {"complex": "complex", "complex_excel": im_call(function)}
+
+
+def _classic(form) -> dict:
+    """The same, the live form made of the classic IM* functions (tan, sinh, cosh)."""
+    return {"complex": "complex", "complex_excel": classic(form)}
+
+
+_simple(
+    "sin",
+    np.sin,
+    "SIN",
+    lambda sp, x: sp.sin(x),
+    "sine (argument in radians)",
+    **_TRIG,
+    **_complex("IMSIN"),
+)
+_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG, **_complex("IMCOS"))
+_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_classic(im_tan))
 
 
 def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
@@ -199,9 +220,34 @@ _simple(
     rule=_atan2_unit,
     arity=2,
 )
-_simple("sinh", np.sinh, "SINH", lambda sp, x: sp.sinh(x), "hyperbolic sine", **_TRIG)
-_simple("cosh", np.cosh, "COSH", lambda sp, x: sp.cosh(x), "hyperbolic cosine", **_TRIG)
-_simple("tanh", np.tanh, "TANH", lambda sp, x: sp.tanh(x), "hyperbolic tangent", **_TRIG)
+_simple(
+    "sinh",
+    np.sinh,
+    "SINH",
+    lambda sp, x: sp.sinh(x),
+    "hyperbolic sine",
+    **_TRIG,
+    **_classic(im_sinh),
+)
+_simple(
+    "cosh",
+    np.cosh,
+    "COSH",
+    lambda sp, x: sp.cosh(x),
+    "hyperbolic cosine",
+    **_TRIG,
+    **_classic(im_cosh),
+)
+_simple(
+    "tanh",
+    np.tanh,
+    "TANH",
+    lambda sp, x: sp.tanh(x),
+    "hyperbolic tangent",
+    **_TRIG,
+    complex="complex",
+    complex_excel=classic(im_tanh),
+)
 _simple(
     "sqrt",
     np.sqrt,
@@ -211,9 +257,18 @@ _simple(
     _sqrt_unit,
     (_SQRT,),
     mathml="<msqrt>{0}</msqrt>",
+    **_complex("IMSQRT"),
 )
-_simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential")
-_simple("ln", np.log, "LN", lambda sp, x: sp.log(x), "natural logarithm", domain=_log_domain("ln"))
+_simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", **_complex("IMEXP"))
+_simple(
+    "ln",
+    np.log,
+    "LN",
+    lambda sp, x: sp.log(x),
+    "natural logarithm",
+    domain=_log_domain("ln"),
+    **_complex("IMLN"),
+)
 _simple(
     "log10",
     np.log10,
@@ -221,6 +276,7 @@ _simple(
     lambda sp, x: sp.log(x, 10),
     "logarithm base 10",
     domain=_log_domain("log10"),
+    **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
 )
 _simple(
@@ -228,9 +284,11 @@ _simple(
     np.abs,
     "ABS",
     lambda sp, x: sp.Abs(x),
-    "absolute value",
+    "absolute value (of a complex number: its modulus)",
     same_unit,
     mathml=mathml_fence("|", "|"),
+    complex="real",
+    complex_excel=im_call("IMABS"),
 )
 _simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
 
@@ -433,6 +491,8 @@ def _sum_excel(body, args=None, consts=None, *, shapes=None) -> tuple[str, int]:
     if hi - lo + 1 > MAX_EXCEL_TERMS:
         raise NotLive(f"sum() of {hi - lo + 1} terms (written out up to {MAX_EXCEL_TERMS})")
     terms = [body(str(i) if i >= 0 else f"({i})") for i in range(lo, hi + 1)]
+    if body.typed.complex:  # complex terms: Excel's IMSUM of them
+        return f"IMSUM({', '.join(terms)})", PREC["atom"]
     return "(" + ")+(".join(terms) + ")", PREC["+"]
 
 
@@ -451,6 +511,8 @@ register(
         doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A); "
         "sum(v): the sum of the elements of a vector or matrix",
         binds=(0, 1),
+        complex="complex",
+        complex_excel=_sum_excel,
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
         arrays=True,
     )

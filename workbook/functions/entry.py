@@ -66,6 +66,11 @@ class Builtin:
     runtime: Callable[..., ty.T] | None = None
     texts: bool = False  # takes text arguments (the unit rule checks each; else numbers only)
     sizes: bool = False  # reads only an array's size: the array may hold texts
+    # complex arguments: "" refused at load; "complex": taken, the value complex when an
+    # argument is; "real": taken, the value real (abs, Re, arg)
+    complex: str = ""
+    # the Excel formula when an argument is complex (Excel's IM* functions); None: not live
+    complex_excel: Callable[..., tuple[str, int]] | None = None
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""

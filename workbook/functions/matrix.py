@@ -64,9 +64,14 @@ def elementwise(op, a, b, a_matrix: bool, b_matrix: bool):
     return op(a, b)
 
 
+def numbers(m) -> np.ndarray:
+    """``m`` as an array of floats, or of complex numbers when it holds complex ones."""
+    return np.asarray(m, dtype=complex if np.iscomplexobj(m) else float)
+
+
 def _last(m):
     """Matrix axes last (numpy.linalg's layout)."""
-    m = np.asarray(m, dtype=float)
+    m = numbers(m)
     return np.moveaxis(m, (0, 1), (-2, -1))
 
 
@@ -76,14 +81,14 @@ def _first(m):
 
 def build(rows: list[list]) -> np.ndarray:
     """A matrix from its elements (each a scalar or an array over the range)."""
-    flat = np.broadcast_arrays(*[np.asarray(v, dtype=float) for row in rows for v in row])
+    flat = np.broadcast_arrays(*[numbers(v) for row in rows for v in row])
     r, c = len(rows), len(rows[0])
     return np.stack(flat).reshape((r, c) + flat[0].shape)
 
 
 def matmul(a, b):
     """Matrix product; two vectors of one length give their dot product (Mathcad's v*w)."""
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    a, b = numbers(a), numbers(b)
     ra, rb = a.ndim - 2, b.ndim - 2
     a, b = pad(a, rb - ra), pad(b, ra - rb)
     (n, k), m = a.shape[:2], b.shape[1]
@@ -101,11 +106,13 @@ def dot(a, b):
 
 
 def _scalar(x):
-    return float(x) if np.ndim(x) == 0 else x
+    if np.ndim(x):
+        return x
+    return complex(x) if np.iscomplexobj(x) else float(x)
 
 
 def transpose(m):
-    return np.swapaxes(np.asarray(m, dtype=float), 0, 1)
+    return np.swapaxes(numbers(m), 0, 1)
 
 
 def det(m):
@@ -155,31 +162,55 @@ def lsolve(m, v):
     return _first(np.linalg.solve(mm, vv))
 
 
-def _real(values, what: str):
+def _real(values, what: str, kind: str = "eigenvalues"):
     if np.any(np.abs(values.imag) > 1e-9 * np.maximum(1.0, np.abs(values.real))):
-        raise DomainError(f"{what}: the matrix has complex eigenvalues (not supported)")
+        raise DomainError(
+            f"{what}: the matrix has complex {kind}; of a complex matrix they are complex "
+            "values (write it with complex elements, M*(1 + 0i)), or take eigenparts(M)"
+            if kind == "eigenvalues"
+            else f"{what}: the polynomial has complex roots; of complex coefficients they are "
+            "complex values (v*(1 + 0i)), or take polyrootparts(v)"
+        )
     return values.real
 
 
+def _order(lam):
+    """Ascending eigenvalues; complex ones by real part (equal to 10 digits of the largest
+    modulus: a conjugate pair's rounding does not split it), then imaginary part."""
+    if np.iscomplexobj(lam):
+        scale = np.max(np.abs(lam), axis=-1, keepdims=True)
+        real = np.round(lam.real / np.where(scale > 0, scale, 1.0), 10)
+        return np.lexsort((lam.imag, real), axis=-1)
+    return np.argsort(lam, axis=-1)
+
+
 def eigenvals(m):
-    """Eigenvalues, ascending, as a column vector."""
+    """Eigenvalues, ascending, as a column vector (of a complex matrix: complex, by real
+    part, then imaginary part)."""
     charge_cubic("eigen", m, "eigenvals()")
-    lam = _real(np.linalg.eigvals(_last(m)), "eigenvals()")
-    lam = np.sort(lam, axis=-1)
+    mm = _last(m)
+    lam = np.linalg.eigvals(mm)
+    if not np.iscomplexobj(mm):
+        lam = _real(lam, "eigenvals()")
+    lam = np.take_along_axis(lam, _order(lam), axis=-1)
     return np.moveaxis(lam[..., None], (-2, -1), (0, 1))
 
 
 def eigenvecs(m):
     """Unit eigenvectors as columns, in the order of eigenvals (ascending); each column's
-    largest component is positive (a fixed sign)."""
+    largest component is positive (a fixed sign; of a complex matrix: real and positive)."""
     charge_cubic("eigen", m, "eigenvecs()")
-    lam, vec = np.linalg.eig(_last(m))
-    lam = _real(lam, "eigenvecs()")
-    vec = _real(vec, "eigenvecs()")
-    order = np.argsort(lam, axis=-1)
-    vec = np.take_along_axis(vec, order[..., None, :], axis=-1)
+    mm = _last(m)
+    lam, vec = np.linalg.eig(mm)
+    if not np.iscomplexobj(mm):
+        lam = _real(lam, "eigenvecs()")
+        vec = _real(vec, "eigenvecs()")
+    vec = np.take_along_axis(vec, _order(lam)[..., None, :], axis=-1)
     big = np.take_along_axis(vec, np.argmax(np.abs(vec), axis=-2)[..., None, :], axis=-2)
-    vec = vec * np.where(big < 0, -1.0, 1.0)
+    if np.iscomplexobj(vec):
+        vec = vec * (np.abs(big) / np.where(big == 0, 1.0, big))
+    else:
+        vec = vec * np.where(big < 0, -1.0, 1.0)
     return _first(vec)
 
 
@@ -237,7 +268,7 @@ def rank(m):
 
 def _polynomial_roots(v, what: str) -> np.ndarray:
     """The roots (complex) of the polynomial v[0] + v[1] x + ... for each value of v."""
-    coefficients = np.moveaxis(np.asarray(v, dtype=float)[:, 0], 0, -1)  # (..., n)
+    coefficients = np.moveaxis(numbers(v)[:, 0], 0, -1)  # (..., n)
     if np.any(coefficients[..., -1] == 0):
         raise InputError(f"{what}: the last coefficient (of the highest power) is 0")
     if not np.all(np.isfinite(coefficients)):
@@ -249,8 +280,12 @@ def _polynomial_roots(v, what: str) -> np.ndarray:
 
 
 def polyroots(v):
-    """The roots of v[0] + v[1] x + ... + v[n] x^n, ascending (real roots only)."""
-    roots = np.sort(_real(_polynomial_roots(v, "polyroots()"), "polyroots()"), axis=-1)
+    """The roots of v[0] + v[1] x + ... + v[n] x^n, ascending (real roots only; of complex
+    coefficients complex roots, by real part, then imaginary part)."""
+    roots = _polynomial_roots(v, "polyroots()")
+    if not np.iscomplexobj(v):
+        roots = _real(roots, "polyroots()", "roots")
+    roots = np.take_along_axis(roots, _order(roots), axis=-1)
     return np.moveaxis(roots[..., None], (-2, -1), (0, 1))
 
 
@@ -310,7 +345,7 @@ def stack(*ms):
 
 
 def _same_range(ms):
-    ms = [np.asarray(m, dtype=float) for m in ms]
+    ms = [numbers(m) for m in ms]
     extra = max(m.ndim - 2 for m in ms)
     ms = [pad(m, extra - (m.ndim - 2)) for m in ms]
     shape = np.broadcast_shapes(*[m.shape[2:] for m in ms])
@@ -321,7 +356,7 @@ def reduce(kind: str, *values, matrix: tuple[bool, ...]):
     """max/min/mean/sum over every element of the matrices (and the scalars) given."""
     parts = []
     for v, is_m in zip(values, matrix):
-        v = np.asarray(v, dtype=float)
+        v = numbers(v)
         if is_m:
             parts.append(v.reshape((-1,) + v.shape[2:]))
         else:
@@ -335,8 +370,8 @@ def reduce(kind: str, *values, matrix: tuple[bool, ...]):
 def index(m, i, j=None, *, origin: int, shape: tuple[int, int], what: str):
     """Element [i] of a vector or [i, j] of a matrix, with the sheet's origin; an index out of
     range or not an integer is an error naming it."""
-    if type(m) is not np.ndarray or m.dtype != float:
-        m = np.asarray(m, dtype=float)
+    if type(m) is not np.ndarray or m.dtype not in (float, complex):
+        m = numbers(m)
     ii = _index_values(i, origin, shape[0], "row" if j is not None else "element", what)
     jj = _index_values(j, origin, shape[1], "column", what) if j is not None else 0
     if m.ndim > 2 and (np.ndim(ii) or np.ndim(jj)):
@@ -380,7 +415,7 @@ def element_index(shape, indices, origin: int, what: str) -> tuple[int, int]:
 
 
 def submatrix(m, ir: int, jr: int, ic: int, jc: int):
-    return np.asarray(m, dtype=float)[ir : jr + 1, ic : jc + 1]
+    return numbers(m)[ir : jr + 1, ic : jc + 1]
 
 
 def size(kind: str, v, origin: int = 0) -> float:

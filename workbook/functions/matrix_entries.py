@@ -119,7 +119,7 @@ def not_live(why: str):
     return printed
 
 
-def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False):
+def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, complex=""):
     register(
         Builtin(
             name,
@@ -132,6 +132,7 @@ def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False):
             arrays=True,
             runtime=runtime,
             sizes=sizes,
+            complex=complex,
         )
     )
 
@@ -198,6 +199,7 @@ entry(
     call("TRANSPOSE"),
     "rows and columns swapped",
     runtime=rt_transpose,
+    complex="complex",
 )
 entry(
     "det",
@@ -206,6 +208,7 @@ entry(
     lambda m, shapes: det(m),
     call("MDETERM"),
     "determinant of a square matrix",
+    complex="complex",
 )
 entry(
     "inverse",
@@ -214,6 +217,7 @@ entry(
     lambda m, shapes: inverse(m),
     call("MINVERSE"),
     "inverse of a square matrix (a singular one is an error)",
+    complex="complex",
 )
 entry(
     "lsolve",
@@ -222,6 +226,7 @@ entry(
     lambda m, v, shapes: lsolve(m, v),
     call("MMULT", "MINVERSE({}), {}"),
     "solution x of M x = v",
+    complex="complex",
 )
 
 
@@ -243,6 +248,7 @@ entry(
     lambda m, shapes: eigenvals(m),
     not_live("eigenvalues have no spreadsheet formula"),
     "eigenvalues of a square matrix, ascending (real ones only)",
+    complex="complex",
 )
 
 
@@ -266,6 +272,7 @@ entry(
     lambda m, shapes: eigenvecs(m),
     not_live("eigenvectors have no spreadsheet formula"),
     "unit eigenvectors as columns, in the order of eigenvals",
+    complex="complex",
 )
 
 
@@ -513,6 +520,7 @@ entry(
     lambda v, shapes: polyroots(v),
     not_live("the roots of a polynomial have no spreadsheet formula"),
     "polyroots(v): the roots of v[0] + v[1]*x + ... + v[n]*x^n, ascending (real ones only)",
+    complex="complex",
 )
 entry(
     "polyrootparts",
@@ -818,6 +826,7 @@ for kind, doc in (
         doc,
         runtime=rt_with_origin("plain"),
         sizes=True,
+        complex="real",
     )
 
 

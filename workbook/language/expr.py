@@ -40,6 +40,14 @@ class Quantity(Node):
 
 
 @dataclass(frozen=True)
+class Imaginary(Node):
+    """A number followed by ``i`` or ``j`` (``4i``, ``2.5j``, as Mathcad writes it): ``value``
+    times the imaginary unit. ``i`` and ``j`` alone stay names (range variables)."""
+
+    value: float
+
+
+@dataclass(frozen=True)
 class Text(Node):
     """A string literal: allowed only as the right side of ``choice == "..."``."""
 
@@ -207,7 +215,17 @@ def _quantity_literals(source: str) -> str:
     i = 0
     while i < len(tokens) - 1:
         num, name = tokens[i], tokens[i + 1]
-        if (
+        if num.type == tokenize.NUMBER and name.string in ("i", "j") and name.start == num.end:
+            # 4i, as Mathcad writes the imaginary unit: Python's 4j (j alone stays a name)
+            unit = tokens[i + 2] if i + 2 < len(tokens) else None
+            if unit is not None and unit.type == tokenize.NAME and unit.string not in _NOT_UNITS:
+                end = _unit_end(tokens, i + 2)  # 4i ohm: refused with what to write
+                spans.append((at(num.start), at(name.end), at(unit.start), at(tokens[end - 1].end)))
+                i = end
+                continue
+            spans.append((at(num.start), at(num.end), at(name.start), at(name.end)))
+            i += 2
+        elif (
             num.type == tokenize.NUMBER
             and name.type == tokenize.NAME
             and name.string not in _NOT_UNITS
@@ -238,7 +256,13 @@ def _quantity_literals(source: str) -> str:
     out = source
     for n0, n1, u0, u1 in reversed(spans):
         unit = out[u0:u1].replace('"', "")
-        out = f"{out[:n0]}({out[n0:n1]} @ {unit!r}){out[u1:]}"
+        if unit in ("i", "j") and u0 == n1:
+            out = f"{out[:n0]}{out[n0:n1]}j{out[u1:]}"
+            continue
+        number = out[n0:n1]
+        if number[-1] in "ij":  # 4i ohm
+            number = number[:-1] + "j"
+        out = f"{out[:n0]}({number} @ {unit!r}){out[u1:]}"
     return out
 
 
@@ -320,6 +344,8 @@ def _convert(node: ast.AST, text: str, what: str, depth: int) -> Node:
         raise LimitError(f"{what}: expression nested more than {MAX_DEPTH} deep")
     d = depth + 1
     if isinstance(node, ast.Constant):
+        if isinstance(node.value, complex):  # 4j (or 4i, read as 4j): only the imaginary part
+            return Imaginary(_finite(node.value.imag, text, what))
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float, str)):
             raise TemplateError(f"{what}: {node.value!r} is not allowed in {text!r}")
         if isinstance(node.value, str):
@@ -403,6 +429,12 @@ def _quantity(node: ast.BinOp, text: str, what: str) -> Quantity:
         and isinstance(unit, ast.Constant)
         and isinstance(unit.value, str)
     ):
+        if isinstance(number, ast.Constant) and isinstance(number.value, complex):
+            z = f"{number_text(number.value.imag)}i"
+            raise TemplateError(
+                f"{what}: a unit after the imaginary number {z} in {text!r}: write the unit "
+                f"as a factor, {z}*1 {unit.value}"
+            )
         raise TemplateError(f"{what}: operator MatMult not allowed in {text!r} (use + - * / ^)")
     return Quantity(_finite(number.value, text, what), unit.value.replace("**", "^"))
 
@@ -468,7 +500,7 @@ class _Children(Visitor):
     def visit_Number(self, node: Number) -> tuple[Node, ...]:
         return ()
 
-    visit_Text = visit_Name = visit_Quantity = visit_Number
+    visit_Text = visit_Name = visit_Quantity = visit_Imaginary = visit_Number
 
     def visit_Unary(self, node: Unary) -> tuple[Node, ...]:
         return (node.operand,)
@@ -549,6 +581,10 @@ class TextPrinter(Visitor):
         # a negative number reads back as a unary minus: bracketed as one (under a power)
         level = PREC["neg"] if math.copysign(1.0, node.value) < 0 else PREC["atom"]
         return number_text(node.value), level
+
+    def visit_Imaginary(self, node: Imaginary) -> tuple[str, int]:
+        level = PREC["neg"] if math.copysign(1.0, node.value) < 0 else PREC["atom"]
+        return number_text(node.value) + "i", level
 
     def visit_Quantity(self, node: Quantity) -> tuple[str, int]:
         # a product for the precedence of what is around it: F/(20 mm^2) keeps its brackets

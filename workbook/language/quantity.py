@@ -45,6 +45,11 @@ def split_quantity(text: str, *, what: str = "value") -> tuple[float | int, str]
         raise InputError(f"{what}: empty value")
     if text[0] in "[({" or "," in text or ";" in text:
         _refuse_list(text, what)
+    if re.search(r"(?<![\w.])[\d.]+(?:[eE][+-]?\d+)?[ij](?!\w)", text):
+        raise InputError(
+            f"{what}: {original!r} is a complex number, and a value is one real number and its "
+            "unit: give the parts as two values (R, X) and define the complex one, R + X*1i"
+        )
     m = _SPECIAL.match(text) or _NUMBER.match(text)
     if m is None:
         raise InputError(

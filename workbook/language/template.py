@@ -64,6 +64,7 @@ SHEET_KEYS = (
     "samples",
     "tolerance",
     "origin",
+    "complex",
 )  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
 INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
 ARGUMENT_KEYS = ("unit", "note", "plain")
@@ -347,6 +348,11 @@ class SheetSpec:
     def origin(self) -> int:
         """The first index of vectors and matrices (Mathcad's ORIGIN; [sheet] origin)."""
         return int(self.meta.get("origin", 0))
+
+    @property
+    def polar(self) -> bool:
+        """Complex results shown as r∠phi (``[sheet] complex = "polar"``), else as a + bi."""
+        return self.meta.get("complex", "rectangular") == "polar"
 
     def line_of(self, key: str, section: str | None = None) -> int | None:
         return find_line(self.text, key, section)
@@ -679,6 +685,12 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             raise err.located(line=line, definition=dname) from None
 
     odes = _odes(data, text, arguments, definitions, claim)
+    if sheet.get("complex", "rectangular") not in ("rectangular", "polar"):
+        raise TemplateError(
+            f'[sheet] complex is "rectangular" (a + bi) or "polar" (r∠phi), got '
+            f"{sheet['complex']!r}",
+            line=find_line(text, "complex", "sheet"),
+        )
     origin = sheet.get("origin", 0)
     if isinstance(origin, bool) or not isinstance(origin, int) or abs(origin) > 1_000_000:
         raise TemplateError(

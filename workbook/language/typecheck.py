@@ -9,6 +9,7 @@ and Excel) read this typed tree, so no back end converts a unit.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import re
 
 import pint
@@ -17,6 +18,7 @@ from ..errors import LimitError, ShapeError, TemplateError, UnitError, WorkbookE
 from ..functions.registry import CONSTANTS, REGISTRY
 from . import expr as ex
 from . import units as un
+from .complextyping import no_order, real_in_program, real_index, real_only, value_kind
 from .fields import nearest
 from .measured import column_vector
 from .template import Definition, SheetSpec, column_node
@@ -142,10 +144,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 f"{at_numbers.message}; with arrays: {err.message}"
             ) from None
 
-    def specialized(self, name: str, shapes: tuple) -> TypedFunction:
+    def specialized(self, name: str, shapes: tuple, complexes: tuple = ()) -> TypedFunction:
         """Function ``name`` typed with its parameters of ``shapes`` (None: a number; () for
-        all numbers), each in the unit declared in [arguments]; typed once per shapes."""
-        key = specialization_key(name, shapes)
+        all numbers), complex where ``complexes`` says so, each in the unit declared in
+        [arguments]; typed once per shapes."""
+        key = specialization_key(name, shapes, complexes)
         if key in self._assumed:  # a call inside its own body: recursion
             d = self._definition(name)
             if d.program is None and d.branches is None:  # nothing can end it
@@ -158,7 +161,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             d = self._definition(name)
             shapes = tuple(shapes) or (None,) * len(d.params)
             units = tuple(self.spec.arguments[p].binding_unit for p in d.params)
-            scope = {p: u if sh is None else (u, sh) for p, u, sh in zip(d.params, units, shapes)}
+            kinds = complexes or (False,) * len(d.params)
+            scope = {
+                p: (u, sh, "complex") if c else u if sh is None else (u, sh)
+                for p, u, sh, c in zip(d.params, units, shapes, kinds)
+            }
             with self._remembered(key):
                 self.functions[key] = self._settled(d, key, units, scope, shapes)
         return self.functions[key]
@@ -273,6 +280,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
         known.update(dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS]))
         hint = nearest(name, known)
+        if kind == "name":  # a value is meant: the sheet's names first (R1 is R_1, not Re())
+            values = nearest(name, {k: v for k, v in known.items() if k not in REGISTRY})
+            hint = values if values or un.is_unit_name(name) else hint
         if kind == "name" and not hint and un.is_unit_name(name):
             hint = f" (a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")
@@ -351,6 +361,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
     def visit_Number(self, node: ex.Number, scope) -> T:
         return TConst(self.dimensionless, value=node.value)
 
+    def visit_Imaginary(self, node: ex.Imaginary, scope) -> T:
+        return TConst(self.dimensionless, value=complex(0.0, node.value))
+
     def visit_Quantity(self, node: ex.Quantity, scope) -> T:
         """``20 mm``: a constant in its unit, read by the reader of input values. A name joined
         to the unit (``2 m*x``) that is also a name of this sheet is refused: write a space."""
@@ -409,9 +422,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
     def _name(self, name: str, scope) -> T:
         if name in scope:
-            if isinstance(scope[name], tuple):  # a program's local vector: (unit, shape)
-                unit, shape = scope[name]
-                return TParam(unit, name=name, shape=shape)
+            if isinstance(scope[name], tuple):  # (unit, shape), and "complex" for a complex one
+                unit, shape, *kind = scope[name]
+                return TParam(unit, name=name, shape=shape, complex=bool(kind))
             return TParam(scope[name], name=name)
         block = self.spec.solve_of(name)
         if block is not None:
@@ -436,7 +449,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     f"write {name}({', '.join(d.params)})"
                 )
             body = self.scalar(name)
-            return TRef(body.unit, name=name, kind="definition", shape=body.shape, text=body.text)
+            return TRef(body.unit, name=name, kind="definition", **value_kind(body))
         if name in self.spec.arguments:
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
         if name in CONSTANTS:  # the sheet's own pi, e or g came first
@@ -474,6 +487,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                             f"{', '.join(opts)}"
                         )
             return TCompare(self.dimensionless, ops=node.ops, operands=tuple(typed), boolean=True)
+        no_order(node, typed)
         typed = meeting(typed)
         first = next((t for t in typed if not is_zero(t)), typed[0])
         out = []
@@ -514,12 +528,16 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     f"({', '.join(d.params)}), got {len(args)}"
                 )
             shapes = tuple(a.shape for a in args)
-            f = self._called(node, shapes) if any(shapes) else self.specialized(name, ())
+            complexes = tuple(a.complex for a in args)
+            if any(shapes) or any(complexes):
+                f = self._called(node, shapes, complexes)
+            else:
+                f = self.specialized(name, ())
             conv = tuple(
                 self._arg(a, u, d.params[i], name, self.spec.arguments[d.params[i]])
                 for i, (a, u) in enumerate(zip(args, f.param_units))
             )
-            return TCall(f.unit, name=f.name, args=conv, shape=f.body.shape, text=f.body.text)
+            return TCall(f.unit, name=f.name, args=conv, **value_kind(f.body))
         if name in self.spec.blocks:
             from .. import blocks
 
@@ -554,25 +572,31 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                     "not supported"
                 )
             return entry.runtime(self, name, tuple(args))
+        real_only(name, entry, args)
         typed = entry.unit_rule(self, name, tuple(args))
+        if entry.complex == "real" and typed.complex:  # abs(z): the modulus is real
+            typed = dataclasses.replace(typed, complex=False)
         return typed if entry.arrays else self.elementwise_call(name, entry, tuple(args), typed)
 
-    def _called(self, node: ex.Call, shapes: tuple) -> TypedFunction:
-        """The specialization of a function called with vectors or matrices; an error in its
-        body for these shapes names the call as well as the definition."""
+    def _called(self, node: ex.Call, shapes: tuple, complexes: tuple = ()) -> TypedFunction:
+        """The specialization of a function called with vectors or matrices, or with complex
+        values; an error in its body for these arguments names the call as well as the
+        definition."""
         name = node.func
         d = self.spec.definitions[name]
-        if d.ode is not None or d.branches is not None:
+        if any(shapes) and (d.ode is not None or d.branches is not None):
             what = "the solution of an ode" if d.ode is not None else "defined by pieces"
             raise TemplateError(
                 f"{ex.to_text(node)}: {name}() is {what}; its arguments are numbers "
                 "(pass elements, v[i])"
             )
         try:
-            return self.specialized(name, shapes)
+            return self.specialized(name, shapes, complexes)
         except WorkbookError as err:
             given = ", ".join(
-                f"{p} a {shape_text(sh)}" for p, sh in zip(d.params, shapes) if sh is not None
+                f"{p} a {'complex ' if c else ''}{shape_text(sh) if sh is not None else 'number'}"
+                for p, sh, c in zip(d.params, shapes, complexes or (False,) * len(shapes))
+                if sh is not None or c
             )
             message = f"{ex.to_text(node)} (with {given}): {err.message}"
             caller = self._stack[-1] if self._stack else None
@@ -615,6 +639,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             else:
                 args.append(self.as_number(self.visit(a, scope), f"argument {i + 1} of {name}()"))
         self.scope = scope
+        real_only(name, entry, args)
         typed = entry.unit_rule(self, name, tuple(args))
         body = args[expr_at]
         if body.shape is not None and typed.shape is None:  # never a matrix taken as a number
@@ -667,8 +692,13 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 f"{name}(): table '{tname}' has no column '{cname}' (columns: "
                 f"{', '.join(c.text for c in table.columns)})"
             )
-        unit = column_type(self, col, table.range.var, f"{name}({tname}, {cname})").unit
-        return TAggregate(unit, func=AGGREGATES[name], table=tname, column=cname)
+        typed = column_type(self, col, table.range.var, f"{name}({tname}, {cname})")
+        if typed.complex:
+            raise TemplateError(
+                f"{name}({tname}, {cname}): the column is complex, and complex numbers have no "
+                "order; make a column of abs(z) or Re(z)"
+            )
+        return TAggregate(typed.unit, func=AGGREGATES[name], table=tname, column=cname)
 
     def _arg(self, a: T, unit: pint.Unit, param: str, fname: str, spec) -> T:
         where = f"argument '{param}' of {fname}() (declared in {un.pretty(spec.unit) or '1'})"
@@ -750,6 +780,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         a run-time array, checked when it runs)."""
         origin = self.spec.origin
         t = self.plain(self.as_number(self.visit(i, scope), "an index"), f"the {word} index")
+        real_index(t, what, word)
         if t.shape is not None and not is_runtime(t.shape):
             raise TemplateError(f"the {word} index is a matrix; an index is a number")
         if isinstance(t, TConst) and size is not None:
@@ -811,7 +842,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         from ..program import typer as pg
 
         def type_expr(node, sc):
-            return self.visit(node, sc)
+            return real_in_program(self.visit(node, sc), node)
 
         def convert(t, unit, where):
             if t.text:
@@ -871,12 +902,14 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 AGGREGATES = {"max_over": "max", "min_over": "min"}
 
 
-def specialization_key(name: str, shapes: tuple) -> str:
+def specialization_key(name: str, shapes: tuple, complexes: tuple = ()) -> str:
     """The name of function ``name`` typed for arguments of ``shapes`` (``dist@2x1,2x1``;
-    ``1`` for a number); ``name`` itself for numbers only."""
-    if not any(shapes):
+    ``1`` for a number, ``c`` after a complex one: ``par@1c,1c``); ``name`` itself for real
+    numbers only."""
+    if not any(shapes) and not any(complexes):
         return name
-    return name + "@" + ",".join(_shape_key(s) for s in shapes)
+    kinds = complexes or (False,) * len(shapes)
+    return name + "@" + ",".join(_shape_key(s) + ("c" if c else "") for s, c in zip(shapes, kinds))
 
 
 def _shape_key(shape) -> str:

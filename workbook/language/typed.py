@@ -20,17 +20,25 @@ from .visitor import Visitor
 @dataclass(frozen=True, eq=False)
 class T:
     """Base of typed nodes: the unit the value is in; ``boolean`` for conditions; ``shape``
-    (rows, columns) for a vector or matrix (None for a scalar); ``text`` for a string value."""
+    (rows, columns) for a vector or matrix (None for a scalar); ``text`` for a string value;
+    ``complex`` for a complex value (or one whose elements are complex). ``complex`` left
+    None is derived from the children: an operator, scaling, index, matrix or built-in call
+    of a complex value is complex (a rule whose value is real, as abs(z), says False)."""
 
     unit: pint.Unit
     boolean: bool = field(default=False, kw_only=True)
     shape: tuple[int, int] | None = field(default=None, kw_only=True)
     text: bool = field(default=False, kw_only=True)
+    complex: bool | None = field(default=None, kw_only=True)
+
+    def __post_init__(self) -> None:
+        if self.complex is None:
+            object.__setattr__(self, "complex", not self.boolean and _derived_complex(self))
 
 
 @dataclass(frozen=True, eq=False)
 class TConst(T):
-    value: float = 0.0
+    value: float | complex = 0.0
     #: folded from quantities (``20 mm/10 mm``, ``15 %`` as a plain number): a plain number,
     #: but not one written bare, so never read as degrees next to an angle
     derived: bool = False
@@ -224,6 +232,25 @@ class _Children(Visitor):
 
 
 _CHILDREN = _Children()
+
+
+def _derived_complex(t: T) -> bool:
+    """Whether ``t`` is complex, from its children (every typed node asks once, when made)."""
+    if isinstance(t, TConst):
+        return isinstance(t.value, complex)
+    if isinstance(t, TBinary):
+        return t.left.complex or t.right.complex
+    if isinstance(t, (TScale, TUnary)):
+        return t.child is not None and t.child.complex
+    if isinstance(t, TFunc):
+        return any(a.complex for a in t.args)
+    if isinstance(t, TMatrix):
+        return any(e.complex for row in t.rows for e in row)
+    if isinstance(t, TIndex):
+        return t.target.complex
+    if isinstance(t, TPiecewise):
+        return any(v.complex for v in t.values)
+    return False
 
 
 def is_bare(t: T) -> bool:

@@ -167,6 +167,11 @@ class UnitRules:
             raise UnitError(f"an exponent must be dimensionless, got {un.dims(right.unit)}")
         right = self.convert(right, self.dimensionless, "exponent")
         if left.unit.dimensionality:
+            if right.complex:
+                raise UnitError(
+                    f"{un.dims(left.unit)} raised to a complex power has no unit; make the "
+                    "base dimensionless (e.g. divide by a reference value)"
+                )
             if not isinstance(right, TConst):
                 raise UnitError(
                     f"{un.dims(left.unit)} raised to a variable power has no fixed unit; "
@@ -179,8 +184,11 @@ class UnitRules:
         left = self.convert(left, self.dimensionless, "base of a power")
         if isinstance(left, TConst) and isinstance(right, TConst):
             try:
-                v = math.pow(left.value, right.value)
-            except (OverflowError, ValueError):
+                if left.complex or right.complex:  # over the complex plane (0^z is 0 or 1)
+                    v = complex(left.value) ** right.value
+                else:
+                    v = math.pow(left.value, right.value)
+            except (OverflowError, ValueError, ZeroDivisionError):
                 raise TemplateError(
                     f"{left.value:g}^{right.value:g} is not a finite number"
                 ) from None

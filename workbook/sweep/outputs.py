@@ -125,6 +125,8 @@ def type_output(sheet, out: Output) -> TypedOutput:
     if isinstance(t, ty.TText) or getattr(t, "text", False) or getattr(t, "boolean", False):
         # a text (a design check's "OK") failed every case with a raw ValueError, exit 0
         raise TemplateError(f"{what}: the output must be a number, not a text or a condition")
+    if t.complex:  # a column of the sweep's table holds real numbers
+        raise TemplateError(f"{what}: the output is complex; sweep abs(z), arg(z), Re(z) or Im(z)")
     if out.reduction in ("argmax", "argmin"):
         shown = sheet.spec.arguments[out.range.var].unit
         return TypedOutput(out, t, shown, 1.0, shown)

@@ -18,6 +18,7 @@ import pint
 
 from ...compute.verdicts import NOT_FAILED
 from ...errors import WorkbookError
+from ...functions.complexes import readable
 from ...language import expr as ex
 from ...language import units as un
 from ...language.template import column_node
@@ -65,7 +66,9 @@ class Values:
                     return q
                 if d.unit is not None:
                     q = q.to(d.unit)
-                mag = q.magnitude if np.ndim(q.magnitude) else float(q.magnitude)
+                mag = q.magnitude
+                if not np.ndim(mag):
+                    mag = complex(mag) if np.iscomplexobj(mag) else float(mag)
                 self._results[name] = (mag, un.pretty(q.units))
             except (WorkbookError, pint.errors.PintError) as err:  # shown, never blank
                 self._results[name] = err
@@ -106,6 +109,8 @@ def num_html(value, digits: int = mm.PRECISION) -> str:
         return "yes" if value else "no"
     if isinstance(value, (int, np.integer)):
         return str(int(value)).replace("-", _MINUS)
+    if isinstance(value, (complex, np.complexfloating)):  # a + bi
+        return escape(readable(value, digits)).replace("-", _MINUS)
     if not isinstance(value, (float, np.floating)):
         return escape(str(value))
     v = float(value)
@@ -357,7 +362,7 @@ class Document:
                 result = Box(_named("result-matrix", d.name, box.xml), box.width)
             else:
                 attrs = f"class='result' data-name='{escape(d.name)}'"
-                result = mm.quantity_box(r[0], r[1], attrs=attrs)
+                result = mm.quantity_box(r[0], r[1], attrs=attrs, polar=self.spec.polar)
             pieces.append(_fit(_eq_box(_EQ, result)))
         blocks = [
             self.spec.blocks[n]

@@ -145,8 +145,11 @@ def number_text(value: float, digits: int = PRECISION) -> tuple[str, int | None]
     return text, None
 
 
-def number_box(value: float, digits: int = PRECISION) -> Box:
-    """A number as MathML: ``−1.5×10⁻⁵``; NaN and infinity as words."""
+def number_box(value: float | complex, digits: int = PRECISION) -> Box:
+    """A number as MathML: ``−1.5×10⁻⁵``; NaN and infinity as words; a complex number as
+    a + bi (``10 − 16.1 i``)."""
+    if isinstance(value, complex):
+        return complex_box(value, digits)
     if not math.isfinite(value):
         word = "not a number" if math.isnan(value) else ("\u221e" if value > 0 else "\u2212\u221e")
         return Box(f"<mtext>{word}</mtext>", 0.5 * len(word), numeric=True)
@@ -163,6 +166,31 @@ def number_box(value: float, digits: int = PRECISION) -> Box:
         width += 0.8
         prec = PREC["neg"]
     return Box(f"<mrow>{xml}</mrow>", width, prec, numeric=True)
+
+
+def polar_box(z: complex, digits: int = PRECISION) -> Box:
+    """``r∠phi°`` (``5∠53.1301°``): the modulus, then the angle in degrees."""
+    r = number_box(abs(z), digits)
+    phi = number_box(math.degrees(math.atan2(z.imag, z.real)) + 0.0, digits)
+    xml = f"<mrow>{r.xml}<mo>\u2220</mo>{phi.xml}<mo>\u00b0</mo></mrow>"
+    return Box(xml, r.width + phi.width + 1.4, PREC["+"], numeric=True)
+
+
+def complex_box(z: complex, digits: int = PRECISION) -> Box:
+    """``a + bi`` (``3 + 4i``, ``−2i``, ``7``): a sum for the precedence of what is around it."""
+    i = Box("<mi>i</mi>", 0.4)
+    if z.imag == 0:
+        return number_box(z.real, digits)
+    im = number_box(abs(z.imag), digits)
+    im = i if im.xml == "<mrow><mn>1</mn></mrow>" else _join(im, i, prec=PREC["*"])
+    if z.real == 0:
+        if z.imag > 0:
+            return Box(im.xml, im.width, PREC["*"], numeric=True)
+        return Box(f"<mrow><mo>{_MINUS}</mo>{im.xml}</mrow>", im.width + 0.8, PREC["neg"], True)
+    re = number_box(z.real, digits)
+    sign = _MINUS if z.imag < 0 else "+"
+    xml = f"<mrow>{re.xml}<mo>{sign}</mo>{im.xml}</mrow>"
+    return Box(xml, re.width + 1.2 + im.width, PREC["+"], numeric=True)
 
 
 def unit_box(text: str, typeset: bool = True) -> Box:
@@ -240,11 +268,17 @@ def _typeset_unit(text: str) -> Box | None:
     return Box(f"<mrow class='unit'>{xml}</mrow>", width)
 
 
-def quantity_box(value: float, unit: str, digits: int = PRECISION, attrs: str = "") -> Box:
+def quantity_box(
+    value: float, unit: str, digits: int = PRECISION, attrs: str = "", polar: bool = False
+) -> Box:
     """A value with its unit, as substituted or as a result: ``20 mm``; ``attrs`` are
-    extra attributes of its element (a result is marked ``class='result'``)."""
-    num = number_box(value, digits)
+    extra attributes of its element (a result is marked ``class='result'``); a complex
+    value with ``polar`` as r∠phi."""
+    polar = polar and isinstance(value, complex)
+    num = polar_box(value, digits) if polar else number_box(value, digits)
     attrs = attrs or "class='value'"
+    if unit and num.prec < PREC["*"]:  # (3 + 4i) ohm
+        num = Box(_parens(num).xml, num.width + 0.7, ATOM, numeric=True)
     if not unit:
         return Box(f"<mrow {attrs}>{num.xml}</mrow>", num.width, num.prec, numeric=True)
     u = unit_box(unit)
@@ -285,7 +319,7 @@ def matrix_box(values, unit: str, digits: int = PRECISION) -> Box:
     def element(v) -> Box:
         if np.ndim(v) == 2:
             return matrix_box(v, "", digits)
-        return number_box(float(v), digits)
+        return number_box(complex(v) if np.iscomplexobj(v) else float(v), digits)
 
     rows = [[element(v) for v in row] for row in values]
     widths = [max(r[j].width for r in rows) for j in range(len(rows[0]))]
@@ -331,6 +365,11 @@ class MathML(Visitor):
         if v.is_integer() and abs(v) < 1e15:
             return Box(f"<mn>{int(v)}</mn>", 0.5 * len(str(int(v))), numeric=True)
         return number_box(v, 15)
+
+    def visit_Imaginary(self, node: ex.Imaginary) -> Box:
+        """``4i`` as written: the number, then an italic i."""
+        num = self.visit_Number(ex.Number(node.value))
+        return Box(f"<mrow>{num.xml}<mi>i</mi></mrow>", num.width + 0.4, num.prec, numeric=True)
 
     def visit_Quantity(self, node: ex.Quantity) -> Box:
         """``20 mm`` as written: the number, then its unit in upright letters."""
@@ -382,6 +421,7 @@ class MathML(Visitor):
                 and _leftmost(node.right) not in ("e", "E")  # 2e would read as a number
                 and not _starts_with_number(right.xml)  # 2⁢10^e would read as 210^e
                 and not (isinstance(node.left, ex.Number) and node.left.value == 0)  # 0⋅α
+                and not isinstance(node.left, ex.Imaginary)  # 1i⋅ω, as Mathcad shows it
             ):
                 sign = Box("<mo>\u2062</mo>", 0.1)  # 2a: invisible times after a number
             else:
