@@ -55,3 +55,69 @@ def test_an_infinite_sample_keeps_its_sign(tmp_path, expr, exact, plain):
 def test_a_sign_change_at_an_infinite_sample_is_still_a_pole(tmp_path, plain):
     with pytest.raises(NumericsError, match="a pole, not a root"):
         value(tmp_path, f"root(1/(x - 0.5){plain}, x, 0.4, 0.6)")
+
+
+# -- linear algebra: estimates from the condition number --------------------------------------
+def _sheet(tmp_path: Path, definitions: str):
+    path = tmp_path / "m.toml"
+    path.write_text(f"[definitions]\n{definitions}", encoding="utf-8")
+    return workbook.load(path)
+
+
+def _estimate(s, name: str) -> float:
+    return max(float(np.max(r.error)) for _, r in s.evaluator.records if r.notes["in"] == name)
+
+
+HILBERT = (
+    "["
+    + ", ".join("[" + ", ".join(f"1/{i + j + 1}" for j in range(10)) + "]" for i in range(10))
+    + "]"
+)
+
+
+def test_a_hilbert_system_carries_its_condition_in_its_estimate(tmp_path):
+    """Hilbert 10x10 (condition 1.6e13): lsolve was 1.3e-4 off (relative) and silent; its
+    estimate (condition x eps x |x|) now covers the error against the exact rational solution,
+    and run/check warn of it, as of det."""
+    s = _sheet(
+        tmp_path,
+        f'H = "{HILBERT}"\nx = "lsolve(H, [1, 1, 1, 1, 1, 1, 1, 1, 1, 1])"\nd = "det(H)"\n',
+    )
+    x = np.ravel(s.evaluate("x").magnitude)
+    h = mpmath.matrix(10, 10)
+    for i in range(10):
+        for j in range(10):
+            h[i, j] = mpmath.mpf(1) / (i + j + 1)
+    exact = mpmath.lu_solve(h, mpmath.matrix([1] * 10))
+    error = max(abs(float(x[i] - exact[i])) for i in range(10))
+    assert error > 1e-6 * max(abs(float(v)) for v in exact)  # the system is ill-conditioned
+    assert error <= _estimate(s, "x")
+    d = float(s.evaluate("d").magnitude)
+    assert abs(d - float(mpmath.det(h))) <= _estimate(s, "d")
+    warned = [f.topic for f in s.check().findings if f.verdict == "warning"]
+    assert "estimate x" in warned and "estimate d" in warned
+
+
+def test_a_well_conditioned_system_is_not_warned_of(tmp_path):
+    s = _sheet(tmp_path, 'x = "lsolve([[4, 1], [1, 3]], [1, 2])"\n')
+    x = np.ravel(s.evaluate("x").magnitude)
+    assert abs(x[0] - 1 / 11) <= max(_estimate(s, "x"), 1e-16)
+    assert not [f for f in s.check().findings if f.verdict == "warning"]
+
+
+@pytest.mark.parametrize(
+    "matrix, double",
+    [
+        # (lambda - 2)^2: rounding splits it into 2 +- 2e-8 (real) ...
+        ("[[1, 1], [-1, 3]]", mpmath.mpf(2)),
+        # ... or into a complex pair 0.2 +- 2.4e-9 i, which was refused as "complex"
+        ("[[0.1, 0.1], [-0.1, 0.3]]", mpmath.mpf("0.2")),
+    ],
+)
+def test_a_defective_matrix_is_named_not_called_complex(tmp_path, matrix, double):
+    s = _sheet(tmp_path, f'A = "{matrix}"\nl = "eigenvals(A)"\n')
+    lam = np.ravel(s.evaluate("l").magnitude)
+    error = max(abs(float(v - double)) for v in lam)
+    assert error <= _estimate(s, "l") <= 1e-6
+    (warning,) = [f for f in s.check().findings if f.topic == "estimate l"]
+    assert "defective" in warning.what and "complex" not in warning.what

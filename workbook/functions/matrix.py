@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import DomainError, InputError
 from ..limits import ELEMENT_WORK, charge_matrix_work
+from ..numerics import linalg
 
 #: A matrix whose condition number exceeds this is singular for inverse and lsolve.
 SINGULAR_COND = 1e14
@@ -110,10 +111,13 @@ def transpose(m):
 
 def det(m):
     charge_cubic("det", m, "det()")
-    return _scalar(np.linalg.det(_last(m)))
+    value = np.linalg.det(_last(m))
+    linalg.determinant(_last(m), value)
+    return _scalar(value)
 
 
 def _check_regular(m, what: str):
+    """The matrix, matrix axes last, and its condition number (per range point)."""
     charge_cubic("inverse" if what.startswith("inverse") else "lsolve", m, what)
     mm = _last(m)
     with np.errstate(all="ignore"):
@@ -124,11 +128,14 @@ def _check_regular(m, what: str):
         raise DomainError(
             f"{what}: the matrix is singular (condition number {shown}, limit {SINGULAR_COND:g})"
         )
-    return mm
+    return mm, cond
 
 
 def inverse(m):
-    return _first(np.linalg.inv(_check_regular(m, "inverse()")))
+    mm, cond = _check_regular(m, "inverse()")
+    out = np.linalg.inv(mm)
+    linalg.solved("inverse", cond, out)
+    return _first(out)
 
 
 def power(m, n: int):
@@ -145,14 +152,16 @@ def power(m, n: int):
 
 
 def lsolve(m, v):
-    mm = _check_regular(m, "lsolve()")
+    mm, cond = _check_regular(m, "lsolve()")
     vv = _last(v)
     extra = mm.ndim - vv.ndim
     if extra > 0:
         vv = vv.reshape((1,) * extra + vv.shape)
     elif extra < 0:
         mm = mm.reshape((1,) * -extra + mm.shape)
-    return _first(np.linalg.solve(mm, vv))
+    out = np.linalg.solve(mm, vv)
+    linalg.solved("lsolve", cond, out)
+    return _first(out)
 
 
 def _real(values, what: str):
@@ -161,10 +170,23 @@ def _real(values, what: str):
     return values.real
 
 
+def _real_eigen(m, lam, vec, what: str):
+    """The eigenvalues' real parts where their imaginary parts are rounding (a defective
+    matrix's multiple eigenvalue split into a pair), with their estimates recorded; else
+    the refusal of complex eigenvalues."""
+    if np.isrealobj(lam):
+        lam = lam.astype(complex)
+    real = linalg.real_eigenvalues(m, lam, vec, what.rstrip("()"))
+    if real is None:
+        return _real(lam, what)
+    return real
+
+
 def eigenvals(m):
     """Eigenvalues, ascending, as a column vector."""
     charge_cubic("eigen", m, "eigenvals()")
-    lam = _real(np.linalg.eigvals(_last(m)), "eigenvals()")
+    lam, vec = np.linalg.eig(_last(m))
+    lam = _real_eigen(_last(m), lam, vec, "eigenvals()")
     lam = np.sort(lam, axis=-1)
     return np.moveaxis(lam[..., None], (-2, -1), (0, 1))
 
@@ -174,8 +196,9 @@ def eigenvecs(m):
     largest component is positive (a fixed sign)."""
     charge_cubic("eigen", m, "eigenvecs()")
     lam, vec = np.linalg.eig(_last(m))
-    lam = _real(lam, "eigenvecs()")
-    vec = _real(vec, "eigenvecs()")
+    lam = _real_eigen(_last(m), lam, vec, "eigenvecs()")
+    if np.iscomplexobj(vec):  # a multiple eigenvalue split by rounding: its vectors too
+        vec = vec.real / np.linalg.norm(vec.real, axis=-2, keepdims=True)
     order = np.argsort(lam, axis=-1)
     vec = np.take_along_axis(vec, order[..., None, :], axis=-1)
     big = np.take_along_axis(vec, np.argmax(np.abs(vec), axis=-2)[..., None, :], axis=-2)
