@@ -121,3 +121,42 @@ def test_a_defective_matrix_is_named_not_called_complex(tmp_path, matrix, double
     assert error <= _estimate(s, "l") <= 1e-6
     (warning,) = [f for f in s.check().findings if f.topic == "estimate l"]
     assert "defective" in warning.what and "complex" not in warning.what
+
+
+# -- sums and products: the rounding of the additions and of EXPR itself ----------------------
+def _warned(tmp_path: Path, expr: str) -> bool:
+    path = tmp_path / "w.toml"
+    path.write_text(f'[definitions]\ny = "{expr}"\n', encoding="utf-8")
+    s = workbook.load(path)
+    s.evaluate("y")
+    return any(f.topic == "estimate y" for f in s.check().findings)
+
+
+def test_a_sum_of_cancelling_terms_carries_their_rounding(tmp_path):
+    """Each term is 1e-9/i^2 left of two numbers near 1/i: the sum was 4e-8 off (relative)
+    with no estimate; EXPR checked in mpmath at log-spaced terms gives one that covers it."""
+    expr = "sum(1/i - 1/(i + 1e-9), i, 1, 20000)"
+    a, n = mpmath.mpf("1e-9"), 20000
+    exact = mpmath.digamma(n + 1) - mpmath.digamma(1) - mpmath.digamma(n + 1 + a)
+    exact += mpmath.digamma(1 + a)
+    v, est = value(tmp_path, expr)
+    error = abs(float(v) - float(exact))
+    assert 1e-9 * float(exact) < error <= est
+    assert _warned(tmp_path, expr)
+
+
+def test_an_alternating_series_carries_the_cancellation_of_its_terms(tmp_path):
+    """exp(-20) by its series: terms up to 4.3e7 leave 2.06e-9, computed as 4.99e-9 (142 %
+    off) with no estimate; n eps sum |term| covers it, and run/check warn."""
+    expr = "sum((-20)^i/product(k, k, 1, i), i, 0, 100)"
+    exact = sum(mpmath.mpf(-20) ** i / mpmath.factorial(i) for i in range(101))
+    v, est = value(tmp_path, expr)
+    assert abs(float(v) - float(exact)) <= est
+    assert _warned(tmp_path, expr)
+
+
+def test_a_plain_sum_and_product_are_not_warned_of(tmp_path):
+    right(tmp_path, "sum(1/i^2, i, 1, 1000)", mpmath.zeta(2) - mpmath.zeta(2, 1001), rel=1e-14)
+    exact = mpmath.fprod(1 + mpmath.mpf(1) / i**2 for i in range(1, 1001))
+    right(tmp_path, "product(1 + 1/i^2, i, 1, 1000)", exact, rel=1e-13)
+    assert not _warned(tmp_path, "sum(1/i^2, i, 1, 1000)")

@@ -469,6 +469,9 @@ def _product_numpy(of, a, b):
         a,
         b,
     )
+    if not (live() or reference()):
+        count = np.maximum(np.asarray(b, dtype=float) - np.asarray(a, dtype=float) + 1, 0)
+        series.record_series(of, a, b, res.value, 0.0, count, kind="product")
     return _out(res.value)
 
 

@@ -46,7 +46,7 @@ def estimate_findings(sheet) -> list:
         scale = float(result.notes.get("scale", 0.0))  # EXPR's size on the interval
         err = float(np.max(np.abs(result.error), initial=0.0))
         # the rounding of the numbers it adds; a linear-algebra estimate is relative already
-        floor = size if result.notes.get("relative") else max(size, scale, 1.0)
+        floor = max(size, scale) if result.notes.get("relative") else max(size, scale, 1.0)
         if err <= ROUNDING * floor:
             continue
         if builtin in CERTIFIED_TO_SCALE:
