@@ -160,3 +160,44 @@ def test_a_plain_sum_and_product_are_not_warned_of(tmp_path):
     exact = mpmath.fprod(1 + mpmath.mpf(1) / i**2 for i in range(1, 1001))
     right(tmp_path, "product(1 + 1/i^2, i, 1, 1000)", exact, rel=1e-13)
     assert not _warned(tmp_path, "sum(1/i^2, i, 1, 1000)")
+
+
+# -- diff: no derivative at a kink; the rounding of the derivative's formula -------------------
+def _diff_sheet(tmp_path: Path, body: str, at: str):
+    path = tmp_path / "d.toml"
+    path.write_text(
+        f'[arguments]\nx = {{ unit = "" }}\n[definitions]\n"f(x)" = "diff({body}, x)"\n'
+        f'y = "f({at})"\n',
+        encoding="utf-8",
+    )
+    return workbook.load(path)
+
+
+@pytest.mark.parametrize(
+    "body, at, slopes",
+    [
+        ("x if x < 1 otherwise 2*x - 1", "1", r"1 on the left and 2 on the right"),
+        ("abs(x - 2)", "2", r"-1 on the left and 1 on the right"),
+    ],
+)
+def test_a_derivative_at_a_kink_is_refused_with_both_slopes(tmp_path, body, at, slopes):
+    """At the join the derivative's formula took one side's slope (2, and 0 for abs)."""
+    with pytest.raises(NumericsError, match=f"kink at x = {at}: its derivative is {slopes}"):
+        _diff_sheet(tmp_path, body, at).evaluate("y")
+
+
+def test_a_derivative_beside_a_kink_is_its_sides_slope(tmp_path):
+    assert float(_diff_sheet(tmp_path, "x if x < 1 otherwise 2*x - 1", "0.5").evaluate("y")) == 1
+
+
+def test_a_derivative_formula_that_cancels_carries_its_rounding(tmp_path):
+    """d/dx (exp(x) - 1 - x)/x^2 at 1e-3: SymPy's formula is a difference of terms near
+    1e6 that leave 0.1667; it was 3e-7 off with no estimate; the formula evaluated again
+    in mpmath gives the estimate, and run/check warn of it."""
+    s = _diff_sheet(tmp_path, "(exp(x) - 1 - x)/x^2", "1e-3")
+    v = float(s.evaluate("y").magnitude)
+    exact = mpmath.diff(lambda x: (mpmath.exp(x) - 1 - x) / x**2, mpmath.mpf("1e-3"))
+    error = abs(v - float(exact))
+    assert error > 1e-8
+    assert error <= _estimate(s, "y")
+    assert any(f.topic == "estimate y" for f in s.check().findings)

@@ -454,9 +454,9 @@ def _extremum_numpy(name: str):
 def _diff_numpy(of, order=1):
     """The derivative's formula evaluated where diff() is (its variable is the enclosing
     one's, in the environment)."""
-    from .derivative import compiled
+    from .slopes import derivative_values
 
-    return compiled(of.evaluator, of.body, of.var_param, int(order))(of.env)
+    return derivative_values(of, int(order))
 
 
 def _product_numpy(of, a, b):
@@ -470,8 +470,7 @@ def _product_numpy(of, a, b):
         b,
     )
     if not (live() or reference()):
-        count = np.maximum(np.asarray(b, dtype=float) - np.asarray(a, dtype=float) + 1, 0)
-        series.record_series(of, a, b, res.value, 0.0, count, kind="product")
+        series.record_series(of, a, b, res.value, 0.0, None, kind="product")
     return _out(res.value)
 
 

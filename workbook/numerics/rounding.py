@@ -8,7 +8,7 @@ the difference of two numbers near 1, with an absolute error near 1e-16 whatever
 per row the difference; the built-ins add what it costs them to their estimate.
 
 Only some rows spread over a call are checked (an mpmath evaluation is ~1e4 times a numpy
-one): the others take the difference of the nearest checked rows relative to their size.
+one): the others take the difference of the nearest checked rows.
 Where EXPR has no mpmath form, or a point has no value in mpmath, nothing is added.
 """
 
@@ -49,11 +49,14 @@ def form_of(of):
         return None
 
 
-def discrepancy(of, shape, xs: np.ndarray, fs: np.ndarray, prepared=None) -> np.ndarray | None:
+def discrepancy(
+    of, shape, xs: np.ndarray, fs: np.ndarray, prepared=None, most: int = 0
+) -> np.ndarray | None:
     """[row, k] per flat row of ``shape``: |numpy's EXPR - mpmath's EXPR| at the points
     ``xs[row, k]`` where numpy's values are ``fs[row, k]`` (None: no mpmath form; 0 where
-    a point has no value; ``prepared``: :func:`form_of`'s). Rows not checked take the
-    checked rows' largest difference relative to max |fs| of a row, times theirs."""
+    a point has no value; ``prepared``: :func:`form_of`'s; ``most``: rows checked,
+    by default ROWS, or more where BUDGET mpmath evaluations allow). Rows not checked take
+    the largest difference of the nearest checked rows (interpolated along the call)."""
     from ..language import typed as ty
     from .mpform import NoValue
 
@@ -73,7 +76,7 @@ def discrepancy(of, shape, xs: np.ndarray, fs: np.ndarray, prepared=None) -> np.
                 fixed[k] = float(np.asarray(v))
             except (TypeError, ValueError):
                 return None
-    most = max(ROWS, BUDGET // max(xs.shape[-1], 1))
+    most = most or max(ROWS, BUDGET // max(xs.shape[-1], 1))
     rows = np.arange(n) if n <= most else np.unique(np.linspace(0, n - 1, most).astype(np.intp))
     out = np.full(xs.shape, np.nan)
     for i in rows:
@@ -90,10 +93,8 @@ def discrepancy(of, shape, xs: np.ndarray, fs: np.ndarray, prepared=None) -> np.
                 return None
             out[i, j] = abs(float(ctx.mpf(float(f)) - exact))
     if n > rows.size:
-        size = np.max(np.where(np.isfinite(fs), np.abs(fs), 0.0), axis=1)
-        with np.errstate(all="ignore"):
-            ratio = np.where(size[rows] > 0, out[rows].max(axis=1) / size[rows], 0.0)
-        # the nearest checked rows' ratio (rounding varies along a table: a step size)
-        fill = np.interp(np.arange(n), rows, np.nan_to_num(ratio)) * size
+        # the nearest checked rows' difference (rounding varies along a table: a step size;
+        # relative to a row's own value it would blow up beside a zero of EXPR)
+        fill = np.interp(np.arange(n), rows, out[rows].max(axis=1))
         out = np.where(np.isnan(out), fill[:, None], out)
     return out

@@ -54,7 +54,7 @@ def reduce(f: Fn, a, b, args=(), *, kind: str = "sum", var: str = "i") -> Result
 SPOT_TERMS = 24
 
 
-def record_series(of, lo, hi, value, absolute, count, kind: str = "sum") -> None:
+def record_series(of, lo, hi, value, absolute, count=None, kind: str = "sum") -> None:
     """Keep the estimate of ``sum``/``product`` over i = lo..hi (per row): the rounding of
     the additions (n eps sum |term|; a product's n eps |value|) plus EXPR's own rounding,
     checked in mpmath at SPOT_TERMS log-spaced terms (numerics.rounding), each standing for
@@ -62,6 +62,8 @@ def record_series(of, lo, hi, value, absolute, count, kind: str = "sum") -> None
     from .rounding import discrepancy, form_of
 
     eps = np.finfo(float).eps
+    if count is None:  # the terms of every row's own bounds
+        count = np.maximum(np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float) + 1, 0)
     value = np.asarray(value, dtype=float)
     shape = np.broadcast_shapes(of.shape, value.shape, np.shape(count), np.shape(absolute))
     value = np.broadcast_to(value, shape).reshape(-1)
