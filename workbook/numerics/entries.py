@@ -370,6 +370,9 @@ def _integral_numpy(of, a, b):
         b,
         *breaks,
     )
+    from .rounding import integral_rounding
+
+    integral_rounding(of, shape, a, b, res)
     of.record("integral", res)
     return _out(res.value)
 
