@@ -213,3 +213,31 @@ def test_an_integrand_that_cancels_carries_its_rounding(tmp_path):
     assert abs(float(v) - float(exact)) <= est
     assert _warned(tmp_path, expr)
     assert not _warned(tmp_path, "integral(x^2, x, 0, 1)")
+
+
+# -- an ODE that blows up: the values before it ------------------------------------------------
+TAN = """[arguments]
+t = { unit = "s" }
+[definitions]
+a = "y(1.2 s)"
+b = "y(1.9 s)"
+[[ode]]
+name = "tan"
+time = "t := 0 .. 2 s"
+rtol = 1e-8
+atol = 1e-10
+states = [{ name = "y", unit = "", initial = "0", derivative = "(1 + y^2)/(1 s)" }]
+"""
+
+
+def test_an_ode_that_blows_up_gives_its_values_before_the_blow_up(tmp_path):
+    """y' = 1 + y^2 is tan t, which blows up at pi/2: every value was refused; y(1.2) is
+    tan 1.2 now, y(1.9) is refused as past the blow-up, and check says the run stopped."""
+    path = tmp_path / "tan.toml"
+    path.write_text(TAN, encoding="utf-8")
+    s = workbook.load(path)
+    assert float(s.evaluate("a").magnitude) == pytest.approx(float(mpmath.tan(1.2)), rel=1e-7)
+    with pytest.raises(workbook.WorkbookError, match=r"y\(1\.9\) is at or past t = 1\.57"):
+        s.evaluate("b")
+    findings = [f for f in s.check().findings if f.topic == "ode tan"]
+    assert findings[0].verdict == "fail" and "values before t = 1.57" in findings[0].note

@@ -55,33 +55,11 @@ def check_derivative(of, fn, order: int, value) -> None:
     _record_rounding(of, order, shape, xs, np.broadcast_to(value, shape).reshape(-1))
 
 
-#: per evaluator and EXPR, its break points compiled (env -> values)
-_BREAKS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _breaks(of, shape) -> list:
-    from .kinks import breaks
-
-    known = _BREAKS.setdefault(of.evaluator, {})
-    key = (id(of.body), of.var)
-    if key not in known:
-        trees = breaks(of.evaluator.typer, of.body, of.var)
-        known[key] = (of.body, [of.evaluator.compile(t) for t in trees])
-    body, fns = known[key]
-    if body is not of.body:  # an id reused by another tree
-        del known[key]
-        return _breaks(of, shape)
-    out = []
-    for fn in fns:
-        try:
-            out.append(np.broadcast_to(np.asarray(fn(of.env), dtype=float), shape).reshape(-1))
-        except (ArithmeticError, ValueError, WorkbookError):  # no value here: no break
-            continue
-    return out
-
-
 def _no_kink(of, fn, order, shape, xs) -> None:
-    breaks = _breaks(of, shape)
+    try:
+        breaks = [np.asarray(b, dtype=float).reshape(-1) for b in of.breaks(shape)]
+    except (ArithmeticError, ValueError, WorkbookError):  # no value here: no break point
+        return
     if not breaks:
         return
     at = np.zeros(xs.size, dtype=bool)
