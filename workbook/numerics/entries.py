@@ -321,7 +321,7 @@ def _root_numpy(of, a, b=None):
 
 
 def _integral_numpy(of, a, b):
-    from . import gauss, quadrature
+    from . import gauss, quadrature, rounding
 
     if live():  # what the workbook's SUMPRODUCT computes
         res = _solve(
@@ -370,9 +370,7 @@ def _integral_numpy(of, a, b):
         b,
         *breaks,
     )
-    from .rounding import integral_rounding
-
-    integral_rounding(of, shape, a, b, res)
+    rounding.integral_rounding(of, shape, a, b, res)  # EXPR's own rounding joins the estimate
     of.record("integral", res)
     return _out(res.value)
 
@@ -455,8 +453,7 @@ def _extremum_numpy(name: str):
 
 
 def _diff_numpy(of, order=1):
-    """The derivative's formula evaluated where diff() is (its variable is the enclosing
-    one's, in the environment)."""
+    """The derivative's formula where diff() is, checked (numerics.slopes)."""
     from .slopes import derivative_values
 
     return derivative_values(of, int(order))
@@ -472,8 +469,7 @@ def _product_numpy(of, a, b):
         a,
         b,
     )
-    if not (live() or reference()):
-        series.record_series(of, a, b, res.value, 0.0, None, kind="product")
+    series.record_series(of, a, b, res.value, 0.0, None, kind="product")
     return _out(res.value)
 
 

@@ -59,8 +59,11 @@ def record_series(of, lo, hi, value, absolute, count=None, kind: str = "sum") ->
     the additions (n eps sum |term|; a product's n eps |value|) plus EXPR's own rounding,
     checked in mpmath at SPOT_TERMS log-spaced terms (numerics.rounding), each standing for
     the terms around it (a sum's absolute differences add; a product's relative ones)."""
+    from ._common import live, reference
     from .rounding import discrepancy, form_of
 
+    if live() or reference():  # a live form's or the reference's call repeats the engine's
+        return
     eps = np.finfo(float).eps
     if count is None:  # the terms of every row's own bounds
         count = np.maximum(np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float) + 1, 0)
