@@ -241,3 +241,19 @@ def test_an_ode_that_blows_up_gives_its_values_before_the_blow_up(tmp_path):
         s.evaluate("b")
     findings = [f for f in s.check().findings if f.topic == "ode tan"]
     assert findings[0].verdict == "fail" and "values before t = 1.57" in findings[0].note
+
+
+def test_bench_goes_on_past_a_definition_the_engine_refuses(tmp_path):
+    """A refused definition (a pole) stopped workbook bench; it is one line of its own now."""
+    from workbook.numerics import bench
+
+    path = tmp_path / "b.toml"
+    path.write_text(
+        '[definitions]\na = "root(x^2 - 2, x, 0, 2)"\nb = "root(1/(x - 0.3), x, 0, 1)"\n'
+        'c = "integral(x^2, x, 0, 1)"\n',
+        encoding="utf-8",
+    )
+    lines = bench.run(workbook.load(path), repeats=1)
+    verdicts = {line.what: line.verdict for line in lines}
+    assert verdicts["a"] == verdicts["c"] == "ok"
+    assert verdicts["b"].startswith("refused by the engine: root(): the function changes sign")
