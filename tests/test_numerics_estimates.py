@@ -257,3 +257,25 @@ def test_bench_goes_on_past_a_definition_the_engine_refuses(tmp_path):
     verdicts = {line.what: line.verdict for line in lines}
     assert verdicts["a"] == verdicts["c"] == "ok"
     assert verdicts["b"].startswith("refused by the engine: root(): the function changes sign")
+
+
+LOGISTIC = """[arguments]
+t = { unit = "s" }
+[definitions]
+t_half = "root(y(t) - 0.5, t, 0 s, 10 s)"
+[[ode]]
+name = "logistic"
+time = "t := 0 .. 10 s"
+states = [{ name = "y", unit = "", initial = "0.01", derivative = "y*(1 - y)/(1 s)" }]
+"""
+
+
+def test_a_root_of_an_ode_state_carries_the_states_global_error(tmp_path):
+    """y = 1/(1 + 99 e^-t) is 0.5 at t = ln 99; at the run's rtol 1e-6 the root was 1.1e-6
+    off with an estimate of 1e-10 (the bracket's); the states' error over the slope is in it."""
+    path = tmp_path / "l.toml"
+    path.write_text(LOGISTIC, encoding="utf-8")
+    s = workbook.load(path)
+    v = float(s.evaluate("t_half").magnitude)
+    error = abs(v - float(mpmath.log(99)))
+    assert 1e-8 < error <= _estimate(s, "t_half") <= 10 * error

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -276,6 +276,14 @@ class Solution:
         out = y[first]
         return float(out) if arr.ndim == 0 else out
 
+    def reference(self) -> Solution | None:
+        """The same states from the error estimate's reference run (tolerances
+        REFERENCE_FACTOR tighter), or None where there is none."""
+        est = self.estimate()
+        if est.failed or est.ref is None or est.ref.sol is None:
+            return None
+        return replace(self, run=est.ref, _estimate=est)
+
     def _before_blow_up(self, k: int, arr: np.ndarray) -> None:
         """Refuse a time at or past the blow-up (the run has no values there), or past the
         first step where the global error estimate exceeds ESTIMATE_LIMIT times the tolerance
@@ -402,6 +410,7 @@ class ErrorEstimate:
     reference: str  # how the reference ran
     failed: str = ""  # why there is no estimate
     trusted: float | None = None  # a run that blew up: the first step beyond ESTIMATE_LIMIT
+    ref: OdeRun | None = None  # the reference run (its dense output: the states' reference)
 
     @property
     def worst(self) -> int:
@@ -435,7 +444,7 @@ def estimate_error(sol: Solution) -> ErrorEstimate:
     if sol.blown is not None:  # values are given up to where the estimate leaves the tolerance
         over = np.flatnonzero(np.max(ratio, axis=0) > ESTIMATE_LIMIT)
         trusted = float(t[over[0]]) if over.size else stop
-    return ErrorEstimate(diff[rows, at], t[at], ratio[rows, at], how, trusted=trusted)
+    return ErrorEstimate(diff[rows, at], t[at], ratio[rows, at], how, trusted=trusted, ref=ref)
 
 
 def flat_names(states, sizes) -> list[str]:

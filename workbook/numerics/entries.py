@@ -276,7 +276,7 @@ def _golden(f, a, b, idx, kind: str, of) -> dict:
 
 
 def _root_numpy(of, a, b=None):
-    from . import roots
+    from . import odestates, roots
 
     tol, var, unit = of.tolerance, of.var, of.unit_text
     if live() and b is not None:
@@ -316,6 +316,7 @@ def _root_numpy(of, a, b=None):
 
     shape = np.broadcast_shapes(of.shape, np.shape(a), *(() if b is None else (np.shape(b),)))
     polish_roots(of, res, shape, tol)
+    odestates.add_root_error(of, shape, res)  # the states' global error, over the slope
     of.record("root", res)
     return _out(res.value)
 
