@@ -19,7 +19,6 @@ import numpy as np
 from ..errors import WorkbookError
 from ..language import typed as ty
 
-
 #: the difference from the reference is the run's error only to within the reference's own
 #: (a root of a logistic state: 1.047e-6 for an error of 1.057e-6): it counts twice
 SAFETY = 2.0
