@@ -279,3 +279,18 @@ def test_a_root_of_an_ode_state_carries_the_states_global_error(tmp_path):
     v = float(s.evaluate("t_half").magnitude)
     error = abs(v - float(mpmath.log(99)))
     assert 1e-8 < error <= _estimate(s, "t_half") <= 10 * error
+
+
+def test_an_integral_of_an_ode_state_carries_the_states_global_error(tmp_path):
+    """The integral of y = 1/(1 + 99 e^-t) over [0, 10] is 10 + ln((1 + 99 e^-10)/100); at
+    the run's rtol 1e-6 it is 1.2e-6 off, which the quadrature's estimate (1e-14) missed."""
+    path = tmp_path / "l.toml"
+    path.write_text(
+        LOGISTIC.replace("root(y(t) - 0.5, t, 0 s, 10 s)", "integral(y(t), t, 0 s, 10 s)"),
+        encoding="utf-8",
+    )
+    s = workbook.load(path)
+    v = float(s.evaluate("t_half").magnitude)
+    exact = 10 + mpmath.log((1 + 99 * mpmath.exp(-10)) / 100)
+    error = abs(v - float(exact))
+    assert 1e-8 < error <= _estimate(s, "t_half") <= 10 * error

@@ -322,7 +322,7 @@ def _root_numpy(of, a, b=None):
 
 
 def _integral_numpy(of, a, b):
-    from . import gauss, quadrature, rounding
+    from . import gauss, odestates, quadrature, rounding
 
     if live():  # what the workbook's SUMPRODUCT computes
         res = _solve(
@@ -372,6 +372,7 @@ def _integral_numpy(of, a, b):
         *breaks,
     )
     rounding.integral_rounding(of, shape, a, b, res)  # EXPR's own rounding joins the estimate
+    odestates.add_integral_error(of, shape, a, b, res)  # and the ODE states' global error
     of.record("integral", res)
     return _out(res.value)
 
@@ -401,7 +402,7 @@ def _extremum_numpy(name: str):
     where = name.startswith("arg")
 
     def hook(of, a, b):
-        from . import extrema
+        from . import extrema, odestates
 
         if live():  # what the workbook's samples and golden-section steps compute
             steps = _live_chain(of, a, b, lambda f, a, b, idx: _golden(f, a, b, idx, kind, of))
@@ -442,6 +443,8 @@ def _extremum_numpy(name: str):
         )
         if where:
             res = Result(res.where, res.where_error, evaluations=res.evaluations, notes=res.notes)
+        else:  # the states' global error where the extremum is
+            odestates.add_value_error(of, np.shape(res.value), res.where, res)
         if "assumes" in res.notes:
             res.notes["why"] = of.no_enclosure
         of.record(name, res)

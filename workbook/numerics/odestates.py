@@ -107,3 +107,36 @@ def add_root_error(of, shape, result) -> None:
     e = root_error(of, shape, result.value)
     if e is not None:
         result.error = np.asarray(result.error, dtype=float) + e.reshape(np.shape(result.error))
+
+
+#: interior nodes at which an integral's EXPR is compared with the reference states
+NODES = 16
+
+
+def add_integral_error(of, shape, a, b, result) -> None:
+    """Add the states' error to an integral's estimate (in place): twice the integral of the
+    difference (the width times its mean at NODES interior points), where EXPR reads a
+    state."""
+    from ._common import live, reference
+
+    if live() or reference() or not ode_names(of):
+        return
+    a, b = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
+    t = (np.arange(NODES) + 0.5) / NODES
+    d = moved(of, shape, a[:, None] + (b - a)[:, None] * t[None, :])
+    if d is not None:
+        add = SAFETY * np.abs(b - a) * d.mean(axis=1)
+        result.error = np.asarray(result.error, dtype=float) + add.reshape(np.shape(result.error))
+
+
+def add_value_error(of, shape, where, result) -> None:
+    """Add the states' error to a maximum's or minimum's estimate (in place): twice the
+    difference where it is, where EXPR reads a state."""
+    from ._common import live, reference
+
+    if live() or reference() or where is None or not ode_names(of):
+        return
+    d = moved(of, shape, np.asarray(where, dtype=float).reshape(-1, 1))
+    if d is not None:
+        add = SAFETY * d[:, 0]
+        result.error = np.asarray(result.error, dtype=float) + add.reshape(np.shape(result.error))
