@@ -294,3 +294,27 @@ def test_an_integral_of_an_ode_state_carries_the_states_global_error(tmp_path):
     exact = 10 + mpmath.log((1 + 99 * mpmath.exp(-10)) / 100)
     error = abs(v - float(exact))
     assert 1e-8 < error <= _estimate(s, "t_half") <= 10 * error
+
+
+@pytest.mark.parametrize(
+    "expr, exact",
+    [
+        ("integral(x^-0.99, x, 0, 1)", mpmath.mpf(100)),
+        (
+            "integral(ln((x - 0.3)^2), x, 0, 1)",
+            2 * (mpmath.mpf("0.7") * mpmath.log(mpmath.mpf("0.7")) - 1)
+            + 2 * mpmath.mpf("0.3") * mpmath.log(mpmath.mpf("0.3")),
+        ),
+    ],
+)
+def test_quadpack_integrates_where_the_vectorised_rule_gives_up(tmp_path, expr, exact):
+    """Both were refused at the refinement limit; QUADPACK's QAGS (extrapolation) takes the
+    pieces tanh-sinh gives up on, its estimate the value's."""
+    right(tmp_path, expr, exact, rel=1e-9)
+
+
+@pytest.mark.parametrize("expr", ["integral(x^-1.01, x, 0, 1)", "integral(x^-1.5, x, 0, 1)"])
+def test_a_divergent_integral_is_not_given_its_analytic_continuation(tmp_path, expr):
+    """QAGS's extrapolation gives x^-1.01 on [0, 1] the value -100: refused, as before."""
+    with pytest.raises(NumericsError, match="refinement limit"):
+        value(tmp_path, expr)
