@@ -29,23 +29,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import DomainError, LimitError, TemplateError
 from ..language import expr as ex
+from .odeauto import MAX_STEPS, MAX_TIME, Choice, auto_run, choose_method
 from .oderun import OdeRun, run_ode, work_precision
 
 METHODS = ("auto", "RK45", "DOP853", "Radau", "BDF", "LSODA")
-#: "auto" takes an implicit method when max(-Re lambda) * span of the Jacobian at the start
-#: exceeds this: an explicit method would then need more than about STIFF_INDEX/3.3 steps for
-#: stability alone, whatever the tolerance.
-STIFF_INDEX = 500.0
 #: A state whose magnitude exceeds this (in its declared unit) stops the run: it blows up.
 BLOWUP = 1e100
-MAX_TIME = 30.0  # wall-clock budget of one run, seconds
-MAX_STEPS = 1_000_000
 MAX_STATES = 1000
 
 
@@ -225,143 +220,6 @@ def _positive(raw: dict, key: str, default: float, where: str) -> float:
     return float(v)
 
 
-# -- stiffness and the choice of method -------------------------------------------------------
-def jacobian(fun: Callable, t: float, y: np.ndarray) -> np.ndarray:
-    """Forward-difference Jacobian of fun(t, y) with respect to y."""
-    y = np.asarray(y, dtype=float)
-    f0 = np.asarray(fun(t, y), dtype=float)
-    jac = np.empty((len(f0), len(y)))
-    for k in range(len(y)):
-        h = math.sqrt(np.finfo(float).eps) * max(1.0, abs(y[k]))
-        yk = y.copy()
-        yk[k] += h
-        jac[:, k] = (np.asarray(fun(t, yk), dtype=float) - f0) / h
-    return jac
-
-
-@dataclass(frozen=True)
-class Choice:
-    """The method "auto" chose, and why (said as a finding)."""
-
-    method: str
-    reason: str
-    eigenvalues: np.ndarray
-    index: float  # max(-Re lambda) * span
-
-
-def choose_method(
-    fun: Callable, t0: float, t1: float, y0, rtol: float, time_unit: str = ""
-) -> Choice:
-    """Explicit unless the Jacobian at the start says the run is stiff (see STIFF_INDEX)."""
-    jac = jacobian(fun, t0, y0)
-    if not np.all(np.isfinite(jac)):
-        return Choice(
-            "LSODA",
-            "the Jacobian at the start is not finite; LSODA switches "
-            "between explicit and implicit steps as it goes",
-            np.array([]),
-            math.nan,
-        )
-    lam = np.linalg.eigvals(jac)
-    span = abs(t1 - t0)
-    decay = float(np.max(-lam.real, initial=0.0))
-    index = decay * span
-    unit = f" 1/{time_unit}" if time_unit else ""
-    fastest = lam[np.argmax(-lam.real)] if lam.size else 0.0
-    where = (
-        f"the Jacobian at t = {t0:g} has its fastest decaying eigenvalue {_complex(fastest)}{unit}"
-    )
-    if index > STIFF_INDEX:
-        method = "Radau" if len(y0) <= 200 else "BDF"
-        reason = (
-            f"{where}; times the span {span:g} that is {index:.3g} > {STIFF_INDEX:g}: stiff "
-            f"(an explicit method would need about {index / 3.3:.3g} steps for stability alone)"
-        )
-        return Choice(method, reason, lam, index)
-    method = "DOP853" if rtol < 1e-6 else "RK45"
-    reason = (
-        f"{where}; times the span {span:g} that is {index:.3g} <= {STIFF_INDEX:g}: not stiff, "
-        f"an explicit method ({'8th order for rtol < 1e-6' if method == 'DOP853' else '5th order'})"
-    )
-    return Choice(method, reason, lam, index)
-
-
-#: An explicit run of "auto" looks at the Jacobian after this many steps and at each doubling
-#: (10, 20, 40, ...): a stiff stretch makes an explicit method take many steps, so it is seen,
-#: and a run that is not stiff pays for a few Jacobians only.
-WATCH_FIRST = 10
-
-
-def stiffness_watch(fun: Callable, t1: float, time_unit: str = "") -> Callable:
-    """A ``watch`` for :func:`run_ode`: stiff when, at the current point, the fastest decay rate
-    times the remaining span exceeds STIFF_INDEX and the step is held by stability (step times
-    that rate above 1; an explicit step that follows the solution is shorter)."""
-    due = [WATCH_FIRST]
-    unit = f" {time_unit}" if time_unit else ""
-    rate = f" 1/{time_unit}" if time_unit else ""
-
-    def watch(solver, nsteps: int) -> str | None:
-        if nsteps < due[0]:
-            return None
-        due[0] *= 2
-        jac = jacobian(fun, solver.t, solver.y)
-        if not np.all(np.isfinite(jac)):
-            return None
-        lam = np.linalg.eigvals(jac)
-        decay = float(np.max(-lam.real, initial=0.0))
-        index, h = decay * abs(t1 - solver.t), float(solver.step_size or 0.0)
-        if index > STIFF_INDEX and h * decay > 1.0:
-            fastest = lam[np.argmax(-lam.real)]
-            return (
-                f"at t = {solver.t:.6g}{unit}, after {nsteps} steps, the Jacobian's fastest "
-                f"decaying eigenvalue is {_complex(fastest)}{rate}"
-                f"; times the remaining span that is {index:.3g} > {STIFF_INDEX:g}, and the "
-                f"step {h:.3g}{unit} is held by stability: stiff"
-            )
-        return None
-
-    return watch
-
-
-def auto_run(fun: Callable, t0: float, t1: float, y0, time_unit: str = "", **options):
-    """The run of method "auto": the method the Jacobian at the start says, and an explicit run
-    watched along the way (:func:`stiffness_watch`); when it turns stiff, an implicit method
-    runs again from the start within what is left of the budget. (run, Choice saying what was
-    used and why)."""
-    choice = choose_method(fun, t0, t1, y0, options.get("rtol", 1e-6), time_unit)
-    if choice.method not in ("RK45", "DOP853"):
-        return run_ode(fun, (t0, t1), y0, method=choice.method, **options), choice
-    first = run_ode(
-        fun,
-        (t0, t1),
-        y0,
-        method=choice.method,
-        watch=stiffness_watch(fun, t1, time_unit),
-        **options,
-    )
-    if first.stop_reason != "stiff":
-        return first, choice
-    method = "Radau" if len(y0) <= 200 else "BDF"
-    budget = dict(options)
-    budget["max_time"] = max(options.get("max_time", MAX_TIME) - first.elapsed, 1e-3)
-    budget["max_steps"] = max(options.get("max_steps", MAX_STEPS) - first.nsteps, 1)
-    run = run_ode(fun, (t0, t1), y0, method=method, **budget)
-    run.elapsed += first.elapsed  # what the result cost, the explicit start included
-    run.nfev += first.nfev
-    reason = (
-        f"{choice.reason}; {first.method} then stopped: {first.notes[-1]}; {method} from the start "
-        f"({first.nsteps} explicit steps, {first.elapsed:.3g} s, before it)"
-    )
-    return run, Choice(method, reason, choice.eigenvalues, choice.index)
-
-
-def _complex(z) -> str:
-    z = complex(z)
-    if abs(z.imag) <= 1e-12 * max(1.0, abs(z.real)):
-        return f"{z.real:.4g}"
-    return f"{z.real:.4g} {'+' if z.imag >= 0 else '-'} {abs(z.imag):.4g}i"
-
-
 # -- a run ------------------------------------------------------------------------------------
 @dataclass
 class Solution:
@@ -380,6 +238,7 @@ class Solution:
         None  # (rtol, atol, max_time) -> OdeRun: the same run, other tolerances
     )
     atol: np.ndarray | None = None  # per number of the state vector
+    blown: tuple[float, str] | None = None  # (time, message) of a blow-up: values before it
     _estimate: ErrorEstimate | None = None
 
     def estimate(self) -> ErrorEstimate:
@@ -403,6 +262,8 @@ class Solution:
                 f"[{self.t0:g}, {self.t1:g}]",
                 definition=self.states[k],
             )
+        if self.blown is not None:
+            self._before_blow_up(k, arr)
         sizes = self.sizes or (None,) * len(self.states)
         first = sum(1 if n is None else n for n in sizes[:k])
         # scipy's dense output takes one time or a line of them: a grid of the numerical
@@ -414,6 +275,35 @@ class Solution:
             return y[first : first + sizes[k]].reshape((sizes[k], 1) + arr.shape)
         out = y[first]
         return float(out) if arr.ndim == 0 else out
+
+    def reference(self) -> Solution | None:
+        """The same states from the error estimate's reference run (tolerances
+        REFERENCE_FACTOR tighter), or None where there is none."""
+        est = self.estimate()
+        if est.failed or est.ref is None or est.ref.sol is None:
+            return None
+        return replace(self, run=est.ref, _estimate=est)
+
+    def _before_blow_up(self, k: int, arr: np.ndarray) -> None:
+        """Refuse a time at or past the blow-up (the run has no values there), or past the
+        first step where the global error estimate exceeds ESTIMATE_LIMIT times the tolerance
+        (the run lags behind a singularity: RK45 reaches y' = y^2 at t = 1.0000003)."""
+        t_b, message = self.blown
+        trusted = self.estimate().trusted
+        sign = np.sign(self.t1 - self.t0)
+        if trusted is not None and (trusted - t_b) * sign < 0:
+            message = (
+                f"the global error estimate exceeds {ESTIMATE_LIMIT:g} times the tolerance "
+                f"from there on, before the blow-up: {message}"
+            )
+            t_b = trusted
+        past = (arr - t_b) * sign >= 0
+        if np.any(past):
+            first = float(np.atleast_1d(arr)[np.atleast_1d(past)][0])
+            raise DomainError(
+                f"{self.states[k]}({first:g}) is at or past t = {t_b:.6g}, where {message}",
+                definition=self.states[k],
+            )
 
     def finding(self) -> str:
         r = self.run
@@ -466,7 +356,11 @@ def solve(
         method = choice.method
     else:
         run = run_ode(fun, (t0, t1), y0, method=method, **options)
-    if not run.ok:
+    blown = None
+    if not run.ok and blew_up(run):
+        # the values before the blow-up are the run's: only those at or past it are refused
+        blown = (float(run.t_reached), _refusal(run, name, flat_names(states, sizes), time_unit))
+    elif not run.ok:
         _refuse(run, name, flat_names(states, sizes), time_unit)
 
     def rerun(r: float, a, seconds: float) -> OdeRun:
@@ -486,6 +380,7 @@ def solve(
         sizes=tuple(sizes),
         rerun=rerun,
         atol=np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy(),
+        blown=blown,
     )
 
 
@@ -514,6 +409,8 @@ class ErrorEstimate:
     ratios: np.ndarray
     reference: str  # how the reference ran
     failed: str = ""  # why there is no estimate
+    trusted: float | None = None  # a run that blew up: the first step beyond ESTIMATE_LIMIT
+    ref: OdeRun | None = None  # the reference run (its dense output: the states' reference)
 
     @property
     def worst(self) -> int:
@@ -522,23 +419,32 @@ class ErrorEstimate:
 
 def estimate_error(sol: Solution) -> ErrorEstimate:
     """The difference between a solution and a run at tolerances REFERENCE_FACTOR tighter."""
-    r = sol.run
+    r, sign = sol.run, (1.0 if sol.t1 >= sol.t0 else -1.0)
     rtol = max(r.rtol / REFERENCE_FACTOR, 1e-13)
     atol = sol.atol / REFERENCE_FACTOR
     budget = min(MAX_TIME, max(REFERENCE_SECONDS, REFERENCE_SLOWER * r.elapsed))
     ref = sol.rerun(rtol, atol, budget)
     how = f"{ref.method} at rtol {rtol:g}, atol {np.max(atol):g}"
-    if not ref.ok:
+    blown = sol.blown is not None and blew_up(ref)
+    if not (ref.ok or blown):
         empty = np.empty(0)
         return ErrorEstimate(empty, empty, empty, how, f"the reference run {ref.summary()}")
-    y_ref = np.asarray(ref.sol(r.t)).reshape(r.y.shape)
-    diff = np.abs(r.y - y_ref)
+    # a run that blew up is compared where both runs have values (before either stopped)
+    stop = min(ref.t_reached * sign, r.t_reached * sign) * sign
+    keep = (r.t - stop) * sign <= 0 if blown else np.ones(r.t.shape, dtype=bool)
+    t, y = r.t[keep], r.y[:, keep]
+    y_ref = np.asarray(ref.sol(t)).reshape(y.shape)
+    diff = np.abs(y - y_ref)
     size = np.maximum(np.abs(y_ref), SIZE_FLOOR * np.max(np.abs(y_ref), axis=1, keepdims=True))
     scale = (atol * REFERENCE_FACTOR)[:, None] + r.rtol * size
     ratio = diff / scale
     at = np.argmax(ratio, axis=1)
     rows = np.arange(len(at))
-    return ErrorEstimate(diff[rows, at], r.t[at], ratio[rows, at], how)
+    trusted = None
+    if sol.blown is not None:  # values are given up to where the estimate leaves the tolerance
+        over = np.flatnonzero(np.max(ratio, axis=0) > ESTIMATE_LIMIT)
+        trusted = float(t[over[0]]) if over.size else stop
+    return ErrorEstimate(diff[rows, at], t[at], ratio[rows, at], how, trusted=trusted, ref=ref)
 
 
 def flat_names(states, sizes) -> list[str]:
@@ -548,6 +454,28 @@ def flat_names(states, sizes) -> list[str]:
     for s, n in zip(states, sizes):
         out += [s] if n is None else [f"{s}[{i}]" for i in range(n)]
     return out
+
+
+def blew_up(run) -> bool:
+    """A run that stopped where its states grow without bound (past BLOWUP, or a solver that
+    failed with states beyond 1e6), with the steps before it kept."""
+    big = run.y.size and np.max(np.abs(run.y[:, -1])) > 1e6
+    failed = run.stop_reason.startswith("failed") and big
+    return run.sol is not None and (run.stop_reason == "blow-up" or failed)
+
+
+def _refusal(run, name: str, states, time_unit: str) -> str:
+    """What a run that blew up or failed says: where, and why."""
+    at = f"t = {run.t_reached:.6g}{' ' + time_unit if time_unit else ''} of {run.t_final:g}"
+    if run.stop_reason == "blow-up":
+        note = run.notes[-1]
+        k = int(note.split()[1])
+        note = note.replace(f"state {k} ", f"state '{states[k]}' ", 1)
+        return f"ode '{name}' stopped at {at}: {note}"
+    big = ""
+    if run.y.size and np.max(np.abs(run.y[:, -1])) > 1e6:
+        big = " (the states grow without bound: the solution blows up)"
+    return f"ode '{name}' ({run.method}) stopped at {at}: {run.stop_reason}{big}"
 
 
 def _refuse(run, name: str, states, time_unit: str) -> None:
@@ -565,17 +493,7 @@ def _refuse(run, name: str, states, time_unit: str) -> None:
             + advice,
             definition=name,
         )
-    if run.stop_reason == "blow-up":
-        note = run.notes[-1]
-        k = int(note.split()[1])
-        note = note.replace(f"state {k} ", f"state '{states[k]}' ", 1)
-        raise DomainError(f"ode '{name}' stopped at {at}: {note}", definition=name)
-    big = ""
-    if run.y.size and np.max(np.abs(run.y[:, -1])) > 1e6:
-        big = " (the states grow without bound: the solution blows up)"
-    raise DomainError(
-        f"ode '{name}' ({run.method}) stopped at {at}: {run.stop_reason}{big}", definition=name
-    )
+    raise DomainError(_refusal(run, name, states, time_unit), definition=name)
 
 
 # -- error against run time -------------------------------------------------------------------
@@ -923,6 +841,9 @@ def sheet_findings(sheet) -> list:
         except WorkbookError as err:
             out.append(Finding(f"ode {name}", "the run did not finish", None, "", "fail", str(err)))
             continue
+        if sol.blown is not None:
+            note = f"{sol.blown[1]}; the values before t = {sol.blown[0]:.6g} are given"
+            out.append(Finding(f"ode {name}", "the run did not finish", None, "", "fail", note))
         out.append(
             Finding(f"ode {name}", f"solved with {sol.method}", None, "", "info", sol.finding())
         )

@@ -337,7 +337,7 @@ class Sheet:
         """The value of scalar definition ``name``, checked (finite, within its limits)."""
         d = self.spec.definitions[name]
         try:
-            with defining(name), matrix_work():
+            with defining(name, self.evaluator.records), matrix_work():
                 value = self.evaluator.compile(self.typer.scalar(name))({})
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
@@ -541,7 +541,7 @@ class Sheet:
             )
         failed: dict[int, str] = {}
         try:
-            with defining(f"{what}: {col.text}"), matrix_work():
+            with defining(f"{what}: {col.text}", self.evaluator.records), matrix_work():
                 out = fn({var: values})
         except DomainError as err:  # some rows leave the domain: the others keep their values
             if t.text or values.ndim != 1:

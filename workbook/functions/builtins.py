@@ -471,11 +471,18 @@ def _sum_numpy(fn, a=None, b=None, *, shapes=None):
     if last - first + 1 > MAX_TERMS:
         raise LimitError(f"sum(): {last - first + 1} terms (limit {MAX_TERMS})")
     same = lo.size == hi.size == 1 or (np.all(lo == lo[0]) and np.all(hi == hi[0]))
-    out = 0.0
+    out, size = 0.0, 0.0
     for i in range(first, last + 1):  # each term is a numpy evaluation over the sheet's arrays
         term = fn(float(i))
         # bounds that vary over a table's rows: the term counts only where i is in a row's range
-        out = out + (term if same else np.where((lo <= i) & (i <= hi), term, 0 * term))
+        term = term if same else np.where((lo <= i) & (i <= hi), term, 0 * term)
+        out, size = out + term, size + np.abs(term)
+    # EXPR as numerics.bound.Bound: the estimate is kept (of real terms: the rounding check
+    # of EXPR runs in real mpmath)
+    if hasattr(fn, "record") and not np.iscomplexobj(out):
+        from ..numerics.series import record_series
+
+        record_series(fn, lo, hi, np.asarray(out, dtype=float), size, np.maximum(hi - lo + 1, 0))
     return out
 
 

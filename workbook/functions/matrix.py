@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import DomainError, InputError
 from ..limits import ELEMENT_WORK, charge_matrix_work
+from ..numerics import linalg
 
 #: A matrix whose condition number exceeds this is singular for inverse and lsolve.
 SINGULAR_COND = 1e14
@@ -117,10 +118,13 @@ def transpose(m):
 
 def det(m):
     charge_cubic("det", m, "det()")
-    return _scalar(np.linalg.det(_last(m)))
+    value = np.linalg.det(_last(m))
+    linalg.determinant(_last(m), value)
+    return _scalar(value)
 
 
 def _check_regular(m, what: str):
+    """The matrix, matrix axes last, and its condition number (per range point)."""
     charge_cubic("inverse" if what.startswith("inverse") else "lsolve", m, what)
     mm = _last(m)
     with np.errstate(all="ignore"):
@@ -131,11 +135,14 @@ def _check_regular(m, what: str):
         raise DomainError(
             f"{what}: the matrix is singular (condition number {shown}, limit {SINGULAR_COND:g})"
         )
-    return mm
+    return mm, cond
 
 
 def inverse(m):
-    return _first(np.linalg.inv(_check_regular(m, "inverse()")))
+    mm, cond = _check_regular(m, "inverse()")
+    out = np.linalg.inv(mm)
+    linalg.solved("inverse", cond, out)
+    return _first(out)
 
 
 def power(m, n: int):
@@ -152,14 +159,16 @@ def power(m, n: int):
 
 
 def lsolve(m, v):
-    mm = _check_regular(m, "lsolve()")
+    mm, cond = _check_regular(m, "lsolve()")
     vv = _last(v)
     extra = mm.ndim - vv.ndim
     if extra > 0:
         vv = vv.reshape((1,) * extra + vv.shape)
     elif extra < 0:
         mm = mm.reshape((1,) * -extra + mm.shape)
-    return _first(np.linalg.solve(mm, vv))
+    out = np.linalg.solve(mm, vv)
+    linalg.solved("lsolve", cond, out)
+    return _first(out)
 
 
 def _real(values, what: str, kind: str = "eigenvalues"):
@@ -184,14 +193,26 @@ def _order(lam):
     return np.argsort(lam, axis=-1)
 
 
+def _real_eigen(m, lam, vec, what: str):
+    """The eigenvalues' real parts where their imaginary parts are rounding (a defective
+    matrix's multiple eigenvalue split into a pair), with their estimates recorded; else
+    the refusal of complex eigenvalues."""
+    if np.isrealobj(lam):
+        lam = lam.astype(complex)
+    real = linalg.real_eigenvalues(m, lam, vec, what.rstrip("()"))
+    if real is None:
+        return _real(lam, what)
+    return real
+
+
 def eigenvals(m):
     """Eigenvalues, ascending, as a column vector (of a complex matrix: complex, by real
     part, then imaginary part)."""
     charge_cubic("eigen", m, "eigenvals()")
     mm = _last(m)
-    lam = np.linalg.eigvals(mm)
+    lam, vec = np.linalg.eig(mm)
     if not np.iscomplexobj(mm):
-        lam = _real(lam, "eigenvals()")
+        lam = _real_eigen(mm, lam, vec, "eigenvals()")
     lam = np.take_along_axis(lam, _order(lam), axis=-1)
     return np.moveaxis(lam[..., None], (-2, -1), (0, 1))
 
@@ -203,8 +224,9 @@ def eigenvecs(m):
     mm = _last(m)
     lam, vec = np.linalg.eig(mm)
     if not np.iscomplexobj(mm):
-        lam = _real(lam, "eigenvecs()")
-        vec = _real(vec, "eigenvecs()")
+        lam = _real_eigen(mm, lam, vec, "eigenvecs()")
+        if np.iscomplexobj(vec):  # a multiple eigenvalue split by rounding: its vectors too
+            vec = vec.real / np.linalg.norm(vec.real, axis=-2, keepdims=True)
     vec = np.take_along_axis(vec, _order(lam)[..., None, :], axis=-1)
     big = np.take_along_axis(vec, np.argmax(np.abs(vec), axis=-2)[..., None, :], axis=-2)
     if np.iscomplexobj(vec):

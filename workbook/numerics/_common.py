@@ -64,15 +64,41 @@ _defining: contextvars.ContextVar[str | None] = contextvars.ContextVar(
 )
 
 
+_records: contextvars.ContextVar[list | None] = contextvars.ContextVar(
+    "workbook_numerics_records", default=None
+)
+
+
 @contextlib.contextmanager
-def defining(what: str) -> Iterator[None]:
+def defining(what: str, records: list | None = None) -> Iterator[None]:
     """Name the definition or table column being computed: the built-ins' results keep it
-    (``Result.notes["in"]``), so that a finding about an estimate can say where it is."""
+    (``Result.notes["in"]``), so that a finding about an estimate can say where it is.
+    ``records`` (the evaluator's list of (built-in, Result)) receives the results of the
+    built-ins that are given no EXPR (``lsolve``, ``eigenvals``: :func:`record`)."""
     token = _defining.set(what)
+    sink = _records.set(records) if records is not None else None
     try:
         yield
     finally:
+        if sink is not None:
+            _records.reset(sink)
         _defining.reset(token)
+
+
+def recording() -> bool:
+    """True where :func:`record` keeps what it is given (inside a sheet's definition)."""
+    return _records.get() is not None
+
+
+def record(name: str, value, error, **notes) -> None:
+    """Keep the error estimate of a built-in computed on values (no EXPR), with the
+    definition being computed, where :func:`defining` was given the list to keep it in."""
+    sink = _records.get()
+    if sink is None:
+        return
+    res = Result(np.asarray(value, dtype=float), np.asarray(error, dtype=float), notes=notes)
+    res.notes.setdefault("in", defined())
+    sink.append((name, res))
 
 
 def defined() -> str | None:

@@ -56,10 +56,14 @@ class Line:
     failed: str = ""  # why the reference could not be computed
     checked: int = 0  # the built-ins' values compared with the reference's
     reference: str = "mpmath"  # the reference's method(s)
+    refused: str = ""  # why the engine refused the definition (its error's first line)
 
     @property
     def verdict(self) -> str:
-        """ok, ESTIMATE LOW, beyond tolerance (estimated), WRONG, or the reference's failure."""
+        """ok, ESTIMATE LOW, beyond tolerance (estimated), WRONG, the engine's refusal, or the
+        reference's failure."""
+        if self.refused:
+            return f"refused by the engine: {self.refused}"
         if self.failed:
             return f"no reference: {self.failed}"
         # the place of a smooth extremum is known to about sqrt(eps) by any method
@@ -74,7 +78,7 @@ class Line:
         return "beyond tolerance (estimated)" if honest else "WRONG"
 
     def text(self) -> str:
-        diff = "" if self.failed else f"{self.difference:>10.1e}"
+        diff = "" if self.failed or self.refused else f"{self.difference:>10.1e}"
         count = f"{self.values} ({self.checked})"
         ref = "" if self.failed else _ms(self.reference_seconds)
         return (
@@ -182,7 +186,13 @@ def run(sheet, repeats: int = REPEATS) -> list[Line]:
     base = current(sheet_tolerance(sheet.spec.meta))
     lines = []
     for what, found, compute in targets(sheet):
-        compute(sheet.with_inputs())  # untimed: imports and first-call costs
+        try:
+            compute(sheet.with_inputs())  # untimed: imports and first-call costs
+        except WorkbookError as err:  # one refusal does not stop the others' lines
+            why = getattr(err, "message", str(err)).splitlines()[0]
+            builtins = ", ".join(sorted(found))
+            lines.append(Line(what, builtins, 0, 0.0, 0.0, 0.0, 0.0, base.rtol, refused=why))
+            continue
         times = []
         for _ in range(max(repeats, 1)):
             fresh = sheet.with_inputs()

@@ -276,7 +276,7 @@ def _golden(f, a, b, idx, kind: str, of) -> dict:
 
 
 def _root_numpy(of, a, b=None):
-    from . import roots
+    from . import odestates, roots
 
     tol, var, unit = of.tolerance, of.var, of.unit_text
     if live() and b is not None:
@@ -316,12 +316,13 @@ def _root_numpy(of, a, b=None):
 
     shape = np.broadcast_shapes(of.shape, np.shape(a), *(() if b is None else (np.shape(b),)))
     polish_roots(of, res, shape, tol)
+    odestates.add_root_error(of, shape, res)  # the states' global error, over the slope
     of.record("root", res)
     return _out(res.value)
 
 
 def _integral_numpy(of, a, b):
-    from . import gauss, quadrature
+    from . import gauss, odestates, quadrature, rounding
 
     if live():  # what the workbook's SUMPRODUCT computes
         res = _solve(
@@ -370,6 +371,8 @@ def _integral_numpy(of, a, b):
         b,
         *breaks,
     )
+    rounding.integral_rounding(of, shape, a, b, res)  # EXPR's own rounding joins the estimate
+    odestates.add_integral_error(of, shape, a, b, res)  # and the ODE states' global error
     of.record("integral", res)
     return _out(res.value)
 
@@ -399,7 +402,7 @@ def _extremum_numpy(name: str):
     where = name.startswith("arg")
 
     def hook(of, a, b):
-        from . import extrema
+        from . import extrema, odestates
 
         if live():  # what the workbook's samples and golden-section steps compute
             steps = _live_chain(of, a, b, lambda f, a, b, idx: _golden(f, a, b, idx, kind, of))
@@ -440,6 +443,8 @@ def _extremum_numpy(name: str):
         )
         if where:
             res = Result(res.where, res.where_error, evaluations=res.evaluations, notes=res.notes)
+        else:  # the states' global error where the extremum is
+            odestates.add_value_error(of, np.shape(res.value), res.where, res)
         if "assumes" in res.notes:
             res.notes["why"] = of.no_enclosure
         of.record(name, res)
@@ -452,11 +457,10 @@ def _extremum_numpy(name: str):
 
 
 def _diff_numpy(of, order=1):
-    """The derivative's formula evaluated where diff() is (its variable is the enclosing
-    one's, in the environment)."""
-    from .derivative import compiled
+    """The derivative's formula where diff() is, checked (numerics.slopes)."""
+    from .slopes import derivative_values
 
-    return compiled(of.evaluator, of.body, of.var_param, int(order))(of.env)
+    return derivative_values(of, int(order))
 
 
 def _product_numpy(of, a, b):
@@ -469,6 +473,7 @@ def _product_numpy(of, a, b):
         a,
         b,
     )
+    series.record_series(of, a, b, res.value, 0.0, None, kind="product")
     return _out(res.value)
 
 

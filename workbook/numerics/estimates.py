@@ -34,7 +34,7 @@ def estimate_findings(sheet) -> list:
     from ..compute.findings import Finding
 
     rtol = sheet_tolerance(sheet.spec.meta).rtol
-    worst: dict[tuple[str, str], tuple[float, float, float]] = {}
+    worst: dict[tuple[str, str], tuple[float, float, float, str]] = {}
     for builtin, result in sheet.evaluator.records:
         where = result.notes.get("in")
         # a result computed outside a definition or a column (a writer's live form, a report)
@@ -45,23 +45,25 @@ def estimate_findings(sheet) -> list:
         size = float(np.max(np.abs(result.value), initial=0.0))
         scale = float(result.notes.get("scale", 0.0))  # EXPR's size on the interval
         err = float(np.max(np.abs(result.error), initial=0.0))
-        if err <= ROUNDING * max(size, scale, 1.0):  # the rounding of the numbers it adds
+        # the rounding of the numbers it adds; a linear-algebra estimate is relative already
+        floor = max(size, scale) if result.notes.get("relative") else max(size, scale, 1.0)
+        if err <= ROUNDING * floor:
             continue
         if builtin in CERTIFIED_TO_SCALE:
             size = max(size, scale)
         relative = err / size if size > 0 else np.inf
         key = (where, builtin)
         if relative > worst.get(key, (-1.0,))[0]:
-            worst[key] = (relative, err, size)
+            worst[key] = (relative, err, size, result.notes.get("named", ""))
     out = assumption_findings(sheet)
-    for (where, builtin), (relative, err, size) in worst.items():
+    for (where, builtin), (relative, err, size, named) in worst.items():
         if relative <= ESTIMATE_LIMIT * rtol:
             continue
         out.append(
             Finding(
                 f"estimate {where}",
                 f"{builtin}: error estimate {err:.3g} for a value of size {size:.6g} "
-                f"(relative {relative:.2g})",
+                f"(relative {relative:.2g})" + (f": {named}" if named else ""),
                 None,
                 "",
                 "warning",

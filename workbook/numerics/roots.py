@@ -48,11 +48,12 @@ def root_in(
         return Result(np.empty(shape), np.empty(shape))
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     xs = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, k + 1)
-    fs = call(f, xs, [g[:, None] for g in args])
-    if not np.isfinite(fs).all():
-        i, j = np.argwhere(~np.isfinite(fs))[0]
+    with np.errstate(all="ignore"):  # an infinite sample (overflow, a pole) keeps its sign
+        fs = call(f, xs, [g[:, None] for g in args])
+    if np.isnan(fs).any():
+        i, j = np.argwhere(np.isnan(fs))[0]
         raise NumericsError(
-            f"root(): the function is not a finite number at {var} = {num(xs[i, j])}{_u(unit)}"
+            f"root(): the function is not a number at {var} = {num(xs[i, j])}{_u(unit)}"
             f"{row_text(label, i, n)}, inside the bracket [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
         )
     # signs as booleans (a byte each, not a float): the sampling is a fair share of the time
@@ -64,6 +65,10 @@ def root_in(
         count = change.sum(axis=1) + zero.sum(axis=1)
     else:
         count = change.sum(axis=1)
+    if not np.isfinite(fs).all():  # a sign change at an infinite sample may be a pole
+        evaluations_poles = _drop_poles(f, xs, fs, args, change, count)
+    else:
+        evaluations_poles = 0
     proven = None
     if enclose is not None and n <= CERTIFY_ROWS:
         proven = _counted(f, enclose, args, lo, hi, xs, fs, tol, var, unit, label)
@@ -92,7 +97,7 @@ def root_in(
         )
     value = np.empty(n)
     error = np.zeros(n)
-    evaluations = k + 1
+    evaluations = k + 1 + evaluations_poles
     sampled = change.any(axis=1) | zero.any(axis=1)
     if proven is not None:  # a root the samples do not bracket, or a multiple one
         done = ~np.isnan(proven.value)
@@ -110,17 +115,87 @@ def root_in(
         todo_args = tuple(g[todo] for g in args)
     if todo.size:
         j = np.argmax(change[todo], axis=1)
-        xl, xr = xs[todo, j], xs[todo, j + 1]
+        xl, xr, fl, fr = xs[todo, j], xs[todo, j + 1], fs[todo, j], fs[todo, j + 1]
+        unproven = np.ones(todo.size, dtype=bool) if proven is None else ~proven.one[todo]
+        if not (np.isfinite(fl).all() and np.isfinite(fr).all()):
+            xl, xr, fl, fr, ev = finite_ends(f, xl, xr, fl, fr, todo_args)
+            evaluations += ev
+            _not_infinite(xl, xr, fl, fr, todo, lo, hi, var, unit, label, n)
         res = find_root(f, (xl, xr), args=todo_args, tolerances=_tolerances(tol))
         _check_status(res, todo, lo, hi, label, n, unit)
         value[todo] = res.x
         error[todo] = _error(res, tol)
         evaluations += int(np.max(res.nfev))
-        unproven = np.ones(todo.size, dtype=bool) if proven is None else ~proven.one[todo]
-        _not_a_pole(
-            res, todo, fs[todo, j], fs[todo, j + 1], xr - xl, lo, hi, var, unit, label, n, unproven
-        )
+        _not_a_pole(res, todo, fl, fr, xr - xl, lo, hi, var, unit, label, n, unproven)
     return Result(value.reshape(shape), error.reshape(shape), evaluations=evaluations)
+
+
+def finite_ends(f, xl, xr, fl, fr, args) -> tuple:
+    """Brackets [xl, xr] with a sign change whose end values may be infinite (overflow, a
+    sample on a pole: an infinite value keeps its sign) bisected, on the sign, until both
+    ends are finite; an end still infinite when the bracket is two adjacent doubles is a pole
+    (:func:`_not_infinite` refuses it). Returns (xl, xr, fl, fr, evaluations)."""
+    xl, xr, fl, fr = (np.array(v, dtype=float) for v in (xl, xr, fl, fr))
+    evaluations = 0
+    for _ in range(2100):  # bisection of the full range of doubles ends well within this
+        todo = np.flatnonzero(~(np.isfinite(fl) & np.isfinite(fr)))
+        if not todo.size:
+            break
+        a, b = xl[todo], xr[todo]
+        m = 0.5 * (a + b)
+        m = np.where(np.isfinite(m), m, 0.5 * a + 0.5 * b)
+        inside = (m > a) & (m < b)
+        if not inside.any():
+            break
+        todo, m = todo[inside], m[inside]
+        with np.errstate(all="ignore"):
+            fm = np.asarray(call(f, m, [g[todo] for g in args]), dtype=float)
+        evaluations += 1
+        fm = np.broadcast_to(fm, m.shape)
+        nan = np.isnan(fm)
+        if nan.any():  # no sign there: the end that is infinite moves in, keeping its value
+            fm = np.where(nan, np.where(np.isfinite(fl[todo]), fr[todo], fl[todo]), fm)
+        left = (fm > 0) == (fl[todo] > 0)
+        xl[todo[left]], fl[todo[left]] = m[left], fm[left]
+        xr[todo[~left]], fr[todo[~left]] = m[~left], fm[~left]
+    return xl, xr, fl, fr, evaluations
+
+
+def _drop_poles(f, xs, fs, args, change, count) -> int:
+    """Sign changes between samples of which one is infinite, where the function stays
+    infinite down to adjacent doubles (a pole), are no roots: cleared from ``change`` and
+    ``count`` (in place) of rows with more than one. Returns the evaluations."""
+    rows_, cols = np.nonzero(change & ~(np.isfinite(fs[:, :-1]) & np.isfinite(fs[:, 1:])))
+    keep = count[rows_] > 1
+    rows_, cols = rows_[keep], cols[keep]
+    if not rows_.size:
+        return 0
+    *_, fl, fr, ev = finite_ends(
+        f,
+        xs[rows_, cols],
+        xs[rows_, cols + 1],
+        fs[rows_, cols],
+        fs[rows_, cols + 1],
+        tuple(g[rows_] for g in args),
+    )
+    pole = ~(np.isfinite(fl) & np.isfinite(fr))
+    change[rows_[pole], cols[pole]] = False
+    np.subtract.at(count, rows_[pole], 1)
+    return ev
+
+
+def _not_infinite(xl, xr, fl, fr, idx, lo, hi, var, unit, label, n) -> None:
+    """Refuse a sign change at which the function stays infinite down to adjacent doubles:
+    the sign change is a pole."""
+    bad = np.flatnonzero(~(np.isfinite(fl) & np.isfinite(fr)))
+    if bad.size:
+        i = bad[0]
+        row = idx[i]
+        raise NumericsError(
+            f"root(): the function changes sign at {var} = {num(0.5 * (xl[i] + xr[i]))}"
+            f"{_u(unit)} in [{num(lo[row])}, {num(hi[row])}]{_u(unit)}{row_text(label, row, n)},"
+            f" where its values are {num(fl[i])} and {num(fr[i])}: a pole, not a root"
+        )
 
 
 #: rows of one call whose roots are counted by interval arithmetic (the count costs about
@@ -156,7 +231,8 @@ def _counted(f, enclose, args, lo, hi, xs, fs, tol, var, unit, label) -> _Proven
     min_width = np.maximum(np.maximum(tol.rtol * span, tol.atol), 64 * np.spacing(span))
     at = lambda p, q, r: enclose(p, q, *[g[r] for g in args])  # noqa: E731
     iso = isolate(at, lo, hi, min_width)
-    scale = np.max(np.abs(fs), axis=1)
+    finite = np.isfinite(fs)
+    scale = np.max(np.where(finite, np.abs(fs), 0.0), axis=1)
     out = _Proven(np.zeros(n, dtype=bool), np.full(n, np.nan), np.zeros(n))
     boxes: dict[str, list] = {"root": [], "multiple": []}
     per_row = np.bincount(iso.row, minlength=n)
@@ -360,12 +436,21 @@ def root_near(
                 continue
             idx = todo[at]
             lo, hi = brackets[side, at, 0], brackets[side, at, 1]
-            res = find_root(
-                f, (lo, hi), args=tuple(g[idx] for g in args), tolerances=_tolerances(tol)
-            )
+            f_lo, f_hi = brackets[side, at, 2], brackets[side, at, 3]
+            sided = tuple(g[idx] for g in args)
+            pole = np.zeros(idx.size, dtype=bool)
+            if not (np.isfinite(f_lo).all() and np.isfinite(f_hi).all()):
+                lo, hi, f_lo, f_hi, ev = finite_ends(f, lo, hi, f_lo, f_hi, sided)
+                evaluations += ev
+                pole = ~(np.isfinite(f_lo) & np.isfinite(f_hi))
+                new_poles[side, idx[pole]] = 0.5 * (lo[pole] + hi[pole])
+                idx, lo, hi, f_lo, f_hi = (v[~pole] for v in (idx, lo, hi, f_lo, f_hi))
+                sided = tuple(g[idx] for g in args)
+                if not idx.size:
+                    continue
+            res = find_root(f, (lo, hi), args=sided, tolerances=_tolerances(tol))
             _check_status(res, idx, brackets[side, :, 0], brackets[side, :, 1], label, n, unit)
             evaluations += int(np.max(res.nfev))
-            f_lo, f_hi = brackets[side, at, 2], brackets[side, at, 3]
             root = ~_far_from_zero(res, f_lo, f_hi, hi - lo)
             new_poles[side, idx[~root]] = res.x[~root]
             idx, x, e = idx[root], res.x[root], _error(res, tol)[root]
@@ -424,7 +509,7 @@ def _brackets_both_sides(f, x0, f0, step, args, poles) -> tuple[np.ndarray, int]
             x = x0[idx] + sign * step[idx] * (2.0**k - 1)
             fx = _values(f, x, [a[idx] for a in args])
             evaluations += 1
-            ok = np.isfinite(fx)
+            ok = ~np.isnan(fx)  # an infinite value (overflow, a pole) keeps its sign
             alive[side, idx[~ok]] = False
             a, b = np.minimum(prev_x[side, idx], x), np.maximum(prev_x[side, idx], x)
             p = poles[side, idx]
