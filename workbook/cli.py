@@ -138,6 +138,12 @@ def _parser() -> argparse.ArgumentParser:
         command.add_argument(
             "--debug", action="store_true", default=argparse.SUPPRESS, help="show Python tracebacks"
         )
+        command.add_argument(
+            "--time-limit",
+            metavar="SECONDS",
+            default=None,
+            help="the wall-clock budget of the command (default 20 s, at most 3600 s)",
+        )
     return p
 
 
@@ -157,6 +163,7 @@ def load_sheet(args, parts=None):
     import workbook
 
     sheet = workbook.load(args.name, parts=parts)
+    _sheet_time_limit(sheet, args)
     if getattr(args, "inputs", None):
         from .roundtrip import changed_inputs
 
@@ -166,6 +173,26 @@ def load_sheet(args, parts=None):
     if sets:
         sheet = sheet.with_inputs(**sets)
     return sheet
+
+
+def _sheet_time_limit(sheet, args) -> None:
+    """A worksheet's ``[sheet] time_limit``: it may lower the default budget, not raise it
+    (``--time-limit`` on the command line wins)."""
+    from . import limits_time
+    from .errors import LimitError
+
+    raw = sheet.spec.meta.get("time_limit")
+    if raw is None or getattr(args, "time_limit", None) is not None:
+        return
+    where = f"{sheet.file}: [sheet] time_limit"
+    seconds = limits_time.check_seconds(raw, where)
+    if seconds > limits_time.DEFAULT_SECONDS:
+        raise LimitError(
+            f"{where} = {raw!r}: a worksheet may lower the time budget (at most "
+            f"{limits_time.DEFAULT_SECONDS:g} s), not raise it; give more time on the command "
+            "line with --time-limit SECONDS"
+        )
+    limits_time.set_seconds(seconds, "[sheet] time_limit")
 
 
 def _command_line(args) -> str:
@@ -472,15 +499,27 @@ def main(argv: list[str] | None = None) -> int:
         import warnings
 
         warnings.simplefilter("ignore", RuntimeWarning)
+    from . import limits_time
+    from .errors import OutOfBudget
     from .outputs.atomic import Terminated, sigterm_as_interrupt
 
     try:
-        with sigterm_as_interrupt():
+        seconds, source = limits_time.DEFAULT_SECONDS, "the default"
+        if getattr(args, "time_limit", None) is not None:
+            seconds = limits_time.check_seconds(args.time_limit, "--time-limit")
+            source = "--time-limit"
+        with sigterm_as_interrupt(), limits_time.command_budget(seconds, source):
             return handler(args)
     except WorkbookError as err:
         if args.debug:
             raise
         print(f"workbook: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except OutOfBudget as exc:  # the time or memory budget of the command ran out
+        limits_time.disarm()
+        if args.debug:
+            raise
+        print(f"workbook: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except (RecursionError, MemoryError) as exc:  # a last resort behind the documented limits
         if args.debug:

@@ -27,14 +27,14 @@ from ..functions.matrix import (
     power,
     size,  # noqa: F401 - rows/cols/length/last of a run-time value
 )
-from ..limits import ELEMENT_WORK, charge_matrix_work
+from ..limits import ELEMENT_WORK, MAX_ARRAY_ELEMENTS, charge_matrix_work, check_elements
 
 #: Arrays inside arrays at most this deep: a deeper one (``T := [T, 1]`` in a loop) would
 #: exhaust the C stack when it is freed or printed.
 MAX_NESTING = 100
 #: Elements of one run-time array (80 MB of numbers; its spare room for growing doubles that
-#: at most).
-MAX_RUNTIME_ELEMENTS = 10_000_000
+#: at most): the limit of every array a program builds, checked before it is made.
+MAX_RUNTIME_ELEMENTS = MAX_ARRAY_ELEMENTS
 
 
 def value(v):
@@ -128,9 +128,13 @@ def _position(i, origin: int, n: int | None, word: str, what: str) -> int:
     x = float(np.asarray(i, dtype=float)) if np.ndim(i) == 0 else None
     if x is None:
         raise InputError(f"{what}: the {word} index is an array; an index is a number")
-    k = round(x)
-    if not np.isfinite(x) or abs(x - k) > 1e-9:
+    if not np.isfinite(x) or abs(x - round(x)) > 1e-9:
         raise InputError(f"{what}: {word} index {x:g} is not an integer")
+    k = round(x)
+    if abs(k) > 2**53:  # beyond any array (and any exact integer)
+        if n is None:
+            check_elements(abs(float(k)), f"{what}: {word} index {x:g}")
+        raise InputError(f"{what}: {word} index {x:g} is out of range")
     k -= origin
     if k < 0 or (n is not None and k >= n):
         shown = f"{n} {word}s: {origin} .. {origin + n - 1}" if n else f"no {word}s"
@@ -195,11 +199,7 @@ def _grown(target: np.ndarray, rows: int, cols: int, nested: bool, what: str) ->
     """``target`` grown to ``rows`` x ``cols`` with zeros: a view into spare rows of the array
     it is a view of when they suffice, else a new array with twice the rows it needs."""
     r, c = target.shape
-    if rows * cols > MAX_RUNTIME_ELEMENTS:
-        raise LimitError(
-            f"{what}: an array of {rows:,} x {cols:,} elements "
-            f"(limit {MAX_RUNTIME_ELEMENTS:,} elements)"
-        )
+    check_elements(float(rows) * cols, f"{what}: growing it to {rows:,} x {cols:,}")
     dtype = object if nested else float
     base = target.base
     if (

@@ -10,7 +10,14 @@ import numpy as np
 import pint
 
 from ..compute.computed import Column, TableData, compute
-from ..errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
+from ..errors import (
+    DomainError,
+    InputError,
+    LimitError,
+    OutOfBudget,
+    TemplateError,
+    WorkbookError,
+)
 from ..functions.registry import CONSTANTS
 from ..language import expr as ex
 from ..language import typecheck as tc
@@ -252,6 +259,9 @@ class Sheet:
             return q.to("") if un.is_compound_ratio(f.unit) else q
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
+        except OutOfBudget as exc:  # the command stops; its message names the definition
+            exc.error.located(file=self.file, line=d.line, definition=name)
+            raise
         except (RecursionError, MemoryError) as exc:
             raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
 
@@ -340,6 +350,9 @@ class Sheet:
                 value = self.evaluator.compile(self.typer.scalar(name))({})
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
+        except OutOfBudget as exc:  # the command stops; its message names the definition
+            exc.error.located(file=self.file, line=d.line, definition=name)
+            raise
         except (RecursionError, MemoryError) as exc:
             raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
         if isinstance(value, str):

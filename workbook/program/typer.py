@@ -3,13 +3,15 @@ of its first value."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import TemplateError
+from ..errors import LimitError, TemplateError
 from ..language import expr as ex
 from ..language.typed import RUNTIME, is_runtime
+from ..limits import MAX_ARRAY_ELEMENTS, count_text
 from .statements import (
     Assign,
     Break,
@@ -209,6 +211,13 @@ class _TypeState:
         reach = None
         if g is not None and not g.why and min(g.extent) >= 0:
             reach = (g.extent[0] + 1, g.extent[1] + 1 if len(g.extent) == 2 else 1)
+            if float(reach[0]) * reach[1] > MAX_ARRAY_ELEMENTS:  # refused before it is made
+                at = ", ".join(f"{e + self.t.origin:g}" for e in g.extent)
+                raise LimitError(
+                    f"{self.where(s)}: '{s.name}' set at index {at} would be an array of "
+                    f"{count_text(float(reach[0]) * reach[1])} elements (limit "
+                    f"{MAX_ARRAY_ELEMENTS:,} elements)"
+                )
         if s.name in self.runtime or is_runtime(shape):
             return self.runtime_item(s)
         if shape is None and reach is None and s.name not in self.reserved:
@@ -362,7 +371,7 @@ def growth(program: Program, origin: int) -> dict[str, _Growth]:
                             f"line {st.line}: its index {ex.to_text(node)} is known only when "
                             "the program runs (a number, or the variable of a for over numbers)"
                         )
-                    elif any(v != int(v) or v < origin for v in values):
+                    elif any(not math.isfinite(v) or v != int(v) or v < origin for v in values):
                         g.why = g.why or f"line {st.line}: an index below the origin or not whole"
                     else:
                         g.extent[d] = max(g.extent[d], int(max(values)) - origin)

@@ -1,0 +1,208 @@
+"""The time budget of one command, and time limits of the blocks inside it.
+
+A command (``workbook run``, ``check``, ``sweep``, ...) has one wall-clock budget, set when
+it starts (:func:`command_budget`): the default :data:`DEFAULT_SECONDS`, lowered by a
+worksheet's ``[sheet] time_limit`` or set by ``--time-limit`` up to :data:`MAX_SECONDS`.
+The work that can run long checks it along the way (:func:`check_time`: a program's
+statements, a table's rows, an ODE's steps and right-hand sides, a sweep's cases, the
+writer); where no check is reached, an alarm stops the command :data:`GRACE_SECONDS` after
+the budget. Either way the command stops with :class:`OutOfBudget`, which is not a value that
+fails (no handler of :class:`workbook.errors.WorkbookError` keeps it): the command line
+prints one paragraph naming the work and exits 2.
+
+:func:`within_seconds` bounds one block inside the command (SymPy's derivative) by the same
+alarm: it stops at its own limit or at the budget, whichever comes first.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+import time
+from dataclasses import dataclass, field
+
+from .errors import LimitError, OutOfBudget
+
+#: The budget of one command when neither the worksheet nor the command line sets one.
+DEFAULT_SECONDS = 20.0
+#: The most ``--time-limit`` may give; a worksheet's ``[sheet] time_limit`` may only lower
+#: the default (a file cannot give itself more time).
+MAX_SECONDS = 3600.0
+#: The alarm that stops work no check reaches comes this long after the budget.
+GRACE_SECONDS = 0.5
+#: Seconds between repeated alarms once the time is up: an alarm that lands in a weakref
+#: callback or a ``__del__`` is printed and ignored by Python, so one alarm is not enough.
+ALARM_REPEAT_SECONDS = 0.05
+
+
+@dataclass
+class Budget:
+    """The wall-clock budget of one command."""
+
+    seconds: float
+    source: str  # how it was set: "the default", "--time-limit", "[sheet] time_limit"
+    start: float = field(default_factory=time.monotonic)
+    doing: str = "the command"  # the last work that checked the budget
+
+    @property
+    def deadline(self) -> float:
+        return self.start + self.seconds
+
+    def spent(self, what: str, definition: str | None = None) -> OutOfBudget:
+        """The error of running past the budget while doing ``what``."""
+        return OutOfBudget(
+            LimitError(
+                f"{what} ran past the time budget of this command ({self.seconds:g} s, "
+                f"{self.source}); make it do less work (fewer rows, points, cases or steps, "
+                f"a looser tolerance), or give it more time with --time-limit SECONDS "
+                f"(at most {MAX_SECONDS:g})",
+                definition=definition,
+            )
+        )
+
+
+_budget: Budget | None = None
+_blocks: list[list] = []  # [deadline, armed, expired exception class] of within_seconds
+
+
+def current() -> Budget | None:
+    """The budget of the running command (None outside one: the Python API is unbounded)."""
+    return _budget
+
+
+def remaining() -> float | None:
+    """Seconds left of the command's budget (None outside a command)."""
+    return None if _budget is None else _budget.deadline - time.monotonic()
+
+
+def check_time(what: str, definition: str | None = None) -> None:
+    """Stop with :class:`OutOfBudget` when the command's budget is spent; ``what`` names the
+    work (a table, a program line, an ODE), ``definition`` the definition it computes."""
+    b = _budget
+    if b is None:
+        return
+    b.doing = what
+    if time.monotonic() > b.deadline:
+        raise b.spent(what, definition)
+
+
+def check_seconds(seconds, source: str) -> float:
+    """A budget given by ``source`` as a number of seconds, within (0, MAX_SECONDS]."""
+    try:
+        value = float(seconds)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if isinstance(seconds, bool) or not 0 < value <= MAX_SECONDS:
+        raise LimitError(
+            f"{source} {seconds!r}: give a number of seconds above 0 and at most {MAX_SECONDS:g}"
+        )
+    return value
+
+
+def set_seconds(seconds: float, source: str) -> None:
+    """Give the running command's budget ``seconds`` from its start (a worksheet's
+    ``time_limit``, read once it is loaded)."""
+    if _budget is not None:
+        _budget.seconds, _budget.source = seconds, source
+        _arm()
+
+
+def _main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+@contextlib.contextmanager
+def command_budget(seconds: float = DEFAULT_SECONDS, source: str = "the default"):
+    """The block is one command with a budget of ``seconds``; in the main thread, an alarm
+    stops work that no :func:`check_time` reaches. Outside the main thread, or inside another
+    budget, the block runs under the budget already there (or none)."""
+    global _budget
+    if _budget is not None or not _main_thread():
+        yield
+        return
+    _budget = Budget(seconds, source)
+    previous = signal.signal(signal.SIGALRM, _on_alarm)
+    _arm()
+    try:
+        yield
+    finally:
+        _budget = None
+        if not _blocks:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def disarm() -> None:
+    """No further alarm for the budget (its error is being reported)."""
+    global _budget
+    _budget = None
+    if not _blocks:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+
+
+def _deadlines() -> list[float]:
+    out = [b[0] for b in _blocks if b[1]]
+    if _budget is not None:
+        out.append(_budget.deadline + GRACE_SECONDS)
+    return out
+
+
+def _arm() -> None:
+    times = _deadlines()
+    if not times or not _main_thread():
+        return
+    wait = max(min(times) - time.monotonic(), 1e-3)
+    signal.setitimer(signal.ITIMER_REAL, wait, ALARM_REPEAT_SECONDS)
+
+
+def _on_alarm(signum, frame) -> None:
+    now = time.monotonic()
+    for block in reversed(_blocks):
+        if block[1] and now >= block[0]:
+            raise block[2]
+    b = _budget
+    if b is not None and now >= b.deadline + GRACE_SECONDS:
+        raise b.spent(f"the work on {b.doing}" if b.doing != "the command" else b.doing)
+    _arm()  # an alarm before any deadline (one was moved): wait for the next
+
+
+@contextlib.contextmanager
+def within_seconds(seconds: float, what: str):
+    """Stop the block with a LimitError after ``seconds`` of wall-clock time (SIGALRM: pure
+    Python work such as SymPy's is interrupted between bytecodes; the alarm repeats until the
+    block has stopped), or with :class:`OutOfBudget` when the command's budget is spent first.
+    Only in the main thread of a process where no other timer is set; elsewhere the block
+    runs unbounded."""
+    if not _main_thread() or (
+        _budget is None and not _blocks and signal.getitimer(signal.ITIMER_REAL)[0] > 0
+    ):
+        yield
+        return
+
+    class _Expired(Exception):
+        pass
+
+    block = [time.monotonic() + seconds, True, _Expired]
+    outermost = _budget is None and not _blocks
+    previous = signal.signal(signal.SIGALRM, _on_alarm) if outermost else None
+    _blocks.append(block)
+    _arm()
+    expired = False
+    try:
+        try:
+            yield
+        finally:
+            block[1] = False  # an alarm raised before this line is caught just below
+    except _Expired:
+        expired = True
+    finally:
+        block[1] = False
+        _blocks.remove(block)
+        if outermost:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, previous)
+        else:
+            _arm()
+    if expired:
+        raise LimitError(f"{what} took more than {seconds:g} s")
