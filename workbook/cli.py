@@ -8,6 +8,7 @@ unless --debug.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 
@@ -493,14 +494,40 @@ def main(argv: list[str] | None = None) -> int:
             "import": cmd_import,
             "report": cmd_report,
         }[args.command]
-    from .errors import WorkbookError
 
     if not args.debug:  # the engine reports non-finite results itself, with the arguments
         import warnings
 
         warnings.simplefilter("ignore", RuntimeWarning)
+    with _quiet_file_errors(args.debug):
+        return _run_command(handler, args)
+
+
+@contextlib.contextmanager
+def _quiet_file_errors(debug: bool):
+    """A file left open by a writer that stopped on a full disk fails again when it is
+    closed by the garbage collector ("Exception ignored in ... OSError"): that second report
+    of the error already said is dropped (shown with --debug)."""
+    import gc
+
+    previous = sys.unraisablehook
+
+    def hook(unraisable):
+        if debug or not isinstance(unraisable.exc_value, OSError):
+            previous(unraisable)
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = previous
+
+
+def _run_command(handler, args) -> int:
+    """``handler(args)`` within the command's budget; every error as its exit status."""
     from . import limits_time
-    from .errors import OutOfBudget
+    from .errors import OutOfBudget, WorkbookError
     from .outputs.atomic import Terminated, sigterm_as_interrupt
 
     try:

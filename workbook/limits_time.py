@@ -87,6 +87,26 @@ def check_time(what: str, definition: str | None = None) -> None:
         raise b.spent(what, definition)
 
 
+def budgeted(fun, what: str, definition: str | None = None):
+    """``fun`` checking the command's budget before each call (an ODE's right-hand side:
+    every step of every solver calls it, an implicit one also for its Jacobian)."""
+    if _budget is None:
+        return fun
+
+    def checked(*args):
+        check_time(what, definition)
+        return fun(*args)
+
+    return checked
+
+
+def within_budget(seconds: float) -> float:
+    """``seconds``, or less when the command's budget ends sooner (an optional run, as an
+    error estimate's reference, stops at its own limit before the command's)."""
+    left = remaining()
+    return seconds if left is None else max(min(seconds, left - GRACE_SECONDS), 1e-3)
+
+
 def check_seconds(seconds, source: str) -> float:
     """A budget given by ``source`` as a number of seconds, within (0, MAX_SECONDS]."""
     try:

@@ -37,6 +37,7 @@ from ..language.typed import TConst
 from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
+from ..limits_time import check_time
 from ..numerics import defining
 from . import runtime as rt
 from .numeric import Evaluator
@@ -345,6 +346,7 @@ class Sheet:
     def _scalar(self, name: str):
         """The value of scalar definition ``name``, checked (finite, within its limits)."""
         d = self.spec.definitions[name]
+        check_time(f"'{name}'")  # names the work, for the budget's alarm
         try:
             with defining(name), matrix_work():
                 value = self.evaluator.compile(self.typer.scalar(name))({})
@@ -552,9 +554,13 @@ class Sheet:
                 what,
             )
         failed: dict[int, str] = {}
+        check_time(f"{what}: column '{col.text}'")  # names the work, for the budget's alarm
         try:
             with defining(f"{what}: {col.text}"), matrix_work():
                 out = fn({var: values})
+        except OutOfBudget as exc:
+            exc.error.located(file=self.file, definition=what)
+            raise
         except DomainError as err:  # some rows leave the domain: the others keep their values
             if t.text or values.ndim != 1:
                 raise self._locate(err, what) from None

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import re
 import signal
 import tempfile
 import threading
@@ -78,8 +80,30 @@ def _mode_for(path: Path) -> int:
 
 
 def os_error(path: Path, exc: OSError) -> InputError:
-    """An error of the file system (disk full, read-only, name too long) as an input error."""
-    return InputError(f"cannot write {path}: {exc.strerror or exc}")
+    """An error of the file system (disk full, read-only, name too long) as an input error
+    naming the output (not the temporary file beside it that was being written)."""
+    hint = {
+        errno.ENOSPC: "; the disk is full: free some space, or write elsewhere",
+        errno.EDQUOT: "; the disk quota is used up: free some space, or write elsewhere",
+        errno.EROFS: "; write elsewhere",
+        errno.EACCES: "; write elsewhere, or change the folder's permissions",
+        errno.EPERM: "; write elsewhere, or change the folder's permissions",
+    }.get(exc.errno, "")
+    return InputError(f"cannot write {target_of(Path(path))}: {exc.strerror or exc}{hint}")
+
+
+_PARTIAL = re.compile(r"^\.(.+)\.[^.]+\.partial$")
+
+
+def target_of(path: Path) -> Path:
+    """The output a temporary path stands for: ``DIR/.NAME.XXXX.partial/...`` is
+    ``DIR/NAME`` (the first such part of the path); any other path is itself."""
+    parts = path.parts
+    for k, part in enumerate(parts):
+        m = _PARTIAL.match(part)
+        if m:
+            return Path(*parts[:k], m.group(1)) if k else Path(m.group(1))
+    return path
 
 
 @contextlib.contextmanager

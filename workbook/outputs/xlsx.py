@@ -116,7 +116,11 @@ def render(form, path: Path) -> None:
         wb.close()
     except Exception as exc:  # xlsxwriter wraps the OSError (disk full, read-only)
         cause = exc.__context__ if isinstance(exc.__context__, OSError) else exc
-        if isinstance(cause, OSError) or type(exc).__name__ == "FileCreateError":
+        if isinstance(cause, OSError):
+            from .atomic import os_error
+
+            raise os_error(Path(path), cause) from None
+        if type(exc).__name__ == "FileCreateError":
             raise InputError(f"cannot write {path}: {getattr(cause, 'strerror', cause)}") from None
         raise
 
