@@ -233,6 +233,7 @@ def cmd_run(args) -> int:
     override (--set) no longer reproduces are counted in the summary, not an error."""
     from .compute.computed import compute
     from .errors import InputError
+    from .limits_time import check_time
     from .outputs.atomic import Outputs, write_csv
     from .outputs.xlsx import write_workbook
 
@@ -266,6 +267,7 @@ def cmd_run(args) -> int:
             write_csv(computed.frame(table), csv_tmps[table])
         if exporter is not None:
             exporter(sheet, export_tmp)
+        check_time("writing the workbook")  # names the work, for the budget's alarm
         write_workbook(computed, xlsx_tmp, force=True)
         refusals = computed.excel.refusals
     for path in csv_paths.values():
@@ -528,8 +530,9 @@ def _run_command(handler, args) -> int:
     """``handler(args)`` within the command's budget; every error as its exit status."""
     from . import limits_time
     from .errors import OutOfBudget, WorkbookError
-    from .outputs.atomic import Terminated, sigterm_as_interrupt
+    from .outputs.atomic import MOVED, Terminated, sigterm_as_interrupt
 
+    moved = len(MOVED)
     try:
         seconds, source = limits_time.DEFAULT_SECONDS, "the default"
         if getattr(args, "time_limit", None) is not None:
@@ -558,7 +561,11 @@ def _run_command(handler, args) -> int:
         )
         return EXIT_INPUT
     except KeyboardInterrupt as exc:
-        print("workbook: interrupted; no output file was changed", file=sys.stderr)
+        if MOVED[moved:]:  # the signal came while they were moved into place: held till done
+            names = ", ".join(str(p) for p in MOVED[moved:])
+            print(f"workbook: interrupted after writing {names} (complete)", file=sys.stderr)
+        else:
+            print("workbook: interrupted; no output file was changed", file=sys.stderr)
         return 143 if isinstance(exc, Terminated) else 130
     except Exception as exc:  # a bug of the engine or of a solver block, not of the worksheet
         if args.debug:
