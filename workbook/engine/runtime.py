@@ -227,12 +227,32 @@ def _grown(target: np.ndarray, rows: int, cols: int, nested: bool, what: str) ->
 
 def _element(x, what: str):
     """An array stored as an element of another: a copy (a later change to the local it came
-    from does not reach it), nested at most :data:`MAX_NESTING` deep."""
+    from does not reach it), nested at most :data:`MAX_NESTING` deep, and of at most the
+    element limit counted whole (an array given itself twice, ``v := [v, v]``, doubles)."""
     if not is_array(x):
         return x
-    if x.dtype == object and nesting(x) >= MAX_NESTING:
-        raise LimitError(f"{what}: arrays nested more than {MAX_NESTING} deep")
+    if x.dtype == object:
+        depth, count = _measure(x, {})
+        if depth >= MAX_NESTING:
+            raise LimitError(f"{what}: arrays nested more than {MAX_NESTING} deep")
+        check_elements(count, f"{what}: an array holding arrays (their elements counted whole)")
     return x.copy()
+
+
+def _measure(v, seen: dict) -> tuple[int, float]:
+    """(how deep, how many numbers counted whole) of a nested array; an array met again (the
+    same one held twice) is measured once."""
+    key = id(v)
+    if key not in seen:
+        depth, count = 0, 0.0
+        for e in v.ravel():
+            if is_array(e):
+                d, c = _measure(e, seen) if e.dtype == object else (1, float(e.size))
+                depth, count = max(depth, d), count + c
+            else:
+                count += 1
+        seen[key] = (depth + 1, count)
+    return seen[key]
 
 
 def nesting(v) -> int:
@@ -241,7 +261,7 @@ def nesting(v) -> int:
         return 0
     if v.dtype != object:
         return 1
-    return 1 + max((nesting(e) for e in v.ravel()), default=0)
+    return _measure(v, {})[0]
 
 
 def build(rows: list[list], what: str = "array"):
