@@ -20,6 +20,8 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from test_hostile import guarded, program
 
 import workbook
@@ -440,6 +442,7 @@ def test_a_signal_at_any_point_of_writing_changes_nothing(tmp_path, sig):
     first = subprocess.run(args, cwd=tmp_path, env=env, capture_output=True, timeout=600)
     assert first.returncode == 0, first.stderr
     before = {n: (tmp_path / n).read_bytes() for n in ("o.xlsx", "o.t.csv")}
+    interrupted = 0
     # the signal at fractions of the time the writing takes, from its first progress line;
     # each run's table is another, so that a complete run changes both files
     for k, fraction in enumerate((0.0, 0.2, 0.4, 0.6, 0.8, 0.95), 1):
@@ -466,6 +469,7 @@ def test_a_signal_at_any_point_of_writing_changes_nothing(tmp_path, sig):
             before = now
             continue
         assert child.returncode == (143 if sig == signal.SIGTERM else 130), err
+        interrupted += 1
         if "interrupted after writing" in err:  # held while they were moved: both new
             assert all(now[n] != before[n] for n in now), err
             before = now
@@ -473,3 +477,87 @@ def test_a_signal_at_any_point_of_writing_changes_nothing(tmp_path, sig):
             assert "interrupted; no output file was changed" in err, err
             assert now == before, fraction
         assert leftovers(tmp_path) == [] and list(scratch.iterdir()) == [], fraction
+    assert interrupted, "every run ended before its signal: nothing was tested"
+
+
+# -- fuzz: generated programs end in exit 0, 1 or 2, within the budget ------------------------
+
+
+FUZZ_EXAMPLES = int(os.environ.get("FUZZ_PROGRAMS", "300"))
+NUMBERS = ["0", "1", "2", "-1", "1.5", "1e300", "0/0", "1/0", "2^2000", "1e6", "n", "k"]
+ARRAYS = ["v", "[1, 2]", "stack(v, v)", "augment(v, v)", "[v, v]", "stack(v, [k])", "w"]
+CALLS = ["rows(v)", "cols(v)", "max(v)", "v[{i}]", "w[{i}]", "length(v)"]
+
+
+@st.composite
+def expressions(draw, depth: int = 0):
+    kind = draw(st.integers(0, 3 if depth < 2 else 1))
+    if kind == 0:
+        return draw(st.sampled_from(NUMBERS))
+    if kind == 1:
+        return draw(st.sampled_from(ARRAYS))
+    if kind == 2:
+        return draw(st.sampled_from(CALLS)).format(i=draw(st.sampled_from(NUMBERS)))
+    op = draw(st.sampled_from(["+", "-", "*", "/", "^"]))
+    return f"({draw(expressions(depth + 1))} {op} {draw(expressions(depth + 1))})"
+
+
+@st.composite
+def blocks(draw, indent: str = "", depth: int = 0):
+    lines = []
+    for _ in range(draw(st.integers(1, 3))):
+        kind = draw(st.integers(0, 5 if depth < 2 else 2))
+        name = draw(st.sampled_from(["v", "w", "acc"]))
+        if kind == 0:
+            lines.append(f"{indent}{name} := {draw(expressions())}")
+        elif kind == 1:
+            index = draw(st.sampled_from(NUMBERS + ["rows(v)", "rows(w) + 1", "k*1e6"]))
+            lines.append(f"{indent}{name}[{index}] := {draw(expressions())}")
+        elif kind == 2:
+            lines.append(f"{indent}{draw(st.sampled_from(['break', 'continue', 'return v']))}")
+        elif kind == 3:
+            last = draw(st.sampled_from(["3", "n", "1e6", "1e300", "0/0", "-5"]))
+            lines.append(f"{indent}for k in 1 .. {last}")
+            lines.extend(draw(blocks(indent + "    ", depth + 1)))
+        elif kind == 4:
+            lines.append(f"{indent}while {draw(expressions())} > 0")
+            lines.extend(draw(blocks(indent + "    ", depth + 1)))
+        else:
+            lines.append(f"{indent}if {draw(expressions())} > 1")
+            lines.extend(draw(blocks(indent + "    ", depth + 1)))
+    return lines
+
+
+def _run_program(body: list[str], budget: str) -> None:
+    import tempfile
+
+    text = program("v := [1, 2]\nw := 0\nacc := 0\n" + "\n".join(body) + "\nv", "p(3)")
+    with tempfile.TemporaryDirectory() as folder:
+        (Path(folder) / "f.toml").write_text(text, encoding="utf-8")
+        start = time.monotonic()
+        code, _, err = run_cli(
+            Path(folder), "run", "f.toml", "--out", "f.xlsx", "--time-limit", budget
+        )
+        elapsed = time.monotonic() - start
+    assert code in (0, 1, 2), (code, err, text)  # never 3: an internal error
+    assert "Traceback" not in err and "internal error" not in err, (err, text)
+    if code == 2:
+        one_paragraph(err)
+    assert elapsed < float(budget) + 30, (elapsed, text)  # a hang guard, not a timing claim
+    assert limits_time.current() is None
+
+
+@settings(max_examples=3, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(blocks())
+def test_generated_programs_end_in_exit_0_1_or_2(body):
+    _run_program(body, "0.2")
+
+
+@pytest.mark.slow  # FUZZ_PROGRAMS generated programs (300 unless set), each within 1 s
+@settings(
+    max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck),
+    database=None,
+)  # fmt: skip
+@given(blocks())
+def test_generated_programs_many(body):
+    _run_program(body, "1")
