@@ -4,6 +4,10 @@ A path given by a user may name a device (``/dev/zero``), a FIFO (a read or a wr
 forever), a sparse file of gigabytes, or an xlsx whose members inflate to gigabytes (a zip
 bomb). Each is refused here, before any parser sees it, with an error of kind
 ``limit exceeded`` or ``input error`` (exit status 2).
+
+The memory of a computation is bounded here too: the matrix work of one evaluation, and the
+elements of every array made while computing (:func:`check_elements`, before it is made). The
+time of a command is in :mod:`workbook.limits_time`.
 """
 
 from __future__ import annotations
