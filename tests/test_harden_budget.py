@@ -561,3 +561,11 @@ def test_generated_programs_end_in_exit_0_1_or_2(body):
 @given(blocks())
 def test_generated_programs_many(body):
     _run_program(body, "1")
+
+
+def test_an_element_set_of_a_number_local_makes_it_a_vector(tmp_path):
+    # found by the fuzz test: w := 0 then w[0] := 0 was an IndexError (exit 3); as Mathcad
+    # (and a run-time array), setting an element of a number makes it a vector
+    path = tmp_path / "n.toml"
+    path.write_text(program("w := 5\nw[2] := 7*n\nw", "p(1)"), encoding="utf-8")
+    assert workbook.load(path).evaluate("s").magnitude.ravel().tolist() == [0.0, 0.0, 7.0]

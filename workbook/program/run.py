@@ -122,7 +122,7 @@ def compile_program(
                     old = env.get(n)
                     if old is None or np.shape(old)[:2] != tuple(grow):
                         target = np.zeros(grow)
-                        if old is not None:
+                        if old is not None and np.ndim(old):  # a number becomes a vector
                             old = np.asarray(old, dtype=float).reshape(np.shape(old)[0], -1)
                             target[: old.shape[0], : old.shape[1]] = old
                         env[n] = target
