@@ -314,10 +314,9 @@ def binary(op: str, a, b, what: str):
             return float(np.sum(a * b))  # Mathcad's v*w of two vectors
         if sa[1] != sb[0]:
             raise InputError(f"{what}: cannot multiply {describe(a)} by {describe(b)}")
-        charge_matrix_work(
-            float(sa[0]) * sa[1] * sb[1],
-            f"{what}: a product of {describe(a)} by {describe(b)}",
-        )
+        product = f"{what}: a product of {describe(a)} by {describe(b)}"
+        charge_matrix_work(float(sa[0]) * sa[1] * sb[1], product)
+        check_elements(float(sa[0]) * sb[1], product)
         return a @ b
     if op == "/":
         if sb is not None:

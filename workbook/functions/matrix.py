@@ -90,6 +90,7 @@ def matmul(a, b):
     charge_matrix_work(
         float(n) * k * m * _points(a, b), f"a product of {n} x {k} by {k} x {m} matrices"
     )
+    check_elements(float(n) * m * _points(a, b), f"a product of {n} x {k} by {k} x {m} matrices")
     return _first(np.matmul(_last(a), _last(b)))
 
 
