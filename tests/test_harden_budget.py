@@ -77,6 +77,11 @@ GROWTH = {
         program("w := 0\nw[rows(w) + n*1e300] := 1\nrows(w)", "p(1)"),
         "element index 1e+300 would make an array of 1e+300 elements",
     ),
+    "outer_product_in_a_program": (
+        program("for k in 0 .. n\n    v[k] := k\nM := v*transpose(v)\nM[1, 1]", "p(4000)"),
+        "a product of a vector of 4001 by a 1x4001 matrix would make an array of "
+        "16,008,001 elements",
+    ),
     "stack_in_a_formula": (
         '[definitions]\ns = "max(stack(identity(2000), identity(2000), identity(2000)))"\n',
         "stack() would make an array of 12,000,000 elements",
@@ -91,7 +96,10 @@ GROWTH = {
 SMALL_LIMIT = 100_000  # elements: the default run's limit, so that each case is quick
 
 
-@pytest.mark.parametrize("name", sorted(GROWTH))
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if "outer" in n else n for n in sorted(GROWTH)],
+)  # the outer product's vector of 4,001 takes over a second to type and fill
 def test_growth_is_refused_before_the_memory_is_taken(tmp_path, monkeypatch, name):
     text, expected = GROWTH[name]
     monkeypatch.setattr(limits, "MAX_ARRAY_ELEMENTS", SMALL_LIMIT)
