@@ -143,7 +143,8 @@ def _parser() -> argparse.ArgumentParser:
             "--time-limit",
             metavar="SECONDS",
             default=None,
-            help="the wall-clock budget of the command (default 20 s, at most 3600 s)",
+            help="the command's budget in seconds of CPU time (default 20, at most 3600; "
+            "wall-clock time is bounded at 3 times it)",
         )
     return p
 
