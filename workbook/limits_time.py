@@ -199,7 +199,19 @@ def _arm() -> None:
     signal.setitimer(signal.ITIMER_REAL, wait, ALARM_REPEAT_SECONDS)
 
 
+def _importing(frame) -> bool:
+    """The interrupted code is inside an import: an exception raised there would leave a
+    module half initialised in ``sys.modules`` (a later import of it fails)."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _on_alarm(signum, frame) -> None:
+    if _importing(frame):
+        return  # the alarm repeats: it is raised once the import is done
     now = time.monotonic()
     for block in reversed(_blocks):
         if block[1] and now >= block[0]:
