@@ -48,9 +48,10 @@ def run_cli(cwd: Path, *args: str):
 
 def spent(seconds: float, source: str) -> str:
     """The regex of the budget a message names: its CPU time or, on a busy machine, the
-    wall-clock cap of 3 times it."""
+    wall-clock cap of WALL_FACTOR times it."""
     cpu = f"{seconds:g} s of CPU time"
-    wall = f"{3 * seconds:g} s of wall-clock time, 3 times its {cpu}"
+    factor = limits_time.WALL_FACTOR
+    wall = f"{factor * seconds:g} s of wall-clock time, {factor:g} times its {cpu}"
     return rf"ran past the time budget of this command \(({cpu}|{wall}), {re.escape(source)};"
 
 

@@ -144,7 +144,7 @@ def _parser() -> argparse.ArgumentParser:
             metavar="SECONDS",
             default=None,
             help="the command's budget in seconds of CPU time (default 20, at most 3600; "
-            "wall-clock time is bounded at 3 times it)",
+            "wall-clock time is bounded at 5 times it)",
         )
     return p
 

@@ -36,7 +36,7 @@ DEFAULT_SECONDS = 20.0
 MAX_SECONDS = 3600.0
 #: Wall-clock time is bounded too, at this many times the budget: a command that waits (on
 #: a process pool, a starved machine) stops as well.
-WALL_FACTOR = 3.0
+WALL_FACTOR = 5.0
 #: The alarm that stops work no check reaches comes this long after the budget.
 GRACE_SECONDS = 0.5
 #: Seconds between repeated alarms once the time is up: an alarm that lands in a weakref
