@@ -28,8 +28,8 @@ from .errors import LimitError, OutOfBudget
 #: The budget of one command, in seconds of its CPU time, when neither the worksheet nor the
 #: command line sets one. CPU time, not wall-clock time: on a machine shared with other work
 #: a command is given its time, not cut short by the others (the shipped templates with every
-#: part take 2 to 6 s of CPU, and up to 24 s of wall-clock time at a load average of 10 on 2
-#: cores).
+#: part take 2 to 9 s of CPU, and took up to 65 s of wall-clock time at a load average near 13
+#: on 2 cores).
 DEFAULT_SECONDS = 20.0
 #: The most ``--time-limit`` may give; a worksheet's ``[sheet] time_limit`` may only lower
 #: the default (a file cannot give itself more time).
