@@ -8,6 +8,7 @@ unless --debug.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 
@@ -144,6 +145,13 @@ def _parser() -> argparse.ArgumentParser:
         command.add_argument(
             "--debug", action="store_true", default=argparse.SUPPRESS, help="show Python tracebacks"
         )
+        command.add_argument(
+            "--time-limit",
+            metavar="SECONDS",
+            default=None,
+            help="the command's budget in seconds of CPU time (default 20, at most 3600; "
+            "wall-clock time is bounded at 5 times it)",
+        )
     return p
 
 
@@ -163,6 +171,7 @@ def load_sheet(args, parts=None):
     import workbook
 
     sheet = workbook.load(args.name, parts=parts)
+    _sheet_time_limit(sheet, args)
     if getattr(args, "inputs", None):
         from .roundtrip import changed_inputs
 
@@ -172,6 +181,26 @@ def load_sheet(args, parts=None):
     if sets:
         sheet = sheet.with_inputs(**sets)
     return sheet
+
+
+def _sheet_time_limit(sheet, args) -> None:
+    """A worksheet's ``[sheet] time_limit``: it may lower the default budget, not raise it
+    (``--time-limit`` on the command line wins)."""
+    from . import limits_time
+    from .errors import LimitError
+
+    raw = sheet.spec.meta.get("time_limit")
+    if raw is None or getattr(args, "time_limit", None) is not None:
+        return
+    where = f"{sheet.file}: [sheet] time_limit"
+    seconds = limits_time.check_seconds(raw, where)
+    if seconds > limits_time.DEFAULT_SECONDS:
+        raise LimitError(
+            f"{where} = {raw!r}: a worksheet may lower the time budget (at most "
+            f"{limits_time.DEFAULT_SECONDS:g} s), not raise it; give more time on the command "
+            "line with --time-limit SECONDS"
+        )
+    limits_time.set_seconds(seconds, "[sheet] time_limit")
 
 
 def _command_line(args) -> str:
@@ -208,6 +237,7 @@ def cmd_run(args) -> int:
     override (--set) no longer reproduces are counted in the summary, not an error."""
     from .compute.computed import compute
     from .errors import InputError
+    from .limits_time import check_time
     from .outputs.atomic import Outputs, write_csv
     from .outputs.xlsx import write_workbook
 
@@ -241,6 +271,7 @@ def cmd_run(args) -> int:
             write_csv(computed.frame(table), csv_tmps[table])
         if exporter is not None:
             exporter(sheet, export_tmp)
+        check_time("writing the workbook")  # names the work, for the budget's alarm
         write_workbook(computed, xlsx_tmp, force=True)
         refusals = computed.excel.refusals
     for path in csv_paths.values():
@@ -513,21 +544,60 @@ def main(argv: list[str] | None = None) -> int:
             "import": cmd_import,
             "report": cmd_report,
         }[args.command]
-    from .errors import WorkbookError
 
     if not args.debug:  # the engine reports non-finite results itself, with the arguments
         import warnings
 
         warnings.simplefilter("ignore", RuntimeWarning)
-    from .outputs.atomic import Terminated, sigterm_as_interrupt
+    with _quiet_file_errors(args.debug):
+        return _run_command(handler, args)
 
+
+@contextlib.contextmanager
+def _quiet_file_errors(debug: bool):
+    """A file left open by a writer that stopped on a full disk fails again when it is
+    closed by the garbage collector ("Exception ignored in ... OSError"): that second report
+    of the error already said is dropped (shown with --debug)."""
+    import gc
+
+    previous = sys.unraisablehook
+
+    def hook(unraisable):
+        if debug or not isinstance(unraisable.exc_value, OSError):
+            previous(unraisable)
+
+    sys.unraisablehook = hook
     try:
-        with sigterm_as_interrupt():
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = previous
+
+
+def _run_command(handler, args) -> int:
+    """``handler(args)`` within the command's budget; every error as its exit status."""
+    from . import limits_time
+    from .errors import OutOfBudget, WorkbookError
+    from .outputs.atomic import MOVED, Terminated, sigterm_as_interrupt
+
+    moved = len(MOVED)
+    try:
+        seconds, source = limits_time.DEFAULT_SECONDS, "the default"
+        if getattr(args, "time_limit", None) is not None:
+            seconds = limits_time.check_seconds(args.time_limit, "--time-limit")
+            source = "--time-limit"
+        with sigterm_as_interrupt(), limits_time.command_budget(seconds, source):
             return handler(args)
     except WorkbookError as err:
         if args.debug:
             raise
         print(f"workbook: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except OutOfBudget as exc:  # the time or memory budget of the command ran out
+        limits_time.disarm()
+        if args.debug:
+            raise
+        print(f"workbook: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except (RecursionError, MemoryError) as exc:  # a last resort behind the documented limits
         if args.debug:
@@ -539,7 +609,11 @@ def main(argv: list[str] | None = None) -> int:
         )
         return EXIT_INPUT
     except KeyboardInterrupt as exc:
-        print("workbook: interrupted; no output file was changed", file=sys.stderr)
+        if MOVED[moved:]:  # the signal came while they were moved into place: held till done
+            names = ", ".join(str(p) for p in MOVED[moved:])
+            print(f"workbook: interrupted after writing {names} (complete)", file=sys.stderr)
+        else:
+            print("workbook: interrupted; no output file was changed", file=sys.stderr)
         return 143 if isinstance(exc, Terminated) else 130
     except Exception as exc:  # a bug of the engine or of a solver block, not of the worksheet
         if args.debug:

@@ -92,6 +92,20 @@ class LimitError(WorkbookError):
     kind = "limit exceeded"
 
 
+class OutOfBudget(BaseException):
+    """The command's budget of time or memory ran out (workbook.limits_time): the command
+    stops. A BaseException, as KeyboardInterrupt, so that no handler that turns a
+    WorkbookError into a value that fails keeps it; ``error`` is the LimitError that says
+    where and what to change (the command line prints it and exits 2)."""
+
+    def __init__(self, error: LimitError):
+        super().__init__(str(error))
+        self.error = error
+
+    def __str__(self) -> str:
+        return str(self.error)
+
+
 class NotSymbolic(WorkbookError):
     """The expression contains something SymPy cannot represent (a solver block)."""
 

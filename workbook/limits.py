@@ -4,6 +4,10 @@ A path given by a user may name a device (``/dev/zero``), a FIFO (a read or a wr
 forever), a sparse file of gigabytes, or an xlsx whose members inflate to gigabytes (a zip
 bomb). Each is refused here, before any parser sees it, with an error of kind
 ``limit exceeded`` or ``input error`` (exit status 2).
+
+The memory of a computation is bounded here too: the matrix work of one evaluation, and the
+elements of every array made while computing (:func:`check_elements`, before it is made). The
+time of a command is in :mod:`workbook.limits_time`.
 """
 
 from __future__ import annotations
@@ -11,13 +15,12 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
-import signal
 import stat
-import threading
 import zipfile
 from pathlib import Path
 
-from .errors import InputError, LimitError
+from .errors import InputError, LimitError, OutOfBudget
+from .limits_time import within_seconds  # noqa: F401 - the time limits live beside
 
 MAX_CSV_BYTES = 20_000_000  # a printed-values CSV
 MAX_INPUTS_XLSX_BYTES = 200_000_000  # an edited workbook given to --inputs (compressed)
@@ -40,6 +43,11 @@ MAX_MATRIX_WORK = 40_000_000_000
 #: What an element-wise operation on a large array costs per element, in multiply-adds of a
 #: product (adding two 2000 x 2000 arrays took 7.9 ms, their product 0.63 s: about 20).
 ELEMENT_WORK = 20
+#: Elements of one array built while a program runs or a built-in joins arrays (stack,
+#: augment, a vector grown by its elements: 80 MB of numbers), and characters of one text
+#: (concat), checked before the memory is taken.
+MAX_ARRAY_ELEMENTS = 10_000_000
+MAX_TEXT_CHARS = 10_000_000
 _STYLES_TYPE = "application/vnd.openxmlformats-officedocument.spreadsheetml.styles+xml"
 _STRINGS_TYPE = "application/vnd.openxmlformats-officedocument.spreadsheetml.sharedStrings+xml"
 
@@ -265,51 +273,6 @@ def exhausted(exc: BaseException) -> LimitError:
     return LimitError("too large for memory (an array or a computation could not be allocated)")
 
 
-#: Seconds between repeated alarms once the time is up: an alarm that lands in a weakref
-#: callback or a ``__del__`` is printed and ignored by Python, so one alarm is not enough.
-ALARM_REPEAT_SECONDS = 0.05
-
-
-@contextlib.contextmanager
-def within_seconds(seconds: float, what: str):
-    """Stop the block with a LimitError after ``seconds`` of wall-clock time (SIGALRM: pure
-    Python work such as SymPy's is interrupted between bytecodes; the alarm repeats until the
-    block has stopped). Only in the main thread of a process where no other timer is set;
-    elsewhere the block runs unbounded."""
-    if (
-        threading.current_thread() is not threading.main_thread()
-        or signal.getitimer(signal.ITIMER_REAL)[0] > 0
-    ):
-        yield
-        return
-
-    class _Expired(Exception):
-        pass
-
-    armed = [True]
-
-    def expire(signum, frame):
-        if armed[0]:
-            raise _Expired
-
-    previous = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, seconds, ALARM_REPEAT_SECONDS)
-    expired = False
-    try:
-        try:
-            yield
-        finally:
-            armed[0] = False  # an alarm raised before this line is caught just below
-    except _Expired:
-        expired = True
-    finally:
-        armed[0] = False
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
-    if expired:
-        raise LimitError(f"{what} took more than {seconds:g} s")
-
-
 _matrix_work: contextvars.ContextVar[list[float] | None] = contextvars.ContextVar(
     "workbook_matrix_work", default=None
 )
@@ -342,3 +305,31 @@ def charge_matrix_work(work: float, what: str) -> None:
         )
     if spent is not None:
         spent[0] = total
+
+
+def count_text(count: float) -> str:
+    """A count for a message: ``12,345,678``, or ``1e+300`` when it is beyond any array."""
+    return f"{count:,.0f}" if count < 1e15 else f"{count:.3g}"
+
+
+def check_elements(count: float, what: str) -> None:
+    """Refuse an array of ``count`` elements before it is made (:data:`MAX_ARRAY_ELEMENTS`):
+    the memory budget of the command is spent, and it stops (:class:`OutOfBudget`)."""
+    if count > MAX_ARRAY_ELEMENTS:
+        raise OutOfBudget(
+            LimitError(
+                f"{what} would make an array of {count_text(count)} elements (limit "
+                f"{MAX_ARRAY_ELEMENTS:,} elements); build a smaller one"
+            )
+        )
+
+
+def check_text_length(count: float, what: str) -> None:
+    """Refuse a text of ``count`` characters before it is made (:data:`MAX_TEXT_CHARS`)."""
+    if count > MAX_TEXT_CHARS:
+        raise OutOfBudget(
+            LimitError(
+                f"{what} would make a text of {count_text(count)} characters "
+                f"(limit {MAX_TEXT_CHARS:,} characters)"
+            )
+        )

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import DomainError, LimitError, TemplateError
 from ..language import expr as ex
+from ..limits_time import budgeted, within_budget
 from .odeauto import MAX_STEPS, MAX_TIME, Choice, auto_run, choose_method
 from .oderun import OdeRun, run_ode, work_precision
 
@@ -335,6 +336,7 @@ def solve(
     """Integrate y' = fun(t, y) from t0 to t1; a run that does not finish is a LimitError
     (budget, step cap) or a DomainError (blow-up, solver failure) that says where and why."""
     y0 = np.asarray(y0, dtype=float)
+    fun = budgeted(fun, f"ode '{name}'")  # the command's time budget, checked at each call
     if not np.all(np.isfinite(y0)):
         raise DomainError(f"ode '{name}': an initial value is not a finite number")
     if t1 == t0:
@@ -365,7 +367,7 @@ def solve(
 
     def rerun(r: float, a, seconds: float) -> OdeRun:
         return run_ode(
-            fun, (t0, t1), y0, method=method, rtol=r, atol=a, max_time=seconds,
+            fun, (t0, t1), y0, method=method, rtol=r, atol=a, max_time=within_budget(seconds),
             max_steps=max_steps, dense_output=True, blowup=BLOWUP,
         )  # fmt: skip
 

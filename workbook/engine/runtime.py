@@ -27,14 +27,14 @@ from ..functions.matrix import (
     power,
     size,  # noqa: F401 - rows/cols/length/last of a run-time value
 )
-from ..limits import ELEMENT_WORK, charge_matrix_work
+from ..limits import ELEMENT_WORK, MAX_ARRAY_ELEMENTS, charge_matrix_work, check_elements
 
 #: Arrays inside arrays at most this deep: a deeper one (``T := [T, 1]`` in a loop) would
 #: exhaust the C stack when it is freed or printed.
 MAX_NESTING = 100
 #: Elements of one run-time array (80 MB of numbers; its spare room for growing doubles that
-#: at most).
-MAX_RUNTIME_ELEMENTS = 10_000_000
+#: at most): the limit of every array a program builds, checked before it is made.
+MAX_RUNTIME_ELEMENTS = MAX_ARRAY_ELEMENTS
 
 
 def value(v):
@@ -128,9 +128,13 @@ def _position(i, origin: int, n: int | None, word: str, what: str) -> int:
     x = float(np.asarray(i, dtype=float)) if np.ndim(i) == 0 else None
     if x is None:
         raise InputError(f"{what}: the {word} index is an array; an index is a number")
-    k = round(x)
-    if not np.isfinite(x) or abs(x - k) > 1e-9:
+    if not np.isfinite(x) or abs(x - round(x)) > 1e-9:
         raise InputError(f"{what}: {word} index {x:g} is not an integer")
+    k = round(x)
+    if abs(k) > 2**53:  # beyond any array (and any exact integer)
+        if n is None:
+            check_elements(abs(float(k)), f"{what}: {word} index {x:g}")
+        raise InputError(f"{what}: {word} index {x:g} is out of range")
     k -= origin
     if k < 0 or (n is not None and k >= n):
         shown = f"{n} {word}s: {origin} .. {origin + n - 1}" if n else f"no {word}s"
@@ -195,11 +199,7 @@ def _grown(target: np.ndarray, rows: int, cols: int, nested: bool, what: str) ->
     """``target`` grown to ``rows`` x ``cols`` with zeros: a view into spare rows of the array
     it is a view of when they suffice, else a new array with twice the rows it needs."""
     r, c = target.shape
-    if rows * cols > MAX_RUNTIME_ELEMENTS:
-        raise LimitError(
-            f"{what}: an array of {rows:,} x {cols:,} elements "
-            f"(limit {MAX_RUNTIME_ELEMENTS:,} elements)"
-        )
+    check_elements(float(rows) * cols, f"{what}: growing it to {rows:,} x {cols:,}")
     dtype = object if nested else float
     base = target.base
     if (
@@ -227,12 +227,32 @@ def _grown(target: np.ndarray, rows: int, cols: int, nested: bool, what: str) ->
 
 def _element(x, what: str):
     """An array stored as an element of another: a copy (a later change to the local it came
-    from does not reach it), nested at most :data:`MAX_NESTING` deep."""
+    from does not reach it), nested at most :data:`MAX_NESTING` deep, and of at most the
+    element limit counted whole (an array given itself twice, ``v := [v, v]``, doubles)."""
     if not is_array(x):
         return x
-    if x.dtype == object and nesting(x) >= MAX_NESTING:
-        raise LimitError(f"{what}: arrays nested more than {MAX_NESTING} deep")
+    if x.dtype == object:
+        depth, count = _measure(x, {})
+        if depth >= MAX_NESTING:
+            raise LimitError(f"{what}: arrays nested more than {MAX_NESTING} deep")
+        check_elements(count, f"{what}: an array holding arrays (their elements counted whole)")
     return x.copy()
+
+
+def _measure(v, seen: dict) -> tuple[int, float]:
+    """(how deep, how many numbers counted whole) of a nested array; an array met again (the
+    same one held twice) is measured once."""
+    key = id(v)
+    if key not in seen:
+        depth, count = 0, 0.0
+        for e in v.ravel():
+            if is_array(e):
+                d, c = _measure(e, seen) if e.dtype == object else (1, float(e.size))
+                depth, count = max(depth, d), count + c
+            else:
+                count += 1
+        seen[key] = (depth + 1, count)
+    return seen[key]
 
 
 def nesting(v) -> int:
@@ -241,7 +261,7 @@ def nesting(v) -> int:
         return 0
     if v.dtype != object:
         return 1
-    return 1 + max((nesting(e) for e in v.ravel()), default=0)
+    return _measure(v, {})[0]
 
 
 def build(rows: list[list], what: str = "array"):
@@ -294,10 +314,9 @@ def binary(op: str, a, b, what: str):
             return float(np.sum(a * b))  # Mathcad's v*w of two vectors
         if sa[1] != sb[0]:
             raise InputError(f"{what}: cannot multiply {describe(a)} by {describe(b)}")
-        charge_matrix_work(
-            float(sa[0]) * sa[1] * sb[1],
-            f"{what}: a product of {describe(a)} by {describe(b)}",
-        )
+        product = f"{what}: a product of {describe(a)} by {describe(b)}"
+        charge_matrix_work(float(sa[0]) * sa[1] * sb[1], product)
+        check_elements(float(sa[0]) * sb[1], product)
         return a @ b
     if op == "/":
         if sb is not None:

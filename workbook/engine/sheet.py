@@ -10,7 +10,14 @@ import numpy as np
 import pint
 
 from ..compute.computed import Column, TableData, compute
-from ..errors import DomainError, InputError, LimitError, TemplateError, WorkbookError
+from ..errors import (
+    DomainError,
+    InputError,
+    LimitError,
+    OutOfBudget,
+    TemplateError,
+    WorkbookError,
+)
 from ..functions.matrix import numbers
 from ..functions.registry import CONSTANTS
 from ..language import expr as ex
@@ -31,6 +38,7 @@ from ..language.typed import TConst
 from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
+from ..limits_time import check_time
 from ..numerics import defining
 from . import runtime as rt
 from .numeric import Evaluator
@@ -253,6 +261,9 @@ class Sheet:
             return q.to("") if un.is_compound_ratio(f.unit) else q
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
+        except OutOfBudget as exc:  # the command stops; its message names the definition
+            exc.error.located(file=self.file, line=d.line, definition=name)
+            raise
         except (RecursionError, MemoryError) as exc:
             raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
 
@@ -336,11 +347,15 @@ class Sheet:
     def _scalar(self, name: str):
         """The value of scalar definition ``name``, checked (finite, within its limits)."""
         d = self.spec.definitions[name]
+        check_time(f"'{name}'")  # names the work, for the budget's alarm
         try:
             with defining(name, self.evaluator.records), matrix_work():
                 value = self.evaluator.compile(self.typer.scalar(name))({})
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
+        except OutOfBudget as exc:  # the command stops; its message names the definition
+            exc.error.located(file=self.file, line=d.line, definition=name)
+            raise
         except (RecursionError, MemoryError) as exc:
             raise exhausted(exc).located(file=self.file, line=d.line, definition=name) from None
         if isinstance(value, str):
@@ -540,9 +555,13 @@ class Sheet:
                 what,
             )
         failed: dict[int, str] = {}
+        check_time(f"{what}: column '{col.text}'")  # names the work, for the budget's alarm
         try:
             with defining(f"{what}: {col.text}", self.evaluator.records), matrix_work():
                 out = fn({var: values})
+        except OutOfBudget as exc:
+            exc.error.located(file=self.file, definition=what)
+            raise
         except DomainError as err:  # some rows leave the domain: the others keep their values
             if t.text or values.ndim != 1:
                 raise self._locate(err, what) from None

@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from ..errors import DomainError, InputError
-from ..limits import ELEMENT_WORK, charge_matrix_work
+from ..limits import ELEMENT_WORK, charge_matrix_work, check_elements
 from ..numerics import linalg
 
 #: A matrix whose condition number exceeds this is singular for inverse and lsolve.
@@ -96,6 +96,7 @@ def matmul(a, b):
     charge_matrix_work(
         float(n) * k * m * _points(a, b), f"a product of {n} x {k} by {k} x {m} matrices"
     )
+    check_elements(float(n) * m * _points(a, b), f"a product of {n} x {k} by {k} x {m} matrices")
     return _first(np.matmul(_last(a), _last(b)))
 
 
@@ -358,11 +359,13 @@ def norm(v):
 
 def augment(*ms):
     ms = _same_range(ms)
+    check_elements(sum(float(m.size) for m in ms), "augment()")
     return np.concatenate(ms, axis=1)
 
 
 def stack(*ms):
     ms = _same_range(ms)
+    check_elements(sum(float(m.size) for m in ms), "stack()")
     return np.concatenate(ms, axis=0)
 
 
@@ -405,7 +408,7 @@ def index(m, i, j=None, *, origin: int, shape: tuple[int, int], what: str):
 
 
 def _index_values(i, origin: int, n: int, word: str, what: str):
-    if isinstance(i, (int, float)):  # one index (in a program's loop): no array work
+    if isinstance(i, (int, float)) and math.isfinite(i):  # one index: no array work
         k = round(i)
         if abs(i - k) <= 1e-9 and 0 <= k - origin < n:
             return k - origin
@@ -414,6 +417,13 @@ def _index_values(i, origin: int, n: int, word: str, what: str):
     if not np.all(np.isfinite(arr)) or np.any(np.abs(arr - k) > 1e-9):
         bad = np.atleast_1d(arr)[~np.atleast_1d(np.isfinite(arr) & (np.abs(arr - k) <= 1e-9))]
         raise InputError(f"{what}: {word} index {bad[0]:g} is not an integer")
+    huge = np.abs(k) > 2.0**53  # beyond any array, and beyond an exact integer
+    if np.any(huge):
+        first = float(np.atleast_1d(k)[np.atleast_1d(huge)][0])
+        raise InputError(
+            f"{what}: {word} index {first:g} is out of range ({n} {word}s: "
+            f"{origin} .. {origin + n - 1} with origin {origin})"
+        )
     k = k.astype(int) - origin
     out = (k < 0) | (k >= n)
     if np.any(out):

@@ -8,6 +8,7 @@ import numpy as np
 from ..errors import NotLive, NotSymbolic, TemplateError
 from ..language import typed as ty
 from ..language.expr import PREC
+from ..limits import check_text_length
 from .entry import Builtin, UnitContext, register
 
 
@@ -32,6 +33,7 @@ def _concat_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
 
 def _concat(*texts):
     if all(isinstance(t, str) for t in texts):
+        check_text_length(sum(len(t) for t in texts), "concat()")
         return "".join(texts)
     return np.frompyfunc(lambda *parts: "".join(parts), len(texts), 1)(*texts)
 

@@ -65,6 +65,7 @@ SHEET_KEYS = (
     "tolerance",
     "origin",
     "complex",
+    "time_limit",
 )  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
 INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
 ARGUMENT_KEYS = ("unit", "note", "plain")
@@ -576,7 +577,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     for key in ("name", "title", "source", "description", "bench", "export"):
         fields.text(key)
     fields.flag("hand_checks")
-    fields.number("samples"), fields.number("tolerance")
+    fields.number("samples"), fields.number("tolerance"), fields.number("time_limit")
     for key, value in fields.table("about").items():
         if not isinstance(value, (str, int, float)) or isinstance(value, bool):
             raise TemplateError(

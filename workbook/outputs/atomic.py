@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import re
+import shutil
 import signal
 import tempfile
 import threading
@@ -43,6 +46,25 @@ def sigterm_as_interrupt():
         signal.signal(signal.SIGTERM, previous)
 
 
+#: Signals held while outputs are moved into place and temporary files removed: a signal
+#: then is handled just after, so that every output is old or new and nothing is left over.
+_HELD = (signal.SIGINT, signal.SIGTERM, signal.SIGALRM)
+
+
+@contextlib.contextmanager
+def signals_held():
+    """Hold Ctrl-C, SIGTERM and the time budget's alarm until the block is done (only in
+    the main thread, where Python runs signal handlers)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def check_target(path: Path, *, kind: str = "xlsx", force: bool = False) -> None:
     """Refuse a directory, a missing parent folder, a FIFO or device, an existing file of
     another kind; an existing CSV is overwritten only with ``force``."""
@@ -78,8 +100,30 @@ def _mode_for(path: Path) -> int:
 
 
 def os_error(path: Path, exc: OSError) -> InputError:
-    """An error of the file system (disk full, read-only, name too long) as an input error."""
-    return InputError(f"cannot write {path}: {exc.strerror or exc}")
+    """An error of the file system (disk full, read-only, name too long) as an input error
+    naming the output (not the temporary file beside it that was being written)."""
+    hint = {
+        errno.ENOSPC: "; the disk is full: free some space, or write elsewhere",
+        errno.EDQUOT: "; the disk quota is used up: free some space, or write elsewhere",
+        errno.EROFS: "; write elsewhere",
+        errno.EACCES: "; write elsewhere, or change the folder's permissions",
+        errno.EPERM: "; write elsewhere, or change the folder's permissions",
+    }.get(exc.errno, "")
+    return InputError(f"cannot write {target_of(Path(path))}: {exc.strerror or exc}{hint}")
+
+
+_PARTIAL = re.compile(r"^\.(.+)\.[^.]+\.partial$")
+
+
+def target_of(path: Path) -> Path:
+    """The output a temporary path stands for: ``DIR/.NAME.XXXX.partial/...`` is
+    ``DIR/NAME`` (the first such part of the path); any other path is itself."""
+    parts = path.parts
+    for k, part in enumerate(parts):
+        m = _PARTIAL.match(part)
+        if m:
+            return Path(*parts[:k], m.group(1)) if k else Path(m.group(1))
+    return path
 
 
 @contextlib.contextmanager
@@ -99,14 +143,20 @@ def replacing(path: Path):
     tmp_path = Path(tmp)
     try:
         yield tmp_path
-        os.chmod(tmp_path, _mode_for(path))
-        os.replace(tmp_path, path)
+        with signals_held():
+            os.chmod(tmp_path, _mode_for(path))
+            os.replace(tmp_path, path)
     except BaseException as exc:  # includes KeyboardInterrupt: the old file stays as it was
-        with contextlib.suppress(OSError):
+        with signals_held(), contextlib.suppress(OSError):
             tmp_path.unlink()
         if isinstance(exc, OSError):
             raise os_error(path, exc) from None
         raise
+
+
+#: The outputs moved into place by :class:`Outputs` in this process: a Ctrl-C held until
+#: they were complete is said to have come after them.
+MOVED: list[Path] = []
 
 
 class Outputs:
@@ -142,8 +192,13 @@ class Outputs:
         return self
 
     def __exit__(self, kind, exc, tb) -> None:
+        with signals_held():
+            self._finish(kind is None)
+
+    def _finish(self, complete: bool) -> None:
+        """Move every output into place (``complete``) and remove the temporary folders."""
         try:
-            if kind is None:
+            if complete:
                 for target, tmp in self.items:
                     if not tmp.exists():
                         raise RuntimeError(f"{target} was not written")
@@ -153,13 +208,10 @@ class Outputs:
                         os.replace(tmp, target)
                     except OSError as err:
                         raise os_error(target, err) from None
+                    MOVED.append(target)
         finally:
             for _, tmp in self.items:
-                with contextlib.suppress(OSError):
-                    for leftover in tmp.parent.iterdir():
-                        leftover.unlink()
-                with contextlib.suppress(OSError):
-                    tmp.parent.rmdir()
+                shutil.rmtree(tmp.parent, ignore_errors=True)
 
 
 def write_csv(frame, path: Path) -> None:

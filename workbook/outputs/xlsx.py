@@ -93,13 +93,22 @@ def write_workbook(computed, path: Path, *, force: bool = False) -> Path:
 
 
 def render(form, path: Path) -> None:
-    """Write ``form`` to ``path`` (not atomically: see :func:`write_workbook`)."""
+    """Write ``form`` to ``path`` (not atomically: see :func:`write_workbook`). xlsxwriter's
+    own temporary files go to a folder beside ``path`` that is removed whatever happens (in
+    the system's temporary folder, a Ctrl-C while saving left them there)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(
+        prefix=f".{Path(path).name[:100]}.", suffix=".partial", dir=Path(path).parent
+    ) as scratch:
+        _render(form, path, scratch)
+
+
+def _render(form, path: Path, scratch: str) -> None:
     import xlsxwriter
 
-    wb = xlsxwriter.Workbook(
-        str(path),
-        {"nan_inf_to_errors": True, "strings_to_formulas": False, "strings_to_urls": False},
-    )
+    options = {"nan_inf_to_errors": True, "strings_to_formulas": False, "strings_to_urls": False}
+    wb = xlsxwriter.Workbook(str(path), {**options, "tmpdir": scratch})
     wb.set_properties(form.properties)
     formats = style.add_formats(wb)
     sheets = []
@@ -116,7 +125,11 @@ def render(form, path: Path) -> None:
         wb.close()
     except Exception as exc:  # xlsxwriter wraps the OSError (disk full, read-only)
         cause = exc.__context__ if isinstance(exc.__context__, OSError) else exc
-        if isinstance(cause, OSError) or type(exc).__name__ == "FileCreateError":
+        if isinstance(cause, OSError):
+            from .atomic import os_error
+
+            raise os_error(Path(path), cause) from None
+        if type(exc).__name__ == "FileCreateError":
             raise InputError(f"cannot write {path}: {getattr(cause, 'strerror', cause)}") from None
         raise
 

@@ -10,6 +10,7 @@ import numpy as np
 from ..engine import runtime as rt
 from ..errors import LimitError, TemplateError
 from ..language.typed import is_runtime
+from ..limits_time import check_time
 from .statements import (
     Assign,
     Break,
@@ -27,6 +28,9 @@ from .typer import TypedProgram
 
 #: Statements one call of a program may execute (a `while` that never ends stops here).
 MAX_STEPS = 1_000_000
+#: The command's time budget is checked every 1,024 statements (a statement is at least
+#: a microsecond; one that builds a large array is bounded by the element limit).
+TIME_CHECK_MASK = 1023
 
 
 # -- running ----------------------------------------------------------------------------------
@@ -60,6 +64,8 @@ def compile_program(
 
     def tick(s: Stmt):
         steps[0] += 1
+        if not steps[0] & TIME_CHECK_MASK:
+            check_time(f"the program of '{name}' (line {s.line})")
         if steps[0] > MAX_STEPS:
             raise LimitError(
                 f"the program of '{name}' ran {MAX_STEPS:,} statements without ending "
@@ -116,7 +122,7 @@ def compile_program(
                     old = env.get(n)
                     if old is None or np.shape(old)[:2] != tuple(grow):
                         target = np.zeros(grow)
-                        if old is not None:
+                        if old is not None and np.ndim(old):  # a number becomes a vector
                             old = np.asarray(old, dtype=float).reshape(np.shape(old)[0], -1)
                             target[: old.shape[0], : old.shape[1]] = old
                         env[n] = target

@@ -3,13 +3,15 @@ of its first value."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import TemplateError
+from ..errors import LimitError, TemplateError
 from ..language import expr as ex
 from ..language.typed import RUNTIME, is_runtime
+from ..limits import MAX_ARRAY_ELEMENTS, count_text
 from .statements import (
     Assign,
     Break,
@@ -199,6 +201,8 @@ class _TypeState:
         return Assign(s.line, s.name, self.t.convert(t, unit, f"{self.where(s)}: '{s.name}'"))
 
     def set_item(self, s: SetItem):
+        for node in s.indices:
+            constant_index(node, self.t.origin, f"{self.where(s)}: {s.name}[...]")
         shape = self.local_shapes.get(s.name)
         given = self.scope.get(s.name)
         if shape is None and isinstance(given, tuple) and s.name not in self.reserved:
@@ -209,6 +213,13 @@ class _TypeState:
         reach = None
         if g is not None and not g.why and min(g.extent) >= 0:
             reach = (g.extent[0] + 1, g.extent[1] + 1 if len(g.extent) == 2 else 1)
+            if float(reach[0]) * reach[1] > MAX_ARRAY_ELEMENTS:  # refused before it is made
+                at = ", ".join(f"{e + self.t.origin:g}" for e in g.extent)
+                raise LimitError(
+                    f"{self.where(s)}: '{s.name}' set at index {at} would be an array of "
+                    f"{count_text(float(reach[0]) * reach[1])} elements (limit "
+                    f"{MAX_ARRAY_ELEMENTS:,} elements)"
+                )
         if s.name in self.runtime or is_runtime(shape):
             return self.runtime_item(s)
         if shape is None and reach is None and s.name not in self.reserved:
@@ -362,7 +373,7 @@ def growth(program: Program, origin: int) -> dict[str, _Growth]:
                             f"line {st.line}: its index {ex.to_text(node)} is known only when "
                             "the program runs (a number, or the variable of a for over numbers)"
                         )
-                    elif any(v != int(v) or v < origin for v in values):
+                    elif any(not math.isfinite(v) or v != int(v) or v < origin for v in values):
                         g.why = g.why or f"line {st.line}: an index below the origin or not whole"
                     else:
                         g.extent[d] = max(g.extent[d], int(max(values)) - origin)
@@ -394,13 +405,59 @@ def growth(program: Program, origin: int) -> dict[str, _Growth]:
     return out
 
 
+_FOLD = {
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b if b else math.copysign(math.inf, a) if a else math.nan,
+    "^": lambda a, b: a**b,
+}
+
+
 def _number(node) -> float | None:
-    """A number written in the program (``3``, ``-1``), else None."""
+    """A number written in the program (``3``, ``-1``, ``0/0``, ``2^40``: numbers and ``+ - *
+    / ^``), else None; NaN or inf where the arithmetic has no finite value."""
     if isinstance(node, ex.Number):
         return float(node.value)
-    if isinstance(node, ex.Unary) and node.op == "-" and isinstance(node.operand, ex.Number):
-        return -float(node.operand.value)
+    if isinstance(node, ex.Unary) and node.op in "+-":
+        v = _number(node.operand)
+        return None if v is None else (-v if node.op == "-" else v)
+    if isinstance(node, ex.Binary) and node.op in _FOLD:
+        a, b = _number(node.left), _number(node.right)
+        if a is None or b is None:
+            return None
+        try:
+            v = _FOLD[node.op](a, b)
+        except OverflowError:
+            return math.inf
+        except (ZeroDivisionError, ValueError):
+            return math.nan
+        return v if isinstance(v, float) else math.nan  # a complex power
     return None
+
+
+def constant_index(node, origin: int, where: str) -> None:
+    """Refuse at load an index written as numbers that is no element's: not a finite
+    number, not whole, below the origin, or beyond any array."""
+    v = _number(node)
+    if v is None:
+        return
+    shown = ex.to_text(node)
+    if shown.replace(" ", "") not in (f"{v:g}", str(v)):
+        shown += f" = {v:g}"
+    if not math.isfinite(v):
+        raise TemplateError(f"{where}: the index {shown} is not a finite number")
+    if v != int(v):
+        raise TemplateError(f"{where}: the index {shown} is not a whole number")
+    if v < origin:
+        raise TemplateError(
+            f"{where}: element index {shown} is out of range (below the origin {origin})"
+        )
+    if v - origin >= MAX_ARRAY_ELEMENTS:
+        raise LimitError(
+            f"{where}: the index {shown} is beyond any array (at most "
+            f"{MAX_ARRAY_ELEMENTS:,} elements)"
+        )
 
 
 def _loop_values(first, second, last):

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import InputError, LimitError
 from ..language import units as un
+from ..limits_time import check_time
 from .grid import Vary, as_varies, grid
 from .outputs import Output, as_outputs, type_output
 from .runners import make_tasks, run_case, run_tasks
@@ -183,10 +184,11 @@ def sweep(
             tasks = tasks[2:]
             if done[-1][3] * len(tasks) < QUICK_SECONDS:
                 chosen = "serial"
-        for index, values, error, secs in itertools.chain(
-            done, run_tasks(tasks, chosen, scheduler, workers, connect_timeout)
+        for k, (index, values, error, secs) in enumerate(
+            itertools.chain(done, run_tasks(tasks, chosen, scheduler, workers, connect_timeout)), 1
         ):
             results[index], errors[index], seconds[index] = values, error, secs
+            check_time(f"the sweep ({k:,} of {n:,} cases done)")
             if progress:
                 progress(error is None)
     elapsed = time.perf_counter() - start
