@@ -84,8 +84,9 @@ def load(text: str, path: Path) -> Document:
 
 
 def compute_values(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem]:
-    """The values of the scalar definitions, until ``budget`` seconds are spent; the
-    problems of those that fail (domain errors, limits, a value outside its bounds)."""
+    """The values of the scalar definitions and the range tables, until ``budget`` seconds
+    are spent; the problems of those that fail (domain errors, limits, a value outside its
+    bounds, a range without points)."""
     sheet = doc.sheet
     if sheet is None:
         return []
@@ -104,6 +105,16 @@ def compute_values(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem
                 found.append(p)
         except (ArithmeticError, ValueError, RecursionError) as exc:  # kept as a diagnostic
             doc.values[name] = exc
+    for t in sheet.spec.tables:  # range tables: their ranges and columns
+        if t.computed or t.range is None or time.perf_counter() - start > budget:
+            continue
+        try:
+            with doc.lock:
+                sheet.table_data(t)
+        except WorkbookError as err:
+            p = problem(doc.lines, err)
+            if p not in found:
+                found.append(p)
     return found
 
 

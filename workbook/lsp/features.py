@@ -228,13 +228,16 @@ def _builtins() -> list[lsp.CompletionItem]:
 
 
 _UNITS: list[lsp.CompletionItem] = []
+#: Prefixed units offered beside the registry's own names (pint makes them on demand).
+_PREFIXES = ("k", "M", "G", "m", "u", "n", "c", "d")
+_PREFIXED = ("m", "g", "s", "N", "Pa", "W", "J", "Hz", "V", "A", "L", "rad", "bar", "Wh")
 
 
 def _units() -> list[lsp.CompletionItem]:
     if not _UNITS:
-        _UNITS.extend(
-            _item(u, lsp.CompletionItemKind.Unit, "unit") for u in sorted(set(un.registry()))
-        )
+        reg = un.registry()
+        names = set(reg) | {p + u for p in _PREFIXES for u in _PREFIXED if (p + u) in reg}
+        _UNITS.extend(_item(u, lsp.CompletionItemKind.Unit, "unit") for u in sorted(names))
     return _UNITS
 
 

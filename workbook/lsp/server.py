@@ -1,5 +1,6 @@
 """The language server (pygls): documents loaded as they are opened and changed, their
-diagnostics published (the load's at once, the values' when they are computed), and the
+diagnostics published twice (the load's at once, then with the values' when they are
+computed), and the
 answers of :mod:`.features`."""
 
 from __future__ import annotations
@@ -52,8 +53,8 @@ async def _changed(ls: WorkbookServer, uri: str, version: int | None) -> None:
         return
     loop = asyncio.get_running_loop()
     more = await loop.run_in_executor(None, document.compute_values, doc)
-    if more and ls.versions.get(uri) == (version or 0) and ls.documents.get(uri) is doc:
-        ls.publish(uri, doc.problems + more, version)
+    if ls.versions.get(uri) == (version or 0) and ls.documents.get(uri) is doc:
+        ls.publish(uri, doc.problems + more, version)  # again, even when nothing was added
 
 
 @server.feature(lsp.TEXT_DOCUMENT_DID_OPEN)
