@@ -295,7 +295,7 @@ class LiveSheet:
                 spec, typer = typer_from.full_spec, typer_from.typer
             else:
                 spec, typer = parse_spec(text, self.path, self.path.stem), None
-                if raw is not None:  # an input edited in the file: the file's value wins
+                if raw is not None and self.raw:  # an input edited in the file: its value wins
                     old, new = _entries(self.raw, "inputs"), _entries(raw, "inputs")
                     overrides = {n: v for n, v in overrides.items() if old.get(n) == new.get(n)}
             values = _input_values(spec, overrides, self.path)

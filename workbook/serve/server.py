@@ -312,6 +312,7 @@ def make_server(site: Site, port: int = 0) -> ThreadingHTTPServer:
     handler = type("SiteHandler", (Handler,), {"site": site})
     server = ThreadingHTTPServer((HOST, port), handler)
     server.daemon_threads = True
+    server.block_on_close = False  # a page listening to events does not hold up a stop
     return server
 
 
