@@ -275,10 +275,15 @@ class LiveSheet:
         return self.rebuild(text, dict(self.overrides))
 
     def set_inputs(self, changes: dict[str, str]) -> Update:
-        """Compute again with inputs changed by the form (the file is not touched)."""
+        """Compute again with inputs changed by the form (the file is not touched); a value
+        that is refused (unit, bounds, choices) changes nothing and is returned as the error."""
         overrides = {**self.overrides, **changes}
         if self.text is None or self.sheet is None:
             return self.rebuild(self.text or "", overrides)
+        try:  # a refused value is said at its field; the page stays as it is
+            _input_values(self.sheet.full_spec, changes, self.path)
+        except WorkbookError as err:
+            return Update(None, err)
         return self.rebuild(self.text, overrides, typer_from=self.sheet)
 
     def rebuild(self, text: str, overrides: dict[str, str], typer_from=None) -> Update:

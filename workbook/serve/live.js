@@ -10,6 +10,7 @@
   const banner = document.getElementById("wb-error");
   const form = document.getElementById("wb-inputs");
   const status = document.getElementById("wb-status");
+  let lastForm = null;
 
   function url(path) {
     return path + "?token=" + encodeURIComponent(token) + "&sheet=" + encodeURIComponent(sheet);
@@ -28,8 +29,9 @@
       banner.hidden = true;
       body.classList.remove("wb-failed");
     }
-    if (state.form !== null && !form.contains(document.activeElement)) {
+    if (state.form !== null && state.form !== lastForm && !form.contains(document.activeElement)) {
       form.innerHTML = state.form;
+      lastForm = state.form;
     }
     body.dataset.version = String(state.version);
   }
@@ -58,8 +60,12 @@
     if (!label) {
       return;
     }
+    const text = inputText(label);
+    if (!text || /^\s/.test(text)) {
+      return; // a field being emptied: nothing to send yet
+    }
     const change = {};
-    change[label.dataset.input] = inputText(label);
+    change[label.dataset.input] = text;
     const note = label.querySelector(".wb-input-error");
     post("/input", change).then(function (res) {
       note.textContent = res.error || "";
