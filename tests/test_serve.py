@@ -302,7 +302,9 @@ def test_incremental_equals_full_on_every_template(name, tmp_path):
     value = live.sheet.values[i.name]
     new_value = f"{float(value.magnitude) * 1.01!r} {value.units:~}".strip()
     live.rebuild(edited, {})
+    live.draw_charts()
     live.set_inputs({i.name: new_value})
+    live.draw_charts()
     full = LiveSheet(path, incremental=False)
     full.rebuild(edited, {i.name: new_value})
     assert (live.error, full.error) == (None, None)

@@ -97,11 +97,17 @@ class Update:
 
 
 class LiveDocument(Document):
-    """The report's Document, its charts drawn again only when their data changed."""
+    """The report's Document, its charts drawn again only when their data changed. With
+    ``drawn`` (chart name -> the SVG shown last) a changed chart is not drawn: the last
+    drawing is shown, marked as being redrawn, and ``pending`` says so (the numbers reach the
+    page first, the drawing follows)."""
 
-    def __init__(self, sheet, charts: dict, **options):
+    def __init__(self, sheet, charts: dict, drawn: dict | None = None, **options):
         super().__init__(sheet, **options)
         self.cache = charts
+        self.drawn = drawn
+        self.pending = False
+        self.shown: dict[str, str] = {}
 
     def charts(self) -> str:
         if not self.spec.charts:
@@ -110,15 +116,19 @@ class LiveDocument(Document):
         for c in self.spec.charts:
             key = _chart_key(self.sheet, c)
             svg = self.cache.get(key) if key else None
-            if svg is None:
+            stale = ""
+            if svg is None and self.drawn is not None and c.name in self.drawn:
+                svg, stale, self.pending = self.drawn[c.name], " class='wb-stale'", True
+            elif svg is None:
                 try:
                     svg = chart_svg(self.sheet, c)
                     if key:
                         self.cache[key] = svg
                 except WorkbookError as err:
                     svg = f"<p class='error'>not drawn: {escape(err.message)}</p>"
+            self.shown[c.name] = svg
             out.append(
-                f"<figure id='chart-{escape(c.name)}'>{svg}"
+                f"<figure id='chart-{escape(c.name)}'{stale}>{svg}"
                 f"<figcaption>{escape(c.title)}</figcaption></figure>"
             )
         return "".join(out)
@@ -139,11 +149,13 @@ def _chart_key(computed, chart) -> str | None:
     return h.hexdigest()
 
 
-def render_body(computed, charts: dict) -> str:
-    """The report of a computed sheet as the live page shows it: the document's body."""
-    doc = LiveDocument(computed, charts)
+def render_body(computed, charts: dict, drawn: dict | None = None) -> LiveDocument:
+    """The report of a computed sheet as the live page shows it: the document (its ``text``
+    the body; see :class:`LiveDocument` for ``drawn``)."""
+    doc = LiveDocument(computed, charts, drawn)
     with np.errstate(all="ignore"):
-        return doc.body()
+        doc.text = doc.body()
+    return doc
 
 
 def _entries(raw: dict, section: str) -> dict:
@@ -255,7 +267,9 @@ class LiveSheet:
         self.html: str = ""
         self.error: WorkbookError | None = None
         self.overrides: dict[str, str] = {}  # input name -> the text the form gave
-        self.charts: dict[str, str] = {}
+        self.charts: dict[str, str] = {}  # chart digest -> its SVG
+        self.drawn: dict[str, str] = {}  # chart name -> the SVG on the page
+        self.pending = False  # a chart on the page is the last drawing, to be drawn again
         self.version = 0
         self.lock = threading.Lock()  # one computation at a time
 
@@ -319,7 +333,9 @@ class LiveSheet:
             computed = compute(sheet)
             seconds["compute"] = time.perf_counter() - t2
             t3 = time.perf_counter()
-            html = render_body(computed, self.charts)
+            drawn = self.drawn if self.incremental and self.drawn else None
+            doc = render_body(computed, self.charts if self.incremental else {}, drawn)
+            html = doc.text
             seconds["render"] = time.perf_counter() - t3
         except WorkbookError as err:
             return self._failed(err, seconds)
@@ -330,11 +346,22 @@ class LiveSheet:
         if len(self.charts) > 64:
             self.charts.clear()
         self.raw, self.sheet, self.computed, self.html = raw or {}, sheet, computed, html
+        self.drawn, self.pending = doc.shown, doc.pending
         self.overrides = overrides
         self.error = None
         self.version += 1
         recomputed = None if changed is None else _downstream(spec, changed)
         return Update(html, None, seconds, recomputed)
+
+    def draw_charts(self) -> Update | None:
+        """Draw the charts the last rendering left as they were (None: none is pending)."""
+        if not self.pending or self.computed is None:
+            return None
+        t0 = time.perf_counter()
+        doc = render_body(self.computed, self.charts)
+        self.html, self.drawn, self.pending = doc.text, doc.shown, False
+        self.version += 1
+        return Update(self.html, None, {"render": time.perf_counter() - t0}, set())
 
     def _failed(self, err: WorkbookError, seconds=None) -> Update:
         self.error = err.located(file=str(self.path))

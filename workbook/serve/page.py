@@ -32,6 +32,7 @@ body { font-family: sans-serif; margin: 0; }
 body.wb-failed #wb-report { opacity: 0.55; }
 #wb-status { margin-left: 1em; font-size: 90%; }
 #wb-report { padding: 0 12px; }
+figure.wb-stale svg { opacity: 0.4; }
 """
 
 

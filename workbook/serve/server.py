@@ -40,12 +40,14 @@ class Site:
         out: Path | None = None,
         writable: bool = True,
         token: str | None = None,
+        incremental: bool = True,
     ):
         self.folder = Path(folder).resolve()
         self.single = single.resolve() if single else None
         self.out = out  # where workbooks go (None: beside the worksheet)
         self.writable = writable  # may the inputs be written back into the file?
         self.token = token or secrets.token_urlsafe(24)
+        self.incremental = incremental  # False: every edit computed in full (the baseline)
         self.sheets: dict[str, LiveSheet] = {}
         self.listeners: dict[str, list[queue.Queue]] = {}
         self.lock = threading.Lock()
@@ -73,7 +75,7 @@ class Site:
         with self.lock:
             live = self.sheets.get(name)
             if live is None:
-                live = LiveSheet(self.folder / name)
+                live = LiveSheet(self.folder / name, incremental=self.incremental)
                 with live.lock:
                     live.refresh()
                 self.sheets[name] = live
@@ -89,12 +91,23 @@ class Site:
             update = live.refresh()
         if update is not None:
             self.push(live)
+            self.draw(live)
+
+    def draw(self, live: LiveSheet) -> None:
+        """Draw the charts an update left as they were, and push the page again."""
+        with live.lock:
+            update = live.draw_charts()
+        if update is not None:
+            self.push(live)
 
     def set_inputs(self, live: LiveSheet, changes: dict[str, str]) -> str | None:
         """Compute again with inputs from the form; the error (a refused value), if any."""
         with live.lock:
             update = live.set_inputs(changes)
-        self.push(live)
+        if update.html is not None or (update.error is not None and live.error is update.error):
+            self.push(live)  # a value refused at its field leaves the page as it is
+        if update.html is not None:
+            threading.Thread(target=self.draw, args=(live,), daemon=True).start()
         return page.error_text(update.error)
 
     def state(self, live: LiveSheet, form: bool = True) -> dict:
@@ -103,6 +116,7 @@ class Site:
             "html": live.html if live.error is None else None,
             "error": page.error_text(live.error),
             "form": page.inputs_form(live.sheet) if form else None,
+            "charts_pending": live.pending,
         }
 
     def push(self, live: LiveSheet) -> None:
