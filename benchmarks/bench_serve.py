@@ -18,7 +18,12 @@ and p95 of
 the repetitions are printed, with the target of 300 ms for a sheet without solver built-ins
 (numerical built-ins, blocks, [[solve]], [[ode]]).
 
-    python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick]
+The language server's diagnostics time is measured too: `workbook lsp` is started as a
+process and spoken to over its stdin and stdout; for every template, a change of the
+document (the same edited formula) is sent and the time until its diagnostics are received
+is taken (the load's publication; the values' follows).
+
+    python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick] [--no-lsp]
 """
 
 from __future__ import annotations
@@ -42,6 +47,7 @@ import workbook  # noqa: E402
 from workbook.serve.server import Site, make_server  # noqa: E402
 
 TARGET_MS = 300.0
+LSP_TARGET_MS = 150.0
 
 
 class Page:
@@ -178,6 +184,115 @@ def measure(name: str, repeats: int) -> dict:
     return {"name": name, "formula": d.name, "input": inp.name, "solvers": solvers, "times": times}
 
 
+class LspClient:
+    """The language server as a process, and the messages it sends (Content-Length framed)."""
+
+    def __init__(self):
+        import subprocess
+
+        env = dict(os.environ, PYTHONPATH=str(ROOT))
+        code = "import sys; from workbook.cli import main; sys.exit(main())"
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", code, "lsp"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            env=env,
+        )
+        self.messages: list[tuple[float, dict]] = []
+        self.cond = threading.Condition()
+        threading.Thread(target=self._read, daemon=True).start()
+        self.send(
+            {
+                "jsonrpc": "2.0",
+                "id": 1,
+                "method": "initialize",
+                "params": {"processId": os.getpid(), "rootUri": None, "capabilities": {}},
+            }
+        )
+        self.wait(lambda m: m.get("id") == 1)
+        self.send({"jsonrpc": "2.0", "method": "initialized", "params": {}})
+
+    def _read(self) -> None:
+        out = self.proc.stdout
+        while True:
+            size = None
+            while True:
+                line = out.readline()
+                if not line:
+                    return
+                if not line.strip():
+                    break
+                if line.lower().startswith(b"content-length:"):
+                    size = int(line.split(b":")[1])
+            body = json.loads(out.read(size))
+            with self.cond:
+                self.messages.append((time.perf_counter(), body))
+                self.cond.notify_all()
+
+    def send(self, message: dict) -> None:
+        data = json.dumps(message).encode()
+        self.proc.stdin.write(b"Content-Length: %d\r\n\r\n" % len(data) + data)
+        self.proc.stdin.flush()
+
+    def wait(self, test, start: int = 0) -> tuple[float, dict]:
+        with self.cond:
+            while True:
+                for when, m in self.messages[start:]:
+                    if test(m):
+                        return when, m
+                self.cond.wait(60)
+
+    def diagnostics_time(self, uri: str, text: str, version: int) -> float:
+        start = len(self.messages)
+        method = "textDocument/didOpen" if version == 1 else "textDocument/didChange"
+        doc = {"uri": uri, "version": version}
+        if version == 1:
+            params = {"textDocument": {**doc, "languageId": "toml", "text": text}}
+        else:
+            params = {"textDocument": doc, "contentChanges": [{"text": text}]}
+        t0 = time.perf_counter()
+        self.send({"jsonrpc": "2.0", "method": method, "params": params})
+        when, _ = self.wait(
+            lambda m: (
+                m.get("method") == "textDocument/publishDiagnostics"
+                and m["params"]["uri"] == uri
+                and m["params"].get("version") == version
+            ),
+            start,
+        )
+        return when - t0
+
+    def close(self) -> None:
+        self.send({"jsonrpc": "2.0", "id": 2, "method": "shutdown", "params": None})
+        self.wait(lambda m: m.get("id") == 2)
+        self.send({"jsonrpc": "2.0", "method": "exit", "params": None})
+        self.proc.wait(timeout=30)
+
+
+def measure_lsp(names: list[str], repeats: int) -> list[tuple[str, list[float]]]:
+    """Seconds from a document change to its (first) diagnostics, per template."""
+    client = LspClient()
+    out = []
+    try:
+        for name in names:
+            path = workbook.list_templates()[name]
+            text = path.read_text(encoding="utf-8")
+            d = _edits(path)[0]
+            uri = path.resolve().as_uri()
+            client.diagnostics_time(uri, text, 1)  # warm-up: the first load of the process
+            times = []
+            for r in range(repeats):
+                version = r + 2
+                edited = _edited(text, d, r)
+                times.append(client.diagnostics_time(uri, edited, version))
+                time.sleep(0.05)
+            out.append((name, times))
+    finally:
+        client.close()
+    return out
+
+
 def _p(values: list[float], q: float) -> float:
     if len(values) == 1:
         return values[0]
@@ -195,6 +310,7 @@ def main(argv=None) -> int:
     )
     ap.add_argument("--only", action="append", default=[])
     ap.add_argument("--quick", action="store_true", help="2 repetitions of concave-cam")
+    ap.add_argument("--no-lsp", action="store_true", help="leave out the language server")
     args = ap.parse_args(argv)
     names = args.only or list(workbook.list_templates())
     if args.quick:
@@ -222,6 +338,18 @@ def main(argv=None) -> int:
                 f"| {name} | {edit} `{m[edit]}` | {_p(inc, 50):.0f} | {p95:.0f} | "
                 f"{_p(drawn, 95):.0f} | {_p(full, 50):.0f} | {_p(full, 95):.0f} | {target} "
                 f"| {len(inc)} repetitions",
+                flush=True,
+            )
+    if not args.no_lsp:
+        print("\n| template | `workbook lsp`: change to diagnostics p50 | p95 | target |")
+        print("| --- | --- | --- | --- |")
+        for name, times in measure_lsp(names, max(args.repeats, 2)):
+            ms = [1000 * t for t in times]
+            ok = _p(ms, 95) <= LSP_TARGET_MS
+            missed += not ok
+            print(
+                f"| {name} | {_p(ms, 50):.0f} | {_p(ms, 95):.0f} | <= {LSP_TARGET_MS:g}"
+                f"{'' if ok else ' MISSED'} | {len(ms)} repetitions",
                 flush=True,
             )
     return 1 if missed and not args.quick else 0

@@ -320,3 +320,23 @@ def test_incremental_equals_full_on_every_template(name, tmp_path):
 def _untimed(html: str) -> str:
     """The report without the rows that say how long a solver ran (measured each time)."""
     return re.sub(r"<tr[^>]*>(?:(?!</tr>).)*\d steps,(?:(?!</tr>).)*</tr>", "", html, flags=re.S)
+
+
+def test_a_newcomers_sheet_and_an_installed_template(tmp_path, monkeypatch):
+    from workbook.errors import InputError
+    from workbook.scaffold import write_starter
+    from workbook.serve import site_for
+
+    path = write_starter("mine", tmp_path / "mine.toml")
+    live = LiveSheet(path)
+    update = live.refresh()
+    assert update.error is None and "class='result'" in update.html
+    monkeypatch.chdir(tmp_path)
+    site = site_for("concave-cam")
+    assert site.files() == ["concave-cam.toml"] and not site.writable
+    assert site.out == tmp_path / "reports"
+    live = site.live("concave-cam.toml")
+    site.set_inputs(live, {"R3": "45 mm"})
+    with pytest.raises(InputError, match="installed template"):
+        site.save_inputs(live)
+    site.stop()

@@ -56,6 +56,7 @@ class Document:
     values: dict[str, object] = field(default_factory=dict)  # name -> quantity or error
     seconds: float = 0.0
     lock: threading.Lock = field(default_factory=threading.Lock)  # one evaluation at a time
+    stale: bool = False  # a newer text has come: its values are no longer wanted
 
     @property
     def lines(self) -> list[str]:
@@ -93,7 +94,9 @@ def compute_values(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem
     found = []
     start = time.perf_counter()
     for name, d in sheet.spec.definitions.items():
-        if d.is_function or time.perf_counter() - start > budget:
+        if doc.stale or time.perf_counter() - start > budget:
+            break
+        if d.is_function:
             continue
         try:
             with doc.lock:
@@ -106,7 +109,9 @@ def compute_values(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem
         except (ArithmeticError, ValueError, RecursionError) as exc:  # kept as a diagnostic
             doc.values[name] = exc
     for t in sheet.spec.tables:  # range tables: their ranges and columns
-        if t.computed or t.range is None or time.perf_counter() - start > budget:
+        if doc.stale or time.perf_counter() - start > budget:
+            break
+        if t.computed or t.range is None:
             continue
         try:
             with doc.lock:

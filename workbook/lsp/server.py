@@ -25,6 +25,9 @@ class WorkbookServer(LanguageServer):
         self.versions: dict[str, int] = {}
 
     def analyse(self, uri: str) -> document.Document:
+        old = self.documents.get(uri)
+        if old is not None:
+            old.stale = True  # its values, if still being computed, stop
         text = self.workspace.get_text_document(uri).source
         path = Path(to_fs_path(uri) or "sheet.toml")
         doc = document.load(text, path)
