@@ -322,15 +322,20 @@ def _untimed(html: str) -> str:
     return re.sub(r"<tr[^>]*>(?:(?!</tr>).)*\d steps,(?:(?!</tr>).)*</tr>", "", html, flags=re.S)
 
 
-def test_a_newcomers_sheet_and_an_installed_template(tmp_path, monkeypatch):
-    from workbook.errors import InputError
+def test_a_newcomers_sheet(tmp_path):
     from workbook.scaffold import write_starter
-    from workbook.serve import site_for
 
     path = write_starter("mine", tmp_path / "mine.toml")
     live = LiveSheet(path)
     update = live.refresh()
     assert update.error is None and "class='result'" in update.html
+
+
+@pytest.mark.slow
+def test_an_installed_template_is_served_read_only(tmp_path, monkeypatch):
+    from workbook.errors import InputError
+    from workbook.serve import site_for
+
     monkeypatch.chdir(tmp_path)
     site = site_for("concave-cam")
     assert site.files() == ["concave-cam.toml"] and not site.writable
