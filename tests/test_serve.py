@@ -345,3 +345,20 @@ def test_an_installed_template_is_served_read_only(tmp_path, monkeypatch):
     with pytest.raises(InputError, match="installed template"):
         site.save_inputs(live)
     site.stop()
+
+
+@pytest.mark.slow
+def test_the_benchmark_runs():
+    """benchmarks/bench_serve.py at one repetition (its timings are not asserted)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import bench_serve
+
+    m = bench_serve.measure("concave-cam", 1)
+    assert set(m["times"]) == {
+        (a, b) for a in ("incremental", "full") for b in ("formula", "input")
+    }
+    assert all(0 < t[0] <= t[1] for ts in m["times"].values() for t in ts)
+    ((name, times),) = bench_serve.measure_lsp(["concave-cam"], 1)
+    assert name == "concave-cam" and len(times) == 1 and times[0] > 0

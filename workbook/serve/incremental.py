@@ -204,7 +204,7 @@ def _downstream(spec, changed: set[str]) -> set[str]:
     return out
 
 
-def _reads(spec, raw_entry, dirty: set[str]) -> bool:
+def _reads(raw_entry, dirty: set[str]) -> bool:
     """Does a TOML entry (a table, a chart) name, directly or through the definitions it
     uses, anything in ``dirty``? Every word of its text counts as a name (over-approximate)."""
     words = set(_NAME.findall(repr(raw_entry)))
@@ -234,7 +234,7 @@ def reusable(old: ReusingSheet, new_spec, new_raw, old_raw, changed: set[str]) -
                 continue
             if kind == "computed table" and (changed or new_spec.tables[index].vary):
                 continue  # a block reads the sheet as it likes: reused only when nothing changed
-            if _reads(new_spec, new_tables.get(index), dirty):
+            if _reads(new_tables.get(index), dirty):
                 continue
         out[key] = value
     return out
