@@ -209,6 +209,7 @@ def test_file_edit_error_and_form_through_events(served, tmp_path):
         line = broken.splitlines().index(next(s for s in broken.splitlines() if "A*L + R" in s))
         assert third["html"] is None
         assert f"live.toml:{line + 1}, in 'V': unit error" in third["error"]
+        assert third["stopped"] == ["V"]  # marked on the last good page
         assert served.site.live("live.toml").html == second["html"]  # the last good one stays
         path.write_text(SHEET, encoding="utf-8")
         fourth = events.next(third["version"])

@@ -143,6 +143,8 @@ def test_live_page_follows_the_file_and_the_form(browser, tmp_path):
         banner = browser.find_element(By.ID, "wb-error")
         _wait(browser, lambda: banner.is_displayed() and banner.text)
         assert "cyl.toml:7, in 'V': unit error" in banner.text
+        stopped = browser.find_elements(By.CSS_SELECTOR, "#wb-report .wb-stopped")
+        assert [e.get_attribute("id") for e in stopped] == ["def-V"]
         assert _number(_shown(browser, "V")) == pytest.approx(v, rel=1e-9)
         path.write_text(SHEET, encoding="utf-8")
         _wait(browser, lambda: not banner.is_displayed())

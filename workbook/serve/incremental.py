@@ -192,7 +192,15 @@ def changed_names(old_raw: dict, new_raw: dict, old_values: dict, new_values: di
     return out
 
 
-def _downstream(spec, changed: set[str]) -> set[str]:
+def stopped_by(spec, err) -> list[str]:
+    """The definitions of ``spec`` an error stops: its own and every one that reads it."""
+    name = getattr(err, "definition", None)
+    if spec is None or name not in spec.definitions:
+        return []
+    return sorted(n for n in downstream(spec, {name}) if n in spec.definitions)
+
+
+def downstream(spec, changed: set[str]) -> set[str]:
     """Every input and definition that reads (transitively) one of ``changed``."""
     out = set(changed)
     for name in [*spec.inputs, *spec.definitions]:
@@ -213,7 +221,7 @@ def _reads(raw_entry, dirty: set[str]) -> bool:
 
 def reusable(old: ReusingSheet, new_spec, new_raw, old_raw, changed: set[str]) -> dict:
     """The values of ``old`` that the Sheet of ``new_spec`` may take as they are."""
-    dirty = _downstream(new_spec, changed)
+    dirty = downstream(new_spec, changed)
     out = {}
     old_tables = _entries(old_raw, "tables")
     new_tables = _entries(new_raw, "tables")
@@ -350,7 +358,7 @@ class LiveSheet:
         self.overrides = overrides
         self.error = None
         self.version += 1
-        recomputed = None if changed is None else _downstream(spec, changed)
+        recomputed = None if changed is None else downstream(spec, changed)
         return Update(html, None, seconds, recomputed)
 
     def draw_charts(self) -> Update | None:

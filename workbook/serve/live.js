@@ -20,6 +20,15 @@
     if (state.html !== null) {
       report.innerHTML = state.html;
     }
+    report.querySelectorAll(".wb-stopped").forEach(function (e) {
+      e.classList.remove("wb-stopped");
+    });
+    (state.stopped || []).forEach(function (name) {
+      const e = document.getElementById("def-" + name);
+      if (e) {
+        e.classList.add("wb-stopped");
+      }
+    });
     if (state.error) {
       banner.textContent = state.error;
       banner.hidden = false;

@@ -33,6 +33,7 @@ body.wb-failed #wb-report { opacity: 0.55; }
 #wb-status { margin-left: 1em; font-size: 90%; }
 #wb-report { padding: 0 12px; }
 figure.wb-stale svg { opacity: 0.4; }
+body.wb-failed .wb-stopped { outline: 2px solid #c00; background: #fff0f0; opacity: 1; }
 """
 
 

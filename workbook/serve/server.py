@@ -19,7 +19,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..errors import InputError, WorkbookError
 from . import page
-from .incremental import LiveSheet
+from .incremental import LiveSheet, stopped_by
 from .watch import Watcher
 
 HOST = "127.0.0.1"
@@ -117,6 +117,8 @@ class Site:
             "error": page.error_text(live.error),
             "form": page.inputs_form(live.sheet) if form else None,
             "charts_pending": live.pending,
+            # the definitions of the last good page the error stops (marked there)
+            "stopped": stopped_by(live.sheet.spec if live.sheet else None, live.error),
         }
 
     def push(self, live: LiveSheet) -> None:

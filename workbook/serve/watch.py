@@ -1,5 +1,7 @@
 """Watching files for edits by polling their modification time and size (no extra
-dependency, and it sees an editor's write-and-rename as well as a write in place)."""
+dependency, and it sees an editor's write-and-rename as well as a write in place). A change
+is reported when the file has stayed as it is for one more poll, so that a file read while
+an editor is still writing it (truncated, half written) is not taken for the edit."""
 
 from __future__ import annotations
 
@@ -9,7 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 #: Seconds between two looks at the files.
-POLL_SECONDS = 0.05
+POLL_SECONDS = 0.04
 
 
 def stamp(path: Path) -> tuple[int, int, int] | None:
@@ -23,7 +25,7 @@ def stamp(path: Path) -> tuple[int, int, int] | None:
 
 class Watcher:
     """Calls ``on_change(path)`` from its own thread when a watched file's :func:`stamp`
-    changes; :meth:`stop` ends the thread."""
+    changed and then held for one poll; :meth:`stop` ends the thread."""
 
     def __init__(self, on_change: Callable[[Path], None], interval: float = POLL_SECONDS):
         self.on_change = on_change
@@ -48,12 +50,18 @@ class Watcher:
             self.thread.join(timeout=5)
 
     def _run(self) -> None:
+        seen: dict[Path, tuple | None] = {}  # a change seen once, reported when it holds
         while not self.stopping.wait(self.interval):
             with self.lock:
                 paths = list(self.stamps.items())
             for path, old in paths:
                 new = stamp(path)
-                if new != old:
+                if new == old:
+                    seen.pop(path, None)
+                elif seen.get(path, "unseen") != new:
+                    seen[path] = new  # an editor may be halfway through writing it
+                else:
+                    del seen[path]
                     with self.lock:
                         self.stamps[path] = new
                     if new is not None:
