@@ -43,6 +43,8 @@ except ImportError:  # Python 3.10
 #: computed in full.
 FOLLOWED = {"inputs", "definitions", "tables", "charts", "printed", "checks", "relations"}
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+#: The charts' section of the report's body (sections are not nested; an SVG holds none).
+_CHARTS = re.compile(r"(<section class='charts'><h2>[^<]*</h2>).*?(</section>)", re.S)
 
 
 class ReusingSheet(Sheet):
@@ -366,8 +368,12 @@ class LiveSheet:
         if not self.pending or self.computed is None:
             return None
         t0 = time.perf_counter()
-        doc = render_body(self.computed, self.charts)
-        self.html, self.drawn, self.pending = doc.text, doc.shown, False
+        doc = LiveDocument(self.computed, self.charts)
+        with np.errstate(all="ignore"):
+            inner = doc.charts()
+        # only the charts' section is made again: the rest of the page is as it was
+        self.html = _CHARTS.sub(lambda m: m.group(1) + inner + m.group(2), self.html, count=1)
+        self.drawn, self.pending = doc.shown, False
         self.version += 1
         return Update(self.html, None, {"render": time.perf_counter() - t0}, set())
 
