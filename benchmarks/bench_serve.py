@@ -81,7 +81,7 @@ class Page:
                     with self.cond:
                         self.events.append(((time.perf_counter(), time.process_time()), data))
                         self.cond.notify_all()
-        except (OSError, ValueError):
+        except (OSError, ValueError, AttributeError):  # closed (http.client: fp is None)
             pass
 
     def wait(self, after: int, drawn: bool = False, timeout: float = 600.0):
@@ -174,8 +174,11 @@ def measure(name: str, repeats: int) -> dict:
                 order = ("incremental", "full") if r % 2 else ("full", "incremental")
                 for mode in order:
                     page = pages[mode]
-                    f = page.edit_file(paths[mode], _edited(text, d, r))
-                    value = f"{float(q.magnitude) * (1.01 + r / 1000)!r} {unit}".strip()
+                    # the two modes' texts and values differ: the results a solver block
+                    # keeps (by text and inputs, for the process) serve neither the other
+                    r2 = 2 * r + (mode == "full")
+                    f = page.edit_file(paths[mode], _edited(text, d, r2))
+                    value = f"{float(q.magnitude) * (1.01 + r2 / 1000)!r} {unit}".strip()
                     i = page.edit_input(inp.name, value)
                     if r:
                         times.setdefault((mode, "formula"), []).append(f)

@@ -47,6 +47,9 @@ _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _CHARTS = re.compile(r"(<section class='charts'><h2>[^<]*</h2>).*?(</section>)", re.S)
 
 
+_MISSING = object()
+
+
 class ReusingSheet(Sheet):
     """A Sheet that takes the values of unchanged definitions, solutions and tables from the
     Sheet before an edit (``reuse``) and remembers what it computes (``seen``), for the next."""
@@ -54,6 +57,7 @@ class ReusingSheet(Sheet):
     def __init__(self, spec, values=None, typer=None, parts=None, *, reuse=None):
         self.reused: dict[Any, Any] = dict(reuse or {})
         self.seen: dict[Any, Any] = {}
+        self.known: dict[str, Any] = {}  # definition name -> its value, once known
         super().__init__(spec, values, typer, parts)
 
     def _take(self, key, make):
@@ -65,10 +69,17 @@ class ReusingSheet(Sheet):
         return value
 
     def scalar_value(self, name: str, kind: str):
-        """As :meth:`Sheet.scalar_value`; a definition's value reused when it did not change."""
+        """As :meth:`Sheet.scalar_value`; a definition's value reused when it did not change.
+        (Called for every reference a formula makes, by an ODE's right-hand side at every
+        step: kept to a lookup once the value is known.)"""
         if kind != "definition":
-            return super().scalar_value(name, kind)
-        return self._take(("value", name), lambda: Sheet.scalar_value(self, name, kind))
+            return Sheet.scalar_value(self, name, kind)
+        value = self.known.get(name, _MISSING)
+        if value is _MISSING:
+            key = ("value", name)
+            value = self.reused[key] if key in self.reused else Sheet.scalar_value(self, name, kind)
+            self.seen[key] = self.known[name] = value
+        return value
 
     def solution(self, block):
         """As :meth:`Sheet.solution`; reused when nothing its equations read changed."""
