@@ -1,4 +1,5 @@
-"""Command line: ``workbook list | run | check | import | bench | sweep | new | report``.
+"""Command line: ``workbook list | run | check | import | bench | sweep | new | report | serve |
+lsp``.
 
 Exit status: 0 success, 1 printed values not reproduced (check), 2 bad input
 (template, units, values, paths), 3 internal error (a bug), 130 interrupted. No traceback
@@ -135,6 +136,15 @@ def _parser() -> argparse.ArgumentParser:
         help="every row of long tables (default: first and last rows above 1,000)",
     )
     rep.add_argument("--force", action="store_true", help="overwrite a file of another kind")
+    srv = sub.add_parser(
+        "serve", help="a live page of the report, computed again as the file or an input changes"
+    )
+    srv.add_argument(
+        "name", nargs="?", help="template name, .toml file or folder (default: this folder)"
+    )
+    srv.add_argument("--port", type=int, default=0, help="port on 127.0.0.1 (default: any free)")
+    srv.add_argument("--no-browser", action="store_true", help="print the URL, open no browser")
+    sub.add_parser("lsp", help="a language server for editors (LSP over stdin and stdout)")
     new = sub.add_parser("new", help="write a commented starter worksheet that runs as it is")
     new.add_argument("name", help="name of the new worksheet (writes NAME.toml)")
     new.add_argument("--out", help="file to write (default ./NAME.toml)")
@@ -522,6 +532,18 @@ def _sweep_command_line(args) -> str:
     return " ".join(parts)
 
 
+def cmd_serve(args) -> int:
+    from .serve import serve
+
+    return serve(args.name, port=args.port, open_browser=not args.no_browser)
+
+
+def cmd_lsp(args) -> int:
+    from .lsp import main as lsp_main
+
+    return lsp_main()
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     if args.version:
@@ -543,6 +565,8 @@ def main(argv: list[str] | None = None) -> int:
             "sweep": cmd_sweep,
             "import": cmd_import,
             "report": cmd_report,
+            "serve": cmd_serve,
+            "lsp": cmd_lsp,
         }[args.command]
 
     if not args.debug:  # the engine reports non-finite results itself, with the arguments
