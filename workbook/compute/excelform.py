@@ -1059,12 +1059,13 @@ class ExcelLayout:
         if v is None:
             return "not checked"
         text = (
-            f"{v.checked} formula cells with arrays, numerical built-ins or helper cells, "
-            "computed by an evaluator independent of the engine (the formulas package; "
-            f"{ROWS_CHECKED} rows of each table column), agree with the engine to {RELATIVE:g} "
-            f"relative; {v.plain} of scalar "
-            "arithmetic only, or helper cells, are not computed"
+            f"{v.checked} formula computations, every formula cell ({ROWS_CHECKED} rows of "
+            "each table column), by an evaluator independent of the engine and of the "
+            "formula printer (its own reader of Excel formulas; the formulas package for the "
+            f"functions that reader lacks), agree with the engine to {RELATIVE:g} relative"
         )
+        if v.plain:
+            text += f"; {v.plain} of scalar arithmetic only, or helper cells, are not computed"
         if v.refusals:
             text += f"; {len(v.refusals)} that did not are values, with a comment"
         if v.unchecked:
