@@ -1,0 +1,150 @@
+"""The live-cell check covers every formula cell: scalar arithmetic too, table columns, text
+results, checks. Its fast reader of Excel formulas (workbook.compute.xleval) is compared
+with the `formulas` package formula by formula, and a ratio scaled twice (the printer's
+mistake put back on purpose) is caught and written as the engine's value."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+
+import numpy as np
+import openpyxl
+import pytest
+from test_cell_units import RATIOS
+
+from workbook.compute import cellunit, livecheck, xleval
+
+
+def _formulas_package(text: str):
+    import formulas
+
+    out = formulas.Parser().ast(text)[1].compile()()
+    a = np.asarray(out, dtype=object)
+    return a if a.ndim == 2 and a.size > 1 else a.ravel()[0]
+
+
+def _same(mine, theirs) -> bool:
+    if isinstance(mine, np.ndarray):
+        theirs = np.asarray(theirs, dtype=object)
+        return mine.shape == theirs.shape and all(
+            _same(float(a), b) for a, b in zip(mine.flat, theirs.flat)
+        )
+    if isinstance(mine, xleval.XlError):
+        return str(theirs).startswith("#")
+    if isinstance(mine, (bool, str)):
+        return str(mine).upper() == str(theirs).upper()
+    if isinstance(mine, float) and math.isnan(mine):
+        return str(theirs).startswith("#")
+    return not isinstance(theirs, str) and math.isclose(mine, float(theirs), rel_tol=1e-13)
+
+
+# Excel's rules where a second reader of formulas is most likely to slip
+CASES = [
+    "=-2^2",
+    "=2^3^2",
+    "=1-2-3",
+    "=8/4/2",
+    "=MOD(-3, 2)",
+    "=MOD(3, -2)",
+    "=ATAN2(1, 2)",
+    "=ATAN2(-1, 0)",
+    "=ROUND(2.5, 0)",
+    "=ROUND(-2.5, 0)",
+    "=TRUNC(-2.7)",
+    "=INT(-2.5)",
+    "=1/0",
+    "=SQRT(-1)",
+    "=IF(1>0, 2, 1/0)",
+    "=IF(1<0, 2, 3)",
+    '="a"&1.5&TRUE',
+    '=IF(2>1, "Euler", "Johnson")',
+    '="a"<"B"',
+    '=1<"a"',
+    "=AND(1>0, 2>1, NOT(0))",
+    "=OR(1<0, 0)",
+    "=SUMPRODUCT({1,2,3}*{4,5,6})",
+    "=SUMPRODUCT({1,2,3},{4,5,6})",
+    "=SUM({1,2,3})+MAX({4,5})-MIN({7,8})",
+    "=SUMSQ({1,2,3})",
+    "=INDEX({10;20;30}, 2)",
+    "=INDEX({1,2;3,4}, 2, 1)",
+    "=MATCH(2.5, {1,2,3})",
+    "=MATCH(2, {1,2,3}, 0)",
+    "=CHOOSE(2, 10, 20, 30)",
+    "=MMULT({1,2;3,4}, {5;6})",
+    "=MINVERSE({2,0;0,4})",
+    "=MDETERM({1,2;3,4})",
+    "=TRANSPOSE({1,2,3})",
+    "=SIN({0.1,0.2})*COS({0.3,0.4})",
+    "=ABS(-3)*SIGN(-2)+EXP(1)+LN(2)+LOG10(1000)+TAN(0.5)+ACOS(0.5)",
+    "=IF({1,0,1}, {1,2,3}, {4,5,6})",
+    "=PI()*POWER(2, 0.5)",
+    "=(1+1E-3)*2.5E+2",
+    "=50%",
+    "=NA()",
+]
+
+
+@pytest.mark.parametrize("text", CASES)
+def test_the_fast_reader_computes_as_the_formulas_package(text):
+    mine = xleval.compile_formula(text)(lambda key: pytest.fail(f"reads {key}"))
+    theirs = _formulas_package(text)
+    assert _same(mine, theirs), (text, mine, theirs)
+
+
+def test_a_formula_it_does_not_know_goes_to_the_formulas_package():
+    with pytest.raises(xleval.Unsupported):
+        xleval.compile_formula("=IFERROR(1/0, 2)")
+    log = livecheck.CellLog()
+    log.values[("S", 0, 0)] = 2.0
+    log.values[("S", 0, 1)] = 2.0
+    log.formulas[("S", 0, 1)] = livecheck.Formula("S", 0, 1, "=IFERROR(1/0, A1)", 0, 1)
+    outcome = livecheck.check(log)
+    assert outcome.checked == 1 and outcome.refusals == []
+
+
+@pytest.fixture
+def scaled_twice(monkeypatch):
+    """The printer's old mistake: a reference printed in the unit the formula is typed in,
+    whatever unit its cell holds the number in."""
+    monkeypatch.setattr(cellunit, "reading", lambda convert, t: t)
+
+
+def test_a_ratio_scaled_twice_is_caught_and_written_as_the_engines_value(
+    tmp_path, sheet_from, scaled_twice
+):
+    sheet = sheet_from(RATIOS)
+    refusals: list = []
+    out = sheet.write_xlsx(tmp_path / "ratios.xlsx", refusals=refusals)
+    where = {r.where for r in refusals}
+    assert any(w.startswith("'Results'!B") for w in where), where  # y = 2*r: plain arithmetic
+    assert any(w.startswith("'Listing'!C") for w in where), where  # "f(x)" = "x*r"
+    ws = openpyxl.load_workbook(out)["Results"]
+    values = openpyxl.load_workbook(out, data_only=True)["Results"]
+    rows = {ws.cell(r, 1).value: r for r in range(2, ws.max_row + 1)}
+    y = ws.cell(rows["y"], 2)
+    assert not str(y.value).startswith("=") and math.isclose(y.value, 1.5, rel_tol=1e-12)
+    assert "independent evaluation" in y.comment.text
+    assert values.cell(rows["r"], 2).value == pytest.approx(0.75, rel=1e-12)
+
+
+def test_run_prints_each_cell_written_as_a_value(tmp_path, scaled_twice):
+    from workbook.cli import main
+
+    path = tmp_path / "ratios.toml"
+    path.write_text(RATIOS, encoding="utf-8")
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(["run", str(path), "--out", str(tmp_path / "r.xlsx")]) == 0
+    lines = [x for x in buf.getvalue().splitlines() if x.startswith("written as a value")]
+    assert lines and all("the engine" in x for x in lines)
+
+
+def test_every_formula_cell_is_computed(tmp_path, sheet_from):
+    sheet = sheet_from(RATIOS)
+    out = sheet.write_xlsx(tmp_path / "ratios.xlsx")
+    about = openpyxl.load_workbook(out)["About"]
+    text = next(r[1] for r in about.iter_rows(values_only=True) if r[0] == "Formulas checked")
+    assert "every formula cell" in text and "not computed" not in text
