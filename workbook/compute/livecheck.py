@@ -291,18 +291,19 @@ def _generic(text: str) -> tuple[str, list[str]]:
     compilation."""
     refs: list[str] = []
 
-    def ref(m: re.Match) -> str:
-        refs.append((m[1] or "") + m[2].replace("$", ""))
+    def one(m: re.Match) -> str:
+        if m[1] is not None:  # an array constant or a text, kept as it is
+            return m[1]
+        refs.append((m[2] or "") + m[3].replace("$", "") if m[3] is not None else m[0])
         return f"_REF_{len(refs) - 1}_"
 
-    def number(m: re.Match) -> str:
-        refs.append(m[0])
-        return f"_REF_{len(refs) - 1}_"
+    return _GENERIC.sub(one, text), refs
 
-    parts = _CONSTANTS.split(text)
-    for i in range(0, len(parts), 2):  # the odd parts are constants, kept as they are
-        parts[i] = _NUMBER.sub(number, _CELLS.sub(ref, parts[i]))
-    return "".join(parts), refs
+
+#: one pass over a formula: a constant (group 1), a reference (groups 2 and 3) or a number
+_GENERIC = re.compile(
+    f"({_CONSTANTS.pattern[1:-1]})|{_CELLS.pattern}|{_NUMBER.pattern}".replace("\n", "")
+)
 
 
 def _compile(text: str):
@@ -370,7 +371,7 @@ def _magnitude(value) -> float:
     return 0.0
 
 
-def _resolver(inputs: _Inputs, refs: list[str], here: str, row_of, read: list[float]):
+def _resolver(inputs: _Inputs, refs: list[str], here: str, row_of, read: list[float], memo: dict):
     """The values a formula compiled by :mod:`workbook.compute.xleval` reads: its generic
     names (``_REF_k_``: a cell, a range or a number) and the defined names."""
 
@@ -381,9 +382,12 @@ def _resolver(inputs: _Inputs, refs: list[str], here: str, row_of, read: list[fl
                 return float(key)
         if row_of is not None:
             key = key.replace(str(SENTINEL), str(row_of))
-        value = inputs.value(key, here)
-        read.append(_magnitude(value))
-        return value
+        found = memo.get((key, here))
+        if found is None:  # the cells do not change while they are checked
+            value = inputs.value(key, here)
+            found = memo[(key, here)] = (value, _magnitude(value))
+        read.append(found[1])
+        return found[0]
 
     return resolve
 
@@ -401,6 +405,7 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
     # difference of near terms) is compared at their scale, its rounding is not an error
     read: list[float] = []
     by = ["the formulas package"]
+    memo: dict = {}  # (reference, sheet) -> (value, magnitude)
 
     def run(text: str, here: str, row_of=None):
         generic, refs = _generic(text)
@@ -412,7 +417,7 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
                 fn = compiled[generic] = _compile(generic)
         if not hasattr(fn, "inputs"):
             by[0] = XLEVAL
-            return fn(_resolver(raw, refs, here, row_of, read))
+            return fn(_resolver(raw, refs, here, row_of, read, memo))
         by[0] = "the formulas package"
         args = []
         for key in fn.inputs:

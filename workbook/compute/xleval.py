@@ -15,6 +15,7 @@ of the templates both ways.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Callable
@@ -38,6 +39,7 @@ class _Err(Exception):
 _TOKEN = re.compile(
     r"\s*(?:"
     r'(?P<str>"(?:[^"]|"")*")'
+    r'|(?P<const>\{[^{}"]*\})'
     r"|(?P<num>(?:\d+\.?\d*|\.\d+)(?:[Ee][+-]?\d+)?)"
     r"|(?P<ref>(?:'[^']+'|[A-Za-z_][\w.]*)!\$?[A-Z]{1,3}\$?\d+(?::\$?[A-Z]{1,3}\$?\d+)?"
     r"|\$?[A-Z]{1,3}\$?\d+:\$?[A-Z]{1,3}\$?\d+|\$[A-Z]{1,3}\$?\d+|[A-Z]{1,3}\$\d+)"
@@ -91,6 +93,8 @@ def _result(v):
 
 # -- coercion -------------------------------------------------------------------------------
 def _num(v) -> float:
+    if type(v) is float and v - v == 0.0:
+        return v
     if isinstance(v, bool):
         return 1.0 if v else 0.0
     if isinstance(v, (float, int)):
@@ -240,9 +244,23 @@ def _compare(op: str, a, b) -> bool:
     return ra >= rb
 
 
+_FAST = {
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "*": lambda a, b: a * b,
+}
+
+
 def _binary(op: str, left: Fn, right: Fn) -> Fn:
+    fast = _FAST.get(op)
+
     def run(r):
         a, b = left(r), right(r)
+        if fast is not None and type(a) is float and type(b) is float:
+            x = fast(a, b)
+            if x - x == 0.0:  # finite (an inf or nan operand gives nan here)
+                return x
+            raise _Err("#NUM!")
         if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
             if op == "&":
                 raise Unsupported("& on arrays")
@@ -629,8 +647,9 @@ class _Parser:
             inner = self.expression(0)
             self.take(")")
             return inner
-        if text == "{":
-            return self.constant()
+        if kind == "const":
+            value = _constant(text)
+            return lambda r: value
         raise Unsupported(f"unexpected {text!r}")
 
     def call(self, name: str) -> Fn:
@@ -647,34 +666,28 @@ class _Parser:
         self.take(")")
         return _call(name, args)
 
-    def constant(self) -> Fn:
-        rows: list[list[object]] = [[]]
-        while True:
-            kind, text = self.take()
-            sign = 1.0
-            if text == "-":
-                sign, (kind, text) = -1.0, self.take()
-            if kind == "num":
-                rows[-1].append(sign * float(text))
-            elif kind == "str":
-                rows[-1].append(text[1:-1].replace('""', '"'))
-            elif kind == "name" and text.upper() in ("TRUE", "FALSE"):
-                rows[-1].append(text.upper() == "TRUE")
-            else:
-                raise Unsupported(f"array constant element {text!r}")
-            kind, text = self.take()
-            if text == "}":
-                break
-            if text == ";":
-                rows.append([])
-            elif text != ",":
-                raise Unsupported(f"array constant separator {text!r}")
-        if any(len(row) != len(rows[0]) for row in rows):
-            raise Unsupported("ragged array constant")
-        value = np.array(rows, dtype=object)
-        if all(isinstance(x, float) for x in value.flat):
-            value = value.astype(float)
-        return lambda r: value
+
+@functools.lru_cache(maxsize=512)
+def _constant(text: str) -> np.ndarray:
+    """An array constant ``{1,2;3,4}`` (numbers and TRUE/FALSE; rows split by ``;``)."""
+    rows = [row.split(",") for row in text[1:-1].split(";")]
+    if any(len(row) != len(rows[0]) for row in rows):
+        raise Unsupported("ragged array constant")
+
+    def element(x: str):
+        x = x.strip()
+        if x.upper() in ("TRUE", "FALSE"):
+            return x.upper() == "TRUE"
+        try:
+            return float(x)
+        except ValueError:
+            raise Unsupported(f"array constant element {x!r}") from None
+
+    value = np.array([[element(x) for x in row] for row in rows], dtype=object)
+    if all(isinstance(x, float) for x in value.flat):
+        value = value.astype(float)
+    value.flags.writeable = False
+    return value
 
 
 def _negate(v):
