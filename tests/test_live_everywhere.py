@@ -148,3 +148,57 @@ def test_every_formula_cell_is_computed(tmp_path, sheet_from):
     about = openpyxl.load_workbook(out)["About"]
     text = next(r[1] for r in about.iter_rows(values_only=True) if r[0] == "Formulas checked")
     assert "every formula cell" in text and "not computed" not in text
+
+
+# |v| of a crank over a turn: four equal peaks (48, 138, 228 and 318 deg), 8 samples apart
+CRANK = """
+[inputs]
+r = "50 mm"
+omega = "100 rad/s"
+
+[arguments]
+th = { unit = "deg" }
+
+[definitions]
+"v(th)" = { expr = "r*omega*sin(2*(th - 3 deg))", unit = "m/s" }
+vmax = { expr = "maximum(abs(v(th)), th, 0 deg, 360 deg)", unit = "m/s" }
+thmax = { expr = "argmax(abs(v(th)), th, 0 deg, 360 deg)", unit = "deg" }
+"""
+
+
+@pytest.mark.slow
+def test_equal_peaks_are_chosen_alike_whatever_the_rounding(tmp_path, sheet_from):
+    """Another program's sin rounds the samples of the later peaks up by an ulp or so: the
+    live formulas still take the first peak, as the engine does (a MATCH of the exact MAX
+    would jump to the later one)."""
+    from test_cell_units import formulas_recalculated
+
+    sheet = sheet_from(CRANK)
+    out = sheet.write_xlsx(tmp_path / "crank.xlsx")
+    book = openpyxl.load_workbook(out)
+    cached = openpyxl.load_workbook(out, data_only=True)["Solver steps"]
+    ws = book["Solver steps"]
+    header = [c.value for c in ws[2]]
+    best = header.index("best") + 1
+    k = int(cached.cell(3, best).value)
+    samples = [cached.cell(3, 2 + j).value for j in range(best - 2)]
+    m = len(samples) - 1
+    later = [j for j in range(m + 1) if j > k and abs(samples[j] - samples[k]) < 1e-12]
+    assert later, samples  # the curve has equal peaks where the engine samples it
+    for j in later:  # each later peak a little higher, as a last-bit difference makes it
+        ws.cell(3, 2 + j).value = samples[j] * (1 + 4e-16)
+    edited = tmp_path / "edited.xlsx"
+    book.save(edited)
+    got = formulas_recalculated(edited)
+    assert got[("SOLVER STEPS", f"{openpyxl.utils.get_column_letter(best)}3")] == k
+    thmax, vmax = sheet.evaluate("thmax").magnitude, sheet.evaluate("vmax").magnitude
+    rows = {book["Results"].cell(r, 1).value: r for r in range(2, book["Results"].max_row + 1)}
+    assert math.isclose(got[("RESULTS", f"B{rows['thmax']}")], thmax, rel_tol=1e-9)
+    assert math.isclose(got[("RESULTS", f"B{rows['vmax']}")], vmax, rel_tol=1e-9)
+    # the exact maximum's first match is a later peak: the tie rule is what kept the first
+    values = np.array(
+        [[samples[j] * (1 + 4e-16) if j in later else samples[j]] for j in range(m + 1)],
+        dtype=object,
+    ).T
+    match = xleval.compile_formula("=MATCH(MAX(S),S,0)-1")(lambda key: values)
+    assert match != k
