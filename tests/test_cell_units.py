@@ -9,8 +9,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import openpyxl
 import pytest
+from openpyxl.utils import get_column_letter
 from recalc import formula_values
 
 from workbook.compute import cellunit
@@ -104,6 +106,56 @@ def formulas_recalculated(xlsx: Path) -> dict[tuple[str, str], object]:
             pass
         out[(sheet.upper(), cell.upper())] = v
     return out
+
+
+def xleval_recalculated(xlsx: Path) -> dict[tuple[str, str], object]:
+    """{(sheet, cell): value} of every formula cell of ``xlsx`` recalculated from its inputs
+    (not from cached values) by workbook.compute.xleval, each formula reading the
+    recalculated values of the cells and defined names it refers to."""
+    from openpyxl.utils import range_boundaries
+
+    from workbook.compute import xleval
+
+    book = openpyxl.load_workbook(xlsx)
+    sheets = {ws.title.upper(): ws for ws in book.worksheets}
+    names = {n.upper(): d.attr_text for n, d in book.defined_names.items()}
+    done: dict[tuple[str, str], object] = {}
+
+    def cell(sheet: str, coord: str):
+        key = (sheet, coord)
+        if key not in done:
+            v = sheets[sheet][coord].value
+            if isinstance(v, str) and v.startswith("="):
+                done[key] = None  # a cycle reads as empty
+                fn = xleval.compile_formula(v)
+                v = fn(lambda ref, here=sheet: read(ref, here))
+                if isinstance(v, np.ndarray):
+                    v = v.flat[0]
+            done[key] = float(v) if isinstance(v, int) and not isinstance(v, bool) else v
+        return done[key]
+
+    def read(ref: str, here: str):
+        if ref.upper() in names:
+            return read(names[ref.upper()], here)
+        sheet, _, cells = ref.rpartition("!")
+        sheet = sheet.strip("'").upper() or here
+        cells = cells.replace("$", "")
+        if ":" not in cells:
+            return cell(sheet, cells)
+        c0, r0, c1, r1 = range_boundaries(cells)
+        out = np.empty((r1 - r0 + 1, c1 - c0 + 1), dtype=object)
+        for i in range(r1 - r0 + 1):
+            for j in range(c1 - c0 + 1):
+                out[i, j] = cell(sheet, f"{get_column_letter(c0 + j)}{r0 + i}")
+        return out
+
+    return {
+        (title, c.coordinate): cell(title, c.coordinate)
+        for title, ws in sheets.items()
+        for row in ws.iter_rows()
+        for c in row
+        if isinstance(c.value, str) and c.value.startswith("=")
+    }
 
 
 def mismatches(xlsx: Path, recalculated: dict | None = None) -> list:
