@@ -13,6 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from recalc import recalculate, soffice
 from test_cell_units import mismatches, xleval_recalculated
+from test_livecheck_libreoffice import differences
 
 POWERS = ["W", "kW", "MW", "mW"]
 LENGTHS = ["mm", "cm", "m", "km", "um"]
@@ -124,8 +125,6 @@ def test_random_sheets_recalculate_to_the_engine(tmp_path, text):
 )
 @given(text=sheets())
 def test_random_sheets_recalculate_in_libreoffice(tmp_path, text):
-    from test_livecheck_libreoffice import differences
-
     out, refusals = _written(tmp_path, text)
     assert refusals == [], f"{text}\n{[r.where + ': ' + r.disagreement for r in refusals]}"
     bad = differences(out, recalculate(out, tmp_path / "lo"))

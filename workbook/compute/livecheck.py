@@ -284,7 +284,7 @@ _NUMBER = re.compile(r"(?<![\w.$])\d+(?:\.\d*)?(?:E[+-]?\d+)?(?![\w.(])")
 _CONSTANTS = re.compile(r'(\{[^{}]*\}|"(?:[^"]|"")*")')  # array constants and texts
 
 
-def _generic(text: str) -> tuple[str, list[str]]:
+def generic(text: str) -> tuple[str, list[str]]:
     """The formula with its cell references and numbers (outside array constants and texts)
     replaced by names _REF_0_, _REF_1_, ...; and what they stand for: formulas that differ
     only in the cells they read or in a constant (a sample's position) share one
@@ -408,13 +408,13 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
     memo: dict = {}  # (reference, sheet) -> (value, magnitude)
 
     def run(text: str, here: str, row_of=None):
-        generic, refs = _generic(text)
-        fn = compiled.get(generic)
+        text_g, refs = generic(text)
+        fn = compiled.get(text_g)
         if fn is None:
             try:
-                fn = compiled[generic] = xleval.compile_formula(generic)
+                fn = compiled[text_g] = xleval.compile_formula(text_g)
             except xleval.Unsupported:  # the formulas package computes the rest
-                fn = compiled[generic] = _compile(generic)
+                fn = compiled[text_g] = _compile(text_g)
         if not hasattr(fn, "inputs"):
             by[0] = XLEVAL
             return fn(_resolver(raw, refs, here, row_of, read, memo))

@@ -242,9 +242,10 @@ def _live_chain(of, a, b, steps_of) -> dict[str, np.ndarray]:
 def _golden(f, a, b, idx, kind: str, of) -> dict:
     """What the workbook's live extremum computes, row by row: EXPR at the 4 x samples + 1
     points A + (B-A)*j/m, the first sample k as good as the best to SAME, then GOLDEN_STEPS
-    golden-section steps on [x(k-1), x(k+1)] (c = hi - (hi-lo)*g, d = lo + (hi-lo)*g, the side of the better of f(c),
-    f(d) kept, the left one when they are within SAME of each other); the result is f at the
-    middle of the last bracket, or the best sample where that is better by more than SAME."""
+    golden-section steps on [x(k-1), x(k+1)] (c = hi - (hi-lo)*g, d = lo + (hi-lo)*g, the
+    side of the better of f(c), f(d) kept, the left one when they are within SAME of each
+    other); the result is f at the middle of the last bracket, or the best sample where that
+    is better by more than SAME."""
     m = 4 * of.tolerance.samples
     sign = 1.0 if kind == "max" else -1.0
     width = b - a
