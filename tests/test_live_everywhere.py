@@ -202,3 +202,40 @@ def test_equal_peaks_are_chosen_alike_whatever_the_rounding(tmp_path, sheet_from
     ).T
     match = xleval.compile_formula("=MATCH(MAX(S),S,0)-1")(lambda key: values)
     assert match != k
+
+
+FROZEN = """
+[inputs]
+a = "2 m"
+n = "4"
+
+[definitions]
+S = "sum(i*a, i, 1, n)"
+y = "2*S + a"
+z = "y/3"
+w = "a*3"
+"""
+
+
+def test_frozen_values_and_the_live_cells_that_read_them_are_marked(tmp_path, sheet_from):
+    out = sheet_from(FROZEN).write_xlsx(tmp_path / "frozen.xlsx")
+    book = openpyxl.load_workbook(out)
+    ws = book["Results"]
+    cells = {ws.cell(r, 1).value: ws.cell(r, 2) for r in range(2, ws.max_row + 1)}
+
+    def fill(c) -> str:
+        return c.fill.fgColor.rgb if c.fill.fill_type else ""
+
+    assert not str(cells["S"].value).startswith("=") and fill(cells["S"]) == "FFD9D9D9"
+    assert "not a formula" in cells["S"].comment.text
+    for name in ("y", "z"):  # z reads S through y
+        assert str(cells[name].value).startswith("=") and fill(cells[name]) == "FFFCE4D6"
+        assert "reads S" in cells[name].comment.text and "workbook run" in cells[name].comment.text
+    assert fill(cells["w"]) == "" and cells["w"].comment is None
+    notes = [str(r[0]) for r in book["Inputs"].iter_rows(values_only=True) if r[0]]
+    assert any(t.startswith("Frozen (grey): S:") and "--inputs" in t for t in notes)
+    assert any(t.startswith("Live but reading a frozen value") and "y, z" in t for t in notes)
+    # the edited workbook's inputs still read back: the lists stand below the input table
+    from workbook.roundtrip import read_inputs
+
+    assert set(read_inputs(sheet_from(FROZEN), out)) <= {"a", "n"}
