@@ -210,10 +210,15 @@ a = "2 m"
 n = "4"
 
 [definitions]
-S = "sum(i*a, i, 1, n)"
 y = "2*S + a"
 z = "y/3"
 w = "a*3"
+total = "sum(i*a, i, 1, n)"
+
+[[solve]]
+unknowns = { S = "1 m" }
+equations = ["S^2 == 20*a^2 + a*S"]
+conditions = ["S > 0"]
 """
 
 
@@ -226,15 +231,18 @@ def test_frozen_values_and_the_live_cells_that_read_them_are_marked(tmp_path, sh
     def fill(c) -> str:
         return c.fill.fgColor.rgb if c.fill.fill_type else ""
 
-    assert not str(cells["S"].value).startswith("=") and fill(cells["S"]) == "FFD9D9D9"
-    assert "not a formula" in cells["S"].comment.text
-    for name in ("y", "z"):  # z reads S through y
-        assert str(cells[name].value).startswith("=") and fill(cells[name]) == "FFFCE4D6"
-        assert "reads S" in cells[name].comment.text and "workbook run" in cells[name].comment.text
+    for name in ("S", "y"):  # found by a solver block; y reads it, so has no formula either
+        assert not str(cells[name].value).startswith("=") and fill(cells[name]) == "FFD9D9D9"
+        assert "not a formula" in cells[name].comment.text
+    z = cells["z"]  # live, but reads y
+    assert str(z.value).startswith("=") and fill(z) == "FFFCE4D6"
+    assert "reads y" in z.comment.text and "workbook run" in z.comment.text
     assert fill(cells["w"]) == "" and cells["w"].comment is None
+    # a sum whose bounds follow an input is live, as guarded terms up to a maximum
+    assert str(cells["total"].value).startswith("=IF(OR(") and fill(cells["total"]) == ""
     notes = [str(r[0]) for r in book["Inputs"].iter_rows(values_only=True) if r[0]]
-    assert any(t.startswith("Frozen (grey): S:") and "--inputs" in t for t in notes)
-    assert any(t.startswith("Live but reading a frozen value") and "y, z" in t for t in notes)
+    assert any(t.startswith("Frozen (grey): S, y:") and "--inputs" in t for t in notes)
+    assert any(t.startswith("Live but reading a frozen value") and ": z" in t for t in notes)
     # the edited workbook's inputs still read back: the lists stand below the input table
     from workbook.roundtrip import read_inputs
 

@@ -716,11 +716,11 @@ def _integral_excel(body, args, consts) -> tuple[str, int]:
 
 
 def _product_excel(body, args, consts) -> tuple[str, int]:
-    from ..functions.builtins import MAX_EXCEL_TERMS, sum_index
+    from ..functions.builtins import MAX_EXCEL_TERMS, live_terms, sum_index
 
     lo, hi = consts
-    if lo is None or hi is None:
-        raise NotLive("product() with bounds that are not constants has no live formula")
+    if lo is None or hi is None:  # bounds that follow the inputs
+        return live_terms(body, args[0], args[1], "*", "1"), ATOM
     lo, hi = sum_index(lo, "first"), sum_index(hi, "last")
     if hi < lo:
         return "1", ATOM
