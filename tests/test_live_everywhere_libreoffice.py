@@ -26,10 +26,12 @@ MARKED = ("FFD9D9D9", "FFFCE4D6")  # frozen, reads a frozen value
 
 
 def _numeric_inputs(sheet) -> list[str]:
-    """The inputs that are numbers and may be raised by 10 % (within their limits)."""
+    """The inputs that are numbers and may be raised by 10 % (within their limits); a count
+    or an order (a whole plain number: n = 4) is not raised, since 4.4 teeth is no edit."""
     out = []
     for n, spec in sheet.spec.inputs.items():
-        if spec.options:
+        q = sheet.values[n]
+        if spec.options or (not q.dimensionality and float(q.magnitude).is_integer()):
             continue
         try:
             sheet.with_inputs(**{n: sheet.values[n] * 1.1})
