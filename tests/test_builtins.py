@@ -100,11 +100,14 @@ def test_sum_excel_formula_against_the_formulas_package(tmp_path):
     assert float(value) == pytest.approx(_fourier(33.0, 5), rel=1e-13)
     total = printer.formula(sheet.typer.scalar("total"), {})
     assert float(formulas.Parser().ast(total)[1].compile()()) == 35.0
-    # bounds that are not constants: no live formula, the writer writes numbers
-    from workbook.compute.excel import NotLive
-
-    with pytest.raises(NotLive, match="not constants"):
-        printer.formula(sheet.typer.function("g").body, {"x": "33"})
+    # bounds that follow an input: guarded terms up to MAX_LIVE_TERMS, #N/A past them
+    live = printer.formula(sheet.typer.function("g").body, {"x": "33"})
+    value = formulas.Parser().ast(live)[1].compile()()
+    assert float(value) == pytest.approx(_fourier(33.0, 5), rel=1e-13)
+    many = ExcelPrinter(sheet.typer, {"R": "2", "n": "40"}).formula(
+        sheet.typer.function("g").body, {"x": "33"}
+    )
+    assert str(formulas.Parser().ast(many)[1].compile()()).startswith("#N/A")
 
 
 def test_sum_in_sympy(tmp_path):

@@ -30,6 +30,7 @@ from ..language import expr as ex
 from ..language import typed as ty
 from ..language import units as un
 from ..language.fields import Fields, nearest
+from . import cellunit
 from .findings import Finding
 from .verdicts import FINDING_VERDICTS
 
@@ -195,12 +196,12 @@ def _typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None
         return t, None, None
     if unit == _PERCENT:
         return t, 100 * _factor(t, un.registry().dimensionless, ""), "%"
-    shown = un.unit(unit, what=spec.label) if unit is not None else _shown_unit(t.unit)
+    shown = un.unit(unit, what=spec.label) if unit is not None else _shown_unit(t)
     return t, _factor(t, shown, unit), shown
 
 
-def _shown_unit(u):
-    return un.registry().dimensionless if un.is_compound_ratio(u) else u
+def _shown_unit(t):
+    return cellunit.stored_unit(t)
 
 
 def _factor(t, dst, dst_text: str | None) -> float:

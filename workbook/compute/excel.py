@@ -20,6 +20,7 @@ from ..functions.registry import CONSTANTS, REGISTRY
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.visitor import Visitor
+from . import cellunit
 
 if TYPE_CHECKING:
     from ..language.typecheck import Typer
@@ -178,6 +179,9 @@ class ExcelPrinter(Visitor):
                 if t.kind == "solve"
                 else f"{t.name} is a column of measured data"
             )
+        read = cellunit.reading(self.typer.convert, t)  # the cell's number in t's unit
+        if read is not t:
+            return self.visit(read, s)
         return self.names.get(t.name, excel_name(t.name)), ATOM
 
     def visit_TScale(self, t, s):
@@ -285,6 +289,9 @@ class ExcelPrinter(Visitor):
         raise NotLive(f"{t.name}() is a solver block ({t.ref}); its values are written as numbers")
 
     def visit_TAggregate(self, t, s):
+        read = cellunit.reading(self.typer.convert, t)  # the column's cells in t's unit
+        if read is not t:
+            return self.visit(read, s)
         ref = self.ranges.get((t.table, t.column))
         if ref is None:
             raise NotLive(

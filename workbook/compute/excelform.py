@@ -34,6 +34,7 @@ from ..limits import MAX_TABLE_CELLS
 from ..outputs import style
 from ..outputs.xlsx import chart_label, write_labels
 from ..version import __version__
+from . import frozen
 from . import verdicts as V
 from .checks import tolerances
 from .excel import ExcelPrinter, NotLive, cell_value
@@ -229,6 +230,9 @@ class ExcelLayout:
         self.log = CellLog()
         self.refused = refused or {}
         self.verified = None  # the check's outcome (livecheck.Outcome), once made
+        # cells written as numbers that cannot follow an edit: (sheet, row, col) -> what
+        self.frozen: dict[tuple[str, int, int], str] = {}
+        self.inputs_end = 0  # the first free row of the Inputs sheet
 
     def ws(self, name: str):
         if name not in self.sheets:
@@ -272,6 +276,7 @@ class ExcelLayout:
             "Yellow cells are inputs: change them and the workbook recalculates.",
             self.fmt["note"],
         )
+        self.inputs_end = row + 2
 
     def write_definitions(self, needed: set[str]) -> None:
         defs = [
@@ -385,6 +390,7 @@ class ExcelLayout:
         q, solved = found.value, found.solution
         ws.write_number(row, 1, float(q.magnitude), self.fmt["number"])
         ws.write_comment(row, 1, "A value, not a formula: found by a [[solve]] block")
+        self.freeze(ws, row, 1, 1, 1, unknown)
         ws.write_string(row, 2, un.typeset(q.units))
         step = un.typeset(un.difference_unit(q.units))  # an error is a difference: delta_degC
         ws.write_string(
@@ -472,6 +478,7 @@ class ExcelLayout:
         ws.write_comment(
             top, 1, "Values, not formulas: an array whose size is known only when its program runs"
         )
+        self.freeze(ws, top, 1, r, c, d.name)
         self.not_live.append(d.name)
         last = f"{_col_letter(c)}${top + r}"
         self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
@@ -522,6 +529,7 @@ class ExcelLayout:
                     _write_value(ws, top + i, 1 + j, cell_value(t, value[i, j]), fmt)
             ws.write_comment(top, 1, f"Values, not formulas: {why}")
             self.not_live.append(what)
+            self.freeze(ws, top, 1, r, c, what)
             return
         ws.write_array_formula(top, 1, top + r - 1, c, formula, fmt, float(value[0, 0]))
         for i in range(r):  # the cached values of the other cells of the array
@@ -529,6 +537,12 @@ class ExcelLayout:
                 if i or j:
                     ws.write_number(top + i, 1 + j, float(value[i, j]), fmt)
         self.formula_cells += 1
+
+    def freeze(self, ws, row: int, col: int, rows: int, cols: int, what: str) -> None:
+        """Cells written as numbers that cannot follow an edit (see :mod:`.frozen`)."""
+        for i in range(rows):
+            for j in range(cols):
+                self.frozen[(ws.name, row + i, col + j)] = what
 
     def _write_cell(self, ws, row, col, t: ty.T, subst, value: float, fmt, what: str) -> bool:
         try:
@@ -543,6 +557,7 @@ class ExcelLayout:
                 ws.write_number(row, col, value, fmt)
             ws.write_comment(row, col, f"A value, not a formula: {why}")
             self.not_live.append(what)
+            self.freeze(ws, row, col, 1, 1, what)
             return False
         if formula.array:  # computes with vectors or matrices: an array formula
             ws.write_array_formula(row, col, row, col, formula, fmt, value)
@@ -706,6 +721,7 @@ class ExcelLayout:
                     )
             ws.write_comment(first - 1, j, f"Values, not formulas: {why}")
             self.not_live.append(f"{table}.{col.text}")
+            self.freeze(ws, first, j, n, 1, f"{table}.{col.text}")
             _failed_comments(ws, first, j, col)
             return False
         steps.write()
@@ -1073,12 +1089,13 @@ class ExcelLayout:
         if v is None:
             return "not checked"
         text = (
-            f"{v.checked} formula cells with arrays, numerical built-ins or helper cells, "
-            "computed by an evaluator independent of the engine (the formulas package; "
-            f"{ROWS_CHECKED} rows of each table column), agree with the engine to {RELATIVE:g} "
-            f"relative; {v.plain} of scalar "
-            "arithmetic only, or helper cells, are not computed"
+            f"{v.checked} formula computations, every formula cell ({ROWS_CHECKED} rows of "
+            "each table column), by an evaluator independent of the engine and of the "
+            "formula printer (its own reader of Excel formulas; the formulas package for the "
+            f"functions that reader lacks), agree with the engine to {RELATIVE:g} relative"
         )
+        if v.plain:
+            text += f"; {v.plain} of scalar arithmetic only, or helper cells, are not computed"
         if v.refusals:
             text += f"; {len(v.refusals)} that did not are values, with a comment"
         if v.unchecked:
@@ -1184,6 +1201,7 @@ def lay_out(computed, sheet, *, command: str | None = None, verify: bool = True)
             w.not_live.extend(_refused_what(outcome.refusals))
         w.wb.refusals = list(outcome.refusals)
         w.verified = outcome
+    w.marked = frozen.mark(w)
     w.write_about()
     form = w.wb
     form.formula_cells, form.not_live, form.verified = w.formula_cells, w.not_live, w.verified

@@ -24,7 +24,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..functions.complexes import parse_text
+from . import xleval
 
+#: the evaluator of most formulas (the formulas package computes the others)
+XLEVAL = "the check's own reader of Excel formulas, workbook.compute.xleval"
 #: largest relative difference between a live formula and the engine's value
 RELATIVE = 1e-9
 #: rows of a table column computed by the check (spread evenly, first and last included)
@@ -81,6 +84,7 @@ class Refusal:
     independent: object
     engine: object
     rows: int = 1  # a column: the rows refused from ``row`` down
+    by: str = "the formulas package"  # the evaluator that computed it
 
     @property
     def where(self) -> str:
@@ -96,7 +100,7 @@ class Refusal:
     def disagreement(self) -> str:
         """One line: the two values."""
         return (
-            f"its live formula computes {_shown(self.independent)} (the formulas package), "
+            f"its live formula computes {_shown(self.independent)} ({self.by}), "
             f"the engine {_shown(self.engine)}"
         )
 
@@ -106,7 +110,7 @@ class Refusal:
         return (
             f"A value, not a formula: the live formula {_short(self.formula)} computes "
             f"{_shown(self.independent)} in an independent evaluation of its Excel formula "
-            f"(the formulas package), the engine {_shown(self.engine)}; the engine's value is "
+            f"({self.by}), the engine {_shown(self.engine)}; the engine's value is "
             "written."
         )
 
@@ -231,8 +235,8 @@ class Outcome:
 class _Inputs:
     """Values of the references a compiled formula reads, from the log."""
 
-    def __init__(self, log: CellLog):
-        self.log = log
+    def __init__(self, log: CellLog, raw: bool = False):
+        self.log, self.raw = log, raw
         self.sheets = {}
         for sheet, _, _ in log.values:
             self.sheets.setdefault(sheet.upper(), sheet)
@@ -259,6 +263,8 @@ class _Inputs:
         return out
 
     def _cell(self, sheet: str, row: int, col: int):
+        if self.raw:  # as the fast evaluator reads them (xleval): None for an empty cell
+            return self.log.values.get((sheet, row, col))
         import schedula
         from formulas.tokens.operand import NUM
 
@@ -279,25 +285,26 @@ _NUMBER = re.compile(r"(?<![\w.$])\d+(?:\.\d*)?(?:E[+-]?\d+)?(?![\w.(])")
 _CONSTANTS = re.compile(r'(\{[^{}]*\}|"(?:[^"]|"")*")')  # array constants and texts
 
 
-def _generic(text: str) -> tuple[str, list[str]]:
+def generic(text: str) -> tuple[str, list[str]]:
     """The formula with its cell references and numbers (outside array constants and texts)
     replaced by names _REF_0_, _REF_1_, ...; and what they stand for: formulas that differ
     only in the cells they read or in a constant (a sample's position) share one
     compilation."""
     refs: list[str] = []
 
-    def ref(m: re.Match) -> str:
-        refs.append((m[1] or "") + m[2].replace("$", ""))
+    def one(m: re.Match) -> str:
+        if m[1] is not None:  # an array constant or a text, kept as it is
+            return m[1]
+        refs.append((m[2] or "") + m[3].replace("$", "") if m[3] is not None else m[0])
         return f"_REF_{len(refs) - 1}_"
 
-    def number(m: re.Match) -> str:
-        refs.append(m[0])
-        return f"_REF_{len(refs) - 1}_"
+    return _GENERIC.sub(one, text), refs
 
-    parts = _CONSTANTS.split(text)
-    for i in range(0, len(parts), 2):  # the odd parts are constants, kept as they are
-        parts[i] = _NUMBER.sub(number, _CELLS.sub(ref, parts[i]))
-    return "".join(parts), refs
+
+#: one pass over a formula: a constant (group 1), a reference (groups 2 and 3) or a number
+_GENERIC = re.compile(
+    f"({_CONSTANTS.pattern[1:-1]})|{_CELLS.pattern}|{_NUMBER.pattern}".replace("\n", "")
+)
 
 
 def _compile(text: str):
@@ -346,10 +353,14 @@ def _agrees(got, cached, scale: float) -> bool:
     if isinstance(cached, (str, bool, np.bool_)):
         return not isinstance(got, (float, int)) and str(got) == str(cached) or got == cached
     cached = float(cached)
+    if isinstance(got, (bool, np.bool_)) and cached in (0.0, 1.0):
+        return float(got) == cached  # a condition's TRUE written as its number, 1
     if isinstance(got, (bool, np.bool_)) or not isinstance(got, (int, float, np.number)):
         return not math.isfinite(cached)  # an Excel error where the engine has none is wrong
     got = float(got)
-    if not math.isfinite(cached) or not math.isfinite(got):
+    if not math.isfinite(got):  # an error element of an array
+        return not math.isfinite(cached)
+    if not math.isfinite(cached):
         return False
     return abs(got - cached) <= RELATIVE * max(abs(cached), abs(got), scale)
 
@@ -383,21 +394,63 @@ def _complex_agree(got, cached: str) -> bool:
     return abs(a - b) <= RELATIVE * max(abs(a), abs(b))
 
 
-def check(log: CellLog, everything: bool = False) -> Outcome:
+def _magnitude(value) -> float:
+    """The largest finite number of a value read by a formula (0 for text)."""
+    if isinstance(value, np.ndarray):
+        return max((_magnitude(v) for v in value.flat), default=0.0)
+    if isinstance(value, (float, int)) and not isinstance(value, bool) and math.isfinite(value):
+        return abs(float(value))
+    return 0.0
+
+
+def _resolver(inputs: _Inputs, refs: list[str], here: str, row_of, read: list[float], memo: dict):
+    """The values a formula compiled by :mod:`workbook.compute.xleval` reads: its generic
+    names (``_REF_k_``: a cell, a range or a number) and the defined names."""
+
+    def resolve(key: str):
+        if key.startswith("_REF_"):
+            key = refs[int(key[5:-1])]
+            if key[0].isdigit():
+                return float(key)
+        if row_of is not None:
+            key = key.replace(str(SENTINEL), str(row_of))
+        found = memo.get((key, here))
+        if found is None:  # the cells do not change while they are checked
+            value = inputs.value(key, here)
+            found = memo[(key, here)] = (value, _magnitude(value))
+        read.append(found[1])
+        return found[0]
+
+    return resolve
+
+
+def check(log: CellLog, everything: bool = True) -> Outcome:
     """Compute the formulas of ``log`` independently (every one with ``everything``, else
     all but the :func:`plain` ones); the ones that disagree with the engine's (cached)
     values."""
-    inputs = _Inputs(log)
+    inputs, raw = _Inputs(log), _Inputs(log, raw=True)
     refusals: list[Refusal] = []
     unchecked: dict[str, int] = {}
     checked = 0
     compiled: dict[str, object] = {}
+    # the magnitudes of the values the formula being computed reads: a result near zero (a
+    # difference of near terms) is compared at their scale, its rounding is not an error
+    read: list[float] = []
+    by = ["the formulas package"]
+    memo: dict = {}  # (reference, sheet) -> (value, magnitude)
 
     def run(text: str, here: str, row_of=None):
-        generic, refs = _generic(text)
-        fn = compiled.get(generic)
+        text_g, refs = generic(text)
+        fn = compiled.get(text_g)
         if fn is None:
-            fn = compiled[generic] = _compile(generic)
+            try:
+                fn = compiled[text_g] = xleval.compile_formula(text_g)
+            except xleval.Unsupported:  # the formulas package computes the rest
+                fn = compiled[text_g] = _compile(text_g)
+        if not hasattr(fn, "inputs"):
+            by[0] = XLEVAL
+            return fn(_resolver(raw, refs, here, row_of, read, memo))
+        by[0] = "the formulas package"
         args = []
         for key in fn.inputs:
             if key.startswith("_REF_"):
@@ -408,6 +461,7 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
             if row_of is not None:
                 key = key.replace(str(SENTINEL), str(row_of))
             args.append(inputs.value(key, here))
+            read.append(_magnitude(args[-1]))
         return fn(*args)
 
     def skipped(err: Exception, cells: int) -> None:
@@ -423,6 +477,7 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
             plain_cells += 1
             continue
         try:
+            read.clear()
             got = np.asarray(run(f.text, f.sheet), dtype=object)
         except Exception as err:  # noqa: BLE001 - a formula the evaluator cannot compute
             skipped(err, 1)
@@ -438,11 +493,11 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
                     value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
                 except IndexError:
                     value = None
-                if cached is not None and not _agrees(value, cached, 0.0):
+                if cached is not None and not _agrees(value, cached, max(read, default=0.0)):
                     if _complex_error(f.text, value):
                         skipped(ValueError(COMPLEX_ERROR), 1)
                         break
-                    refusals.append(Refusal(f.sheet, f.row, f.col, f.text, value, cached))
+                    refusals.append(Refusal(f.sheet, f.row, f.col, f.text, value, cached, by=by[0]))
                     break
             else:
                 continue
@@ -462,16 +517,19 @@ def check(log: CellLog, everything: bool = False) -> Outcome:
         for i in rows if c.n > 1 else [0]:
             row = c.first + i
             try:
+                read.clear()
                 got = _first(run(template, c.sheet, row + 1))
             except Exception as err:  # noqa: BLE001 - a formula the evaluator cannot compute
                 skipped(err, c.n)
                 break
             checked += 1
-            if not _agrees(got, cached_all[i], scale):
+            if not _agrees(got, cached_all[i], max([scale, *read])):
                 if _complex_error(template, got):
                     skipped(ValueError(COMPLEX_ERROR), c.n)
                     break
                 text = str(row + 1).join(c.pieces)
-                refusals.append(Refusal(c.sheet, c.first, c.col, text, got, cached_all[i], c.n))
+                refusals.append(
+                    Refusal(c.sheet, c.first, c.col, text, got, cached_all[i], c.n, by[0])
+                )
                 break
     return Outcome(refusals, checked, unchecked, plain_cells)

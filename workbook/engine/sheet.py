@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pint
 
+from ..compute import cellunit
 from ..compute.computed import Column, TableData, compute
 from ..errors import (
     DomainError,
@@ -258,7 +259,7 @@ class Sheet:
             if f.body.text or isinstance(out, str):  # a text, or an array's element that is one
                 return out if np.ndim(out) == 0 else np.asarray(out, dtype=object)
             q = Q(numbers(out) if np.ndim(out) else numbers(out).item(), f.unit)
-            return q.to("") if un.is_compound_ratio(f.unit) else q
+            return q.to(cellunit.stored_unit(f.body))
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
         except OutOfBudget as exc:  # the command stops; its message names the definition
@@ -270,10 +271,7 @@ class Sheet:
     def scalar_typed(self, name: str) -> ty.T:
         """The typed tree of scalar definition ``name`` in the unit it is shown in: a
         dimensionless product of units (``kg*mm/m^2/Pa/s^2``) becomes a plain number."""
-        t = self.typer.scalar(name)
-        if un.is_compound_ratio(t.unit):
-            t = self.typer.convert(t, un.registry().dimensionless, f"'{name}'")
-        return t
+        return cellunit.in_cell(self.typer.convert, self.typer.scalar(name), f"'{name}'")
 
     def scalar_quantity(self, name: str) -> pint.Quantity | str:
         """The value of scalar definition ``name`` in the unit it is shown in (a text as
@@ -282,8 +280,7 @@ class Sheet:
         value = self.scalar_value(name, "definition")
         if t.text or isinstance(value, str):  # a text element of a run-time array, too
             return value
-        q = un.registry().Quantity(value, t.unit)
-        return q.to("") if un.is_compound_ratio(t.unit) else q
+        return un.registry().Quantity(value, t.unit).to(cellunit.stored_unit(t))
 
     def _bind(self, fname: str, params, args, kwargs) -> dict:
         if len(args) > len(params):
@@ -439,7 +436,10 @@ class Sheet:
                     f"row(s); the first: {column.failed[row]}",
                     definition=what,
                 )
-            self._memo[key] = column.values
+            # max_over() is typed in the column's unit, the column held as its cells hold it
+            typed = tc.column_type(self.typer, col, spec.range.var, what)
+            factor = cellunit.read_factor(typed)
+            self._memo[key] = column.values if factor == 1.0 else column.values * factor
         return self._memo[key]
 
     def describe_call(self, fname: str, params, env) -> str:
@@ -519,9 +519,7 @@ class Sheet:
                 t = self.typer.convert(
                     t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}"
                 )
-            elif un.is_compound_ratio(t.unit):
-                t = self.typer.convert(t, un.registry().dimensionless, what)
-            return t
+            return cellunit.in_cell(self.typer.convert, t, what)
         except WorkbookError as err:
             raise self._locate(err, what) from None
 

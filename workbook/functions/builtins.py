@@ -445,6 +445,22 @@ def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
     return ty.TFunc(body.unit, func=name, args=(body, var, a, b), shape=body.shape)
 
 
+#: terms of the live form of a sum or product whose bounds depend on inputs: an edit that
+#: asks for more (or for a bound that is not an integer) shows #N/A
+MAX_LIVE_TERMS = 32
+
+
+def live_terms(body, lo: str, hi: str, op: str, empty: str) -> str:
+    """EXPR at lo, lo + 1, ... up to hi, for bounds that follow the inputs: MAX_LIVE_TERMS
+    terms, each ``IF(lo+k<=hi, EXPR(lo+k), empty)`` (Excel computes only the branch it takes,
+    so a term past hi is never evaluated), joined by ``op``."""
+    lo, hi = f"({lo})", f"({hi})"
+    at = [lo] + [f"({lo}+{k})" for k in range(1, MAX_LIVE_TERMS)]
+    terms = [f"IF({x}<={hi},{body(x)},{empty})" for x in at]
+    guard = f"OR({hi}-{lo}+1>{MAX_LIVE_TERMS},{lo}<>INT({lo}),{hi}<>INT({hi}))"
+    return f"IF({guard},NA(),{op.join(terms)})"
+
+
 def sum_index(value, which: str) -> int:
     x = float(np.asarray(value, dtype=float).flat[0])
     if not math.isfinite(x) or x != math.floor(x):
@@ -490,8 +506,8 @@ def _sum_excel(body, args=None, consts=None, *, shapes=None) -> tuple[str, int]:
     if shapes is not None:  # sum(v): body is the printed vector
         return f"SUM({body[0]})", PREC["atom"]
     lo, hi = consts
-    if lo is None or hi is None:
-        raise NotLive("sum() with bounds that are not constants has no live formula")
+    if lo is None or hi is None:  # bounds that follow the inputs
+        return live_terms(body, args[0], args[1], "+", "0"), PREC["atom"]
     lo, hi = sum_index(lo, "first"), sum_index(hi, "last")
     if hi < lo:
         return "0", PREC["atom"]

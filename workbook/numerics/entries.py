@@ -241,18 +241,23 @@ def _live_chain(of, a, b, steps_of) -> dict[str, np.ndarray]:
 
 def _golden(f, a, b, idx, kind: str, of) -> dict:
     """What the workbook's live extremum computes, row by row: EXPR at the 4 x samples + 1
-    points A + (B-A)*j/m, the first best sample k, then GOLDEN_STEPS golden-section steps on
-    [x(k-1), x(k+1)] (c = hi - (hi-lo)*g, d = lo + (hi-lo)*g, the side of the better of f(c),
-    f(d) kept, the left one when they are within SAME of each other); the result is f at the
-    middle of the last bracket, or the best sample where that is better by more than SAME."""
+    points A + (B-A)*j/m, the first sample k as good as the best to SAME, then GOLDEN_STEPS
+    golden-section steps on [x(k-1), x(k+1)] (c = hi - (hi-lo)*g, d = lo + (hi-lo)*g, the
+    side of the better of f(c), f(d) kept, the left one when they are within SAME of each
+    other); the result is f at the middle of the last bracket, or the best sample where that
+    is better by more than SAME."""
     m = 4 * of.tolerance.samples
     sign = 1.0 if kind == "max" else -1.0
     width = b - a
     xs = [a + width * j / m for j in range(m + 1)]
     fs = [np.broadcast_to(np.asarray(f(x, idx), dtype=float), a.shape) for x in xs]
-    stack = sign * np.vstack(fs)
-    k = np.argmax(stack, axis=0)  # the first best sample
-    best = np.take_along_axis(np.vstack(fs), k[None], axis=0)[0]
+    values = np.vstack(fs)
+    top = np.max(sign * values, axis=0) * sign  # the best sample's value
+    # the first sample as good as the best to SAME (the workbook's samples, computed by
+    # another program, break a tie of two equal peaks the same way)
+    near = sign * (values - top) >= -SAME * (np.abs(values) + np.abs(top))
+    k = np.argmax(near, axis=0)
+    best = np.take_along_axis(values, k[None], axis=0)[0]
     lo = a + width * np.maximum(k - 1, 0) / m
     hi = a + width * np.minimum(k + 1, m) / m
     out = {"samples": fs, "k": k.astype(float), "lo": [lo], "hi": [hi], "fc": [], "fd": []}
@@ -625,6 +630,15 @@ def _close_to_engine(name: str, steps: dict) -> None:
         )
 
 
+def _first_best(kind: str, samples: str, m: int) -> str:
+    """Excel's position (from 0) of the first of the m + 1 samples (a row of cells) as good
+    as the best to SAME (as ``_golden``): m less the largest of (m - j) over the samples j
+    that are."""
+    near = _not_worse(kind, samples, f"{kind.upper()}({samples})")
+    countdown = ",".join(str(m - j) for j in range(m + 1))
+    return f"{m}-SUMPRODUCT(MAX(({near})*{{{countdown}}}))"
+
+
 def _not_worse(kind: str, p: str, q: str) -> str:
     """Excel's test that EXPR at p is at least as good as at q, to SAME (as ``_golden``)."""
     diff = f"{p}-{q}" if kind == "max" else f"{q}-{p}"
@@ -665,8 +679,9 @@ def _extremum_excel(name: str):
         for j in range(m + 1):
             write(j, "=" + body(x(str(j))), steps["samples"][j])
         samples = f"{ref(0)}:{ref(m).split('!')[1]}"
-        best, k = f"{kind.upper()}({samples})", ref(m + 1)
-        write(m + 1, f"=MATCH({best},{samples},0)-1", steps["k"])
+        k = ref(m + 1)
+        write(m + 1, "=" + _first_best(kind, samples, m), steps["k"])
+        best = f"INDEX({samples},1,{k}+1)"
         g = repr(GOLDEN)
         col = m + 2
         for s in range(n + 1):
@@ -706,11 +721,11 @@ def _integral_excel(body, args, consts) -> tuple[str, int]:
 
 
 def _product_excel(body, args, consts) -> tuple[str, int]:
-    from ..functions.builtins import MAX_EXCEL_TERMS, sum_index
+    from ..functions.builtins import MAX_EXCEL_TERMS, live_terms, sum_index
 
     lo, hi = consts
-    if lo is None or hi is None:
-        raise NotLive("product() with bounds that are not constants has no live formula")
+    if lo is None or hi is None:  # bounds that follow the inputs
+        return live_terms(body, args[0], args[1], "*", "1"), ATOM
     lo, hi = sum_index(lo, "first"), sum_index(hi, "last")
     if hi < lo:
         return "1", ATOM

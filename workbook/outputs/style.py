@@ -17,6 +17,9 @@ FORMATS: dict[str, dict] = {
     "pass": {"font_color": "#006100", "bg_color": "#C6EFCE"},
     "fail": {"font_color": "#9C0006", "bg_color": "#FFC7CE"},
     "wrap": {"text_wrap": True, "valign": "top"},
+    # a value that does not follow an edit of the inputs, and a live cell that reads one
+    "frozen": {"bg_color": "#D9D9D9", "italic": True, "num_format": "General"},
+    "stale": {"bg_color": "#FCE4D6", "num_format": "General"},
 }
 
 GRIDLINES = {"visible": True, "line": {"color": "#D9D9D9"}}
