@@ -212,6 +212,7 @@ def test_imported_names_are_chosen_as_by_the_scan():
                 mathcad=random.choice(["a", "b"]),
                 is_range=random.random() < 0.1,
                 final=None,
+                broken=False,
             )
             for _ in range(random.randint(1, 40))
         ]
