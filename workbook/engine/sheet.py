@@ -27,6 +27,7 @@ from ..language.template import (
     select_parts,
 )
 from ..language.typed import TConst
+from ..language.typedsheet import TypedSheet
 from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
@@ -47,6 +48,7 @@ class Sheet:
         values: dict[str, Any] | None = None,
         typer: tc.Typer | None = None,
         parts=None,
+        typed: TypedSheet | None = None,
     ):
         self.full_spec = spec
         self.parts = resolve_parts(spec, parts)
@@ -56,6 +58,8 @@ class Sheet:
         )
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
         self.typer = typer or tc.Typer(spec, input_units)
+        # the trees typed at load besides the definitions' (shared by with_inputs, with_parts)
+        self.typed = typed if typed is not None else TypedSheet()
         self._memo: dict[str, object] = {}
         # names evaluated through this sheet (by blocks, among others): what a block table or
         # a finding reads counts as used, without a hand-kept list in the template
@@ -128,6 +132,46 @@ class Sheet:
                 self.typer.function(d.name)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
+        self._type_ranges_and_printed()
+
+    def _type_ranges_and_printed(self) -> None:
+        """Type at load the range bounds of every table and chart series and the formulas of
+        the printed values (the rows of their files, read once): the compute stage reads the
+        trees. One that fails is left for the table, chart or check that shows its error."""
+        ranges = [(t.range, f"table {t.name}") for t in self.full_spec.tables if t.range]
+        for c in self.full_spec.charts:
+            ranges += [(s.range or c.range, f"chart {c.name}") for s in c.series if s.table is None]
+        for rng, what in ranges:
+            try:
+                self.range_bounds(rng, what)
+                if rng.points is not None:
+                    self.range_points(rng, what)
+            except WorkbookError:
+                pass
+        for p in self.full_spec.printed:
+            try:
+                rows = p.rows()
+            except WorkbookError:
+                continue
+            for row in rows:
+                at = None if math.isnan(row.at) else row.at
+                try:
+                    self.typed_printed(row.name, at, p.argument, row.unit)
+                except WorkbookError:
+                    pass
+
+    def typed_printed(self, name: str, at: float | None, argument: str, unit: str) -> ty.T:
+        """The formula of a printed value in its printed unit: ``name``, or the function
+        ``name`` at ``at`` of its ``argument`` (typed at load)."""
+
+        def typed() -> ty.T:
+            node = ex.Name(name)
+            if at is not None and argument:
+                node = ex.Call(name, (ex.Number(float(at)),))
+            t = self.typer.expression(node, {}, f"check {name}")
+            return self.typer.convert(t, un.unit(unit), "check")
+
+        return self.typed.tree(None, ("printed", name, at, bool(argument), unit), typed)
 
     def check_not_circular(self, block) -> None:
         """Refuse a [[solve]] block whose equations use a definition that needs one of its
@@ -183,12 +227,12 @@ class Sheet:
                 values[name] = coerce_input(spec, raw, file=self.file)
             except WorkbookError as err:  # point at the input's declaration (unit, bounds)
                 raise err.located(file=self.file, line=spec.line, definition=name) from None
-        return Sheet(self.full_spec, values, self.typer, self.parts)
+        return Sheet(self.full_spec, values, self.typer, self.parts, self.typed)
 
     def with_parts(self, *names: str) -> Sheet:
         """The same sheet computing and writing the optional parts ``names`` (``"all"``: every
         part; none: only what is not in a part). See ``[parts]`` in docs/language.md."""
-        return Sheet(self.full_spec, self.values, self.typer, names)
+        return Sheet(self.full_spec, self.values, self.typer, names, self.typed)
 
     @property
     def left_out(self) -> list[str]:
@@ -454,7 +498,10 @@ class Sheet:
 
     def range_bounds(self, rng: RangeSpec, what: str = "range") -> list[ty.T | None]:
         """The typed first, second (or None) and last value of a range, in the range
-        variable's declared unit (a plain number is taken as already in it)."""
+        variable's declared unit (a plain number is taken as already in it); typed at load."""
+        return self.typed.tree(rng, "bounds", lambda: self._typed_bounds(rng, what))
+
+    def _typed_bounds(self, rng: RangeSpec, what: str) -> list[ty.T | None]:
         spec = self.spec.arguments.get(rng.var)
         out: list[ty.T | None] = []
         for node, unit in zip((rng.first, rng.second, rng.last), rng.units):
@@ -483,10 +530,18 @@ class Sheet:
             for t in self.range_bounds(rng, what)
         ]
         if rng.points is not None:  # logspace(first, last, points)
-            points = self.typer.plain(self.typer.expression(rng.points, {}, what), what)
+            points = self.range_points(rng, what)
             n = float(self.evaluator.compile(points)({}))
             return log_range_values(nums[0], nums[2], n, what=what)
         return range_values(nums[0], nums[1], nums[2], what=what)
+
+    def range_points(self, rng: RangeSpec, what: str = "range") -> ty.T:
+        """The typed number of points of a log range (``points``), typed at load."""
+        return self.typed.tree(
+            rng,
+            "points",
+            lambda: self.typer.plain(self.typer.expression(rng.points, {}, what), what),
+        )
 
     def _scope(self, var: str) -> dict:
         spec = self.spec.arguments.get(var)
@@ -497,6 +552,11 @@ class Sheet:
         return column_node(self.spec, col, var)
 
     def typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
+        """The typed tree of a table column or chart series over range variable ``var``, in
+        the unit it is shown in (typed at load)."""
+        return self.typed.tree(col, ("column", var), lambda: self._typed_column(col, var, what))
+
+    def _typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
         try:
             t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
             if col.unit is not None:
