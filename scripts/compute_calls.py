@@ -10,8 +10,9 @@ the report's HTML is rendered (what ``workbook run`` and ``workbook report`` do 
 The typer is every function of ``workbook/language/typecheck.py`` and of its bases
 (``typearrays.py``, ``unitrules.py``): ``Typer.expression`` types a free expression,
 ``Typer.scalar`` and ``Typer.function`` type a definition or return its typed tree when it is
-typed already. A parse is a call of ``workbook.language.expr.parse``; a printed-value file
-read is a call of ``workbook.language.printed.read_printed``.
+typed already; "typing" counts the calls that type a tree (``Typer.expression``, a
+``visit_`` method, a conversion, a definition's body). A parse is a call of
+``workbook.language.expr.parse``; a printed-value file read, of ``printed.read_printed``.
 """
 
 from __future__ import annotations
@@ -38,7 +39,10 @@ TYPER = (
 PARSE = ("workbook/language/expr.py", "parse")
 PRINTED = ("workbook/language/printed.py", "read_printed")
 #: the functions shown by name in the table (the others of the typer are summed in "typer")
-SHOWN = ("Typer.expression", "Typer.scalar", "Typer.function")
+SHOWN = ("typecheck.expression", "typecheck.scalar", "typecheck.function")
+#: the typer's functions that type a tree (the others return trees typed before, or answer
+#: questions about units and names): "typing" counts these and every visit_ method
+TYPING = ("expression", "_typed_body", "specialized", "convert", "plain", "program_body")
 
 
 def sheets() -> list[str]:
@@ -60,8 +64,9 @@ def counted(run) -> Counter:
         path = file.replace("\\", "/")
         if any(path.endswith("/" + m) for m in TYPER):
             out["typer"] += calls
-            name = function.rsplit(".", 1)[-1]
-            out[f"Typer.{name}"] += calls
+            out[f"{Path(path).stem}.{function}"] += calls
+            if function in TYPING or function.startswith("visit_"):
+                out["typing"] += calls
         elif path.endswith("/" + PARSE[0]) and function == PARSE[1]:
             out["parse"] += calls
         elif path.endswith("/" + PRINTED[0]) and function == PRINTED[1]:
@@ -90,11 +95,11 @@ def calls(name: str) -> Counter:
 
 
 def main(names: list[str]) -> None:
-    heads = ["sheet", "typer", *(s.split(".")[1] for s in SHOWN), "parse", "printed"]
+    heads = ["sheet", "typer", "typing", *(s.split(".")[1] for s in SHOWN), "parse", "printed"]
     print(" | ".join(heads))
     for name in names or sheets():
         found = calls(name)
-        row = [name, found["typer"], *(found[s] for s in SHOWN), found["parse"]]
+        row = [name, found["typer"], found["typing"], *(found[s] for s in SHOWN), found["parse"]]
         print(" | ".join(str(v) for v in [*row, found["printed"]]))
 
 

@@ -755,7 +755,10 @@ class Sheet:
         from ..outputs.xlsx import write_workbook
 
         check_target(Path(path), force=force)  # before any work
-        computed = compute(self, report=report, excel=True, command=command, verify=verify)
+        if report is None or report is self._memo.get(("check",)):
+            computed = self.computed(excel=True, command=command, verify=verify)
+        else:  # a report made elsewhere: this workbook's own
+            computed = compute(self, report=report, excel=True, command=command, verify=verify)
         if refusals is not None:
             refusals.extend(computed.excel.refusals)
         return write_workbook(computed, Path(path), force=force)
@@ -766,13 +769,26 @@ class Sheet:
         from ..outputs.report import report_targets, write_report
 
         path, _ = report_targets(self.name, path, pdf=pdf, force=options.get("force", False))
-        return write_report(compute(self), path, pdf=pdf, **options)[0]
+        return write_report(self.computed(), path, pdf=pdf, **options)[0]
+
+    def computed(self, *, excel: bool = False, command: str | None = None, verify: bool = True):
+        """This sheet computed (a :class:`workbook.compute.computed.ComputedSheet`), once per
+        Sheet and kind: as the report and the notebook view show it, or with ``excel`` as the
+        workbook writes it (once per ``command`` and ``verify``). A Sheet does not change (other
+        inputs or parts are another Sheet), so what is computed is reused."""
+        key = ("computed", excel, command if excel else None, verify if excel else None)
+        if key not in self._memo:
+            self._memo[key] = compute(self, excel=excel, command=command, verify=verify)
+        return self._memo[key]
 
     def check(self):
-        """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`."""
+        """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`,
+        made once per Sheet (the workbook's and the report's Checks read it)."""
         from ..compute.checks import run_checks
 
-        return run_checks(self)
+        if ("check",) not in self._memo:
+            self._memo[("check",)] = run_checks(self)
+        return self._memo[("check",)]
 
     def unused_inputs(self) -> list[str]:
         """Inputs that no table, chart, printed value, check or scalar definition (each is on
@@ -786,7 +802,7 @@ class Sheet:
     def _repr_html_(self) -> str:
         from ..outputs.notebook import sheet_html
 
-        return sheet_html(self)
+        return sheet_html(self.computed())
 
 
 #: A column with more failed rows than this is an error, not a table with error cells.
