@@ -170,7 +170,10 @@ def type_checks(sheet) -> None:
 
 def _typed_value(sheet, spec: CheckSpec):
     """The typed value and the factor that shows it in its unit (typed at load, then read)."""
-    return sheet.typed.tree(spec, "value", lambda: _value_typed(sheet, spec))
+    found = sheet.typed.get(spec, "value")
+    return (
+        found if found is not None else sheet.typed.keep(spec, "value", _value_typed(sheet, spec))
+    )
 
 
 def _value_typed(sheet, spec: CheckSpec):
@@ -185,7 +188,10 @@ def _value_typed(sheet, spec: CheckSpec):
 
 def _typed_condition(sheet, spec: CheckSpec):
     """The typed condition ``ok`` (typed at load, then read)."""
-    return sheet.typed.tree(spec, "ok", lambda: _condition_typed(sheet, spec))
+    found = sheet.typed.get(spec, "ok")
+    return (
+        found if found is not None else sheet.typed.keep(spec, "ok", _condition_typed(sheet, spec))
+    )
 
 
 def _condition_typed(sheet, spec: CheckSpec):
@@ -200,7 +206,10 @@ def _condition_typed(sheet, spec: CheckSpec):
 def _typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None):
     """A placeholder's typed tree, factor and unit shown (typed at load, then read)."""
     key = ("placeholder", expression, unit)
-    return sheet.typed.tree(spec, key, lambda: _placeholder_typed(sheet, spec, expression, unit))
+    found = sheet.typed.get(spec, key)
+    if found is None:
+        found = sheet.typed.keep(spec, key, _placeholder_typed(sheet, spec, expression, unit))
+    return found
 
 
 def _placeholder_typed(sheet, spec: CheckSpec, expression: str, unit: str | None):

@@ -27,7 +27,7 @@ from ..language.template import (
     select_parts,
 )
 from ..language.typed import TConst
-from ..language.typedsheet import TypedSheet
+from ..language.typedsheet import TypedSheet, printed_rows
 from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
@@ -150,7 +150,7 @@ class Sheet:
                 pass
         for p in self.full_spec.printed:
             try:
-                rows = p.rows()
+                rows = printed_rows(p)
             except WorkbookError:
                 continue
             for row in rows:
@@ -164,14 +164,23 @@ class Sheet:
         """The formula of a printed value in its printed unit: ``name``, or the function
         ``name`` at ``at`` of its ``argument`` (typed at load)."""
 
-        def typed() -> ty.T:
+        def typed() -> ty.T | WorkbookError:
             node = ex.Name(name)
             if at is not None and argument:
                 node = ex.Call(name, (ex.Number(float(at)),))
-            t = self.typer.expression(node, {}, f"check {name}")
-            return self.typer.convert(t, un.unit(unit), "check")
+            try:
+                t = self.typer.expression(node, {}, f"check {name}")
+                return self.typer.convert(t, un.unit(unit), "check")
+            except WorkbookError as err:  # kept: the workbook writes the value as a number
+                return err
 
-        return self.typed.tree(None, ("printed", name, at, bool(argument), unit), typed)
+        key = ("printed", name, at, bool(argument), unit)
+        t = self.typed.get(None, key)
+        if t is None:
+            t = self.typed.keep(None, key, typed())
+        if isinstance(t, WorkbookError):
+            raise t.reworded(t.message)
+        return t
 
     def check_not_circular(self, block) -> None:
         """Refuse a [[solve]] block whose equations use a definition that needs one of its
@@ -499,7 +508,12 @@ class Sheet:
     def range_bounds(self, rng: RangeSpec, what: str = "range") -> list[ty.T | None]:
         """The typed first, second (or None) and last value of a range, in the range
         variable's declared unit (a plain number is taken as already in it); typed at load."""
-        return self.typed.tree(rng, "bounds", lambda: self._typed_bounds(rng, what))
+        found = self.typed.get(rng, "bounds")
+        return (
+            found
+            if found is not None
+            else self.typed.keep(rng, "bounds", self._typed_bounds(rng, what))
+        )
 
     def _typed_bounds(self, rng: RangeSpec, what: str) -> list[ty.T | None]:
         spec = self.spec.arguments.get(rng.var)
@@ -537,11 +551,11 @@ class Sheet:
 
     def range_points(self, rng: RangeSpec, what: str = "range") -> ty.T:
         """The typed number of points of a log range (``points``), typed at load."""
-        return self.typed.tree(
-            rng,
-            "points",
-            lambda: self.typer.plain(self.typer.expression(rng.points, {}, what), what),
-        )
+        found = self.typed.get(rng, "points")
+        if found is None:
+            t = self.typer.plain(self.typer.expression(rng.points, {}, what), what)
+            found = self.typed.keep(rng, "points", t)
+        return found
 
     def _scope(self, var: str) -> dict:
         spec = self.spec.arguments.get(var)
@@ -554,7 +568,10 @@ class Sheet:
     def typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
         """The typed tree of a table column or chart series over range variable ``var``, in
         the unit it is shown in (typed at load)."""
-        return self.typed.tree(col, ("column", var), lambda: self._typed_column(col, var, what))
+        found = self.typed.get(col, ("column", var))
+        if found is None:
+            found = self.typed.keep(col, ("column", var), self._typed_column(col, var, what))
+        return found
 
     def _typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
         try:

@@ -298,22 +298,8 @@ class PrintedSpec:
     note: str = ""
     part: str | None = None
     folder: Path | None = None  # the template's folder: the file must resolve inside it
-    # the rows of the file once read, or the error reading it (see rows)
+    # the rows of the file once read, or the error reading it (typedsheet.printed_rows)
     read: Any = field(default=None, init=False, repr=False, compare=False)
-
-    def rows(self) -> list:
-        """The rows of the file (``printed.PrintedRow``), read once; a file that cannot be
-        read raises its error each time it is asked."""
-        if self.read is None:
-            from .printed import read_printed
-
-            try:
-                self.read = read_printed(self)
-            except WorkbookError as err:
-                self.read = err
-        if isinstance(self.read, WorkbookError):
-            raise self.read.reworded(self.read.message)
-        return self.read
 
 
 @dataclass

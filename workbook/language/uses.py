@@ -14,6 +14,7 @@ from . import expr as ex
 from . import typecheck as tc
 from .ranges import RangeSpec
 from .template import SheetSpec, column_node
+from .typedsheet import printed_rows
 
 
 def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
@@ -71,6 +72,6 @@ def names_used(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> set[s
 def printed_names(p) -> set[str]:
     """Names of a printed-values file (none if it cannot be read: the checks report that)."""
     try:
-        return {row.name for row in p.rows()}
+        return {row.name for row in printed_rows(p)}
     except WorkbookError:
         return set()
