@@ -135,17 +135,24 @@ class Sheet:
         self._type_ranges_and_printed()
 
     def _type_ranges_and_printed(self) -> None:
-        """Type at load the range bounds of every table and chart series and the formulas of
-        the printed values (the rows of their files, read once): the compute stage reads the
-        trees. One that fails is left for the table, chart or check that shows its error."""
-        ranges = [(t.range, f"table {t.name}") for t in self.full_spec.tables if t.range]
+        """Type at load the range bounds of every table and chart series, the x of each series
+        over a range and the formulas of the printed values (the rows of their files, read
+        once): the compute stage reads the trees. One that fails is left for the table, chart
+        or check that shows its error."""
+        ranges = [(t.range, None, f"table {t.name}") for t in self.full_spec.tables if t.range]
         for c in self.full_spec.charts:
-            ranges += [(s.range or c.range, f"chart {c.name}") for s in c.series if s.table is None]
-        for rng, what in ranges:
+            ranges += [
+                (s.range or c.range, s.x or c.x, f"chart {c.name}")
+                for s in c.series
+                if s.table is None
+            ]
+        for rng, x, what in ranges:
             try:
                 self.range_bounds(rng, what)
                 if rng.points is not None:
                     self.range_points(rng, what)
+                if x is not None:
+                    self.typed_column(x, rng.var, what)
             except WorkbookError:
                 pass
         for p in self.full_spec.printed:
