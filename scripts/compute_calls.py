@@ -42,7 +42,8 @@ PRINTED = ("workbook/language/printed.py", "read_printed")
 SHOWN = ("typecheck.expression", "typecheck.scalar", "typecheck.function")
 #: the typer's functions that type a tree (the others return trees typed before, or answer
 #: questions about units and names): "typing" counts these and every visit_ method
-TYPING = ("expression", "_typed_body", "specialized", "convert", "plain", "program_body")
+#: (a failure remembered is raised again without typing: Typer.specialized is not counted)
+TYPING = ("expression", "_typed_body", "convert", "plain", "program_body")
 
 
 def sheets() -> list[str]:
