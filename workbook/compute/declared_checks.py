@@ -68,6 +68,8 @@ class CheckSpec:
     example_only: bool | tuple[str, ...] = False
     part: str | None = None
     line: int | None = None
+    # the expression of every placeholder of ``what`` and ``note``, parsed: text -> node
+    parsed: dict[str, ex.Node] = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -105,7 +107,7 @@ def read_check(raw: dict, line: int | None) -> CheckSpec:
         )
         for piece in (spec.what, spec.note):
             for expression, _ in placeholders(piece):
-                ex.parse(expression, what=f"check {text!r}")
+                spec.parsed[expression] = ex.parse(expression, what=f"check {text!r}")
         if spec.unit is not None:
             un.unit(spec.unit, what=f"check {text!r}")
     except WorkbookError as err:
@@ -168,6 +170,14 @@ def type_checks(sheet) -> None:
 
 
 def _typed_value(sheet, spec: CheckSpec):
+    """The typed value and the factor that shows it in its unit (typed at load, then read)."""
+    found = sheet.typed.get(spec, "value")
+    return (
+        found if found is not None else sheet.typed.keep(spec, "value", _value_typed(sheet, spec))
+    )
+
+
+def _value_typed(sheet, spec: CheckSpec):
     if spec.value is None:
         return None, None
     t = sheet.typer.expression(spec.value, {}, spec.label)
@@ -178,6 +188,14 @@ def _typed_value(sheet, spec: CheckSpec):
 
 
 def _typed_condition(sheet, spec: CheckSpec):
+    """The typed condition ``ok`` (typed at load, then read)."""
+    found = sheet.typed.get(spec, "ok")
+    return (
+        found if found is not None else sheet.typed.keep(spec, "ok", _condition_typed(sheet, spec))
+    )
+
+
+def _condition_typed(sheet, spec: CheckSpec):
     if spec.ok is None:
         return None
     t = sheet.typer.expression(spec.ok, {}, spec.label)
@@ -187,7 +205,16 @@ def _typed_condition(sheet, spec: CheckSpec):
 
 
 def _typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None):
-    t = sheet.typer.expression(ex.parse(expression, what=spec.label), {}, spec.label)
+    """A placeholder's typed tree, factor and unit shown (typed at load, then read)."""
+    key = ("placeholder", expression, unit)
+    found = sheet.typed.get(spec, key)
+    if found is None:
+        found = sheet.typed.keep(spec, key, _placeholder_typed(sheet, spec, expression, unit))
+    return found
+
+
+def _placeholder_typed(sheet, spec: CheckSpec, expression: str, unit: str | None):
+    t = sheet.typer.expression(spec.parsed[expression], {}, spec.label)
     if getattr(t, "boolean", False) or t.shape:
         raise TemplateError(f"{{{expression}}} must be one number or a text")
     if getattr(t, "text", False) or getattr(t, "kind", None) == "choice":  # a choice is text

@@ -1063,12 +1063,8 @@ class ExcelLayout:
 
     def _write_checked_value(self, ws, row, r) -> bool:
         """Computed value as a live formula: the function at the printed argument, in its unit."""
-        node = ex.Name(r.name)
-        if r.at is not None and r.argument:
-            node = ex.Call(r.name, (ex.Number(float(r.at)),))
         try:
-            t = self.sheet.typer.expression(node, {}, f"check {r.name}")
-            t = self.sheet.typer.convert(t, un.unit(r.unit), "check")
+            t = self.sheet.typed_printed(r.name, r.at, r.argument, r.unit)
             self._write_cell_plain(ws, row, 5, t, r.computed)
             return True
         except NotLive:

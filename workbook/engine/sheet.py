@@ -36,6 +36,7 @@ from ..language.template import (
     select_parts,
 )
 from ..language.typed import TConst
+from ..language.typedsheet import TypedSheet, printed_rows
 from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
@@ -57,6 +58,7 @@ class Sheet:
         values: dict[str, Any] | None = None,
         typer: tc.Typer | None = None,
         parts=None,
+        typed: TypedSheet | None = None,
     ):
         self.full_spec = spec
         self.parts = resolve_parts(spec, parts)
@@ -66,6 +68,8 @@ class Sheet:
         )
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
         self.typer = typer or tc.Typer(spec, input_units)
+        # the trees typed at load besides the definitions' (shared by with_inputs, with_parts)
+        self.typed = typed if typed is not None else TypedSheet()
         self._memo: dict[str, object] = {}
         # names evaluated through this sheet (by blocks, among others): what a block table or
         # a finding reads counts as used, without a hand-kept list in the template
@@ -138,6 +142,62 @@ class Sheet:
                 self.typer.function(d.name)
             except WorkbookError as err:
                 raise err.located(file=self.file, line=d.line, definition=d.name) from None
+        self._type_ranges_and_printed()
+
+    def _type_ranges_and_printed(self) -> None:
+        """Type at load the range bounds of every table and chart series, the x of each series
+        over a range and the formulas of the printed values (the rows of their files, read
+        once): the compute stage reads the trees. One that fails is left for the table, chart
+        or check that shows its error."""
+        ranges = [(t.range, None, f"table {t.name}") for t in self.full_spec.tables if t.range]
+        for c in self.full_spec.charts:
+            ranges += [
+                (s.range or c.range, s.x or c.x, f"chart {c.name}")
+                for s in c.series
+                if s.table is None
+            ]
+        for rng, x, what in ranges:
+            try:
+                self.range_bounds(rng, what)
+                if rng.points is not None:
+                    self.range_points(rng, what)
+                if x is not None:
+                    self.typed_column(x, rng.var, what)
+            except WorkbookError:
+                pass
+        for p in self.full_spec.printed:
+            try:
+                rows = printed_rows(p)
+            except WorkbookError:
+                continue
+            for row in rows:
+                at = None if math.isnan(row.at) else row.at
+                try:
+                    self.typed_printed(row.name, at, p.argument, row.unit)
+                except WorkbookError:
+                    pass
+
+    def typed_printed(self, name: str, at: float | None, argument: str, unit: str) -> ty.T:
+        """The formula of a printed value in its printed unit: ``name``, or the function
+        ``name`` at ``at`` of its ``argument`` (typed at load)."""
+
+        def typed() -> ty.T | WorkbookError:
+            node = ex.Name(name)
+            if at is not None and argument:
+                node = ex.Call(name, (ex.Number(float(at)),))
+            try:
+                t = self.typer.expression(node, {}, f"check {name}")
+                return self.typer.convert(t, un.unit(unit), "check")
+            except WorkbookError as err:  # kept: the workbook writes the value as a number
+                return err
+
+        key = ("printed", name, at, bool(argument), unit)
+        t = self.typed.get(None, key)
+        if t is None:
+            t = self.typed.keep(None, key, typed())
+        if isinstance(t, WorkbookError):
+            raise t.reworded(t.message)
+        return t
 
     def check_not_circular(self, block) -> None:
         """Refuse a [[solve]] block whose equations use a definition that needs one of its
@@ -193,12 +253,12 @@ class Sheet:
                 values[name] = coerce_input(spec, raw, file=self.file)
             except WorkbookError as err:  # point at the input's declaration (unit, bounds)
                 raise err.located(file=self.file, line=spec.line, definition=name) from None
-        return Sheet(self.full_spec, values, self.typer, self.parts)
+        return Sheet(self.full_spec, values, self.typer, self.parts, self.typed)
 
     def with_parts(self, *names: str) -> Sheet:
         """The same sheet computing and writing the optional parts ``names`` (``"all"``: every
         part; none: only what is not in a part). See ``[parts]`` in docs/language.md."""
-        return Sheet(self.full_spec, self.values, self.typer, names)
+        return Sheet(self.full_spec, self.values, self.typer, names, self.typed)
 
     @property
     def left_out(self) -> list[str]:
@@ -470,7 +530,15 @@ class Sheet:
 
     def range_bounds(self, rng: RangeSpec, what: str = "range") -> list[ty.T | None]:
         """The typed first, second (or None) and last value of a range, in the range
-        variable's declared unit (a plain number is taken as already in it)."""
+        variable's declared unit (a plain number is taken as already in it); typed at load."""
+        found = self.typed.get(rng, "bounds")
+        return (
+            found
+            if found is not None
+            else self.typed.keep(rng, "bounds", self._typed_bounds(rng, what))
+        )
+
+    def _typed_bounds(self, rng: RangeSpec, what: str) -> list[ty.T | None]:
         spec = self.spec.arguments.get(rng.var)
         out: list[ty.T | None] = []
         for node, unit in zip((rng.first, rng.second, rng.last), rng.units):
@@ -499,10 +567,18 @@ class Sheet:
             for t in self.range_bounds(rng, what)
         ]
         if rng.points is not None:  # logspace(first, last, points)
-            points = self.typer.plain(self.typer.expression(rng.points, {}, what), what)
+            points = self.range_points(rng, what)
             n = float(self.evaluator.compile(points)({}))
             return log_range_values(nums[0], nums[2], n, what=what)
         return range_values(nums[0], nums[1], nums[2], what=what)
+
+    def range_points(self, rng: RangeSpec, what: str = "range") -> ty.T:
+        """The typed number of points of a log range (``points``), typed at load."""
+        found = self.typed.get(rng, "points")
+        if found is None:
+            t = self.typer.plain(self.typer.expression(rng.points, {}, what), what)
+            found = self.typed.keep(rng, "points", t)
+        return found
 
     def _scope(self, var: str) -> dict:
         spec = self.spec.arguments.get(var)
@@ -513,6 +589,14 @@ class Sheet:
         return column_node(self.spec, col, var)
 
     def typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
+        """The typed tree of a table column or chart series over range variable ``var``, in
+        the unit it is shown in (typed at load)."""
+        found = self.typed.get(col, ("column", var))
+        if found is None:
+            found = self.typed.keep(col, ("column", var), self._typed_column(col, var, what))
+        return found
+
+    def _typed_column(self, col: ColumnSpec, var: str, what: str) -> ty.T:
         try:
             t = self.typer.expression(self.column_node(col, var), self._scope(var), what)
             if col.unit is not None:
@@ -713,7 +797,10 @@ class Sheet:
         from ..outputs.xlsx import write_workbook
 
         check_target(Path(path), force=force)  # before any work
-        computed = compute(self, report=report, excel=True, command=command, verify=verify)
+        if report is None or report is self._memo.get(("check",)):
+            computed = self.computed(excel=True, command=command, verify=verify)
+        else:  # a report made elsewhere: this workbook's own
+            computed = compute(self, report=report, excel=True, command=command, verify=verify)
         if refusals is not None:
             refusals.extend(computed.excel.refusals)
         return write_workbook(computed, Path(path), force=force)
@@ -724,13 +811,26 @@ class Sheet:
         from ..outputs.report import report_targets, write_report
 
         path, _ = report_targets(self.name, path, pdf=pdf, force=options.get("force", False))
-        return write_report(compute(self), path, pdf=pdf, **options)[0]
+        return write_report(self.computed(), path, pdf=pdf, **options)[0]
+
+    def computed(self, *, excel: bool = False, command: str | None = None, verify: bool = True):
+        """This sheet computed (a :class:`workbook.compute.computed.ComputedSheet`), once per
+        Sheet and kind: as the report and the notebook view show it, or with ``excel`` as the
+        workbook writes it (once per ``command`` and ``verify``). A Sheet does not change (other
+        inputs or parts are another Sheet), so what is computed is reused."""
+        key = ("computed", excel, command if excel else None, verify if excel else None)
+        if key not in self._memo:
+            self._memo[key] = compute(self, excel=excel, command=command, verify=verify)
+        return self._memo[key]
 
     def check(self):
-        """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`."""
+        """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`,
+        made once per Sheet (the workbook's and the report's Checks read it)."""
         from ..compute.checks import run_checks
 
-        return run_checks(self)
+        if ("check",) not in self._memo:
+            self._memo[("check",)] = run_checks(self)
+        return self._memo[("check",)]
 
     def unused_inputs(self) -> list[str]:
         """Inputs that no table, chart, printed value, check or scalar definition (each is on
@@ -744,7 +844,7 @@ class Sheet:
     def _repr_html_(self) -> str:
         from ..outputs.notebook import sheet_html
 
-        return sheet_html(self)
+        return sheet_html(self.computed())
 
 
 #: A column with more failed rows than this is an error, not a table with error cells.

@@ -300,6 +300,8 @@ class PrintedSpec:
     note: str = ""
     part: str | None = None
     folder: Path | None = None  # the template's folder: the file must resolve inside it
+    # the rows of the file once read, or the error reading it (typedsheet.printed_rows)
+    read: Any = field(default=None, init=False, repr=False, compare=False)
 
 
 @dataclass

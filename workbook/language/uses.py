@@ -9,13 +9,12 @@ finds the ranges that show a function.
 
 from __future__ import annotations
 
-from ..compute.declared_checks import placeholders
 from ..errors import WorkbookError
 from . import expr as ex
 from . import typecheck as tc
-from .printed import read_printed
 from .ranges import RangeSpec
 from .template import SheetSpec, column_node
+from .typedsheet import printed_rows
 
 
 def ranged_outputs(spec: SheetSpec) -> list[tuple[RangeSpec, list[ex.Node]]]:
@@ -60,8 +59,7 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
         for c in spec.checks:
             roots += [n for n in (c.value, c.ok) if n is not None]
             roots += [ex.Name(n) for n in c.inputs]
-            for piece in (c.what, c.note):
-                roots += [ex.parse(text) for text, _ in placeholders(piece)]
+            roots += list(c.parsed.values())  # the placeholders of what and note
     return roots
 
 
@@ -74,6 +72,6 @@ def names_used(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> set[s
 def printed_names(p) -> set[str]:
     """Names of a printed-values file (none if it cannot be read: the checks report that)."""
     try:
-        return {row.name for row in read_printed(p)}
+        return {row.name for row in printed_rows(p)}
     except WorkbookError:
         return set()
