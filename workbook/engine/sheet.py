@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import cmath
+import math
 from pathlib import Path
 from typing import Any
 
@@ -165,6 +166,12 @@ class Sheet:
                     self.typed_column(x, rng.var, what)
             except WorkbookError:
                 pass
+        for name, d in self.full_spec.definitions.items():
+            if not d.is_function:
+                try:
+                    self.scalar_typed(name)
+                except WorkbookError:
+                    pass
         for p in self.full_spec.printed:
             try:
                 rows = printed_rows(p)
@@ -331,7 +338,17 @@ class Sheet:
     def scalar_typed(self, name: str) -> ty.T:
         """The typed tree of scalar definition ``name`` in the unit it is shown in: a
         dimensionless product of units (``kg*mm/m^2/Pa/s^2``) becomes a plain number."""
-        return cellunit.in_cell(self.typer.convert, self.typer.scalar(name), f"'{name}'")
+        key = ("scalar", name)
+        t = self.typed.get(None, key)
+        if t is None:
+            try:
+                t = cellunit.in_cell(self.typer.convert, self.typer.scalar(name), f"'{name}'")
+            except WorkbookError as err:  # kept: the workbook and the report show it
+                t = err
+            self.typed.keep(None, key, t)
+        if isinstance(t, WorkbookError):
+            raise t.reworded(t.message)
+        return t
 
     def scalar_quantity(self, name: str) -> pint.Quantity | str:
         """The value of scalar definition ``name`` in the unit it is shown in (a text as
