@@ -11,6 +11,7 @@ from ..language.visitor import Visitor
 from . import names as nm
 from . import trees as tt
 from .functions import (
+    FIXED_ORDER,
     MATHCAD_FUNCTIONS,
     OPERATOR_FUNCTIONS,
     OPERATOR_FUNCTIONS_2,
@@ -437,6 +438,9 @@ class ExprTranslator(Visitor):
                     raise Untranslatable(f"{text}() with {len(args)} arguments")
                 args = [args[i] for i in order]
             return self._builtin(name, text, [self.value(a) for a in args])
+        if text in FIXED_ORDER and not key[1] and len(args) == 1:
+            name, order = FIXED_ORDER[text]
+            return self._builtin(name, text, [ex.Number(float(order)), self.value(args[0])])
         if text in REFUSED and not key[1]:
             raise Untranslatable(f"Mathcad's {text}() {REFUSED[text]}")
         raise Untranslatable(
