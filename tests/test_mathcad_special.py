@@ -155,3 +155,22 @@ def test_prime_factorial_and_gamma(tmp_path, capsys):
     capsys.readouterr()
     result = check_sheet(tmp_path, capsys, "prime-special")
     assert (result["printed"], result["reproduced"]) == (2, 2), result
+
+
+def test_prime_vector_sum(tmp_path, capsys):
+    """Prime's vector sum Σv (Σ with empty placeholders for its variable and its upper bound)
+    is the sum of v's elements."""
+    ns = 'xmlns:ml="http://schemas.mathsoft.com/math50"'
+    v = matrix(real(1.5), real(2), real(4))
+    total = (
+        "<ml:apply><ml:summation/><ml:lambda><ml:boundVars><ml:placeholder/></ml:boundVars>"
+        f"{ident('v')}</ml:lambda><ml:upperBound><ml:placeholder/></ml:upperBound></ml:apply>"
+    )
+    regions = prime_region(1, 1, f"<ml:define {ns}>{ident('v')}{v}</ml:define>")
+    regions += prime_region(2, 2, f"<ml:eval {ns}>{total}</ml:eval>")
+    src = prime_package(tmp_path / "vector-sum.mcdx", regions, prime_result(2, real(7.5)))
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    assert '"sum(v)"' in (tmp_path / "vector-sum.toml").read_text(encoding="utf-8")
+    result = check_sheet(tmp_path, capsys, "vector-sum")
+    assert (result["printed"], result["reproduced"]) == (1, 1), result

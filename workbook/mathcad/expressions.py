@@ -30,6 +30,16 @@ if TYPE_CHECKING:
     from .translate import Translator
 
 
+def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
+    """Prime's vector sum: Σ whose bound variable and upper bound are empty placeholders."""
+    if len(bvars) != 1 or bvars[0].tag != "placeholder":
+        return False
+    rest = [a for a in args if a is not lam]
+    return all(
+        a.tag == "upperBound" and all(c.tag == "placeholder" for c in a.children) for a in rest
+    )
+
+
 class ExprTranslator(Visitor):
     """Mathcad math element -> expression tree, names resolved in a scope."""
 
@@ -224,6 +234,9 @@ class ExprTranslator(Visitor):
         if lam is None or len(lam.children) != 2:
             raise Untranslatable(f"{_what(tag)} without a bound variable")
         bvars = lam.children[0].children
+        if tag == "summation" and _vector_sum(bvars, args, lam):
+            # Prime's vector sum (Σv: Σ with empty placeholders) is the sum of v's elements
+            return self._builtin("sum", "the vector sum", [self.value(lam.children[1])])
         if len(bvars) != 1:
             raise Untranslatable(f"{_what(tag)} over {len(bvars)} variables")
         body, var = self.bound(bvars[0], lam.children[1])
