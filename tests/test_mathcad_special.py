@@ -16,6 +16,7 @@ from mathcad_xml import (
     define,
     ident,
     import_sheet,
+    index,
     matrix,
     prime_package,
     prime_region,
@@ -174,3 +175,29 @@ def test_prime_vector_sum(tmp_path, capsys):
     assert '"sum(v)"' in (tmp_path / "vector-sum.toml").read_text(encoding="utf-8")
     result = check_sheet(tmp_path, capsys, "vector-sum")
     assert (result["printed"], result["reproduced"]) == (1, 1), result
+
+
+def test_an_element_assignment_at_a_shifted_index(tmp_path, capsys):
+    """Data[i + N] := d[i] over i := 0 .. 2 (N := 2, d a vector of 3) sets Data[2..4] and keeps
+    Data[0], Data[1] of the vector before; E[j - 1] := j over j := 1 .. 2 is [1, 2]."""
+    span = "<ml:range>" + real(0) + real(2) + "</ml:range>"
+    shifted = index(ident("Data"), apply("plus", ident("i"), ident("N")))
+    d = matrix(real(7), real(8), real(9))
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "shifted",
+        define(1, ident("i"), span),
+        define(2, ident("N"), real(2)),
+        define(3, ident("d"), d),
+        define(4, ident("Data"), matrix(real(1), real(2))),
+        define(5, shifted, index(ident("d"), ident("i"))),
+        define(6, ident("s"), shown(index(ident("Data"), real(4)), real(9))),
+        define(7, ident("r"), shown(call("rows", ident("Data")), real(5))),
+        define(8, ident("j"), "<ml:range>" + real(1) + real(2) + "</ml:range>"),
+        define(9, index(ident("E"), apply("minus", ident("j"), real(1))), ident("j")),
+        define(10, ident("t"), shown(index(ident("E"), real(1)), real(2))),
+    )
+    assert "Data_of(0), Data_of(1), Data_of(2)]" in text
+    result = check_sheet(tmp_path, capsys, "shifted")
+    assert (result["printed"], result["reproduced"]) == (3, 3), result
