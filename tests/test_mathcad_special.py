@@ -201,3 +201,19 @@ def test_an_element_assignment_at_a_shifted_index(tmp_path, capsys):
     assert "Data_of(0), Data_of(1), Data_of(2)]" in text
     result = check_sheet(tmp_path, capsys, "shifted")
     assert (result["printed"], result["reproduced"]) == (3, 3), result
+
+
+def test_prime_math_inside_a_text_region_computes(tmp_path, capsys):
+    """Prime computes a math region placed inside a text region, where the text stands: its
+    definition is read by the regions after it."""
+    ns = 'xmlns:ml="http://schemas.mathsoft.com/math50"'
+    inner = prime_region(2, 1, f"<ml:define {ns}>{ident('w')}{real(3)}</ml:define>")
+    text = (
+        f'<region region-id="1"><text item-idref="none"><regions>{inner}</regions></text></region>'
+    )
+    shown_w = prime_region(3, 2, f"<ml:eval {ns}>{apply('mult', ident('w'), real(2))}</ml:eval>")
+    src = prime_package(tmp_path / "inline.mcdx", text + shown_w, prime_result(2, real(6)))
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    result = check_sheet(tmp_path, capsys, "inline")
+    assert (result["printed"], result["reproduced"]) == (1, 1), result
