@@ -130,6 +130,23 @@ def _cells_of(cells, function: str) -> list:
     return found[0]
 
 
+def test_excel_forms_are_excels_functions(tmp_path):
+    """Each call is printed as Excel's function (GAMMA with its prefix, BESSELJ x first)."""
+    from workbook.compute.excel import ExcelPrinter
+
+    text = '[inputs]\nx = "1.7"\nn = "7"\nk = "2"\n\n[definitions]\n'
+    text += "".join(f'{k} = "{v}"\n' for k, (v, _) in EXCEL_CASES.items())
+    sheet = workbook.load(write_template(tmp_path, text))
+    printer = ExcelPrinter(sheet.typer, {"x": "x_", "n": "n_", "k": "k_"})
+    printed = {name: printer.formula(sheet.typer.scalar(name), {}) for name in EXCEL_CASES}
+    assert printed["c_gamma"] == "=_xlfn.GAMMA(x_)"
+    assert printed["c_j"] == "=BESSELJ(x_, k_)"
+    assert printed["c_combin"] == "=COMBIN(n_, k_)"
+    for name, (_, function) in EXCEL_CASES.items():
+        assert function in printed[name], (name, printed[name])
+
+
+@pytest.mark.slow
 def test_excel_forms_agree_with_the_formulas_package(tmp_path):
     """Every live formula recalculated by `formulas` (which has no COMBIN: checked by
     LibreOffice below) agrees with the engine."""
