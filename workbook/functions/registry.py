@@ -1,18 +1,21 @@
 """The complete registry of built-in functions: the plain ones of
 :mod:`workbook.functions.builtins`, the distributions of :mod:`workbook.functions.distributions`,
 the numerical ones of :mod:`workbook.numerics.entries`, the complex ones of
-:mod:`workbook.functions.complexes`, the texts of :mod:`workbook.functions.texts` and the vector
-and matrix ones of :mod:`workbook.functions.matrix_entries`. Every back end reads built-ins from
-here, and the built-in constants (pi, e, g) as :data:`CONSTANTS`
-(:mod:`workbook.functions.constants`)."""
+:mod:`workbook.functions.complexes`, the texts of :mod:`workbook.functions.texts`, the vector and
+matrix ones of :mod:`workbook.functions.matrix_entries`, the special functions of
+:mod:`workbook.functions.special` and the decompositions of
+:mod:`workbook.functions.decompositions`. Every back end reads built-ins from here, and the
+built-in constants (pi, e, g) as :data:`CONSTANTS` (:mod:`workbook.functions.constants`)."""
 
 from __future__ import annotations
 
 from ..numerics import entries as _numerical  # noqa: F401 - root, integral, ..., diff register
 from . import builtins as _plain  # noqa: F401 - registers the plain built-ins on import
 from . import complexes as _complexes  # noqa: F401 - Re, Im, arg, conj, polar
+from . import decompositions as _decompositions  # noqa: F401 - cholesky, qr, svd
 from . import distributions as _distributions  # noqa: F401 - pnorm, qt, pchisq, ...
 from . import matrix_entries as _matrix  # noqa: F401 - min, max, mean, the vector and matrix built-ins
+from . import special as _special  # noqa: F401 - gamma, erf, Bessel functions, factorial
 from . import texts as _texts  # noqa: F401 - concat, num2str
 from .constants import CONSTANTS
 from .entry import ENTRIES

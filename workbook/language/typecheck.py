@@ -277,13 +277,14 @@ class Typer(ArrayTyping, UnitRules, Visitor):
     def _unknown(self, kind: str, name: str, scope=()) -> TemplateError:
         """``unknown name 'x'`` with the nearest names a formula of this sheet may use."""
         spec = self.spec
-        known = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
-        known.update(dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS]))
+        own = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
+        known = {**own, **dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS])}
         hint = nearest(name, known)
         if kind == "name":  # a value is meant: the sheet's names first (R1 is R_1, not Re())
             values = nearest(name, {k: v for k, v in known.items() if k not in REGISTRY})
             hint = values if values or un.is_unit_name(name) else hint
-        if kind == "name" and not hint and un.is_unit_name(name):
+        if kind == "name" and un.is_unit_name(name) and not nearest(name, own):
+            # a unit's name: the unit's hint before a built-in's that looks like it (mm, gamma)
             hint = f" (a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")
 

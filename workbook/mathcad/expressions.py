@@ -11,6 +11,7 @@ from ..language.visitor import Visitor
 from . import names as nm
 from . import trees as tt
 from .functions import (
+    FIXED_ORDER,
     MATHCAD_FUNCTIONS,
     OPERATOR_FUNCTIONS,
     OPERATOR_FUNCTIONS_2,
@@ -27,6 +28,16 @@ from .units import FORMULA_UNITS
 
 if TYPE_CHECKING:
     from .translate import Translator
+
+
+def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
+    """Prime's vector sum: Σ whose bound variable and upper bound are empty placeholders."""
+    if len(bvars) != 1 or bvars[0].tag != "placeholder":
+        return False
+    rest = [a for a in args if a is not lam]
+    return all(
+        a.tag == "upperBound" and all(c.tag == "placeholder" for c in a.children) for a in rest
+    )
 
 
 class ExprTranslator(Visitor):
@@ -223,6 +234,9 @@ class ExprTranslator(Visitor):
         if lam is None or len(lam.children) != 2:
             raise Untranslatable(f"{_what(tag)} without a bound variable")
         bvars = lam.children[0].children
+        if tag == "summation" and _vector_sum(bvars, args, lam):
+            # Prime's vector sum (Σv: Σ with empty placeholders) is the sum of v's elements
+            return self._builtin("sum", "the vector sum", [self.value(lam.children[1])])
         if len(bvars) != 1:
             raise Untranslatable(f"{_what(tag)} over {len(bvars)} variables")
         body, var = self.bound(bvars[0], lam.children[1])
@@ -437,6 +451,9 @@ class ExprTranslator(Visitor):
                     raise Untranslatable(f"{text}() with {len(args)} arguments")
                 args = [args[i] for i in order]
             return self._builtin(name, text, [self.value(a) for a in args])
+        if text in FIXED_ORDER and not key[1] and len(args) == 1:
+            name, order = FIXED_ORDER[text]
+            return self._builtin(name, text, [ex.Number(float(order)), self.value(args[0])])
         if text in REFUSED and not key[1]:
             raise Untranslatable(f"Mathcad's {text}() {REFUSED[text]}")
         raise Untranslatable(

@@ -49,6 +49,18 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "pF": ("pF", None), "qF": ("qF", None),
     "dexp": ("dexp", None), "pexp": ("pexp", None), "qexp": ("qexp", None),
     "dunif": ("dunif", None), "punif": ("punif", None), "qunif": ("qunif", None),
+    # special functions (workbook.functions.special) and decompositions; Γ(a, x), the
+    # incomplete gamma function, is not translated (one argument only)
+    "Γ": ("gamma", (0,)), "erf": ("erf", None), "erfc": ("erfc", None),
+    "Jn": ("bessel_j", None), "Yn": ("bessel_y", None), "In": ("bessel_i", None),
+    "Kn": ("bessel_k", None), "combin": ("combin", None), "permut": ("permut", None),
+    "cholesky": ("cholesky", None),
+}  # fmt: skip
+
+#: Mathcad's Bessel functions of a fixed order: ``J0(x)`` is ``bessel_j(0, x)``.
+FIXED_ORDER: dict[str, tuple[str, int]] = {
+    f"{letter}{order}": (f"bessel_{letter.lower()}", order)
+    for letter in "JYIK" for order in (0, 1)
 }  # fmt: skip
 
 #: Mathcad functions that are never translated, and why (a worksheet reads and writes no
@@ -75,6 +87,20 @@ REFUSED: dict[str, str] = {
     for name in ("rnd", "runif", "rnorm", "rbeta", "rbinom", "rcauchy", "rchisq", "rexp",
                  "rF", "rgamma", "rgeom", "rhypergeom", "rlnorm", "rlogis", "rnbinom",
                  "rpois", "rt", "rweibull", "rsample")
+} | {
+    # the language's qr and svd fix the signs their own way (R's diagonal >= 0, U's columns
+    # largest component positive); Mathcad's are its solver's, and no stored result shows them
+    name: "gives a decomposition whose signs are those of Mathcad's solver, which no stored "
+    f"result shows (the language's {name} fixes them its own way)"
+    for name in ("qr", "svd")
+} | {
+    "regress": "gives a vector whose first elements are Mathcad's own bookkeeping for interp "
+    "(the language fits a line with fit_slope and fit_intercept)",
+    "loess": "gives a vector of Mathcad's own local fits for interp, not a formula",
+    "linfit": "fits a combination of the functions of a vector of functions, which the language "
+    "has no value for",
+    "genfit": "fits by Mathcad's own nonlinear solver from a guess, with a vector of functions "
+    "the language has no value for",
 }  # fmt: skip
 
 #: Mathcad functions that write a value to a file (``WRITEPRN("f", M)``, or
@@ -94,6 +120,7 @@ OPERATOR_FUNCTIONS: dict[str, str] = {
     "sqrt": "sqrt", "absval": "abs", "transpose": "transpose",
     "determinant": "det",  # |M| written as the determinant operator
     "polyroots": "polyroots",  # the keyword form (its method: the roots are the same)
+    "factorial": "factorial",  # n!
 }  # fmt: skip
 
 #: Mathcad operators of two operands written as elements, and their built-in

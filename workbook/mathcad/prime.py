@@ -209,6 +209,9 @@ class _Regions:
                 out.append(self.math(el, content))
             elif tag == "text":
                 out.append(Region(kind="text", text=self.text(content), **self._base(el)))
+                inner = content.find(f"{{{WS50}}}regions")
+                if inner is not None:  # math regions inside the text compute where it stands
+                    self.collect(inner, out)
             elif tag == "solveblock":
                 self.solve_block(el, content, out)
             elif tag == "Area":

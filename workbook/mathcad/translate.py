@@ -607,6 +607,9 @@ class Translator(ResultsMixin, SolveMixin):
             raise Untranslatable("an element assignment to something that is not a name")
         key = _key(target)
         nodes = index.children if index.tag == "sequence" else [index]
+        shift = 0  # v[i + N] := f(i): the element at i + N, N a whole number known at import
+        if len(nodes) == 1 and (shifted := self._shifted_index(nodes[0])) is not None:
+            nodes, shift = [shifted[0]], shifted[1]
         ranges = [self.range_of(n) if n.tag == "id" else None for n in nodes]
         if all(r is None for r in ranges):
             self.element(region, key, lhs, rhs)
@@ -627,10 +630,10 @@ class Translator(ResultsMixin, SolveMixin):
             values = [[int(v) for v in u.range_values] for u in unique]
             if any(v != u.range_values for v, u in zip(values, unique)):
                 raise Untranslatable("an element assignment over a range of fractional values")
-            if any(min(v) < self.origin for v in values):
+            if any(min(v) + shift < self.origin for v in values):
                 raise Untranslatable("an element assignment below ORIGIN")
             old = None
-            reach = max(values[place[0]]) - self.origin + 1
+            reach = max(values[place[0]]) + shift - self.origin + 1
             if shown is not None and len(ranges) == 1 and shown == reach:
                 before = None  # Mathcad showed the range's elements only: none kept
             if before is not None:  # Mathcad keeps the elements the range does not reach
@@ -640,7 +643,7 @@ class Translator(ResultsMixin, SolveMixin):
                         "an element assignment over a range to a name defined before whose "
                         "size is not known at import"
                     )
-            size = [max(values[place[k]]) - self.origin + 1 for k in range(len(ranges))]
+            size = [max(values[place[k]]) + shift - self.origin + 1 for k in range(len(ranges))]
             if old is not None:
                 size = [max(n, old[k]) for k, n in enumerate(size)]
             if math.prod(size) > 10_000:
@@ -669,7 +672,7 @@ class Translator(ResultsMixin, SolveMixin):
             chosen: dict[int, int] = {}
             reached = True
             for k, a in enumerate(at):
-                u = place[k]
+                u, a = place[k], a - shift
                 if a not in values[u] or chosen.setdefault(u, a) != a:
                     reached = False
             if reached:
@@ -685,6 +688,29 @@ class Translator(ResultsMixin, SolveMixin):
         else:
             rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
         self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
+
+    def _shifted_index(self, node: MNode) -> tuple[MNode, int] | None:
+        """``i + N``, ``N + i`` or ``i - N`` (i a range variable, N a name or number that is
+        not one, a whole number known at import): (i, N or -N); else None."""
+        if node.tag != "apply" or len(node.children) != 3:
+            return None
+        op, a, b = node.children
+        if op.tag not in ("plus", "minus"):
+            return None
+        if op.tag == "plus" and self._is_range(b) and not self._is_range(a):
+            a, b = b, a
+        if not self._is_range(a) or b.tag not in ("id", "real") or self._is_range(b):
+            return None
+        try:
+            value = float(self.quantity(b).to("").magnitude)
+        except Exception:  # noqa: BLE001 - not a plain number known at import
+            return None
+        if not (math.isfinite(value) and value == int(value)):
+            return None
+        return a, int(value) if op.tag == "plus" else -int(value)
+
+    def _is_range(self, node: MNode) -> bool:
+        return node.tag == "id" and self.range_of(node) is not None
 
     def _shape_of(self, before: Sym) -> tuple[int, int] | None:
         """(rows, columns) of a vector or matrix the worksheet wrote out before (None: not
