@@ -536,15 +536,15 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             tr.definitions.append(d)
             continue
         try:
-            names = name_of
-            if run is not None:
-                moving = run.moving
-
-                def names(sheet, row, col, moving=moving):
-                    return moving.get((sheet, row, col)) or name_of(sheet, row, col)
-
             ft = FormulaTranslator(
-                book, cell.sheet, names, tr.functions, book.names, _block(cell), tr.ranges
+                book,
+                cell.sheet,
+                name_of,
+                tr.functions,
+                book.names,
+                _block(cell),
+                tr.ranges,
+                moving=run.moving if run is not None else None,
             )
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:
@@ -554,7 +554,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 for ref in ft.out.refs
                 for r in range(ref.r1, ref.r2 + 1)
                 for c in range(ref.c1, ref.c2 + 1)
-                if run is None or (ref.sheet, r, c) not in run.moving
+                if not getattr(ref, "moved", False)
             ]
         except FormulaProblem as exc:
             d.problem = str(exc)

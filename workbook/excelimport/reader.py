@@ -3,6 +3,7 @@ defined names and its array formulas; never a macro run, never an external link 
 
 from __future__ import annotations
 
+import re
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,6 +43,8 @@ class Book:
     path: Path
     sheets: dict[str, dict[tuple[int, int], Cell]] = field(default_factory=dict)
     names: dict[str, tuple[str, str]] = field(default_factory=dict)  # name -> (sheet, A1 ref)
+    #: defined names that are not one range: a constant (``0.5``) or a formula, as text
+    name_formulas: dict[str, str] = field(default_factory=dict)
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
 
     def cell(self, sheet: str, row: int, col: int) -> Cell | None:
@@ -133,11 +136,41 @@ def read_book(path: Path) -> Book:
                 cell.formula = cells[master].formula
                 cell.value = value
         book.sheets[ws.title] = cells
-    for name, dn in _defined_names(wb):
-        dests = list(getattr(dn, "destinations", []) or [])
-        if len(dests) == 1 and book.sheet_named(dests[0][0]):
-            book.names[name] = (book.sheet_named(dests[0][0]), dests[0][1].replace("$", ""))
+    read_names(book, _defined_names(wb))
     return book
+
+
+#: a defined name that is one reference: Sheet1!$A$1, 'Load table'!$B$2:$C$9
+_NAME_REF = re.compile(r"^(?:'(?:[^']|'')+'|[^'!*/+\-^&=<>(),\"]+)!\$?[A-Za-z]{1,3}\$?\d+"
+                       r"(?::\$?[A-Za-z]{1,3}\$?\d+)?$")
+
+
+def read_names(book: Book, items) -> None:
+    """Defined names: one range (``book.names``), else a constant or a formula
+    (``book.name_formulas``); a name whose text reads another workbook or a DDE link (``cmd|``)
+    is listed, never followed."""
+    for name, dn in items:
+        text = str(getattr(dn, "attr_text", None) or getattr(dn, "value", "") or "").strip()
+        text = text.removeprefix("=")
+        if not text:
+            continue
+        if "|" in text or "[" in text:
+            book.skipped.append(
+                (f"the defined name {name}", "a DDE or external link (never followed)")
+            )
+            continue
+        if _NAME_REF.match(text):
+            try:
+                dests = list(getattr(dn, "destinations", []) or [])
+            except Exception:  # noqa: BLE001 - openpyxl's tokenizer refuses the text
+                dests = []
+            if len(dests) == 1 and book.sheet_named(dests[0][0]):
+                book.names[name] = (book.sheet_named(dests[0][0]), dests[0][1].replace("$", ""))
+                continue
+        if "#REF!" in text.upper():
+            book.skipped.append((f"the defined name {name}", f"a broken reference ({text[:60]})"))
+            continue
+        book.name_formulas[name] = text
 
 
 def _defined_names(wb):

@@ -53,9 +53,36 @@ def _sheet_name(path: Path) -> str:
     return name or "imported"
 
 
+#: the first characters by which a spreadsheet opening a CSV reads a cell as a formula
+_LIVE = ("=", "+", "-", "@", "\t", "\r", "|", "%")
+
+
+def csv_text(text: str) -> str:
+    """A text from the imported file as a CSV cell that no spreadsheet reads as a formula
+    (``=cmd|' /C calc'!A0`` is written ``'=cmd|' /C calc'!A0``), on one line."""
+    text = text.replace("\r", " ").replace("\n", " ")
+    return "'" + text if text.startswith(_LIVE) else text
+
+
+def uncompared(text: str) -> str | None:
+    """Why a cached text is not compared (None: it is): one that a spreadsheet would read as a
+    formula or that spans lines (written escaped, so the comparison would be with the escaped
+    text), or one that the printed values would read as a number."""
+    if text.startswith(_LIVE) or "\n" in text or "\r" in text:
+        return "a text a spreadsheet reads as a formula: escaped, not compared"
+    try:
+        float(text)
+    except ValueError:
+        return None
+    return "a text that reads as a number: not compared"
+
+
 def _cached(value) -> tuple[str, str] | None:
-    """(kind, CSV text) of a cached value: a number, a text, an error; None if empty."""
-    if value is None or isinstance(value, bool):
+    """(kind, CSV text) of a cached value: a number, a text, an error; None if empty.
+    TRUE and FALSE are the numbers 1 and 0, as a comparison gives them."""
+    if isinstance(value, bool):
+        return ("number", "1.0" if value else "0.0")
+    if value is None:
         return None
     if isinstance(value, (int, float)):
         return ("number", repr(float(value)))
@@ -64,7 +91,7 @@ def _cached(value) -> tuple[str, str] | None:
             "#DIV/0", "#N/A", "#NAME", "#NULL", "#NUM", "#REF", "#VALUE", "#GETTING_DATA",
         ):  # fmt: skip
             return ("error", value)
-        if value == "":
+        if not value.strip():
             return None
         return ("text", value)
     return None
@@ -198,6 +225,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
     w.writerow(["name", "argument", "value", "unit"])
     printed = []
     files = {}
+    reasons: dict[str, str] = {}  # cell -> why its cached value is not compared
     if tables:
         doc["tables"] = list(tables.values())
     for label, group, arg in (("", rows, None), (".at", at_rows, "k_at"), (".rows", run_rows, ROW)):
@@ -212,10 +240,13 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         for n, at, (kind, text), ref in group:
             counts[kind + "s"] += 1
             if kind == "error":
-                out.write(f"# {ref}: Excel shows {text} (an error value: not compared)\n")
+                out.write(f"# {csv_text(ref)}: Excel shows {text} (an error value: not compared)\n")
                 continue
-            out.write(f"# {ref}\n")
-            w.writerow([n, at, text, ""])
+            if kind == "text" and uncompared(text):
+                reasons[ref] = uncompared(text)
+                continue
+            out.write(f"# {csv_text(ref)}\n")
+            w.writerow([n, at, csv_text(text) if kind == "text" else text, ""])
             counts["cells"][ref] = (n, float(at) if at else None)
         fname = f"{name}.excel{label}.csv"
         files[fname] = out.getvalue()
@@ -231,6 +262,18 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         if arg:
             entry["argument"] = arg
         printed.append(entry)
+    group = _not_translated_rows(tr, skip, counts, reasons)
+    if group:
+        fname = f"{name}.excel.not-translated.csv"
+        files[fname] = group
+        printed.append(
+            {
+                "file": fname,
+                "title": "Excel's cached values of the formula cells not translated",
+                "rel_tolerance": REL_TOLERANCE,
+                "tolerance": ABS_TOLERANCE,
+            }
+        )
     if printed:
         doc["printed"] = printed
     head = [
@@ -249,6 +292,48 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             head.append(f"#   ... and {len(listed) - 400} more")
     toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
     return toml, files, counts
+
+
+def _not_translated_rows(tr: Translation, skip: dict, counts: dict, reasons: dict) -> str:
+    """The CSV of the formula cells with a cached value (a number or a text) that no
+    translated definition gives: each is a printed value whose name says the cell and why, so
+    that ``workbook check`` counts it as not computable, with its reason."""
+    for d in tr.definitions:
+        why = d.problem or skip.get(d.name) or (d.element and skip.get(d.element[0]))
+        if why:
+            reasons.setdefault(d.cell.ref, why)
+            if d.run is not None:
+                for key in d.run.keys():
+                    reasons.setdefault(f"{key[0]}!{_addr(key[1], key[2])}", why)
+    for what, why in tr.listed:
+        reasons.setdefault(what.split(" ")[0], why)
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    out.write("# Excel's cached values of formula cells not translated (not computable)\n")
+    w.writerow(["name", "argument", "value", "unit"])
+    n = 0
+    for cells in tr.book.sheets.values():
+        for key in sorted(cells):
+            cell = cells[key]
+            if cell.formula is None or cell.ref in counts["cells"]:
+                continue
+            cached = _cached(cell.value)
+            if cached is None or cached[0] == "error":
+                continue
+            why = reasons.get(cell.ref, "beyond the formulas translated")
+            why = re.sub(r"\s+", " ", why)[:160]
+            value = csv_text(cached[1]) if cached[0] == "text" else cached[1]
+            w.writerow([csv_text(f"{cell.ref} (not translated: {why})"), "", value, ""])
+            counts["cells"][cell.ref] = None
+            n += 1
+    counts["not translated"] = n
+    return out.getvalue() if n else ""
+
+
+def _addr(row: int, col: int) -> str:
+    from openpyxl.utils import get_column_letter
+
+    return f"{get_column_letter(col)}{row}"
 
 
 def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
@@ -331,7 +416,7 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
         files=paths,
         definitions=n_def,
         functions=n_fn,
-        printed=counts["numbers"] + counts["texts"],
+        printed=counts["numbers"] + counts["texts"] + counts.get("not translated", 0),
         not_translated=list(tr.listed) + list(skip.items()),
         cells=counts["cells"],
     )
