@@ -90,6 +90,8 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
                 ).translate(parsed[_key(cell)].tree)
             except FormulaProblem:
                 pass
+            except Exception:  # noqa: BLE001 - listed with its reason when translated below
+                pass
     _name_cells(tr, cells, read, reserved)
     _runs(tr, cells, parsed, reserved)
     _name_params(tr, reserved)
@@ -131,13 +133,13 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
             body = "\n".join(t for _, t in proc.lines)
             if re.search(r"\bSolver\w*\b", body):
                 tr.listed.append((where, "runs Solver (a Solver model is not translated)"))
-            if proc.kind != "Function" or mod.document or is_event(proc):
+            if proc.kind != "Function" or (mod.document and not _host(mod)) or is_event(proc):
                 why = (
                     "an event procedure"
                     if is_event(proc)
                     else "a Sub (it writes cells or runs commands)"
                     if proc.kind == "Sub"
-                    else "in a sheet, workbook, class or form module"
+                    else "in a class or form module"
                     if mod.document
                     else "a Property"
                 )
@@ -168,6 +170,17 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
     tr.reserved_functions = {i.final.lower() for i in tr.functions.values()}  # type: ignore[attr-defined]
 
 
+#: the module of the workbook (ThisWorkbook) or of a worksheet, whose Public functions cells
+#: call as ``=ThisWorkbook.f(...)`` or ``=Sheet1.f(...)``
+_HOSTS = ("{00020819-", "{00020820-")
+
+
+def _host(mod: Module) -> bool:
+    """A ThisWorkbook or sheet module (not a class or a form)."""
+    m = re.search(r'^Attribute VB_Base = "([^"]+)"', mod.code, re.M)
+    return m is not None and any(h in m.group(1) for h in _HOSTS)
+
+
 def _module_consts(mod: Module) -> list[str]:
     return [
         line
@@ -176,16 +189,81 @@ def _module_consts(mod: Module) -> list[str]:
     ]
 
 
-def _module_vars(mod: Module) -> set[str]:
-    out = set()
+def _module_vars(mod: Module) -> dict[str, str]:
+    """{lower-case name: its declaration as a local ``Dim``} of the module's variables."""
+    out = {}
     for _, line in mod.declarations:
         m = re.match(
-            r"^(?:dim|public|private|global)\s+(?!const\b|declare\b|function\b|sub\b|type\b|enum\b)(\w+)",
+            r"^(?:dim|public|private|global|static)\s+(?!const\b|declare\b|function\b|sub\b|"
+            r"type\b|enum\b|withevents\b)(.+)$",
             line,
             re.I,
         )
-        if m:
-            out.add(m.group(1).lower())
+        if not m:
+            continue
+        for piece in _top_level_split(m.group(1)):
+            name = re.match(r"\s*(\w+)", piece)
+            if name:
+                out[name.group(1).lower()] = "Dim " + piece.strip()
+    return out
+
+
+def _top_level_split(text: str) -> list[str]:
+    """``a(1 To 3) As Double, b`` -> the declarations split at commas outside brackets."""
+    parts, depth, start = [], 0, 0
+    for i, ch in enumerate(text):
+        depth += ch == "("
+        depth -= ch == ")"
+        if ch == "," and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    return parts + [text[start:]]
+
+
+def _assigns(lines, name: str) -> bool:
+    """Whether a procedure's lines give the variable a value (``x = ...``, ``x(i) = ...``,
+    ``Set x = ...``, ``ReDim x(...)``)."""
+    target = re.compile(
+        rf"^(?:set\s+|let\s+)?{re.escape(name)}\s*(?:\([^=]*\))?\s*=|^redim\s+(?:preserve\s+)?"
+        rf"{re.escape(name)}\b",
+        re.I,
+    )
+    return any(target.match(t.strip()) for _, t in lines)
+
+
+def _module_state(tr: Translation, info: FunctionInfo, body: str) -> list[tuple[int, str]]:
+    """The module variables the function uses, as locals, where its value does not depend on
+    the order of calls: no other procedure gives the variable a value, and the function gives
+    it one before it reads it (or never gives it one: it is always Empty). Otherwise
+    NotTranslated, naming the variable."""
+    out = []
+    for name, decl in info.module_vars.items():  # type: ignore[attr-defined]
+        if not re.search(rf"\b{re.escape(name)}\b", body, re.I):
+            continue
+        writers = [
+            p.name
+            for mod in tr.modules
+            for p in mod.procedures
+            if p is not info.proc and _assigns(p.lines, name)
+        ]
+        if writers:
+            raise NotTranslated(
+                f"uses the module variable {name}, which {writers[0]} gives a value (state "
+                "kept between calls)"
+            )
+        if _assigns(info.proc.lines, name):
+            first = next(
+                t for _, t in info.proc.lines if re.search(rf"\b{re.escape(name)}\b", t, re.I)
+            )
+            rhs = first.split("=", 1)[1] if "=" in first else first
+            if not _assigns([(0, first)], name) or re.search(
+                rf"\b{re.escape(name)}\b", rhs, re.I
+            ):
+                raise NotTranslated(
+                    f"uses the module variable {name} before it gives it a value (state kept "
+                    "between calls)"
+                )
+        out.append((0, decl))
     return out
 
 
@@ -457,17 +535,13 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
             body = "\n".join(x for _, x in info.proc.lines)
             info.problem, info.calls, info.dropped = None, set(), set()
             try:
-                for name in info.module_vars:  # type: ignore[attr-defined]
-                    if re.search(rf"\b{re.escape(name)}\b", body, re.I):
-                        raise NotTranslated(
-                            f"uses the module variable {name} (state kept between calls)"
-                        )
+                state = _module_state(tr, info, body)
                 consts = [
                     c for c in info.consts if _const_name(c) and _mentions(body, _const_name(c))
                 ]  # type: ignore[attr-defined]
                 t.prefix = [
                     (0, re.sub(r"^(public|private|global)\s+", "", c, flags=re.I)) for c in consts
-                ]
+                ] + state
                 info.program = t.translate()
             except NotTranslated as exc:
                 info.problem = str(exc)
@@ -558,6 +632,8 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             ]
         except FormulaProblem as exc:
             d.problem = str(exc)
+        except Exception as exc:  # noqa: BLE001 - a formula the translation did not foresee
+            d.problem = f"not translated ({type(exc).__name__}: {exc})"
         tr.definitions.append(d)
     # inputs are bounded: a formula that would take the count past MAX_INPUTS is listed
     constants: set = set()

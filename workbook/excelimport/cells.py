@@ -639,6 +639,7 @@ class FormulaTranslator:
         if len(args) > len(params):
             raise FormulaProblem(f"{info.proc.name} called with {len(args)} arguments")
         texts, flags = [], []
+        from .vbaexpr import VbaSyntax
         from .vbaprogram import NotTranslated, default_text
 
         for k, p in enumerate(params):
@@ -653,8 +654,8 @@ class FormulaTranslator:
                     raise FormulaProblem(f"{info.proc.name} called without the Optional {p.name}")
                 try:
                     texts.append(default_text(p))
-                except NotTranslated as exc:
-                    raise FormulaProblem(str(exc)) from None
+                except (NotTranslated, VbaSyntax) as exc:
+                    raise FormulaProblem(f"the default of {p.name}: {exc}") from None
             elif a[0] == "leaf" and a[1] == "Range" and p.type.lower() in ("range", "variant"):
                 ref = self.ref_of(a[2])
                 if p.type.lower() == "range" or not ref.single:
@@ -681,7 +682,9 @@ class FormulaTranslator:
 
 def _row_relative(token) -> bool:
     """A reference whose row moves when the formula is filled down (``M183``, ``$M183``)."""
-    text = str(getattr(token, "name", token)).split("!")[-1]
+    source, end = getattr(token, "source", None), getattr(token, "end_match", None)
+    text = source[:end] if isinstance(source, str) and isinstance(end, int) else str(token)
+    text = text.split("!")[-1]  # the parser's name drops the $: its source keeps them
     m = re.match(r"\$?[A-Za-z]{1,3}(\$?)\d+$", text)
     return m is not None and not m.group(1)
 
