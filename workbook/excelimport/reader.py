@@ -79,14 +79,31 @@ def read_book(path: Path) -> Book:
     regular_file(path, what="workbook", max_bytes=MAX_BOOK_BYTES)
     book = Book(path)
     if path.suffix.lower() == ".xls":
-        book.skipped.append(
-            (
-                "the cells of the workbook",
-                "an Excel 97-2003 (.xls) file: its cell formulas are BIFF8 records, which "
-                "this import does not decode; its VBA is read",
-            )
-        )
-        return book
+        return _read_xls(book, path)
+    return _read_xlsx(book, path)
+
+
+def _read_xls(book: Book, path: Path) -> Book:
+    """An Excel 97-2003 workbook: its formulas from LibreOffice's conversion to .xlsx, the
+    values Excel cached from the file's own records."""
+    import tempfile
+
+    from . import xls
+
+    cached = xls.cached_values(path)
+    with tempfile.TemporaryDirectory(prefix="workbook-xls-") as tmp:
+        converted = xls.convert(path, Path(tmp))
+        _read_xlsx(book, converted)
+    by_name = {name: values for name, values in cached}
+    for k, (sheet, cells) in enumerate(book.sheets.items()):
+        values = by_name.get(sheet, cached[k][1] if k < len(cached) else {})
+        for key, cell in cells.items():
+            if cell.formula is not None:
+                cell.value = values.get(key)
+    return book
+
+
+def _read_xlsx(book: Book, path: Path) -> Book:
     check_archive(path)
     import warnings
 
