@@ -11,11 +11,14 @@ from .cells import FormulaProblem, FormulaTranslator, parse_formula
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .vba import Module, Procedure, is_event, read_modules
+from .vbamembers import record_types
 from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
 
 #: formulas translated at most (those that call VBA functions first; a multi-cell array
 #: formula counts once)
 MAX_DEFINITIONS = 4000
+#: formula cells translated at most (the cells of formulas filled down included)
+MAX_FORMULA_CELLS = 40_000
 #: constant cells imported as inputs at most
 MAX_INPUTS = 4000
 _UNIT_IN_LABEL = re.compile(r"[\(\[]\s*([^\)\]]{1,16}?)\s*[\)\]]")
@@ -116,6 +119,9 @@ def _key(cell: Cell) -> tuple[str, int, int]:
 
 def _collect_functions(tr: Translation, reserved: set[str]) -> None:
     taken = set(reserved)
+    records: dict = {}
+    for mod in tr.modules:
+        records.update(record_types(mod.code))
     for mod in tr.modules:
         option_base = any(
             re.match(r"^Option\s+Base\s+1", line, re.I) for _, line in mod.declarations
@@ -166,6 +172,7 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
                 if re.match(r"^(public|global)\s+const\b", line, re.I)
             ]
             info.module_vars = _module_vars(mod)  # type: ignore[attr-defined]
+            info.record_types = records  # type: ignore[attr-defined]
             tr.functions[key] = info
     tr.reserved_functions = {i.final.lower() for i in tr.functions.values()}  # type: ignore[attr-defined]
 
@@ -256,9 +263,7 @@ def _module_state(tr: Translation, info: FunctionInfo, body: str) -> list[tuple[
                 t for _, t in info.proc.lines if re.search(rf"\b{re.escape(name)}\b", t, re.I)
             )
             rhs = first.split("=", 1)[1] if "=" in first else first
-            if not _assigns([(0, first)], name) or re.search(
-                rf"\b{re.escape(name)}\b", rhs, re.I
-            ):
+            if not _assigns([(0, first)], name) or re.search(rf"\b{re.escape(name)}\b", rhs, re.I):
                 raise NotTranslated(
                     f"uses the module variable {name} before it gives it a value (state kept "
                     "between calls)"
@@ -279,15 +284,17 @@ def _mentions(body: str, name: str) -> bool:
 def _formula_cells(tr: Translation) -> list[Cell]:
     """Formula cells to translate, in reading order: those that call a VBA function first,
     then the others, at most MAX_DEFINITIONS formulas (a multi-cell array formula is one
-    formula: its other cells come with it)."""
+    formula: its other cells come with it; so is a formula filled down a column, whose cells
+    below come with the first), and at most MAX_FORMULA_CELLS cells."""
     out = []
     for cells in tr.book.sheets.values():
         for r, c in sorted(cells):
             cell = cells[(r, c)]
             if cell.formula is not None:
                 out.append(cell)
-    formulas = [c for c in out if not _follows_master(c)]
-    if len(formulas) <= MAX_DEFINITIONS:
+    below = {id(c) for c in out if _fills_down(tr.book, c)}
+    formulas = [c for c in out if not _follows_master(c) and id(c) not in below]
+    if len(formulas) <= MAX_DEFINITIONS and len(out) <= MAX_FORMULA_CELLS:
         return out
     names = set(tr.functions)
     calls = [
@@ -300,21 +307,47 @@ def _formula_cells(tr: Translation) -> list[Cell]:
         if len(chosen) >= MAX_DEFINITIONS:
             break
         chosen.add(id(c))
-    masters = {(c.sheet, c.row, c.col) for c in formulas if id(c) in chosen}
-    kept = [
-        c
-        for c in out
-        if id(c) in chosen or (_follows_master(c) and (c.sheet, *c.array_master) in masters)
-    ]
-    left = len(formulas) - len(chosen)
+    kept_keys = set()
+    kept = []
+    for c in sorted(out, key=lambda c: (c.sheet, c.col, c.row)):  # a column top down
+        key = (c.sheet, c.row, c.col)
+        if (
+            id(c) in chosen
+            or (_follows_master(c) and (c.sheet, *c.array_master) in kept_keys)
+            or (id(c) in below and (c.sheet, c.row - 1, c.col) in kept_keys)
+        ):
+            kept_keys.add(key)
+    kept = [c for c in out if (c.sheet, c.row, c.col) in kept_keys][:MAX_FORMULA_CELLS]
+    left = len(out) - len(kept)
     tr.listed.append(
         (
-            f"{left:,} formulas",
+            f"{left:,} formula cells",
             f"beyond the {MAX_DEFINITIONS:,} formulas translated (those that call VBA "
-            "functions first)",
+            f"functions first; a formula filled down counts once), or the "
+            f"{MAX_FORMULA_CELLS:,} cells",
         )
     )
     return kept
+
+
+def _relative(formula: str, row: int) -> str:
+    """The formula with each relative row written from ``row`` (R1C1's view of it), so that
+    the cells of a formula filled down have one text."""
+    return re.sub(
+        r"(?<![A-Za-z_\d.])(\$?[A-Za-z]{1,3})(\$?)(\d+)(?![\d(])",
+        lambda m: m.group(0) if m.group(2) else f"{m.group(1)}[{int(m.group(3)) - row}]",
+        formula,
+    )
+
+
+def _fills_down(book: Book, cell: Cell) -> bool:
+    """The cell above holds the same formula, filled down (not an array formula)."""
+    if cell.array is not None:
+        return False
+    above = book.cell(cell.sheet, cell.row - 1, cell.col)
+    if above is None or above.formula is None or above.array is not None:
+        return False
+    return _relative(above.formula, above.row) == _relative(cell.formula, cell.row)
 
 
 def _follows_master(cell: Cell) -> bool:

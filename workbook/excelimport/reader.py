@@ -158,8 +158,10 @@ def _read_xlsx(book: Book, path: Path) -> Book:
 
 
 #: a defined name that is one reference: Sheet1!$A$1, 'Load table'!$B$2:$C$9
-_NAME_REF = re.compile(r"^(?:'(?:[^']|'')+'|[^'!*/+\-^&=<>(),\"]+)!\$?[A-Za-z]{1,3}\$?\d+"
-                       r"(?::\$?[A-Za-z]{1,3}\$?\d+)?$")
+_NAME_REF = re.compile(
+    r"^(?:'(?:[^']|'')+'|[^'!*/+\-^&=<>(),\"]+)!\$?[A-Za-z]{1,3}\$?\d+"
+    r"(?::\$?[A-Za-z]{1,3}\$?\d+)?$"
+)
 
 
 def read_names(book: Book, items) -> None:
