@@ -26,7 +26,7 @@ def cut_error_handler(name: str, body: list[tuple[int, str]]) -> list[tuple[int,
     if not starts:
         return body
     if len(starts) > 1:
-        raise NotTranslated("line {}: a second On Error GoTo".format(body[starts[1]][0]))
+        raise NotTranslated(f"line {body[starts[1]][0]}: a second On Error GoTo")
     h = starts[0]
     label = _GOTO.match(body[h][1].strip()).group(1)
     at = next(

@@ -20,7 +20,8 @@ def record_types(code: str) -> dict[str, list[tuple[str, str]]]:
     blocks."""
     out = {}
     for m in re.finditer(
-        r"^[ \t]*(?:Public[ \t]+|Private[ \t]+)?Type[ \t]+(\w+)[ \t]*\r?\n(.*?)^[ \t]*End[ \t]+Type\b",
+        r"^[ \t]*(?:Public[ \t]+|Private[ \t]+)?Type[ \t]+(\w+)[ \t]*\r?\n"
+        r"(.*?)^[ \t]*End[ \t]+Type\b",
         code,
         re.I | re.M | re.S,
     ):
@@ -119,6 +120,12 @@ class Members:
             return f"{how}({', '.join(vals)})"
         if fn in EXCEL:
             return self._template(EXCEL[fn], args, fn)
+        from ..functions.excel_functions import FUNCTIONS
+
+        if fn not in FUNCTIONS and fn.replace("_", ".") not in FUNCTIONS:
+            # no such method: VBA stops with run-time error 438 where the call runs, and the
+            # cell shows #VALUE!
+            return "(1/0)"
         raise NotTranslated(f"WorksheetFunction.{fn}: not mapped")
 
 

@@ -12,10 +12,10 @@ import re
 from dataclasses import dataclass, field
 
 from .functions import VBA
-from .vbaerrors import cut_error_handler
-from .vbamembers import Members, NotTranslated
 from .vba import Procedure, split_top
+from .vbaerrors import cut_error_handler
 from .vbaexpr import VbaSyntax, parse, strip
+from .vbamembers import Members, NotTranslated
 
 INTEGER_TYPES = {"integer", "long", "byte", "longlong", "longptr"}
 NUMBER_TYPES = INTEGER_TYPES | {"double", "single", "currency", "decimal"}

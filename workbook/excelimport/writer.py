@@ -228,7 +228,22 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
     reasons: dict[str, str] = {}  # cell -> why its cached value is not compared
     if tables:
         doc["tables"] = list(tables.values())
+    memo: dict = {}
+    groups = []
     for label, group, arg in (("", rows, None), (".at", at_rows, "k_at"), (".rows", run_rows, ROW)):
+        plain, by_decade = _split_cancelling(tr, group, memo)
+        groups.append((label, plain, arg, ABS_TOLERANCE, ""))
+        for dec, part in sorted(by_decade.items()):
+            groups.append(
+                (
+                    f"{label}.cancel-e{dec}",
+                    part,
+                    arg,
+                    REL_TOLERANCE * 10.0**dec,
+                    f", differences of numbers of up to 1e{dec} (compared to their tolerance)",
+                )
+            )
+    for label, group, arg, tolerance, what in groups:
         if not group:
             continue
         out = io.StringIO()
@@ -255,9 +270,10 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             "title": "Excel's cached values"
             + {None: "", "k_at": " of the cells of array formulas", ROW: " of filled-down columns"}[
                 arg
-            ],
+            ]
+            + what,
             "rel_tolerance": REL_TOLERANCE,
-            "tolerance": ABS_TOLERANCE,
+            "tolerance": tolerance,
         }
         if arg:
             entry["argument"] = arg
@@ -292,6 +308,22 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             head.append(f"#   ... and {len(listed) - 400} more")
     toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
     return toml, files, counts
+
+
+def _split_cancelling(tr: Translation, group: list, memo: dict) -> tuple[list, dict]:
+    """The rows of ``group`` compared as they are, and {power of ten: rows} of the cells whose
+    value is a difference of nearly equal numbers of that size (see cancellation.py)."""
+    from .cancellation import decade
+
+    plain, by_decade = [], {}
+    for row in group:
+        _, _, (kind, text), ref = row
+        found = decade(tr.book, ref, float(text), memo) if kind == "number" else None
+        if found is None:
+            plain.append(row)
+        else:
+            by_decade.setdefault(found, []).append(row)
+    return plain, by_decade
 
 
 def _not_translated_rows(tr: Translation, skip: dict, counts: dict, reasons: dict) -> str:

@@ -79,7 +79,7 @@ def cached_values(path: Path) -> list[tuple[str, dict[tuple[int, int], object]]]
     except (OSError, ValueError) as exc:
         raise InputError(f"{path}: cannot read it as an Excel 97-2003 file ({exc})") from None
     sheets: list[tuple[int, str]] = []
-    for rtype, start, body in _records(data, 0):
+    for rtype, _, body in _records(data, 0):
         if rtype == _SHEET and len(body) >= 8:
             offset, kind = struct.unpack_from("<IB", body, 0)[0], body[5]
             if kind == 0:  # a worksheet (not a chart or macro sheet)
