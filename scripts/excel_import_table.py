@@ -25,6 +25,7 @@ ROOT = Path(__file__).resolve().parent.parent
 SHARED = ROOT.parent / "shared"
 FOLDERS = [SHARED / "excel-vba", SHARED / "corpus-more" / "excel-vba-a"]
 SUFFIXES = (".xlsm", ".xlsx", ".xls")
+sys.path.insert(0, str(ROOT))
 
 
 def addins(book: Path) -> list[Path]:
@@ -33,11 +34,18 @@ def addins(book: Path) -> list[Path]:
     return sorted(p for p in book.parent.glob("*.xla*") if p.stem.lower().startswith(stem))
 
 
-def cached_formula_cells(book: Path) -> int | None:
+def cached_formula_cells(book: Path) -> int:
     """Formula cells (each cell of a multi-cell array formula) whose cached value is a number,
-    a text or TRUE/FALSE (not empty, not an error value), counted with openpyxl; None for .xls."""
-    if book.suffix.lower() == ".xls":
-        return None
+    a text or TRUE/FALSE (not empty, not an error value), counted with openpyxl."""
+    if book.suffix.lower() == ".xls":  # the file's FORMULA records (the importer's reader)
+        from workbook.excelimport.xls import cached_values
+
+        return sum(
+            1
+            for _, values in cached_values(book)
+            for v in values.values()
+            if v is not None and not (isinstance(v, str) and (not v.strip() or _is_error(v)))
+        )
     import warnings
 
     import openpyxl
@@ -99,6 +107,7 @@ def measure(book: Path, timeout: float = 900.0) -> dict:
             args += ["--vba", str(addin)]
         code, out, err, seconds = _run(args, timeout)
         row.update(import_exit=code, import_seconds=round(seconds, 1))
+        row["cached"] = cached_formula_cells(book)
         if code != 0:
             row["error"] = (err.strip().splitlines() or [""])[-1][:300]
             return row
@@ -115,7 +124,6 @@ def measure(book: Path, timeout: float = 900.0) -> dict:
         reproduced=counts["reproduced"],
         wrong=counts["failed"],
         not_computable=counts["not_computable"],
-        cached=cached_formula_cells(book),
     )
     return row
 
@@ -127,29 +135,44 @@ def table(rows: list[dict]) -> str:
         "| counted by check | reproduced | wrong | not computable |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
-    total = dict.fromkeys(("printed", "reproduced", "wrong", "not_computable"), 0)
+    total = dict.fromkeys(("cached", "printed", "reproduced", "wrong", "not_computable"), 0)
     for r in rows:
         name = r["workbook"] + (f" (+ {', '.join(r['vba'])})" if r["vba"] else "")
+        total["cached"] += r.get("cached") or 0
         if "printed" not in r:
             lines.append(
                 f"| {r['folder']} | {name} | {r['import_exit']} | {r.get('check_exit', '')} "
-                f"| | | | | {r.get('error', '')} |"
+                f"| {r.get('cached') or 0:,} | | | | {r.get('error', '')[:90]} |"
             )
             continue
-        cached = "" if r["cached"] is None else f"{r['cached']:,}"
+        cached = f"{r['cached']:,}"
         lines.append(
             f"| {r['folder']} | {name} | {r['import_exit']} | {r['check_exit']} | {cached} "
             f"| {r['printed']:,} | {r['reproduced']:,} | {r['wrong']:,} "
             f"| {r['not_computable']:,} |"
         )
-        for key in total:
+        for key in ("printed", "reproduced", "wrong", "not_computable"):
             total[key] += r[key]
-    share = total["reproduced"] / total["printed"] if total["printed"] else 0.0
+    share = total["reproduced"] / total["cached"] if total["cached"] else 0.0
     lines.append(
-        f"| all | | | | | {total['printed']:,} | {total['reproduced']:,} ({share:.1%}) "
-        f"| {total['wrong']:,} | {total['not_computable']:,} |"
+        f"| all | | | | {total['cached']:,} | {total['printed']:,} | {total['reproduced']:,} "
+        f"({share:.1%} of the cached values) | {total['wrong']:,} | {total['not_computable']:,} |"
     )
     return "\n".join(lines)
+
+
+def _books(folders: list[Path]) -> list[Path]:
+    out = []
+    for folder in folders:
+        if not folder.is_dir():
+            print(f"{folder}: not found, left out", file=sys.stderr)
+            continue
+        out += sorted(p for p in folder.iterdir() if p.suffix.lower() in SUFFIXES)
+    return out
+
+
+def _find(row: dict, folders: list[Path]) -> Path:
+    return next(b for b in _books(folders) if b.name == row["workbook"])
 
 
 def main(argv: list[str]) -> int:
@@ -160,14 +183,17 @@ def main(argv: list[str]) -> int:
     parser.add_argument("folders", nargs="*", type=Path)
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--timeout", type=float, default=900.0)
+    parser.add_argument("--table", type=Path, help="print the table of a --json output")
     opts = parser.parse_args(argv)
     folders, timeout = opts.folders or FOLDERS, opts.timeout
-    rows = []
-    for folder in folders:
-        if not folder.is_dir():
-            print(f"{folder}: not found, left out", file=sys.stderr)
-            continue
-        for book in sorted(p for p in folder.iterdir() if p.suffix.lower() in SUFFIXES):
+    if opts.table:  # the rows of an earlier --json run
+        rows = json.loads(opts.table.read_text())
+        for r in rows:
+            if r.get("cached") is None:
+                r["cached"] = cached_formula_cells(_find(r, folders))
+    else:
+        rows = []
+        for book in _books(folders):
             rows.append(measure(book, timeout))
             print(json.dumps(rows[-1]), file=sys.stderr, flush=True)
     print(json.dumps(rows, indent=1) if opts.json else table(rows))

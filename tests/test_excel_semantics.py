@@ -65,6 +65,7 @@ def _compare(path: Path, tmp: Path, expected_cells: set[str]) -> None:
             assert math.isnan(value), (key, want, value)
 
 
+@pytest.mark.slow  # the formulas package takes seconds to load
 def test_lists_leave_out_empty_and_text_cells(tmp_path):
     wb = openpyxl.Workbook()
     ws = wb.active
@@ -81,6 +82,7 @@ def test_lists_leave_out_empty_and_text_cells(tmp_path):
     _compare(path, tmp_path / "out", {"F1", "G1", "H1", "K1", "N1", "F2", "G2", "H2"})
 
 
+@pytest.mark.slow  # the formulas package takes seconds to load
 def test_fill_down_keeps_absolute_and_mixed_references(tmp_path):
     wb = openpyxl.Workbook()
     ws = wb.active
@@ -94,6 +96,7 @@ def test_fill_down_keeps_absolute_and_mixed_references(tmp_path):
     _compare(path, tmp_path / "out", {f"B{r}" for r in range(3, 8)} | {"C7"})
 
 
+@pytest.mark.slow  # the formulas package takes seconds to load
 def test_defined_names_constants_ranges_and_formulas(tmp_path):
     from openpyxl.workbook.defined_name import DefinedName
 
@@ -123,3 +126,107 @@ def test_a_dde_name_is_listed_and_the_import_goes_on(tmp_path):
     assert main(["import", str(path), "--out", str(tmp_path / "o")]) == 0
     toml = (tmp_path / "o" / "dde.toml").read_text()
     assert "the defined name evil: a DDE or external link" in toml
+
+
+def test_average_of_a_row_with_empty_and_text_cells_is_checked(tmp_path, capsys):
+    """The same rule, fast: Excel's cached values (written as Excel computes them: the mean
+    of the numbers only) are reproduced by the imported sheet."""
+    xlsxwriter = pytest.importorskip("xlsxwriter")
+    from workbook.cli import main
+
+    path = tmp_path / "avg.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    row = [4, None, "n/a", 10, None, 7]
+    for k, v in enumerate(row):
+        if v is not None:
+            ws.write(0, k, v)
+    numbers = [v for v in row if isinstance(v, int)]
+    ws.write_formula("H1", "=AVERAGE(A1:F1)", None, sum(numbers) / len(numbers))
+    ws.write_formula("I1", "=COUNT(A1:F1)+MIN(A1:F1)", None, len(numbers) + min(numbers))
+    for r in range(2, 6):
+        ws.write(r, 0, r * 1.5)
+        ws.write_formula(r, 1, f"=5*A{r + 1}/SUM($A$3:$A$6)", None, 5 * r / sum(range(2, 6)))
+    wb.close()
+    assert main(["import", str(path), "--out", str(tmp_path / "o")]) == 0
+    code, report = _check(tmp_path / "o" / "avg.toml", capsys)
+    assert (code, report["printed"], report["reproduced"]) == (0, 6, 6)
+
+
+def _check(toml: Path, capsys) -> tuple[int, dict]:
+    import json
+
+    from workbook.cli import main
+
+    capsys.readouterr()
+    code = main(["check", str(toml), "--json"])
+    return code, json.loads(capsys.readouterr().out)
+
+
+def test_a_cached_text_that_reads_as_a_formula_is_escaped(tmp_path, capsys):
+    xlsxwriter = pytest.importorskip("xlsxwriter")
+    from workbook.cli import main
+
+    path = tmp_path / "evil.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write("A1", 2)
+    ws.write_formula("B1", '=IF(A1>1,"x","y")', None, "=cmd|' /C calc'!A0")
+    ws.write_formula("B2", "=A1*3", None, 6)
+    ws.write_formula("B3", '=CONVERT(A1,"m","ft")', None, "+cmd|' /C calc'!A0")
+    wb.close()
+    assert main(["import", str(path), "--out", str(tmp_path / "o")]) == 0
+    texts = "".join(p.read_text() for p in (tmp_path / "o").glob("*.csv"))
+    assert "=cmd" in texts  # written, escaped
+    for line in texts.splitlines():
+        for cell in line.split(","):
+            assert not cell.startswith(("=", "+", "-", "@")), line
+    code, report = _check(tmp_path / "o" / "evil.toml", capsys)
+    # B2 reproduced; B1 (its text escaped) and B3 (not translated) counted, not computable
+    assert (report["printed"], report["reproduced"], report["failed"]) == (3, 1, 0)
+    assert code == 1
+    assert "escaped, not compared" in report["failures"][0]["name"]
+
+
+def test_a_difference_of_nearly_equal_numbers_has_their_tolerance(tmp_path, capsys):
+    xlsxwriter = pytest.importorskip("xlsxwriter")
+    from workbook.cli import main
+
+    path = tmp_path / "cancel.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write("A1", 12345678.9)
+    ws.write("A2", 0.1)
+    ws.write_formula("B1", "=A1+A2", None, 12345679.0)
+    # Excel shows 0 where the subtraction cancels; the engine gives about 1.9e-9
+    ws.write_formula("C1", "=B1-A1-A2", None, 0)
+    ws.write_formula("C2", "=A2*2", None, 0.2000001)  # a wrong cached value stays wrong
+    wb.close()
+    assert main(["import", str(path), "--out", str(tmp_path / "o")]) == 0
+    assert (tmp_path / "o" / "cancel.excel.cancel-e8.csv").is_file()
+    code, report = _check(tmp_path / "o" / "cancel.toml", capsys)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 1)
+    assert [f["name"] for f in report["failures"]] == ["C2"]
+
+
+def test_vba_functions_of_thisworkbook_and_what_is_refused():
+    from workbook.excelimport.book import translate_vba
+
+    host = (
+        'Attribute VB_Name = "ThisWorkbook"\n'
+        'Attribute VB_Base = "0{00020819-0000-0000-C000-000000000046}"\n'
+    )
+    found = translate_vba(
+        host + "Public Function Twice(x As Double) As Double\n    Twice = 2 * x\nEnd Function\n",
+        "ThisWorkbook",
+    )
+    assert found["Twice"].problem is None
+    found = translate_vba(
+        "Private calls As Long\n\nSub Reset()\n    calls = 0\nEnd Sub\n\n"
+        "Function Counted(x As Double) As Double\n    calls = calls + 1\n    Counted = x * calls\n"
+        "End Function\n\nFunction Ratio(a As Double, b As Double) As Double\n"
+        "    On Error GoTo fail\n    Ratio = a / b\n    Exit Function\nfail:\n    Ratio = 0\n"
+        "End Function\n"
+    )
+    assert "module variable calls, which Reset gives a value" in found["Counted"].problem
+    assert "the error path does more than give an error value" in found["Ratio"].problem

@@ -25,6 +25,8 @@ EXCEL: dict[str, tuple[str, tuple[int, ...]]] = {
     "TANH": ("tanh({0})", (1,)),
     "SIGN": ("sign({0})", (1,)),
     "PI": ("pi", (0,)),
+    "TRUE": ("1", (0,)),  # TRUE() and FALSE(), as LibreOffice writes the constants
+    "FALSE": ("0", (0,)),
     "POWER": ("({0})^({1})", (2,)),
     "RADIANS": ("({0})*pi/180", (1,)),
     "DEGREES": ("({0})*180/pi", (1,)),

@@ -90,6 +90,7 @@ def _read_xls(book: Book, path: Path) -> Book:
 
     from . import xls
 
+    xls.soffice()  # exit 2 at once when LibreOffice is missing
     cached = xls.cached_values(path)
     with tempfile.TemporaryDirectory(prefix="workbook-xls-") as tmp:
         converted = xls.convert(path, Path(tmp))
