@@ -25,6 +25,7 @@ EXCEL: dict[str, tuple[str, tuple[int, ...]]] = {
     "TANH": ("tanh({0})", (1,)),
     "SIGN": ("sign({0})", (1,)),
     "PI": ("pi", (0,)),
+    "NA": ("1/0", (0,)),  # #N/A: an error value, no number
     "TRUE": ("1", (0,)),  # TRUE() and FALSE(), as LibreOffice writes the constants
     "FALSE": ("0", (0,)),
     "POWER": ("({0})^({1})", (2,)),
