@@ -226,16 +226,37 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         doc["arguments"] = arguments
     if definitions:
         doc["definitions"] = definitions
+    if tables:
+        doc["tables"] = list(tables.values())
+    files, printed, counts = _printed_files(tr, name, skip, rows, at_rows, run_rows)
+    if printed:
+        doc["printed"] = printed
+    head = [
+        f"# Imported from {tr.path.name} by `workbook import`: inputs from the constant cells",
+        "# that formulas read, definitions from formula cells, functions from VBA Functions,",
+        "# and Excel's cached values as printed values (`workbook check` compares them).",
+        "# Excel has no units: the numbers are plain; a unit a label names is proposed in a note.",
+    ]
+    listed = list(tr.listed) + [(k, v) for k, v in skip.items()]
+    if listed:
+        head.append("#")
+        head.append(f"# Not translated ({len(listed)}; their cells count as not reproduced):")
+        for what, why in listed[:400]:
+            head += _comment(f"  {what}: {why}")
+        if len(listed) > 400:
+            head.append(f"#   ... and {len(listed) - 400} more")
+    toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
+    return toml, files, counts
+
+
+def _printed_files(tr: Translation, name: str, skip: dict, rows, at_rows, run_rows):
+    """(files {name: CSV text}, the [[printed]] entries, counts) of Excel's cached values: the
+    translated cells by kind (cells, cells of array formulas, filled-down columns), the
+    differences of nearly equal numbers by their size, and the cells not translated."""
     counts: dict = {"numbers": 0, "texts": 0, "errors": 0, "cells": {}}
-    out = io.StringIO()
-    w = csv.writer(out, lineterminator="\n")
-    out.write("# Excel's cached values of the translated cells (imported by `workbook import`)\n")
-    w.writerow(["name", "argument", "value", "unit"])
     printed = []
     files = {}
     reasons: dict[str, str] = {}  # cell -> why its cached value is not compared
-    if tables:
-        doc["tables"] = list(tables.values())
     memo: dict = {}
     groups = []
     for label, group, arg in (("", rows, None), (".at", at_rows, "k_at"), (".rows", run_rows, ROW)):
@@ -298,24 +319,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
                 "tolerance": ABS_TOLERANCE,
             }
         )
-    if printed:
-        doc["printed"] = printed
-    head = [
-        f"# Imported from {tr.path.name} by `workbook import`: inputs from the constant cells",
-        "# that formulas read, definitions from formula cells, functions from VBA Functions,",
-        "# and Excel's cached values as printed values (`workbook check` compares them).",
-        "# Excel has no units: the numbers are plain; a unit a label names is proposed in a note.",
-    ]
-    listed = list(tr.listed) + [(k, v) for k, v in skip.items()]
-    if listed:
-        head.append("#")
-        head.append(f"# Not translated ({len(listed)}; their cells count as not reproduced):")
-        for what, why in listed[:400]:
-            head += _comment(f"  {what}: {why}")
-        if len(listed) > 400:
-            head.append(f"#   ... and {len(listed) - 400} more")
-    toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
-    return toml, files, counts
+    return files, printed, counts
 
 
 def _split_cancelling(tr: Translation, group: list, memo: dict) -> tuple[list, dict]:
