@@ -230,3 +230,33 @@ def test_vba_functions_of_thisworkbook_and_what_is_refused():
     )
     assert "module variable calls, which Reset gives a value" in found["Counted"].problem
     assert "the error path does more than give an error value" in found["Ratio"].problem
+
+
+def test_paramarray_and_a_call_with_too_many_arguments(tmp_path, capsys):
+    xlsxwriter = pytest.importorskip("xlsxwriter")
+    from workbook.cli import main
+
+    wb = xlsxwriter.Workbook(str(tmp_path / "pa.xlsx"))
+    ws = wb.add_worksheet("S")
+    ws.write("A1", 2)
+    ws.write("A2", 3)
+    ws.write_formula("B1", "=Total(10, A1, A2, 4)", None, 10 * (2 + 3 + 4))
+    ws.write_formula("B2", "=Total(1, A1)", None, 2)
+    ws.write_formula("B3", "=Pair(A1, A2, 5)", None, "#VALUE!")  # one argument too many
+    ws.write_formula("B4", "=B3+1", None, "#VALUE!")
+    wb.close()
+    (tmp_path / "m.bas").write_text(
+        'Attribute VB_Name = "M"\n'
+        "Function Total(k As Double, ParamArray xs() As Variant) As Double\n"
+        "    Dim i As Long, t As Double\n"
+        "    For i = LBound(xs) To UBound(xs)\n        t = t + xs(i)\n    Next i\n"
+        "    Total = k * t\nEnd Function\n\n"
+        "Function Pair(a As Double, b As Double) As Double\n    Pair = a + b\nEnd Function\n"
+    )
+    out = tmp_path / "o"
+    assert main(["import", str(tmp_path / "pa.xlsx"), "--vba", str(tmp_path / "m.bas"),
+                 "--out", str(out)]) == 0  # fmt: skip
+    assert "Not translated" not in (out / "pa.toml").read_text()
+    code, report = _check(out / "pa.toml", capsys)
+    assert (report["printed"], report["reproduced"]) == (2, 2)
+    assert code == 1  # B3 and B4 have no value, as Excel shows #VALUE!

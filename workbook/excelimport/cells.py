@@ -636,8 +636,15 @@ class FormulaTranslator:
             raise FormulaProblem(f"calls {info.proc.name}, not translated: {info.problem}")
         self.out.udfs.add(key)
         params = info.proc.params
-        if len(args) > len(params):
-            raise FormulaProblem(f"{info.proc.name} called with {len(args)} arguments")
+        if params and params[-1].rest:  # ParamArray: the rest of the arguments, one array
+            if len(args) < len(params):
+                raise FormulaProblem(f"{info.proc.name} called without its ParamArray values")
+            packed = [self.value(a) for a in args[len(params) - 1 :]]
+            args = list(args[: len(params) - 1]) + [
+                ("leaf", "Packed", "[" + ", ".join(packed) + "]")
+            ]
+        if len(args) > len(params):  # Excel shows #VALUE!: the cell has no value
+            return "(1/0)"
         texts, flags = [], []
         from .vbaexpr import VbaSyntax
         from .vbaprogram import NotTranslated, default_text
@@ -645,6 +652,9 @@ class FormulaTranslator:
         for k, p in enumerate(params):
             a = args[k] if k < len(args) else None
             given = a is not None and not (a[0] == "leaf" and a[1] == "Empty")
+            if given and a[1] == "Packed":
+                texts.append(a[2])
+                continue
             if not given:
                 if not p.optional:
                     raise FormulaProblem(f"{info.proc.name} called without {p.name}")
