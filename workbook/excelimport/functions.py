@@ -56,6 +56,7 @@ VBA: dict[str, tuple[str, tuple[int, ...]]] = {
     "sgn": ("sign({0})", (1,)),
     "int": ("floor({0})", (1,)),
     "fix": ("trunc({0})", (1,)),
+    "cbool": ("(-1 if {0} != 0 otherwise 0)", (1,)),  # True is -1
     "cdbl": ("{0}", (1,)),
     "csng": ("{0}", (1,)),
     "cdec": ("{0}", (1,)),
