@@ -46,6 +46,7 @@ class Book:
     #: defined names that are not one range: a constant (``0.5``) or a formula, as text
     name_formulas: dict[str, str] = field(default_factory=dict)
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
+    stale: bool = False  # saved before Excel finished calculating: cached values may be old
 
     def cell(self, sheet: str, row: int, col: int) -> Cell | None:
         return self.sheets.get(sheet, {}).get((row, col))
@@ -117,6 +118,8 @@ def _read_xlsx(book: Book, path: Path) -> Book:
             cached = openpyxl.load_workbook(path, data_only=True, keep_links=False)
     except Exception as exc:  # noqa: BLE001 - zip, XML: the file is not a readable workbook
         raise InputError(f"{path}: cannot read it as an Excel workbook ({exc})") from None
+    calc = getattr(wb, "calculation", None)
+    book.stale = calc is not None and calc.calcCompleted is False
     total = 0
     for ws in wb.worksheets:
         cells: dict[tuple[int, int], Cell] = {}

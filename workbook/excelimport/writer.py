@@ -237,6 +237,12 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         "# and Excel's cached values as printed values (`workbook check` compares them).",
         "# Excel has no units: the numbers are plain; a unit a label names is proposed in a note.",
     ]
+    if tr.book.stale:
+        head += _comment(
+            "Excel saved this workbook before it finished calculating (calcCompleted=0, "
+            "manual calculation): a cached value may be older than its inputs, so a value "
+            "not reproduced is to be checked by hand."
+        )
     listed = list(tr.listed) + [(k, v) for k, v in skip.items()]
     if listed:
         head.append("#")
