@@ -260,3 +260,18 @@ def test_paramarray_and_a_call_with_too_many_arguments(tmp_path, capsys):
     code, report = _check(out / "pa.toml", capsys)
     assert (report["printed"], report["reproduced"]) == (2, 2)
     assert code == 1  # B3 and B4 have no value, as Excel shows #VALUE!
+
+
+def test_a_sheet_whose_name_starts_with_a_digit(tmp_path):
+    xlsxwriter = pytest.importorskip("xlsxwriter")
+    from workbook.cli import main
+
+    wb = xlsxwriter.Workbook(str(tmp_path / "digits.xlsx"))
+    first, second = wb.add_worksheet("3Stage"), wb.add_worksheet("Länge")
+    first.write("A1", 2)
+    first.write_formula("B1", "=A1*2", None, 4)
+    second.write_formula("A1", "='3Stage'!B1+1", None, 5)
+    second.write_formula("A2", "=SUM('3Stage'!A1:B1)", None, 6)
+    wb.close()
+    assert main(["import", str(tmp_path / "digits.xlsx"), "--out", str(tmp_path / "o")]) == 0
+    assert main(["check", str(tmp_path / "o" / "digits.toml")]) == 0

@@ -158,7 +158,7 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
             key = proc.name.lower()
             if key in tr.functions:
                 continue  # the first definition wins, as Excel finds it first
-            final = re.sub(r"\W", "_", proc.name)
+            final = re.sub(r"[^A-Za-z0-9_]", "_", proc.name)
             while final.lower() in taken:
                 final += "_"
             taken.add(final.lower())
@@ -427,7 +427,7 @@ def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) ->
         sheet, row, col = key
         base = by_cell.get(key)
         if base is not None:
-            base = re.sub(r"\W", "_", base)
+            base = re.sub(r"[^A-Za-z0-9_]", "_", base)
         else:
             base = _ident(_label(book, sheet, row, col) or "")
         if base is None:
@@ -435,7 +435,10 @@ def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) ->
 
             base = f"{get_column_letter(col)}{row}"
             if many:
-                base = f"{re.sub(r'[^A-Za-z0-9]', '', sheet)[:12] or 'S'}_{base}"
+                prefix = re.sub(r"[^A-Za-z0-9]", "", sheet)[:12]
+                if not prefix or prefix[0].isdigit():  # a name starts with a letter
+                    prefix = "S" + prefix
+                base = f"{prefix}_{base}"
         name, n = base, 2
         while name.lower() in taken:
             name = f"{base}_{n}"
@@ -533,7 +536,7 @@ def _name_params(tr: Translation, reserved: set[str]) -> None:
         used: set[str] = set()
         body = "\n".join(t for _, t in info.proc.lines)
         for p in info.proc.params:
-            name = re.sub(r"\W", "_", p.name)
+            name = re.sub(r"[^A-Za-z0-9_]", "_", p.name)
             while name.lower() in taken or name.lower() in used:
                 name += "_"
             used.add(name.lower())

@@ -269,7 +269,7 @@ class FormulaTranslator:
         if name is None:
             from openpyxl.utils import get_column_letter
 
-            sheet = re.sub(r"\W+", "", ref.sheet)[:12]
+            sheet = re.sub(r"[^A-Za-z0-9_]+", "", ref.sheet)[:12]
             corner = f"{get_column_letter(ref.c1)}{ref.r1}_{get_column_letter(ref.c2)}{ref.r2}"
             name = f"range_{sheet}_{corner}"
             while name in self.ranges.values():

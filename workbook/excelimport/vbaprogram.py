@@ -97,7 +97,7 @@ class Translator(Members):
         key = vba_name.lower()
         if not fresh and key in self.names:
             return self.names[key]
-        base = re.sub(r"\W", "_", vba_name)
+        base = re.sub(r"[^A-Za-z0-9_]", "_", vba_name)
         name, n = base, 1
         taken = {v.lower() for v in self.names.values()}
         while name.lower() in self.reserved or name.lower() in taken or name.lower() in KEYWORDS:
