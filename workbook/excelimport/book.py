@@ -171,7 +171,15 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
                 for line in _module_consts(other)
                 if re.match(r"^(public|global)\s+const\b", line, re.I)
             ]
-            info.module_vars = _module_vars(mod)  # type: ignore[attr-defined]
+            info.module_vars = {  # type: ignore[attr-defined]
+                **{  # a Public variable of another module is seen here too
+                    k: v
+                    for other in tr.modules
+                    if other is not mod
+                    for k, v in _module_vars(other, public_only=True).items()
+                },
+                **_module_vars(mod),
+            }
             info.record_types = records  # type: ignore[attr-defined]
             tr.functions[key] = info
     tr.reserved_functions = {i.final.lower() for i in tr.functions.values()}  # type: ignore[attr-defined]
@@ -196,12 +204,14 @@ def _module_consts(mod: Module) -> list[str]:
     ]
 
 
-def _module_vars(mod: Module) -> dict[str, str]:
-    """{lower-case name: its declaration as a local ``Dim``} of the module's variables."""
+def _module_vars(mod: Module, public_only: bool = False) -> dict[str, str]:
+    """{lower-case name: its declaration as a local ``Dim``} of the module's variables (its
+    Public and Global ones only, with ``public_only``)."""
     out = {}
+    scopes = "public|global" if public_only else "dim|public|private|global|static"
     for _, line in mod.declarations:
         m = re.match(
-            r"^(?:dim|public|private|global|static)\s+(?!const\b|declare\b|function\b|sub\b|"
+            rf"^(?:{scopes})\s+(?!const\b|declare\b|function\b|sub\b|"
             r"type\b|enum\b|withevents\b)(.+)$",
             line,
             re.I,
