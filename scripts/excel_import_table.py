@@ -135,21 +135,24 @@ def table(rows: list[dict]) -> str:
         "| counted by check | reproduced | wrong | not computable |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
+    if any("commit" in r for r in rows):  # rows measured on different commits say which
+        lines = [lines[0] + " commit |", lines[1] + " --- |"]
     total = dict.fromkeys(("cached", "printed", "reproduced", "wrong", "not_computable"), 0)
     for r in rows:
         name = r["workbook"] + (f" (+ {', '.join(r['vba'])})" if r["vba"] else "")
+        end = f" {r['commit']} |" if "commit" in r else ""
         total["cached"] += r.get("cached") or 0
         if "printed" not in r:
             lines.append(
                 f"| {r['folder']} | {name} | {r['import_exit']} | {r.get('check_exit', '')} "
-                f"| {r.get('cached') or 0:,} | | | | {r.get('error', '')[:90]} |"
+                f"| {r.get('cached') or 0:,} | | | | {r.get('error', '')[:90]} |{end}"
             )
             continue
         cached = f"{r['cached']:,}"
         lines.append(
             f"| {r['folder']} | {name} | {r['import_exit']} | {r['check_exit']} | {cached} "
             f"| {r['printed']:,} | {r['reproduced']:,} | {r['wrong']:,} "
-            f"| {r['not_computable']:,} |"
+            f"| {r['not_computable']:,} |{end}"
         )
         for key in ("printed", "reproduced", "wrong", "not_computable"):
             total[key] += r[key]

@@ -175,7 +175,7 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
                 **{  # a Public variable of another module is seen here too
                     k: v
                     for other in tr.modules
-                    if other is not mod
+                    if other is not mod and not other.document  # a class's fields are its own
                     for k, v in _module_vars(other, public_only=True).items()
                 },
                 **_module_vars(mod),
@@ -254,8 +254,14 @@ def _module_state(tr: Translation, info: FunctionInfo, body: str) -> list[tuple[
     it one before it reads it (or never gives it one: it is always Empty). Otherwise
     NotTranslated, naming the variable."""
     out = []
+    own = {p.name.lower() for p in info.proc.params} | {
+        m.group(1).lower()
+        for _, t in info.proc.lines
+        for part in re.findall(r"(?i)^(?:dim|static|const)\s+(.*)$", t)
+        for m in re.finditer(r"(?:^|,)\s*(\w+)", part)
+    }  # an argument or a local of the same name hides the module's variable
     for name, decl in info.module_vars.items():  # type: ignore[attr-defined]
-        if not re.search(rf"\b{re.escape(name)}\b", body, re.I):
+        if name in own or not re.search(rf"\b{re.escape(name)}\b", body, re.I):
             continue
         writers = [
             p.name
