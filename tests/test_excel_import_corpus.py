@@ -16,7 +16,32 @@ SHARED = ROOT.parent / "shared"
 FOLDERS = [SHARED / "excel-vba", SHARED / "corpus-more" / "excel-vba-a"]
 
 #: workbook -> cached values reproduced, as measured (docs/excel-import.md, The corpus)
-REPRODUCED: dict[str, int] = {}
+REPRODUCED: dict[str, int] = {
+    "aero-toolkit-test.xlsm": 866,
+    "beam-user-functions.xlsm": 1947,
+    "circular-section.xlsm": 1435,
+    "dynamic-balancing.xlsm": 0,
+    "engineering-box-sandbox.xlsm": 70,
+    "feed-section-scenario1.xlsm": 221,
+    "general-beam-analysis.xlsm": 3194,
+    "pressure-loss.xlsm": 28,
+    "refprop.xls": 14,
+    "structural-calc.xlsm": 256,
+    "traverse-computation.xlsm": 5,
+    "wood-shear-wall-foundation.xlsm": 14492,
+    "beam-bending.xlsm": 9,
+    "bearing-capacity-samples.xlsm": 132,
+    "bearing-capacity-template.xlsm": 46,
+    "internal-capacity-template.xlsm": 451,
+    "pdata.xlsm": 3191,
+    "ppr1978-worked-examples.xlsm": 1805,
+    "steel-asd-design.xlsm": 1,
+    "vincenty-test.xlsm": 12620,
+    "vincenty.xls": 0,
+}
+#: values Excel cached before it finished calculating (the workbook says calcCompleted="0"),
+#: which the translation computes as Excel's formulas do: listed in docs/excel-import.md
+STALE = {"pdata.xlsm": 14}
 
 pytestmark = [
     pytest.mark.slow,
@@ -42,6 +67,6 @@ def test_corpus_workbook(book):
     row = measure(book)
     assert row["import_exit"] == 0, row.get("error")
     assert row["check_exit"] in (0, 1), row.get("error")
-    assert row["wrong"] == 0
+    assert row["wrong"] == STALE.get(book.name, 0)
     assert row["printed"] == row["cached"]  # every formula cell with a cached value counted
     assert row["reproduced"] >= REPRODUCED.get(book.name, 0)
