@@ -213,15 +213,18 @@ def test_import_reproduces_the_cached_values(imported, capsys):
     # exit 1: Ratio has no value (a division by zero), as B15 holds #DIV/0! in Excel; B20
     assert main(["check", str(toml), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # 18 formula cells: B15 holds an error value (not compared), B17 is not translated;
-    # B20 shows a message where the function otherwise gives numbers: an error here
+    # 18 formula cells: B15 holds an error value (not compared), B17 is not translated (not
+    # computable, counted with its reason); B20 shows a message where the function otherwise
+    # gives numbers: an error here
     assert {k: report[k] for k in ("printed", "reproduced", "failed")} == {
-        "printed": 16,
+        "printed": 17,
         "reproduced": 15,
         "failed": 0,
     }
-    assert report["not_computable"] == 1
-    assert [f["name"] for f in report["failures"]] == ["Message"]
+    assert report["not_computable"] == 2
+    names = [f["name"] for f in report["failures"]]
+    assert names[0] == "Message"
+    assert names[1].startswith("Beam!B17 (not translated: ")
 
 
 def test_the_sheet_gives_the_values_excel_stored(imported):

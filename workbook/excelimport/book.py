@@ -11,11 +11,14 @@ from .cells import FormulaProblem, FormulaTranslator, parse_formula
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .vba import Module, Procedure, is_event, read_modules
+from .vbamembers import record_types
 from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
 
 #: formulas translated at most (those that call VBA functions first; a multi-cell array
 #: formula counts once)
 MAX_DEFINITIONS = 4000
+#: formula cells translated at most (the cells of formulas filled down included)
+MAX_FORMULA_CELLS = 40_000
 #: constant cells imported as inputs at most
 MAX_INPUTS = 4000
 _UNIT_IN_LABEL = re.compile(r"[\(\[]\s*([^\)\]]{1,16}?)\s*[\)\]]")
@@ -90,6 +93,8 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
                 ).translate(parsed[_key(cell)].tree)
             except FormulaProblem:
                 pass
+            except Exception:  # noqa: BLE001 - listed with its reason when translated below
+                pass
     _name_cells(tr, cells, read, reserved)
     _runs(tr, cells, parsed, reserved)
     _name_params(tr, reserved)
@@ -114,6 +119,9 @@ def _key(cell: Cell) -> tuple[str, int, int]:
 
 def _collect_functions(tr: Translation, reserved: set[str]) -> None:
     taken = set(reserved)
+    records: dict = {}
+    for mod in tr.modules:
+        records.update(record_types(mod.code))
     for mod in tr.modules:
         option_base = any(
             re.match(r"^Option\s+Base\s+1", line, re.I) for _, line in mod.declarations
@@ -131,13 +139,13 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
             body = "\n".join(t for _, t in proc.lines)
             if re.search(r"\bSolver\w*\b", body):
                 tr.listed.append((where, "runs Solver (a Solver model is not translated)"))
-            if proc.kind != "Function" or mod.document or is_event(proc):
+            if proc.kind != "Function" or (mod.document and not _host(mod)) or is_event(proc):
                 why = (
                     "an event procedure"
                     if is_event(proc)
                     else "a Sub (it writes cells or runs commands)"
                     if proc.kind == "Sub"
-                    else "in a sheet, workbook, class or form module"
+                    else "in a class or form module"
                     if mod.document
                     else "a Property"
                 )
@@ -150,7 +158,7 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
             key = proc.name.lower()
             if key in tr.functions:
                 continue  # the first definition wins, as Excel finds it first
-            final = re.sub(r"\W", "_", proc.name)
+            final = re.sub(r"[^A-Za-z0-9_]", "_", proc.name)
             while final.lower() in taken:
                 final += "_"
             taken.add(final.lower())
@@ -163,9 +171,29 @@ def _collect_functions(tr: Translation, reserved: set[str]) -> None:
                 for line in _module_consts(other)
                 if re.match(r"^(public|global)\s+const\b", line, re.I)
             ]
-            info.module_vars = _module_vars(mod)  # type: ignore[attr-defined]
+            info.module_vars = {  # type: ignore[attr-defined]
+                **{  # a Public variable of another module is seen here too
+                    k: v
+                    for other in tr.modules
+                    if other is not mod and not other.document  # a class's fields are its own
+                    for k, v in _module_vars(other, public_only=True).items()
+                },
+                **_module_vars(mod),
+            }
+            info.record_types = records  # type: ignore[attr-defined]
             tr.functions[key] = info
     tr.reserved_functions = {i.final.lower() for i in tr.functions.values()}  # type: ignore[attr-defined]
+
+
+#: the module of the workbook (ThisWorkbook) or of a worksheet, whose Public functions cells
+#: call as ``=ThisWorkbook.f(...)`` or ``=Sheet1.f(...)``
+_HOSTS = ("{00020819-", "{00020820-")
+
+
+def _host(mod: Module) -> bool:
+    """A ThisWorkbook or sheet module (not a class or a form)."""
+    m = re.search(r'^Attribute VB_Base = "([^"]+)"', mod.code, re.M)
+    return m is not None and any(h in m.group(1) for h in _HOSTS)
 
 
 def _module_consts(mod: Module) -> list[str]:
@@ -176,16 +204,87 @@ def _module_consts(mod: Module) -> list[str]:
     ]
 
 
-def _module_vars(mod: Module) -> set[str]:
-    out = set()
+def _module_vars(mod: Module, public_only: bool = False) -> dict[str, str]:
+    """{lower-case name: its declaration as a local ``Dim``} of the module's variables (its
+    Public and Global ones only, with ``public_only``)."""
+    out = {}
+    scopes = "public|global" if public_only else "dim|public|private|global|static"
     for _, line in mod.declarations:
         m = re.match(
-            r"^(?:dim|public|private|global)\s+(?!const\b|declare\b|function\b|sub\b|type\b|enum\b)(\w+)",
+            rf"^(?:{scopes})\s+(?!const\b|declare\b|function\b|sub\b|"
+            r"type\b|enum\b|withevents\b)(.+)$",
             line,
             re.I,
         )
-        if m:
-            out.add(m.group(1).lower())
+        if not m:
+            continue
+        for piece in _top_level_split(m.group(1)):
+            name = re.match(r"\s*(\w+)", piece)
+            if name:
+                out[name.group(1).lower()] = "Dim " + piece.strip()
+    return out
+
+
+def _top_level_split(text: str) -> list[str]:
+    """``a(1 To 3) As Double, b`` -> the declarations split at commas outside brackets."""
+    parts, depth, start = [], 0, 0
+    for i, ch in enumerate(text):
+        depth += ch == "("
+        depth -= ch == ")"
+        if ch == "," and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    return parts + [text[start:]]
+
+
+def _assigns(lines, name: str) -> bool:
+    """Whether a procedure's lines give the variable a value (``x = ...``, ``x(i) = ...``,
+    ``Set x = ...``, ``ReDim x(...)``)."""
+    target = re.compile(
+        rf"^(?:set\s+|let\s+)?{re.escape(name)}\s*(?:\([^=]*\))?\s*=|^redim\s+(?:preserve\s+)?"
+        rf"{re.escape(name)}\b",
+        re.I,
+    )
+    return any(target.match(t.strip()) for _, t in lines)
+
+
+def _module_state(tr: Translation, info: FunctionInfo, body: str) -> list[tuple[int, str]]:
+    """The module variables the function uses, as locals, where its value does not depend on
+    the order of calls: no other procedure gives the variable a value, and the function gives
+    it one before it reads it (or never gives it one: it is always Empty). Otherwise
+    NotTranslated, naming the variable."""
+    out = []
+    own = {p.name.lower() for p in info.proc.params} | {
+        m.group(1).lower()
+        for _, t in info.proc.lines
+        for part in re.findall(r"(?i)^(?:dim|static|const)\s+(.*)$", t)
+        for m in re.finditer(r"(?:^|,)\s*(\w+)", part)
+    }  # an argument or a local of the same name hides the module's variable
+    for name, decl in info.module_vars.items():  # type: ignore[attr-defined]
+        if name in own or not re.search(rf"\b{re.escape(name)}\b", body, re.I):
+            continue
+        writers = [
+            p.name
+            for mod in tr.modules
+            for p in mod.procedures
+            if p is not info.proc and _assigns(p.lines, name)
+        ]
+        if writers:
+            raise NotTranslated(
+                f"uses the module variable {name}, which {writers[0]} gives a value (state "
+                "kept between calls)"
+            )
+        if _assigns(info.proc.lines, name):
+            first = next(
+                t for _, t in info.proc.lines if re.search(rf"\b{re.escape(name)}\b", t, re.I)
+            )
+            rhs = first.split("=", 1)[1] if "=" in first else first
+            if not _assigns([(0, first)], name) or re.search(rf"\b{re.escape(name)}\b", rhs, re.I):
+                raise NotTranslated(
+                    f"uses the module variable {name} before it gives it a value (state kept "
+                    "between calls)"
+                )
+        out.append((0, decl))
     return out
 
 
@@ -201,15 +300,17 @@ def _mentions(body: str, name: str) -> bool:
 def _formula_cells(tr: Translation) -> list[Cell]:
     """Formula cells to translate, in reading order: those that call a VBA function first,
     then the others, at most MAX_DEFINITIONS formulas (a multi-cell array formula is one
-    formula: its other cells come with it)."""
+    formula: its other cells come with it; so is a formula filled down a column, whose cells
+    below come with the first), and at most MAX_FORMULA_CELLS cells."""
     out = []
     for cells in tr.book.sheets.values():
         for r, c in sorted(cells):
             cell = cells[(r, c)]
             if cell.formula is not None:
                 out.append(cell)
-    formulas = [c for c in out if not _follows_master(c)]
-    if len(formulas) <= MAX_DEFINITIONS:
+    below = {id(c) for c in out if _fills_down(tr.book, c)}
+    formulas = [c for c in out if not _follows_master(c) and id(c) not in below]
+    if len(formulas) <= MAX_DEFINITIONS and len(out) <= MAX_FORMULA_CELLS:
         return out
     names = set(tr.functions)
     calls = [
@@ -222,21 +323,47 @@ def _formula_cells(tr: Translation) -> list[Cell]:
         if len(chosen) >= MAX_DEFINITIONS:
             break
         chosen.add(id(c))
-    masters = {(c.sheet, c.row, c.col) for c in formulas if id(c) in chosen}
-    kept = [
-        c
-        for c in out
-        if id(c) in chosen or (_follows_master(c) and (c.sheet, *c.array_master) in masters)
-    ]
-    left = len(formulas) - len(chosen)
+    kept_keys = set()
+    kept = []
+    for c in sorted(out, key=lambda c: (c.sheet, c.col, c.row)):  # a column top down
+        key = (c.sheet, c.row, c.col)
+        if (
+            id(c) in chosen
+            or (_follows_master(c) and (c.sheet, *c.array_master) in kept_keys)
+            or (id(c) in below and (c.sheet, c.row - 1, c.col) in kept_keys)
+        ):
+            kept_keys.add(key)
+    kept = [c for c in out if (c.sheet, c.row, c.col) in kept_keys][:MAX_FORMULA_CELLS]
+    left = len(out) - len(kept)
     tr.listed.append(
         (
-            f"{left:,} formulas",
+            f"{left:,} formula cells",
             f"beyond the {MAX_DEFINITIONS:,} formulas translated (those that call VBA "
-            "functions first)",
+            f"functions first; a formula filled down counts once), or the "
+            f"{MAX_FORMULA_CELLS:,} cells",
         )
     )
     return kept
+
+
+def _relative(formula: str, row: int) -> str:
+    """The formula with each relative row written from ``row`` (R1C1's view of it), so that
+    the cells of a formula filled down have one text."""
+    return re.sub(
+        r"(?<![A-Za-z_\d.])(\$?[A-Za-z]{1,3})(\$?)(\d+)(?![\d(])",
+        lambda m: m.group(0) if m.group(2) else f"{m.group(1)}[{int(m.group(3)) - row}]",
+        formula,
+    )
+
+
+def _fills_down(book: Book, cell: Cell) -> bool:
+    """The cell above holds the same formula, filled down (not an array formula)."""
+    if cell.array is not None:
+        return False
+    above = book.cell(cell.sheet, cell.row - 1, cell.col)
+    if above is None or above.formula is None or above.array is not None:
+        return False
+    return _relative(above.formula, above.row) == _relative(cell.formula, cell.row)
 
 
 def _follows_master(cell: Cell) -> bool:
@@ -316,7 +443,7 @@ def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) ->
         sheet, row, col = key
         base = by_cell.get(key)
         if base is not None:
-            base = re.sub(r"\W", "_", base)
+            base = re.sub(r"[^A-Za-z0-9_]", "_", base)
         else:
             base = _ident(_label(book, sheet, row, col) or "")
         if base is None:
@@ -324,7 +451,10 @@ def _name_cells(tr: Translation, cells: list[Cell], read, reserved: set[str]) ->
 
             base = f"{get_column_letter(col)}{row}"
             if many:
-                base = f"{re.sub(r'[^A-Za-z0-9]', '', sheet)[:12] or 'S'}_{base}"
+                prefix = re.sub(r"[^A-Za-z0-9]", "", sheet)[:12]
+                if not prefix or prefix[0].isdigit():  # a name starts with a letter
+                    prefix = "S" + prefix
+                base = f"{prefix}_{base}"
         name, n = base, 2
         while name.lower() in taken:
             name = f"{base}_{n}"
@@ -424,7 +554,7 @@ def _name_params(tr: Translation, reserved: set[str]) -> None:
         used: set[str] = set()
         body = "\n".join(t for _, t in info.proc.lines)
         for p in info.proc.params:
-            name = re.sub(r"\W", "_", p.name)
+            name = re.sub(r"[^A-Za-z0-9_]", "_", p.name)
             while name.lower() in taken or name.lower() in used:
                 name += "_"
             used.add(name.lower())
@@ -459,17 +589,13 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
             body = "\n".join(x for _, x in info.proc.lines)
             info.problem, info.calls, info.dropped = None, set(), set()
             try:
-                for name in info.module_vars:  # type: ignore[attr-defined]
-                    if re.search(rf"\b{re.escape(name)}\b", body, re.I):
-                        raise NotTranslated(
-                            f"uses the module variable {name} (state kept between calls)"
-                        )
+                state = _module_state(tr, info, body)
                 consts = [
                     c for c in info.consts if _const_name(c) and _mentions(body, _const_name(c))
                 ]  # type: ignore[attr-defined]
                 t.prefix = [
                     (0, re.sub(r"^(public|private|global)\s+", "", c, flags=re.I)) for c in consts
-                ]
+                ] + state
                 info.program = t.translate()
             except NotTranslated as exc:
                 info.problem = str(exc)
@@ -538,15 +664,15 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             tr.definitions.append(d)
             continue
         try:
-            names = name_of
-            if run is not None:
-                moving = run.moving
-
-                def names(sheet, row, col, moving=moving):
-                    return moving.get((sheet, row, col)) or name_of(sheet, row, col)
-
             ft = FormulaTranslator(
-                book, cell.sheet, names, tr.functions, book.names, _block(cell), tr.ranges
+                book,
+                cell.sheet,
+                name_of,
+                tr.functions,
+                book.names,
+                _block(cell),
+                tr.ranges,
+                moving=run.moving if run is not None else None,
             )
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:
@@ -556,10 +682,12 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 for ref in ft.out.refs
                 for r in range(ref.r1, ref.r2 + 1)
                 for c in range(ref.c1, ref.c2 + 1)
-                if run is None or (ref.sheet, r, c) not in run.moving
+                if not getattr(ref, "moved", False)
             ]
         except FormulaProblem as exc:
             d.problem = str(exc)
+        except Exception as exc:  # noqa: BLE001 - a formula the translation did not foresee
+            d.problem = f"not translated ({type(exc).__name__}: {exc})"
         tr.definitions.append(d)
     # inputs are bounded: a formula that would take the count past MAX_INPUTS is listed
     constants: set = set()

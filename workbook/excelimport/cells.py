@@ -11,7 +11,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .functions import EXCEL, EXCEL_VARIADIC, VOLATILE
+from .aggregates import AGGREGATES, aggregate
+from .functions import EXCEL, VOLATILE
 
 #: a prefix that calls into an add-in or another workbook: [1]!f( or 'Book.xlam'!f(
 _LINK = re.compile(
@@ -102,9 +103,21 @@ class FormulaTranslator:
     """Walks a formula tree; ``name_of(sheet, row, col)`` gives a cell's name."""
 
     def __init__(
-        self, book, sheet: str, name_of, functions: dict, names: dict, block=None, ranges=None
+        self,
+        book,
+        sheet: str,
+        name_of,
+        functions: dict,
+        names: dict,
+        block=None,
+        ranges=None,
+        moving: dict | None = None,
     ) -> None:
         self.book = book
+        # a filled-down column: {(sheet, row, col) of the first row: the name that moves}, for
+        # the references whose row is relative (``M183``, never ``$M$183``)
+        self.moving = moving or {}
+        self.depth = 0  # defined names whose formula is being translated, one in another
         self.block = block  # (rows, columns) of the cells of a multi-cell array formula
         # {matrix literal: name}: a range that formulas read is one definition, named here
         self.ranges = ranges
@@ -200,15 +213,52 @@ class FormulaTranslator:
         return Ref(sheet, min(r1, r2), min(c1, c2), max(r1, r2), max(c1, c2))
 
     def reference(self, token) -> str:
+        if self.is_name_formula(token):
+            return self.name_formula(token)
         ref = self.ref_of(token)
         self.out.refs.append(ref)
         if ref.single:
-            return self.name_of(ref.sheet, ref.r1, ref.c1)
+            return self.single(ref, token)
         rows = [
             [self.name_of(ref.sheet, r, c) for c in range(ref.c1, ref.c2 + 1)]
             for r in range(ref.r1, ref.r2 + 1)
         ]
         return self.shared("[" + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]", ref)
+
+    def single(self, ref: Ref, token) -> str:
+        """The name of one cell a reference reads: in a filled-down column, the moving name
+        when the reference's row is relative and the cell is the one that moves."""
+        key = (ref.sheet, ref.r1, ref.c1)
+        if key in self.moving and _row_relative(token):
+            ref.moved = True  # type: ignore[attr-defined]
+            return self.moving[key]
+        return self.name_of(ref.sheet, ref.r1, ref.c1)
+
+    def is_name_formula(self, token) -> bool:
+        """A defined name that is a constant or a formula, not one range."""
+        attr = getattr(token, "attr", {})
+        if "r1" in attr:
+            return False
+        key = str(attr.get("ref", token.name)).lower()
+        return key not in self.defined and key in self.name_texts()
+
+    def name_texts(self) -> dict[str, str]:
+        return {k.lower(): v for k, v in getattr(self.book, "name_formulas", {}).items()}
+
+    def name_formula(self, token) -> str:
+        """A defined name's constant or formula, translated where it is used (its references
+        are those of the name: absolute, on the sheet the name writes)."""
+        text = self.name_texts()[str(token.attr.get("ref", token.name)).lower()]
+        if self.depth > 20:
+            raise FormulaProblem(f"the defined name {token.name}: names nested too deeply")
+        self.depth += 1
+        try:
+            tree = parse_formula(text).tree
+            return f"({self.value(tree, 0)})"
+        except FormulaProblem as exc:
+            raise FormulaProblem(f"the defined name {token.name} ({text[:40]}): {exc}") from None
+        finally:
+            self.depth -= 1
 
     def shared(self, literal: str, ref: Ref) -> str:
         """The name of the definition of a range's matrix (one for every formula that reads
@@ -219,7 +269,7 @@ class FormulaTranslator:
         if name is None:
             from openpyxl.utils import get_column_letter
 
-            sheet = re.sub(r"\W+", "", ref.sheet)[:12]
+            sheet = re.sub(r"[^A-Za-z0-9_]+", "", ref.sheet)[:12]
             corner = f"{get_column_letter(ref.c1)}{ref.r1}_{get_column_letter(ref.c2)}{ref.r2}"
             name = f"range_{sheet}_{corner}"
             while name in self.ranges.values():
@@ -227,16 +277,26 @@ class FormulaTranslator:
             self.ranges[literal] = name
         return name
 
-    def cells_of(self, node) -> list[str] | None:
-        """The names of a range argument, in reading order (None if not a range)."""
-        if node[0] == "leaf" and node[1] == "Range":
+    def cells_of(self, node, numbers_only: bool = False) -> list[str] | None:
+        """The names of a range argument, in reading order (None if not a reference).
+
+        With ``numbers_only`` (Excel's SUM, AVERAGE, MIN, MAX, COUNT, STDEV...), the cells that
+        Excel leaves out of a reference are left out: empty cells, texts and TRUE/FALSE (of a
+        formula cell, as its cached value shows)."""
+        if node[0] == "leaf" and node[1] == "Range" and not self.is_name_formula(node[2]):
             ref = self.ref_of(node[2])
             self.out.refs.append(ref)
-            return [
-                self.name_of(ref.sheet, r, c)
-                for r in range(ref.r1, ref.r2 + 1)
-                for c in range(ref.c1, ref.c2 + 1)
-            ]
+            if ref.single:
+                key = (ref.sheet, ref.r1, ref.c1)
+                if key in self.moving and _row_relative(node[2]):
+                    return [self.single(ref, node[2])]
+            names = []
+            for r in range(ref.r1, ref.r2 + 1):
+                for c in range(ref.c1, ref.c2 + 1):
+                    if numbers_only and not _holds_number(self.book.cell(ref.sheet, r, c)):
+                        continue
+                    names.append(self.name_of(ref.sheet, r, c))
+            return names
         return None
 
     def operator(self, op: str, args, ctx: int) -> str:
@@ -294,17 +354,8 @@ class FormulaTranslator:
             return f"({self.value(args[1], 1)} if {cond} otherwise {self.value(args[2], 1)})"
         if upper in ("AND", "OR", "NOT"):
             return f"(1 if {self.condition(('fn', name, args))} otherwise 0)"
-        if upper in EXCEL_VARIADIC:
-            items: list[str] = []
-            for a in args:
-                cells = self.cells_of(a)
-                items += cells if cells is not None else [self.value(a, 1)]
-            how = EXCEL_VARIADIC[upper]
-            if how == "+":
-                return "(" + " + ".join(items) + ")" if len(items) > 1 else items[0]
-            if how == "mean":
-                return f"mean([{', '.join(items)}])"
-            return f"{how}({', '.join(items)})" if len(items) > 1 else items[0]
+        if upper in AGGREGATES:
+            return aggregate(self, upper, args)
         if upper in EXCEL:
             text, arities = EXCEL[upper]
             if len(args) not in arities:
@@ -585,14 +636,25 @@ class FormulaTranslator:
             raise FormulaProblem(f"calls {info.proc.name}, not translated: {info.problem}")
         self.out.udfs.add(key)
         params = info.proc.params
-        if len(args) > len(params):
-            raise FormulaProblem(f"{info.proc.name} called with {len(args)} arguments")
+        if params and params[-1].rest:  # ParamArray: the rest of the arguments, one array
+            if len(args) < len(params):
+                raise FormulaProblem(f"{info.proc.name} called without its ParamArray values")
+            packed = [self.value(a) for a in args[len(params) - 1 :]]
+            args = list(args[: len(params) - 1]) + [
+                ("leaf", "Packed", "[" + ", ".join(packed) + "]")
+            ]
+        if len(args) > len(params):  # Excel shows #VALUE!: the cell has no value
+            return "(1/0)"
         texts, flags = [], []
+        from .vbaexpr import VbaSyntax
         from .vbaprogram import NotTranslated, default_text
 
         for k, p in enumerate(params):
             a = args[k] if k < len(args) else None
             given = a is not None and not (a[0] == "leaf" and a[1] == "Empty")
+            if given and a[1] == "Packed":
+                texts.append(a[2])
+                continue
             if not given:
                 if not p.optional:
                     raise FormulaProblem(f"{info.proc.name} called without {p.name}")
@@ -602,8 +664,8 @@ class FormulaTranslator:
                     raise FormulaProblem(f"{info.proc.name} called without the Optional {p.name}")
                 try:
                     texts.append(default_text(p))
-                except NotTranslated as exc:
-                    raise FormulaProblem(str(exc)) from None
+                except (NotTranslated, VbaSyntax) as exc:
+                    raise FormulaProblem(f"the default of {p.name}: {exc}") from None
             elif a[0] == "leaf" and a[1] == "Range" and p.type.lower() in ("range", "variant"):
                 ref = self.ref_of(a[2])
                 if p.type.lower() == "range" or not ref.single:
@@ -626,6 +688,25 @@ class FormulaTranslator:
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
+
+
+def _row_relative(token) -> bool:
+    """A reference whose row moves when the formula is filled down (``M183``, ``$M183``)."""
+    source, end = getattr(token, "source", None), getattr(token, "end_match", None)
+    text = source[:end] if isinstance(source, str) and isinstance(end, int) else str(token)
+    text = text.split("!")[-1]  # the parser's name drops the $: its source keeps them
+    m = re.match(r"\$?[A-Za-z]{1,3}(\$?)\d+$", text)
+    return m is not None and not m.group(1)
+
+
+def _holds_number(cell) -> bool:
+    """Whether Excel counts the cell in SUM, AVERAGE, MIN, MAX, COUNT over a reference: a
+    number, or an error value (which the function then gives); not empty, text, TRUE/FALSE."""
+    if cell is None or cell.value is None or isinstance(cell.value, bool):
+        return False
+    if isinstance(cell.value, str):
+        return cell.formula is not None and cell.value.startswith("#")
+    return isinstance(cell.value, (int, float))
 
 
 def _br(text: str, level: int, ctx: int) -> str:

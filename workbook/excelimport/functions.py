@@ -25,6 +25,9 @@ EXCEL: dict[str, tuple[str, tuple[int, ...]]] = {
     "TANH": ("tanh({0})", (1,)),
     "SIGN": ("sign({0})", (1,)),
     "PI": ("pi", (0,)),
+    "NA": ("1/0", (0,)),  # #N/A: an error value, no number
+    "TRUE": ("1", (0,)),  # TRUE() and FALSE(), as LibreOffice writes the constants
+    "FALSE": ("0", (0,)),
     "POWER": ("({0})^({1})", (2,)),
     "RADIANS": ("({0})*pi/180", (1,)),
     "DEGREES": ("({0})*180/pi", (1,)),
@@ -53,6 +56,7 @@ VBA: dict[str, tuple[str, tuple[int, ...]]] = {
     "sgn": ("sign({0})", (1,)),
     "int": ("floor({0})", (1,)),
     "fix": ("trunc({0})", (1,)),
+    "cbool": ("(-1 if {0} != 0 otherwise 0)", (1,)),  # True is -1
     "cdbl": ("{0}", (1,)),
     "csng": ("{0}", (1,)),
     "cdec": ("{0}", (1,)),

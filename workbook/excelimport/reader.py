@@ -3,6 +3,7 @@ defined names and its array formulas; never a macro run, never an external link 
 
 from __future__ import annotations
 
+import re
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,7 +43,10 @@ class Book:
     path: Path
     sheets: dict[str, dict[tuple[int, int], Cell]] = field(default_factory=dict)
     names: dict[str, tuple[str, str]] = field(default_factory=dict)  # name -> (sheet, A1 ref)
+    #: defined names that are not one range: a constant (``0.5``) or a formula, as text
+    name_formulas: dict[str, str] = field(default_factory=dict)
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
+    stale: bool = False  # saved before Excel finished calculating: cached values may be old
 
     def cell(self, sheet: str, row: int, col: int) -> Cell | None:
         return self.sheets.get(sheet, {}).get((row, col))
@@ -76,14 +80,32 @@ def read_book(path: Path) -> Book:
     regular_file(path, what="workbook", max_bytes=MAX_BOOK_BYTES)
     book = Book(path)
     if path.suffix.lower() == ".xls":
-        book.skipped.append(
-            (
-                "the cells of the workbook",
-                "an Excel 97-2003 (.xls) file: its cell formulas are BIFF8 records, which "
-                "this import does not decode; its VBA is read",
-            )
-        )
-        return book
+        return _read_xls(book, path)
+    return _read_xlsx(book, path)
+
+
+def _read_xls(book: Book, path: Path) -> Book:
+    """An Excel 97-2003 workbook: its formulas from LibreOffice's conversion to .xlsx, the
+    values Excel cached from the file's own records."""
+    import tempfile
+
+    from . import xls
+
+    xls.soffice()  # exit 2 at once when LibreOffice is missing
+    cached = xls.cached_values(path)
+    with tempfile.TemporaryDirectory(prefix="workbook-xls-") as tmp:
+        converted = xls.convert(path, Path(tmp))
+        _read_xlsx(book, converted)
+    by_name = {name: values for name, values in cached}
+    for k, (sheet, cells) in enumerate(book.sheets.items()):
+        values = by_name.get(sheet, cached[k][1] if k < len(cached) else {})
+        for key, cell in cells.items():
+            if cell.formula is not None:
+                cell.value = values.get(key)
+    return book
+
+
+def _read_xlsx(book: Book, path: Path) -> Book:
     check_archive(path)
     import warnings
 
@@ -96,6 +118,8 @@ def read_book(path: Path) -> Book:
             cached = openpyxl.load_workbook(path, data_only=True, keep_links=False)
     except Exception as exc:  # noqa: BLE001 - zip, XML: the file is not a readable workbook
         raise InputError(f"{path}: cannot read it as an Excel workbook ({exc})") from None
+    calc = getattr(wb, "calculation", None)
+    book.stale = calc is not None and calc.calcCompleted is False
     total = 0
     for ws in wb.worksheets:
         cells: dict[tuple[int, int], Cell] = {}
@@ -133,11 +157,43 @@ def read_book(path: Path) -> Book:
                 cell.formula = cells[master].formula
                 cell.value = value
         book.sheets[ws.title] = cells
-    for name, dn in _defined_names(wb):
-        dests = list(getattr(dn, "destinations", []) or [])
-        if len(dests) == 1 and book.sheet_named(dests[0][0]):
-            book.names[name] = (book.sheet_named(dests[0][0]), dests[0][1].replace("$", ""))
+    read_names(book, _defined_names(wb))
     return book
+
+
+#: a defined name that is one reference: Sheet1!$A$1, 'Load table'!$B$2:$C$9
+_NAME_REF = re.compile(
+    r"^(?:'(?:[^']|'')+'|[^'!*/+\-^&=<>(),\"]+)!\$?[A-Za-z]{1,3}\$?\d+"
+    r"(?::\$?[A-Za-z]{1,3}\$?\d+)?$"
+)
+
+
+def read_names(book: Book, items) -> None:
+    """Defined names: one range (``book.names``), else a constant or a formula
+    (``book.name_formulas``); a name whose text reads another workbook or a DDE link (``cmd|``)
+    is listed, never followed."""
+    for name, dn in items:
+        text = str(getattr(dn, "attr_text", None) or getattr(dn, "value", "") or "").strip()
+        text = text.removeprefix("=")
+        if not text:
+            continue
+        if "|" in text or "[" in text:
+            book.skipped.append(
+                (f"the defined name {name}", "a DDE or external link (never followed)")
+            )
+            continue
+        if _NAME_REF.match(text):
+            try:
+                dests = list(getattr(dn, "destinations", []) or [])
+            except Exception:  # noqa: BLE001 - openpyxl's tokenizer refuses the text
+                dests = []
+            if len(dests) == 1 and book.sheet_named(dests[0][0]):
+                book.names[name] = (book.sheet_named(dests[0][0]), dests[0][1].replace("$", ""))
+                continue
+        if "#REF!" in text.upper():
+            book.skipped.append((f"the defined name {name}", f"a broken reference ({text[:60]})"))
+            continue
+        book.name_formulas[name] = text
 
 
 def _defined_names(wb):

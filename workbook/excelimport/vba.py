@@ -34,6 +34,7 @@ class Param:
     optional: bool = False
     default: str | None = None
     array: bool = False  # declared name() (an array)
+    rest: bool = False  # ParamArray: the arguments from here on, as one array from 0
 
 
 @dataclass
@@ -145,13 +146,13 @@ def parse_params(text: str) -> list[Param]:
         part = part.strip()
         if not part:
             continue
-        optional = False
+        optional = is_rest = False
         words = part.split()
         while words and words[0].lower() in ("optional", "byval", "byref", "paramarray"):
             if words[0].lower() == "optional":
                 optional = True
             if words[0].lower() == "paramarray":
-                optional = True
+                optional = is_rest = True
             words.pop(0)
         rest = " ".join(words)
         default = None
@@ -160,7 +161,9 @@ def parse_params(text: str) -> list[Param]:
         m = re.match(r"([A-Za-z_][A-Za-z0-9_]*)\s*(\(\))?\s*(?:As\s+([A-Za-z_.]+))?", rest, re.I)
         if not m:
             continue
-        out.append(Param(m.group(1), m.group(3) or "Variant", optional, default, bool(m.group(2))))
+        out.append(
+            Param(m.group(1), m.group(3) or "Variant", optional, default, bool(m.group(2)), is_rest)
+        )
     return out
 
 

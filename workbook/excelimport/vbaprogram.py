@@ -11,9 +11,11 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .functions import EXCEL, EXCEL_VARIADIC, VBA
+from .functions import VBA
 from .vba import Procedure, split_top
+from .vbaerrors import cut_error_handler
 from .vbaexpr import VbaSyntax, parse, strip
+from .vbamembers import Members, NotTranslated
 
 INTEGER_TYPES = {"integer", "long", "byte", "longlong", "longptr"}
 NUMBER_TYPES = INTEGER_TYPES | {"double", "single", "currency", "decimal"}
@@ -25,10 +27,6 @@ KEYWORDS = {
     "yield", "assert", "async", "await", "pi",
 }  # fmt: skip
 MAX_ZERO_ARRAY = 10_000  # elements of a Dim'd array written out as zeros
-
-
-class NotTranslated(Exception):
-    """A construct this translation does not take (the reason is the message)."""
 
 
 @dataclass
@@ -65,7 +63,7 @@ class _Array:
     is_range: bool = False
 
 
-class Translator:
+class Translator(Members):
     """One VBA Function to program text (raises NotTranslated with the reason)."""
 
     def __init__(self, info: FunctionInfo, functions: dict[str, FunctionInfo], reserved: set):
@@ -89,13 +87,17 @@ class Translator:
                     1 if p.type.lower() == "range" else 0, 0, p.type.lower() == "range"
                 )
         self.ret = self.local(self.proc.name + "_value", fresh=True)
+        self.record_types = getattr(info, "record_types", {})
+        self.records_of: dict[str, list] = {}  # local (lower case) -> its Type's fields
+        if self.proc.returns.lower() in self.record_types:
+            self.records_of[self.proc.name.lower()] = self.record(self.proc.returns)
 
     # -- names -------------------------------------------------------------------------
     def local(self, vba_name: str, fresh: bool = False) -> str:
         key = vba_name.lower()
         if not fresh and key in self.names:
             return self.names[key]
-        base = re.sub(r"\W", "_", vba_name)
+        base = re.sub(r"[^A-Za-z0-9_]", "_", vba_name)
         name, n = base, 1
         taken = {v.lower() for v in self.names.values()}
         while name.lower() in self.reserved or name.lower() in taken or name.lower() in KEYWORDS:
@@ -110,7 +112,7 @@ class Translator:
 
     # -- statements --------------------------------------------------------------------
     def translate(self) -> str:
-        body = list(self.prefix) + list(self.proc.lines)
+        body = list(self.prefix) + cut_error_handler(self.proc.name, list(self.proc.lines))
         self.body = body
         self.at = 0
         self.assigned = False
@@ -137,6 +139,8 @@ class Translator:
                 self.lines.append(f"{name} := {bankers(name)}")
         if ret_type in NUMBER_TYPES or ret_type == "boolean":
             self.lines.append(f"{self.ret} := 0")
+        elif ret_type in self.record_types:
+            self.lines.append(f"{self.ret} := {self.zeros(ret_type)}")
         start = len(self.lines)
         self.block(body, 0, 0, ())
         # VBA gives every declared number 0 when the function starts (Dim does not run)
@@ -216,6 +220,9 @@ class Translator:
             raise NotTranslated(f"{text}: an error path whose meaning a worksheet cannot keep")
         if low in ("application.volatile", "application.volatile true"):
             self.info.volatile = True
+            return i + 1
+        if word.startswith("err.raise") or low.startswith("err.raise"):
+            self.emit(indent, f"return {self.error_value()}")  # the cell shows an error
             return i + 1
         if low.startswith("debug.print") or low.startswith("debug.assert"):
             return i + 1  # no effect on the value
@@ -303,6 +310,11 @@ class Translator:
                 value = bankers(value)
             self.emit(indent, f"{self.local(target[1][1])}[{index}] := {value}")
             return i + 1
+        if target[0] == "mem":
+            found = self.field_index(target[1], target[2])
+            if found is not None:
+                self.emit(indent, f"{found[0]}[{found[1]}] := {self.value(rhs)}")
+                return i + 1
         raise NotTranslated(f"{left} = ...: writes to a cell, a property or an object")
 
     def assign_result(self, rhs, indent: int, i: int, lines) -> int:
@@ -416,6 +428,10 @@ class Translator:
             key = name.lower()
             self.types[key] = (typ or "variant").lower()
             final = self.local(name)
+            if self.types[key] in self.record_types and bounds is None and value is None:
+                self.records_of[key] = self.record(typ)
+                self.emit(indent, f"{final} := {self.zeros(typ)}")
+                continue
             if is_const or value is not None:
                 if value is None:
                     raise NotTranslated(f"Const {name} without a value")
@@ -924,58 +940,6 @@ class Translator:
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
-
-    def member(self, node, args) -> str:
-        _, obj, attr = node
-        low = attr.lower()
-        obj = strip(obj)
-        chain = _chain(node)
-        if chain and chain[0].lower() in ("application", "worksheetfunction", "math"):
-            fn = chain[-1].upper()
-            if chain[0].lower() == "math":
-                return self.call(("call", ("id", chain[-1]), args))
-            return self.excel_call(fn, args)
-        if obj[0] == "id" and obj[1].lower() in self.arrays:
-            arr = self.arrays[obj[1].lower()]
-            src = self.local(obj[1])
-            if low in ("value", "value2") and not args:
-                return src
-            if low == "count":
-                return f"rows({src})*cols({src})" if arr.is_range else f"rows({src})"
-            if low in ("cells", "item") and args:
-                return f"{src}[{self.indices(obj[1].lower(), args)}]"
-        if obj[0] == "mem" and low == "count" and obj[2].lower() in ("rows", "columns"):
-            inner = strip(obj[1])
-            if inner[0] == "id" and inner[1].lower() in self.arrays:
-                src = self.local(inner[1])
-                return f"rows({src})" if obj[2].lower() == "rows" else f"cols({src})"
-        if obj[0] == "id" and low in {f for f in self.functions}:  # Module.Function(...)
-            return self._call_function(low, args)
-        raise NotTranslated(f"{'.'.join(chain) or attr}: an object or a property")
-
-    def excel_call(self, fn: str, args) -> str:
-        if fn in EXCEL_VARIADIC:
-            vals = [self.value(a) for a in args if a is not None]
-            how = EXCEL_VARIADIC[fn]
-            if how == "+":
-                raise NotTranslated("WorksheetFunction.Sum (of ranges)")
-            if how == "mean":
-                return f"mean([{', '.join(vals)}])" if len(vals) > 1 else f"mean({vals[0]})"
-            return f"{how}({', '.join(vals)})"
-        if fn in EXCEL:
-            return self._template(EXCEL[fn], args, fn)
-        raise NotTranslated(f"WorksheetFunction.{fn}: not mapped")
-
-
-def _chain(node) -> list[str]:
-    out = []
-    while node[0] == "mem":
-        out.append(node[2])
-        node = strip(node[1])
-    if node[0] == "id":
-        out.append(node[1])
-        return out[::-1]
-    return []
 
 
 def default_text(p) -> str:

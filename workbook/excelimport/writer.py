@@ -53,9 +53,44 @@ def _sheet_name(path: Path) -> str:
     return name or "imported"
 
 
+#: the first characters by which a spreadsheet opening a CSV reads a cell as a formula
+_LIVE = ("=", "+", "-", "@", "\t", "\r", "|", "%")
+#: after a leading + or -, what a formula needs to call anything (a function, a link)
+_CALLS = re.compile(r"[A-Za-z(|!=@]")
+
+
+def _live(text: str) -> bool:
+    if text.startswith(("+", "-")):
+        return _CALLS.search(text) is not None
+    return text.startswith(_LIVE)
+
+
+def csv_text(text: str) -> str:
+    """A text from the imported file as a CSV cell that no spreadsheet reads as a formula
+    (``=cmd|' /C calc'!A0`` is written ``'=cmd|' /C calc'!A0``), on one line."""
+    text = text.replace("\r", " ").replace("\n", " ")
+    return "'" + text if _live(text) else text
+
+
+def uncompared(text: str) -> str | None:
+    """Why a cached text is not compared (None: it is): one that a spreadsheet would read as a
+    formula or that spans lines (written escaped, so the comparison would be with the escaped
+    text), or one that the printed values would read as a number."""
+    if _live(text) or "\n" in text or "\r" in text:
+        return "a text a spreadsheet reads as a formula: escaped, not compared"
+    try:
+        float(text)
+    except ValueError:
+        return None
+    return "a text that reads as a number: not compared"
+
+
 def _cached(value) -> tuple[str, str] | None:
-    """(kind, CSV text) of a cached value: a number, a text, an error; None if empty."""
-    if value is None or isinstance(value, bool):
+    """(kind, CSV text) of a cached value: a number, a text, an error; None if empty.
+    TRUE and FALSE are the numbers 1 and 0, as a comparison gives them."""
+    if isinstance(value, bool):
+        return ("number", "1.0" if value else "0.0")
+    if value is None:
         return None
     if isinstance(value, (int, float)):
         return ("number", repr(float(value)))
@@ -64,7 +99,7 @@ def _cached(value) -> tuple[str, str] | None:
             "#DIV/0", "#N/A", "#NAME", "#NULL", "#NUM", "#REF", "#VALUE", "#GETTING_DATA",
         ):  # fmt: skip
             return ("error", value)
-        if value == "":
+        if not value.strip():
             return None
         return ("text", value)
     return None
@@ -191,16 +226,59 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         doc["arguments"] = arguments
     if definitions:
         doc["definitions"] = definitions
-    counts: dict = {"numbers": 0, "texts": 0, "errors": 0, "cells": {}}
-    out = io.StringIO()
-    w = csv.writer(out, lineterminator="\n")
-    out.write("# Excel's cached values of the translated cells (imported by `workbook import`)\n")
-    w.writerow(["name", "argument", "value", "unit"])
-    printed = []
-    files = {}
     if tables:
         doc["tables"] = list(tables.values())
+    files, printed, counts = _printed_files(tr, name, skip, rows, at_rows, run_rows)
+    if printed:
+        doc["printed"] = printed
+    head = [
+        f"# Imported from {tr.path.name} by `workbook import`: inputs from the constant cells",
+        "# that formulas read, definitions from formula cells, functions from VBA Functions,",
+        "# and Excel's cached values as printed values (`workbook check` compares them).",
+        "# Excel has no units: the numbers are plain; a unit a label names is proposed in a note.",
+    ]
+    if tr.book.stale:
+        head += _comment(
+            "Excel saved this workbook before it finished calculating (calcCompleted=0, "
+            "manual calculation): a cached value may be older than its inputs, so a value "
+            "not reproduced is to be checked by hand."
+        )
+    listed = list(tr.listed) + [(k, v) for k, v in skip.items()]
+    if listed:
+        head.append("#")
+        head.append(f"# Not translated ({len(listed)}; their cells count as not reproduced):")
+        for what, why in listed[:400]:
+            head += _comment(f"  {what}: {why}")
+        if len(listed) > 400:
+            head.append(f"#   ... and {len(listed) - 400} more")
+    toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
+    return toml, files, counts
+
+
+def _printed_files(tr: Translation, name: str, skip: dict, rows, at_rows, run_rows):
+    """(files {name: CSV text}, the [[printed]] entries, counts) of Excel's cached values: the
+    translated cells by kind (cells, cells of array formulas, filled-down columns), the
+    differences of nearly equal numbers by their size, and the cells not translated."""
+    counts: dict = {"numbers": 0, "texts": 0, "errors": 0, "cells": {}}
+    printed = []
+    files = {}
+    reasons: dict[str, str] = {}  # cell -> why its cached value is not compared
+    memo: dict = {}
+    groups = []
     for label, group, arg in (("", rows, None), (".at", at_rows, "k_at"), (".rows", run_rows, ROW)):
+        plain, by_decade = _split_cancelling(tr, group, memo)
+        groups.append((label, plain, arg, ABS_TOLERANCE, ""))
+        for dec, part in sorted(by_decade.items()):
+            groups.append(
+                (
+                    f"{label}.cancel-e{dec}",
+                    part,
+                    arg,
+                    REL_TOLERANCE * 10.0**dec,
+                    f", differences of numbers of up to 1e{dec} (compared to their tolerance)",
+                )
+            )
+    for label, group, arg, tolerance, what in groups:
         if not group:
             continue
         out = io.StringIO()
@@ -212,10 +290,13 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
         for n, at, (kind, text), ref in group:
             counts[kind + "s"] += 1
             if kind == "error":
-                out.write(f"# {ref}: Excel shows {text} (an error value: not compared)\n")
+                out.write(f"# {csv_text(ref)}: Excel shows {text} (an error value: not compared)\n")
                 continue
-            out.write(f"# {ref}\n")
-            w.writerow([n, at, text, ""])
+            if kind == "text" and uncompared(text):
+                reasons[ref] = uncompared(text)
+                continue
+            out.write(f"# {csv_text(ref)}\n")
+            w.writerow([n, at, csv_text(text) if kind == "text" else text, ""])
             counts["cells"][ref] = (n, float(at) if at else None)
         fname = f"{name}.excel{label}.csv"
         files[fname] = out.getvalue()
@@ -224,31 +305,85 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             "title": "Excel's cached values"
             + {None: "", "k_at": " of the cells of array formulas", ROW: " of filled-down columns"}[
                 arg
-            ],
+            ]
+            + what,
             "rel_tolerance": REL_TOLERANCE,
-            "tolerance": ABS_TOLERANCE,
+            "tolerance": tolerance,
         }
         if arg:
             entry["argument"] = arg
         printed.append(entry)
-    if printed:
-        doc["printed"] = printed
-    head = [
-        f"# Imported from {tr.path.name} by `workbook import`: inputs from the constant cells",
-        "# that formulas read, definitions from formula cells, functions from VBA Functions,",
-        "# and Excel's cached values as printed values (`workbook check` compares them).",
-        "# Excel has no units: the numbers are plain; a unit a label names is proposed in a note.",
-    ]
-    listed = list(tr.listed) + [(k, v) for k, v in skip.items()]
-    if listed:
-        head.append("#")
-        head.append(f"# Not translated ({len(listed)}; their cells count as not reproduced):")
-        for what, why in listed[:400]:
-            head += _comment(f"  {what}: {why}")
-        if len(listed) > 400:
-            head.append(f"#   ... and {len(listed) - 400} more")
-    toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
-    return toml, files, counts
+    group = _not_translated_rows(tr, skip, counts, reasons)
+    if group:
+        fname = f"{name}.excel.not-translated.csv"
+        files[fname] = group
+        printed.append(
+            {
+                "file": fname,
+                "title": "Excel's cached values of the formula cells not translated",
+                "rel_tolerance": REL_TOLERANCE,
+                "tolerance": ABS_TOLERANCE,
+            }
+        )
+    return files, printed, counts
+
+
+def _split_cancelling(tr: Translation, group: list, memo: dict) -> tuple[list, dict]:
+    """The rows of ``group`` compared as they are, and {power of ten: rows} of the cells whose
+    value is a difference of nearly equal numbers of that size (see cancellation.py)."""
+    from .cancellation import decade
+
+    plain, by_decade = [], {}
+    for row in group:
+        _, _, (kind, text), ref = row
+        found = decade(tr.book, ref, float(text), memo) if kind == "number" else None
+        if found is None:
+            plain.append(row)
+        else:
+            by_decade.setdefault(found, []).append(row)
+    return plain, by_decade
+
+
+def _not_translated_rows(tr: Translation, skip: dict, counts: dict, reasons: dict) -> str:
+    """The CSV of the formula cells with a cached value (a number or a text) that no
+    translated definition gives: each is a printed value whose name says the cell and why, so
+    that ``workbook check`` counts it as not computable, with its reason."""
+    for d in tr.definitions:
+        why = d.problem or skip.get(d.name) or (d.element and skip.get(d.element[0]))
+        if why:
+            reasons.setdefault(d.cell.ref, why)
+            if d.run is not None:
+                for key in d.run.keys():
+                    reasons.setdefault(f"{key[0]}!{_addr(key[1], key[2])}", why)
+    for what, why in tr.listed:
+        reasons.setdefault(what.split(" ")[0], why)
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    out.write("# Excel's cached values of formula cells not translated (not computable)\n")
+    w.writerow(["name", "argument", "value", "unit"])
+    n = 0
+    for cells in tr.book.sheets.values():
+        for key in sorted(cells):
+            cell = cells[key]
+            if cell.formula is None or cell.ref in counts["cells"]:
+                continue
+            cached = _cached(cell.value)
+            if cached is None or cached[0] == "error":
+                continue
+            why = reasons.get(cell.ref, "beyond the formulas translated")
+            why = re.sub(r"\s+", " ", why)[:160]
+            value = csv_text(cached[1]) if cached[0] == "text" else cached[1]
+            w.writerow([csv_text(f"{cell.ref} (not translated: {why})"), "", value, ""])
+            counts["cells"][cell.ref] = None
+            n += 1
+    counts["not translated"] = n
+    return out.getvalue() if n else ""
+
+
+def _addr(row: int, col: int) -> str:
+    from openpyxl.utils import get_column_letter
+
+    return f"{get_column_letter(col)}{row}"
 
 
 def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
@@ -331,7 +466,7 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
         files=paths,
         definitions=n_def,
         functions=n_fn,
-        printed=counts["numbers"] + counts["texts"],
+        printed=counts["numbers"] + counts["texts"] + counts.get("not translated", 0),
         not_translated=list(tr.listed) + list(skip.items()),
         cells=counts["cells"],
     )

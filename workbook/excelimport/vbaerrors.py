@@ -1,0 +1,50 @@
+"""``On Error GoTo LABEL`` in a VBA function, as documented: an error in the function (or in
+what it calls) jumps to the label. Where the code at the label only gives the function an
+error value (``CVErr(...)``) or raises the error again (``Err.Raise``), choosing between them
+by ``Err.Number``, the cell shows an error value whatever the error was: the translation is
+the code before the label, and an error there leaves the function without a value, as the
+cell has none. A handler that gives a number, resumes, or does anything else is refused."""
+
+from __future__ import annotations
+
+import re
+
+from .vbamembers import NotTranslated
+
+_GOTO = re.compile(r"^on\s+error\s+goto\s+([A-Za-z_]\w*):?$", re.I)
+_HANDLER_LINES = (
+    re.compile(r"^(?:else\s*)?if\s+err\.number\s*(?:=|<>)\s*[\w.()-]+\s+then$", re.I),
+    re.compile(r"^(?:else|end\s+if|exit\s+function)$", re.I),
+    re.compile(r"^err\.raise\b", re.I),
+)
+
+
+def cut_error_handler(name: str, body: list[tuple[int, str]]) -> list[tuple[int, str]]:
+    """The body without its ``On Error GoTo`` line and its handler, where the handler gives
+    only error values (else NotTranslated, naming the line); the body as it is without one."""
+    starts = [k for k, (_, text) in enumerate(body) if _GOTO.match(text.strip())]
+    if not starts:
+        return body
+    if len(starts) > 1:
+        raise NotTranslated(f"line {body[starts[1]][0]}: a second On Error GoTo")
+    h = starts[0]
+    label = _GOTO.match(body[h][1].strip()).group(1)
+    at = next(
+        (k for k, (_, t) in enumerate(body) if t.strip().lower() == f"{label.lower()}:"), None
+    )
+    if at is None or at < h:
+        raise NotTranslated(f"line {body[h][0]}: On Error GoTo {label} without its label")
+    if at == 0 or body[at - 1][1].strip().lower() != "exit function":
+        raise NotTranslated(
+            f"line {body[at][0]}: the code runs on into the error path at {label} (no Exit "
+            "Function before it)"
+        )
+    error_value = re.compile(rf"^{re.escape(name)}\s*=\s*CVErr\s*\(.*\)$", re.I)
+    for number, text in body[at + 1 :]:
+        text = text.strip()
+        if not (error_value.match(text) or any(p.match(text) for p in _HANDLER_LINES)):
+            raise NotTranslated(
+                f"line {number}: On Error GoTo {label}: the error path does more than give an "
+                f"error value ({text[:60]!r})"
+            )
+    return body[:h] + body[h + 1 : at]
