@@ -335,6 +335,27 @@ def extremum_of(of, a, b, kind: str, where: bool) -> np.ndarray | None:
     return _each(kind, of.var, prepared, one)
 
 
+#: terms of one row of a sum or product that the reference adds at most
+SERIES_TERMS = 20_000
+
+
+def series(of, lo, hi, kind: str) -> np.ndarray | None:
+    """The reference of sum/product(EXPR, I, A, B): every term in mpmath at 32 digits, added
+    (``fsum``) or multiplied exactly at that precision; None without an mpmath form."""
+    prepared = _prepared(of, kind, DIGITS, lo, hi)
+    if prepared is None:
+        return None
+
+    def one(ctx, g, ab, i):
+        first, last = int(ab[0]), int(ab[1])
+        if last - first + 1 > SERIES_TERMS:
+            raise Unconverged(f"{last - first + 1} terms (the reference adds {SERIES_TERMS})")
+        terms = [g(ctx.mpf(k)) for k in range(first, last + 1)]
+        return ctx.fsum(terms) if kind == "sum" else ctx.fprod(terms)
+
+    return _each(kind, of.var, prepared, one)
+
+
 # -- roots inside the rounding noise: polished in extended precision ----------------------------
 #: rows of one call polished at most (a table of multiple roots keeps its noise-limited
 #: estimates beyond that)
