@@ -59,7 +59,10 @@ KNOWN_ELSEWHERE = {
         ),
     ),
     # the numerical methods with an error estimate (bench) and their live Excel forms
-    ("numerics/bench.py", ("argmax", "argmin", "integral", "maximum", "minimum", "root")),
+    (
+        "numerics/bench.py",
+        ("argmax", "argmin", "integral", "maximum", "minimum", "product", "root", "sum"),
+    ),
     ("numerics/live.py", ("argmax", "argmin", "maximum", "minimum")),
     # interval arithmetic of the one-argument built-ins (root counts, global extrema,
     # features of integrands): a back end whose rules could be a field of the entry

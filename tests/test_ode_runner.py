@@ -18,9 +18,9 @@ def _stiff(t, y):
 
 def test_auto_takes_an_implicit_method_for_a_stiff_system_and_says_why():
     s = ode.solve(_stiff, 0.0, 5.0, [0.0, 1.0], name="st", states=("a", "b"), rtol=1e-8, atol=1e-10)
-    assert s.method == "Radau"
-    assert "stiff" in s.choice.reason and "-1000" in s.choice.reason
-    assert "Radau" in s.finding()
+    assert s.method == "LSODA"
+    assert "stiff" in s.choice.reason and "decay rate 1000" in s.choice.reason
+    assert "LSODA" in s.finding()
     t = np.linspace(0, 5, 11)
     # closed form of a' = -k (a - cos t), a(0) = 0
     k = 1000.0
@@ -32,7 +32,7 @@ def test_auto_takes_an_implicit_method_for_a_stiff_system_and_says_why():
 def test_auto_takes_an_explicit_method_when_not_stiff():
     f = lambda t, y: np.array([y[1], -y[0]])  # noqa: E731
     s = ode.solve(f, 0.0, 10.0, [1.0, 0.0], name="osc", states=("x", "v"), rtol=1e-10, atol=1e-12)
-    assert s.method == "DOP853" and "not stiff" in s.choice.reason
+    assert s.method == "DOP853" and "watched for stiffness" in s.choice.reason
     t = np.linspace(0, 10, 7)
     assert np.max(np.abs(s(0, t) - np.cos(t))) < 1e-8
     coarse = ode.solve(f, 0.0, 10.0, [1.0, 0.0], name="osc", states=("x", "v"), rtol=1e-4)

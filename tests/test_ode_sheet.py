@@ -111,13 +111,13 @@ def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):
         ),
     )
     sol = sheet.evaluator.ode_solution("stiff")
-    assert sol.method == "Radau"
+    assert sol.method == "LSODA"
     assert "stiff" in sol.choice.reason
     findings = [f for f in run_checks(sheet).findings if f.topic == "ode stiff"]
-    assert findings and "Radau" in findings[0].note and "-2e+04" in findings[0].note
+    assert findings and "LSODA" in findings[0].note and "decay rate 2e+04" in findings[0].note
     np.testing.assert_allclose(
-        sheet.evaluate("b", [0.5, 2]).to("m").magnitude, np.exp(-2 * np.array([0.5, 2])), rtol=1e-7
-    )
+        sheet.evaluate("b", [0.5, 2]).to("m").magnitude, np.exp(-2 * np.array([0.5, 2])), rtol=1e-6
+    )  # LSODA's global error at rtol 1e-8 is 1.1e-7 here
 
 
 def test_units_of_derivatives_are_checked_at_load(tmp_path):
