@@ -61,10 +61,10 @@ class Evaluator(Visitor):
         typer: tc.Typer,
         scalar_value: Callable[[str, str], object],
         describe_args: Callable[[str, tuple, dict], str],
-        column_values: Callable[[str, str], object] | None = None,
+        column_values: Callable[[str, str, object], object] | None = None,
     ):
         self.typer = typer
-        self.column_values = column_values  # (table, column) -> values, for max_over()
+        self.column_values = column_values  # (table, column, unit) -> values, for max_over()
         self.solve_at: Callable | None = None  # (unknown, env) -> values, set by the Sheet
         self.scalar_value = scalar_value  # (name, kind) -> magnitude in the ref's unit
         self.describe_args = describe_args
@@ -325,7 +325,7 @@ class Evaluator(Visitor):
         get, red = self.column_values, (np.max if t.func == "max" else np.min)
         if get is None:
             raise InputError(f"{t.func}_over({t.table}, {t.column}) needs a sheet's tables")
-        return lambda env: float(red(get(t.table, t.column)))
+        return lambda env: float(red(get(t.table, t.column, t.unit)))
 
     def visit_TPiecewise(self, t: ty.TPiecewise) -> Fn:
         if ty.is_runtime(t.shape):

@@ -497,8 +497,9 @@ class Sheet:
 
         return solved_at(self, self.spec.solve_of(name), name, env)
 
-    def _column_values(self, table: str, column: str) -> np.ndarray:
-        """Values of one column of a range table (for max_over/min_over), memoised."""
+    def _column_values(self, table: str, column: str, unit: pint.Unit) -> np.ndarray:
+        """Values of one column of a range table in ``unit``, the column's typed unit (for
+        max_over/min_over), memoised."""
         key = ("column", table, column)
         if key not in self._memo:
             spec = next(t for t in self.full_spec.tables if t.name == table)  # any part
@@ -514,8 +515,7 @@ class Sheet:
                     definition=what,
                 )
             # max_over() is typed in the column's unit, the column held as its cells hold it
-            typed = tc.column_type(self.typer, col, spec.range.var, what)
-            factor = cellunit.read_factor(typed)
+            factor = cellunit.read_factor(ty.TConst(unit, value=1.0))
             self._memo[key] = column.values if factor == 1.0 else column.values * factor
         return self._memo[key]
 
