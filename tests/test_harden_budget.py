@@ -613,3 +613,43 @@ def test_the_alarm_waits_for_an_import_to_finish(tmp_path, monkeypatch):
             while True:  # and is raised here, once the import is done
                 pass
     assert sys.modules["slow_module"].READY
+
+
+def test_the_default_budget_grows_with_the_size_of_what_it_is_given():
+    from workbook import limits_time as lt
+
+    with lt.command_budget():
+        lt.grow_default(100.0, "a large worksheet")
+        assert lt.current().seconds == lt.DEFAULT_SECONDS + 100.0
+        lt.grow_default(1.0, "a smaller one")  # the largest grant holds
+        assert lt.current().seconds == lt.DEFAULT_SECONDS + 100.0
+        lt.grow_default(1e9, "a huge one")
+        assert lt.current().seconds == lt.MAX_SIZED_SECONDS
+    with lt.command_budget(3.0, "--time-limit"):  # a budget the user set is kept
+        lt.grow_default(100.0, "a large worksheet")
+        assert lt.current().seconds == 3.0
+
+
+def test_a_worksheet_of_many_definitions_gets_more_time_a_small_one_none(tmp_path):
+    from workbook import limits_time as lt
+
+    many = "\n".join(f'd{k} = "{k}*2"' for k in range(2000))
+    with lt.command_budget():
+        workbook.loads(f"[definitions]\n{many}\n")
+        assert lt.current().seconds == pytest.approx(lt.DEFAULT_SECONDS + 2000 * 0.005)
+    with lt.command_budget():
+        workbook.loads('[definitions]\nx = "2"\n')
+        assert lt.current().seconds < lt.DEFAULT_SECONDS + 0.01
+
+
+def test_the_long_lived_commands_run_without_a_budget():
+    import types
+
+    from workbook import cli
+    from workbook import limits_time as lt
+
+    seen = []
+    for command in ("serve", "lsp", "run"):
+        args = types.SimpleNamespace(command=command, debug=False, time_limit=None)
+        cli._run_command(lambda a: seen.append(lt.current() is None) or 0, args)
+    assert seen == [True, True, False]

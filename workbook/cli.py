@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import sys
 from pathlib import Path
 
@@ -598,6 +599,15 @@ def _quiet_file_errors(debug: bool):
         sys.unraisablehook = previous
 
 
+def _grow_for_file(limits_time, path) -> None:
+    """The default budget of an import grows with the size of the file imported."""
+    try:
+        size = os.path.getsize(path)
+    except OSError:  # the import itself says what is wrong with the path
+        return
+    limits_time.grow_default(limits_time.SECONDS_PER_KILOBYTE * size / 1024, f"'{path}'")
+
+
 def _run_command(handler, args) -> int:
     """``handler(args)`` within the command's budget; every error as its exit status."""
     from . import limits_time
@@ -610,7 +620,12 @@ def _run_command(handler, args) -> int:
         if getattr(args, "time_limit", None) is not None:
             seconds = limits_time.check_seconds(args.time_limit, "--time-limit")
             source = "--time-limit"
+        if args.command in ("serve", "lsp"):  # long-lived: each has no end to budget
+            with sigterm_as_interrupt():
+                return handler(args)
         with sigterm_as_interrupt(), limits_time.command_budget(seconds, source):
+            if args.command == "import" and getattr(args, "file", None):
+                _grow_for_file(limits_time, args.file)
             return handler(args)
     except WorkbookError as err:
         if args.debug:

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 import pint
 
+from .. import limits_time
 from ..compute import cellunit
 from ..compute.computed import Column, TableData, compute
 from ..errors import (
@@ -93,6 +94,8 @@ class Sheet:
 
     def check_units(self) -> None:
         """Infer the unit of every definition, table column and chart series (load time)."""
+        items = len(self.spec.definitions) + len(self.spec.inputs)
+        limits_time.grow_default(limits_time.SECONDS_PER_ITEM * items, f"'{self.file}'")
         for block in self.spec.solves:
             from ..language.given_find import typed_equations
 
@@ -172,11 +175,15 @@ class Sheet:
                     self.scalar_typed(name)
                 except WorkbookError:
                     pass
+        read = 0
         for p in self.full_spec.printed:
             try:
                 rows = printed_rows(p)
             except WorkbookError:
                 continue
+            read += len(rows)
+            items = len(self.spec.definitions) + len(self.spec.inputs) + read
+            limits_time.grow_default(limits_time.SECONDS_PER_ITEM * items, f"'{self.file}'")
             for row in rows:
                 at = None if math.isnan(row.at) else row.at
                 try:
