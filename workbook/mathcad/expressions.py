@@ -304,31 +304,26 @@ class ExprTranslator(Visitor):
 
     def _column(self, args: list[MNode]) -> ex.Node:
         """Mathcad's column M<j>: submatrix(M, first row, last row, j, j)."""
-        m, j = self.value(args[0]), self.value(args[1])
-        shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
-        if shift:
-            j = ex.Binary("+", j, ex.Number(float(shift)))
-        o = self.tr.sheet_origin
-        last = ex.Call("rows", (m,))
-        if o != 1:
-            last = (
-                ex.Binary("-", last, ex.Number(float(1 - o)))
-                if o < 1
-                else ex.Binary("+", last, ex.Number(float(o - 1)))
-            )
-        return ex.Call("submatrix", (m, ex.Number(float(o)), last, j, j))
+        m, j, first, last = self._slice(args, "rows")
+        return ex.Call("submatrix", (m, first, last, j, j))
 
     def _row(self, args: list[MNode]) -> ex.Node:
         """Prime's row M<i> (a row of one row): submatrix(M, i, i, first column, last)."""
-        m, i = self.value(args[0]), self.value(args[1])
+        m, i, first, last = self._slice(args, "cols")
+        return ex.Call("submatrix", (m, i, i, first, last))
+
+    def _slice(self, args: list[MNode], size: str) -> tuple[ex.Node, ...]:
+        """M, the index of its column or row, and the first and last index along the other
+        axis (``size``: rows or cols) in the sheet's origin."""
+        m, k = self.value(args[0]), self.value(args[1])
         shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
         if shift:
-            i = ex.Binary("+", i, ex.Number(float(shift)))
+            k = ex.Binary("+", k, ex.Number(float(shift)))
         o = self.tr.sheet_origin
-        last = ex.Call("cols", (m,))
+        last = ex.Call(size, (m,))
         if o != 1:
             last = ex.Binary("-" if o < 1 else "+", last, ex.Number(float(abs(o - 1))))
-        return ex.Call("submatrix", (m, i, i, ex.Number(float(o)), last))
+        return m, k, ex.Number(float(o)), last
 
     def visit_sqrt(self, node: MNode) -> ex.Node:  # <ml:sqrt> used as an element
         return self._builtin("sqrt", "sqrt", [self.value(node.children[0])])
