@@ -18,6 +18,7 @@ import pytest
 import workbook
 from workbook.blocks import reducer
 from workbook.errors import InputError, WorkbookError
+from workbook.language import units as un
 
 
 @pytest.fixture(scope="module")
@@ -431,7 +432,9 @@ def test_libreoffice_recalculates_the_live_profile(sheet, tmp_path):
     col = {h: openpyxl.utils.get_column_letter(i + 1) for i, h in enumerate(heads)}
     for i in (0, 45, 90, 180):
         for h in ("x_t [mm]", "y_t [mm]", "a [deg]"):
-            got = values[("Listing", f"{col[h]}{3 + i}")]
+            name, unit = h[:-1].split(" [")  # the workbook's header typesets the unit: a [°]
+            shown = f"{name} [{un.typeset(un.unit(unit))}]"
+            got = values[("Listing", f"{col[shown]}{3 + i}")]
             assert got == pytest.approx(ref[h].iloc[i], rel=1e-9, abs=1e-12), (h, i)
 
 
