@@ -215,7 +215,7 @@ def to_png(pdf: Path, png: Path) -> tuple[int, int]:
 
 def render(name: str, out_dir: Path) -> dict | None:
     import workbook
-    from workbook.engine.sheet import Sheet
+    from workbook.facade import Sheet
 
     sheet = workbook.load(name)
     chart = main_chart(sheet.spec)

@@ -9,7 +9,7 @@ import pytest
 import scipy.linalg as sl
 
 import workbook
-from workbook.engine.sheet import Sheet
+from workbook.facade import Sheet
 from workbook.language.template import load_spec
 
 RNG = np.random.default_rng(7)

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from recalc import cell_values, recalculate, soffice
 
-from workbook.engine.sheet import Sheet
+from workbook.facade import Sheet
 from workbook.language.template import load_spec
 
 pytestmark = [

@@ -14,8 +14,8 @@ from workbook.compute.excel import ExcelPrinter
 from workbook.engine import symbolic
 from workbook.engine.analysis import typed_text
 from workbook.engine.numeric import Evaluator
-from workbook.engine.sheet import Sheet
 from workbook.engine.symbolic import SympyConverter
+from workbook.facade import Sheet
 from workbook.functions.builtins import Builtin, register
 from workbook.functions.registry import REGISTRY
 from workbook.language import typed as ty

@@ -111,8 +111,8 @@ def test_the_sheets_of_other_inputs_and_parts_share_the_typed_trees(tmp_path):
 
 
 def test_a_sheet_is_checked_and_computed_once_through_the_api(tmp_path, monkeypatch):
+    from workbook import facade
     from workbook.compute import checks, computed
-    from workbook.engine import sheet as sheet_module
 
     calls = {"compute": 0, "check": 0}
 
@@ -125,7 +125,7 @@ def test_a_sheet_is_checked_and_computed_once_through_the_api(tmp_path, monkeypa
 
         monkeypatch.setattr(module, attr, wrapper)
 
-    counting("compute", sheet_module, "compute")
+    counting("compute", facade, "compute")
     counting("check", checks, "run_checks")
     sheet = small(tmp_path)
     report = sheet.check()

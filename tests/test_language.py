@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 import workbook
-from workbook.engine.sheet import Sheet
+from workbook.facade import Sheet
 from workbook.language.template import load_spec
 
 DOC = Path(__file__).parent.parent / "docs" / "language.md"

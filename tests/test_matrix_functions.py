@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from workbook.engine.sheet import Sheet
 from workbook.errors import TemplateError, UnitError
+from workbook.facade import Sheet
 from workbook.language.template import load_spec
 
 DATA = Path(__file__).parent / "data" / "matrix_functions.toml"

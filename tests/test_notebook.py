@@ -10,7 +10,7 @@ from workbook.outputs import notebook
 
 def test_the_html_shows_inputs_definitions_and_tables(concave):
     text = concave._repr_html_()
-    assert text == notebook.sheet_html(concave)
+    assert text == notebook.sheet_html(concave.computed())
     assert "1. Inputs</h2>" in text and "<tr data-name='R3'>" in text
     assert "radius of the concave flank" in text
     assert "2. Calculation</h2>" in text and "id='def-k'" in text
@@ -21,12 +21,12 @@ def test_the_html_shows_inputs_definitions_and_tables(concave):
 
 
 def test_tables_are_dataframes_with_units_in_the_headers(concave):
-    frames = notebook.tables(concave)
+    frames = notebook.tables(concave.computed())
     assert list(frames) == ["flank_AB", "nose_BB", "flank_BA", "curves"]
     df = frames["flank_AB"]
     assert list(df.columns) == ["phi [deg]", "h1 [mm]", "v1 [m/s]", "j1 [m/s^2]"]
     assert df["v1 [m/s]"].iloc[-1] == pytest.approx(3.152, abs=5e-4)  # the printed v1(22)
-    inputs = notebook.inputs_frame(concave.with_inputs(R3="45 mm"))
+    inputs = notebook.inputs_frame(concave.with_inputs(R3="45 mm").computed())
     assert inputs.set_index("name").loc["R3", "value"] == 45.0
     assert inputs.set_index("name").loc["phi_n", "unit"] == "deg"
 

@@ -8,7 +8,7 @@ import pytest
 
 import workbook
 from workbook.compute.checks import run_checks
-from workbook.engine.sheet import Sheet
+from workbook.facade import Sheet
 from workbook.language.template import load_spec
 
 HEAD = """

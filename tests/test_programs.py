@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook.engine.sheet import Sheet
+from workbook.facade import Sheet
 from workbook.language.template import load_spec
 from workbook.program.run import MAX_STEPS
 

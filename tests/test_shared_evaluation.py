@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from workbook.compute.excel import ExcelPrinter
-from workbook.engine.sheet import Sheet
+from workbook.facade import Sheet
 from workbook.functions.registry import REGISTRY
 from workbook.language.template import load_spec
 from workbook.sweep import sweep

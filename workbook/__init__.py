@@ -50,7 +50,7 @@ def load(name_or_path: str | Path, parts=None):
 
     ``parts`` chooses the template's optional parts to compute and write: None (only what is
     in no part), a part name, several names, or ``"all"``."""
-    from .engine.sheet import Sheet
+    from .facade import Sheet
     from .language.template import load_spec
 
     path = template_path(name_or_path)
@@ -61,8 +61,8 @@ def loads(text: str, name: str = "sheet", folder: str | Path = ".", parts=None):
     """A :class:`Sheet` from template text (TOML), its units checked, as :func:`load` gives
     from a file. Messages name ``FOLDER/NAME.toml`` (no file is read or written), and files
     the text names ([data] CSV) are read from ``folder``."""
-    from .engine.sheet import Sheet
     from .errors import LimitError
+    from .facade import Sheet
     from .language.template import MAX_TEMPLATE_BYTES, parse_spec
 
     if len(text.encode("utf-8")) > MAX_TEMPLATE_BYTES:
@@ -72,7 +72,7 @@ def loads(text: str, name: str = "sheet", folder: str | Path = ".", parts=None):
 
 def __getattr__(name):
     if name == "Sheet":
-        from .engine.sheet import Sheet
+        from .facade import Sheet
 
         return Sheet
     raise AttributeError(name)

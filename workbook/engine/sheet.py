@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import cmath
 import math
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -12,7 +11,7 @@ import pint
 
 from .. import limits_time
 from ..compute import cellunit
-from ..compute.computed import Column, TableData, compute
+from ..compute.computed import Column, TableData
 from ..errors import (
     DomainError,
     InputError,
@@ -267,12 +266,28 @@ class Sheet:
                 values[name] = coerce_input(spec, raw, file=self.file)
             except WorkbookError as err:  # point at the input's declaration (unit, bounds)
                 raise err.located(file=self.file, line=spec.line, definition=name) from None
-        return Sheet(self.full_spec, values, self.typer, self.parts, self.typed)
+        return self.another(values, self.parts)
 
     def with_parts(self, *names: str) -> Sheet:
         """The same sheet computing and writing the optional parts ``names`` (``"all"``: every
         part; none: only what is not in a part). See ``[parts]`` in docs/language.md."""
-        return Sheet(self.full_spec, self.values, self.typer, names, self.typed)
+        return self.another(self.values, names)
+
+    def another(self, values: dict[str, Any], parts) -> Sheet:
+        """A Sheet of the same template, typer and typed trees with other input values or
+        parts (``with_inputs``, ``with_parts``); a subclass makes one of its own kind."""
+        return Sheet(self.full_spec, values, self.typer, parts, self.typed)
+
+    def once(self, key: tuple, make):
+        """``make()``, made once per Sheet under ``key`` (a Sheet does not change: other
+        inputs or parts are another Sheet)."""
+        if key not in self._memo:
+            self._memo[key] = make()
+        return self._memo[key]
+
+    def made(self, key: tuple):
+        """What :meth:`once` made under ``key``, or None when nothing was made yet."""
+        return self._memo.get(key)
 
     @property
     def left_out(self) -> list[str]:
@@ -803,58 +818,12 @@ class Sheet:
             )
         return self._memo[key]
 
-    def write_xlsx(
-        self,
-        path,
-        *,
-        force: bool = False,
-        command: str | None = None,
-        report=None,
-        verify: bool = True,
-        refusals: list | None = None,
-    ) -> Path:
-        """Write the workbook (atomically); returns the path written. ``report``: the check
-        report if already made; ``verify``: check every live formula with an independent
-        evaluator first (one that disagrees is written as the engine's value, and appended
-        to ``refusals`` when given)."""
-        from ..outputs.atomic import check_target
-        from ..outputs.xlsx import write_workbook
-
-        check_target(Path(path), force=force)  # before any work
-        if report is None or report is self._memo.get(("check",)):
-            computed = self.computed(excel=True, command=command, verify=verify)
-        else:  # a report made elsewhere: this workbook's own
-            computed = compute(self, report=report, excel=True, command=command, verify=verify)
-        if refusals is not None:
-            refusals.extend(computed.excel.refusals)
-        return write_workbook(computed, Path(path), force=force)
-
-    def report(self, path=None, pdf: bool = False, **options) -> Path:
-        """Write the calculation as a document: ``path`` (default ``reports/NAME.html``) and,
-        with ``pdf``, the PDF beside it (needs Chromium). Returns the HTML path."""
-        from ..outputs.report import report_targets, write_report
-
-        path, _ = report_targets(self.name, path, pdf=pdf, force=options.get("force", False))
-        return write_report(self.computed(), path, pdf=pdf, **options)[0]
-
-    def computed(self, *, excel: bool = False, command: str | None = None, verify: bool = True):
-        """This sheet computed (a :class:`workbook.compute.computed.ComputedSheet`), once per
-        Sheet and kind: as the report and the notebook view show it, or with ``excel`` as the
-        workbook writes it (once per ``command`` and ``verify``). A Sheet does not change (other
-        inputs or parts are another Sheet), so what is computed is reused."""
-        key = ("computed", excel, command if excel else None, verify if excel else None)
-        if key not in self._memo:
-            self._memo[key] = compute(self, excel=excel, command=command, verify=verify)
-        return self._memo[key]
-
     def check(self):
         """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`,
         made once per Sheet (the workbook's and the report's Checks read it)."""
         from ..compute.checks import run_checks
 
-        if ("check",) not in self._memo:
-            self._memo[("check",)] = run_checks(self)
-        return self._memo[("check",)]
+        return self.once(("check",), lambda: run_checks(self))
 
     def unused_inputs(self) -> list[str]:
         """Inputs that no table, chart, printed value, check or scalar definition (each is on
@@ -864,11 +833,6 @@ class Sheet:
         shown = {n for n, d in self.full_spec.definitions.items() if not d.is_function}
         used = names_used(self.full_spec, hand_checks=True, reads=self.reads | shown)
         return [n for n in self.full_spec.inputs if n not in used]
-
-    def _repr_html_(self) -> str:
-        from ..outputs.notebook import sheet_html
-
-        return sheet_html(self.computed())
 
 
 #: A column with more failed rows than this is an error, not a table with error cells.

@@ -4,24 +4,21 @@ Jupyter calls the Sheet's ``_repr_html_``, which is :func:`sheet_html`: what ``w
 report`` writes (:mod:`workbook.outputs.report`). Tables are pandas DataFrames with the unit in
 every header (``sheet.table(name)``, :func:`tables`). A value that fails is shown with its error
 instead of breaking the display. Each function reads a computed sheet
-(:func:`workbook.compute.computed.compute`); given a Sheet, it computes it first."""
+(:class:`workbook.compute.computed.ComputedSheet`, ``sheet.computed()``): none computes."""
 
 from __future__ import annotations
 
 import html
+from typing import TYPE_CHECKING
 
-from ..compute.computed import ComputedSheet, compute
 from ..errors import WorkbookError
 from ..language import units as un
 
-
-def computed(sheet, *, check: bool | None = None) -> ComputedSheet:
-    """``sheet`` computed (as the report computes it; ``check=False``: without the check
-    report), or itself if it already is."""
-    return sheet if isinstance(sheet, ComputedSheet) else compute(sheet, check=check)
+if TYPE_CHECKING:
+    from ..compute.computed import ComputedSheet
 
 
-def inputs_frame(sheet):
+def inputs_frame(sheet: ComputedSheet):
     """Inputs as a DataFrame: name, value, unit, note."""
     import pandas as pd
 
@@ -35,11 +32,10 @@ def inputs_frame(sheet):
     return pd.DataFrame(rows, columns=["name", "value", "unit", "note"])
 
 
-def definitions_frame(sheet):
+def definitions_frame(sheet: ComputedSheet):
     """Scalar definitions with their values (or the error that stops them)."""
     import pandas as pd
 
-    sheet = computed(sheet, check=False)
     rows = []
     for name, d in sheet.spec.definitions.items():
         if d.is_function:
@@ -59,11 +55,10 @@ def definitions_frame(sheet):
     return pd.DataFrame(rows, columns=["name", "value", "unit", "formula", "note"])
 
 
-def functions_frame(sheet):
+def functions_frame(sheet: ComputedSheet):
     """Functions: signature, unit, formula, note."""
     import pandas as pd
 
-    sheet = computed(sheet, check=False)
     rows = []
     for name, d in sheet.spec.definitions.items():
         if not d.is_function:
@@ -74,9 +69,8 @@ def functions_frame(sheet):
     return pd.DataFrame(rows, columns=["function", "unit", "formula", "note"])
 
 
-def tables(sheet) -> dict:
+def tables(sheet: ComputedSheet) -> dict:
     """Every range table as a DataFrame (unit in every header); block tables are skipped."""
-    sheet = computed(sheet, check=False)
     return {t.name: sheet.frame(t.name) for t in sheet.spec.tables if not t.block}
 
 
@@ -85,12 +79,19 @@ def _choice_note(spec) -> str:
     return f"{spec.note} ({opts})" if spec.note else opts
 
 
-def sheet_html(sheet) -> str:
-    """HTML of a Sheet for Jupyter: the same rendering as ``workbook report`` (formulas as
-    MathML, the values put in, tables, charts, checks), as a fragment with its own style."""
+def sheet_html(sheet: ComputedSheet) -> str:
+    """HTML of a computed sheet for Jupyter: the same rendering as ``workbook report``
+    (formulas as MathML, the values put in, tables, charts, checks), as a fragment with its
+    own style."""
     from .report import fragment
 
     try:
-        return fragment(computed(sheet))
-    except WorkbookError as err:  # a worksheet's error is shown (a bug raises: IPython shows it)
-        return f"<p>{html.escape(sheet.name)}: error: {html.escape(str(err))}</p>"
+        return fragment(sheet)
+    except WorkbookError as err:
+        return error_html(sheet.name, err)
+
+
+def error_html(name: str, err: WorkbookError) -> str:
+    """A worksheet's error as Jupyter shows it in place of the sheet (a bug raises: IPython
+    shows it)."""
+    return f"<p>{html.escape(name)}: error: {html.escape(str(err))}</p>"
