@@ -89,7 +89,7 @@ class Raw:
         """``classic``: skip xlsxwriter's formula rewriting as the engine does (information)."""
         import xlsxwriter
 
-        from workbook.outputs.xlsx import _classic_formulas_as_they_are
+        from workbook.outputs.xlsx import classic_formulas_as_they_are
 
         wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
         bold = wb.add_format({"bold": True})
@@ -108,7 +108,7 @@ class Raw:
             wb.define_name(name, f"=Definitions!$B${row + 1}")
         ws = wb.add_worksheet("Listing")
         if classic:
-            _classic_formulas_as_they_are(ws)
+            classic_formulas_as_they_are(ws)
         ws.write_string(0, 0, self.title, bold)
         ws.write_row(1, 0, self.heads, bold)
         n = len(self.x)

@@ -43,7 +43,7 @@ SHOWN = ("typecheck.expression", "typecheck.scalar", "typecheck.function")
 #: the typer's functions that type a tree (the others return trees typed before, or answer
 #: questions about units and names): "typing" counts these and every visit_ method
 #: (a failure remembered is raised again without typing: Typer.specialized is not counted)
-TYPING = ("expression", "_typed_body", "convert", "plain", "program_body")
+TYPING = ("expression", "typed_body", "convert", "plain", "program_body")
 
 
 def sheets() -> list[str]:

@@ -402,10 +402,10 @@ def test_ctrl_c_leaves_no_partial_state(sheet, monkeypatch):
     monkeypatch.setattr(cp, "run", interrupted)
     from workbook import blocks
 
-    before = set(blocks._CACHE)
+    before = blocks.kept()
     with pytest.raises(KeyboardInterrupt):
         cp.study(p, (1e6,), (1e-3, 1e-4), label=None)
-    assert not any(k[2][0] == "study" for k in set(blocks._CACHE) - before)
+    assert not any(k[2][0] == "study" for k in blocks.kept() - before)
 
 
 def test_ctrl_c_during_write_keeps_old_file(tmp_path, monkeypatch):

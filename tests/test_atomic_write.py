@@ -83,13 +83,13 @@ def test_failure_while_writing_keeps_the_previous_workbook(previous, monkeypatch
 def test_failure_while_saving_keeps_the_previous_workbook(previous, monkeypatch, failure):
     """The file itself: half of the laid-out cells written, then a failure."""
     before = digest(previous / "out.xlsx")
-    original = xlsx._replay
+    original = xlsx.replay
 
     def half_then_fail(wb, sheets, ops, formats):
         original(wb, sheets, ops[: len(ops) // 2], formats)
         raise failure("forced failure in the middle of writing")
 
-    monkeypatch.setattr(xlsx, "_replay", half_then_fail)
+    monkeypatch.setattr(xlsx, "replay", half_then_fail)
     (previous / "s.toml").write_text(TEMPLATE.replace("10 mm", "12 mm"), encoding="utf-8")
     assert main(["run", "s.toml", "--out", "out.xlsx"]) == (
         130 if failure is KeyboardInterrupt else 3
@@ -141,7 +141,7 @@ def pause(original):
         return out
     return run
 if stage == "writing":
-    xlsx._replay = pause(xlsx._replay)  # the file is being written
+    xlsx.replay = pause(xlsx.replay)  # the file is being written
 else:
     import workbook.engine.sheet
     original = workbook.engine.sheet.Sheet.check

@@ -134,7 +134,7 @@ def test_table_beyond_excel_rows_is_refused_with_csv_offer(tmp_path):
 
 
 def test_unit_check_happens_once_at_load(monkeypatch, tmp_path):
-    calls = {"_typed_body": 0, "visit": 0}
+    calls = {"typed_body": 0, "visit": 0}
     for name in calls:
         original = getattr(tc.Typer, name)
 
@@ -145,7 +145,7 @@ def test_unit_check_happens_once_at_load(monkeypatch, tmp_path):
         monkeypatch.setattr(tc.Typer, name, counted)
     sheet = workbook.load("concave-cam")
     n_defs = len(sheet.spec.definitions)
-    assert calls["_typed_body"] == n_defs  # every definition typed, each once
+    assert calls["typed_body"] == n_defs  # every definition typed, each once
     after_load = dict(calls)
     phi = np.linspace(0, 104, 1001)
     for _ in range(3):
@@ -159,7 +159,7 @@ def test_unit_check_happens_once_at_load(monkeypatch, tmp_path):
     assert calls == after_load  # evaluation does no unit inference at all
     # (findings blocks may build variant sheets, e.g. with the true pi: their own unit check)
     report = sheet.check()
-    before = calls["_typed_body"]
+    before = calls["typed_body"]
     other.table("flank_AB")
     sheet.write_xlsx(tmp_path / "cam.xlsx", report=report)
-    assert calls["_typed_body"] == before  # tables and the writer retype no definition
+    assert calls["typed_body"] == before  # tables and the writer retype no definition

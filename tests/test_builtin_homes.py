@@ -18,7 +18,8 @@ from test_builtins import DOC, documented
 import workbook
 from workbook.compute.excel import ExcelPrinter
 from workbook.engine import symbolic
-from workbook.functions.builtins import Builtin, excel_call, plain_in, register
+from workbook.functions.builtins import excel_call, plain_in
+from workbook.functions.entry import Builtin, register
 from workbook.functions.excel_functions import stored
 from workbook.functions.registry import REGISTRY
 from workbook.language import typed as ty

@@ -16,7 +16,7 @@ from workbook.engine.analysis import typed_text
 from workbook.engine.numeric import Evaluator
 from workbook.engine.symbolic import SympyConverter
 from workbook.facade import Sheet
-from workbook.functions.builtins import Builtin, register
+from workbook.functions.entry import Builtin, register
 from workbook.functions.registry import REGISTRY
 from workbook.language import typed as ty
 from workbook.language.template import load_spec

@@ -170,7 +170,7 @@ def test_measured_lift_noise_gain(valve, tmp_path):
     assert len(df) == 121
     phi = df["phi [deg]"].to_numpy()
     assert df["h formula [mm]"].to_numpy() == pytest.approx(hw(phi, *WEAR["worn 2"]), abs=1e-12)
-    m = wear._measured(valve)
+    m = wear.filtered_lift(valve)
     g0, g1, g2 = m["gain"]
     # the reported gain is the one white noise sees: check on a long noise record
     noise = np.random.default_rng(1).normal(0, 1, 200_000)

@@ -118,7 +118,7 @@ def test_a_bug_in_a_block_is_exit_3_in_one_line(tmp_path, monkeypatch, capsys):
     def broken(sheet):
         return 1 / 0
 
-    monkeypatch.setattr(blocks._REGISTRY["wear.measured_findings"], "func", broken)
+    monkeypatch.setattr(blocks.get("wear.measured_findings"), "func", broken)
     capsys.readouterr()
     assert main(args) == 3
     err = capsys.readouterr().err

@@ -1,5 +1,5 @@
 """The writer skips xlsxwriter's formula rewriting for classic functions
-(``xlsx._classic_formulas_as_they_are`` replaces the private ``Worksheet._prepare_formula``).
+(``xlsx.classic_formulas_as_they_are`` replaces the private ``Worksheet._prepare_formula``).
 Guard: every template's worksheets are byte for byte the same with and without it, on the
 xlsxwriter versions pyproject.toml allows."""
 
@@ -28,16 +28,16 @@ def _worksheets(path) -> dict[str, bytes]:
 def test_the_shortcut_changes_no_worksheet(tmp_path, monkeypatch, name):
     sheet = workbook.load(name)
     patched = []
-    shortcut = xlsx._classic_formulas_as_they_are
+    shortcut = xlsx.classic_formulas_as_they_are
 
     def spy(ws):
         shortcut(ws)
         patched.append(ws.__dict__.get("_prepare_formula") is not None)
 
-    monkeypatch.setattr(xlsx, "_classic_formulas_as_they_are", spy)
+    monkeypatch.setattr(xlsx, "classic_formulas_as_they_are", spy)
     fast = _worksheets(sheet.write_xlsx(tmp_path / "fast.xlsx"))
     assert patched and all(patched), "the shortcut was not installed: xlsxwriter changed"
-    monkeypatch.setattr(xlsx, "_classic_formulas_as_they_are", lambda ws: None)
+    monkeypatch.setattr(xlsx, "classic_formulas_as_they_are", lambda ws: None)
     plain = _worksheets(sheet.write_xlsx(tmp_path / "plain.xlsx"))
     assert b"<f>" in b"".join(plain.values())
     assert fast.keys() == plain.keys()

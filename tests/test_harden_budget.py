@@ -651,5 +651,5 @@ def test_the_long_lived_commands_run_without_a_budget():
     seen = []
     for command in ("serve", "lsp", "run"):
         args = types.SimpleNamespace(command=command, debug=False, time_limit=None)
-        cli._run_command(lambda a: seen.append(lt.current() is None) or 0, args)
+        cli.run_command(lambda a: seen.append(lt.current() is None) or 0, args)
     assert seen == [True, True, False]

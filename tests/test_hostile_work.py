@@ -26,7 +26,7 @@ from workbook.cli import main
 from workbook.compute import excelform
 from workbook.errors import LimitError
 from workbook.functions.excel_names import ExcelNames, needs_change
-from workbook.language.template import _scan_for_line, find_line
+from workbook.language.template import find_line, scan_for_line
 from workbook.mathcad import writer
 
 # -- matrix work ------------------------------------------------------------------------------
@@ -119,7 +119,7 @@ def test_the_line_index_finds_what_the_scan_finds():
     for _ in range(1000):
         text = "".join(random.choice(alphabet) for _ in range(random.randint(0, 60)))
         for key, section in itertools.product(keys, sections):
-            assert find_line(text, key, section) == _scan_for_line(text, key, section)
+            assert find_line(text, key, section) == scan_for_line(text, key, section)
 
 
 def _names_by_scan(names: list[str]) -> dict[str, str]:

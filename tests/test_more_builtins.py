@@ -13,7 +13,7 @@ from conftest import write_template
 
 import workbook
 from workbook.errors import WorkbookError
-from workbook.functions.builtins import _round_numpy
+from workbook.functions.builtins import round_numpy
 
 SHEET = """
 [inputs]
@@ -64,18 +64,18 @@ def test_round_to_decimals(sheet, n):
 
 def test_round_keeps_a_decimal_half_as_written():
     # the doubles of 2.675 and 1.005 are just below the half; Excel and LibreOffice round up
-    assert _round_numpy(2.675, 2) == 2.68
-    assert _round_numpy(1.005, 2) == 1.01
-    assert _round_numpy(-2.675, 2) == -2.68
-    assert _round_numpy(0.49999999999999, 0) == 0.0  # far from the half (many ulps): down
-    assert _round_numpy(2.0**50 + 0.25, 0) == 2.0**50  # no tolerance for large values
+    assert round_numpy(2.675, 2) == 2.68
+    assert round_numpy(1.005, 2) == 1.01
+    assert round_numpy(-2.675, 2) == -2.68
+    assert round_numpy(0.49999999999999, 0) == 0.0  # far from the half (many ulps): down
+    assert round_numpy(2.0**50 + 0.25, 0) == 2.0**50  # no tolerance for large values
 
 
 def test_round_edges():
-    assert _round_numpy(1e300, 2) == 1e300
-    assert _round_numpy(123.0, -400) == 0.0
-    assert np.isnan(_round_numpy(1.5, 0.5))
-    assert str(_round_numpy(-0.3)) == "0.0"  # not -0.0
+    assert round_numpy(1e300, 2) == 1e300
+    assert round_numpy(123.0, -400) == 0.0
+    assert np.isnan(round_numpy(1.5, 0.5))
+    assert str(round_numpy(-0.3)) == "0.0"  # not -0.0
 
 
 def test_trunc_goes_toward_zero(sheet):

@@ -476,6 +476,6 @@ def test_sign_changes_end_where_one_ulp_exceeds_the_tolerance(monkeypatch):
     def linear(_sheet, name, k, phi):
         return np.asarray(phi, dtype=float) - root
 
-    monkeypatch.setattr(reducer, "_f", linear)
-    (found,) = reducer._sign_changes(None, np.array([35640.0]), np.array([35640.25]))
+    monkeypatch.setattr(reducer, "profile_values", linear)
+    (found,) = reducer.sign_changes(None, np.array([35640.0]), np.array([35640.25]))
     assert found == pytest.approx(root, abs=1e-10)

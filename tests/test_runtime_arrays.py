@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 import workbook
 from workbook.engine import runtime as rt
 from workbook.errors import InputError, WorkbookError
+from workbook.functions.matrix import size
 
 SHEET = '''
 [sheet]
@@ -220,8 +221,8 @@ def test_index_errors_name_the_index():
 
 
 def test_sizes_of_a_number_are_zero_as_mathcad():
-    assert rt.size("rows", 5.0) == 0.0
-    assert rt.size("last", np.zeros((4, 1)), origin=1) == 4.0
+    assert size("rows", 5.0) == 0.0
+    assert size("last", np.zeros((4, 1)), origin=1) == 4.0
 
 
 def test_matrix_rules_when_running():
@@ -249,7 +250,7 @@ def test_set_item_matches_a_list_model(steps):
         v = rt.set_item(v, [i], x, origin=1, what="v")
         model += [0.0] * (i - len(model))
         model[i - 1] = x
-        assert rt.size("rows", v) == len(model)
+        assert size("rows", v) == len(model)
     assert v.ravel().tolist() == model
     for i, x in enumerate(model, start=1):
         assert rt.index(v, [i], origin=1, what="v") == x

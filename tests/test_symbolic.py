@@ -10,6 +10,7 @@ import sympy as sp
 import workbook
 from workbook.engine import symbolic
 from workbook.engine.analysis import true_pi_sheet
+from workbook.errors import NotSymbolic
 
 
 def test_exact_numbers():
@@ -78,9 +79,7 @@ def test_stable_lift_form_is_algebraically_formula_1():
 
 
 def test_block_is_not_symbolic(tmp_path):
-    from workbook.blocks import Finding  # noqa: F401 - the package imports
-
-    with pytest.raises(symbolic.NotSymbolic):
+    with pytest.raises(NotSymbolic):
         symbolic.to_sympy(workbook.load("concave-cam"), "nothing_here")
 
 

@@ -23,13 +23,13 @@ def _chain(n: int) -> str:
 def _typings(monkeypatch, tmp_path, text: str):
     """Load ``text``; (the error, how many definition bodies were typed)."""
     calls = []
-    real = typecheck.Typer._typed_body
+    real = typecheck.Typer.typed_body
 
     def counted(self, d, scope):
         calls.append(d.name)
         return real(self, d, scope)
 
-    monkeypatch.setattr(typecheck.Typer, "_typed_body", counted)
+    monkeypatch.setattr(typecheck.Typer, "typed_body", counted)
     path = tmp_path / "sheet.toml"
     path.write_text(text, encoding="utf-8")
     with pytest.raises(WorkbookError) as caught:

@@ -575,7 +575,7 @@ def main(argv: list[str] | None = None) -> int:
 
         warnings.simplefilter("ignore", RuntimeWarning)
     with _quiet_file_errors(args.debug):
-        return _run_command(handler, args)
+        return run_command(handler, args)
 
 
 @contextlib.contextmanager
@@ -608,7 +608,7 @@ def _grow_for_file(limits_time, path) -> None:
     limits_time.grow_default(limits_time.SECONDS_PER_KILOBYTE * size / 1024, f"'{path}'")
 
 
-def _run_command(handler, args) -> int:
+def run_command(handler, args) -> int:
     """``handler(args)`` within the command's budget; every error as its exit status."""
     from . import limits_time
     from .errors import OutOfBudget, WorkbookError

@@ -33,12 +33,10 @@ from typing import Any
 
 import numpy as np
 
-from ..compute.findings import Finding
 from ..errors import TemplateError
 
 __all__ = [
     "Block",
-    "Finding",
     "input_magnitude",
     "block",
     "table_block",
@@ -46,6 +44,7 @@ __all__ = [
     "bench_block",
     "export_block",
     "get",
+    "kept",
 ]
 
 _REGISTRY: dict[str, Block] = {}
@@ -92,6 +91,11 @@ def cached(sheet, key, make):
             _CACHE.clear()
         _CACHE[full] = value
     return _CACHE[full]
+
+
+def kept() -> set:
+    """The keys of the results :func:`cached` keeps: (content, input values, key)."""
+    return set(_CACHE)
 
 
 def input_magnitude(sheet, name: str, unit: str) -> float:

@@ -16,8 +16,9 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..compute.findings import Finding
 from ..engine import ode, oderun
-from . import Finding, bench_block, cached, findings_block, table_block
+from . import bench_block, cached, findings_block, table_block
 
 
 def _v(sheet, name: str, unit: str, **args):

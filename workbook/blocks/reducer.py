@@ -20,8 +20,9 @@ import math
 
 import numpy as np
 
+from ..compute.findings import Finding
 from ..errors import InputError, LimitError
-from . import Finding, cached, export_block, findings_block, table_block
+from . import cached, export_block, findings_block, table_block
 
 #: The closure finding passes when the traces agree to this distance (mm); no [[checks]] line:
 #: the distance is this block's, not an expression of the sheet.
@@ -33,7 +34,7 @@ MAX_ROWS = 75_000
 _SAMPLE_DEG = 0.25
 
 
-def _f(sheet, name: str, k, phi_deg):
+def profile_values(sheet, name: str, k, phi_deg):
     """The sheet's profile function ``name(k, phi)`` or ``name(phi)`` (phi in deg) as numbers
     in the unit the template declares for it, broadcast."""
     spec = sheet.spec.definitions[name]
@@ -100,7 +101,11 @@ def distance_to_trace(sheet, px, py):
 
     def build():
         s = np.arange(0.0, period, _SAMPLE_DEG)
-        return s, cKDTree(np.column_stack([_f(sheet, "x_t", 0, s), _f(sheet, "y_t", 0, s)]))
+        return s, cKDTree(
+            np.column_stack(
+                [profile_values(sheet, "x_t", 0, s), profile_values(sheet, "y_t", 0, s)]
+            )
+        )
 
     s_grid, tree = cached(sheet, "reducer trace", build)
     px, py = np.asarray(px, dtype=float).ravel(), np.asarray(py, dtype=float).ravel()
@@ -108,7 +113,7 @@ def distance_to_trace(sheet, px, py):
     s = s_grid[idx].copy()
     for _ in range(12):
         x, y, dx, dy, ddx, ddy = (
-            _f(sheet, n, 0, s) for n in ("x_t", "y_t", "dx_t", "dy_t", "ddx_t", "ddy_t")
+            profile_values(sheet, n, 0, s) for n in ("x_t", "y_t", "dx_t", "dy_t", "ddx_t", "ddy_t")
         )
         g = (x - px) * dx + (y - py) * dy
         dg = dx * dx + dy * dy + (x - px) * ddx + (y - py) * ddy
@@ -117,7 +122,7 @@ def distance_to_trace(sheet, px, py):
         s = s + step
         if np.all(np.abs(step) < 1e-13 * max(1.0, period)):
             break
-    d = np.hypot(_f(sheet, "x_t", 0, s) - px, _f(sheet, "y_t", 0, s) - py)
+    d = np.hypot(profile_values(sheet, "x_t", 0, s) - px, profile_values(sheet, "y_t", 0, s) - py)
     return np.minimum(d, d0), s
 
 
@@ -126,7 +131,9 @@ def closure(sheet) -> dict:
     validate(sheet)
     K, PHI = _rollers(sheet)
     K, PHI = K[K > 0], PHI[K > 0]
-    d, _ = distance_to_trace(sheet, _f(sheet, "x_t", K, PHI), _f(sheet, "y_t", K, PHI))
+    d, _ = distance_to_trace(
+        sheet, profile_values(sheet, "x_t", K, PHI), profile_values(sheet, "y_t", K, PHI)
+    )
     i = int(np.argmax(d))
     return {"max": float(d[i]), "k": int(K[i]), "phi": float(PHI[i]), "points": int(d.size)}
 
@@ -146,7 +153,7 @@ def undercut(sheet) -> dict:
 def _undercut(sheet) -> dict:
     L = _mag(sheet, "period", "deg")
     s = np.arange(0.0, L, _SAMPLE_DEG)
-    g = _f(sheet, "offset_margin", 0, s)
+    g = profile_values(sheet, "offset_margin", 0, s)
     out = {"cusps": [], "loops": [], "teeth": 0}
     if _mag(sheet, "kappa_max", "1/mm") <= 0 or not np.any(g <= 0):
         return out
@@ -155,13 +162,13 @@ def _undercut(sheet) -> dict:
     ss = np.concatenate([s[start:], s[:start] + L, [s[start] + L]])
     gg = np.concatenate([g[start:], g[:start], [g[start]]])
     crossings = np.nonzero(np.sign(gg[:-1]) != np.sign(gg[1:]))[0]
-    roots = _sign_changes(sheet, ss[crossings], ss[crossings + 1])
+    roots = sign_changes(sheet, ss[crossings], ss[crossings + 1])
     pairs = [(roots[j], roots[j + 1]) for j in range(0, len(roots) - 1, 2)]
     out["teeth"] = len(pairs)
     if not pairs:
         return out
     c = np.array(pairs)  # teeth x 2
-    xs, ys, psis = (_f(sheet, n, 0, c) for n in ("x_k", "y_k", "psi_k"))
+    xs, ys, psis = (profile_values(sheet, n, 0, c) for n in ("x_k", "y_k", "psi_k"))
     for tooth in range(len(pairs)):
         for side in (0, 1):
             x, y, psi = float(xs[tooth, side]), float(ys[tooth, side]), float(psis[tooth, side])
@@ -173,18 +180,18 @@ def _undercut(sheet) -> dict:
     return out
 
 
-def _sign_changes(sheet, a: np.ndarray, b: np.ndarray, xtol: float = 1e-12) -> list[float]:
+def sign_changes(sheet, a: np.ndarray, b: np.ndarray, xtol: float = 1e-12) -> list[float]:
     """Where 1 - rp*kappa_n changes sign in each bracket [a, b] (one sign change each), all
     brackets at once: bisection to ``xtol`` deg (and 4 ulps), then the secant of the last
     bracket."""
     a, b = np.asarray(a, dtype=float).copy(), np.asarray(b, dtype=float).copy()
     if a.size == 0:
         return []
-    fa, fb = (_f(sheet, "offset_margin", 0, x) for x in (a, b))
+    fa, fb = (profile_values(sheet, "offset_margin", 0, x) for x in (a, b))
     # brentq's tolerance: xtol, and 4 ulps of the angle (far out, 1e-12 deg is below one ulp)
     while np.any(b - a > xtol + 4 * np.finfo(float).eps * np.abs(b)):
         m = 0.5 * (a + b)
-        fm = _f(sheet, "offset_margin", 0, m)
+        fm = profile_values(sheet, "offset_margin", 0, m)
         left = np.sign(fm) == np.sign(fa)
         a, fa = np.where(left, m, a), np.where(left, fm, fa)
         b, fb = np.where(left, b, m), np.where(left, fb, fm)
@@ -195,7 +202,7 @@ def _sign_changes(sheet, a: np.ndarray, b: np.ndarray, xtol: float = 1e-12) -> l
 
 
 def _offset(sheet, s):
-    return tuple(_f(sheet, n, 0, s) for n in ("x_k", "y_k", "dx_k", "dy_k"))
+    return tuple(profile_values(sheet, n, 0, s) for n in ("x_k", "y_k", "dx_k", "dy_k"))
 
 
 def _loop_crossings(sheet, c1: np.ndarray, c2: np.ndarray, L: float) -> list[dict | None]:
@@ -234,7 +241,7 @@ def _loop_crossings(sheet, c1: np.ndarray, c2: np.ndarray, L: float) -> list[dic
     out: list[dict | None] = [None] * len(c1)
     if s1.size:
         x, y = _offset(sheet, s1)[:2]
-        psi = _f(sheet, "psi_k", 0, s1)
+        psi = profile_values(sheet, "psi_k", 0, s1)
         for n, k in enumerate(np.nonzero(found)[0]):
             out[k] = {
                 **{"phi1": float(s1[n]) % L, "phi2": float(s2[n]) % L},
@@ -272,9 +279,9 @@ def roller_table(sheet):
 
     validate(sheet)
     K, PHI = _rollers(sheet)
-    cols = {"k": K, "phi [deg]": PHI, "a [deg]": _f(sheet, "a", K, PHI)}
+    cols = {"k": K, "phi [deg]": PHI, "a [deg]": profile_values(sheet, "a", K, PHI)}
     for name in ("rho", "x_t", "y_t", "x_k", "y_k"):
-        cols[f"{name} [mm]"] = _f(sheet, name, K, PHI)
+        cols[f"{name} [mm]"] = profile_values(sheet, name, K, PHI)
     return pd.DataFrame(cols)
 
 
@@ -371,7 +378,7 @@ def findings(sheet) -> list[Finding]:
 
     if _mag(sheet, "kappa_max", "1/mm") > 0:
         phi = _mag(sheet, "phi_valley", "deg")
-        x, y = (float(_f(sheet, name, 0, phi)) for name in ("x_t", "y_t"))
+        x, y = (float(profile_values(sheet, name, 0, phi)) for name in ("x_t", "y_t"))
         what = "smallest radius of curvature of the concave parts of the theoretical profile "
         what += f"(roller 0 at phi = {phi:.6g} deg, x_t = {x:.6g} mm, y_t = {y:.6g} mm)"
         add("undercut", what, _mag(sheet, "rho_min", "mm"), "mm", "info", "rp must stay below it")
@@ -400,7 +407,9 @@ def findings(sheet) -> list[Finding]:
 
     # the practical profile must keep the distance rp from the theoretical one
     prof = _grid(sheet, "profile")
-    d, _ = distance_to_trace(sheet, _f(sheet, "x_k", 0, prof), _f(sheet, "y_k", 0, prof))
+    d, _ = distance_to_trace(
+        sheet, profile_values(sheet, "x_k", 0, prof), profile_values(sheet, "y_k", 0, prof)
+    )
     gap = float(np.max(np.abs(d - rp)))
     what = (
         "distance of the practical profile from the theoretical profile: largest departure from rp"

@@ -16,7 +16,8 @@ import math
 
 import numpy as np
 
-from . import Finding, cached, findings_block, input_magnitude, table_block
+from ..compute.findings import Finding
+from . import cached, findings_block, input_magnitude, table_block
 
 SG_WINDOW = 15  # points (30 deg at a 2 deg spacing); cubic Savitzky-Golay
 SG_ORDER = 3
@@ -40,7 +41,10 @@ def measured_points(sheet):
     return phi, h
 
 
-def _measured(sheet):
+def filtered_lift(sheet):
+    """The measured lift filtered (Savitzky-Golay): its derivatives, the noise, the filter's
+    noise gains and errors against the true lift, computed once per sheet."""
+
     def make():
         from scipy.signal import savgol_coeffs, savgol_filter
 
@@ -91,7 +95,7 @@ def measured_lift(sheet):
     """Measured worn lift: Savitzky-Golay velocity and acceleration against the wear formula."""
     import pandas as pd
 
-    m = _measured(sheet)
+    m = filtered_lift(sheet)
     return pd.DataFrame(
         {
             "phi [deg]": m["phi"],
@@ -116,7 +120,7 @@ def measured_findings(sheet):
     out = []
     Phi = input_magnitude(sheet, "Phi", "deg")
     try:
-        m = _measured(sheet)
+        m = filtered_lift(sheet)
     except WorkbookError as exc:  # a bad table is reported, not fatal to the checks
         out.append(
             Finding(

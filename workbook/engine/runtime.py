@@ -23,10 +23,7 @@ import operator
 import numpy as np
 
 from ..errors import InputError, LimitError
-from ..functions.matrix import (
-    power,
-    size,  # noqa: F401 - rows/cols/length/last of a run-time value
-)
+from ..functions.matrix import power
 from ..limits import ELEMENT_WORK, MAX_ARRAY_ELEMENTS, charge_matrix_work, check_elements
 
 #: Arrays inside arrays at most this deep: a deeper one (``T := [T, 1]`` in a loop) would

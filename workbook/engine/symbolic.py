@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from ..errors import NotSymbolic, WorkbookError  # noqa: F401 - NotSymbolic is part of this module's interface
+from ..errors import NotSymbolic, WorkbookError
 from ..functions.registry import CONSTANTS, REGISTRY
 from ..language import typed as ty
 from ..language import units as un

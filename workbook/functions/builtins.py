@@ -67,13 +67,7 @@ from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.units import pretty
 from .complexes import classic, im_call, im_cosh, im_sinh, im_tan, im_tanh
-from .entry import (  # noqa: F401 - the entry record is part of this module's interface
-    Arity,
-    Builtin,
-    Domain,
-    UnitContext,
-    register,
-)
+from .entry import Builtin, Domain, UnitContext, register
 
 
 # -- unit rules ------------------------------------------------------------------------------
@@ -366,7 +360,7 @@ _simple(
 )
 
 
-def _round_numpy(x, n=0.0):
+def round_numpy(x, n=0.0):
     """Round half away from zero to ``n`` decimals (Mathcad's round, Excel's ROUND). A value
     within 4 units in the last place below a half is taken as the half it was written as
     (2.675 to 2 decimals is 2.68, as in Excel and LibreOffice, though the double nearest to
@@ -396,7 +390,7 @@ def _round_sympy(sp, x, n=0):
 
 _simple(
     "round",
-    _round_numpy,
+    round_numpy,
     _excel_round,
     _round_sympy,
     "round(x): nearest integer, a half away from zero; round(x, n): to n decimals "

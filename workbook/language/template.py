@@ -372,7 +372,7 @@ def find_line(text: str, key: str, section: str | None = None) -> int | None:
             ):
                 return number
         return None
-    return _scan_for_line(text, key, section)
+    return scan_for_line(text, key, section)
 
 
 _QUOTES = "\"'"
@@ -384,7 +384,7 @@ def _key_lines(text: str) -> dict[str, list[tuple[int, str | None]]]:
     the section the line is in: one pass over a template, so that finding the lines of its
     definitions is linear (a scan per key took minutes for 30,000 definitions).
 
-    A line matches :func:`_scan_for_line`'s pattern for a key without ``=``, quotes or outer
+    A line matches :func:`scan_for_line`'s pattern for a key without ``=``, quotes or outer
     blanks exactly when the text before its first ``=``, stripped, is the key with an
     optional quote on either side."""
     index: dict[str, list[tuple[int, str | None]]] = {}
@@ -411,7 +411,9 @@ def _key_lines(text: str) -> dict[str, list[tuple[int, str | None]]]:
     return index
 
 
-def _scan_for_line(text: str, key: str, section: str | None) -> int | None:
+def scan_for_line(text: str, key: str, section: str | None) -> int | None:
+    """The line of ``key = ...`` in ``[section]`` of the worksheet text (any section when
+    None), or None."""
     pattern = re.compile(r'^\s*["\']?' + re.escape(key) + r'["\']?\s*=')
     in_section = section is None
     for number, line in enumerate(text.splitlines(), start=1):

@@ -105,7 +105,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             if d.is_function:
                 raise TemplateError(f"'{name}' is a function of {', '.join(d.params)}")
             with self._remembered(("scalar", name)):
-                body = self._typed_body(d, {})
+                body = self.typed_body(d, {})
                 if d.unit is not None:
                     body = self.convert(body, d.unit, _declared(name, d.unit))
             self.scalars[name] = body
@@ -206,7 +206,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             # assumption: it is forgotten unless the assumption holds
             functions, scalars = set(self.functions), set(self.scalars)
             try:
-                body = self._typed_body(d, scope)
+                body = self.typed_body(d, scope)
                 if d.unit is not None:
                     body = self.convert(body, d.unit, _declared(d.name, d.unit))
             except WorkbookError as err:
@@ -288,7 +288,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             hint = f" (a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")
 
-    def _typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
+    def typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
+        """The typed tree of definition ``d``'s body, its names in ``scope`` (a circular
+        definition is refused)."""
         if d.name in self._stack:
             cycle = " -> ".join(self._stack[self._stack.index(d.name) :] + [d.name])
             raise TemplateError(f"circular definition: {cycle}", line=d.line, definition=d.name)

@@ -50,7 +50,7 @@ def chart_label(ws, sheet_name: str, text: str, row: int, header_fmt=None):
 _CALLED = re.compile(r"([A-Za-z_][A-Za-z0-9._]*)\(")
 
 
-def _classic_formulas_as_they_are(ws) -> None:
+def classic_formulas_as_they_are(ws) -> None:
     """Skip xlsxwriter's ~30 regex substitutions per formula when they cannot change it.
 
     xlsxwriter rewrites every formula to prefix Excel 365 functions (FILTER, XLOOKUP...) with
@@ -114,11 +114,11 @@ def _render(form, path: Path, scratch: str) -> None:
     sheets = []
     for sheet in form.sheets:
         ws = wb.add_worksheet(sheet.name)
-        _classic_formulas_as_they_are(ws)
+        classic_formulas_as_they_are(ws)
         sheets.append(ws)
     for name, ref in form.names:
         wb.define_name(name, ref)
-    _replay(wb, sheets, form.ops, formats)
+    replay(wb, sheets, form.ops, formats)
     if form.formula_cells > PROGRESS_CELLS:
         _progress(f"{Path(path).name}: saving {form.formula_cells:,} formula cells")
     try:
@@ -134,7 +134,7 @@ def _render(form, path: Path, scratch: str) -> None:
         raise
 
 
-def _replay(wb, sheets: list, ops, formats: dict) -> None:
+def replay(wb, sheets: list, ops, formats: dict) -> None:
     """Write the recorded operations, in the order they were laid out: (sheet index, method,
     arguments, index of the format role among the arguments or -1)."""
     for index, method, args, at in ops:
