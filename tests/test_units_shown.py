@@ -118,3 +118,12 @@ def test_typeset_does_not_change_how_units_are_spelt():
         assert un.shown_factors(text) is not None
     assert un.pretty(un.unit("L/s")) == before
     assert un.shown_factors("pieces") is None  # a label is not a unit
+
+
+def test_pretty_is_a_function_of_the_unit_alone():
+    """What a sheet loaded before spelt does not change how a unit is shown: the same unit
+    text before and after sheets that write kohm, um and l/min."""
+    units = [un.unit(t) for t in ("kohm", "um", "l/min", "mL", "W/(m*K)")]
+    before = [un.pretty(u) for u in units]
+    workbook.loads('[inputs]\nR = "2 kohm"\nd = "3 um"\nQ = "4 l/min"\nV = "5 mL"\n')
+    assert [un.pretty(u) for u in units] == before == ["kΩ", "µm", "L/min", "mL", "W/(m*K)"]

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import functools
 import math
-import re
 
 import pint
 from pint.util import to_units_container
@@ -137,7 +136,6 @@ def _parsed_unit(text: str, what: str, shown: str) -> pint.Unit:
         raise InputError(f"{what}: cannot read {shown!r}: {bad} is not a unit{near}") from None
     except Exception as exc:  # noqa: BLE001 - pint raises many kinds for malformed text
         raise InputError(f"{what}: cannot read {shown!r} as a unit ({exc})") from None
-    _remember_spelling(text)
     big = [(n, p) for n, p in u.dimensionality.items() if abs(p) > MAX_UNIT_POWER]
     if big:  # ((kg^12)^12)^12: each power is allowed, the product of them is not
         name, power = big[0]
@@ -246,20 +244,20 @@ def is_compound_ratio(u: pint.Unit) -> bool:
     return not u.dimensionality and ("/" in text or "*" in text) and not is_angle(u)
 
 
-#: How a worksheet spelt a unit, by pint's name: "L" for liter, "degC" (see :func:`pretty`).
-_SPELLING: dict[str, str] = {}
+#: How a worksheet spells a unit where pint's symbol is not what it types: pint's liter is l.
+_SPELT = {"liter": "L"}
 
 
 def pretty(u: pint.Unit) -> str:
-    """Compact unit text for headers, in the order and spelling the worksheet declared it:
-    'mm', 'm/s^2', 'N*m' (not pint's sorted 'm*N'), 'L/s' (pint's symbol is 'l'),
-    'W/(m*K)'. A unit name is shown as a worksheet spelt it when that is shorter than pint's
-    name, else by pint's symbol ('%' for percent)."""
+    """Compact unit text for headers, in the order the worksheet declared it: 'mm', 'm/s^2',
+    'N*m' (not pint's sorted 'm*N'), 'L/s' (pint's symbol is 'l'), 'W/(m*K)'. Each unit by
+    pint's symbol ('%' for percent, 'degC'), the liter as a worksheet writes it; a function of
+    the unit alone (what was read before does not change it)."""
     if u == registry().dimensionless:
         return ""
     top, bottom = [], []
     for name, power in to_units_container(u).items():
-        symbol = _SPELLING.get(name) or _symbol(name)
+        symbol = _symbol(name)
         p = abs(power)
         text = symbol if p == 1 else f"{symbol}^{p:g}"
         (top if power > 0 else bottom).append(text)
@@ -271,24 +269,18 @@ def pretty(u: pint.Unit) -> str:
 
 @functools.lru_cache(maxsize=512)
 def _symbol(name: str) -> str:
-    return registry().get_symbol(name).replace("°", "deg").replace("Δ", "delta_")
+    return _named(name, _SPELT).replace("°", "deg").replace("Δ", "delta_")
 
 
-def _remember_spelling(text: str) -> None:
-    """Note how each unit name of a unit text the reader accepted is spelt (see pretty). A
-    typeset name (``Δ°C``, ``m²``, copied from a report) is not a spelling: pretty keeps the
-    text a worksheet types, and :func:`typeset` shows those."""
-    for token in re.findall(r"[^\W\d][\w°µμΩ%]*|[°%Ω]", text):
-        if not token.isascii():
-            continue
-        try:
-            items = list(to_units_container(_unit_of(token)).items())
-        except Exception:  # noqa: BLE001 - a name pint reads only in context
-            continue
-        if len(items) == 1 and items[0][1] == 1:
-            name = items[0][0]
-            if len(token) < len(name) and name not in _SPELLING:
-                _SPELLING[name] = token
+def _named(name: str, symbols: dict[str, str]) -> str:
+    """pint's symbol of unit ``name``, or its own in ``symbols`` (prefixed too: mL)."""
+    if name in symbols:
+        return symbols[name]
+    symbol = registry().get_symbol(name)
+    for full, shown in symbols.items():
+        if name.endswith(full) and symbol.endswith(registry().get_symbol(full)):
+            return symbol[: len(symbol) - len(registry().get_symbol(full))] + shown
+    return symbol
 
 
 #: How a unit is typeset for people where pint's symbol is not what a person writes (pint's
@@ -313,14 +305,7 @@ def typeset_factors(u: pint.Unit) -> tuple[list[tuple[str, float]], list[tuple[s
 
 @functools.lru_cache(maxsize=512)
 def _typeset_symbol(name: str) -> str:
-    if name in _TYPESET_SYMBOLS:
-        return _TYPESET_SYMBOLS[name]
-    symbol = registry().get_symbol(name)
-    for full, shown in _TYPESET_SYMBOLS.items():  # a prefixed liter: mL
-        if name.endswith(full) and symbol.endswith(registry().get_symbol(full)):
-            prefix = symbol[: len(symbol) - len(registry().get_symbol(full))]
-            return prefix + shown
-    return symbol
+    return _named(name, _TYPESET_SYMBOLS)
 
 
 def shown_factors(text: str) -> tuple[list[tuple[str, float]], list[tuple[str, float]]] | None:
