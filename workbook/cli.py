@@ -26,30 +26,81 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="store_true", help="print the version")
     sub = p.add_subparsers(dest="command")
     sub.add_parser("list", help="list the installed templates")
-
-    def sheet_args(sp):
-        sp.add_argument("name", help="template name (see 'workbook list') or path to a .toml file")
-        sp.add_argument(
-            "--set",
-            action="append",
-            default=[],
-            metavar="NAME=VALUE",
-            help='override an input, e.g. --set R3="40 mm" (repeatable)',
+    _run_parser(sub)
+    chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
+    _sheet_args(chk)
+    _part_args(chk, "all")
+    chk.add_argument(
+        "--json", action="store_true", help="print one JSON object (counts and failures)"
+    )
+    imp = sub.add_parser(
+        "import",
+        help="translate a Mathcad worksheet (.xmcd, Prime's .mcdx) or an Excel workbook",
+    )
+    imp.add_argument("file", help="the .xmcd or .mcdx file, or the .xlsm/.xlsx/.xls workbook")
+    imp.add_argument(
+        "--vba", action="append", default=[], help="VBA from an add-in or a .bas/.cls module"
+    )
+    imp.add_argument("--out", default=".", help="folder to write NAME.toml into (default: .)")
+    imp.add_argument("--force", action="store_true", help="replace existing files")
+    bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
+    _sheet_args(bench)
+    bench.add_argument("--quick", action="store_true", help="a small, fast version")
+    _sweep_parser(sub)
+    _report_parser(sub)
+    srv = sub.add_parser(
+        "serve", help="a live page of the report, computed again as the file or an input changes"
+    )
+    srv.add_argument(
+        "name", nargs="?", help="template name, .toml file or folder (default: this folder)"
+    )
+    srv.add_argument("--port", type=int, default=0, help="port on 127.0.0.1 (default: any free)")
+    srv.add_argument("--no-browser", action="store_true", help="print the URL, open no browser")
+    sub.add_parser("lsp", help="a language server for editors (LSP over stdin and stdout)")
+    new = sub.add_parser("new", help="write a commented starter worksheet that runs as it is")
+    new.add_argument("name", help="name of the new worksheet (writes NAME.toml)")
+    new.add_argument("--out", help="file to write (default ./NAME.toml)")
+    new.add_argument("--force", action="store_true", help="overwrite an existing file")
+    for command in sub.choices.values():  # `workbook run X --debug` and `workbook --debug run X`
+        command.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help="show Python tracebacks"
         )
-
-    def part_args(sp, default: str):
-        sp.add_argument(
-            "--part",
-            action="append",
-            default=[],
-            metavar="PART",
-            help=f"an optional part of the worksheet, e.g. hand-checks, or 'all' (repeatable; "
-            f"default: {default})",
+        command.add_argument(
+            "--time-limit",
+            metavar="SECONDS",
+            default=None,
+            help="the command's budget in seconds of CPU time (default 20, at most 3600; "
+            "wall-clock time is bounded at 5 times it)",
         )
+    return p
 
+
+def _sheet_args(sp) -> None:
+    sp.add_argument("name", help="template name (see 'workbook list') or path to a .toml file")
+    sp.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help='override an input, e.g. --set R3="40 mm" (repeatable)',
+    )
+
+
+def _part_args(sp, default: str) -> None:
+    sp.add_argument(
+        "--part",
+        action="append",
+        default=[],
+        metavar="PART",
+        help=f"an optional part of the worksheet, e.g. hand-checks, or 'all' (repeatable; "
+        f"default: {default})",
+    )
+
+
+def _run_parser(sub) -> None:
     run = sub.add_parser("run", help="compute a worksheet and write its Excel workbook")
-    sheet_args(run)
-    part_args(run, "none: what is in no part")
+    _sheet_args(run)
+    _part_args(run, "none: what is in no part")
     run.add_argument("--out", help="output .xlsx (default reports/NAME.xlsx)")
     run.add_argument("--force", action="store_true", help="overwrite a file that is not an xlsx")
     run.add_argument(
@@ -76,27 +127,11 @@ def _parser() -> argparse.ArgumentParser:
         type=int,
         help="print only the first N results (default: every result; all are on the Results sheet)",
     )
-    chk = sub.add_parser("check", help="compare with the printed values; exit 1 if any fails")
-    sheet_args(chk)
-    part_args(chk, "all")
-    chk.add_argument(
-        "--json", action="store_true", help="print one JSON object (counts and failures)"
-    )
-    imp = sub.add_parser(
-        "import",
-        help="translate a Mathcad worksheet (.xmcd, Prime's .mcdx) or an Excel workbook",
-    )
-    imp.add_argument("file", help="the .xmcd or .mcdx file, or the .xlsm/.xlsx/.xls workbook")
-    imp.add_argument(
-        "--vba", action="append", default=[], help="VBA from an add-in or a .bas/.cls module"
-    )
-    imp.add_argument("--out", default=".", help="folder to write NAME.toml into (default: .)")
-    imp.add_argument("--force", action="store_true", help="replace existing files")
-    bench = sub.add_parser("bench", help="error against run time of the sheet's numerical methods")
-    sheet_args(bench)
-    bench.add_argument("--quick", action="store_true", help="a small, fast version")
+
+
+def _sweep_parser(sub) -> None:
     sw = sub.add_parser("sweep", help="chosen outputs over a grid of inputs: a table and a chart")
-    sheet_args(sw)
+    _sheet_args(sw)
     sw.add_argument(
         "--vary",
         action="append",
@@ -122,11 +157,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     sw.add_argument("--workers", type=int, help="processes of the local pool (default: CPUs)")
     sw.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (tcp://...)")
+
+
+def _report_parser(sub) -> None:
     rep = sub.add_parser(
         "report", help="the calculation as a document: reports/NAME.html (and --pdf)"
     )
-    sheet_args(rep)
-    part_args(rep, "none: what is in no part")
+    _sheet_args(rep)
+    _part_args(rep, "none: what is in no part")
     rep.add_argument("--out", help="output .html (default reports/NAME.html)")
     rep.add_argument(
         "--pdf", action="store_true", help="also print it to PDF beside the HTML (Chromium)"
@@ -137,33 +175,6 @@ def _parser() -> argparse.ArgumentParser:
         help="every row of long tables (default: first and last rows above 1,000)",
     )
     rep.add_argument("--force", action="store_true", help="overwrite a file of another kind")
-    srv = sub.add_parser(
-        "serve", help="a live page of the report, computed again as the file or an input changes"
-    )
-    srv.add_argument(
-        "name", nargs="?", help="template name, .toml file or folder (default: this folder)"
-    )
-    srv.add_argument("--port", type=int, default=0, help="port on 127.0.0.1 (default: any free)")
-    srv.add_argument("--no-browser", action="store_true", help="print the URL, open no browser")
-    sub.add_parser("lsp", help="a language server for editors (LSP over stdin and stdout)")
-    new = sub.add_parser("new", help="write a commented starter worksheet that runs as it is")
-    new.add_argument("name", help="name of the new worksheet (writes NAME.toml)")
-    new.add_argument("--out", help="file to write (default ./NAME.toml)")
-    new.add_argument("--force", action="store_true", help="overwrite an existing file")
-    for (
-        command
-    ) in sub.choices.values():  # `workbook run X --debug` as well as `workbook --debug run X`
-        command.add_argument(
-            "--debug", action="store_true", default=argparse.SUPPRESS, help="show Python tracebacks"
-        )
-        command.add_argument(
-            "--time-limit",
-            metavar="SECONDS",
-            default=None,
-            help="the command's budget in seconds of CPU time (default 20, at most 3600; "
-            "wall-clock time is bounded at 5 times it)",
-        )
-    return p
 
 
 def parse_sets(items: list[str]) -> dict[str, str]:
