@@ -18,7 +18,7 @@ import mpmath
 import numpy as np
 import openpyxl
 import pytest
-from test_hostile import guarded
+from helpers.hostile import guarded
 
 import workbook
 from workbook import limits
@@ -26,7 +26,7 @@ from workbook.cli import main
 from workbook.compute import excelform
 from workbook.errors import LimitError
 from workbook.functions.excel_names import ExcelNames, needs_change
-from workbook.language.template import find_line, scan_for_line
+from workbook.language.fields import find_line, scan_for_line
 from workbook.mathcad import writer
 
 # -- matrix work ------------------------------------------------------------------------------

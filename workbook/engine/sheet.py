@@ -28,14 +28,9 @@ from ..language import typed as ty
 from ..language import units as un
 from ..language.fields import nearest
 from ..language.ranges import RangeSpec, log_range_values, range_values
-from ..language.template import (
-    ColumnSpec,
-    SheetSpec,
-    check_input_value,
-    column_node,
-    resolve_parts,
-    select_parts,
-)
+from ..language.shown import column_node
+from ..language.spec import ColumnSpec, SheetSpec
+from ..language.template import check_input_value, resolve_parts, select_parts
 from ..language.typed import TConst
 from ..language.typedsheet import TypedSheet, printed_rows
 from ..language.unitrules import is_scaled_angle

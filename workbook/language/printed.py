@@ -10,7 +10,7 @@ from pathlib import Path
 from ..errors import TemplateError, WorkbookError
 from ..limits import MAX_CSV_BYTES, file_beside, read_text
 from . import units as un
-from .template import PrintedSpec
+from .spec import PrintedSpec
 
 
 @dataclass

@@ -6,425 +6,52 @@ The template is data: TOML parsed by the standard library, expressions parsed by
 
 from __future__ import annotations
 
-import functools
-import math
 import re
 
 try:
     import tomllib
 except ImportError:  # Python 3.10
     import tomli as tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
 import pint
 
 from ..compute.declared_checks import read_check
-from ..errors import InputError, LimitError, TemplateError, UnitError, WorkbookError
+from ..errors import InputError, LimitError, TemplateError, WorkbookError
 from ..functions.registry import REGISTRY
 from . import expr as ex
 from . import units as un
-from .fields import Fields, nearest, value_line
-from .ranges import RangeSpec, parse_range
+from .fields import Fields, find_line, nearest, value_line
+from .shown import chart_spec, name_line, relation_spec, table_spec
+from .spec import (
+    ALL_PARTS,
+    ARGUMENT_KEYS,
+    DEFINITION_KEYS,
+    FINDING_KEYS,
+    INPUT_KEYS,
+    MISPRINT_KEYS,
+    PART_KEYS,
+    PRINTED_KEYS,
+    SECTIONS,
+    SHEET_KEYS,
+    SWEEP_KEYS,
+    ArgumentSpec,
+    Branch,
+    Definition,
+    InputSpec,
+    Limits,
+    Misprint,
+    PartSpec,
+    PrintedSpec,
+    SheetSpec,
+    TableSpec,
+)
 
 MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
 
-SECTIONS = {
-    "sheet",
-    "inputs",
-    "arguments",
-    "definitions",
-    "blocks",
-    "tables",
-    "charts",
-    "printed",
-    "relations",
-    "findings",
-    "checks",
-    "sweep",
-    "parts",
-    "data",
-    "solve",
-    "ode",
-}
-ALL_PARTS = "all"
-MAX_VARY = 50  # curves of one family table
 
-# The keys each table of a template may hold (anything else is a misspelling: refused).
-SHEET_KEYS = (
-    "name",
-    "title",
-    "source",
-    "description",
-    "bench",
-    "export",
-    "about",
-    "hand_checks",
-    "samples",
-    "tolerance",
-    "origin",
-    "complex",
-    "time_limit",
-)  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
-INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
-ARGUMENT_KEYS = ("unit", "note", "plain")
-DEFINITION_KEYS = ("expr", "pieces", "program", "unit", "note", "positive", "min", "max")
-PART_KEYS = ("title", "note")
-TABLE_KEYS = ("name", "title", "range", "columns", "sheet", "block", "part", "vary")
-COLUMN_KEYS = ("expr", "unit", "title")
-CHART_KEYS = (
-    "name",
-    "title",
-    "range",
-    "x",
-    "x_title",
-    "y_title",
-    "y2_title",
-    "series",
-    "log_x",
-    "log_y",
-    "equal_axes",
-    "part",
-)
-AXIS_KEYS = ("expr", "title", "unit")
-SERIES_KEYS = ("y", "unit", "name", "line", "axis", "marker", "x", "x_unit", "range", "table")
-PRINTED_KEYS = (
-    "file",
-    "title",
-    "argument",
-    "tolerance",
-    "rel_tolerance",
-    "role",
-    "misprints",
-    "note",
-    "part",
-)
-MISPRINT_KEYS = ("name", "at", "note", "corrected")
-RELATION_KEYS = ("relation", "range", "unit", "part")
-FINDING_KEYS = ("block", "title", "part")
-SWEEP_KEYS = ("outputs", "units")
 _PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
-
-
-@dataclass
-class InputSpec:
-    name: str
-    value: pint.Quantity | str
-    unit: pint.Unit | None  # None for a choice input
-    note: str = ""
-    options: tuple[str, ...] = ()
-    minimum: pint.Quantity | None = None
-    maximum: pint.Quantity | None = None
-    positive: bool = False
-    line: int | None = None
-    label: str = ""  # unit shown beside a plain number (e.g. "deg" for Mathcad's Theta = 52)
-
-
-@dataclass
-class ArgumentSpec:
-    name: str
-    unit: pint.Unit
-    note: str = ""
-    line: int | None = None
-    plain: bool = False  # inside formulas the argument is a plain number in `unit` (Mathcad style)
-
-    @property
-    def binding_unit(self) -> pint.Unit:
-        return un.registry().dimensionless if self.plain else self.unit
-
-
-@dataclass
-class Branch:
-    value: ex.Node
-    condition: ex.Node | None  # None: 'otherwise'
-    text: str
-
-
-@dataclass(frozen=True)
-class Limits:
-    """What a definition's values must meet, declared like an input's bounds: a value outside
-    is an error naming the definition and its limit, never a number."""
-
-    positive: bool = False
-    minimum: pint.Quantity | None = None  # a plain number is in the definition's unit
-    maximum: pint.Quantity | None = None
-
-    def magnitudes(self, unit, display=None, what: str = "") -> tuple[float, float, bool]:
-        """(lowest, highest, positive) as magnitudes in ``unit``; a plain-number bound is in
-        ``display`` (the unit the definition is shown in), else in ``unit``."""
-        out = []
-        for bound, default in ((self.minimum, -math.inf), (self.maximum, math.inf)):
-            if bound is None:
-                out.append(default)
-                continue
-            q = bound
-            if q.unitless and not un.registry().Quantity(1, unit).unitless:
-                q = un.registry().Quantity(q.magnitude, display or unit)
-            try:
-                out.append(float(q.to(unit).magnitude))
-            except pint.DimensionalityError:
-                raise UnitError(
-                    f"{what}: the limit {bound:~} is {un.dims(bound.units)}, the value "
-                    f"{un.dims(unit)} ({un.pretty(unit)})"
-                ) from None
-        return out[0], out[1], self.positive
-
-    def text(self, display: str = "") -> str:
-        """The limits as the template says them: "positive", "at least 0 mm"."""
-        parts = ["positive"] if self.positive else []
-        for bound, word in ((self.minimum, "at least"), (self.maximum, "at most")):
-            if bound is not None:
-                unit = "" if not bound.unitless else display
-                parts.append(f"{word} {bound:~}{(' ' + unit) if unit else ''}".rstrip())
-        return " and ".join(parts)
-
-
-@dataclass
-class Definition:
-    name: str
-    params: tuple[str, ...]
-    body: ex.Node | None
-    branches: list[Branch] | None = None
-    text: str = ""
-    note: str = ""
-    unit: pint.Unit | None = None  # display unit, optional
-    line: int | None = None
-    program: Any = None  # workbook.program.statements.Program: a body of statements
-    ode: tuple[str, int] | None = None  # a state of an [[ode]]: (ode name, state index)
-    limits: Limits | None = None  # what its values must meet (positive = true, min, max)
-
-    @property
-    def is_function(self) -> bool:
-        return bool(self.params)
-
-    def expressions(self) -> list[ex.Node]:
-        """Every expression the definition's value is made of (for dependencies)."""
-        if self.body is not None:
-            return [self.body]
-        if self.branches is not None:
-            return [x for b in self.branches for x in (b.value, b.condition) if x is not None]
-        if self.program is not None:
-            from ..program.statements import expressions
-
-            return list(expressions(self.program.body))
-        return []  # an ODE state: its section's expressions are listed by the sheet
-
-
-@dataclass
-class PartSpec:
-    """An optional part of a worksheet (hand checks, studies): left out unless asked for."""
-
-    name: str
-    title: str
-    note: str = ""
-    line: int | None = None
-
-
-@dataclass
-class ColumnSpec:
-    text: str
-    node: ex.Node
-    unit: pint.Unit | None
-    title: str
-
-
-@dataclass
-class TableSpec:
-    name: str
-    title: str
-    range: RangeSpec | None
-    columns: list[ColumnSpec]
-    sheet: str = "Listing"
-    block: str | None = None
-    line: int | None = None
-    part: str | None = None
-    # a family of curves: input name -> the values (texts) the columns are computed at
-    vary: dict[str, tuple[str, ...]] = field(default_factory=dict)
-
-    @property
-    def computed(self) -> bool:
-        """Values computed by the engine and written as numbers (a solver block's table, or
-        a family over input values), not a live formula per cell."""
-        return bool(self.block or self.vary)
-
-
-@dataclass
-class SeriesSpec:
-    y: ColumnSpec
-    name: str
-    line: str = "solid"  # solid | dash | dot | none
-    axis: str = "primary"
-    marker: bool = False
-    x: ColumnSpec | None = None
-    range: RangeSpec | None = None
-    table: str | None = None  # series read from a block table: column names
-    x_column: str | None = None
-    y_column: str | None = None
-
-
-@dataclass
-class ChartSpec:
-    name: str
-    title: str
-    range: RangeSpec | None
-    x: ColumnSpec | None
-    x_title: str
-    y_title: str
-    y2_title: str = ""
-    series: list[SeriesSpec] = field(default_factory=list)
-    log_x: bool = False
-    log_y: bool = False
-    equal_axes: bool = False
-    line: int | None = None
-    part: str | None = None
-
-
-@dataclass
-class Misprint:
-    name: str
-    at: float
-    note: str
-    corrected: float | None = None
-
-
-@dataclass
-class PrintedSpec:
-    file: Path
-    title: str
-    argument: str
-    tolerance: float | None = None  # absolute, in the printed unit
-    rel_tolerance: float | None = None
-    role: str = "check"  # check | information
-    misprints: list[Misprint] = field(default_factory=list)
-    note: str = ""
-    part: str | None = None
-    folder: Path | None = None  # the template's folder: the file must resolve inside it
-    # the rows of the file once read, or the error reading it (typedsheet.printed_rows)
-    read: Any = field(default=None, init=False, repr=False, compare=False)
-
-
-@dataclass
-class RelationSpec:
-    """A declared derivative relation: child == factor * d(parent)/d(var)."""
-
-    text: str
-    child: str
-    factor: ex.Node
-    parent: str
-    var: str
-    var_unit: str
-    range: RangeSpec | None
-    line: int | None = None
-    part: str | None = None
-
-
-@dataclass
-class SheetSpec:
-    name: str
-    title: str
-    path: Path
-    source: str
-    description: str
-    inputs: dict[str, InputSpec]
-    arguments: dict[str, ArgumentSpec]
-    definitions: dict[str, Definition]
-    blocks: dict[str, str]
-    tables: list[TableSpec]
-    charts: list[ChartSpec]
-    printed: list[PrintedSpec]
-    relations: list[RelationSpec]
-    findings: list[dict]
-    meta: dict[str, Any]
-    text: str
-    parts: dict[str, PartSpec] = field(default_factory=dict)
-    data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
-    solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
-    odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.engine.ode.OdeSpec
-    checks: list[Any] = field(default_factory=list)  # declared_checks.CheckSpec, [[checks]]
-
-    def solve_of(self, name: str):
-        """The [[solve]] block that finds ``name``, or None."""
-        return next((s for s in self.solves if name in s.unknowns), None)
-
-    @property
-    def origin(self) -> int:
-        """The first index of vectors and matrices (Mathcad's ORIGIN; [sheet] origin)."""
-        return int(self.meta.get("origin", 0))
-
-    @property
-    def polar(self) -> bool:
-        """Complex results shown as r∠phi (``[sheet] complex = "polar"``), else as a + bi."""
-        return self.meta.get("complex", "rectangular") == "polar"
-
-    def line_of(self, key: str, section: str | None = None) -> int | None:
-        return find_line(self.text, key, section)
-
-
-def find_line(text: str, key: str, section: str | None = None) -> int | None:
-    """Line number (1-based) where ``key = ...`` is written, optionally inside [section]."""
-    plain = key and "=" not in key and key == key.strip() and key[0] not in _QUOTES
-    if plain and key[-1] not in _QUOTES:  # the index holds every line such a key matches
-        for number, in_section in _key_lines(text).get(key, ()):
-            if section is None or (
-                in_section is not None
-                and (in_section == section or in_section.startswith(section + "."))
-            ):
-                return number
-        return None
-    return scan_for_line(text, key, section)
-
-
-_QUOTES = "\"'"
-
-
-@functools.lru_cache(maxsize=4)
-def _key_lines(text: str) -> dict[str, list[tuple[int, str | None]]]:
-    """Each key a line may be written for (``KEY =``, ``"KEY" =``), with the line number and
-    the section the line is in: one pass over a template, so that finding the lines of its
-    definitions is linear (a scan per key took minutes for 30,000 definitions).
-
-    A line matches :func:`scan_for_line`'s pattern for a key without ``=``, quotes or outer
-    blanks exactly when the text before its first ``=``, stripped, is the key with an
-    optional quote on either side."""
-    index: dict[str, list[tuple[int, str | None]]] = {}
-    current: str | None = None
-    for number, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        header = stripped.startswith("[")
-        if header:
-            current = stripped.strip("[]").strip()
-        head, eq, _ = line.partition("=")
-        if not eq or not head.strip():
-            continue
-        head = head.strip()
-        keys = {head}
-        opens, closes = head[0] in _QUOTES, head[-1] in _QUOTES
-        if opens:
-            keys.add(head[1:])
-        if closes:
-            keys.add(head[:-1])
-        if opens and closes and len(head) > 1:
-            keys.add(head[1:-1])
-        for k in keys:  # a section header is a key's line only when no section is asked
-            index.setdefault(k, []).append((number, None if header else current))
-    return index
-
-
-def scan_for_line(text: str, key: str, section: str | None) -> int | None:
-    """The line of ``key = ...`` in ``[section]`` of the worksheet text (any section when
-    None), or None."""
-    pattern = re.compile(r'^\s*["\']?' + re.escape(key) + r'["\']?\s*=')
-    in_section = section is None
-    for number, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if section is not None and stripped.startswith("["):
-            name = stripped.strip("[]").strip()
-            in_section = name == section or name.startswith(section + ".")
-            continue
-        if in_section and pattern.match(line):
-            return number
-    return None
 
 
 _SIGNATURE = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
@@ -521,19 +148,6 @@ def _fields(raw: dict, allowed, what: str, text: str, section: str) -> Fields:
         raise err.located(line=find_line(text, bad, section) if bad else None) from None
 
 
-_SHEET_NAME_BAD = re.compile(r"[\[\]:*?/\\']")
-
-
-def sheet_name(name: str, what: str) -> str:
-    """A worksheet name Excel accepts: 1 to 31 characters, none of ``[]:*?/\\``, no leading or
-    trailing apostrophe (the writer quotes names in formulas)."""
-    if not name.strip() or len(name) > 31 or _SHEET_NAME_BAD.search(name):
-        raise TemplateError(
-            f"{what}: sheet name {name!r} must be 1 to 31 characters without [ ] : * ? / \\ '"
-        )
-    return name
-
-
 WRITER_SHEETS = ("Inputs", "Definitions", "Charts", "Checks", "About")  # the writer's own
 
 
@@ -576,133 +190,14 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             f"(known: {', '.join(sorted(SECTIONS))})",
             line=find_line(text, key) or _section_line(text, key),
         )
-    sheet = _table(data, "sheet")
-    fields = _fields(sheet, SHEET_KEYS, "[sheet]", text, "sheet")
-    for key in ("name", "title", "source", "description", "bench", "export"):
-        fields.text(key)
-    fields.flag("hand_checks")
-    fields.number("samples"), fields.number("tolerance"), fields.number("time_limit")
-    for key, value in fields.table("about").items():
-        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
-            raise TemplateError(
-                f"[sheet] about: {key} must be text, got {value!r}",
-                line=find_line(text, key, "sheet"),
-            )
-    sweep = _fields(_table(data, "sweep"), SWEEP_KEYS, "[sweep]", text, "sweep")
-    for key in SWEEP_KEYS:
-        sweep.table(key)
-    if "name" in sheet and not re.match(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$", str(sheet["name"])):
-        raise TemplateError(  # the name becomes reports/NAME.xlsx: no folders, no '..'
-            f"[sheet] name {str(sheet['name'])[:80]!r} must be letters, digits, '-', '_', '.'",
-            line=find_line(text, "name", "sheet"),
-        )
-    seen: dict[str, str] = {}
-
-    def claim(key: str, section: str, line, function: bool = True):
-        if not ex.is_identifier(key):
-            raise TemplateError(
-                f"'{key}' is not a valid name (letters, digits, _)", line=line, definition=key
-            )
-        if key in REGISTRY and function:
-            raise TemplateError(
-                f"'{key}' shadows the built-in function {key}(); choose another name",
-                line=line,
-                definition=key,
-            )
-        if key in seen:
-            raise TemplateError(
-                f"'{key}' is defined twice (in [{seen[key]}] and [{section}])",
-                line=line,
-                definition=key,
-            )
-        seen[key] = section
-
-    inputs: dict[str, InputSpec] = {}
-    for key, raw in _table(data, "inputs").items():
-        line = find_line(text, key, "inputs")
-        claim(key, "inputs", line, function=False)
-        try:
-            inputs[key] = _input(key, raw, line)
-        except WorkbookError as err:
-            raise err.located(line=line, definition=key) from None
-
-    arguments: dict[str, ArgumentSpec] = {}
-    for key, raw in _table(data, "arguments").items():
-        line = find_line(text, key, "arguments")
-        if not ex.is_identifier(key):
-            raise TemplateError(f"'{key}' is not a valid argument name", line=line)
-        if isinstance(raw, str):
-            raw = {"unit": raw}
-        if not isinstance(raw, dict):
-            raise TemplateError(
-                'an argument is declared as { unit = "deg", note = "..." }',
-                line=line,
-                definition=key,
-            )
-        try:
-            f = Fields(raw, ARGUMENT_KEYS, f"argument {key}")
-            arguments[key] = ArgumentSpec(
-                key, un.unit(f.text("unit"), what=key), f.text("note"), line, f.flag("plain")
-            )
-        except WorkbookError as err:
-            raise err.located(line=line, definition=key) from None
-
-    blocks: dict[str, str] = {}
-    for key, raw in _table(data, "blocks").items():
-        line = find_line(text, key, "blocks")
-        claim(key, "blocks", line)
-        if not isinstance(raw, str) or not re.match(r"^[a-z_][a-z0-9_]*\.[a-z_][a-z0-9_]*$", raw):
-            raise TemplateError(
-                "a block is named as 'module.function' (e.g. 'r0.direct')",
-                line=line,
-                definition=key,
-            )
-        blocks[key] = raw
-
-    definitions: dict[str, Definition] = {}
-    for key, raw in _table(data, "definitions").items():
-        line = find_line(text, key, "definitions")
-        m = _SIGNATURE.match(key)
-        if not m:
-            raise TemplateError(
-                f"cannot read definition name {key!r} (write 'f(x, y)' or 'x')", line=line
-            )
-        dname = m.group(1)
-        params = tuple(p.strip() for p in m.group(2).split(",")) if m.group(2) else ()
-        if m.group(2) is not None and not m.group(2).strip():
-            params = ()
-        claim(dname, "definitions", line, function=m.group(2) is not None)
-        for p in params:
-            if not ex.is_identifier(p):
-                raise TemplateError(f"bad parameter name {p!r}", line=line, definition=dname)
-            if p not in arguments:
-                raise TemplateError(
-                    f"parameter '{p}' has no declared unit: add it to [arguments] "
-                    f'(e.g. {p} = {{ unit = "deg" }})',
-                    line=line,
-                    definition=dname,
-                )
-        if len(set(params)) != len(params):
-            raise TemplateError("a parameter is repeated", line=line, definition=dname)
-        try:
-            definitions[dname] = _definition(dname, params, raw, line)
-        except WorkbookError as err:
-            raise err.located(line=line, definition=dname) from None
-
+    sheet = _sheet_section(data, text)
+    claim = _Claims()
+    inputs = _inputs(data, text, claim)
+    arguments = _arguments(data, text)
+    blocks = _blocks(data, text, claim)
+    definitions = _definitions(data, text, arguments, claim)
     odes = _odes(data, text, arguments, definitions, claim)
-    if sheet.get("complex", "rectangular") not in ("rectangular", "polar"):
-        raise TemplateError(
-            f'[sheet] complex is "rectangular" (a + bi) or "polar" (r∠phi), got '
-            f"{sheet['complex']!r}",
-            line=find_line(text, "complex", "sheet"),
-        )
-    origin = sheet.get("origin", 0)
-    if isinstance(origin, bool) or not isinstance(origin, int) or abs(origin) > 1_000_000:
-        raise TemplateError(
-            f"[sheet] origin is the first index of vectors, an integer (0 or 1), got {origin!r}",
-            line=find_line(text, "origin", "sheet"),
-        )
-
+    _sheet_options(sheet, text)
     for pname in arguments:
         if pname in inputs or pname in definitions:
             raise TemplateError(
@@ -722,32 +217,12 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         measured[col.name] = col
 
     solves = read_solves(_list(data, "solve"), text)
-    for block in solves:
-        for name in block.unknowns:
-            claim(name, "solve", block.line)
-    for block in solves:  # Mathcad's th(a) := Find(x): each unknown a function of the parameters
-        for p in block.parameters:
-            if p not in arguments:
-                raise TemplateError(
-                    f"[[solve]] parameter '{p}' has no declared unit: add it to [arguments]",
-                    line=block.line,
-                    definition=block.what,
-                )
-        for unknown in block.parameters and block.unknowns:
-            definitions[unknown] = Definition(
-                unknown,
-                block.parameters,
-                ex.Name(unknown),
-                None,
-                f"Find({', '.join(block.unknowns)}) of the [[solve]] block",
-                "solved at each value of " + ", ".join(block.parameters),
-                line=block.line,
-            )
+    _claim_solves(solves, arguments, definitions, claim)
 
-    tables = [_table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
-    charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
+    tables = [table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
+    charts = [chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
     printed = [_printed_spec(p, path, text) for p in _list(data, "printed")]
-    relations = [_relation_spec(r, text) for r in _list(data, "relations")]
+    relations = [relation_spec(r, text) for r in _list(data, "relations")]
     headers = _header_lines(text, "checks")
     checks = [
         read_check(raw, headers[i] if i < len(headers) else None)
@@ -796,6 +271,185 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     )
 
 
+def _sheet_section(data: dict, text: str) -> dict:
+    """[sheet] and [sweep], their keys checked; returns [sheet]."""
+    sheet = _table(data, "sheet")
+    fields = _fields(sheet, SHEET_KEYS, "[sheet]", text, "sheet")
+    for key in ("name", "title", "source", "description", "bench", "export"):
+        fields.text(key)
+    fields.flag("hand_checks")
+    fields.number("samples"), fields.number("tolerance"), fields.number("time_limit")
+    for key, value in fields.table("about").items():
+        if not isinstance(value, (str, int, float)) or isinstance(value, bool):
+            raise TemplateError(
+                f"[sheet] about: {key} must be text, got {value!r}",
+                line=find_line(text, key, "sheet"),
+            )
+    sweep = _fields(_table(data, "sweep"), SWEEP_KEYS, "[sweep]", text, "sweep")
+    for key in SWEEP_KEYS:
+        sweep.table(key)
+    if "name" in sheet and not re.match(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,79}$", str(sheet["name"])):
+        raise TemplateError(  # the name becomes reports/NAME.xlsx: no folders, no '..'
+            f"[sheet] name {str(sheet['name'])[:80]!r} must be letters, digits, '-', '_', '.'",
+            line=find_line(text, "name", "sheet"),
+        )
+    return sheet
+
+
+def _sheet_options(sheet: dict, text: str) -> None:
+    """[sheet] complex and origin, checked."""
+    if sheet.get("complex", "rectangular") not in ("rectangular", "polar"):
+        raise TemplateError(
+            f'[sheet] complex is "rectangular" (a + bi) or "polar" (r∠phi), got '
+            f"{sheet['complex']!r}",
+            line=find_line(text, "complex", "sheet"),
+        )
+    origin = sheet.get("origin", 0)
+    if isinstance(origin, bool) or not isinstance(origin, int) or abs(origin) > 1_000_000:
+        raise TemplateError(
+            f"[sheet] origin is the first index of vectors, an integer (0 or 1), got {origin!r}",
+            line=find_line(text, "origin", "sheet"),
+        )
+
+
+class _Claims:
+    """The names a worksheet defines, each claimed once by the section that defines it:
+    ``claim(key, section, line, function=True)`` refuses a bad name, a built-in's name (for a
+    function) and a name defined twice."""
+
+    def __init__(self):
+        self.seen: dict[str, str] = {}
+
+    def __call__(self, key: str, section: str, line, function: bool = True) -> None:
+        if not ex.is_identifier(key):
+            raise TemplateError(
+                f"'{key}' is not a valid name (letters, digits, _)", line=line, definition=key
+            )
+        if key in REGISTRY and function:
+            raise TemplateError(
+                f"'{key}' shadows the built-in function {key}(); choose another name",
+                line=line,
+                definition=key,
+            )
+        if key in self.seen:
+            raise TemplateError(
+                f"'{key}' is defined twice (in [{self.seen[key]}] and [{section}])",
+                line=line,
+                definition=key,
+            )
+        self.seen[key] = section
+
+
+def _inputs(data: dict, text: str, claim: _Claims) -> dict[str, InputSpec]:
+    inputs: dict[str, InputSpec] = {}
+    for key, raw in _table(data, "inputs").items():
+        line = find_line(text, key, "inputs")
+        claim(key, "inputs", line, function=False)
+        try:
+            inputs[key] = _input(key, raw, line)
+        except WorkbookError as err:
+            raise err.located(line=line, definition=key) from None
+    return inputs
+
+
+def _arguments(data: dict, text: str) -> dict[str, ArgumentSpec]:
+    arguments: dict[str, ArgumentSpec] = {}
+    for key, raw in _table(data, "arguments").items():
+        line = find_line(text, key, "arguments")
+        if not ex.is_identifier(key):
+            raise TemplateError(f"'{key}' is not a valid argument name", line=line)
+        if isinstance(raw, str):
+            raw = {"unit": raw}
+        if not isinstance(raw, dict):
+            raise TemplateError(
+                'an argument is declared as { unit = "deg", note = "..." }',
+                line=line,
+                definition=key,
+            )
+        try:
+            f = Fields(raw, ARGUMENT_KEYS, f"argument {key}")
+            arguments[key] = ArgumentSpec(
+                key, un.unit(f.text("unit"), what=key), f.text("note"), line, f.flag("plain")
+            )
+        except WorkbookError as err:
+            raise err.located(line=line, definition=key) from None
+    return arguments
+
+
+def _blocks(data: dict, text: str, claim: _Claims) -> dict[str, str]:
+    blocks: dict[str, str] = {}
+    for key, raw in _table(data, "blocks").items():
+        line = find_line(text, key, "blocks")
+        claim(key, "blocks", line)
+        if not isinstance(raw, str) or not re.match(r"^[a-z_][a-z0-9_]*\.[a-z_][a-z0-9_]*$", raw):
+            raise TemplateError(
+                "a block is named as 'module.function' (e.g. 'r0.direct')",
+                line=line,
+                definition=key,
+            )
+        blocks[key] = raw
+    return blocks
+
+
+def _definitions(data: dict, text: str, arguments: dict, claim: _Claims) -> dict[str, Definition]:
+    definitions: dict[str, Definition] = {}
+    for key, raw in _table(data, "definitions").items():
+        line = find_line(text, key, "definitions")
+        m = _SIGNATURE.match(key)
+        if not m:
+            raise TemplateError(
+                f"cannot read definition name {key!r} (write 'f(x, y)' or 'x')", line=line
+            )
+        dname = m.group(1)
+        params = tuple(p.strip() for p in m.group(2).split(",")) if m.group(2) else ()
+        if m.group(2) is not None and not m.group(2).strip():
+            params = ()
+        claim(dname, "definitions", line, function=m.group(2) is not None)
+        for p in params:
+            if not ex.is_identifier(p):
+                raise TemplateError(f"bad parameter name {p!r}", line=line, definition=dname)
+            if p not in arguments:
+                raise TemplateError(
+                    f"parameter '{p}' has no declared unit: add it to [arguments] "
+                    f'(e.g. {p} = {{ unit = "deg" }})',
+                    line=line,
+                    definition=dname,
+                )
+        if len(set(params)) != len(params):
+            raise TemplateError("a parameter is repeated", line=line, definition=dname)
+        try:
+            definitions[dname] = _definition(dname, params, raw, line)
+        except WorkbookError as err:
+            raise err.located(line=line, definition=dname) from None
+    return definitions
+
+
+def _claim_solves(solves, arguments: dict, definitions: dict, claim: _Claims) -> None:
+    """Claim the unknowns of the [[solve]] blocks; an unknown of a block with parameters
+    becomes a definition, a function of them."""
+    for block in solves:
+        for name in block.unknowns:
+            claim(name, "solve", block.line)
+    for block in solves:  # Mathcad's th(a) := Find(x): each unknown a function of the parameters
+        for p in block.parameters:
+            if p not in arguments:
+                raise TemplateError(
+                    f"[[solve]] parameter '{p}' has no declared unit: add it to [arguments]",
+                    line=block.line,
+                    definition=block.what,
+                )
+        for unknown in block.parameters and block.unknowns:
+            definitions[unknown] = Definition(
+                unknown,
+                block.parameters,
+                ex.Name(unknown),
+                None,
+                f"Find({', '.join(block.unknowns)}) of the [[solve]] block",
+                "solved at each value of " + ", ".join(block.parameters),
+                line=block.line,
+            )
+
+
 def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
     """``[[ode]]`` sections; each state becomes a definition, a function of the time."""
     from ..engine.ode import parse_spec
@@ -803,7 +457,7 @@ def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
     out = {}
     for k, raw in enumerate(_list(data, "ode")):
         name = raw.get("name") if isinstance(raw, dict) else None
-        line = _name_line(text, name) if isinstance(name, str) else _section_line(text, "ode")
+        line = name_line(text, name) if isinstance(name, str) else _section_line(text, "ode")
         try:
             spec = parse_spec(raw, where=f"[[ode]] {k + 1}", line=line)
         except WorkbookError as err:
@@ -822,7 +476,7 @@ def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
                 line=line,
             )
         for i, st in enumerate(spec.states):
-            claim(st.name, f"ode {spec.name}", _name_line(text, st.name) or line)
+            claim(st.name, f"ode {spec.name}", name_line(text, st.name) or line)
             definitions[st.name] = Definition(
                 st.name,
                 (spec.var,),
@@ -1079,176 +733,6 @@ def _definition(name: str, params: tuple[str, ...], raw, line) -> Definition:
     return Definition(name, params, ex.parse(raw, what=what), None, raw, note, display, line)
 
 
-def _column(
-    text: str, unit_text, default_var: str | None, what: str, title: str = ""
-) -> ColumnSpec:
-    node = ex.parse(text, what=what)
-    return ColumnSpec(
-        text, node, un.unit(unit_text, what=what) if unit_text is not None else None, title or text
-    )
-
-
-def _columns(raw, default_var, what) -> list[ColumnSpec]:
-    cols = []
-    if isinstance(raw, dict):
-        for k, v in raw.items():
-            if not isinstance(v, str):
-                raise TemplateError(
-                    f'{what}: column {k!r}: its unit must be text like "mm", got {v!r}'
-                )
-        raw = [{"expr": k, "unit": v} for k, v in raw.items()]
-    if not isinstance(raw, list):
-        raise TemplateError(f'{what}: columns are {{ h1 = "mm", v1 = "m/s" }}')
-    for item in raw:
-        if isinstance(item, str):
-            item = {"expr": item}
-        if not isinstance(item, dict) or "expr" not in item:
-            raise TemplateError(f'{what}: a column is {{ expr = "h1", unit = "mm" }}')
-        f = Fields(item, COLUMN_KEYS, f"{what}, column {item['expr']!r}")
-        cols.append(
-            _column(f.text("expr"), f.text("unit", None), default_var, what, f.text("title"))
-        )
-    return cols
-
-
-def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
-    name = str(raw.get("name", f"table{index + 1}"))
-    line = _name_line(text, name)
-    try:
-        f = Fields(raw, TABLE_KEYS, f"table {name}")
-        f.text("name"), f.text("part", None)
-        rng = parse_range(f.text("range"), what=f"table {name}", log=True) if "range" in f else None
-        cols = _columns(raw.get("columns", []), rng.var if rng else None, f"table {name}")
-        shown = [(c.title, None if c.unit is None else str(c.unit)) for c in cols]
-        twice = next((c for c, k in zip(cols, shown) if shown.count(k) > 1), None)
-        if twice is not None:
-            raise TemplateError(
-                f"table {name}: column {twice.title!r} is listed twice in the same unit"
-            )
-        block = f.text("block", None)
-        if not block and rng is None:
-            raise TemplateError(f"table {name} needs a range (or a block)")
-        vary = _vary(f, name)
-        if vary and (block or not cols):
-            raise TemplateError(f"table {name}: vary needs a range and columns (not a block)")
-        return TableSpec(
-            name,
-            f.text("title", name),
-            rng,
-            cols,
-            sheet_name(f.text("sheet", "Listing"), f"table {name}"),
-            block,
-            line,
-            vary=vary,
-        )
-    except WorkbookError as err:
-        raise err.located(line=line, definition=f"table {name}") from None
-
-
-def _vary(f: Fields, name: str) -> dict[str, tuple[str, ...]]:
-    """``vary = { c1 = ["1500 N/m", "3000 N/m"] }``: one input and its values (checked
-    against the input when the sheet loads)."""
-    raw = f.table("vary")
-    if len(raw) > 1:
-        raise TemplateError(
-            f"table {name}: vary takes one input (a family of curves), got {len(raw)}"
-        )
-    out = {}
-    for key, values in raw.items():
-        if (
-            not isinstance(values, list)
-            or not values
-            or not all(isinstance(v, (str, int, float)) and not isinstance(v, bool) for v in values)
-        ):
-            raise TemplateError(
-                f'table {name}: vary.{key} must be a list of values like ["1500 N/m", "3000 N/m"]'
-            )
-        if len(values) > MAX_VARY:
-            raise LimitError(
-                f"table {name}: vary.{key} has {len(values)} values (limit {MAX_VARY})"
-            )
-        out[str(key)] = tuple(str(v) for v in values)
-    return out
-
-
-def _name_line(text: str, name: str) -> int | None:
-    pattern = re.compile(r'^\s*name\s*=\s*["\']' + re.escape(name) + r'["\']')
-    for number, line in enumerate(text.splitlines(), start=1):
-        if pattern.match(line):
-            return number
-    return None
-
-
-def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
-    name = str(raw.get("name", f"chart{index + 1}"))
-    line = _name_line(text, name)
-    what = f"chart {name}"
-    try:
-        f = Fields(raw, CHART_KEYS, what)
-        f.text("name"), f.text("part", None)
-        rng = parse_range(f.text("range"), what=what, log=True) if "range" in f else None
-        x_raw = raw.get("x", rng.var if rng else None)
-        x_title = ""
-        if isinstance(x_raw, dict):
-            fx = Fields(x_raw, AXIS_KEYS, f"{what}, x")
-            x_title = fx.text("title")
-            expr = fx.required_text("expr", 'x = { expr = "phi" }')
-            x = _column(expr, fx.text("unit", None), None, what, x_title)
-        elif x_raw is not None:
-            x = _column(Fields({"x": x_raw}, ("x",), what).text("x"), None, None, what)
-        else:
-            x = None
-        series = []
-        for raw_s in f.tables("series"):
-            label = raw_s.get("name", raw_s.get("y", len(series) + 1))
-            s = Fields(raw_s, SERIES_KEYS, f"{what}, series {label!r}")
-            y_text = s.required_text("y", 'y = "h1"')
-            common = dict(
-                name=s.text("name", y_text),
-                line=s.text("line", "solid"),
-                axis=s.text("axis", "primary"),
-                marker=s.flag("marker"),
-            )
-            if "table" in s:
-                series.append(
-                    SeriesSpec(
-                        y=_column("0", None, None, what),
-                        table=s.text("table"),
-                        x_column=s.text("x"),
-                        y_column=y_text,
-                        **common,
-                    )
-                )
-                continue
-            y = _column(y_text, s.text("unit", None), None, what, common["name"])
-            srange = parse_range(s.text("range"), what=what, log=True) if "range" in s else None
-            sx = _column(s.text("x"), s.text("x_unit", None), None, what) if "x" in s else None
-            series.append(SeriesSpec(y, x=sx, range=srange, **common))
-        if not series:
-            raise TemplateError(f"{what} has no series")
-        for s in series:
-            if s.line not in ("solid", "dash", "dot", "none"):
-                raise TemplateError(f"{what}: line must be solid, dash, dot or none")
-            if s.axis not in ("primary", "secondary"):
-                raise TemplateError(f"{what}: axis must be primary or secondary")
-        return ChartSpec(
-            name,
-            f.text("title", name),
-            rng,
-            x,
-            x_title or f.text("x_title"),
-            f.text("y_title"),
-            f.text("y2_title"),
-            series,
-            f.flag("log_x"),
-            f.flag("log_y"),
-            f.flag("equal_axes"),
-            line,
-        )
-    except WorkbookError as err:
-        raise err.located(line=line, definition=what) from None
-
-
 def _printed_spec(raw: dict, path: Path, text: str) -> PrintedSpec:
     if "file" not in raw:
         raise TemplateError('[[printed]] needs file = "...csv"')
@@ -1297,51 +781,3 @@ def _printed_fields(raw: dict, path: Path, text: str) -> PrintedSpec:
         f.text("note"),
         folder=path.parent,
     )
-
-
-_RELATION = re.compile(
-    r"^\s*([A-Za-z]\w*)\s*=\s*(.*?)\s*\*?\s*d\(\s*([A-Za-z]\w*)\s*\)\s*/\s*d\(\s*([A-Za-z]\w*)\s*\)\s*$"
-)
-
-
-def _relation_spec(raw: dict, text: str) -> RelationSpec:
-    rel = raw.get("relation")
-    if not isinstance(rel, str):
-        raise TemplateError('[[relations]] needs relation = "v1 = omega * d(h1)/d(phi)"')
-    line = value_line(text, rel)
-    try:
-        f = Fields(raw, RELATION_KEYS, f"relation {rel!r}")
-        f.text("part", None), f.text("range"), f.text("unit")
-    except WorkbookError as err:
-        raise err.located(line=line) from None
-    m = _RELATION.match(rel)
-    if not m:
-        raise TemplateError(
-            f"cannot read relation {rel!r} (write 'v1 = omega * d(h1)/d(phi)')", line=line
-        )
-    factor = m.group(2).strip().rstrip("*").strip() or "1"
-    try:
-        rng = parse_range(raw["range"], what=rel) if "range" in raw else None
-        un.unit(f.text("unit", "rad"), what=rel)
-    except WorkbookError as err:
-        raise err.located(line=line) from None
-    return RelationSpec(
-        rel,
-        m.group(1),
-        ex.parse(factor, what=rel),
-        m.group(3),
-        m.group(4),
-        str(raw.get("unit", "rad")),
-        rng,
-        line,
-    )
-
-
-def column_node(spec: SheetSpec, col, var: str) -> ex.Node:
-    """A bare one-argument function name as a column means that function of the range variable."""
-    node = col.node
-    if isinstance(node, ex.Name):
-        d = spec.definitions.get(node.id)
-        if d is not None and d.is_function and len(d.params) == 1:
-            return ex.Call(node.id, (ex.Name(var),))
-    return node

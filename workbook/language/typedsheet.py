@@ -18,7 +18,7 @@ from typing import Any
 
 from ..errors import WorkbookError
 from .printed import PrintedRow, read_printed
-from .template import PrintedSpec
+from .spec import PrintedSpec
 
 
 class TypedSheet:

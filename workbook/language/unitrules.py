@@ -22,7 +22,7 @@ from . import units as un
 from .typed import T, TBinary, TCall, TConst, TRef, TScale, children, is_bare, is_zero
 
 if TYPE_CHECKING:
-    from .template import SheetSpec
+    from .spec import SheetSpec
 
 
 class UnitRules:

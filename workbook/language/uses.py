@@ -13,7 +13,8 @@ from ..errors import WorkbookError
 from . import expr as ex
 from . import typecheck as tc
 from .ranges import RangeSpec
-from .template import SheetSpec, column_node
+from .shown import column_node
+from .spec import SheetSpec
 from .typedsheet import printed_rows
 
 
