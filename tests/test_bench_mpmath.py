@@ -7,7 +7,7 @@ from pathlib import Path
 
 import mpmath
 import pytest
-from test_hard_numerics import HARD_SHEET
+from helpers.sheets import HARD_SHEET
 
 import workbook
 from workbook.numerics import bench, mpref

@@ -13,7 +13,7 @@ import mpmath
 import numpy as np
 import openpyxl
 import pytest
-from test_builtins import DOC, documented
+from helpers.docs import DOC, documented
 
 import workbook
 from workbook.compute.excel import ExcelPrinter

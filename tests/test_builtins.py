@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import mpmath
 import numpy as np
 import pytest
+from helpers.docs import DOC, documented
 
 from workbook import WorkbookError
 from workbook.compute.excel import ExcelPrinter
@@ -21,8 +21,6 @@ from workbook.functions.registry import REGISTRY
 from workbook.language import typed as ty
 from workbook.language.template import load_spec
 from workbook.language.visitor import UnhandledNode
-
-DOC = Path(__file__).parent.parent / "docs" / "language.md"
 
 SHEET = """
 [sheet]
@@ -62,11 +60,6 @@ def test_every_entry_is_complete():
         assert callable(b.unit_rule) and callable(b.numpy)
         assert callable(b.excel) and callable(b.sympy)
         assert b.doc
-
-
-def documented(text: str) -> list[str]:
-    """The built-ins the reference lists (its line "Built-in functions: `...`")."""
-    return re.search(r"Built-in functions: `([^`]*)`", text).group(1).split()
 
 
 def test_the_reference_lists_every_builtin():

@@ -9,10 +9,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
 import openpyxl
 import pytest
-from openpyxl.utils import get_column_letter
+from helpers.recalculated import formulas_recalculated, mismatches
+from helpers.sheets import RATIOS
 from recalc import formula_values
 
 from workbook.compute import cellunit
@@ -20,52 +20,6 @@ from workbook.language import units as un
 
 RELATIVE = 1e-9
 
-RATIOS = """
-[sheet]
-title = "Ratios of prefixed units"
-
-[inputs]
-P1 = "1.5 kW"
-P2 = "2000 W"
-d = "10 mm"
-D = "0.6 m"
-E = "200 GPa"
-Sy = "250 MPa"
-eta = "85 %"
-theta = "30 deg"
-T1 = "20 degC"
-k = "3"
-dT = "10 delta_degC"
-
-[arguments]
-x = { unit = "" }
-
-[definitions]
-r = "P1/P2"
-y = "2*r"
-s = "d/D"
-s1 = "s + 1"
-lam = "sqrt(E/Sy)"
-mode = "\\"Euler\\" if lam > 20 otherwise \\"Johnson\\""
-Pcr = "1000*r/lam^2 if lam > 20 otherwise 1000*r*(1 - lam/60)"
-q = { expr = "r*eta", unit = "%" }
-q1 = { expr = "P1/P2", unit = "" }
-ang = { expr = "theta*r", unit = "deg" }
-c = "cos(theta)*s"
-T2 = { expr = "T1 + dT*q1", unit = "degC" }
-T3 = { expr = "T2", unit = "K" }
-n = "k*r"
-"f(x)" = "x*r"
-"g(x)" = "x*P1/P2"
-"h(x)" = "x*d/D + r"
-m = "max_over(T, g)"
-m2 = "m*2"
-
-[[tables]]
-name = "T"
-range = "x := 0, 0.25 .. 1"
-columns = ["x", "f(x)", "g", "h"]
-"""
 
 # the engine's numbers, worked out by hand: P1/P2 = 0.75, d/D = 1/60, E/Sy = 800
 EXPECTED = {
@@ -85,96 +39,6 @@ EXPECTED = {
     "m": 0.75,
     "m2": 1.5,
 }
-
-
-def formulas_recalculated(xlsx: Path) -> dict[tuple[str, str], object]:
-    """{(sheet, cell): value} of every cell of ``xlsx`` recalculated by the formulas package
-    (its own parser and its own Excel functions, not the writer's)."""
-    import formulas
-
-    solution = formulas.ExcelModel().loads(str(xlsx)).finish().calculate()
-    out = {}
-    for key, value in solution.items():
-        if "!" not in key or ":" in key.split("!")[1]:
-            continue
-        book_sheet, cell = key.split("!")
-        sheet = book_sheet.split("]", 1)[1].strip("'")
-        v = getattr(value, "value", value)
-        try:
-            v = v[0][0]
-        except (TypeError, IndexError):
-            pass
-        out[(sheet.upper(), cell.upper())] = v
-    return out
-
-
-def xleval_recalculated(xlsx: Path) -> dict[tuple[str, str], object]:
-    """{(sheet, cell): value} of every formula cell of ``xlsx`` recalculated from its inputs
-    (not from cached values) by workbook.compute.xleval, each formula reading the
-    recalculated values of the cells and defined names it refers to."""
-    from openpyxl.utils import range_boundaries
-
-    from workbook.compute import xleval
-
-    book = openpyxl.load_workbook(xlsx)
-    sheets = {ws.title.upper(): ws for ws in book.worksheets}
-    names = {n.upper(): d.attr_text for n, d in book.defined_names.items()}
-    done: dict[tuple[str, str], object] = {}
-
-    def cell(sheet: str, coord: str):
-        key = (sheet, coord)
-        if key not in done:
-            v = sheets[sheet][coord].value
-            if isinstance(v, str) and v.startswith("="):
-                done[key] = None  # a cycle reads as empty
-                fn = xleval.compile_formula(v)
-                v = fn(lambda ref, here=sheet: read(ref, here))
-                if isinstance(v, np.ndarray):
-                    v = v.flat[0]
-            done[key] = float(v) if isinstance(v, int) and not isinstance(v, bool) else v
-        return done[key]
-
-    def read(ref: str, here: str):
-        if ref.upper() in names:
-            return read(names[ref.upper()], here)
-        sheet, _, cells = ref.rpartition("!")
-        sheet = sheet.strip("'").upper() or here
-        cells = cells.replace("$", "")
-        if ":" not in cells:
-            return cell(sheet, cells)
-        c0, r0, c1, r1 = range_boundaries(cells)
-        out = np.empty((r1 - r0 + 1, c1 - c0 + 1), dtype=object)
-        for i in range(r1 - r0 + 1):
-            for j in range(c1 - c0 + 1):
-                out[i, j] = cell(sheet, f"{get_column_letter(c0 + j)}{r0 + i}")
-        return out
-
-    return {
-        (title, c.coordinate): cell(title, c.coordinate)
-        for title, ws in sheets.items()
-        for row in ws.iter_rows()
-        for c in row
-        if isinstance(c.value, str) and c.value.startswith("=")
-    }
-
-
-def mismatches(xlsx: Path, recalculated: dict | None = None) -> list:
-    """Formula cells whose recalculated value differs from the one the writer cached (the
-    engine's) beyond RELATIVE (an absolute 1e-12 floor for zeros), with the formula."""
-    cached = formula_values(xlsx)
-    recalculated = formulas_recalculated(xlsx) if recalculated is None else recalculated
-    bad = []
-    for (sheet, cell), (formula, value) in cached.items():
-        got = recalculated.get((sheet.upper(), cell.upper()))
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            if str(got) != str(value) and got != value:
-                bad.append((sheet, cell, formula, value, got))
-            continue
-        if isinstance(got, bool) or not isinstance(got, (int, float)):
-            bad.append((sheet, cell, formula, value, got))
-        elif abs(got - value) > RELATIVE * max(abs(value), abs(got)) + 1e-12:
-            bad.append((sheet, cell, formula, value, got))
-    return bad
 
 
 def results(xlsx: Path) -> dict[str, tuple[object, object]]:

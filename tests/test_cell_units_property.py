@@ -9,11 +9,10 @@ from __future__ import annotations
 import os
 
 import pytest
+from helpers.recalculated import differences, mismatches, xleval_recalculated
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from recalc import recalculate, soffice
-from test_cell_units import mismatches, xleval_recalculated
-from test_livecheck_libreoffice import differences
 
 POWERS = ["W", "kW", "MW", "mW"]
 LENGTHS = ["mm", "cm", "m", "km", "um"]

@@ -8,6 +8,7 @@ import math
 import mpmath
 import numpy as np
 import pytest
+from helpers.sheets import AC
 
 import workbook
 from workbook.compute.livecheck import _agrees, _complex_error
@@ -133,41 +134,6 @@ def test_the_flag_says_which_values_are_complex(tmp_path):
     )
     flags = {n: sheet.typer.scalar(n).complex for n in ("z", "m", "a", "r", "c")}
     assert flags == {"z": True, "m": False, "a": False, "r": False, "c": True}
-
-
-# -- units ------------------------------------------------------------------------------------
-AC = """[inputs]
-R = "10 ohm"
-L = "50 mH"
-C = "100 uF"
-f = "50 Hz"
-V = "230 V"
-
-[arguments]
-a = { unit = "ohm" }
-b = { unit = "ohm" }
-fr = { unit = "Hz" }
-
-[definitions]
-omega = "2*pi*f"
-Z = { expr = "R + 1i*omega*L + 1/(1i*omega*C)", unit = "ohm" }
-Zk = { expr = "Z", unit = "kohm" }
-I = { expr = "V/Z", unit = "A" }
-I_mag = { expr = "abs(I)", unit = "mA" }
-phi = { expr = "arg(Z)", unit = "deg" }
-"par(a, b)" = "a*b/(a + b)"
-"Zf(fr)" = "R + 1i*2*pi*fr*L"
-Zp = "par(Z, 1i*omega*L)"
-Zr = "par(R, R)"
-P = "polar(V, 30 deg)"
-S = { expr = "V*conj(I)", unit = "W" }
-Y = "[[1/R + 1/(1i*omega*L), -1/R], [-1/R, 1/R + 1i*omega*C]]"
-
-[[tables]]
-name = "sweep"
-range = "fr := 10 Hz, 20 Hz .. 100 Hz"
-columns = { "Zf(fr)" = "ohm", "abs(Zf(fr))" = "ohm", "arg(Zf(fr))" = "deg" }
-"""
 
 
 def _ac_reference():

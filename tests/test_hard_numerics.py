@@ -7,6 +7,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
+from helpers.sheets import HARD_SHEET
 
 import workbook
 from workbook.numerics import NumericsError
@@ -216,21 +217,6 @@ def test_an_end_point_singularity_estimate_covers_the_rounding_of_its_nodes(tmp_
     exact = 2 * mpmath.sqrt(_MP("0.3")) + 2 * mpmath.sqrt(_MP("0.7"))
     right(tmp_path, "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)", exact, rel=1e-7)
 
-
-HARD_SHEET = """
-[sheet]
-title = "hard cases"
-[definitions]
-peak = "maximum(exp(-((x - 0.3)/1e-4)^2), x, 0, 1)"
-wave = "maximum(sin(100*x)*exp(-x), x, 0, 10)"
-narrow = "integral(exp(-((x - 3.7)/1e-2)^2), x, 0, 10)"
-step = "integral(tanh(1e3*x), x, -1, 2)"
-lorentz = "integral(1/(1 + ((x - 0.4)/1e-3)^2), x, 0, 1)"
-cusp = "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)"
-triple = "root(x^3 - 3*x^2 + 3*x - 1, x, 0, 1.7)"
-sqrt2 = "root(x^2 - 2, x, 0, 2)"
-where = "argmax(sin(100*x)*exp(-x), x, 0, 10)"
-"""
 
 EXACT = {
     "peak": mpmath.mpf(1),

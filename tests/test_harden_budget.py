@@ -20,9 +20,9 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers.hostile import guarded, program
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_hostile import guarded, program
 
 import workbook
 from workbook import limits, limits_time

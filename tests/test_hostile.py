@@ -15,7 +15,7 @@ import os
 import time
 
 import pytest
-from guard_server import SERVER_INSTANCE
+from helpers.hostile import WALL_SECONDS, guarded, program
 
 from workbook import limits as file_limits
 from workbook.compute import excelform
@@ -24,30 +24,6 @@ from workbook.language import expr, ranges, template, typecheck
 from workbook.numerics import derivative
 from workbook.sweep.driver import MAX_SWEEP_POINTS
 from workbook.sweep.grid import MAX_CASES
-
-MEMORY = 1536 * 2**20  # bytes of address space for one run
-CPU_SECONDS = 60
-WALL_SECONDS = 120  # generous: CI machines are shared; a refused case takes about 1 s of CPU
-
-
-def guarded(tmp_path, text: str | bytes, *args: str):
-    """Run the command line on ``text`` (or ``args``) in a fresh guarded process."""
-    path = tmp_path / "hostile.toml"
-    if isinstance(text, bytes):
-        path.write_bytes(text)
-    else:
-        path.write_text(text, encoding="utf-8")
-    start = time.monotonic()
-    out = SERVER_INSTANCE.run(
-        tmp_path,
-        list(args or ("run", path.name)),
-        memory=MEMORY,
-        cpu=CPU_SECONDS,
-        wall=WALL_SECONDS,
-    )
-    out.elapsed = time.monotonic() - start
-    return out
-
 
 HEAD = '[inputs]\nR1 = "20 mm"\n\n[arguments]\nx = { unit = "" }\n\n[definitions]\n'
 TABLE = '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { s = "" }\n'
@@ -284,17 +260,6 @@ def test_solver_loop_asked_for_billions_of_steps(tmp_path):
 
 
 # -- programs and run-time arrays at their bounds ------------------------------------------
-
-
-def program(body: str, value: str) -> str:
-    """A sheet with a one-argument program ``p(n)`` and the definition ``s = value``."""
-    return (
-        '[arguments]\nn = { unit = "" }\n\n[definitions]\n"p(n)" = { program = """\n'
-        + body.strip("\n")
-        + '\n""" }\ns = '
-        + json.dumps(value)
-        + "\n"
-    )
 
 
 NEST_IN_ITSELF = program("T := [1, 2]\nfor k in 1 .. n\n    T := [T, 1]\nT", "p(8000)")

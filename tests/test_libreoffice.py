@@ -5,6 +5,7 @@ import shutil
 
 import openpyxl
 import pytest
+from helpers.recalculated import assert_same
 from recalc import cell_values, formula_values, recalculate, soffice
 
 if soffice() is None and os.environ.get("CI"):
@@ -13,30 +14,6 @@ pytestmark = [
     pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed"),
     pytest.mark.slow,  # each test starts LibreOffice (10 s or more)
 ]
-
-
-#: Excel's error values. LibreOffice saves some errors under another code (SQRT(-1) is #NUM!
-#: in Excel, #VALUE! in LibreOffice): an error must stay an error, never become a number.
-ERRORS = frozenset({"#NULL!", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#N/A"})
-
-
-def assert_same(original, recalculated, rel=1e-9):
-    cached = formula_values(original)
-    new = cell_values(recalculated)
-    assert cached, "the workbook has no formulas"
-    bad = []
-    for key, (formula, value) in cached.items():
-        got = new.get(key)
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            if not isinstance(got, (int, float)) or abs(got - value) > rel * max(1.0, abs(value)):
-                bad.append((key, formula[:80], value, got))
-        elif value in ERRORS:
-            if got not in ERRORS:
-                bad.append((key, formula[:80], value, got))
-        elif value != got:
-            bad.append((key, formula[:80], value, got))
-    assert not bad, f"{len(bad)} of {len(cached)} formula cells differ, e.g. {bad[:5]}"
-    return len(cached)
 
 
 def test_concave_cam_recalculates_to_engine_values(tmp_path, concave):

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import openpyxl
 import pytest
-from test_cell_units import RATIOS
+from helpers.sheets import FROZEN, RATIOS
 
 from workbook.compute import cellunit, livecheck, xleval
 
@@ -171,7 +171,7 @@ def test_equal_peaks_are_chosen_alike_whatever_the_rounding(tmp_path, sheet_from
     """Another program's sin rounds the samples of the later peaks up by an ulp or so: the
     live formulas still take the first peak, as the engine does (a MATCH of the exact MAX
     would jump to the later one)."""
-    from test_cell_units import formulas_recalculated
+    from helpers.recalculated import formulas_recalculated
 
     sheet = sheet_from(CRANK)
     out = sheet.write_xlsx(tmp_path / "crank.xlsx")
@@ -202,24 +202,6 @@ def test_equal_peaks_are_chosen_alike_whatever_the_rounding(tmp_path, sheet_from
     ).T
     match = xleval.compile_formula("=MATCH(MAX(S),S,0)-1")(lambda key: values)
     assert match != k
-
-
-FROZEN = """
-[inputs]
-a = "2 m"
-n = "4"
-
-[definitions]
-y = "2*S + a"
-z = "y/3"
-w = "a*3"
-total = "sum(i*a, i, 1, n)"
-
-[[solve]]
-unknowns = { S = "1 m" }
-equations = ["S^2 == 20*a^2 + a*S"]
-conditions = ["S > 0"]
-"""
 
 
 def test_frozen_values_and_the_live_cells_that_read_them_are_marked(tmp_path, sheet_from):

@@ -9,9 +9,8 @@ from pathlib import Path
 
 import openpyxl
 import pytest
+from helpers.sheets import FROZEN, RATIOS
 from recalc import cell_values, formula_values, recalculate, soffice
-from test_cell_units import RATIOS
-from test_live_everywhere import FROZEN
 
 import workbook
 

@@ -4,16 +4,14 @@ Every template and every worksheet under tests/data, and worksheets that hypothe
 of the numerical built-ins (integrals of integrals, roots of integrals, integrals of roots,
 sums and extrema of them, functions of vectors). Slow: each starts LibreOffice."""
 
-import math
 import os
-import re
 from pathlib import Path
 
 import pytest
+from helpers.recalculated import differences
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from recalc import cell_values, formula_values, recalculate, soffice
-from test_libreoffice import ERRORS
+from recalc import recalculate, soffice
 
 import workbook
 
@@ -26,48 +24,6 @@ pytestmark = [
 
 DATA = Path(__file__).parent / "data"
 RELATIVE = 1e-9
-
-
-def differences(original: Path, recalculated: Path) -> list:
-    """Formula cells whose LibreOffice value differs from the engine's (cached) beyond
-    RELATIVE of the largest of: the two values, the largest value in its column, and the
-    values of the cells of its sheet it reads (a value near zero is then a difference of
-    near terms, |computed - printed| on the Checks sheet: its rounding is not an error)."""
-    cached = formula_values(original)
-    written = cell_values(original)
-    new = cell_values(recalculated)
-
-    def number(v) -> float:
-        return abs(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else 0.0
-
-    column: dict[tuple[str, str], float] = {}
-    for (sheet, cell), (_, value) in cached.items():
-        key = (sheet, cell.rstrip("0123456789"))
-        column[key] = max(column.get(key, 0.0), number(value))
-    bad = []
-    for key, (formula, value) in cached.items():
-        got = new.get(key)
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            if isinstance(value, float) and not math.isfinite(value):
-                continue  # an error cell in the engine too (#NUM!)
-            read = [
-                number(written.get((quoted or bare or key[0], f"{c}{r}")))
-                for quoted, bare, c, r in re.findall(
-                    r"(?:'([^']+)'!|(?<![\w$'])([A-Za-z_]\w*)!)?(?<![\w$])\$?([A-Z]{1,3})\$?(\d+)(?![\w(])",
-                    formula,
-                )
-            ]
-            scale = max(
-                [abs(value), number(got), column[(key[0], key[1].rstrip("0123456789"))]] + read
-            )
-            ok = isinstance(got, (int, float)) and abs(got - value) <= RELATIVE * scale
-            if not ok:
-                bad.append((key, formula[:100], value, got))
-        elif value in ERRORS and got in ERRORS:
-            continue  # an error stays an error (SQRT(-1): Excel's #NUM!, LibreOffice's #VALUE!)
-        elif value != got:
-            bad.append((key, formula[:100], value, got))
-    return bad
 
 
 SHEETS = [*workbook.list_templates(), *sorted(str(p) for p in DATA.glob("*.toml"))]

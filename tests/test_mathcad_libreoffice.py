@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from helpers.recalculated import assert_same
 from recalc import recalculate, soffice
-from test_libreoffice import assert_same
 
 from workbook.cli import main
 

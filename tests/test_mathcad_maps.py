@@ -9,6 +9,8 @@ import math
 import struct
 
 import pytest
+from helpers.mathcad import bare_worksheet as _worksheet
+from helpers.mathcad import region as _region
 
 from workbook.cli import main
 from workbook.language import units as un
@@ -56,13 +58,6 @@ def test_function_map_is_one_to_one_onto_names():
 ML = "http://schemas.mathsoft.com/math30"
 
 
-def _region(rid: int, body: str) -> str:
-    return (
-        f'<region region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}">'
-        f'<math><ml:define xmlns:ml="{ML}">{body}</ml:define></math></region>'
-    )
-
-
 def _eval(rid: int, body: str, result: str) -> str:
     return (
         f'<region region-id="{rid}" left="0" top="{rid * 20}" align-y="{rid * 20}">'
@@ -82,14 +77,6 @@ def _id(name, sub=None) -> str:
 
 def _apply(op, *args) -> str:
     return f"<ml:apply><ml:{op}/>{''.join(args)}</ml:apply>"
-
-
-def _worksheet(*regions: str) -> str:
-    return (
-        '<?xml version="1.0" encoding="UTF-8"?>\n<worksheet '
-        'xmlns="http://schemas.mathsoft.com/worksheet30" '
-        f'xmlns:ml="{ML}"><regions>{"".join(regions)}</regions></worksheet>'
-    )
 
 
 def test_redefinitions_read_the_definition_in_force(tmp_path, capsys):

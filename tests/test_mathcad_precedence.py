@@ -5,9 +5,14 @@ from __future__ import annotations
 
 import json
 
+from helpers.mathcad import bare_worksheet as _worksheet
+from helpers.mathcad import region as _region
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_mathcad_maps import _apply, _eval, _id, _real, _region, _worksheet
+from mathcad_xml import apply as _apply
+from mathcad_xml import evaluate as _eval
+from mathcad_xml import ident as _id
+from mathcad_xml import real as _real
 
 from workbook.cli import main
 from workbook.language import expr as ex

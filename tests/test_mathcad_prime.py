@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import io
-import json
 import re
 import zipfile
 from pathlib import Path
 
 import pytest
+from helpers.mathcad import check_json as _check
+from helpers.mathcad import prime_ident as _id
 from mathcad_xml import prime_package as _package
 from mathcad_xml import prime_region as _region
 from mathcad_xml import prime_result as _result
@@ -22,12 +23,6 @@ SPAN = (
     '<Span xmlns="http://schemas.microsoft.com/winfx/2006/xaml/presentation" '
     'xmlns:pw="clr-namespace:Ptc.Wpf;assembly=Ptc.Core">{}<pw:Subscript>{}</pw:Subscript></Span>'
 )
-
-
-def _check(toml: Path, capsys) -> dict:
-    capsys.readouterr()
-    main(["check", str(toml), "--json"])
-    return json.loads(capsys.readouterr().out)
 
 
 def _unit(name: str) -> str:
@@ -198,10 +193,6 @@ def test_every_prime_worksheet_imports_and_none_is_wrong(name, tmp_path, capsys)
     assert not re.search(r"\\u0000|\x00", toml.read_text(encoding="utf-8"))
     result = _check(toml, capsys)
     assert result["reproduced"] + result["not_computable"] == result["printed"], result["failures"]
-
-
-def _id(name: str, label: str = "VARIABLE") -> str:
-    return f'<ml:id labels="{label}">{name}</ml:id>'
 
 
 def _eval(rid: int, body: str) -> str:

@@ -7,9 +7,12 @@ from __future__ import annotations
 import zipfile
 from pathlib import Path
 
+from helpers.mathcad import check_json as _check
+from helpers.mathcad import prime_ident as _id
 from mathcad_xml import PRIME_RESULTS as RESULTS
 from mathcad_xml import PRIME_WS as WS
-from test_mathcad_prime import _check, _id, _region, _result
+from mathcad_xml import prime_region as _region
+from mathcad_xml import prime_result as _result
 
 from workbook.cli import main
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 
-from mathcad_xml import ML  # noqa: F401 - for the tests that import it from here
+from mathcad_xml import ML
 from mathcad_xml import apply as _apply
 from mathcad_xml import call as _call
 from mathcad_xml import define as _define
