@@ -49,6 +49,16 @@ columns = { y = "mm" }
 )
 
 
+@pytest.fixture(scope="module")
+def sheet(request, tmp_path_factory):
+    """The test module's worksheet: its ``SHEET`` text, written to a folder of its own and
+    loaded once per module (a module with another sheet defines its own ``sheet``)."""
+    import workbook
+
+    folder = tmp_path_factory.mktemp(request.module.__name__)
+    return workbook.load(write_template(folder, request.module.SHEET))
+
+
 @pytest.fixture
 def sheet_from(tmp_path):
     """``sheet_from(text)``: a Sheet from template text (workbook.loads); files the text

@@ -53,11 +53,6 @@ columns = { "w(psi)" = "mm" }
 """
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("angles"), SHEET))
-
-
 def test_pi_in_range_bounds_is_radians_as_in_a_call(sheet):
     """phi := 0, pi/6 .. pi is 0, 30 .. 180 degrees, as y(pi/2) reads pi/2 as 90 degrees."""
     radians = sheet.table("radians")

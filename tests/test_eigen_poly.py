@@ -41,11 +41,6 @@ mixed = "polyrootparts([-1, 0, 0, 1])"
 """
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("eig"), SHEET))
-
-
 def _mp_eig(rows):
     with mp.workdps(50):
         values, vectors = mpmath.eig(mpmath.matrix(rows))

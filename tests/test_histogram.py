@@ -39,11 +39,6 @@ def _counts(edges, values):
     return counts
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("hist"), SHEET))
-
-
 def test_equal_intervals_between_the_smallest_and_largest(sheet):
     got = np.asarray(sheet.evaluate("H").magnitude, dtype=float)
     lo, hi = float(DATA.min()), float(DATA.max())

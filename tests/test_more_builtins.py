@@ -33,11 +33,6 @@ Lr = { expr = "round(L/step)*step", unit = "mm" }
 """
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("more"), SHEET))
-
-
 def _away(u: float, n: int = 0) -> float:
     """Half away from zero, of the exact value of the double u."""
     with mpmath.workdps(60):

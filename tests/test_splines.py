@@ -80,11 +80,6 @@ def _exact(ends: str, x: float) -> tuple[float, float]:
     return float(a + b * u + c * u**2 + d * u**3), float(2 * c + 6 * d * u)
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("spl"), SHEET))
-
-
 @pytest.mark.parametrize(
     "ends, vector, function", [("linear", "N", "n"), ("parabolic", "P", "p"), ("cubic", "C", "c")]
 )

@@ -36,11 +36,6 @@ columns = { "tag(phi)" = "" }
 """
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("txt"), SHEET))
-
-
 def test_texts_joined_and_numbers_written(sheet):
     assert sheet.evaluate("label") == "n = 3 bolts"
     assert sheet.evaluate("quoted") == "it's 5 < 6 & 7, x"
