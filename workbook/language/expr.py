@@ -530,6 +530,11 @@ class _Children(Visitor):
 _CHILDREN = _Children()
 
 
+def children(node: Node) -> tuple[Node, ...]:
+    """The nodes directly below ``node`` (none for a name or a number)."""
+    return _CHILDREN.visit(node)
+
+
 def walk(node: Node):
     """Yield every node of the tree, parents first."""
     yield node
