@@ -538,7 +538,7 @@ def children(node: Node) -> tuple[Node, ...]:
 def walk(node: Node):
     """Yield every node of the tree, parents first."""
     yield node
-    for child in _CHILDREN.visit(node):
+    for child in children(node):
         yield from walk(child)
 
 
