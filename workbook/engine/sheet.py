@@ -27,10 +27,10 @@ from ..language import typecheck as tc
 from ..language import typed as ty
 from ..language import units as un
 from ..language.fields import nearest
+from ..language.parts import resolve_parts, select_parts
 from ..language.ranges import RangeSpec, log_range_values, range_values
-from ..language.shown import column_node
 from ..language.spec import ColumnSpec, SheetSpec
-from ..language.template import check_input_value, resolve_parts, select_parts
+from ..language.template import check_input_value, column_node
 from ..language.typed import TConst
 from ..language.typedsheet import TypedSheet, printed_rows
 from ..language.unitrules import is_scaled_angle

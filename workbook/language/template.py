@@ -23,35 +23,44 @@ from ..functions.registry import REGISTRY
 from . import expr as ex
 from . import units as un
 from .fields import Fields, find_line, nearest, value_line
-from .shown import chart_spec, name_line, relation_spec, table_spec
+from .parts import assign_parts
+from .ranges import parse_range
 from .spec import (
     ALL_PARTS,
     ARGUMENT_KEYS,
+    AXIS_KEYS,
+    CHART_KEYS,
+    COLUMN_KEYS,
     DEFINITION_KEYS,
     FINDING_KEYS,
     INPUT_KEYS,
+    MAX_VARY,
     MISPRINT_KEYS,
     PART_KEYS,
     PRINTED_KEYS,
+    RELATION_KEYS,
     SECTIONS,
+    SERIES_KEYS,
     SHEET_KEYS,
     SWEEP_KEYS,
+    TABLE_KEYS,
     ArgumentSpec,
     Branch,
+    ChartSpec,
+    ColumnSpec,
     Definition,
     InputSpec,
     Limits,
     Misprint,
     PartSpec,
     PrintedSpec,
+    RelationSpec,
+    SeriesSpec,
     SheetSpec,
     TableSpec,
 )
 
 MAX_TEMPLATE_BYTES = 2_000_000  # a template file larger than this is refused
-
-
-_PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
 
 
 _SIGNATURE = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
@@ -219,10 +228,10 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
     solves = read_solves(_list(data, "solve"), text)
     _claim_solves(solves, arguments, definitions, claim)
 
-    tables = [table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
-    charts = [chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
+    tables = [_table_spec(i, t, text) for i, t in enumerate(_list(data, "tables"))]
+    charts = [_chart_spec(i, c, text) for i, c in enumerate(_list(data, "charts"))]
     printed = [_printed_spec(p, path, text) for p in _list(data, "printed")]
-    relations = [relation_spec(r, text) for r in _list(data, "relations")]
+    relations = [_relation_spec(r, text) for r in _list(data, "relations")]
     headers = _header_lines(text, "checks")
     checks = [
         read_check(raw, headers[i] if i < len(headers) else None)
@@ -244,7 +253,11 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
             raise TemplateError(f"two tables are named '{t.name}'", line=t.line)
         names_seen.add(t.name)
     parts = _parts(_table(data, "parts"), text)
-    _assign_parts(data, parts, text, tables, charts, printed, relations)
+    arrays = {
+        k: _list(data, k)
+        for k in ("tables", "charts", "printed", "relations", "findings", "checks")
+    }
+    assign_parts(arrays, parts, text, tables, charts, printed, relations)
 
     return SheetSpec(
         name=str(sheet.get("name", name)),
@@ -457,7 +470,7 @@ def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
     out = {}
     for k, raw in enumerate(_list(data, "ode")):
         name = raw.get("name") if isinstance(raw, dict) else None
-        line = name_line(text, name) if isinstance(name, str) else _section_line(text, "ode")
+        line = _name_line(text, name) if isinstance(name, str) else _section_line(text, "ode")
         try:
             spec = parse_spec(raw, where=f"[[ode]] {k + 1}", line=line)
         except WorkbookError as err:
@@ -476,7 +489,7 @@ def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
                 line=line,
             )
         for i, st in enumerate(spec.states):
-            claim(st.name, f"ode {spec.name}", name_line(text, st.name) or line)
+            claim(st.name, f"ode {spec.name}", _name_line(text, st.name) or line)
             definitions[st.name] = Definition(
                 st.name,
                 (spec.var,),
@@ -490,102 +503,6 @@ def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
             )
         out[spec.name] = spec
     return out
-
-
-def _parts(raw: dict, text: str) -> dict[str, PartSpec]:
-    parts = {}
-    for key, value in raw.items():
-        line = find_line(text, key, "parts")
-        if not _PART_NAME.match(key) or key == ALL_PARTS:
-            raise TemplateError(
-                f"part name {key!r}: lowercase letters, digits and '-' (and not 'all')", line=line
-            )
-        if isinstance(value, str):
-            value = {"title": value}
-        if not isinstance(value, dict):
-            raise TemplateError(
-                'a part is declared as { title = "...", note = "..." }', line=line, definition=key
-            )
-        try:
-            f = Fields(value, PART_KEYS, f"part {key}")
-            parts[key] = PartSpec(key, f.text("title", key), f.text("note"), line)
-        except WorkbookError as err:
-            raise err.located(line=line, definition=key) from None
-    return parts
-
-
-def _assign_parts(data: dict, parts: dict[str, PartSpec], text: str, *specs: list) -> None:
-    """Set ``part`` on every table, chart, printed file and relation that names one. A section
-    may name only a declared part, and a chart that draws a block table of a part must be in
-    that part (else it would draw a table that was not written)."""
-    sections = ("tables", "charts", "printed", "relations")
-    for section, items in zip(sections, specs):
-        for item, raw in zip(items, _list(data, section)):
-            item.part = _part_of(raw, parts, section, text, getattr(item, "line", None))
-    for raw in _list(data, "findings"):
-        _part_of(raw, parts, "findings", text, None)
-    for raw in _list(data, "checks"):
-        _part_of(raw, parts, "checks", text, None)
-    tables, charts = specs[0], specs[1]
-    table_part = {t.name: t.part for t in tables}
-    for c in charts:
-        for s in c.series:
-            if s.table in table_part and table_part[s.table] not in (None, c.part):
-                raise TemplateError(
-                    f"chart {c.name} draws table {s.table} of part {table_part[s.table]!r}: "
-                    f'give the chart part = "{table_part[s.table]}" too',
-                    line=c.line,
-                    definition=f"chart {c.name}",
-                )
-
-
-def _part_of(raw: dict, parts: dict[str, PartSpec], section: str, text: str, line) -> str | None:
-    part = raw.get("part")
-    if part is None:
-        return None
-    if not isinstance(part, str) or part not in parts:
-        known = ", ".join(parts) or "none declared"
-        raise TemplateError(
-            f"[[{section}]] part = {part!r} is not declared in [parts] (parts: {known})",
-            line=line or value_line(text, f"part = {part!r}".replace("'", '"')),
-        )
-    return part
-
-
-def select_parts(spec: SheetSpec, chosen: frozenset[str]) -> SheetSpec:
-    """The spec with only the sections of no part or of a chosen part."""
-    if set(spec.parts) <= chosen:
-        return spec
-
-    def keep(part) -> bool:
-        return part is None or part in chosen
-
-    return replace(
-        spec,
-        tables=[t for t in spec.tables if keep(t.part)],
-        charts=[c for c in spec.charts if keep(c.part)],
-        printed=[p for p in spec.printed if keep(p.part)],
-        relations=[r for r in spec.relations if keep(r.part)],
-        findings=[f for f in spec.findings if keep(f.get("part"))],
-        checks=[c for c in spec.checks if keep(c.part)],
-    )
-
-
-def resolve_parts(spec: SheetSpec, parts) -> frozenset[str]:
-    """``None`` (the default: no optional part), ``"all"``, a part name, or several names."""
-    if parts is None:
-        return frozenset()
-    names = [parts] if isinstance(parts, str) else list(parts)
-    if ALL_PARTS in names:
-        return frozenset(spec.parts)
-    unknown = [n for n in names if n not in spec.parts]
-    if unknown:
-        known = ", ".join(spec.parts) or "it has none"
-        raise InputError(
-            f"{spec.name} has no part {unknown[0]!r} (parts: {known}; or 'all')",
-            file=str(spec.path),
-        )
-    return frozenset(names)
 
 
 def _section_line(text: str, key: str) -> int | None:
@@ -781,3 +698,259 @@ def _printed_fields(raw: dict, path: Path, text: str) -> PrintedSpec:
         f.text("note"),
         folder=path.parent,
     )
+
+
+_SHEET_NAME_BAD = re.compile(r"[\[\]:*?/\\']")
+
+
+def sheet_name(name: str, what: str) -> str:
+    """A worksheet name Excel accepts: 1 to 31 characters, none of ``[]:*?/\\``, no leading or
+    trailing apostrophe (the writer quotes names in formulas)."""
+    if not name.strip() or len(name) > 31 or _SHEET_NAME_BAD.search(name):
+        raise TemplateError(
+            f"{what}: sheet name {name!r} must be 1 to 31 characters without [ ] : * ? / \\ '"
+        )
+    return name
+
+
+def _column(
+    text: str, unit_text, default_var: str | None, what: str, title: str = ""
+) -> ColumnSpec:
+    node = ex.parse(text, what=what)
+    return ColumnSpec(
+        text, node, un.unit(unit_text, what=what) if unit_text is not None else None, title or text
+    )
+
+
+def _columns(raw, default_var, what) -> list[ColumnSpec]:
+    cols = []
+    if isinstance(raw, dict):
+        for k, v in raw.items():
+            if not isinstance(v, str):
+                raise TemplateError(
+                    f'{what}: column {k!r}: its unit must be text like "mm", got {v!r}'
+                )
+        raw = [{"expr": k, "unit": v} for k, v in raw.items()]
+    if not isinstance(raw, list):
+        raise TemplateError(f'{what}: columns are {{ h1 = "mm", v1 = "m/s" }}')
+    for item in raw:
+        if isinstance(item, str):
+            item = {"expr": item}
+        if not isinstance(item, dict) or "expr" not in item:
+            raise TemplateError(f'{what}: a column is {{ expr = "h1", unit = "mm" }}')
+        f = Fields(item, COLUMN_KEYS, f"{what}, column {item['expr']!r}")
+        cols.append(
+            _column(f.text("expr"), f.text("unit", None), default_var, what, f.text("title"))
+        )
+    return cols
+
+
+def _table_spec(index: int, raw: dict, text: str) -> TableSpec:
+    name = str(raw.get("name", f"table{index + 1}"))
+    line = _name_line(text, name)
+    try:
+        f = Fields(raw, TABLE_KEYS, f"table {name}")
+        f.text("name"), f.text("part", None)
+        rng = parse_range(f.text("range"), what=f"table {name}", log=True) if "range" in f else None
+        cols = _columns(raw.get("columns", []), rng.var if rng else None, f"table {name}")
+        shown = [(c.title, None if c.unit is None else str(c.unit)) for c in cols]
+        twice = next((c for c, k in zip(cols, shown) if shown.count(k) > 1), None)
+        if twice is not None:
+            raise TemplateError(
+                f"table {name}: column {twice.title!r} is listed twice in the same unit"
+            )
+        block = f.text("block", None)
+        if not block and rng is None:
+            raise TemplateError(f"table {name} needs a range (or a block)")
+        vary = _vary(f, name)
+        if vary and (block or not cols):
+            raise TemplateError(f"table {name}: vary needs a range and columns (not a block)")
+        return TableSpec(
+            name,
+            f.text("title", name),
+            rng,
+            cols,
+            sheet_name(f.text("sheet", "Listing"), f"table {name}"),
+            block,
+            line,
+            vary=vary,
+        )
+    except WorkbookError as err:
+        raise err.located(line=line, definition=f"table {name}") from None
+
+
+def _vary(f: Fields, name: str) -> dict[str, tuple[str, ...]]:
+    """``vary = { c1 = ["1500 N/m", "3000 N/m"] }``: one input and its values (checked
+    against the input when the sheet loads)."""
+    raw = f.table("vary")
+    if len(raw) > 1:
+        raise TemplateError(
+            f"table {name}: vary takes one input (a family of curves), got {len(raw)}"
+        )
+    out = {}
+    for key, values in raw.items():
+        if (
+            not isinstance(values, list)
+            or not values
+            or not all(isinstance(v, (str, int, float)) and not isinstance(v, bool) for v in values)
+        ):
+            raise TemplateError(
+                f'table {name}: vary.{key} must be a list of values like ["1500 N/m", "3000 N/m"]'
+            )
+        if len(values) > MAX_VARY:
+            raise LimitError(
+                f"table {name}: vary.{key} has {len(values)} values (limit {MAX_VARY})"
+            )
+        out[str(key)] = tuple(str(v) for v in values)
+    return out
+
+
+def _name_line(text: str, name: str) -> int | None:
+    pattern = re.compile(r'^\s*name\s*=\s*["\']' + re.escape(name) + r'["\']')
+    for number, line in enumerate(text.splitlines(), start=1):
+        if pattern.match(line):
+            return number
+    return None
+
+
+def _chart_spec(index: int, raw: dict, text: str) -> ChartSpec:
+    name = str(raw.get("name", f"chart{index + 1}"))
+    line = _name_line(text, name)
+    what = f"chart {name}"
+    try:
+        f = Fields(raw, CHART_KEYS, what)
+        f.text("name"), f.text("part", None)
+        rng = parse_range(f.text("range"), what=what, log=True) if "range" in f else None
+        x_raw = raw.get("x", rng.var if rng else None)
+        x_title = ""
+        if isinstance(x_raw, dict):
+            fx = Fields(x_raw, AXIS_KEYS, f"{what}, x")
+            x_title = fx.text("title")
+            expr = fx.required_text("expr", 'x = { expr = "phi" }')
+            x = _column(expr, fx.text("unit", None), None, what, x_title)
+        elif x_raw is not None:
+            x = _column(Fields({"x": x_raw}, ("x",), what).text("x"), None, None, what)
+        else:
+            x = None
+        series = []
+        for raw_s in f.tables("series"):
+            label = raw_s.get("name", raw_s.get("y", len(series) + 1))
+            s = Fields(raw_s, SERIES_KEYS, f"{what}, series {label!r}")
+            y_text = s.required_text("y", 'y = "h1"')
+            common = dict(
+                name=s.text("name", y_text),
+                line=s.text("line", "solid"),
+                axis=s.text("axis", "primary"),
+                marker=s.flag("marker"),
+            )
+            if "table" in s:
+                series.append(
+                    SeriesSpec(
+                        y=_column("0", None, None, what),
+                        table=s.text("table"),
+                        x_column=s.text("x"),
+                        y_column=y_text,
+                        **common,
+                    )
+                )
+                continue
+            y = _column(y_text, s.text("unit", None), None, what, common["name"])
+            srange = parse_range(s.text("range"), what=what, log=True) if "range" in s else None
+            sx = _column(s.text("x"), s.text("x_unit", None), None, what) if "x" in s else None
+            series.append(SeriesSpec(y, x=sx, range=srange, **common))
+        if not series:
+            raise TemplateError(f"{what} has no series")
+        for s in series:
+            if s.line not in ("solid", "dash", "dot", "none"):
+                raise TemplateError(f"{what}: line must be solid, dash, dot or none")
+            if s.axis not in ("primary", "secondary"):
+                raise TemplateError(f"{what}: axis must be primary or secondary")
+        return ChartSpec(
+            name,
+            f.text("title", name),
+            rng,
+            x,
+            x_title or f.text("x_title"),
+            f.text("y_title"),
+            f.text("y2_title"),
+            series,
+            f.flag("log_x"),
+            f.flag("log_y"),
+            f.flag("equal_axes"),
+            line,
+        )
+    except WorkbookError as err:
+        raise err.located(line=line, definition=what) from None
+
+
+_RELATION = re.compile(
+    r"^\s*([A-Za-z]\w*)\s*=\s*(.*?)\s*\*?\s*d\(\s*([A-Za-z]\w*)\s*\)\s*/\s*d\(\s*([A-Za-z]\w*)\s*\)\s*$"
+)
+
+
+def _relation_spec(raw: dict, text: str) -> RelationSpec:
+    rel = raw.get("relation")
+    if not isinstance(rel, str):
+        raise TemplateError('[[relations]] needs relation = "v1 = omega * d(h1)/d(phi)"')
+    line = value_line(text, rel)
+    try:
+        f = Fields(raw, RELATION_KEYS, f"relation {rel!r}")
+        f.text("part", None), f.text("range"), f.text("unit")
+    except WorkbookError as err:
+        raise err.located(line=line) from None
+    m = _RELATION.match(rel)
+    if not m:
+        raise TemplateError(
+            f"cannot read relation {rel!r} (write 'v1 = omega * d(h1)/d(phi)')", line=line
+        )
+    factor = m.group(2).strip().rstrip("*").strip() or "1"
+    try:
+        rng = parse_range(raw["range"], what=rel) if "range" in raw else None
+        un.unit(f.text("unit", "rad"), what=rel)
+    except WorkbookError as err:
+        raise err.located(line=line) from None
+    return RelationSpec(
+        rel,
+        m.group(1),
+        ex.parse(factor, what=rel),
+        m.group(3),
+        m.group(4),
+        str(raw.get("unit", "rad")),
+        rng,
+        line,
+    )
+
+
+def column_node(spec: SheetSpec, col, var: str) -> ex.Node:
+    """A bare one-argument function name as a column means that function of the range variable."""
+    node = col.node
+    if isinstance(node, ex.Name):
+        d = spec.definitions.get(node.id)
+        if d is not None and d.is_function and len(d.params) == 1:
+            return ex.Call(node.id, (ex.Name(var),))
+    return node
+
+
+_PART_NAME = re.compile(r"^[a-z][a-z0-9-]{0,39}$")
+
+
+def _parts(raw: dict, text: str) -> dict[str, PartSpec]:
+    parts = {}
+    for key, value in raw.items():
+        line = find_line(text, key, "parts")
+        if not _PART_NAME.match(key) or key == ALL_PARTS:
+            raise TemplateError(
+                f"part name {key!r}: lowercase letters, digits and '-' (and not 'all')", line=line
+            )
+        if isinstance(value, str):
+            value = {"title": value}
+        if not isinstance(value, dict):
+            raise TemplateError(
+                'a part is declared as { title = "...", note = "..." }', line=line, definition=key
+            )
+        try:
+            f = Fields(value, PART_KEYS, f"part {key}")
+            parts[key] = PartSpec(key, f.text("title", key), f.text("note"), line)
+        except WorkbookError as err:
+            raise err.located(line=line, definition=key) from None
+    return parts

@@ -21,8 +21,8 @@ from . import units as un
 from .complextyping import no_order, real_in_program, real_index, real_only, value_kind
 from .fields import nearest
 from .measured import column_vector
-from .shown import column_node
 from .spec import Definition, SheetSpec
+from .template import column_node
 from .typearrays import ArrayTyping
 from .typed import (
     RUNTIME,

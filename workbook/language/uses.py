@@ -13,8 +13,8 @@ from ..errors import WorkbookError
 from . import expr as ex
 from . import typecheck as tc
 from .ranges import RangeSpec
-from .shown import column_node
 from .spec import SheetSpec
+from .template import column_node
 from .typedsheet import printed_rows
 
 

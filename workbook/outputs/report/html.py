@@ -21,7 +21,7 @@ from ...errors import WorkbookError
 from ...functions.complexes import readable
 from ...language import expr as ex
 from ...language import units as un
-from ...language.shown import column_node
+from ...language.template import column_node
 from ...language.visitor import UnhandledNode
 from ...version import __version__
 from . import mathml as mm
