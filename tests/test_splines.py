@@ -85,6 +85,7 @@ def sheet(tmp_path_factory):
     return workbook.load(write_template(tmp_path_factory.mktemp("spl"), SHEET))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "ends, vector, function", [("linear", "N", "n"), ("parabolic", "P", "p"), ("cubic", "C", "c")]
 )

@@ -103,6 +103,7 @@ def every_sum(tmp_path_factory):
     return _sheet(tmp, "".join(f'{n} = "{f}"\n' for n, f in ACCEPTED))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "i,op,a,b",
     [(i, *c) for i, c in enumerate(CASES)],
@@ -155,6 +156,7 @@ def _check_recalculation(tmp, cases):
         assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (name, formula, got, want)
 
 
+@pytest.mark.slow
 def test_the_workbook_recalculates_to_the_engine(tmp_path):
     """The `formulas` package (an independent Excel evaluator) recalculates sums of the
     workbook (one in twelve of the table's) to the engine's number."""
