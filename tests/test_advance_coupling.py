@@ -158,6 +158,7 @@ def test_trend_phi2_rises_with_phi20(sheet, w):
     assert all(b > a for a, b in zip(vals, vals[1:]))
 
 
+@pytest.mark.slow
 def test_trend_findings_hold(sheet):
     ws = cp.speeds(sheet)
     for key in cp.FAMILY_TABLES:
@@ -204,6 +205,7 @@ def test_linear_forms(sheet):
     assert abs(dev[0]) > 5 and abs(dev[1]) < 5 and abs(dev[2]) > 5
 
 
+@pytest.mark.slow
 def test_soft_spring_denominator_is_reported_not_divided(sheet):
     soft = sheet.with_inputs(c1="800 N/m")
     assert float(soft.evaluate("D_lin", omega1=110).magnitude) < 0
@@ -272,6 +274,7 @@ def test_stiffness_grows_with_c2(sheet):
     assert variant(sheet, 1e10).evaluate("method_used") == "Radau"
 
 
+@pytest.mark.slow
 def test_exact_solution_matches_tight_solve_ivp(sheet):
     from scipy.integrate import solve_ivp
 
@@ -315,6 +318,7 @@ def _rigid_reference(t_end, n_out=401):
     return np.vstack([sol.y[1], k * sol.y[1]])
 
 
+@pytest.mark.slow
 def test_rigid_limit_and_default_solver_at_c2_1e10(sheet):
     ref = _rigid_reference(0.2)
     cs = cp.case(variant(sheet, 1e10))
@@ -352,6 +356,7 @@ def test_default_solver_within_2x_of_fastest(sheet):
     assert t_def <= 2 * t_best, (best["method"], best["rtol"], t_best, t_def)
 
 
+@pytest.mark.slow
 def test_errors_fall_with_rtol_at_moderate_c2(sheet):
     p = variant(sheet, t_end=0.1)
     df = cp.study(p, (1e6,), (1e-3, 1e-6, 1e-9), max_time=5.0, label=None)
@@ -361,6 +366,7 @@ def test_errors_fall_with_rtol_at_moderate_c2(sheet):
 
 
 # -- extreme cases ------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_explicit_method_on_a_very_stiff_tooth_is_bounded(sheet):
     run, need = cp.stall_run(sheet, "RK45", c2=1e14, max_time=0.3, max_steps=10**7)
     assert not run.ok and run.stop_reason == "time budget"
@@ -370,6 +376,7 @@ def test_explicit_method_on_a_very_stiff_tooth_is_bounded(sheet):
     assert "step cap" in run.summary()
 
 
+@pytest.mark.slow
 def test_weights_on_the_stop_dynamics(sheet):
     p = variant(sheet, t_end=0.05, omega_dyn="50 rad/s")
     assert float(p.evaluate("F0", omega1=50).magnitude) <= 0  # on the stop
@@ -380,6 +387,7 @@ def test_weights_on_the_stop_dynamics(sheet):
     assert np.all(p.evaluate("phi2_r", t=cp.times(p)).magnitude == 0.0)
 
 
+@pytest.mark.slow
 def test_run_ode_progress_goes_to_stderr(sheet, capsys):
     s = variant(sheet, 1e8, 0.05)
     fun, t0, t1, y0 = ode.problem(s.typer.ode("motion"), s.evaluator.compile)
@@ -388,6 +396,7 @@ def test_run_ode_progress_goes_to_stderr(sheet, capsys):
     assert "[probe] t = " in err and "finished" in err
 
 
+@pytest.mark.slow
 def test_ctrl_c_leaves_no_partial_state(sheet, monkeypatch):
     p = variant(sheet, t_end=0.013)
     calls = {"n": 0}
@@ -408,6 +417,7 @@ def test_ctrl_c_leaves_no_partial_state(sheet, monkeypatch):
     assert not any(k[2][0] == "study" for k in blocks.kept() - before)
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_write_keeps_old_file(tmp_path, monkeypatch):
     sheet = workbook.load("advance-coupling")
     out = tmp_path / "ac.xlsx"
@@ -426,6 +436,7 @@ def test_ctrl_c_during_write_keeps_old_file(tmp_path, monkeypatch):
 
 
 # -- solver helpers -----------------------------------------------------------------------------
+@pytest.mark.slow
 def test_bench_quick_runs_every_method(sheet):
     df = cp.bench(sheet, quick=True)
     assert set(df["method"]) == set(oderun.SOLVERS)

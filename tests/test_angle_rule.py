@@ -113,6 +113,7 @@ def test_no_warning_without_degrees(tmp_path):
     assert not [f for f in sheet.check().findings if f.topic == "angles"]
 
 
+@pytest.mark.slow
 def test_run_prints_the_warnings_and_exits_0(tmp_path):
     write_template(tmp_path, SLIPS, "slips.toml")
     code = "import sys; from workbook.cli import main; sys.exit(main())"

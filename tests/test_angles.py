@@ -124,6 +124,7 @@ def _run(*args, cwd):
     )
 
 
+@pytest.mark.slow
 def test_workbook_run(tmp_path):
     (tmp_path / "angles.toml").write_text(SHEET, encoding="utf-8")
     done = _run("run", "angles.toml", "--out", "angles.xlsx", cwd=tmp_path)

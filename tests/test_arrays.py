@@ -226,6 +226,7 @@ def test_a_computed_index_out_of_range_is_an_error(tmp_path):
         s.evaluate("g", 0.5)
 
 
+@pytest.mark.slow
 def test_run_prints_matrices_and_texts(tmp_path, capsys):
     from pathlib import Path
 

@@ -57,6 +57,7 @@ def leftovers(folder: Path) -> list[str]:
     return sorted(p.name for p in folder.iterdir() if p.name.endswith(".partial"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "method", ["write_inputs", "write_range_table", "write_charts", "write_about"]
 )
@@ -79,6 +80,7 @@ def test_failure_while_writing_keeps_the_previous_workbook(previous, monkeypatch
     assert leftovers(previous) == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("failure", [KeyboardInterrupt, RuntimeError])
 def test_failure_while_saving_keeps_the_previous_workbook(previous, monkeypatch, failure):
     """The file itself: half of the laid-out cells written, then a failure."""
@@ -154,6 +156,7 @@ sys.exit(main(["run", "s.toml", "--out", "out.xlsx"]))
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("stage", "sig", "status"),
     [

@@ -146,6 +146,7 @@ def fresh_results(tmp_path_factory):
         return {case.path.stem: (case, cwd, before, out) for case, cwd, before, out in done}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
 def test_bad_input(results, path):
     _check(*results[path.stem])
@@ -182,6 +183,7 @@ def _check(case: Case, cwd: Path, before: str | None, out: subprocess.CompletedP
         assert written == ([case.setup[1]] if case.setup else []), written
 
 
+@pytest.mark.slow
 def test_debug_shows_the_traceback(tmp_path):
     case = read_case(CORPUS / "unit_sum.toml")
     out = run_case(case, tmp_path, "--debug")
@@ -189,6 +191,7 @@ def test_debug_shows_the_traceback(tmp_path):
     assert "Traceback" in out.stderr and "UnitError" in out.stderr
 
 
+@pytest.mark.slow
 def test_not_xlsx_is_overwritten_with_force(tmp_path):
     case = read_case(CORPUS / "out_not_xlsx.toml")
     (tmp_path / "out.xlsx").write_text("notes\n")
@@ -198,6 +201,7 @@ def test_not_xlsx_is_overwritten_with_force(tmp_path):
     assert (tmp_path / "out.xlsx").read_bytes()[:2] == b"PK"
 
 
+@pytest.mark.slow
 def test_failed_check_exits_1(tmp_path):
     (tmp_path / "t.csv").write_text("name,argument,value,unit\nR2,,41,mm\n")
     (tmp_path / "t.toml").write_text(

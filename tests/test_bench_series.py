@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import mpmath
 import numpy as np
+import pytest
 
 import workbook
 from workbook.numerics import bench
@@ -23,6 +24,7 @@ v = "sum([1, 2, 3])"
 """
 
 
+@pytest.mark.slow
 def test_bench_compares_sums_and_products_with_mpmath(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text(SHEET, encoding="utf-8")

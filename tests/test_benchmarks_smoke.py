@@ -72,6 +72,7 @@ def test_plain_numpy_matches_the_sheet():
     assert bench_evaluate.h1(np.array([5.0]))[0] == pytest.approx(0.202, abs=5e-4)
 
 
+@pytest.mark.slow
 def test_write_bench_tiny():
     _check(bench_write.run(n=30, reps=1), 2)
 
@@ -81,10 +82,12 @@ def test_coldstart_bench_tiny():
     _check(bench_coldstart.run(reps=1), 2)  # the ratio, and the Mathcad sheet alone
 
 
+@pytest.mark.slow
 def test_load_bench_tiny():
     _check(bench_load.run(reps=1), 1)
 
 
+@pytest.mark.slow
 def test_run_quick():
     out = subprocess.run(
         [sys.executable, str(BENCH / "run.py"), "--quick", "--only", "evaluate", "--only", "write"],
@@ -112,6 +115,7 @@ columns = { y = "mm" }
 """
 
 
+@pytest.mark.slow
 def test_table_beyond_excel_rows_is_refused_with_csv_offer(tmp_path):
     path = tmp_path / "big.toml"
     path.write_text(BIG, encoding="utf-8")

@@ -125,6 +125,7 @@ def builtin_lists(package: Path = PACKAGE) -> set[tuple[str, tuple[str, ...]]]:
     return found
 
 
+@pytest.mark.slow
 def test_no_module_lists_builtins_but_their_homes():
     assert builtin_lists() == KNOWN_ELSEWHERE
 

@@ -84,6 +84,7 @@ def test_sum_against_mpmath(tmp_path):
     assert sheet.evaluate("empty").magnitude == 0
 
 
+@pytest.mark.slow
 def test_sum_excel_formula_against_the_formulas_package(tmp_path):
     formulas = pytest.importorskip("formulas")
     sheet = _sheet(tmp_path)

@@ -81,6 +81,7 @@ def test_time_sections_against_reference_and_quad(valve):
     assert float(mag(valve.evaluate("TS0_s"), "mm^2*s")) == pytest.approx(ts0 / (6 * 3000))
 
 
+@pytest.mark.slow
 def test_reference_values_in_check_report(valve):
     report = valve.check()
     rows = [r for r in report.rows if r.source.startswith("Reference")]
@@ -99,6 +100,7 @@ def test_integrands_are_the_written_out_ones(valve):
     )
 
 
+@pytest.mark.slow
 def test_validity_limit_warning_and_formulas_1_2(valve):
     assert float(mag(valve.evaluate("h_lim"), "mm")) == pytest.approx(6.0)
     findings = valve.check().findings
@@ -371,6 +373,7 @@ def chart_xml(path):
         return {n: z.read(n).decode("utf-8") for n in z.namelist() if n.startswith("xl/charts/")}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_workbook_charts_show_unworn_and_worn(name, tmp_path):
     sheet = workbook.load(name)

@@ -72,6 +72,7 @@ def test_the_engine_and_the_cached_values_are_the_hand_worked_numbers(ratios):
     assert cells["mode"][1] == "Euler"
 
 
+@pytest.mark.slow
 def test_every_formula_cell_recalculates_to_the_engine(ratios):
     _, out, refusals = ratios
     assert refusals == []  # no formula had to be written as a number

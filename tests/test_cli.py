@@ -28,6 +28,7 @@ def test_list_names_first():
     assert any(line.startswith("concave-cam\t") for line in out.stdout.splitlines())
 
 
+@pytest.mark.slow
 def test_run_writes_default_path(tmp_path):
     out = run("run", "concave-cam", cwd=tmp_path)
     assert out.returncode == 0, out.stderr
@@ -40,6 +41,7 @@ def test_run_writes_default_path(tmp_path):
     assert {"Listing", "Charts", "Checks", "About"} <= set(wb.sheetnames)
 
 
+@pytest.mark.slow
 def test_run_with_set_and_out(tmp_path):
     target = tmp_path / "r3.xlsx"
     out = run("run", "concave-cam", "--set", "R3=40 mm", "--out", str(target))
@@ -52,6 +54,7 @@ def test_run_with_set_and_out(tmp_path):
     assert any('--set R3="40 mm"' in str(t) for t in texts)
 
 
+@pytest.mark.slow
 def test_check_exit_codes(tmp_path):
     ok = run("check", "concave-cam")
     assert ok.returncode == 0
@@ -61,6 +64,7 @@ def test_check_exit_codes(tmp_path):
     assert "NOT reproduced" in bad.stdout
 
 
+@pytest.mark.slow
 def test_bad_input_exit_2_without_traceback():
     out = run("run", "concave-cam", "--set", "R3=40 kg")
     assert out.returncode == 2
@@ -103,6 +107,7 @@ def test_export_profile_csv_for_cad(tmp_path):
     assert none.returncode == 2 and "has no export" in none.stderr
 
 
+@pytest.mark.slow
 def test_a_bug_in_a_block_is_exit_3_in_one_line(tmp_path, monkeypatch, capsys):
     """An exception that is not a WorkbookError (a bug, not a user mistake): one line, exit 3,
     the previous output untouched; --debug shows the traceback."""

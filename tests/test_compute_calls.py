@@ -88,6 +88,7 @@ def test_the_count_sees_typing_and_parsing(tmp_path):
     assert found["typer"] >= found["typing"]
 
 
+@pytest.mark.slow
 def test_computing_and_writing_a_small_sheet_types_and_parses_nothing(tmp_path):
     sheet = small(tmp_path)
     out = tmp_path / "out"
@@ -110,6 +111,7 @@ def test_the_sheets_of_other_inputs_and_parts_share_the_typed_trees(tmp_path):
     assert other.computed().table("curve").columns[1].values[0] == pytest.approx(9.0)
 
 
+@pytest.mark.slow
 def test_a_sheet_is_checked_and_computed_once_through_the_api(tmp_path, monkeypatch):
     from workbook import facade
     from workbook.compute import checks, computed

@@ -121,6 +121,7 @@ def rendered_without_evaluation(sheet, tmp_path) -> None:
     assert (tmp_path / f"{name}.xlsx").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_rendering_a_small_sheet_makes_no_call_into_typing_or_evaluation(tmp_path):
     from conftest import write_template
 

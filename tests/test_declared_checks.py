@@ -153,6 +153,7 @@ part = "extra"
     assert [f.what for f in workbook.load(path, parts="all").check().findings] == ["in a part"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("check", "message"),
     [

@@ -84,12 +84,14 @@ def test_a_limit_of_another_dimension_is_refused_at_load(tmp_path):
         workbook.load(write_template(tmp_path, text))
 
 
+@pytest.mark.slow
 def test_run_stops_at_a_negative_port_area_of_the_valve(tmp_path):
     code, out, err = _cli(tmp_path, "run", "cam-wear-valve", "--set", "d_stem=50 mm")
     assert code != 0 and "reproduced" not in out
     assert "A_port = -706.858 mm^2 breaks its declared limit (positive)" in err
 
 
+@pytest.mark.slow
 def test_the_valve_at_89_degrees_names_the_value_that_fails(tmp_path):
     code, _, err = _cli(tmp_path, "run", "cam-wear-valve", "--set", "alpha=89 deg")
     assert code == 1

@@ -43,6 +43,7 @@ def test_an_estimate_far_above_the_tolerance_is_a_warning_naming_the_definition(
     assert f"over {ESTIMATE_LIMIT:g} times the sheet's tolerance" in finding.note
 
 
+@pytest.mark.slow
 def test_the_findings_do_not_depend_on_what_was_written_before(tmp_path):
     # the writer's own evaluations (live forms) repeat the definitions' built-ins: they must
     # not add findings to the next check

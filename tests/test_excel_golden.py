@@ -163,6 +163,7 @@ def test_every_plain_builtin_is_printed_here():
     assert plain - called == set()
 
 
+@pytest.mark.slow
 def test_every_formula_cell_matches_the_formulas_package(golden):
     _, cells, recalculated, _ = golden
     assert len(cells) > 2 * len(CASES)

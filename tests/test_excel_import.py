@@ -207,6 +207,7 @@ def imported(tmp_path_factory):
     return out / "beam.toml", expected
 
 
+@pytest.mark.slow
 def test_import_reproduces_the_cached_values(imported, capsys):
     toml, _ = imported
     capsys.readouterr()
@@ -260,6 +261,7 @@ def test_listed_never_dropped(imported):
     assert 'value = "12.5"' in text  # never applied
 
 
+@pytest.mark.slow
 def test_existing_output_needs_force(imported, tmp_path):
     toml, _ = imported
     path, bas, _ = build(tmp_path)
@@ -268,6 +270,7 @@ def test_existing_output_needs_force(imported, tmp_path):
     assert main(["import", str(path), "--vba", str(bas), "--out", str(out), "--force"]) == 0
 
 
+@pytest.mark.slow
 def test_bad_workbooks_exit_2(tmp_path, capsys):
     assert main(["import", str(tmp_path / "missing.xlsm")]) == 2
     broken = tmp_path / "broken.xlsx"
@@ -316,6 +319,7 @@ End Function
 """
 
 
+@pytest.mark.slow
 def test_minimum_radius_loop_from_a_bas_module(tmp_path, capsys):
     """The VBA loop of r0-synthesis, as an exported module beside a workbook whose cell calls
     it: the imported sheet's r0 is the template's."""
@@ -354,6 +358,7 @@ def test_minimum_radius_loop_from_a_bas_module(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 
 
+@pytest.mark.slow
 def test_a_filled_down_column_is_one_definition_over_a_range(tmp_path, capsys):
     import workbook
 
@@ -392,6 +397,7 @@ def test_a_filled_down_column_is_one_definition_over_a_range(tmp_path, capsys):
     assert report["printed"] == report["reproduced"] == 31  # 10 + 10 + 10 running + 1
 
 
+@pytest.mark.slow
 def test_a_zip_bomb_is_refused_before_it_inflates(tmp_path, capsys):
     import zipfile
 

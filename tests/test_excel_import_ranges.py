@@ -223,6 +223,7 @@ def test_an_error_value_in_a_local_gives_no_value(imported):
         sheet.evaluate(failing)  # Excel shows #VALUE!: VBA stops at the error value's use
 
 
+@pytest.mark.slow
 def test_a_date_or_a_text_with_a_quote_is_listed_never_a_stand_in(tmp_path, capsys):
     import datetime
 

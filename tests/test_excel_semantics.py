@@ -128,6 +128,7 @@ def test_a_dde_name_is_listed_and_the_import_goes_on(tmp_path):
     assert "the defined name evil: a DDE or external link" in toml
 
 
+@pytest.mark.slow
 def test_average_of_a_row_with_empty_and_text_cells_is_checked(tmp_path, capsys):
     """The same rule, fast: Excel's cached values (written as Excel computes them: the mean
     of the numbers only) are reproduced by the imported sheet."""
@@ -163,6 +164,7 @@ def _check(toml: Path, capsys) -> tuple[int, dict]:
     return code, json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_a_cached_text_that_reads_as_a_formula_is_escaped(tmp_path, capsys):
     xlsxwriter = pytest.importorskip("xlsxwriter")
     from workbook.cli import main
@@ -188,6 +190,7 @@ def test_a_cached_text_that_reads_as_a_formula_is_escaped(tmp_path, capsys):
     assert "escaped, not compared" in report["failures"][0]["name"]
 
 
+@pytest.mark.slow
 def test_a_difference_of_nearly_equal_numbers_has_their_tolerance(tmp_path, capsys):
     xlsxwriter = pytest.importorskip("xlsxwriter")
     from workbook.cli import main
@@ -232,6 +235,7 @@ def test_vba_functions_of_thisworkbook_and_what_is_refused():
     assert "the error path does more than give an error value" in found["Ratio"].problem
 
 
+@pytest.mark.slow
 def test_paramarray_and_a_call_with_too_many_arguments(tmp_path, capsys):
     xlsxwriter = pytest.importorskip("xlsxwriter")
     from workbook.cli import main
@@ -262,6 +266,7 @@ def test_paramarray_and_a_call_with_too_many_arguments(tmp_path, capsys):
     assert code == 1  # B3 and B4 have no value, as Excel shows #VALUE!
 
 
+@pytest.mark.slow
 def test_a_sheet_whose_name_starts_with_a_digit(tmp_path):
     xlsxwriter = pytest.importorskip("xlsxwriter")
     from workbook.cli import main

@@ -59,6 +59,7 @@ def test_each_column_at_each_value_against_numpy(tmp_path):
     np.testing.assert_allclose(df["t [s]"], t, rtol=1e-15)
 
 
+@pytest.mark.slow
 def test_the_workbook_holds_the_family_as_numbers_with_a_comment_and_a_chart(tmp_path):
     out = tmp_path / "spring.xlsx"
     assert main(["run", str(spring(tmp_path)), "--out", str(out)]) == 0
@@ -72,6 +73,7 @@ def test_the_workbook_holds_the_family_as_numbers_with_a_comment_and_a_chart(tmp
     assert len(charts) == 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("vary", "message"),
     [

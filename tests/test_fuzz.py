@@ -387,12 +387,14 @@ def check_template(folder, slots, items) -> None:
     assert time.monotonic() - start < CASE_SECONDS, text
 
 
+@pytest.mark.slow
 @fuzz_settings(FAST_EXAMPLES)
 @given(text=quantity_texts())
 def test_quantity_text(text):
     check_quantity(text)
 
 
+@pytest.mark.slow
 @fuzz_settings(FAST_EXAMPLES)
 @given(case=templates())
 def test_template_values(fuzz_folder, case):
@@ -462,6 +464,7 @@ def labels():
     return st.one_of(pieces, st.text(min_size=1, max_size=30))
 
 
+@pytest.mark.slow
 @fuzz_settings(FAST_EXAMPLES // 2)  # a workbook each: about 0.1 s
 @given(texts=st.lists(labels(), min_size=4, max_size=4))
 def test_chart_labels_are_never_references(tmp_path_factory, texts):

@@ -90,6 +90,7 @@ def test_formula_9_has_a_sign_error(relations, child, at):
     assert 0.27 < r.rel < 0.29
 
 
+@pytest.mark.slow
 def test_check_lists_every_relation(concave):
     report = concave.check()
     assert report.ok
@@ -299,6 +300,7 @@ def test_domain_error_names_function_and_interval(concave):
     assert "sqrt of a negative number" in h1.failed[min(h1.failed)]
 
 
+@pytest.mark.slow
 def test_flank_domain_limit(concave):
     f = [x for x in concave.check().findings if x.topic == "domains" and x.what.startswith("h1")]
     # k sin(phi) = 1 at asin(1/k), in the sheet's degrees
@@ -384,6 +386,7 @@ def test_derivative_references_against_mpmath(concave):
         assert jj == pytest.approx(float(OMEGA**2 * mpmath.diff(_mp_lift, x, 2)), rel=1e-13)
 
 
+@pytest.mark.slow
 def test_bench_command(capsys):
     from workbook.cli import main
 
@@ -393,6 +396,7 @@ def test_bench_command(capsys):
 
 
 # -- 7. where it shows -----------------------------------------------------------------------------
+@pytest.mark.slow
 def test_check_command(capsys):
     from workbook.cli import main
 

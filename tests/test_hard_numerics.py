@@ -232,6 +232,7 @@ EXACT = {
 }  # fmt: skip
 
 
+@pytest.mark.slow
 def test_bench_verdicts_agree_with_mpmath(tmp_path):
     """`workbook bench` on the hard cases: its reference is other methods (Brent, QUADPACK,
     dense sampling), never the engine's routine; every "ok" is right against mpmath (50
@@ -423,6 +424,7 @@ x = { unit = "" }
 """
 
 
+@pytest.mark.slow
 def test_integrals_nearly_singular_beside_the_interval_have_honest_estimates():
     """220 integrands whose singular point is 1e-8 .. 0.1 outside [0, B]: every estimate
     covers the error against the closed form (mpmath, 30 digits), or the error is within the

@@ -169,6 +169,7 @@ half = "L/2"
 """
 
 
+@pytest.mark.slow
 def test_scalars_are_written_printed_and_simplified(tmp_path):
     write(tmp_path / "s.toml", SCALARS)
     out = cli(tmp_path, "run", "s.toml", "--out", "s.xlsx")
@@ -286,6 +287,7 @@ def _rezip(src: Path, dst: Path, replace: dict[str, bytes]) -> Path:
     return dst
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["bomb", "xml", "nan", "shared", "laughs", "date", "comma"])
 def test_inputs_workbook_is_checked(tmp_path, kind, monkeypatch):
     import zipfile
@@ -382,6 +384,7 @@ series = [{ y = "y", unit = "mm", name = "=A1" }]
 """
 
 
+@pytest.mark.slow
 def test_labels_are_text_never_formulas_or_links(tmp_path):
     write(tmp_path / "t.toml", INJECT)
     out = cli(tmp_path, "run", "t.toml", "--out", "t.xlsx", "--csv", "t")
@@ -401,6 +404,7 @@ def test_labels_are_text_never_formulas_or_links(tmp_path):
     assert lines[0].startswith("phi [deg],'=1+1 [mm],http://example.com [mm]")
 
 
+@pytest.mark.slow
 def test_csv_and_export_overwrite_only_with_force(tmp_path):
     write(tmp_path / "t.toml", INJECT)
     (tmp_path / "t.t.csv").write_text("keep\n")
@@ -451,6 +455,7 @@ def test_a_scheduler_address_is_checked(address):
         check_scheduler(address, 1.0)
 
 
+@pytest.mark.slow
 def test_a_server_that_is_not_a_scheduler_is_refused_within_the_timeout():
     import socket
     import threading
@@ -517,6 +522,7 @@ def test_a_derivative_across_a_condition_on_a_choice_is_refused(tmp_path):
     assert out.returncode == 2 and "choice 'mode'" in out.stderr
 
 
+@pytest.mark.slow
 def test_a_scalar_piecewise_with_no_true_piece_is_an_input_error(tmp_path):
     path = write(tmp_path / "p.toml", NO_PIECE)
     with pytest.raises(InputError, match="no piece applies") as err:
@@ -651,6 +657,7 @@ def test_text_cells_and_chart_labels_of_a_run_stay_text(tmp_path):
     assert sorted(c.value for c in texts) == sorted(CHART_LABELS)
 
 
+@pytest.mark.slow
 def test_sweep_choice_values_and_chart_labels_stay_text(tmp_path):
     write(tmp_path / "t.toml", INJECT_LABELS)
     vary = ["--vary", "mode=-2+3,@SUM(A1)", "--vary", "R=1mm,2mm", "--output", "q=y(0.5)"]
@@ -720,6 +727,7 @@ def test_an_array_stays_what_it_was_when_a_local_changes_later(tmp_path):
 # -- exit 3 cases that are input errors ----------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["cspline", "linterp"])
 def test_data_too_large_for_doubles_is_a_numerical_error(tmp_path, kind):
     # the spline's slopes overflowed: scipy's ValueError was an internal error (exit 3)
@@ -734,6 +742,7 @@ def test_data_too_large_for_doubles_is_a_numerical_error(tmp_path, kind):
     assert "d.toml:7, in 'a': numerical error" in out.stderr and "overflows" in out.stderr
 
 
+@pytest.mark.slow
 def test_a_tls_scheduler_without_tls_settings_is_an_input_error(tmp_path, monkeypatch):
     pytest.importorskip("distributed")
     for key in list(os.environ):
@@ -801,6 +810,7 @@ columns = { y = "" }
 """
 
 
+@pytest.mark.slow
 def test_a_family_table_is_checked_before_its_curves_are_computed(tmp_path):
     # 50 curves x 2e6 rows built 1.66 GB before the row check refused the table
     from workbook.engine.sheet import MAX_FAMILY_CELLS
@@ -818,6 +828,7 @@ def test_a_family_table_is_checked_before_its_curves_are_computed(tmp_path):
     assert table.shape == (100, 3) and table.iloc[99, 2] == 2 * 99
 
 
+@pytest.mark.slow
 def test_a_sweep_is_bounded_before_any_case_runs(tmp_path):
     # 10^6 cases took 148 s; a maximum over 1.9e6 points x 1e4 cases ran past 60 s
     from workbook.sweep.driver import MAX_SWEEP_POINTS
@@ -862,6 +873,7 @@ a = "linterp(x, y, u)"
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["file", "folder"])
 def test_a_link_out_of_the_worksheet_folder_is_refused_unread(tmp_path, how):
     # passwd_link.csv -> /etc/passwd was followed and its first line printed in the error
@@ -974,6 +986,7 @@ def test_a_solve_using_a_definition_of_its_unknown_names_the_circle(tmp_path):
     assert float(sheet.evaluate("z").to("m").magnitude) == pytest.approx(3.0, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_a_sweep_of_a_text_output_is_refused_at_load(tmp_path):
     # every case failed with a raw ValueError and the sweep exited 0
     write(tmp_path / "t.toml", INJECT_LABELS)
@@ -1085,6 +1098,7 @@ def _swollen(src: Path, dst: Path, member: str, grow) -> Path:
     return dst
 
 
+@pytest.mark.slow
 def test_inputs_with_swollen_styles_or_shared_strings_are_refused_unparsed(tmp_path):
     # a 60 MB styles.xml took 57 s and 1.55 GB in openpyxl; 3.5 million shared strings 59 s
     from workbook.limits import MAX_SHARED_STRINGS, MAX_STYLES_BYTES
@@ -1115,6 +1129,7 @@ def test_inputs_with_swollen_styles_or_shared_strings_are_refused_unparsed(tmp_p
     assert cli(tmp_path, "run", "t.toml", "--inputs", str(base), "--out", "o.xlsx").returncode == 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("n", "fits"), [(16_382, True), (16_383, False)])
 def test_a_row_vector_at_the_last_column_is_written_whole_or_refused(tmp_path, n, fits):
     # a 1 x 20,001 result was cut at column XFD with exit 0

@@ -175,6 +175,7 @@ INDICES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("index", sorted(INDICES))
 @pytest.mark.parametrize("local", ["v := [1, 2]\n", "w := 0\n", ""])
 def test_an_index_written_as_numbers_is_refused_at_load(tmp_path, index, local):
@@ -189,6 +190,7 @@ def test_an_index_written_as_numbers_is_refused_at_load(tmp_path, index, local):
     assert not (tmp_path / "i.xlsx").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "index, message",
     [
@@ -260,6 +262,7 @@ SLOW_WORK = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(SLOW_WORK))
 def test_work_past_the_budget_stops_the_command(tmp_path, name):
     text, definition, work = SLOW_WORK[name]
@@ -273,6 +276,7 @@ def test_work_past_the_budget_stops_the_command(tmp_path, name):
     assert limits_time.current() is None  # the budget ends with the command
 
 
+@pytest.mark.slow
 def test_a_sweep_of_ten_thousand_listed_values_stops_at_the_budget(tmp_path):
     (tmp_path / "s.toml").write_text(
         '[inputs]\nR = "40 mm"\n\n[arguments]\nx = { unit = "" }\n\n[definitions]\n'
@@ -290,6 +294,7 @@ def test_a_sweep_of_ten_thousand_listed_values_stops_at_the_budget(tmp_path):
     assert "Traceback" not in err and not (tmp_path / "s.csv").exists()
 
 
+@pytest.mark.slow
 def test_the_budget_is_set_by_the_sheet_only_downwards(tmp_path):
     slow = SLOW_WORK["program_appending_to_itself"][0]
     (tmp_path / "w.toml").write_text("[sheet]\ntime_limit = 0.1\n\n" + slow, encoding="utf-8")
@@ -305,6 +310,7 @@ def test_the_budget_is_set_by_the_sheet_only_downwards(tmp_path):
     assert code == 2 and re.search(spent(0.1, "--time-limit"), err), err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value", ["0", "-1", "abc", "nan", "inf", "3601"])
 def test_a_time_limit_outside_its_caps_is_refused(tmp_path, value):
     (tmp_path / "a.toml").write_text('[definitions]\ns = "1"\n', encoding="utf-8")
@@ -376,6 +382,7 @@ def _no_space(*args, **kwargs):
     raise OSError(errno.ENOSPC, "No space left on device")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("where", ["xlsx", "csv"])
 def test_a_full_disk_is_one_paragraph_and_changes_nothing(written, monkeypatch, where):
     import pandas as pd
@@ -570,6 +577,7 @@ def _run_program(body: list[str], budget: str) -> None:
     assert limits_time.current() is None
 
 
+@pytest.mark.slow
 @settings(max_examples=3, deadline=None, suppress_health_check=list(HealthCheck), database=None)
 @given(blocks())
 def test_generated_programs_end_in_exit_0_1_or_2(body):

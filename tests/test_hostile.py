@@ -293,6 +293,7 @@ RUNTIME_HOSTILE = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(RUNTIME_HOSTILE))
 def test_a_program_at_its_bounds_is_stopped_with_a_message(tmp_path, name):
     text, status, expected = RUNTIME_HOSTILE[name]

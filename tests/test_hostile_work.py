@@ -277,6 +277,7 @@ def test_tables_past_the_cells_of_a_workbook_are_refused_before_they_are_written
     assert not (tmp_path / "u.xlsx").exists() and not list(tmp_path.glob(".*partial*"))
 
 
+@pytest.mark.slow
 def test_an_import_of_two_thousand_refused_definitions_is_one_pass(tmp_path, capsys):
     # 125/250/500/2,000 refused definitions took 2.8/9.3/37/>60 s: the import was retried once
     # for each refusal, and each retry loaded the whole worksheet

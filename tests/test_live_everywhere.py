@@ -130,6 +130,7 @@ def test_a_ratio_scaled_twice_is_caught_and_written_as_the_engines_value(
     assert values.cell(rows["r"], 2).value == pytest.approx(0.75, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_run_prints_each_cell_written_as_a_value(tmp_path, scaled_twice):
     from workbook.cli import main
 

@@ -72,6 +72,7 @@ def _formulas_package(path) -> dict:
     return out
 
 
+@pytest.mark.slow
 def test_nested_integrals_are_live_and_recalculate_to_the_engine(tmp_path, sheet_from):
     sheet = sheet_from(BEAM)
     out = tmp_path / "beam.xlsx"
@@ -118,6 +119,7 @@ def test_a_live_formula_that_disagrees_is_written_as_the_engines_value(
     assert "that did not are values" in texts[0]
 
 
+@pytest.mark.slow
 def test_run_says_which_cells_are_values(tmp_path, monkeypatch):
     from workbook.cli import main
 
@@ -135,6 +137,7 @@ def test_run_says_which_cells_are_values(tmp_path, monkeypatch):
     assert len(lines) == 3 and all("the engine" in line for line in lines)
 
 
+@pytest.mark.slow
 def test_an_integral_inside_two_integrals_is_a_value(tmp_path, sheet_from):
     triple = "integral(integral(integral(w/L^2, u, 0, s), s, 0, x), x, 0, L)"
     text = BEAM.replace('s = { unit = "m" }', 's = { unit = "m" }\nu = { unit = "m" }')

@@ -39,6 +39,7 @@ def _walk(name: str) -> load_walk.Walk:
         return load_walk.walk(lambda: workbook.load(name))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", TEMPLATES)
 def test_loading_a_template_climbs_back_up_at_most_six_times(name):
     found = _walk(name)

@@ -173,6 +173,7 @@ def _line_of(text: str, start: str) -> int:
     return next(i for i, line in enumerate(text.splitlines()) if line.startswith(start))
 
 
+@pytest.mark.slow
 def test_capabilities(client):
     caps = client.capabilities
     for key in (
@@ -230,6 +231,7 @@ def test_domain_error_of_a_value_is_published_after_the_load(client):
     assert d["code"] == "domain error" and d["range"]["start"]["line"] == 4
 
 
+@pytest.mark.slow
 def test_hover_value_function_builtin_and_estimate(client):
     path = client.folder / "hover.toml"
     path.write_text(SHEET, encoding="utf-8")

@@ -26,6 +26,7 @@ def _check(path: Path, capsys) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_wind_load_reproduces_every_stored_result(tmp_path, capsys):
     toml, line = _import("wind-load.xmcd", tmp_path, capsys)
     assert re.match(r"wrote .*wind-load.toml: \d+ definitions, 2 results", line)
@@ -38,6 +39,7 @@ def test_wind_load_reproduces_every_stored_result(tmp_path, capsys):
     assert result["reproduced"] == 2, result["failures"]
 
 
+@pytest.mark.slow
 def test_timber_beam_never_a_wrong_number(tmp_path, capsys):
     """Every stored result is reproduced or not computable; a not computable one belongs to
     a region the worksheet lists as not translated."""
@@ -57,6 +59,7 @@ def test_timber_beam_never_a_wrong_number(tmp_path, capsys):
     assert csv.count("\n") > 60
 
 
+@pytest.mark.slow
 def test_overwrite_needs_force(tmp_path, capsys):
     _import("wind-load.xmcd", tmp_path, capsys)
     assert main(["import", str(DATA / "wind-load.xmcd"), "--out", str(tmp_path)]) == 2
@@ -65,6 +68,7 @@ def test_overwrite_needs_force(tmp_path, capsys):
     assert main(args) == 0
 
 
+@pytest.mark.slow
 def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
     toml, _ = _import("frame/example.xmcd", tmp_path, capsys)
     text = toml.read_text(encoding="utf-8")
@@ -78,6 +82,7 @@ def test_reference_is_followed_relative_to_the_file(tmp_path, capsys):
     assert 'WRITEPRN wrote this value to the file "last_EH.txt"' in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "name, status",
     [
@@ -96,6 +101,7 @@ def test_imported_worksheet_runs(name, status, tmp_path, capsys):
     assert out.exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["lagrange-polynomial.xmcd", "fermat-spiral.xmcd"])
 def test_vectors_over_ranges_reproduce_every_stored_value(name, tmp_path, capsys):
     """t1[i] := ..., A[i, j] := f(i, j) over ranges, columns and a matrix Mathcad showed."""
@@ -131,6 +137,7 @@ def test_no_stored_result_is_reproduced_wrongly(name, tmp_path, capsys):
     assert all(f["name"] in from_solve for f in wrong), wrong
 
 
+@pytest.mark.slow
 def test_solve_blocks_reach_the_roots_mathcad_found(tmp_path, capsys):
     """parabola-ellipse: intersections by solve blocks with several roots, inequalities beside
     the equations, one equation in two unknowns; each root is the one Mathcad stored (within
@@ -151,6 +158,7 @@ def _charts(xlsx: Path) -> list:
     return [c for ws in book.worksheets for c in ws._charts]
 
 
+@pytest.mark.slow
 def test_plots_become_native_charts(tmp_path, capsys):
     """fermat-spiral: an X-Y plot of y(x) over the range x, two polar plots of r(phi) (x = r
     cos(phi), y = r sin(phi)), and one whose second trace uses a name Mathcad could not
@@ -167,6 +175,7 @@ def test_plots_become_native_charts(tmp_path, capsys):
     assert len(_charts(out)) == 4
 
 
+@pytest.mark.slow
 def test_a_plot_item_that_is_not_gzip_or_too_large_is_listed(tmp_path, capsys):
     """A plot's binary item is untrusted: not gzip, or larger than the limit once unpacked
     (a bomb), is listed as not translated, never unpacked beyond the limit."""
@@ -188,6 +197,7 @@ def test_a_plot_item_that_is_not_gzip_or_too_large_is_listed(tmp_path, capsys):
     assert "a plot whose binary item is larger than" in text
 
 
+@pytest.mark.slow
 def test_plot_of_vectors_is_a_series_over_their_index(tmp_path, capsys):
     """points-and-lines: Y against X (two vectors of six points) is a series of markers over
     the index; a trace over a range variable beside it keeps its own range; a quick plot (a
@@ -206,6 +216,7 @@ def test_plot_of_vectors_is_a_series_over_their_index(tmp_path, capsys):
     assert len(_charts(out)) == text.count("[[charts]]")
 
 
+@pytest.mark.slow
 def test_a_trace_with_a_gap_is_drawn_with_the_others(tmp_path, capsys):
     """parabola-ellipse, region 406: f(x) = x^3 + 4 sqrt(x^3) over a quick plot's -10 .. 10
     has no value below 0: Mathcad leaves a gap, and so does the chart (its rows below 0 fail,

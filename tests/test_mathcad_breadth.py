@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 from mathcad_xml import apply as _apply
 from mathcad_xml import check_sheet as _check
 from mathcad_xml import define as _define
@@ -17,6 +18,7 @@ def _vectorize(body: str) -> str:
     return _apply("vectorize", body)
 
 
+@pytest.mark.slow
 def test_vectorize_of_an_expression_is_element_by_element(tmp_path, capsys):
     """v := [1; 4; 9], w := [2; 3; 4]: ->(v*w) = [2; 12; 36] (not the dot product 50),
     ->(sqrt(v) + [1; 1; 1]) = [2; 3; 4], ->(v/2) = [0.5; 2; 4.5]."""
@@ -41,6 +43,7 @@ def test_vectorize_of_an_expression_is_element_by_element(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (9, 9), result["failures"]
 
 
+@pytest.mark.slow
 def test_vectorize_that_cannot_be_element_by_element_is_listed(tmp_path, capsys):
     """->(max(v)) (a function of a vector) and ->(v*u) with vectors of 3 and 2 are listed,
     never computed otherwise than Mathcad."""
@@ -68,6 +71,7 @@ def _shown(body: str, result: str) -> str:
     return f"<ml:eval>{body}<ml:result>{result}</ml:result></ml:eval>"
 
 
+@pytest.mark.slow
 def test_element_definition_shown_is_the_whole_vector(tmp_path, capsys):
     """i := 0 .. 2, v[i] := i^2 = [0; 1; 4] (Mathcad shows the vector it built), then
     v[i] := 10 + i over the same range (every element again) = [10; 11; 12]; j := 0 .. 1,
@@ -99,6 +103,7 @@ def test_element_definition_shown_is_the_whole_vector(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (13, 13, 0), result
 
 
+@pytest.mark.slow
 def test_sum_over_a_range_variable(tmp_path, capsys):
     """i := 1 .. 4: Σ_i i^2 = 30 (Mathcad's sum over a range variable, without bounds);
     k := 0, 0.5 .. 2 (not of whole steps) is listed."""

@@ -37,6 +37,7 @@ def _cells(m: np.ndarray) -> str:
     return matrix(*(real(v) for v in m.T.flatten()), cols=m.shape[1])
 
 
+@pytest.mark.slow
 def test_the_determinant_operator_is_det(tmp_path, capsys):
     m = np.array([[6.5, 4.2, 4.7], [6.2, -1.5, -5.0], [6.3, 2.2, 4.9]])
     text = import_sheet(
@@ -50,6 +51,7 @@ def test_the_determinant_operator_is_det(tmp_path, capsys):
     assert check_sheet(tmp_path, capsys, "det")["reproduced"] == 1
 
 
+@pytest.mark.slow
 def test_rkfixed_is_mathcad_runge_kutta(tmp_path, capsys):
     """u := rkfixed(y0, 0, 2, 10, D) with D(x, y) := [y1; -y0 - 0.3 y1 + sin x]: against the
     classical fourth-order Runge-Kutta written out here (x added step by step)."""
@@ -88,6 +90,7 @@ def test_rkfixed_is_mathcad_runge_kutta(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (33, 33), result["failures"][:3]
 
 
+@pytest.mark.slow
 def test_histogram_of_a_matrix_counts_every_element(tmp_path, capsys):
     """histogram(4, M) of a 3 x 2 matrix: Mathcad counts its six values (numpy's counts)."""
     m = np.array([[0.5, 2.5], [1.5, 3.9], [0.1, 2.0]])
@@ -106,6 +109,7 @@ def test_histogram_of_a_matrix_counts_every_element(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (8, 8), result["failures"][:3]
 
 
+@pytest.mark.slow
 def test_a_random_number_is_not_computable_with_the_reason(tmp_path, capsys):
     text = import_sheet(
         tmp_path,
@@ -119,6 +123,7 @@ def test_a_random_number_is_not_computable_with_the_reason(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["not_computable"]) == (2, 1, 1)
 
 
+@pytest.mark.slow
 def test_an_element_shown_is_compared_as_the_element(tmp_path, capsys):
     """x[1] := 6/3 = 2 (Mathcad shows the element): compared as 2, not as the vector x."""
     import_sheet(
@@ -162,6 +167,7 @@ def test_rkfixed_reproduces_mathcad_stored_matrix(tmp_path, capsys):
     assert result["failed"] == 0 and result["reproduced"] >= 122, result["failures"][:3]
 
 
+@pytest.mark.slow
 def test_prime_divides_a_number_by_a_vector_element_by_element(tmp_path, capsys):
     """Prime's T := 2 pi / w of a vector w stores the vector of quotients: vectorize."""
     w = [1.5, 2.0, 4.0]

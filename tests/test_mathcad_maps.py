@@ -79,6 +79,7 @@ def _apply(op, *args) -> str:
     return f"<ml:apply><ml:{op}/>{''.join(args)}</ml:apply>"
 
 
+@pytest.mark.slow
 def test_redefinitions_read_the_definition_in_force(tmp_path, capsys):
     """x := 2, y := x^2, x := 5, then y = and x*y = : Mathcad's order decides."""
     src = tmp_path / "order.xmcd"
@@ -111,6 +112,7 @@ def _function(rid: int, name: str, params: list[str], body: str) -> str:
     )
 
 
+@pytest.mark.slow
 def test_function_argument_takes_the_unit_it_is_called_with(tmp_path, capsys):
     """M(x) := q*x*(L - x)/2 with q = 10 kN/m, L = 6 m; M(3 m) = 45 kN*m as Mathcad stored."""
     stored = (
@@ -151,6 +153,7 @@ def test_function_argument_takes_the_unit_it_is_called_with(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 
 
+@pytest.mark.slow
 def test_printed_text_where_the_sheet_computes_a_number_fails(tmp_path, capsys):
     """A printed text ("OK", as Mathcad shows) is compared as text: a number is a FAIL."""
     (tmp_path / "t.toml").write_text(
@@ -163,6 +166,7 @@ def test_printed_text_where_the_sheet_computes_a_number_fails(tmp_path, capsys):
     assert result["failures"][0]["printed"] == "OK"
 
 
+@pytest.mark.slow
 def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
     """x := 1, Given x^2 = 2, s := Find(x) = sqrt(2): root(x^2 - 2, x, guess)."""
     import math
@@ -197,6 +201,7 @@ def test_given_find_in_one_unknown_is_a_root_from_the_guess(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 
 
+@pytest.mark.slow
 def test_program_with_a_loop(tmp_path, capsys):
     """s(n) := | a <- 0 ; for i in 1..n: a <- a + i ; a |, and s(4) = 10 as stored."""
     loop = (
@@ -220,6 +225,7 @@ def test_program_with_a_loop(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reproduced"] == 1
 
 
+@pytest.mark.slow
 def test_element_assignment_makes_and_grows_a_vector(tmp_path, capsys):
     """Mathcad makes v by v[2] <- n (the gap filled with 0): g(5) = [0, 0, 5] as Mathcad
     stored it; v[n] <- n (a length known only when the program runs) is a run-time array."""
@@ -250,6 +256,7 @@ def test_element_assignment_makes_and_grows_a_vector(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
 
 
+@pytest.mark.slow
 def test_matrix_column_is_a_submatrix(tmp_path, capsys):
     """M := [[1, 2], [3, 4], [5, 6]] (stored column by column), max(M<1>) = 6 and the column
     itself, at ORIGIN 0: Mathcad's stored values are reproduced."""
@@ -288,6 +295,7 @@ def _extremum(op: str, f: str, x: str) -> str:
     )
 
 
+@pytest.mark.slow
 def test_maximize_and_minimize_from_a_guess(tmp_path, capsys):
     """f(x) := x (10 - x) - 4 has its largest value at 5 (a root of its slope where it curves
     down), g(x) := cos(x) from the guess 2 its smallest at pi (not 0 or 2 pi, maxima); the
@@ -321,6 +329,7 @@ def _metres(inner: str) -> str:
     )
 
 
+@pytest.mark.slow
 def test_functions_of_vectors_translate(tmp_path, capsys):
     """P := (3, 4) m, Q := (0, 1) m, dist(a, b) := |a - b|, y(v) := v[1], twice(v) := 2 v:
     Mathcad's |x| of a vector is its length; the stored results are reproduced."""
@@ -356,6 +365,7 @@ def test_functions_of_vectors_translate(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (5, 5), result["failures"]
 
 
+@pytest.mark.slow
 def test_writeprn_is_the_value_written(tmp_path, capsys):
     """WRITEPRN("a.prn", M) = M (Mathcad 15's form) and WRITEPRN("b.prn") := v (older
     worksheets): each value written is a definition of its own with a note naming the file,
@@ -388,6 +398,7 @@ def test_writeprn_is_the_value_written(tmp_path, capsys):
     assert not (tmp_path / "a.prn").exists() and not (tmp_path / "b.csv").exists()
 
 
+@pytest.mark.slow
 def test_writeprn_of_another_value_fails_the_check(tmp_path, capsys):
     """A stored result that is not the value written is reported as failed, not passed."""
     call = (
@@ -466,6 +477,7 @@ def _with_items(sheet: str, items: dict[int, str]) -> str:
     return sheet.replace("</worksheet>", f"<binaryContent>{body}</binaryContent></worksheet>")
 
 
+@pytest.mark.slow
 def test_data_table_is_a_matrix(tmp_path, capsys):
     """S, a data table of 2 x 3 numbers (a negative one, fractions), and v, one of a single
     column: S becomes a matrix by rows, v a column vector; Mathcad's stored S = and v[1] =
@@ -539,6 +551,7 @@ def test_data_table_with_a_cyclic_sector_chain_is_refused():
         grid(base64.b64encode(gzip.compress(looped)).decode())
 
 
+@pytest.mark.slow
 def test_a_function_that_calls_itself_is_a_recursion(tmp_path, capsys):
     """fact(n) := 1 if n <= 1, n*fact(n - 1) otherwise; fact(6) = 720 as Mathcad stored."""
     program = (
@@ -573,6 +586,7 @@ def test_compound_result_unit_names():
     assert result_unit("Ms") == "Ms"  # a symbol is never lowered (Ms is not ms)
 
 
+@pytest.mark.slow
 def test_a_result_in_an_unknown_unit_costs_only_that_result(tmp_path, capsys):
     """x := 2 (stored in a unit no registry knows) and y := 3 (stored plainly): the check
     compares y, lists x's result, and does not stop."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from mathcad_xml import (
     apply,
     call,
@@ -23,6 +24,7 @@ from mathcad_xml import (
 )
 
 
+@pytest.mark.slow
 def test_the_second_derivative_is_not_the_first(tmp_path, capsys):
     """f(x) := x^3 sin(x); d2 := d²/dx² f(x) at x = 0.7 (Mathcad's degree 2), d1 the first:
     both against the derivatives written out by hand."""
@@ -45,6 +47,7 @@ def test_the_second_derivative_is_not_the_first(tmp_path, capsys):
     assert result["reproduced"] == 2, result["failures"]
 
 
+@pytest.mark.slow
 def test_a_derivative_of_an_order_not_written_is_refused(tmp_path, capsys):
     """d^n/dx^n with n a name: refused with the reason, never read as the first."""
     text = import_sheet(
@@ -62,6 +65,7 @@ def _vector(*values) -> str:
     return matrix(*(real(v) for v in values))
 
 
+@pytest.mark.slow
 def test_origin_set_after_the_first_index_refuses_submatrix_and_last(tmp_path, capsys):
     """v := [10; 20; 30]; v[0] = 10 (ORIGIN 0, the worksheet's origin), then ORIGIN := 1:
     last(v) (Mathcad's 3) and submatrix(v, 1, 2, 1, 1) (Mathcad's [10; 20]) are refused, as
@@ -87,6 +91,7 @@ def test_origin_set_after_the_first_index_refuses_submatrix_and_last(tmp_path, c
     assert (result["printed"], result["reproduced"], result["failed"]) == (3, 2, 0)
 
 
+@pytest.mark.slow
 def test_a_chain_of_equations_in_a_solve_block_is_two_equations(tmp_path, capsys):
     """Given x = y = 2 - z (stored (x = y) = 2 - z) and x + y + z = 3: Find(x, y, z) is
     (1, 1, 1), the solution of x = y, y = 2 - z and the sum (not of (x = y as 1 or 0) =

@@ -4,6 +4,7 @@ the worksheet is still compared (``check --json`` exits 0 or 1, never 2)."""
 
 from __future__ import annotations
 
+import pytest
 from mathcad_xml import (
     apply,
     check_sheet,
@@ -16,6 +17,7 @@ from mathcad_xml import (
 )
 
 
+@pytest.mark.slow
 def test_a_unit_of_another_dimension_costs_that_value(tmp_path, capsys):
     """x := 2 shown as 2 m (a stored unit that does not fit a plain number), y := 3 shown as
     3: x is not computable with the reason, y is compared."""
@@ -33,6 +35,7 @@ def test_a_unit_of_another_dimension_costs_that_value(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["not_computable"]) == (2, 1, 1)
 
 
+@pytest.mark.slow
 def test_a_unit_power_out_of_range_costs_that_value(tmp_path, capsys):
     """A stored unit m^14 (beyond the language's powers): that value only."""
     text = import_sheet(
@@ -49,6 +52,7 @@ def test_a_unit_power_out_of_range_costs_that_value(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["not_computable"]) == (2, 1, 1)
 
 
+@pytest.mark.slow
 def test_a_name_e_left_out_never_reads_the_constant(tmp_path, capsys):
     """e := h/2 = 14.2 m with h defined nowhere: the region is left out, and its stored
     value is not computable (never compared with Euler's number, dimensionless)."""

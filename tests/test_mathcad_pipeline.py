@@ -41,6 +41,7 @@ def _length(value: float) -> str:
     return _apply("mult", _real(value), _id("m"))
 
 
+@pytest.mark.slow
 def test_refused_regions_are_found_in_one_pass(tmp_path, capsys, counted):
     """L := 2.5 m; r := round(L) and s := floor(L) (the engine refuses both: the result would
     depend on the unit); q := r*2 and t := s + 1 use them; a := 3 = 3 is kept. One
@@ -70,6 +71,7 @@ def test_refused_regions_are_found_in_one_pass(tmp_path, capsys, counted):
     assert (result["printed"], result["reproduced"], result["failed"]) == (2, 1, 0), result
 
 
+@pytest.mark.slow
 def test_a_worksheet_the_engine_takes_is_loaded_once(tmp_path, capsys, counted):
     """Nothing refused: the typing pass is the only load (the document it typed is the data
     written, read back exactly)."""
@@ -86,6 +88,7 @@ def test_a_worksheet_the_engine_takes_is_loaded_once(tmp_path, capsys, counted):
     assert (result["printed"], result["reproduced"]) == (1, 1), result
 
 
+@pytest.mark.slow
 def test_a_range_over_a_value_the_engine_computes(tmp_path, capsys):
     """L := 3.4 m; n := round(L/m) + 1; i := 0 .. n-1 and i*2 listed over it: the range's
     values (0, 1, 2, 3) are computed by the engine, with any of its built-ins (round)."""
@@ -106,6 +109,7 @@ def test_a_range_over_a_value_the_engine_computes(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (4, 4, 0), result
 
 
+@pytest.mark.slow
 def test_a_chain_of_definitions_is_typed_once(tmp_path, capsys, monkeypatch):
     """x1 := x0/2, x2 := x1/2, ... (is an angle divided? the engine tells, for each link):
     what the engine typed once stands in as an input of its unit, so the worksheets written to

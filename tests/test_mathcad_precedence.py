@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from helpers.mathcad import bare_worksheet as _worksheet
 from helpers.mathcad import region as _region
 from hypothesis import given, settings
@@ -64,6 +65,7 @@ def _canonical(tree: ex.Node) -> ex.Node:
     return ex.map_children(tree, _canonical)
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None)
 @given(TREES)
 def test_printed_tree_parses_back_to_itself(tree):
@@ -77,6 +79,7 @@ def test_unary_minus_under_a_power_keeps_its_brackets():
     assert ex.to_text(ex.Unary("-", ex.Binary("^", ex.Number(1.0), ex.Name("i")))) == "-1^i"
 
 
+@pytest.mark.slow
 def test_a_negative_literal_under_a_power_is_powered_with_its_sign(tmp_path, capsys):
     """Mathcad stores (-1)^2 as a literal -1 under the power, = 1 and (-2)^3 = -8, and
     -(2^2) = -4 as a minus applied to the power."""

@@ -29,6 +29,7 @@ def _unit(name: str) -> str:
     return f'<ml:id labels="UNIT">{name}</ml:id>'
 
 
+@pytest.mark.slow
 def test_prime_results_in_their_displayed_unit(tmp_path, capsys):
     """q_k := 15.8 kg/m * 10 N/kg = ? kN/m stores 0.158 (the override's unit); M := 637 kN *
     1.92 m = ? kN stores 1223.04 with the residual unit meter; K := 2500 = ? 10^3 stores 2.5;
@@ -104,6 +105,7 @@ def test_prime_results_in_their_displayed_unit(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (5, 5), result["failures"]
 
 
+@pytest.mark.slow
 def test_a_wrong_stored_value_is_a_failure_not_a_pass(tmp_path, capsys):
     """The comparison is real: 0.159 kN/m stored for 0.158 fails."""
     regions = _region(
@@ -141,6 +143,7 @@ def _with(worksheet: bytes) -> bytes:
     return buf.getvalue()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "data, message",
     [
@@ -169,6 +172,7 @@ SMALL = {  # file: (values stored, reproduced) as measured
 }
 
 
+@pytest.mark.slow
 @needs_corpus
 @pytest.mark.parametrize("name", sorted(SMALL))
 def test_small_prime_worksheets_reproduce(name, tmp_path, capsys):
@@ -201,6 +205,7 @@ def _eval(rid: int, body: str) -> str:
     )
 
 
+@pytest.mark.slow
 def test_constants_labels_and_if_chains(tmp_path, capsys):
     """g labelled CONSTANT is standard gravity (not the gram), g labelled VARIABLE and not
     defined is not a unit either (listed); f(x) := if x > 2: 10 else if x > 0: 20 else 30 takes
@@ -255,6 +260,7 @@ def test_constants_labels_and_if_chains(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (5, 4, 0), result
 
 
+@pytest.mark.slow
 def test_if_blocks_in_a_program(tmp_path, capsys):
     """f(x) := | if x > 10: (y <- 100; y) / else if x > 0: (y <- 2 x; y + 0) / else: -x |
     in a program with a line after the first: f(20) = 100, f(3) = 6, f(-2) = 2."""
@@ -321,6 +327,7 @@ def _combo(selected: int, cols: int, *values: float) -> str:
     )
 
 
+@pytest.mark.slow
 def test_combo_box_is_the_selected_row(tmp_path, capsys):
     """f_yk from a combo box of 410, 500, 550 with SelectedRow 2 (counted from 0) is 550;
     [a; b] from rows (1, 2) and (3, 4) with SelectedRow 1 is a = 3, b = 4."""
@@ -344,6 +351,7 @@ def test_combo_box_is_the_selected_row(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (3, 3), result
 
 
+@pytest.mark.slow
 def test_bounds_of_a_sum(tmp_path, capsys):
     """Prime writes a sum's bounds as lowerBound and upperBound: Σ_{i=1}^{4} i^2 = 30."""
     lam = (

@@ -7,6 +7,7 @@ from __future__ import annotations
 import zipfile
 from pathlib import Path
 
+import pytest
 from helpers.mathcad import check_json as _check
 from helpers.mathcad import prime_ident as _id
 from mathcad_xml import PRIME_RESULTS as RESULTS
@@ -69,6 +70,7 @@ def _f_of_indices() -> str:
     return _function(1, "f", ["x", "y"], body)
 
 
+@pytest.mark.slow
 def test_matrix_of_a_function_counts_from_0(tmp_path, capsys):
     """matrix(3, 2, f) with f(x, y) = x^2 - y is [[0, -1], [1, 0], [4, 3]] (i and j from 0)."""
     want = [[i * i - j for j in range(2)] for i in range(3)]
@@ -80,6 +82,7 @@ def test_matrix_of_a_function_counts_from_0(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (6, 6, 0), result
 
 
+@pytest.mark.slow
 def test_matrix_of_a_function_at_origin_1(tmp_path, capsys):
     """At ORIGIN 1, matrix(m, n, f) of a function of its indices is listed (which indices
     Mathcad gives f there is not known); of a function that ignores them, translated."""
@@ -104,6 +107,7 @@ def test_matrix_of_a_function_at_origin_1(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (10, 6, 0), result
 
 
+@pytest.mark.slow
 def test_matrix_of_a_size_not_known_at_import_is_listed(tmp_path, capsys):
     regions = _f_of_indices() + _eval(2, _call("matrix", _id("n"), _real(2), _id("f")))
     results = _result(1) + _result(2, _stored_matrix([[0, -1]]))
@@ -113,6 +117,7 @@ def test_matrix_of_a_size_not_known_at_import_is_listed(tmp_path, capsys):
     assert "region 2: an evaluation ( = ): matrix(m, n, f) whose size is not a number known" in text
 
 
+@pytest.mark.slow
 def test_a_function_redefined_from_its_previous_definition(tmp_path, capsys):
     """B(x) := x + 1, then B(x) := B(x)*2 (Mathcad reads the previous B): B(3) = 8; a
     function first defined calling itself stays Mathcad's recursion."""
@@ -130,6 +135,7 @@ def test_a_function_redefined_from_its_previous_definition(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (1, 1, 0), result
 
 
+@pytest.mark.slow
 def test_a_sum_of_matrices(tmp_path, capsys):
     """K := Σ_{j=1}^{3} M·j with M = [[1, 2], [3, 4]]: 6 M, a matrix (not a number)."""
     m = (
@@ -154,6 +160,7 @@ def test_a_sum_of_matrices(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (4, 4, 0), result
 
 
+@pytest.mark.slow
 def test_a_difference_is_compared_within_the_round_off_of_its_terms(tmp_path, capsys):
     """w := [2401; 1000.3], shown; Mathcad stored (w/7)*7 - w as round-off (5e-12, 6e-12),
     which is reproduced within 1e-9 of the largest term Mathcad showed (2401); a stored
@@ -188,6 +195,7 @@ def _index(target: str, *at: str) -> str:
     return f"<ml:apply><ml:indexer/>{target}{inner}</ml:apply>"
 
 
+@pytest.mark.slow
 def test_a_program_with_a_local_function_and_an_element_matrix(tmp_path, capsys):
     """K[i] := | g(r, c) <- r + 10 c           (a local function)
                 | K[i] <- matrix(2, 2, g)        (the local vector K, used only at i)
@@ -238,6 +246,7 @@ def test_a_program_with_a_local_function_and_an_element_matrix(tmp_path, capsys)
     assert "a local function that reads the program's a" in text
 
 
+@pytest.mark.slow
 def test_a_stored_zero_among_large_elements_is_round_off(tmp_path, capsys):
     """stack(M, (M/3)*3 - M) with M = [128822157.11805557; 0.1]: Mathcad stored exact zeros
     below, ours are 1.5e-8 and 0 (round-off of 1.3e8): compared within 1e-15 of the largest
@@ -280,6 +289,7 @@ def _define_shown(rid: int, lhs: str, rhs: str) -> str:
     return _region(rid, rid, f"<ml:define>{lhs}<ml:eval>{rhs}</ml:eval></ml:define>")
 
 
+@pytest.mark.slow
 def test_a_column_of_a_computed_index_and_sorted_eigenvalues(tmp_path, capsys):
     """X[i, j] := D[i, j] - mean(D<j>) over i := 0..1, j := 0..2 (a column whose index is a
     parameter); sort(eigenvals(S)) (Prime's order of eigenvalues does not matter once they
@@ -334,6 +344,7 @@ def test_a_column_of_a_computed_index_and_sorted_eigenvalues(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (12, 8, 0), result
 
 
+@pytest.mark.slow
 def test_elements_over_a_range_replace_a_vector_when_mathcad_shows_so(tmp_path, capsys):
     """x := [7; 8; 9], then x[j] := 2 j over j := 0..1, shown by Mathcad with 2 rows: Prime
     replaced x (it keeps no element of the old x), x = [0; 2]; shown with 3 rows, it kept
@@ -366,6 +377,7 @@ def test_elements_over_a_range_replace_a_vector_when_mathcad_shows_so(tmp_path, 
         assert (result["printed"], result["reproduced"], result["failed"]) == (n, n, 0), result
 
 
+@pytest.mark.slow
 def test_names_of_a_matrix_defined_by_a_program(tmp_path, capsys):
     """[a; b] := | x <- 2 ; [x; 3 x] : a = 2, b = 6."""
     lhs = f'<ml:matrix rows="2" cols="1">{_id("a")}{_id("b")}</ml:matrix>'
@@ -386,6 +398,7 @@ def test_names_of_a_matrix_defined_by_a_program(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result
 
 
+@pytest.mark.slow
 def test_an_element_defined_from_its_previous_value(tmp_path, capsys):
     """v := [1; 2; 3]; v[1] := 10 v[1] (the right side reads the previous v, not the new one,
     which was a circular definition): v = [1; 20; 3]."""
@@ -408,6 +421,7 @@ def test_an_element_defined_from_its_previous_value(tmp_path, capsys):
     assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result
 
 
+@pytest.mark.slow
 def test_vectorize_over_a_vector_of_a_length_known_when_computed(tmp_path, capsys):
     """v := lsolve(M, b) (its length not known at import); →(v·v + 1) is the language's
     vectorize(v * v + 1): [5; 10]."""

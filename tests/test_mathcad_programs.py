@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from mathcad_xml import ML
 from mathcad_xml import apply as _apply
 from mathcad_xml import call as _call
@@ -51,6 +52,7 @@ def _check(tmp_path, capsys, name: str) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_comparison_as_a_number_and_numbers_as_conditions(tmp_path, capsys):
     """f(x) := (x > 2)*3 + 1 (Mathcad's comparison is 1 or 0); g(a, b) := | if (a = 1)*(b = 1):
     10 / otherwise: 20 | (a product of comparisons is Mathcad's and); h(a) := | s <- a ; if s:
@@ -81,6 +83,7 @@ def test_comparison_as_a_number_and_numbers_as_conditions(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (4, 4), result["failures"]
 
 
+@pytest.mark.slow
 def test_ranged_inequality_is_a_chain(tmp_path, capsys):
     """Mathcad stores a <= t <= b as a comparison whose left side is a comparison: the chain
     1 <= t <= 3 (not (1 <= t) <= 3, which is always true); in(5) = 0, in(2) = 1."""
@@ -99,6 +102,7 @@ def test_ranged_inequality_is_a_chain(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]
 
 
+@pytest.mark.slow
 def test_destructuring_takes_each_element_at_origin(tmp_path, capsys):
     """| [a; b] <- pair(x) ; a - b | at ORIGIN 1: a fresh local, then a := parts[1],
     b := parts[2]; d(5) = 5 - 10 = -5 as stored."""
@@ -119,6 +123,7 @@ def test_destructuring_takes_each_element_at_origin(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
 
 
+@pytest.mark.slow
 def test_column_assignment_is_a_loop(tmp_path, capsys):
     """| M<1> <- v ; M<0> <- 2 v ; M | (ORIGIN 0): each column element by element, a loop of
     a fresh name over the vector (the engine grows M where its length is known)."""
@@ -139,6 +144,7 @@ def test_column_assignment_is_a_loop(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (4, 4), result["failures"]
 
 
+@pytest.mark.slow
 def test_locals_start_at_zero_where_read_first(tmp_path, capsys):
     """| for i in 1..n: s <- s + i ; s | (Mathcad's s starts at 0) gets s := 0 first; a local
     given on every path before it is read does not; s(4) = 10 as stored."""
@@ -157,6 +163,7 @@ def test_locals_start_at_zero_where_read_first(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
 
 
+@pytest.mark.slow
 def test_local_set_in_one_branch_starts_at_zero(tmp_path, capsys):
     """f_kon set only where a <= 0, then read: f_kon := 0 on the first line; g(1) = 5."""
     body = _program(
@@ -173,6 +180,7 @@ def test_local_set_in_one_branch_starts_at_zero(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
 
 
+@pytest.mark.slow
 def test_break_outside_a_loop(tmp_path, capsys):
     """| y <- 2 x ; if y > 0: y / otherwise: break | ends without a value where y <= 0: the
     break is dropped (the engine says so); a break before the program's end is listed."""
@@ -206,6 +214,7 @@ def test_break_outside_a_loop(tmp_path, capsys):
     assert "without a value" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_break_in_the_first_branch_keeps_the_other(tmp_path, capsys):
     """| if f = 0: break / otherwise: | ... | at the end: `if f != 0` over the other branch."""
     body = _program(
@@ -222,6 +231,7 @@ def test_break_in_the_first_branch_keeps_the_other(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
 
 
+@pytest.mark.slow
 def test_parameter_set_by_elements_is_a_local_copy(tmp_path, capsys):
     """| A[1] <- 7 ; A | sets an element of Mathcad's own copy of the argument: A_local."""
     body = _program(_local(_index(_id("A"), _real(1)), _real(7)), _id("A"))
@@ -229,6 +239,7 @@ def test_parameter_set_by_elements_is_a_local_copy(tmp_path, capsys):
     assert "A_local := A\nA_local[1] := 7\nA_local" in text
 
 
+@pytest.mark.slow
 def test_elements_defined_one_by_one(tmp_path, capsys):
     """v[0] := 5, w := 1, v[1] := 7 (ORIGIN 0): each a new definition of v that copies the
     previous one and sets its element; v = [5, 7] as stored."""
@@ -247,6 +258,7 @@ def test_elements_defined_one_by_one(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]
 
 
+@pytest.mark.slow
 def test_nested_array_result_is_one_value_per_leaf(tmp_path, capsys):
     """T := [pair(1); pair(2)] with pair(n) := [n; [10 n; 10 n + 1]]: Mathcad stores T as a
     vector of [number; vector] pairs; one printed value per number, read by chained indices,
@@ -279,6 +291,7 @@ def test_nested_array_result_is_one_value_per_leaf(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (6, 6), result["failures"]
 
 
+@pytest.mark.slow
 def test_collapsed_area_is_read_at_its_place(tmp_path, capsys):
     """A collapsed area's regions lie, in the file, below the region after the area; Mathcad
     reads them at the area's place: f defined inside the area is defined before g uses it."""
@@ -297,6 +310,7 @@ def test_collapsed_area_is_read_at_its_place(tmp_path, capsys):
     assert result["reproduced"] == 1, result["failures"]
 
 
+@pytest.mark.slow
 def test_two_locals_whose_identifiers_meet_stay_two(tmp_path, capsys):
     """x.LN and x.LN_ (Mathcad: two names) are two locals of one program."""
     body = _program(
@@ -313,6 +327,7 @@ def test_two_locals_whose_identifiers_meet_stay_two(tmp_path, capsys):
     assert result["reproduced"] == 1, result["failures"]
 
 
+@pytest.mark.slow
 def test_top_level_destructuring(tmp_path, capsys):
     """[a; b] := pair(3) (ORIGIN 1): the value a definition of its own, each name an element;
     b = 6 as stored."""
@@ -332,6 +347,7 @@ def test_top_level_destructuring(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
 
 
+@pytest.mark.slow
 def test_break_inside_a_loop_stays_and_continue_outside_is_listed(tmp_path, capsys):
     """A break inside a while loop is the loop's; a continue outside any loop is listed; an
     element assignment at i + 1 over a range variable i sets v[1..3] (v[0] is 0)."""

@@ -52,6 +52,7 @@ CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_hostile_file_is_refused(case, tmp_path, capsys):
     data, message = CASES[case]
@@ -64,6 +65,7 @@ def test_hostile_file_is_refused(case, tmp_path, capsys):
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
 
 
+@pytest.mark.slow
 def test_reference_outside_the_folder_is_refused(tmp_path, capsys):
     inner = tmp_path / "inner"
     inner.mkdir()
@@ -96,6 +98,7 @@ def _worksheet(*regions: str) -> str:
 FORGED = "&#10;[blocks]&#10;x = 1&#10;"
 
 
+@pytest.mark.slow
 def test_names_and_region_ids_cannot_forge_the_generated_files(tmp_path, capsys):
     """A newline in a region id or in a Mathcad name, DEL and a line separator in a name and
     in a text region: each stays inside its comment, string or CSV cell; no [blocks] section,
@@ -128,6 +131,7 @@ def test_names_and_region_ids_cannot_forge_the_generated_files(tmp_path, capsys)
     assert checked["printed"] == 3 and checked["reproduced"] == 1, checked
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "body, reason",
     [
@@ -163,6 +167,7 @@ def test_a_broken_size_or_range_is_listed(body, reason, tmp_path, capsys):
     assert reason in (tmp_path / "broken.toml").read_text(encoding="utf-8")
 
 
+@pytest.mark.slow
 def test_a_stored_result_that_is_not_a_number_is_listed(tmp_path, capsys):
     src = tmp_path / "stored.xmcd"
     results = ["nan", "abc", "1e999"]
@@ -186,6 +191,7 @@ def test_a_stored_result_that_is_not_a_number_is_listed(tmp_path, capsys):
     assert "not finite (1e999)" in text
 
 
+@pytest.mark.slow
 def test_out_naming_a_file_is_refused(tmp_path, capsys):
     src = tmp_path / "one.xmcd"
     src.write_text(_worksheet(_math("1", "define", "<ml:id>a</ml:id><ml:real>2</ml:real>")))
@@ -207,6 +213,7 @@ def _import_in_child(path: Path, out: Path) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
 def test_a_fifo_is_refused_unopened(tmp_path):
     fifo = tmp_path / "pipe.xmcd"
@@ -216,6 +223,7 @@ def test_a_fifo_is_refused_unopened(tmp_path):
     assert "not a regular file (a named pipe)" in done.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not Path("/dev/zero").exists(), reason="no /dev/zero here")
 def test_a_device_behind_a_link_is_refused_unread(tmp_path):
     link = tmp_path / "zero.xmcd"

@@ -56,6 +56,7 @@ CALLS = [
 ]
 
 
+@pytest.mark.slow
 def test_each_call_is_the_languages_and_reproduces_mpmath(tmp_path, capsys):
     regions = [
         define(k + 1, ident(f"v{k}"), shown(mathcad, real(repr(value))))
@@ -68,6 +69,7 @@ def test_each_call_is_the_languages_and_reproduces_mpmath(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (len(CALLS), len(CALLS)), result
 
 
+@pytest.mark.slow
 def test_a_worksheets_own_j1_is_its_own(tmp_path, capsys):
     """J1 defined by the worksheet (a variable, as in the corpora) is not Mathcad's Bessel J1."""
     text = import_sheet(
@@ -81,6 +83,7 @@ def test_a_worksheets_own_j1_is_its_own(tmp_path, capsys):
     assert check_sheet(tmp_path, capsys, "own")["reproduced"] == 1
 
 
+@pytest.mark.slow
 def test_the_factorial_of_a_sum_and_the_incomplete_gamma(tmp_path, capsys):
     text = import_sheet(
         tmp_path,
@@ -98,6 +101,7 @@ def test_the_factorial_of_a_sum_and_the_incomplete_gamma(tmp_path, capsys):
     assert (result["reproduced"], result["not_computable"]) == (1, 1), result
 
 
+@pytest.mark.slow
 def test_cholesky_is_the_languages(tmp_path, capsys):
     a = np.array([[4.0, 12.0, -16.0], [12.0, 37.0, -43.0], [-16.0, -43.0, 98.0]])
     with mpmath.workdps(50):
@@ -115,6 +119,7 @@ def test_cholesky_is_the_languages(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (9, 9), result
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "name, reason",
     [
@@ -138,6 +143,7 @@ def test_refused_with_the_reason(tmp_path, capsys, name, reason):
     assert result["reproduced"] == 0 and result["not_computable"] == 4, result
 
 
+@pytest.mark.slow
 def test_prime_factorial_and_gamma(tmp_path, capsys):
     """In Prime, n! and Γ(x) are written as in Mathcad 15 (the namespace math50)."""
     body_f = (
@@ -158,6 +164,7 @@ def test_prime_factorial_and_gamma(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (2, 2), result
 
 
+@pytest.mark.slow
 def test_prime_vector_sum(tmp_path, capsys):
     """Prime's vector sum Σv (Σ with empty placeholders for its variable and its upper bound)
     is the sum of v's elements."""
@@ -177,6 +184,7 @@ def test_prime_vector_sum(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (1, 1), result
 
 
+@pytest.mark.slow
 def test_an_element_assignment_at_a_shifted_index(tmp_path, capsys):
     """Data[i + N] := d[i] over i := 0 .. 2 (N := 2, d a vector of 3) sets Data[2..4] and keeps
     Data[0], Data[1] of the vector before; E[j - 1] := j over j := 1 .. 2 is [1, 2]."""
@@ -203,6 +211,7 @@ def test_an_element_assignment_at_a_shifted_index(tmp_path, capsys):
     assert (result["printed"], result["reproduced"]) == (3, 3), result
 
 
+@pytest.mark.slow
 def test_prime_math_inside_a_text_region_computes(tmp_path, capsys):
     """Prime computes a math region placed inside a text region, where the text stands: its
     definition is read by the regions after it."""

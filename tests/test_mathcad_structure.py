@@ -27,6 +27,7 @@ def _import(path, capsys) -> tuple[int, str]:
     return code, capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("where", ["regions", "math"])
 def test_an_xinclude_in_an_xmcd_is_refused(tmp_path, capsys, where):
     sheet = worksheet(define(1, ident("x"), real(2)), evaluate(2, ident("x"), real(2)))
@@ -42,6 +43,7 @@ def test_an_xinclude_in_an_xmcd_is_refused(tmp_path, capsys, where):
     assert not (tmp_path / "inc.toml").exists()
 
 
+@pytest.mark.slow
 def test_an_xinclude_in_an_mcdx_is_refused(tmp_path, capsys):
     body = f"<ml:define><ml:id>x</ml:id>{INCLUDE}</ml:define>"
     src = prime_package(tmp_path / "inc.mcdx", prime_region(1, 1, body), prime_result(1))
@@ -50,6 +52,7 @@ def test_an_xinclude_in_an_mcdx_is_refused(tmp_path, capsys):
     assert "of mathcad/worksheet.xml: an XInclude element" in err
 
 
+@pytest.mark.slow
 def test_an_element_of_another_kind_in_an_mcdx_definition_is_refused(tmp_path, capsys):
     """Prime's reader reads only Mathcad's namespaces: a definition whose right side is an
     element of another one has one side, and the file is refused (was an IndexError)."""
@@ -60,6 +63,7 @@ def test_an_element_of_another_kind_in_an_mcdx_definition_is_refused(tmp_path, c
     assert "region 1: <define> with 1 elements inside" in err
 
 
+@pytest.mark.slow
 def test_an_operator_without_its_operands_is_refused(tmp_path, capsys):
     plus = '<ml:apply><ml:plus/><ml:real>1</ml:real><foo:bar xmlns:foo="urn:o"/></ml:apply>'
     src = tmp_path / "plus.xmcd"

@@ -92,6 +92,7 @@ def test_cspline_over_the_columns_still_interpolates(sheet):
     assert sh.evaluate("R_op_c").to("ohm").magnitude == pytest.approx(want, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_workbook_recalculates_the_regression(sheet):
     sh, tmp = sheet
     path = sh.write_xlsx(tmp / "pt100.xlsx")

@@ -8,6 +8,7 @@ import workbook
 from workbook.outputs import notebook
 
 
+@pytest.mark.slow
 def test_the_html_shows_inputs_definitions_and_tables(concave):
     text = concave._repr_html_()
     assert text == notebook.sheet_html(concave.computed())
@@ -31,6 +32,7 @@ def test_tables_are_dataframes_with_units_in_the_headers(concave):
     assert inputs.set_index("name").loc["phi_n", "unit"] == "deg"
 
 
+@pytest.mark.slow
 def test_ipython_displays_it():
     formatters = pytest.importorskip("IPython.core.formatters")
     sheet = workbook.load("concave-cam")

@@ -198,6 +198,7 @@ def test_rows_are_named_in_errors(pipe, tmp_path):
         s.evaluate("g", [1.0, -1.0])
 
 
+@pytest.mark.slow
 def test_loading_a_sheet_with_numerical_builtins_imports_no_scipy():
     import subprocess
     import sys
@@ -412,6 +413,7 @@ def test_rows_are_solved_in_chunks_with_the_same_results(pipe, tmp_path, monkeyp
 ALL = Path(__file__).parent / "data" / "numerical-builtins.toml"
 
 
+@pytest.mark.slow
 def test_every_builtin_runs_from_a_plain_template(tmp_path, capsys):
     """root (both forms), integral, diff, sum, product, maximum, argmax, Given/Find and data
     interpolation in one template, through the command line; values against closed forms."""
@@ -485,12 +487,14 @@ def _heavy_imports(body: str, *argv: str) -> str:
     return done.stdout.splitlines()[-1]
 
 
+@pytest.mark.slow
 def test_loading_every_template_imports_no_sympy_mpmath_or_scipy_solvers():
     # reducer-profile calls diff: its derivatives are found when first evaluated
     body = "for name in workbook.list_templates():\n    workbook.load(name)"
     assert _heavy_imports(body) == "-"
 
 
+@pytest.mark.slow
 def test_cold_start_of_concave_cam_imports_no_sympy_mpmath_or_scipy_solvers(tmp_path):
     body = (
         "from workbook.cli import main\n"
@@ -499,6 +503,7 @@ def test_cold_start_of_concave_cam_imports_no_sympy_mpmath_or_scipy_solvers(tmp_
     assert _heavy_imports(body, str(tmp_path / "cc.xlsx")) == "-"
 
 
+@pytest.mark.slow
 def test_a_derivative_is_found_at_first_use(tmp_path):
     path = tmp_path / "d.toml"
     path.write_text(EXTREMA, encoding="utf-8")
@@ -553,6 +558,7 @@ def test_diff_errors_without_sympy_come_at_load(tmp_path, line, message):
     assert "d.toml" in str(err.value)
 
 
+@pytest.mark.slow
 def test_a_derivative_sympy_cannot_write_back_is_an_error_at_first_use(tmp_path):
     from workbook.cli import main
 
@@ -610,6 +616,7 @@ def _root_table(tmp_path):
     return s, path, wb, ws
 
 
+@pytest.mark.slow
 def test_a_root_in_a_table_column_is_live_as_bisection_steps(tmp_path):
     s, path, wb, ws = _root_table(tmp_path)
     heads = [c.value for c in ws[2]]
@@ -748,6 +755,7 @@ def _cells(wb):
     return out
 
 
+@pytest.mark.slow
 def test_extrema_are_live_where_close_to_the_engine(tmp_path):
     s, path, wb = _extrema_book(tmp_path)
     for key, (sheet_name, ref, comment) in _cells(wb).items():

@@ -18,6 +18,7 @@ def robertson(t, y):
     return [-0.04 * y1 + 1e4 * y2 * y3, 0.04 * y1 - 1e4 * y2 * y3 - 3e7 * y2**2, 3e7 * y2**2]
 
 
+@pytest.mark.slow
 def test_robertson_turns_stiff_and_auto_goes_on_with_lsoda():
     sheet = workbook.load(DATA / "robertson.toml")
     sol = sheet.evaluator.ode_solution("rob")

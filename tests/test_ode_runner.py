@@ -49,6 +49,7 @@ def test_the_dense_output_agrees_with_solve_ivp():
     assert np.max(np.abs(s(0, t) - ref.y[0])) < 1e-8
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["auto", "RK45", "Radau"])
 def test_a_solution_that_blows_up_is_stopped_and_said_so(method):
     """y' = y^2, y(0) = 1 is 1/(1 - t): refused at and past the blow-up at t = 1 (and where

@@ -176,6 +176,7 @@ states = [
 """
 
 
+@pytest.mark.slow
 def test_vector_states_against_the_matrix_exponential(tmp_path):
     """M x'' + C x' + K x = 0 as two vector states, against expm of the first-order system
     written out here; the method is a choice input and rtol an input."""
@@ -211,6 +212,7 @@ def test_vector_state_shapes_and_method_names_are_checked_at_load(tmp_path):
         Sheet(load_spec(path))
 
 
+@pytest.mark.slow
 def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
     from workbook.engine import ode as wo
 
@@ -225,6 +227,7 @@ def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
     assert capped.stop_reason == "step cap" and not capped.ok
 
 
+@pytest.mark.slow
 def test_a_method_given_by_a_text_definition_is_checked_when_it_is_evaluated(tmp_path):
     text = MASS.replace('method = "scheme"', 'method = "pick"').replace(
         "[definitions]\n",

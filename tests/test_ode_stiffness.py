@@ -81,6 +81,7 @@ def test_a_saddle_stays_explicit_over_five_periods():
     assert np.allclose(run.y[:, -1], direct.y[:, -1], rtol=1e-12, atol=1e-14)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "f, span, y0",
     [

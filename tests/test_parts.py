@@ -33,6 +33,7 @@ def _about(path) -> dict:
     return {r[0]: r[1] for r in openpyxl.load_workbook(path)["About"].iter_rows(values_only=True)}
 
 
+@pytest.mark.slow
 def test_plain_run_leaves_out_the_hand_checks_and_their_imports(tmp_path):
     rc, modules = _fresh_run(tmp_path / "cc.xlsx")
     assert rc == 0 and modules == "-"
@@ -60,6 +61,7 @@ def test_part_adds_the_hand_checks(tmp_path):
     assert about["Regenerate with"] == "workbook run concave-cam --part hand-checks"
 
 
+@pytest.mark.slow
 def test_parts_do_not_change_the_main_tables(tmp_path):
     plain = workbook.load("concave-cam")
     whole = plain.with_parts("all")
@@ -70,6 +72,7 @@ def test_parts_do_not_change_the_main_tables(tmp_path):
     assert [r.computed for r in plain.check().rows] == [r.computed for r in whole.check().rows]
 
 
+@pytest.mark.slow
 def test_selection_survives_new_inputs():
     sheet = workbook.load("concave-cam", parts="all")
     assert sheet.with_inputs(R3="45 mm").parts == {"hand-checks"}
@@ -78,6 +81,7 @@ def test_selection_survives_new_inputs():
     assert len(sheet.spec.relations) == 7
 
 
+@pytest.mark.slow
 def test_unknown_part_is_an_input_error(tmp_path, capsys):
     with pytest.raises(InputError, match=r"no part 'nope' \(parts: hand-checks; or 'all'\)"):
         workbook.load("concave-cam", parts="nope")
@@ -86,6 +90,7 @@ def test_unknown_part_is_an_input_error(tmp_path, capsys):
     assert not (tmp_path / "x.xlsx").exists()
 
 
+@pytest.mark.slow
 def test_a_table_of_a_left_out_part_names_the_part(tmp_path, capsys):
     with pytest.raises(InputError, match="in the optional part hand-checks of concave-cam"):
         workbook.load("concave-cam").table("stability")

@@ -112,6 +112,7 @@ def test_program_errors_at_load(tmp_path, body, message):
     assert "p.toml" in str(info.value)
 
 
+@pytest.mark.slow
 def test_a_while_that_never_ends_is_stopped_by_the_step_limit(tmp_path):
     sheet = _sheet(
         tmp_path, HEAD + "[definitions]\n" + prog("loop(x)", "while x > 0\n    x := x + 1\nx")

@@ -242,6 +242,7 @@ CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law, ds, am, phr, e", CASES)
 def test_direct_matches_refined_brute_force(sheet, law, ds, am, phr, e):
     p = dict(H=16.0, phi_rise=math.radians(phr), alpha_max=am, e=e, delta_sigma=ds, law=law)
@@ -253,12 +254,14 @@ def test_direct_matches_refined_brute_force(sheet, law, ds, am, phr, e):
     assert mm(s.evaluate("r0")) == pytest.approx(brute_r0(**p), rel=1e-11, abs=1e-11)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", LAWS)
 def test_direct_matches_mpmath(sheet, law):
     ref = reference_r0(**dict(SCENE, law=law))
     assert mm(sheet.with_inputs(law=law).evaluate("r0")) == pytest.approx(ref, rel=1e-13)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", LAWS)
 def test_rise_laws(sheet, law):
     s = sheet.with_inputs(law=law)
@@ -377,6 +380,7 @@ def test_absolute_not_signed_pressure_angle(sheet):
 
 
 # -- error against run time ------------------------------------------------------------------------
+@pytest.mark.slow
 def test_bench_direct_faster_and_more_accurate(sheet):
     df = R.bench(sheet, quick=True)
     row = df[(df["dr [mm]"] == 0.001) & (df["angles"] == 101)].iloc[0]

@@ -62,6 +62,7 @@ def test_recursive_values(tmp_path):
     assert d500.magnitude == 500.0
 
 
+@pytest.mark.slow
 def test_a_recursion_too_deep_is_a_limit_naming_the_function(tmp_path):
     s = _load(tmp_path)
     with pytest.raises(LimitError, match=r"depth\(\) called itself more than 1000 deep"):

@@ -97,6 +97,7 @@ def test_inputs_and_derived_scalars(sheet):
 # -- the practical profile against mpmath, at every table point --------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n,sense", [(12, "same"), (12, "opposite"), (7, "same"), (7, "opposite")])
 def test_practical_profile_matches_mpmath(sheet, n, sense):
     s = sheet.with_inputs(n=n, sense=sense, dphi="10 deg")
@@ -108,6 +109,7 @@ def test_practical_profile_matches_mpmath(sheet, n, sense):
         assert got == pytest.approx(ref, abs=1e-10), (int(r["k"]), r["phi [deg]"])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sense", ["same", "opposite"])
 def test_offset_lies_at_distance_rp_at_every_point(sheet, sense):
     s = sheet.with_inputs(sense=sense)
@@ -141,6 +143,7 @@ def test_normal_includes_the_cam_rotation(sheet):
 # -- closure: all n traces coincide ----------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "n,sense,Z", [(12, "same", 11), (12, "opposite", 13), (7, "same", 6), (7, "opposite", 8)]
 )
@@ -155,6 +158,7 @@ def test_closure_holds(sheet, n, sense, Z):
     assert f[0].verdict == "ok" and f[0].value < 1e-9
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "changes",
     [{"transform": "printed"}, {"ratio": "printed"}, {"transform": "printed", "ratio": "printed"}],
@@ -171,6 +175,7 @@ def test_printed_variants_do_not_close(sheet, changes):
         assert closed.verdict == "warning" and closed.value > 1
 
 
+@pytest.mark.slow
 def test_printed_transform_is_not_a_rotation(sheet):
     s = sheet.with_inputs(transform="printed")
     # a rotation keeps the distance from the axis; the printed (4) does not
@@ -190,6 +195,7 @@ def valley_radius(n, e1, r2, sense):
     return (r2 - e1) ** 2 / (Z**2 * (e1 - e1**2 / r2) - (r2 - e1))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n,sense", [(12, "same"), (12, "opposite"), (7, "opposite")])
 def test_smallest_concave_radius(sheet, n, sense):
     s = sheet.with_inputs(n=n, sense=sense)
@@ -198,6 +204,7 @@ def test_smallest_concave_radius(sheet, n, sense):
     assert rho_min == pytest.approx(valley_radius(n, 2, 40, sense), rel=1e-9)
 
 
+@pytest.mark.slow
 def test_example_limit_is_7_525(sheet):
     assert sheet.evaluate("rho_min").to("mm").magnitude == pytest.approx(7.525, abs=5e-4)
     # at the valley, roller 0
@@ -205,6 +212,7 @@ def test_example_limit_is_7_525(sheet):
     assert sheet.evaluate("rp_packing").to("mm").magnitude == pytest.approx(9.8351, abs=1e-4)
 
 
+@pytest.mark.slow
 def test_rp_7_5_regular(sheet):
     s = sheet.with_inputs(rp="7.5 mm")
     f = [x for x in s.check().findings if x.topic == "undercut"]
@@ -214,6 +222,7 @@ def test_rp_7_5_regular(sheet):
     assert s.table("undercut").empty
 
 
+@pytest.mark.slow
 def test_rp_7_6_undercut(sheet):
     s = sheet.with_inputs(rp="7.6 mm")
     report = s.check()
@@ -251,6 +260,7 @@ def test_rp_7_6_undercut(sheet):
     assert list(ut["kind"]).count("cusp") == 22
 
 
+@pytest.mark.slow
 def test_packing_limit_verdict(sheet):
     s = sheet.with_inputs(e1="0.3 mm", rp="10.3 mm")  # convex; packing limit 10.275 mm
     f = [x for x in s.check().findings if x.topic == "undercut"]
@@ -261,6 +271,7 @@ def test_packing_limit_verdict(sheet):
     assert margin.verdict == "fail" and margin.value == pytest.approx(10.275116 - 10.3, abs=1e-6)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("factor,concave", [(0.98, False), (1.02, True)])
 def test_concave_parts_exist_when_z2_e1_exceeds_r2(sheet, factor, concave):
     e1 = factor * 40 / 121
@@ -275,6 +286,7 @@ def test_concave_parts_exist_when_z2_e1_exceeds_r2(sheet, factor, concave):
 # -- degenerate inputs ----------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sense", ["same", "opposite"])
 def test_e1_zero_gives_circles(sheet, sense):
     s = sheet.with_inputs(e1="0 mm", sense=sense)
@@ -324,6 +336,7 @@ def test_derivatives_are_those_of_the_profile(sheet):
 # -- workbook, chart and CAD export ------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sense,lobes", [("same", 11), ("opposite", 13)])
 def test_profile_has_z_lobes(sheet, sense, lobes):
     p = sheet.with_inputs(sense=sense).table("profile")
@@ -360,6 +373,7 @@ def test_invalid_profile_is_still_written(sheet, tmp_path):
     assert wb["Profile"].max_row > 1900
 
 
+@pytest.mark.slow
 def test_export_profile_csv(sheet, tmp_path):
     path = reducer.export_profile_csv(sheet, tmp_path / "cam.csv")
     lines = path.read_text().splitlines()
@@ -377,6 +391,7 @@ def test_export_profile_csv(sheet, tmp_path):
     assert ok.exists()
 
 
+@pytest.mark.slow
 def test_check_is_quick(sheet):
     import time
 
@@ -459,6 +474,7 @@ def test_row_count_is_the_templates(sheet, sense, table):
     assert rows == {"same": 12 * 181, "opposite": 13 * 180 + 1}[sense]
 
 
+@pytest.mark.slow
 def test_polar_angles_of_the_undercut_are_the_templates(sheet):
     s = sheet.with_inputs(rp="7.6 mm")
     uc = reducer.undercut(s)

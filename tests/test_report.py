@@ -116,6 +116,7 @@ def _canon(node) -> str:
     return re.sub(r"_([0-9])", r"\1", ex.to_text(node))
 
 
+@pytest.mark.slow
 def test_every_template_formula_reads_back(concave):
     """Every formula of every installed template, as displayed, parses back to itself."""
     for name in workbook.list_templates():
@@ -279,6 +280,7 @@ def _compare_cells(cells, indices, values, name) -> int:
     return len(cells)
 
 
+@pytest.mark.slow
 def test_every_number_is_the_engines(concave, concave_report):
     assert check_numbers(concave, concave_report) > 300
 
@@ -349,6 +351,7 @@ def test_long_tables_show_their_ends(tmp_path):
     assert len(full.get_element_by_id("table-t").xpath(".//tbody/tr")) == 1801
 
 
+@pytest.mark.slow
 def test_the_notebook_shows_the_same_rendering(concave, concave_report):
     page = concave_report
     shown = concave._repr_html_()
@@ -359,6 +362,7 @@ def test_the_notebook_shows_the_same_rendering(concave, concave_report):
 # -- command line and API ------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_cli_writes_the_report(tmp_path, capsys):
     path = write_template(tmp_path, SINE_TABLE)
     out = tmp_path / "r.html"
@@ -373,6 +377,7 @@ def test_cli_writes_the_report(tmp_path, capsys):
     assert main(["report", str(path), "--out", str(other), "--force"]) == 0
 
 
+@pytest.mark.slow
 def test_pdf_without_chromium_is_a_clear_error(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("WORKBOOK_CHROMIUM", str(tmp_path / "no-such-chromium"))
     path = write_template(tmp_path, SINE_TABLE)

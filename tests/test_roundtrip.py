@@ -58,6 +58,7 @@ def generated(tmp_path_factory):
     return path
 
 
+@pytest.mark.slow
 def test_edited_R3_gives_what_with_inputs_gives(tmp_path, generated, concave, capsys):
     edited = edit(generated, tmp_path / "edited.xlsx", R3=45)
     out = tmp_path / "again.xlsx"
@@ -97,6 +98,7 @@ def test_unchanged_workbook_changes_nothing(generated, concave):
     assert values["phi_n"].magnitude == 38  # a plain number shown with the label deg
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "change, message",
     [
@@ -115,6 +117,7 @@ def test_bad_edits_are_refused_like_set(tmp_path, generated, capsys, change, mes
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_unknown_rows_and_missing_files(tmp_path, generated, capsys):
     edited = tmp_path / "extra.xlsx"
     shutil.copy(generated, edited)
@@ -134,6 +137,7 @@ def test_unknown_rows_and_missing_files(tmp_path, generated, capsys):
     assert "cannot read it as an xlsx workbook" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_set_wins_over_the_edited_file(tmp_path, generated, concave):
     edited = edit(generated, tmp_path / "e.xlsx", R3=45)
     out = tmp_path / "o.xlsx"
@@ -182,6 +186,7 @@ columns = { phi2 = "rad" }
 """
 
 
+@pytest.mark.slow
 def test_the_parts_that_are_not_formulas_are_regenerated(tmp_path):
     path = write_template(tmp_path, SOLVER, "solver.toml")
     first = tmp_path / "first.xlsx"

@@ -19,6 +19,7 @@ MANY = '[inputs]\nx = "2 mm"\n\n[definitions]\n' + "".join(
 )
 
 
+@pytest.mark.slow
 def test_run_prints_every_result_and_first_n_on_request(tmp_path, capsys):
     path = write_template(tmp_path, MANY)
     assert main(["run", str(path), "--out", str(tmp_path / "m.xlsx")]) == 0
@@ -32,6 +33,7 @@ def test_run_prints_every_result_and_first_n_on_request(tmp_path, capsys):
     assert "  ... and 25 more on the Results sheet" in out
 
 
+@pytest.mark.slow
 def test_a_negative_first_is_refused(tmp_path, capsys):
     path = write_template(tmp_path, MANY)
     assert main(["run", str(path), "--out", str(tmp_path / "m.xlsx"), "--first", "-1"]) == 2

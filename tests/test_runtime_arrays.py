@@ -234,6 +234,7 @@ def test_matrix_rules_when_running():
 
 
 # -- a model: a run-time vector against a Python list -------------------------------------------
+@pytest.mark.slow
 @given(
     st.lists(
         st.tuples(st.integers(min_value=1, max_value=12), st.floats(-1e6, 1e6)),

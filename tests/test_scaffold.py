@@ -10,6 +10,7 @@ from workbook.cli import main
 from workbook.scaffold import starter
 
 
+@pytest.mark.slow
 def test_new_run_and_open_a_workbook_with_a_chart(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["new", "throw"]) == 0
@@ -38,6 +39,7 @@ def test_new_run_and_open_a_workbook_with_a_chart(tmp_path, monkeypatch, capsys)
     assert sheet.check().ok
 
 
+@pytest.mark.slow
 def test_the_starter_sweeps(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["new", "throw"]) == 0
@@ -54,6 +56,7 @@ def test_the_starter_sweeps(tmp_path, monkeypatch):
     assert t.loc[t["alpha [deg]"] == 30, "top [m]"].item() == pytest.approx(top, abs=1e-3)
 
 
+@pytest.mark.slow
 def test_new_refuses_to_overwrite_and_bad_names(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["new", "a"]) == 0

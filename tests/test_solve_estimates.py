@@ -51,6 +51,7 @@ def test_a_well_conditioned_system_is_for_information(tmp_path):
     assert found["solve x, y"].what.startswith("x = 1.910672978 m (error estimate")
 
 
+@pytest.mark.slow
 def test_run_prints_the_unknowns_as_results(tmp_path):
     path = write_template(tmp_path, SHEET)
     out, err = io.StringIO(), io.StringIO()

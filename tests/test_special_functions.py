@@ -41,6 +41,7 @@ def test_every_special_function_is_tested_here():
     assert set(CASES) == NAMES
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_special_function_agrees_with_mpmath(tmp_path, name):
     reference, points, rel = CASES[name]

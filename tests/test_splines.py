@@ -80,6 +80,7 @@ def _exact(ends: str, x: float) -> tuple[float, float]:
     return float(a + b * u + c * u**2 + d * u**3), float(2 * c + 6 * d * u)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "ends, vector, function", [("linear", "N", "n"), ("parabolic", "P", "p"), ("cubic", "C", "c")]
 )

@@ -64,6 +64,7 @@ def test_peak_velocity_over_R3_matches_the_paper_and_its_formula(concave):
     assert printed == pytest.approx(3.152, abs=5e-4)  # Mathcad listing: v1(22) = 3.152
 
 
+@pytest.mark.slow
 def test_vector_serial_and_processes_give_identical_tables(concave):
     outs = {
         "v_peak": V_PEAK,
@@ -100,6 +101,7 @@ def test_a_failed_case_is_recorded_and_the_others_go_on(concave):
     assert "must be positive" in res.table["error"][0] and res.table["error"][1] is None
 
 
+@pytest.mark.slow
 def test_vector_blocks_split_around_failing_cases(concave, monkeypatch):
     grid = {"R3": "5mm..60mm:23", "R1": "15mm..25mm:5"}
     outs = {"v": V_PEAK, "k": "k"}
@@ -176,6 +178,7 @@ units = { twoR = "cm" }
     assert t["twoR [cm]"].tolist() == [2.0, 4.0]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "output, message",
     [
@@ -207,6 +210,7 @@ def test_bad_outputs_are_one_error_and_write_nothing(tmp_path, capsys, output, m
     assert out.read_bytes() == b"old"
 
 
+@pytest.mark.slow
 def test_bad_vary_is_refused(capsys):
     for vary, message in [
         ("R3=40kg..60kg:3", "[mass]"),
@@ -229,6 +233,7 @@ def test_bad_vary_is_refused(capsys):
         assert message in capsys.readouterr().err, vary
 
 
+@pytest.mark.slow
 def test_command_line_writes_a_table_and_a_chart(tmp_path, capsys):
     out = tmp_path / "r3.xlsx"
     code = main(
@@ -305,6 +310,7 @@ def coupling():
     return workbook.load("advance-coupling")
 
 
+@pytest.mark.slow
 def test_steady_phi2_over_c1_serial_and_processes(coupling):
     outs = {"phi2_steady": PHI2}
     serial = sw.sweep(coupling, {"c1": C1_GRID}, outs, mode="serial")

@@ -69,6 +69,7 @@ def _mathcad_sum(op: str, a: str, b: str) -> bool:
 COMBINATIONS = [c for c in itertools.product("+-*/", UNITS, UNITS) if not _mathcad_sum(*c)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("op,a,b", COMBINATIONS, ids=[f"{a}{o}{b}" for o, a, b in COMBINATIONS])
 def test_arithmetic_of_two_temperatures_is_pints(tmp_path, op, a, b):
     """Where the language follows pint; kelvin in a sum with an absolute temperature is a

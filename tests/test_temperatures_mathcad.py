@@ -103,6 +103,7 @@ def every_sum(tmp_path_factory):
     return _sheet(tmp, "".join(f'{n} = "{f}"\n' for n, f in ACCEPTED))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "i,op,a,b",
     [(i, *c) for i, c in enumerate(CASES)],
@@ -155,6 +156,7 @@ def _check_recalculation(tmp, cases):
         assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (name, formula, got, want)
 
 
+@pytest.mark.slow
 def test_the_workbook_recalculates_to_the_engine(tmp_path):
     """The `formulas` package (an independent Excel evaluator) recalculates sums of the
     workbook (one in twelve of the table's) to the engine's number."""
@@ -220,3 +222,26 @@ T_3 = "T_in + eta*(T_2 - T_in)"
         got = sheet.evaluate(name)
         assert str(got.units) == str(un.unit(unit)), (name, got)
         assert _in_kelvin(got) == pytest.approx(kelvin, rel=1e-13), name
+
+
+@pytest.mark.parametrize("unit", ["degC", "degF"])
+def test_an_indexed_sum_of_absolute_temperatures_adds_their_kelvin(sheet_from, unit):
+    """sum(T1 + i*dT, i, 1, n) with T1 absolute: each term is a number of kelvin, as in
+    sum(v) of a vector of temperatures and in Mathcad (not the sum of the scale's numbers)."""
+    sheet = sheet_from(
+        f"""
+[inputs]
+T1 = "27 {unit}"
+dT = "15 K"
+n = "12"
+[definitions]
+S = {{ expr = "sum(T1 + i*dT, i, 1, n)", unit = "K" }}
+v = {{ expr = "[T1, T1 + dT]", unit = "{unit}" }}
+Sv = {{ expr = "sum(v)", unit = "K" }}
+Sk = {{ expr = "sum(T1 + i*dT, i, 1, 2)", unit = "K" }}
+"""
+    )
+    t1 = float(un.registry().Quantity(27, unit).to("K").magnitude)
+    assert sheet.evaluate("S").to("K").magnitude == pytest.approx(12 * t1 + 15 * 78, rel=1e-12)
+    assert sheet.evaluate("Sv").to("K").magnitude == pytest.approx(2 * t1 + 15, rel=1e-12)
+    assert sheet.evaluate("Sk").to("K").magnitude == pytest.approx(2 * t1 + 45, rel=1e-12)

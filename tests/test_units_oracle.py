@@ -179,6 +179,7 @@ def folder(tmp_path_factory):
     return tmp_path_factory.mktemp("units-oracle")
 
 
+@pytest.mark.slow
 @fuzz_settings(300)
 @given(case=expressions)
 def test_the_engine_agrees_with_pint(folder, case):

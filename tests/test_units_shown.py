@@ -49,6 +49,7 @@ def test_pretty_keeps_the_declared_order(text, shown):
     assert un.unit(shown) == un.unit(text)  # what is shown reads back as the same unit
 
 
+@pytest.mark.slow
 def test_run_and_the_workbook_show_the_declared_units(tmp_path):
     path = write_template(tmp_path, SHEET, "shown.toml")
     code = "import sys; from workbook.cli import main; sys.exit(main())"

@@ -65,7 +65,8 @@ import numpy as np
 from ..errors import InputError, LimitError, NotLive, TemplateError, UnitError
 from ..language import typed as ty
 from ..language.expr import PREC
-from ..language.units import pretty
+from ..language.unitrules import sum_kind
+from ..language.units import pretty, registry
 from .complexes import classic, im_call, im_cosh, im_sinh, im_tan, im_tanh
 from .entry import Builtin, Domain, UnitContext, register
 
@@ -435,6 +436,8 @@ def _sum_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
         raise UnitError(f"sum(): the index {var.name} must be a plain number (integers A..B)")
     a = ctx.plain(a, "sum(): the first index")
     b = ctx.plain(b, "sum(): the last index")
+    if sum_kind(body.unit) == "absolute":  # as sum(v) and Mathcad: absolute ones add in kelvin
+        body = ctx.convert(body, registry().kelvin, "sum()")
     # a sum of vectors or matrices (of one shape, or of a run-time array) has their shape
     return ty.TFunc(body.unit, func=name, args=(body, var, a, b), shape=body.shape)
 
