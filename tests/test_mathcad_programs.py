@@ -361,3 +361,43 @@ def test_break_inside_a_loop_stays_and_continue_outside_is_listed(tmp_path, caps
     assert 'v = { expr = "[0, v_of(0), v_of(1), v_of(2)]"' in text
     result = _check(tmp_path, capsys, "loops")
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
+
+
+def test_a_program_as_the_value_of_a_local(tmp_path, capsys):
+    """f(n) := | k <- (| 4 if n = 4 ; 3 if n = 3 ; 9 if n > 3) ; k + 1: the inner program's
+    value is that of the last line it ran (a false `if` line runs nothing), so f(4) = 10
+    (its third line ran after its first) and f(3) = 4; f(2) runs no value line, and its
+    stored 1 (what a value of 0 would give) is not computable, never reproduced."""
+    inner = _program(
+        _if(_apply("equal", _id("n"), _real(4)), _real(4)),
+        _if(_apply("equal", _id("n"), _real(3)), _real(3)),
+        _if(_apply("greaterThan", _id("n"), _real(3)), _real(9)),
+    )
+    body = _program(_local(_id("k"), inner), _apply("plus", _id("k"), _real(1)))
+    _import(
+        tmp_path,
+        capsys,
+        "inner",
+        _function(1, "f", ["n"], body),
+        _eval(2, _call("f", _real(4)), _real(10)),
+        _eval(3, _call("f", _real(3)), _real(4)),
+        _eval(4, _call("f", _real(2)), _real(1)),
+    )
+    result = _check(tmp_path, capsys, "inner")
+    counts = (result["reproduced"], result["failed"], result["not_computable"])
+    assert counts == (2, 0, 1), result["failures"]
+
+
+def test_a_local_program_that_reads_a_local_is_refused(tmp_path, capsys):
+    """g(n) := | s <- n ; k <- (| s if s > 1 ; 0 otherwise) ; k: the inner program reads the
+    local s, which it would need as an argument: the function is listed as not translated."""
+    inner = _program(_if(_apply("greaterThan", _id("s"), _real(1)), _id("s")), _otherwise(_real(0)))
+    body = _program(_local(_id("s"), _id("n")), _local(_id("k"), inner), _id("k"))
+    text = _import(
+        tmp_path,
+        capsys,
+        "reads",
+        _function(1, "g", ["n"], body),
+        _eval(2, _call("g", _real(3)), _real(3)),
+    )
+    assert "a program as the value of a local that reads or sets the program's s" in text

@@ -14,6 +14,7 @@ from . import names as nm
 from .reader import MNode
 from .symbols import Sym, Untranslatable, matrix_size, what
 from .symbols import key as name_key
+from .translation import Item
 
 Line = tuple[int, list]  # (indent, parts: text or expression trees)
 
@@ -278,8 +279,44 @@ class ProgramTranslator:
             return []
         if lhs.tag != "id":
             raise Untranslatable("an assignment to something that is not a name in a program")
+        if rhs.tag == "program":
+            value = self._subprogram(lhs, rhs)
+            return [(0, [self._local(lhs), " := ", value])]
         value = self._expr(rhs)  # the right side sees the local's previous value
         return [(0, [self._local(lhs), " := ", value])]
+
+    def _subprogram(self, lhs: MNode, rhs: MNode) -> ex.Node:
+        """k <- program: the inner program's value (Mathcad's: that of the last line it ran,
+        a false ``if`` line running nothing) as a function of the sheet's of its own, called
+        with the parameters it reads; one that runs no value line is then an error of that
+        function, never a value. It may read the program's parameters and the sheet's names,
+        not the program's locals, nor set a name of the program."""
+        inner = rhs.children
+        whole, elements = _targets(inner)
+        sets = (set(whole) | elements) & (set(self.scope) | set(self.params))
+        read = {key for key, _ in _reads(rhs)} - set(whole) - elements
+        locals_read = sorted(s.mathcad for k, s in self.locals.items() if k in read)
+        if sets or locals_read:
+            names = sorted(self.scope[k].mathcad for k in sets if k in self.scope) + locals_read
+            raise Untranslatable(
+                f"a program as the value of a local that reads or sets the program's "
+                f"{', '.join(names)}"
+            )
+        params = [(k, s) for k, s in self.params.items() if k in read]
+        scope = dict(params)
+        scope |= {k: s for k, s in self.scope.items() if s.kind == "func"}  # local functions
+        parts = self.tr.program(rhs, scope)
+        base = f"{nm.identifier(*name_key(lhs))}_value"
+        if not params:
+            sym = self.tr.new_sym("var", base, base, self.tr.region, generated=True)
+            self.tr.out.items.append(Item("definition", self.tr.region, sym=sym, **parts))
+            return ex.Name(sym.token())
+        sym = self.tr.new_sym("func", base, base, self.tr.region, generated=True)
+        psyms = [s for _, s in params]
+        self.tr.out.items.append(Item("function", self.tr.region, sym=sym, params=psyms, **parts))
+        args = tuple(ex.Name(s.token()) for s in psyms)
+        self.tr.calls.setdefault(sym, []).append(args)
+        return ex.Call(sym.token(), args)
 
     def _local_function(self, lhs: MNode, rhs: MNode) -> None:
         """f(x, y) <- EXPR: a local function, written out at each call (``f(2, 3)`` is EXPR
