@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from mathcad_xml import (
     apply,
+    array_cells,
     call,
     check_sheet,
     define,
@@ -32,18 +33,13 @@ from workbook.cli import main
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
-def _cells(m: np.ndarray) -> str:
-    """A matrix as Mathcad stores it (column by column)."""
-    return matrix(*(real(v) for v in m.T.flatten()), cols=m.shape[1])
-
-
 def test_the_determinant_operator_is_det(tmp_path, capsys):
     m = np.array([[6.5, 4.2, 4.7], [6.2, -1.5, -5.0], [6.3, 2.2, 4.9]])
     text = import_sheet(
         tmp_path,
         capsys,
         "det",
-        define(1, ident("M"), _cells(m)),
+        define(1, ident("M"), array_cells(m)),
         define(2, ident("d"), shown(apply("determinant", ident("M")), real(np.linalg.det(m)))),
     )
     assert 'd = { expr = "det(M)"' in text
@@ -82,7 +78,7 @@ def test_rkfixed_is_mathcad_runge_kutta(tmp_path, capsys):
         "rk",
         function(1, "D", ["x", "y"], deriv),
         define(2, ident("y0"), matrix(real(1), real(0))),
-        define(3, ident("u"), shown(rk, _cells(expected))),
+        define(3, ident("u"), shown(rk, array_cells(expected))),
     )
     result = check_sheet(tmp_path, capsys, "rk")
     assert (result["printed"], result["reproduced"]) == (33, 33), result["failures"][:3]
@@ -93,12 +89,12 @@ def test_histogram_of_a_matrix_counts_every_element(tmp_path, capsys):
     m = np.array([[0.5, 2.5], [1.5, 3.9], [0.1, 2.0]])
     counts, edges = np.histogram(m.flatten(), bins=4)
     mids = (edges[:-1] + edges[1:]) / 2
-    stored = _cells(np.column_stack([mids, counts]))
+    stored = array_cells(np.column_stack([mids, counts]))
     import_sheet(
         tmp_path,
         capsys,
         "hist",
-        define(1, ident("M"), _cells(m)),
+        define(1, ident("M"), array_cells(m)),
         define(2, ident("n"), real(4)),
         define(3, ident("H"), shown(call("histogram", ident("n"), ident("M")), stored)),
     )

@@ -4,12 +4,12 @@ and worksheet functions, indices and columns, sums, integrals and derivatives, v
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from ..language import expr as ex
 from ..language.visitor import Visitor
 from . import names as nm
 from . import trees as tt
+from .context import TranslatorContext
 from .functions import (
     FIXED_ORDER,
     MATHCAD_FUNCTIONS,
@@ -26,9 +26,6 @@ from .symbols import what as _what
 from .translation import uses
 from .units import FORMULA_UNITS
 
-if TYPE_CHECKING:
-    from .translate import Translator
-
 
 def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
     """Prime's vector sum: Σ whose bound variable and upper bound are empty placeholders."""
@@ -43,7 +40,7 @@ def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
 class ExprTranslator(Visitor):
     """Mathcad math element -> expression tree, names resolved in a scope."""
 
-    def __init__(self, tr: Translator, local: dict[tuple[str, str], Sym] | None = None):
+    def __init__(self, tr: TranslatorContext, local: dict[tuple[str, str], Sym] | None = None):
         self.tr = tr
         self.local = local or {}
         self.ranges: list[Sym] = []  # range variables this expression uses
@@ -530,7 +527,7 @@ ELEMENTWISE = frozenset(
 )  # fmt: skip
 
 
-def whole_at_import(tr: Translator, node: MNode, what: str) -> int:
+def whole_at_import(tr: TranslatorContext, node: MNode, what: str) -> int:
     """A size Mathcad gives as an expression: a whole number of at least 1 known at import."""
     try:
         value = float(tr.quantity(node).to("").magnitude)

@@ -6,17 +6,14 @@ rewrites of the language's trees (renaming, substituting)."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from ..language import expr as ex
+from .context import TranslatorContext
 from .functions import ORIGIN_FUNCTIONS, WRITERS
 from .reader import MNode, Region
 from .symbols import Untranslatable, matrix_size, whole_number
 from .symbols import key as _key
 from .units import FORMULA_UNITS, result_unit
-
-if TYPE_CHECKING:
-    from .translate import Translator
 
 BINARY = {"plus": "+", "minus": "-", "mult": "*", "div": "/", "pow": "^"}
 COMPARE = {
@@ -372,7 +369,7 @@ def quantity_text(node: MNode) -> str | None:
     return None
 
 
-def range_values(tr: Translator, first: MNode, second: MNode | None, last: MNode):
+def range_values(tr: TranslatorContext, first: MNode, second: MNode | None, last: MNode):
     """Mathcad's values of a range first, second .. last (up to last, not beyond), and the
     range's unit; the bounds must be values known at import (numbers, inputs, definitions)."""
     why = "a range whose bounds are not values known at import"
