@@ -64,6 +64,18 @@ class ExprTranslator(Visitor):
             return ex.Unary("-", ex.Number(-value))
         return ex.Number(value)
 
+    def visit_imag(self, node: MNode) -> ex.Node:
+        """Mathcad's imaginary literal (``4i``, ``2j``: its text is the imaginary part)."""
+        try:
+            value = float(node.text.strip())
+        except ValueError:
+            raise Untranslatable(f"the imaginary number {node.text.strip()!r}") from None
+        if not math.isfinite(value):
+            raise Untranslatable(f"the imaginary number {node.text.strip()!r} is not finite")
+        if math.copysign(1.0, value) < 0:
+            return ex.Unary("-", ex.Imaginary(-value))
+        return ex.Imaginary(value)
+
     def visit_parens(self, node: MNode) -> ex.Node:
         return self.visit(node.children[0])
 

@@ -253,6 +253,8 @@ def leaves(node: MNode, path: tuple = ()):
     matrix column by column)."""
     if node.tag != "matrix":
         unit, values = stored(node)
+        if any(isinstance(v, complex) for v in values):
+            raise Untranslatable("a complex number inside a nested array result")
         if len(values) != 1:
             raise Untranslatable("a nested array result with a matrix that has units")
         yield path, unit, values[0]
@@ -307,8 +309,15 @@ def stored(node: MNode) -> tuple[str, list[float | str]]:
         return (units.pop() if units else ""), values
     if node.tag == "unreadable":
         raise Untranslatable(node.attrs.get("why", "a stored result that cannot be read"))
-    if node.tag == "complex":
-        raise Untranslatable("a complex result (complex numbers are not in the language)")
+    if node.tag == "complex":  # Mathcad's <complex><real/><imag/></complex>
+        parts = {c.tag: c.text for c in node.children}
+        try:
+            z = complex(float(parts.get("real", "0")), float(parts["imag"]))
+        except (KeyError, ValueError):
+            raise Untranslatable("a stored complex number that cannot be read") from None
+        if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+            raise Untranslatable("a stored complex number that is not finite")
+        return "", [z]
     raise Untranslatable(f"a result of kind <{node.tag}>")
 
 
