@@ -506,6 +506,9 @@ class ExprTranslator(Visitor):
             raise Untranslatable("matrix(m, n, f) whose f is not the name of a function")
         if sym.broken:
             raise Untranslatable(uses(sym))
+        if any(_key(n) in self.local for a in args[:2] for n in tt.walk(a) if n.tag == "id"):
+            # a program's local or parameter: never the sheet's name of the same spelling
+            raise Untranslatable("matrix(m, n, f) whose size is not a number known at import")
         m, n = (whole_at_import(self.tr, a, "matrix(m, n, f)") for a in args[:2])
         if m * n > MAX_WRITTEN_ELEMENTS:
             raise Untranslatable(f"matrix(m, n, f) of more than {MAX_WRITTEN_ELEMENTS} elements")

@@ -242,6 +242,13 @@ def unit_monomial(node: MNode) -> str:
     return " * ".join(parts)
 
 
+def walk(node: MNode):
+    """``node`` and every node under it."""
+    yield node
+    for c in node.children:
+        yield from walk(c)
+
+
 def is_nested(node: MNode) -> bool:
     """Is ``node`` a stored array whose elements are arrays (Mathcad's nested array)?"""
     return node.tag == "matrix" and any(c.tag == "matrix" for c in node.children)
