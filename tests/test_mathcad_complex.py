@@ -84,3 +84,34 @@ def test_prime_imaginary_unit(tmp_path, capsys):
     capsys.readouterr()
     result = check_sheet(tmp_path, capsys, "prime-cx")
     assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]
+
+
+def test_a_complex_result_not_translated_counts_each_number_once(tmp_path, capsys):
+    """v = [1 + 2i; 3] shown for a name the sheet never defines: its two stored numbers are
+    two values, not computable (each counted once, never compared)."""
+    import_sheet(
+        tmp_path,
+        capsys,
+        "cxlost",
+        evaluate(1, ident("v"), matrix(stored(1 + 2j), real(3))),
+    )
+    result = check_sheet(tmp_path, capsys, "cxlost")
+    assert (result["printed"], result["not_computable"]) == (2, 2), result
+
+
+def test_a_complex_result_over_a_range(tmp_path, capsys):
+    """x := 0 .. 2; x + 2i = [2i; 1 + 2i; 2 + 2i]: the real and imaginary parts at each x."""
+    rng = "<ml:range><ml:real>0</ml:real><ml:real>2</ml:real></ml:range>"
+    import_sheet(
+        tmp_path,
+        capsys,
+        "cxrange",
+        define(1, ident("x"), rng),
+        evaluate(
+            2,
+            apply("plus", ident("x"), imag(2.0)),
+            matrix(*(stored(complex(v, 2)) for v in range(3))),
+        ),
+    )
+    result = check_sheet(tmp_path, capsys, "cxrange")
+    assert (result["printed"], result["reproduced"]) == (6, 6), result["failures"]

@@ -144,7 +144,10 @@ class ResultsMixin:
                 et = ExprTranslator(self)
                 base = et.value(expr)
                 if et.ranges:
-                    raise Untranslatable("a complex result over a range variable")
+                    self.complex_over_range(
+                        region, base, list(dict.fromkeys(et.ranges)), unit, parts, mathcad
+                    )
+                    return
             if not isinstance(base, ex.Name):  # one definition, read by both parts
                 whole = self.new_sym("helper", f"result_{region.id}_value", mathcad, region.id)
                 self.out.items.append(Item("definition", region.id, sym=whole, body=base))
@@ -158,13 +161,33 @@ class ResultsMixin:
                 call = ex.Call(part, (base,))
                 self.out.items.append(Item("definition", region.id, sym=sym, body=call))
                 self.out.results.append(Result(region.id, sym, what, unit, [(None, numbers[0])]))
-        except Untranslatable as why:
-            flat = [x for p in parts for x in p]
-            self.broken_result(region, mathcad, unit, flat, str(why))
+        except Untranslatable as why:  # each number Mathcad stored counts once, as a text
+            texts = [f"{a!r}{'-' if b < 0 else '+'}{abs(b)!r}i" for a, b in parts]
+            self.broken_result(region, mathcad, unit, texts, str(why))
             if target is None:
                 raise
             if not target.broken:
                 self.skip(region.id, f"the result of {mathcad}", str(why))
+
+    def complex_over_range(self, region: Region, body: ex.Node, ranges, unit, parts, mathcad):
+        """A complex result of an expression over one range variable: the real and the
+        imaginary part at each of the range's values, each a function of it."""
+        if len(ranges) > 1:
+            raise Untranslatable("an evaluation over two range variables (a matrix)")
+        var = ranges[0]
+        at = next(i for i in self.out.items if i.sym is var).range_values
+        if len(at) != len(parts):
+            raise Untranslatable(
+                f"Mathcad lists {len(parts)} values of the range {var.mathcad}, which has {len(at)}"
+            )
+        for k, part in enumerate(("Re", "Im")):
+            param = self.new_sym("param", var.base, var.mathcad, unit=var.unit)
+            what = f"{part}({mathcad})"
+            sym = self.new_sym("helper", f"result_{region.id}_{part.lower()}", what, region.id)
+            inner = ex.Call(part, (tt.rename(body, {var.token(): param.token()}),))
+            self.out.items.append(Item("function", region.id, sym=sym, params=[param], body=inner))
+            values = list(zip(at, (p[k] for p in parts)))
+            self.out.results.append(Result(region.id, sym, what, unit, values, param))
 
     def broken_result(self, region: Region, mathcad: str, unit: str, values, why: str) -> None:
         """Stored values whose evaluation is not translated: kept, so they count."""
