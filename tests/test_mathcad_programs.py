@@ -467,3 +467,20 @@ def test_a_local_function_reading_a_local_set_twice_is_refused(tmp_path, capsys)
 def _function_lhs(name: str, *params: str) -> str:
     bound = "".join(_id(p) for p in params)
     return f"<ml:function>{_id(name)}<ml:boundVars>{bound}</ml:boundVars></ml:function>"
+
+
+def test_a_matrix_of_names_defined_with_its_value_shown(tmp_path, capsys):
+    """[a; b] := [3; 4·2] = [3; 8] (Prime shows the right side's value): the value compared
+    element by element, and a + b = 11 reads the names."""
+    lhs = _matrix(_id("a"), _id("b"))
+    rhs = _matrix(_real(3), _apply("mult", _real(4), _real(2)))
+    shown = f"<ml:eval>{rhs}<ml:result>{_matrix(_real(3), _real(8))}</ml:result></ml:eval>"
+    _import(
+        tmp_path,
+        capsys,
+        "names",
+        _define(1, lhs, shown),
+        _eval(2, _apply("plus", _id("a"), _id("b")), _real(11)),
+    )
+    result = _check(tmp_path, capsys, "names")
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]

@@ -430,8 +430,15 @@ class Translator(ResultsMixin, SolveMixin):
                 element = not tt.shows_array(evaluation) and not tt.mentions(rhs, key)
                 self.evaluation(region, evaluation, None if element else self.scope[key])
             return
-        if lhs.tag == "matrix" and evaluation is None:
-            self.destructure(region, lhs, rhs)
+        if lhs.tag == "matrix":
+            try:
+                whole = self.destructure(region, lhs, rhs)
+            except Untranslatable:
+                if evaluation is not None:
+                    self.stored_but_broken(region, evaluation, "[...] := ...")
+                raise
+            if evaluation is not None:  # [a; b] := value = the value Mathcad shows
+                self.evaluation(region, evaluation, whole)
             return
         if lhs.tag != "id":
             if evaluation is not None:
@@ -724,9 +731,9 @@ class Translator(ResultsMixin, SolveMixin):
             return len(tree.rows), len(tree.rows[0])
         return None
 
-    def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> None:
-        """[a; b] := value: the value a definition of its own (``parts``), then each name
-        its element at ORIGIN."""
+    def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> Sym:
+        """[a; b] := value: the value a definition of its own (``parts``, returned), then
+        each name its element at ORIGIN."""
         rows, cols = matrix_size(lhs)
         names = lhs.children
         if rows * cols != len(names) or not names or any(n.tag != "id" for n in names):
@@ -756,6 +763,7 @@ class Translator(ResultsMixin, SolveMixin):
                 sym = self.define(_key(names[c * rows + r]), "var", region.id)
                 item = ex.Index(ex.Name(whole.token()), index)
                 self.out.items.append(Item("definition", region.id, sym=sym, body=item))
+        return whole
 
     def element(self, region: Region, key, lhs: MNode, rhs: MNode) -> None:
         """v[k] := value at an index that is not a range variable (Mathcad sets one element
