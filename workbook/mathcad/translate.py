@@ -386,6 +386,10 @@ class Translator(ResultsMixin, SolveMixin):
             self.definition(region, node)
         elif node.tag == "eval":
             self.evaluation(region, node, None)
+        elif node.tag == "symEval" and tt.symbolic_numbers(node) is not None:
+            # expr → a number Mathcad found: compared as a stored result of expr
+            found = MNode("result", {}, "", [tt.symbolic_numbers(node)], node.line)
+            self.evaluation(region, MNode("eval", {}, "", [node.children[0], found]), None)
         elif node.tag == "id" and node.text.strip() == "Given":
             self.close_given("a solve block without Find")
             self.given = [region.id]

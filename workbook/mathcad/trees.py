@@ -215,6 +215,34 @@ def symbolic_result(node: MNode) -> MNode:
     return node
 
 
+def symbolic_numbers(node: MNode) -> MNode | None:
+    """The result of a symbolic evaluation (→) without keywords, as a stored result, where
+    Mathcad found a number or a matrix of numbers; else None (an expression is no value to
+    compare, and a keyword such as ``float, 3`` rounds the result)."""
+    if len(node.children) != 2 or node.children[1].tag != "symResult":
+        return None
+    found = node.children[1].children
+    if len(found) != 1:
+        return None
+
+    def number(n: MNode) -> MNode | None:
+        if n.tag == "real":
+            return n
+        if n.tag == "apply" and len(n.children) == 2 and n.children[0].tag == "neg":
+            inner = number(n.children[1])
+            if inner is not None and not inner.text.strip().startswith("-"):
+                return MNode("real", {}, "-" + inner.text.strip(), [], inner.line)
+        return None
+
+    value = found[0]
+    if value.tag == "matrix":
+        cells = [number(c) for c in value.children]
+        if not cells or any(c is None for c in cells):
+            return None
+        return MNode("matrix", dict(value.attrs), "", cells, value.line)
+    return number(value)
+
+
 def has_matrix(tree: ex.Node) -> bool:
     """Is a vector or matrix written inside ``tree``?"""
     return any(isinstance(n, ex.Matrix) for n in ex.walk(tree))
