@@ -8,7 +8,8 @@ from mathcad_xml import ML, apply, at, check_sheet, define, ident, import_sheet,
 
 
 def symbolic(rid: int, expr: str, found: str, keywords: str = "") -> str:
-    body = f'<ml:symEval xmlns:ml="{ML}">{expr}{keywords}<ml:symResult>{found}</ml:symResult></ml:symEval>'
+    inner = f"{expr}{keywords}<ml:symResult>{found}</ml:symResult>"
+    body = f'<ml:symEval xmlns:ml="{ML}">{inner}</ml:symEval>'
     return f"<region {at(rid)}><math>{body}</math></region>"
 
 
