@@ -175,3 +175,25 @@ def test_prime_divides_a_number_by_a_vector_element_by_element(tmp_path, capsys)
     main(["check", str(tmp_path / "periods.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
     assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
+
+
+def test_linfit_is_the_least_squares_combination(tmp_path, capsys):
+    """F(x) := [1; x; sin(x)]; c := linfit(vx, vy, F): against numpy's least squares."""
+    vx = np.array([0.5, 1.0, 2.0, 3.5, 4.0, 6.0])
+    vy = np.array([1.2, 2.3, 2.9, 4.1, 5.6, 6.2])
+    design = np.stack([np.ones_like(vx), vx, np.sin(vx)], axis=1)
+    want = np.linalg.lstsq(design, vy, rcond=None)[0]
+    f_body = matrix(real(1), ident("x"), call("sin", ident("x")))
+    fit = call("linfit", f"<ml:sequence>{ident('vx')}{ident('vy')}{ident('F')}</ml:sequence>")
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "linfit",
+        define(1, ident("vx"), matrix(*(real(float(v)) for v in vx))),
+        define(2, ident("vy"), matrix(*(real(float(v)) for v in vy))),
+        function(3, "F", ["x"], f_body),
+        define(4, ident("c"), shown(fit, matrix(*(real(repr(float(v))) for v in want)))),
+    )
+    assert "geninv(stack(transpose(F(vx[0]))" in text
+    result = check_sheet(tmp_path, capsys, "linfit")
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]

@@ -439,6 +439,8 @@ class ExprTranslator(Visitor):
             from .odes import rkfixed
 
             return rkfixed(self, args)
+        if text == "linfit" and not key[1] and len(args) == 3:
+            return self._linfit(args)
         if text == "histogram" and not key[1] and len(args) == 2:
             return self._histogram(args)
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
@@ -494,6 +496,32 @@ class ExprTranslator(Visitor):
                 ),
             )
         return self._builtin("histogram", "histogram", [n, data])
+
+    def _linfit(self, args: list[MNode]) -> ex.Node:
+        """Mathcad's linfit(vx, vy, F): the coefficients of the combination of the functions
+        of F (a function of x giving a vector) nearest vy in least squares, ``geninv(A) *
+        vy`` where row i of A is F(vx[i]) (vx a vector of the sheet of a length known at
+        import, written out row by row)."""
+        vx, vy = self.value(args[0]), self.value(args[1])
+        f = tt.unparen(args[2])
+        sym = (self.local.get(_key(f)) or self.tr.scope.get(_key(f))) if f.tag == "id" else None
+        if sym is None or sym.kind != "func":
+            raise Untranslatable("linfit(vx, vy, F) whose F is not the name of a function")
+        if sym.broken:
+            raise Untranslatable(uses(sym))
+        n = self.tr.vector_length_of(vx) if isinstance(vx, ex.Name) else None
+        if n is None or n > MAX_WRITTEN_ELEMENTS:
+            raise Untranslatable("linfit(vx, vy, F) whose vx is not a vector of a known length")
+        rows = []
+        for i in range(n):
+            x = (ex.Index(vx, (ex.Number(float(self.tr.sheet_origin + i)),)),)
+            if sym.token() in self.tr.inline:
+                row = self.tr.local_call(sym, x)
+            else:
+                self.tr.calls.setdefault(sym, []).append(x)
+                row = ex.Call(sym.token(), x)
+            rows.append(ex.Call("transpose", (row,)))
+        return ex.Binary("*", ex.Call("geninv", (ex.Call("stack", tuple(rows)),)), vy)
 
     def _matrix_of_function(self, args: list[MNode]) -> ex.Node:
         """Mathcad's matrix(m, n, f): the m x n matrix of f(i, j), i and j counted from 0

@@ -97,8 +97,6 @@ REFUSED: dict[str, str] = {
     "regress": "gives a vector whose first elements are Mathcad's own bookkeeping for interp "
     "(the language fits a line with fit_slope and fit_intercept)",
     "loess": "gives a vector of Mathcad's own local fits for interp, not a formula",
-    "linfit": "fits a combination of the functions of a vector of functions, which the language "
-    "has no value for",
     "genfit": "fits by Mathcad's own nonlinear solver from a guess, with a vector of functions "
     "the language has no value for",
 }  # fmt: skip
