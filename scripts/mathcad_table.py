@@ -94,6 +94,7 @@ def evaluations(toml: Path, failures: list[dict]) -> tuple[int, int]:
 def _short(reason: str) -> str:
     reason = re.sub(r"uses \S+, which is not translated: ", "uses an untranslated name: ", reason)
     reason = re.sub(r"piece '.*?': ", "", reason)
+    reason = re.sub(r" (for|at) [^ ]+ = [^ :;]+", "", reason)  # one reason for every argument
     return reason[:150]
 
 

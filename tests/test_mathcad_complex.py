@@ -115,3 +115,21 @@ def test_a_complex_result_over_a_range(tmp_path, capsys):
     )
     result = check_sheet(tmp_path, capsys, "cxrange")
     assert (result["printed"], result["reproduced"]) == (6, 6), result["failures"]
+
+
+def test_the_functions_of_complex_numbers(tmp_path, capsys):
+    """Z := 3 + 4i; Re(Z) = 3, Im(Z) = 4, arg(Z) = atan2(4, 3) (Mathcad's names)."""
+    from mathcad_xml import call
+
+    z = 3 + 4j
+    import_sheet(
+        tmp_path,
+        capsys,
+        "cxfun",
+        define(1, ident("Z"), apply("plus", real(3), imag(4.0))),
+        evaluate(2, call("Re", ident("Z")), real(z.real)),
+        evaluate(3, call("Im", ident("Z")), real(z.imag)),
+        evaluate(4, call("arg", ident("Z")), real(cmath.phase(z))),
+    )
+    result = check_sheet(tmp_path, capsys, "cxfun")
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]

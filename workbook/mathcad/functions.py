@@ -55,6 +55,8 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "Jn": ("bessel_j", None), "Yn": ("bessel_y", None), "In": ("bessel_i", None),
     "Kn": ("bessel_k", None), "combin": ("combin", None), "permut": ("permut", None),
     "cholesky": ("cholesky", None),
+    # complex numbers (docs/language.md, Complex numbers)
+    "Re": ("Re", None), "Im": ("Im", None), "arg": ("arg", None),
 }  # fmt: skip
 
 #: Mathcad's Bessel functions of a fixed order: ``J0(x)`` is ``bessel_j(0, x)``.
