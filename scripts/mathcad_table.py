@@ -42,19 +42,26 @@ def reasons(toml: Path, failures: list[dict]) -> Counter:
     """Why each result is not reproduced: the untranslated region's reason, else the error."""
     text = toml.read_text(encoding="utf-8")
     why = dict(re.findall(r"^#   region (\S+): (.*)$", text, re.M))
+    # a definition left out, by its Mathcad name (its value may be shown in another region)
+    by_name = dict(re.findall(r"^#   region \S+: (\S+) := \.\.\.: (.*)$", text, re.M))
     region_of: dict[str, str] = {}
+    shown: dict[str, str] = {}  # region -> the Mathcad name it shows
     for csv in toml.parent.glob(f"{toml.stem}.mathcad*.csv"):
         region = None
         for line in csv.read_text(encoding="utf-8").splitlines():
-            m = re.match(r"# region (\S+):", line)
+            m = re.match(r"# region (\S+): (\S+)$", line) or re.match(r"# region (\S+):", line)
             if m:
                 region = m.group(1)
+                if m.lastindex == 2:
+                    shown[region] = m.group(2)
             elif region and line and not line.startswith("#"):
                 region_of.setdefault(line.split(",")[0], region)
     counts: Counter = Counter()
     for f in failures:
         region = region_of.get(f["name"])
-        if region in why:
+        if region not in why and shown.get(region) in by_name:
+            reason = by_name[shown[region]]
+        elif region in why:
             reason = why[region].split(": ", 1)[-1]
         elif "error" in f:
             reason = "error: " + f["error"].split(": ", 2)[-1]
@@ -87,6 +94,7 @@ def evaluations(toml: Path, failures: list[dict]) -> tuple[int, int]:
 def _short(reason: str) -> str:
     reason = re.sub(r"uses \S+, which is not translated: ", "uses an untranslated name: ", reason)
     reason = re.sub(r"piece '.*?': ", "", reason)
+    reason = re.sub(r" (for|at) [^ ]+ = [^ :;]+", "", reason)  # one reason for every argument
     return reason[:150]
 
 

@@ -39,6 +39,11 @@ def matrix(*cells, cols=1) -> str:
     return f'<ml:matrix rows="{rows}" cols="{cols}">{"".join(cells)}</ml:matrix>'
 
 
+def array_cells(m) -> str:
+    """A numpy matrix as Mathcad stores it (column by column)."""
+    return matrix(*(real(v) for v in m.T.flatten()), cols=m.shape[1])
+
+
 def local(lhs, rhs) -> str:
     return f"<ml:localDefine>{lhs}{rhs}</ml:localDefine>"
 

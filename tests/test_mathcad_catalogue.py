@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from mathcad_xml import (
     apply,
+    array_cells,
     call,
     check_sheet,
     define,
@@ -32,11 +33,6 @@ from workbook.cli import main
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 
-def _cells(m: np.ndarray) -> str:
-    """A matrix as Mathcad stores it (column by column)."""
-    return matrix(*(real(v) for v in m.T.flatten()), cols=m.shape[1])
-
-
 @pytest.mark.slow
 def test_the_determinant_operator_is_det(tmp_path, capsys):
     m = np.array([[6.5, 4.2, 4.7], [6.2, -1.5, -5.0], [6.3, 2.2, 4.9]])
@@ -44,7 +40,7 @@ def test_the_determinant_operator_is_det(tmp_path, capsys):
         tmp_path,
         capsys,
         "det",
-        define(1, ident("M"), _cells(m)),
+        define(1, ident("M"), array_cells(m)),
         define(2, ident("d"), shown(apply("determinant", ident("M")), real(np.linalg.det(m)))),
     )
     assert 'd = { expr = "det(M)"' in text
@@ -84,7 +80,7 @@ def test_rkfixed_is_mathcad_runge_kutta(tmp_path, capsys):
         "rk",
         function(1, "D", ["x", "y"], deriv),
         define(2, ident("y0"), matrix(real(1), real(0))),
-        define(3, ident("u"), shown(rk, _cells(expected))),
+        define(3, ident("u"), shown(rk, array_cells(expected))),
     )
     result = check_sheet(tmp_path, capsys, "rk")
     assert (result["printed"], result["reproduced"]) == (33, 33), result["failures"][:3]
@@ -96,12 +92,12 @@ def test_histogram_of_a_matrix_counts_every_element(tmp_path, capsys):
     m = np.array([[0.5, 2.5], [1.5, 3.9], [0.1, 2.0]])
     counts, edges = np.histogram(m.flatten(), bins=4)
     mids = (edges[:-1] + edges[1:]) / 2
-    stored = _cells(np.column_stack([mids, counts]))
+    stored = array_cells(np.column_stack([mids, counts]))
     import_sheet(
         tmp_path,
         capsys,
         "hist",
-        define(1, ident("M"), _cells(m)),
+        define(1, ident("M"), array_cells(m)),
         define(2, ident("n"), real(4)),
         define(3, ident("H"), shown(call("histogram", ident("n"), ident("M")), stored)),
     )
@@ -184,4 +180,26 @@ def test_prime_divides_a_number_by_a_vector_element_by_element(tmp_path, capsys)
     capsys.readouterr()
     main(["check", str(tmp_path / "periods.toml"), "--json"])
     result = json.loads(capsys.readouterr().out)
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
+
+
+def test_linfit_is_the_least_squares_combination(tmp_path, capsys):
+    """F(x) := [1; x; sin(x)]; c := linfit(vx, vy, F): against numpy's least squares."""
+    vx = np.array([0.5, 1.0, 2.0, 3.5, 4.0, 6.0])
+    vy = np.array([1.2, 2.3, 2.9, 4.1, 5.6, 6.2])
+    design = np.stack([np.ones_like(vx), vx, np.sin(vx)], axis=1)
+    want = np.linalg.lstsq(design, vy, rcond=None)[0]
+    f_body = matrix(real(1), ident("x"), call("sin", ident("x")))
+    fit = call("linfit", f"<ml:sequence>{ident('vx')}{ident('vy')}{ident('F')}</ml:sequence>")
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "linfit",
+        define(1, ident("vx"), matrix(*(real(float(v)) for v in vx))),
+        define(2, ident("vy"), matrix(*(real(float(v)) for v in vy))),
+        function(3, "F", ["x"], f_body),
+        define(4, ident("c"), shown(fit, matrix(*(real(repr(float(v))) for v in want)))),
+    )
+    assert "geninv(stack(transpose(F(vx[0]))" in text
+    result = check_sheet(tmp_path, capsys, "linfit")
     assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]

@@ -638,3 +638,22 @@ def test_every_unit_name_of_both_corpora_is_mapped():
     for name in sorted(results):
         un.registry().Unit(result_unit(name))
     assert sorted(formulas - set(FORMULA_UNITS)) == []
+
+
+def test_g_is_the_acceleration_of_gravity_and_gm_the_gram(tmp_path, capsys):
+    """Mathcad's unit list: g is the acceleration of gravity (9.80665 m/s^2) and gm the gram;
+    W := 2 kg·g = 19.6133 N, m := 500 gm = 0.5 kg."""
+    from mathcad_xml import apply, check_sheet, define, evaluate, ident, import_sheet, real, united
+
+    kg_g = apply("mult", apply("mult", real(2), ident("kg")), ident("g"))
+    import_sheet(
+        tmp_path,
+        capsys,
+        "gravity",
+        define(1, ident("W"), kg_g),
+        define(2, ident("m"), apply("mult", real(500), ident("gm"))),
+        evaluate(3, ident("W"), united(2 * 9.80665, ("kg", 1), ("m", 1), ("s", -2))),
+        evaluate(4, ident("m"), united(0.5, ("kg", 1))),
+    )
+    result = check_sheet(tmp_path, capsys, "gravity")
+    assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]

@@ -119,3 +119,28 @@ def test_a_chain_of_equations_in_a_solve_block_is_two_equations(tmp_path, capsys
     )
     result = check_sheet(tmp_path, capsys, "chain")
     assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
+
+
+def test_a_range_whose_bounds_index_a_vector_at_origin_1(tmp_path, capsys):
+    """ORIGIN 1; P := [9; 16]; x := P[1], P[1] + 1 .. 12; 2x = [18; 20; 22; 24]: the range's
+    bounds are computed at import at the worksheet's origin (P[1] is 9, never 16)."""
+    from mathcad_xml import evaluate, index, matrix, real
+
+    first = index(ident("P"), real(1))
+    rng = (
+        f"<ml:range><ml:sequence>{first}{apply('plus', first, real(1))}</ml:sequence>"
+        f"{real(12)}</ml:range>"
+    )
+    import_sheet(
+        tmp_path,
+        capsys,
+        "rng1",
+        define(1, ident("P"), matrix(real(9), real(16))),
+        define(2, ident("x"), rng),
+        evaluate(
+            3, apply("mult", real(2), ident("x")), matrix(*(real(v) for v in (18, 20, 22, 24)))
+        ),
+        origin=1,
+    )
+    result = check_sheet(tmp_path, capsys, "rng1")
+    assert (result["printed"], result["reproduced"]) == (4, 4), result["failures"]

@@ -202,7 +202,7 @@ def test_a_program_with_a_local_function_and_an_element_matrix(tmp_path, capsys)
                 | (K[i])[0, 1] <- i
                 | K[i]
     over i := 0 .. 1 is the vector of [[0, i], [1, 11]]; K[1] = [[0, 1], [1, 11]]. A local
-    function that reads a local of the program is listed."""
+    function that reads a local the program gives once, before it, reads its one value."""
     g = f"<ml:function>{_id('g')}<ml:boundVars>{_id('r')}{_id('c')}</ml:boundVars></ml:function>"
     g_body = (
         f"<ml:apply><ml:plus/>{_id('r')}<ml:apply><ml:mult/><ml:real>10</ml:real>{_id('c')}"
@@ -242,8 +242,9 @@ def test_a_program_with_a_local_function_and_an_element_matrix(tmp_path, capsys)
         _result(1) + _result(2, "<ml:real>3</ml:real>"),
     )
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
-    text = (tmp_path / "q.toml").read_text(encoding="utf-8")
-    assert "a local function that reads the program's a" in text
+    # a, given once before g, has one value at every call of g: g(1, 1) = 1 + 2
+    result = _check(tmp_path / "q.toml", capsys)
+    assert (result["printed"], result["reproduced"]) == (1, 1), result
 
 
 @pytest.mark.slow

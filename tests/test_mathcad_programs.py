@@ -377,3 +377,126 @@ def test_break_inside_a_loop_stays_and_continue_outside_is_listed(tmp_path, caps
     assert 'v = { expr = "[0, v_of(0), v_of(1), v_of(2)]"' in text
     result = _check(tmp_path, capsys, "loops")
     assert (result["printed"], result["reproduced"]) == (1, 1), result["failures"]
+
+
+def test_a_program_as_the_value_of_a_local(tmp_path, capsys):
+    """f(n) := | k <- (| 4 if n = 4 ; 3 if n = 3 ; 9 if n > 3) ; k + 1: the inner program's
+    value is that of the last line it ran (a false `if` line runs nothing), so f(4) = 10
+    (its third line ran after its first) and f(3) = 4; f(2) runs no value line, and its
+    stored 1 (what a value of 0 would give) is not computable, never reproduced."""
+    inner = _program(
+        _if(_apply("equal", _id("n"), _real(4)), _real(4)),
+        _if(_apply("equal", _id("n"), _real(3)), _real(3)),
+        _if(_apply("greaterThan", _id("n"), _real(3)), _real(9)),
+    )
+    body = _program(_local(_id("k"), inner), _apply("plus", _id("k"), _real(1)))
+    _import(
+        tmp_path,
+        capsys,
+        "inner",
+        _function(1, "f", ["n"], body),
+        _eval(2, _call("f", _real(4)), _real(10)),
+        _eval(3, _call("f", _real(3)), _real(4)),
+        _eval(4, _call("f", _real(2)), _real(1)),
+    )
+    result = _check(tmp_path, capsys, "inner")
+    counts = (result["reproduced"], result["failed"], result["not_computable"])
+    assert counts == (2, 0, 1), result["failures"]
+
+
+def test_a_local_program_that_reads_a_local_is_refused(tmp_path, capsys):
+    """g(n) := | s <- n ; k <- (| s if s > 1 ; 0 otherwise) ; k: the inner program reads the
+    local s, which it would need as an argument: the function is listed as not translated."""
+    inner = _program(_if(_apply("greaterThan", _id("s"), _real(1)), _id("s")), _otherwise(_real(0)))
+    body = _program(_local(_id("s"), _id("n")), _local(_id("k"), inner), _id("k"))
+    text = _import(
+        tmp_path,
+        capsys,
+        "reads",
+        _function(1, "g", ["n"], body),
+        _eval(2, _call("g", _real(3)), _real(3)),
+    )
+    assert "a program as the value of a local that reads or sets the program's s" in text
+
+
+def _seq(*args: str) -> str:
+    return f"<ml:sequence>{''.join(args)}</ml:sequence>"
+
+
+def test_matrix_of_a_size_the_program_computes(tmp_path, capsys):
+    """n := 10 on the sheet; f(n) := | c <- 2n ; g(x, y) <- c ; M <- matrix(n, 2, g) ;
+    [a; b] <- [matrix(n, 1, g); 7] ; M[n-1, 1] + rows(a) + b: the size is the parameter n
+    (never the sheet's 10), the elements g(i, j) = c (a local given once before g), so
+    f(3) = 6 + 3 + 7 = 16 and f(4) = 8 + 4 + 7 = 19."""
+    n = _id("n")
+    body = _program(
+        _local(_id("c"), _apply("mult", _real(2), n)),
+        _local(_function_lhs("g", "x", "y"), _id("c")),
+        _local(_id("M"), _call("matrix", _seq(n, _real(2), _id("g")))),
+        _local(
+            _matrix(_id("a"), _id("b")),
+            _matrix(_call("matrix", _seq(n, _real(1), _id("g"))), _real(7)),
+        ),
+        _apply(
+            "plus",
+            _apply(
+                "plus",
+                _index(_id("M"), _apply("minus", n, _real(1)), _real(1)),
+                _call("rows", _id("a")),
+            ),
+            _id("b"),
+        ),
+    )
+    text = _import(
+        tmp_path,
+        capsys,
+        "sized",
+        _define(1, _id("n"), _real(10)),
+        _function(2, "f", ["n"], body),
+        _eval(3, _call("f", _real(3)), _real(16)),
+        _eval(4, _call("f", _real(4)), _real(19)),
+    )
+    assert "for j in 0 .. 2 - 1" in text  # the elements set one by one
+    result = _check(tmp_path, capsys, "sized")
+    assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]
+
+
+def test_a_local_function_reading_a_local_set_twice_is_refused(tmp_path, capsys):
+    """h(n) := | c <- n ; c <- c + 1 ; g(x) <- c ; g(0): c has two values in the program,
+    and which one Mathcad's g reads where it is called is not known: not translated."""
+    body = _program(
+        _local(_id("c"), _id("n")),
+        _local(_id("c"), _apply("plus", _id("c"), _real(1))),
+        _local(_function_lhs("g", "x"), _id("c")),
+        _call("g", _real(0)),
+    )
+    text = _import(
+        tmp_path,
+        capsys,
+        "twice",
+        _function(1, "h", ["n"], body),
+        _eval(2, _call("h", _real(1)), _real(2)),
+    )
+    assert "a local function that reads the program's c, which the program sets more" in text
+
+
+def _function_lhs(name: str, *params: str) -> str:
+    bound = "".join(_id(p) for p in params)
+    return f"<ml:function>{_id(name)}<ml:boundVars>{bound}</ml:boundVars></ml:function>"
+
+
+def test_a_matrix_of_names_defined_with_its_value_shown(tmp_path, capsys):
+    """[a; b] := [3; 4·2] = [3; 8] (Prime shows the right side's value): the value compared
+    element by element, and a + b = 11 reads the names."""
+    lhs = _matrix(_id("a"), _id("b"))
+    rhs = _matrix(_real(3), _apply("mult", _real(4), _real(2)))
+    shown = f"<ml:eval>{rhs}<ml:result>{_matrix(_real(3), _real(8))}</ml:result></ml:eval>"
+    _import(
+        tmp_path,
+        capsys,
+        "names",
+        _define(1, lhs, shown),
+        _eval(2, _apply("plus", _id("a"), _id("b")), _real(11)),
+    )
+    result = _check(tmp_path, capsys, "names")
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]

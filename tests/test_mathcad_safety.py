@@ -231,3 +231,32 @@ def test_a_device_behind_a_link_is_refused_unread(tmp_path):
     done = _import_in_child(link, tmp_path / "out")
     assert done.returncode == 2, done.stderr
     assert "not a regular file (a character device)" in done.stderr
+
+
+def test_stored_texts_that_a_spreadsheet_would_run_are_escaped_and_still_reproduced(
+    tmp_path, capsys
+):
+    """Mathcad stores the texts "=1+1" and "-OK": the printed-values CSV holds them with a
+    leading apostrophe (a spreadsheet opening the file shows them as text), and the check
+    reads them back without it: both are reproduced."""
+    import csv
+
+    from mathcad_xml import check_sheet, define, evaluate, ident, import_sheet
+
+    def text(t: str) -> str:
+        return f"<ml:str>{t}</ml:str>"
+
+    import_sheet(
+        tmp_path,
+        capsys,
+        "texts",
+        define(1, ident("s"), text("=1+1")),
+        define(2, ident("t"), text("-OK")),
+        evaluate(3, ident("s"), text("=1+1")),
+        evaluate(4, ident("t"), text("-OK")),
+    )
+    with open(tmp_path / "texts.mathcad.csv", newline="", encoding="utf-8") as f:
+        values = [r[2] for r in csv.reader(f) if r and not r[0].startswith("#")][1:]
+    assert values == ["'=1+1", "'-OK"]
+    result = check_sheet(tmp_path, capsys, "texts")
+    assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from mathcad_xml import (
     apply,
+    array_cells,
     call,
     check_sheet,
     define,
@@ -106,13 +107,12 @@ def test_cholesky_is_the_languages(tmp_path, capsys):
     a = np.array([[4.0, 12.0, -16.0], [12.0, 37.0, -43.0], [-16.0, -43.0, 98.0]])
     with mpmath.workdps(50):
         want = np.array(mpmath.cholesky(mpmath.matrix(a.tolist())).tolist(), dtype=float)
-    cells = lambda m: matrix(*(real(v) for v in m.T.flatten()), cols=m.shape[1])  # noqa: E731
     text = import_sheet(
         tmp_path,
         capsys,
         "chol",
-        define(1, ident("A"), cells(a)),
-        define(2, ident("L"), shown(call("cholesky", ident("A")), cells(want))),
+        define(1, ident("A"), array_cells(a)),
+        define(2, ident("L"), shown(call("cholesky", ident("A")), array_cells(want))),
     )
     assert '"cholesky(A)"' in text
     result = check_sheet(tmp_path, capsys, "chol")

@@ -46,12 +46,18 @@ def read_commented_csv(path, what: str):
 
 
 def _number_or_text(cell: str) -> float | str:
-    """A printed value: a number, else a text (compared as text with what the sheet gives)."""
+    """A printed value: a number, else a text (compared as text with what the sheet gives);
+    a text that a writer escaped for spreadsheets (a leading apostrophe before = + - @) is
+    read without its apostrophe."""
+    from ..outputs.atomic import csv_text
+
     try:
         return float(cell)
     except ValueError:
         if not cell.strip():
             raise
+        if cell.startswith("'") and csv_text(cell[1:]) == cell:
+            return cell[1:]
         return cell
 
 

@@ -407,7 +407,11 @@ class AtImport:
         }
         try:
             if key not in self.worksheets:  # the same needs (a range over n, again): reused
-                part = Translation(items=items, syms=sorted(syms, key=lambda s: self.order[id(s)]))
+                part = Translation(
+                    items=items,
+                    syms=sorted(syms, key=lambda s: self.order[id(s)]),
+                    origin=self.out.origin,  # the worksheet's indices count from its origin
+                )
                 doc, _ = document(part, "at-import", Path("at-import.xmcd"))
                 spec = spec_from_data(doc.data, Path("at-import.toml"), "at-import")
                 input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}

@@ -4,12 +4,12 @@ and worksheet functions, indices and columns, sums, integrals and derivatives, v
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from ..language import expr as ex
 from ..language.visitor import Visitor
 from . import names as nm
 from . import trees as tt
+from .context import TranslatorContext
 from .functions import (
     FIXED_ORDER,
     MATHCAD_FUNCTIONS,
@@ -26,9 +26,6 @@ from .symbols import what as _what
 from .translation import uses
 from .units import FORMULA_UNITS
 
-if TYPE_CHECKING:
-    from .translate import Translator
-
 
 def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
     """Prime's vector sum: Σ whose bound variable and upper bound are empty placeholders."""
@@ -43,7 +40,7 @@ def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
 class ExprTranslator(Visitor):
     """Mathcad math element -> expression tree, names resolved in a scope."""
 
-    def __init__(self, tr: Translator, local: dict[tuple[str, str], Sym] | None = None):
+    def __init__(self, tr: TranslatorContext, local: dict[tuple[str, str], Sym] | None = None):
         self.tr = tr
         self.local = local or {}
         self.ranges: list[Sym] = []  # range variables this expression uses
@@ -66,6 +63,18 @@ class ExprTranslator(Visitor):
         if math.copysign(1.0, value) < 0:
             return ex.Unary("-", ex.Number(-value))
         return ex.Number(value)
+
+    def visit_imag(self, node: MNode) -> ex.Node:
+        """Mathcad's imaginary literal (``4i``, ``2j``: its text is the imaginary part)."""
+        try:
+            value = float(node.text.strip())
+        except ValueError:
+            raise Untranslatable(f"the imaginary number {node.text.strip()!r}") from None
+        if not math.isfinite(value):
+            raise Untranslatable(f"the imaginary number {node.text.strip()!r} is not finite")
+        if math.copysign(1.0, value) < 0:
+            return ex.Unary("-", ex.Imaginary(-value))
+        return ex.Imaginary(value)
 
     def visit_parens(self, node: MNode) -> ex.Node:
         return self.visit(node.children[0])
@@ -430,6 +439,8 @@ class ExprTranslator(Visitor):
             from .odes import rkfixed
 
             return rkfixed(self, args)
+        if text == "linfit" and not key[1] and len(args) == 3:
+            return self._linfit(args)
         if text == "histogram" and not key[1] and len(args) == 2:
             return self._histogram(args)
         if text in ("min", "max") and len(args) == 1 and args[0].tag == "matrix":
@@ -486,6 +497,32 @@ class ExprTranslator(Visitor):
             )
         return self._builtin("histogram", "histogram", [n, data])
 
+    def _linfit(self, args: list[MNode]) -> ex.Node:
+        """Mathcad's linfit(vx, vy, F): the coefficients of the combination of the functions
+        of F (a function of x giving a vector) nearest vy in least squares, ``geninv(A) *
+        vy`` where row i of A is F(vx[i]) (vx a vector of the sheet of a length known at
+        import, written out row by row)."""
+        vx, vy = self.value(args[0]), self.value(args[1])
+        f = tt.unparen(args[2])
+        sym = (self.local.get(_key(f)) or self.tr.scope.get(_key(f))) if f.tag == "id" else None
+        if sym is None or sym.kind != "func":
+            raise Untranslatable("linfit(vx, vy, F) whose F is not the name of a function")
+        if sym.broken:
+            raise Untranslatable(uses(sym))
+        n = self.tr.vector_length_of(vx) if isinstance(vx, ex.Name) else None
+        if n is None or n > MAX_WRITTEN_ELEMENTS:
+            raise Untranslatable("linfit(vx, vy, F) whose vx is not a vector of a known length")
+        rows = []
+        for i in range(n):
+            x = (ex.Index(vx, (ex.Number(float(self.tr.sheet_origin + i)),)),)
+            if sym.token() in self.tr.inline:
+                row = self.tr.local_call(sym, x)
+            else:
+                self.tr.calls.setdefault(sym, []).append(x)
+                row = ex.Call(sym.token(), x)
+            rows.append(ex.Call("transpose", (row,)))
+        return ex.Binary("*", ex.Call("geninv", (ex.Call("stack", tuple(rows)),)), vy)
+
     def _matrix_of_function(self, args: list[MNode]) -> ex.Node:
         """Mathcad's matrix(m, n, f): the m x n matrix of f(i, j), i and j counted from 0
         (whatever ORIGIN), written out as a matrix of calls; m and n must be whole numbers
@@ -497,6 +534,9 @@ class ExprTranslator(Visitor):
             raise Untranslatable("matrix(m, n, f) whose f is not the name of a function")
         if sym.broken:
             raise Untranslatable(uses(sym))
+        if any(_key(n) in self.local for a in args[:2] for n in tt.walk(a) if n.tag == "id"):
+            # a program's local or parameter: never the sheet's name of the same spelling
+            raise Untranslatable("matrix(m, n, f) whose size is not a number known at import")
         m, n = (whole_at_import(self.tr, a, "matrix(m, n, f)") for a in args[:2])
         if m * n > MAX_WRITTEN_ELEMENTS:
             raise Untranslatable(f"matrix(m, n, f) of more than {MAX_WRITTEN_ELEMENTS} elements")
@@ -530,7 +570,7 @@ ELEMENTWISE = frozenset(
 )  # fmt: skip
 
 
-def whole_at_import(tr: Translator, node: MNode, what: str) -> int:
+def whole_at_import(tr: TranslatorContext, node: MNode, what: str) -> int:
     """A size Mathcad gives as an expression: a whole number of at least 1 known at import."""
     try:
         value = float(tr.quantity(node).to("").magnitude)

@@ -55,6 +55,8 @@ MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
     "Jn": ("bessel_j", None), "Yn": ("bessel_y", None), "In": ("bessel_i", None),
     "Kn": ("bessel_k", None), "combin": ("combin", None), "permut": ("permut", None),
     "cholesky": ("cholesky", None),
+    # complex numbers (docs/language.md, Complex numbers)
+    "Re": ("Re", None), "Im": ("Im", None), "arg": ("arg", None),
 }  # fmt: skip
 
 #: Mathcad's Bessel functions of a fixed order: ``J0(x)`` is ``bessel_j(0, x)``.
@@ -97,8 +99,6 @@ REFUSED: dict[str, str] = {
     "regress": "gives a vector whose first elements are Mathcad's own bookkeeping for interp "
     "(the language fits a line with fit_slope and fit_intercept)",
     "loess": "gives a vector of Mathcad's own local fits for interp, not a formula",
-    "linfit": "fits a combination of the functions of a vector of functions, which the language "
-    "has no value for",
     "genfit": "fits by Mathcad's own nonlinear solver from a guess, with a vector of functions "
     "the language has no value for",
 }  # fmt: skip

@@ -19,11 +19,11 @@ from .symbols import key as _key
 from .translation import Item
 
 if TYPE_CHECKING:
-    from .expressions import ExprTranslator
+    from .context import ExpressionContext
     from .reader import MNode
 
 
-def rkfixed(et: ExprTranslator, args: list[MNode]) -> ex.Node:
+def rkfixed(et: ExpressionContext, args: list[MNode]) -> ex.Node:
     """The matrix of rkfixed(y, x1, x2, npoints, D): a definition of its own, a program."""
     tr = et.tr
     if len(args) != 5:

@@ -14,6 +14,7 @@ from . import names as nm
 from .reader import MNode
 from .symbols import Sym, Untranslatable, matrix_size, what
 from .symbols import key as name_key
+from .translation import Item
 
 Line = tuple[int, list]  # (indent, parts: text or expression trees)
 
@@ -33,11 +34,14 @@ class ProgramTranslator:
         self.locals: dict[tuple[str, str], Sym] = {}
         self.loops = 0  # loops around the statement being translated
         self.taken: set[str] = set()  # identifiers of the program's names
+        self.assignments: dict[tuple[str, str], int] = {}  # whole assignments of each name
+        self.zero_started: set[tuple[str, str]] = set()  # locals Mathcad starts at 0
 
     def lines(self, program: MNode) -> list[Line]:
         program = _one_index_locals(program, set(self.params))
         body = program.children if program.tag == "program" else [program]
         self.taken = {nm.identifier(*name_key(n)) for n in _walk(program) if n.tag == "id"}
+        self.assignments = _assignments(body)
         out: list[Line] = []
         self._copies(body, out)
         self._zero_starts(body, out)
@@ -126,6 +130,7 @@ class ProgramTranslator:
             return have
 
         run(body, given)
+        self.zero_started = set(flagged)
         for key in flagged:
             sym = self._local_key(key)
             out.append((0, [ex.Name(sym.token()), " := ", ex.Number(0.0)]))
@@ -278,8 +283,61 @@ class ProgramTranslator:
             return []
         if lhs.tag != "id":
             raise Untranslatable("an assignment to something that is not a name in a program")
+        if rhs.tag == "program":
+            value = self._subprogram(lhs, rhs)
+            return [(0, [self._local(lhs), " := ", value])]
+        if _runtime_matrix(rhs, self.scope):
+            tmp = ex.Name(self._fresh("matrix").token())
+            return [*self._matrix_lines(tmp, rhs), (0, [self._local(lhs), " := ", tmp])]
         value = self._expr(rhs)  # the right side sees the local's previous value
         return [(0, [self._local(lhs), " := ", value])]
+
+    def _subprogram(self, lhs: MNode, rhs: MNode) -> ex.Node:
+        """k <- program: the inner program's value (Mathcad's: that of the last line it ran,
+        a false ``if`` line running nothing) as a function of the sheet's of its own, called
+        with the parameters it reads; one that runs no value line is then an error of that
+        function, never a value. It may read the program's parameters and the sheet's names,
+        not the program's locals, nor set a name of the program."""
+        inner = rhs.children
+        whole, elements = _targets(inner)
+        sets = (set(whole) | elements) & (set(self.scope) | set(self.params))
+        read = {key for key, _ in _reads(rhs)} - set(whole) - elements
+        locals_read = sorted(s.mathcad for k, s in self.locals.items() if k in read)
+        if sets or locals_read:
+            names = sorted(self.scope[k].mathcad for k in sets if k in self.scope) + locals_read
+            raise Untranslatable(
+                f"a program as the value of a local that reads or sets the program's "
+                f"{', '.join(names)}"
+            )
+        # the parameters the local functions it may call read are its parameters too
+        tokens = {
+            t
+            for s in self.scope.values()
+            if s.token() in self.tr.inline
+            for t in ex.names(self.tr.inline[s.token()][1])
+        }
+        params = [(k, s) for k, s in self.params.items() if k in read or s.token() in tokens]
+        fixed_locals = [s.mathcad for s in self.locals.values() if s.token() in tokens]
+        if fixed_locals:
+            raise Untranslatable(
+                "a program as the value of a local that calls a local function reading the "
+                f"program's {', '.join(sorted(fixed_locals))}"
+            )
+        scope = dict(params)
+        scope |= {k: s for k, s in self.scope.items() if s.kind == "func"}  # local functions
+        # a program of the language (not pieces): its arguments may be arrays
+        parts = {"program": ProgramTranslator(self.tr, scope, self.expressions).lines(rhs)}
+        base = f"{nm.identifier(*name_key(lhs))}_value"
+        if not params:
+            sym = self.tr.new_sym("var", base, base, self.tr.region, generated=True)
+            self.tr.out.items.append(Item("definition", self.tr.region, sym=sym, **parts))
+            return ex.Name(sym.token())
+        sym = self.tr.new_sym("func", base, base, self.tr.region, generated=True)
+        psyms = [s for _, s in params]
+        self.tr.out.items.append(Item("function", self.tr.region, sym=sym, params=psyms, **parts))
+        args = tuple(ex.Name(s.token()) for s in psyms)
+        self.tr.calls.setdefault(sym, []).append(args)
+        return ex.Call(sym.token(), args)
 
     def _local_function(self, lhs: MNode, rhs: MNode) -> None:
         """f(x, y) <- EXPR: a local function, written out at each call (``f(2, 3)`` is EXPR
@@ -296,13 +354,20 @@ class ProgramTranslator:
         body = et.value(rhs)
         if et.ranges:
             raise Untranslatable("a local function over a range variable")
-        program_locals = {s.token() for s in self.locals.values()}
-        program_locals |= {s.token() for s in self.params.values()}
+        # a local given once, before this line and never again, has one value at every
+        # call; a parameter too (one the program sets is a local copy)
+        fixed = {
+            s.token()
+            for k, s in self.locals.items()
+            if self.assignments.get(k) == 1 and k not in self.zero_started and k not in self.params
+        }
+        program_locals = {s.token() for s in self.locals.values()} - fixed
         read = ex.names(body) & program_locals
         if read:
             names = sorted(s.mathcad for s in self.locals.values() if s.token() in read)
             raise Untranslatable(
-                f"a local function that reads the program's {', '.join(names) or 'parameters'}"
+                f"a local function that reads the program's {', '.join(names)}, which the "
+                "program sets more than once"
             )
         sym = self.tr.new_sym(
             "func", nm.identifier(*name_key(fname)), nm.mathcad_text(*name_key(fname))
@@ -364,6 +429,12 @@ class ProgramTranslator:
             raise Untranslatable("a matrix of names whose size does not match its elements")
         if any(n.tag != "id" for n in names):
             raise Untranslatable("an assignment to a matrix of something that is not names")
+        if (
+            rhs.tag == "matrix"
+            and matrix_size(rhs) == (rows, cols)
+            and len(rhs.children) == len(names)
+        ):
+            return self._destructure_literal(names, rhs.children)
         value = self._expr(rhs)
         tmp = ex.Name(self._fresh("parts").token())
         lines: list[tuple[int, list]] = [(0, [tmp, " := ", value])]
@@ -375,6 +446,56 @@ class ProgramTranslator:
                 name = self._local(names[c * rows + r])
                 lines.append((0, [name, " := ", ex.Index(tmp, index)]))
         return lines
+
+    def _destructure_literal(self, names: list[MNode], values: list[MNode]) -> list[Line]:
+        """[a; b] <- [A; B]: each name its element, every element computed before any name
+        is set (as Mathcad computes the right side first)."""
+        lines: list[Line] = []
+        temps = []
+        for value in values:
+            tmp = ex.Name(self._fresh("part").token())
+            if _runtime_matrix(value, self.scope):
+                lines += self._matrix_lines(tmp, value)
+            else:
+                lines.append((0, [tmp, " := ", self._expr(value)]))
+            temps.append(tmp)
+        for name, tmp in zip(names, temps):
+            lines.append((0, [self._local(name), " := ", tmp]))
+        return lines
+
+    def _matrix_lines(self, target: ex.Name, rhs: MNode) -> list[Line]:
+        """target <- matrix(m, n, f) whose size the program computes: its elements f(i, j),
+        i and j from 0 (whatever ORIGIN), set one by one in a matrix made by them. At an
+        ORIGIN other than 0, only a function that does not read its arguments (as for a
+        size known at import)."""
+        m, n, f = rhs.children[1].children
+        sym = self.scope.get(name_key(f)) or self.tr.scope.get(name_key(f))
+        if sym is None or sym.kind != "func":
+            raise Untranslatable("matrix(m, n, f) whose f is not the name of a function")
+        if sym.broken:
+            raise Untranslatable(f"uses {sym.mathcad}, which is not translated: {sym.broken}")
+        if self.tr.origin != 0 and not self.tr.ignores_arguments(sym):
+            raise Untranslatable(
+                f"matrix(m, n, f) at ORIGIN {self.tr.origin} of a function of its indices "
+                "(which indices Mathcad gives f there is not known)"
+            )
+        rows, cols = self._expr(m), self._expr(n)
+        i, j = (ex.Name(self._fresh(b).token()) for b in ("i", "j"))
+        if sym.token() in self.tr.inline:
+            value = self.tr.local_call(sym, (i, j))
+        else:
+            self.tr.calls.setdefault(sym, []).append((i, j))
+            value = ex.Call(sym.token(), (i, j))
+        o = ex.Number(float(self.tr.sheet_origin))
+        one = ex.Number(1.0)
+        zero = ex.Number(0.0)
+        at = (ex.Binary("+", i, o), ex.Binary("+", j, o))
+        return [
+            (0, [target, " := ", zero]),
+            (0, ["for ", i, " in ", zero, " .. ", ex.Binary("-", rows, one)]),
+            (4, ["for ", j, " in ", zero, " .. ", ex.Binary("-", cols, one)]),
+            (8, [ex.Index(target, at), " := ", value]),
+        ]
 
     def _shifted(self, index: ex.Node) -> ex.Node:
         shift = self.tr.sheet_origin - self.tr.origin  # ORIGIN redefined after the first index
@@ -438,6 +559,39 @@ def _negate(cond: ex.Node) -> ex.Node:
     if isinstance(cond, ex.Compare) and len(cond.ops) == 1:
         return ex.Compare((_NEGATED[cond.ops[0]],), cond.operands)
     return ex.Unary("not", cond)
+
+
+def _assignments(body: list[MNode]) -> dict[tuple[str, str], int]:
+    """How many statements of the program give each name a whole value (assignments,
+    destructuring, loop variables), wherever they are."""
+    counts: dict[tuple[str, str], int] = {}
+    for stmt in body:
+        for node in _walk(stmt):
+            names: list[MNode] = []
+            if node.tag == "localDefine":
+                lhs = node.children[0]
+                names = (
+                    [lhs] if lhs.tag == "id" else list(lhs.children) if lhs.tag == "matrix" else []
+                )
+            elif node.tag == "for":
+                names = [node.children[0]]
+            for n in names:
+                if n.tag == "id":
+                    counts[name_key(n)] = counts.get(name_key(n), 0) + 1
+    return counts
+
+
+def _runtime_matrix(node: MNode, scope: dict) -> bool:
+    """Is ``node`` matrix(m, n, f) whose m or n reads a name of the program (a size known
+    only when it runs)?"""
+    if node.tag != "apply" or len(node.children) != 2 or node.children[0].tag != "id":
+        return False
+    if name_key(node.children[0]) != ("matrix", "") or node.children[1].tag != "sequence":
+        return False
+    args = node.children[1].children
+    if len(args) != 3 or name_key(node.children[0]) in scope:
+        return False
+    return any(key in scope for a in args[:2] for key, _ in _reads(a))
 
 
 def _is_break(body: MNode) -> bool:

@@ -46,6 +46,9 @@ class ResultsMixin:
         if writer is not None:
             self.written(region, *writer[:2], writer[2], node)
             return
+        if any(isinstance(v, complex) for v in values):
+            self.complex_result(region, expr, target, unit, values, shape, mathcad)
+            return
         self.remember_shown(expr, target, unit, values)
         before = len(self.out.results)
         try:
@@ -125,6 +128,67 @@ class ResultsMixin:
             self.broken_result(region, mathcad, unit, values, str(why))
             raise
 
+    def complex_result(self, region: Region, expr: MNode, target, unit, values, shape, mathcad):
+        """A result with complex numbers: its real parts and its imaginary parts, each a
+        printed value of ``Re(...)`` and ``Im(...)`` of what Mathcad evaluated (a real
+        element's imaginary part is 0)."""
+        if any(isinstance(v, str) for v in values):
+            raise Untranslatable("a stored result of texts and complex numbers")
+        parts = [(complex(v).real, complex(v).imag) for v in values]
+        try:
+            if target is not None:
+                if target.broken:
+                    raise Untranslatable(target.broken)
+                base: ex.Node = ex.Name(target.token())
+            else:
+                et = ExprTranslator(self)
+                base = et.value(expr)
+                if et.ranges:
+                    self.complex_over_range(
+                        region, base, list(dict.fromkeys(et.ranges)), unit, parts, mathcad
+                    )
+                    return
+            if not isinstance(base, ex.Name):  # one definition, read by both parts
+                whole = self.new_sym("helper", f"result_{region.id}_value", mathcad, region.id)
+                self.out.items.append(Item("definition", region.id, sym=whole, body=base))
+                base = ex.Name(whole.token())
+            for k, part in enumerate(("Re", "Im")):
+                numbers, what = [p[k] for p in parts], f"{part}({mathcad})"
+                if len(values) > 1:
+                    self.array_result(region, base, shape, numbers, unit, what, part)
+                    continue
+                sym = self.new_sym("helper", f"result_{region.id}_{part.lower()}", what, region.id)
+                call = ex.Call(part, (base,))
+                self.out.items.append(Item("definition", region.id, sym=sym, body=call))
+                self.out.results.append(Result(region.id, sym, what, unit, [(None, numbers[0])]))
+        except Untranslatable as why:  # each number Mathcad stored counts once, as a text
+            texts = [f"{a!r}{'-' if b < 0 else '+'}{abs(b)!r}i" for a, b in parts]
+            self.broken_result(region, mathcad, unit, texts, str(why))
+            if target is None:
+                raise
+            if not target.broken:
+                self.skip(region.id, f"the result of {mathcad}", str(why))
+
+    def complex_over_range(self, region: Region, body: ex.Node, ranges, unit, parts, mathcad):
+        """A complex result of an expression over one range variable: the real and the
+        imaginary part at each of the range's values, each a function of it."""
+        if len(ranges) > 1:
+            raise Untranslatable("an evaluation over two range variables (a matrix)")
+        var = ranges[0]
+        at = next(i for i in self.out.items if i.sym is var).range_values
+        if len(at) != len(parts):
+            raise Untranslatable(
+                f"Mathcad lists {len(parts)} values of the range {var.mathcad}, which has {len(at)}"
+            )
+        for k, part in enumerate(("Re", "Im")):
+            param = self.new_sym("param", var.base, var.mathcad, unit=var.unit)
+            what = f"{part}({mathcad})"
+            sym = self.new_sym("helper", f"result_{region.id}_{part.lower()}", what, region.id)
+            inner = ex.Call(part, (tt.rename(body, {var.token(): param.token()}),))
+            self.out.items.append(Item("function", region.id, sym=sym, params=[param], body=inner))
+            values = list(zip(at, (p[k] for p in parts)))
+            self.out.results.append(Result(region.id, sym, what, unit, values, param))
+
     def broken_result(self, region: Region, mathcad: str, unit: str, values, why: str) -> None:
         """Stored values whose evaluation is not translated: kept, so they count."""
         sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
@@ -136,9 +200,12 @@ class ResultsMixin:
             self._index = self.new_sym("param", "index", "an index", unit="")
         return self._index
 
-    def array_result(self, region: Region, base: ex.Node, shape, values, unit, mathcad) -> None:
+    def array_result(
+        self, region: Region, base: ex.Node, shape, values, unit, mathcad, part: str = ""
+    ) -> None:
         """A vector or matrix Mathcad shows: each element a printed value of a function of
-        its index (for a matrix, of the element's number row by row from 0)."""
+        its index (for a matrix, of the element's number row by row from 0); ``part``: "Re"
+        or "Im", the real or imaginary part of each element."""
         rows, cols = shape
         if rows * cols != len(values):
             raise Untranslatable("an array result whose size does not match its values")
@@ -161,7 +228,10 @@ class ResultsMixin:
                 for r in range(rows)
                 for c in range(cols)
             ]
-        sym = self.new_sym("helper", f"result_{region.id}", mathcad, region.id)
+        if part:
+            body = ex.Call(part, (body,))
+        name = f"result_{region.id}" + (f"_{part.lower()}" if part else "")
+        sym = self.new_sym("helper", name, mathcad, region.id)
         self.out.items.append(Item("function", region.id, sym=sym, params=[k], body=body))
         self.out.results.append(Result(region.id, sym, mathcad, unit, at, k))
 

@@ -386,6 +386,10 @@ class Translator(ResultsMixin, SolveMixin):
             self.definition(region, node)
         elif node.tag == "eval":
             self.evaluation(region, node, None)
+        elif node.tag == "symEval" and tt.symbolic_numbers(node) is not None:
+            # expr → a number Mathcad found: compared as a stored result of expr
+            found = MNode("result", {}, "", [tt.symbolic_numbers(node)], node.line)
+            self.evaluation(region, MNode("eval", {}, "", [node.children[0], found]), None)
         elif node.tag == "id" and node.text.strip() == "Given":
             self.close_given("a solve block without Find")
             self.given = [region.id]
@@ -430,8 +434,15 @@ class Translator(ResultsMixin, SolveMixin):
                 element = not tt.shows_array(evaluation) and not tt.mentions(rhs, key)
                 self.evaluation(region, evaluation, None if element else self.scope[key])
             return
-        if lhs.tag == "matrix" and evaluation is None:
-            self.destructure(region, lhs, rhs)
+        if lhs.tag == "matrix":
+            try:
+                whole = self.destructure(region, lhs, rhs)
+            except Untranslatable:
+                if evaluation is not None:
+                    self.stored_but_broken(region, evaluation, "[...] := ...")
+                raise
+            if evaluation is not None:  # [a; b] := value = the value Mathcad shows
+                self.evaluation(region, evaluation, whole)
             return
         if lhs.tag != "id":
             if evaluation is not None:
@@ -724,9 +735,9 @@ class Translator(ResultsMixin, SolveMixin):
             return len(tree.rows), len(tree.rows[0])
         return None
 
-    def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> None:
-        """[a; b] := value: the value a definition of its own (``parts``), then each name
-        its element at ORIGIN."""
+    def destructure(self, region: Region, lhs: MNode, rhs: MNode) -> Sym:
+        """[a; b] := value: the value a definition of its own (``parts``, returned), then
+        each name its element at ORIGIN."""
         rows, cols = matrix_size(lhs)
         names = lhs.children
         if rows * cols != len(names) or not names or any(n.tag != "id" for n in names):
@@ -756,6 +767,7 @@ class Translator(ResultsMixin, SolveMixin):
                 sym = self.define(_key(names[c * rows + r]), "var", region.id)
                 item = ex.Index(ex.Name(whole.token()), index)
                 self.out.items.append(Item("definition", region.id, sym=sym, body=item))
+        return whole
 
     def element(self, region: Region, key, lhs: MNode, rhs: MNode) -> None:
         """v[k] := value at an index that is not a range variable (Mathcad sets one element

@@ -6,17 +6,14 @@ rewrites of the language's trees (renaming, substituting)."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from ..language import expr as ex
+from .context import TranslatorContext
 from .functions import ORIGIN_FUNCTIONS, WRITERS
 from .reader import MNode, Region
 from .symbols import Untranslatable, matrix_size, whole_number
 from .symbols import key as _key
 from .units import FORMULA_UNITS, result_unit
-
-if TYPE_CHECKING:
-    from .translate import Translator
 
 BINARY = {"plus": "+", "minus": "-", "mult": "*", "div": "/", "pow": "^"}
 COMPARE = {
@@ -218,6 +215,34 @@ def symbolic_result(node: MNode) -> MNode:
     return node
 
 
+def symbolic_numbers(node: MNode) -> MNode | None:
+    """The result of a symbolic evaluation (→) without keywords, as a stored result, where
+    Mathcad found a number or a matrix of numbers; else None (an expression is no value to
+    compare, and a keyword such as ``float, 3`` rounds the result)."""
+    if len(node.children) != 2 or node.children[1].tag != "symResult":
+        return None
+    found = node.children[1].children
+    if len(found) != 1:
+        return None
+
+    def number(n: MNode) -> MNode | None:
+        if n.tag == "real":
+            return n
+        if n.tag == "apply" and len(n.children) == 2 and n.children[0].tag == "neg":
+            inner = number(n.children[1])
+            if inner is not None and not inner.text.strip().startswith("-"):
+                return MNode("real", {}, "-" + inner.text.strip(), [], inner.line)
+        return None
+
+    value = found[0]
+    if value.tag == "matrix":
+        cells = [number(c) for c in value.children]
+        if not cells or any(c is None for c in cells):
+            return None
+        return MNode("matrix", dict(value.attrs), "", cells, value.line)
+    return number(value)
+
+
 def has_matrix(tree: ex.Node) -> bool:
     """Is a vector or matrix written inside ``tree``?"""
     return any(isinstance(n, ex.Matrix) for n in ex.walk(tree))
@@ -245,6 +270,13 @@ def unit_monomial(node: MNode) -> str:
     return " * ".join(parts)
 
 
+def walk(node: MNode):
+    """``node`` and every node under it."""
+    yield node
+    for c in node.children:
+        yield from walk(c)
+
+
 def is_nested(node: MNode) -> bool:
     """Is ``node`` a stored array whose elements are arrays (Mathcad's nested array)?"""
     return node.tag == "matrix" and any(c.tag == "matrix" for c in node.children)
@@ -256,6 +288,8 @@ def leaves(node: MNode, path: tuple = ()):
     matrix column by column)."""
     if node.tag != "matrix":
         unit, values = stored(node)
+        if any(isinstance(v, complex) for v in values):
+            raise Untranslatable("a complex number inside a nested array result")
         if len(values) != 1:
             raise Untranslatable("a nested array result with a matrix that has units")
         yield path, unit, values[0]
@@ -310,8 +344,15 @@ def stored(node: MNode) -> tuple[str, list[float | str]]:
         return (units.pop() if units else ""), values
     if node.tag == "unreadable":
         raise Untranslatable(node.attrs.get("why", "a stored result that cannot be read"))
-    if node.tag == "complex":
-        raise Untranslatable("a complex result (complex numbers are not in the language)")
+    if node.tag == "complex":  # Mathcad's <complex><real/><imag/></complex>
+        parts = {c.tag: c.text for c in node.children}
+        try:
+            z = complex(float(parts.get("real", "0")), float(parts["imag"]))
+        except (KeyError, ValueError):
+            raise Untranslatable("a stored complex number that cannot be read") from None
+        if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+            raise Untranslatable("a stored complex number that is not finite")
+        return "", [z]
     raise Untranslatable(f"a result of kind <{node.tag}>")
 
 
@@ -372,7 +413,7 @@ def quantity_text(node: MNode) -> str | None:
     return None
 
 
-def range_values(tr: Translator, first: MNode, second: MNode | None, last: MNode):
+def range_values(tr: TranslatorContext, first: MNode, second: MNode | None, last: MNode):
     """Mathcad's values of a range first, second .. last (up to last, not beyond), and the
     range's unit; the bounds must be values known at import (numbers, inputs, definitions)."""
     why = "a range whose bounds are not values known at import"

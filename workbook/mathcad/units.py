@@ -14,7 +14,8 @@ FORMULA_UNITS: dict[str, str] = {
     "μm": "micrometer", "nm": "nanometer", "in": "inch", "ft": "foot", "yd": "yard",
     "mi": "mile",
     # mass
-    "kg": "kilogram", "g": "gram", "mg": "milligram", "tonne": "tonne", "ton": "ton",
+    # Mathcad's gram is gm; its g is the acceleration of gravity (Prime's constant g too)
+    "kg": "kilogram", "gm": "gram", "mg": "milligram", "tonne": "tonne", "ton": "ton",
     "lb": "pound", "oz": "ounce",
     # time
     "s": "second", "ms": "millisecond", "min": "minute", "hr": "hour", "day": "day",
@@ -44,8 +45,9 @@ FORMULA_UNITS: dict[str, str] = {
     # frequency, speed
     "Hz": "hertz", "kHz": "kilohertz", "MHz": "megahertz", "rpm": "revolutions_per_minute",
     "mph": "mile_per_hour", "kph": "kilometer_per_hour", "knot": "knot",
+    "g": "standard_gravity",
     # temperature (differences) and amount
-    "K": "kelvin", "R": "degree_Rankine", "mol": "mole", "cd": "candela",
+    "K": "kelvin", "R": "degree_Rankine", "mol": "mole", "mole": "mole", "cd": "candela",
     # area
     "ha": "hectare", "acre": "acre",
     # ratios and signs

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..language import expr as ex
+from ..outputs.atomic import csv_text
 from .functions import language_functions
 from .symbols import Sym
 from .tomldoc import Document, is_one_line, one_line
@@ -319,7 +320,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         rows.append([f"# region {res.region}: {res.name}"])
         for at, value in res.rows:
             at_text = "" if at is None else repr(float(at))
-            val = value if isinstance(value, str) else repr(float(value))
+            val = csv_text(value) if isinstance(value, str) else repr(float(value))
             rows.append([sym_name, at_text, val, pretty_unit(res.unit) if res.unit else ""])
     printed: list[tuple] = []
     round_off = {r.region: r.round_off for r in tr.results if r.round_off}
@@ -362,7 +363,7 @@ def _misfit_rows(res) -> list[list[str]]:
     rows = [[f"# region {res.region}: {res.name}: not computable: {res.misfit}"]]
     for at, value in res.rows:
         at_text = "" if at is None else repr(float(at))
-        val = value if isinstance(value, str) else repr(float(value))
+        val = csv_text(value) if isinstance(value, str) else repr(float(value))
         rows.append([f"not computable result of region {res.region}", at_text, val, ""])
     return rows
 

@@ -1,0 +1,49 @@
+"""What an expression's translation reads of the worksheet's translator (a protocol, so that
+the expression and tree modules need not import the translator that imports them)."""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+from ..language import expr as ex
+from .reader import MNode
+from .symbols import Sym
+from .translation import Item, Translation
+
+
+class TranslatorContext(Protocol):
+    """The worksheet translator as ExprTranslator, the ODE solvers and trees use it."""
+
+    scope: dict[tuple[str, str], Sym]  # Mathcad name -> the symbol in force
+    out: Translation
+    calls: dict[Sym, list[tuple[ex.Node, ...]]]  # call sites of each function
+    inline: dict[str, tuple[list[str], ex.Node]]  # local functions of programs
+    origin: int  # Mathcad's ORIGIN where the translation is
+    sheet_origin: int  # the worksheet's [sheet] origin
+    region: str  # the region being translated
+
+    def at_import(self) -> Any: ...
+    def quantity(self, node: MNode, why: str = ...) -> Any: ...
+    def new_sym(self, kind: str, base: str, mathcad: str, region: str = "", **kw) -> Sym: ...
+    def sym_of(self, name: ex.Name) -> Sym: ...
+    def mathcad_name(self, name: str) -> str: ...
+    def unit_sym(self, name: str) -> Sym: ...
+    def local_call(self, sym: Sym, args: tuple[ex.Node, ...]) -> ex.Node: ...
+    def ignores_arguments(self, sym: Sym) -> bool: ...
+    def is_array(self, token: str) -> bool: ...
+    def vector_length_of(self, tree: ex.Node) -> int | None: ...
+    def range_of(self, node: MNode) -> Item | None: ...
+    def find(self, et: Any, args: list[MNode], method: str = "") -> ex.Node: ...
+    def extremum(self, et: Any, args: list[MNode], largest: bool) -> ex.Node: ...
+    def program(self, program: MNode, local: dict) -> dict: ...
+
+
+class ExpressionContext(Protocol):
+    """An expression translator as the ODE solvers use it: its translator, its local names,
+    the range variables it met, and the translation of one Mathcad expression."""
+
+    tr: TranslatorContext
+    local: dict[tuple[str, str], Sym]
+    ranges: list[Sym]
+
+    def value(self, node: MNode) -> ex.Node: ...
