@@ -7,6 +7,7 @@ import math
 import re
 
 import numpy as np
+import openpyxl
 import pytest
 
 import workbook
@@ -264,3 +265,19 @@ def test_a_for_loop_never_goes_beyond_its_last_value(tmp_path):
     assert sheet.evaluate("down", 10).magnitude == 10_741  # 10, 7, 4, 1
     assert sheet.evaluate("tenths", 1).magnitude == 11  # 1 is on the step, within rounding
     assert list(sheet.table("t").iloc[:, 0]) == [1, 3, 5, 7, 9, 10]
+
+
+def test_a_local_whose_assignment_did_not_run_is_an_error_of_the_program(tmp_path):
+    """`k := 1 if x == 4` then `k`: where the `if` is false, k has no value. The engine says
+    so for that definition (not a crash), and the workbook's nested IF gives #N/A there."""
+    sheet = _sheet(
+        tmp_path,
+        HEAD + "[definitions]\n" + prog("f(x)", "k := 1 if x == 4\nk") + 'a = "f(4)"\nb = "f(3)"\n',
+    )
+    assert float(sheet.evaluate("a").magnitude) == 1
+    with pytest.raises(workbook.WorkbookError, match="reads the local 'k' before any line"):
+        sheet.evaluate("b")
+    text = HEAD + "[definitions]\n" + prog("f(x)", "k := 1 if x == 4\nk") + 'a = "f(4)"\n'
+    book = openpyxl.load_workbook(_sheet(tmp_path, text).write_xlsx(tmp_path / "p.xlsx"))
+    formulas = [c.value for ws in book for row in ws.iter_rows() for c in row]
+    assert "=IF(4=4, (1), NA())" in formulas  # where k is unset, #N/A

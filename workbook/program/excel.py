@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from .statements import Assign, If, Return, SetItem, Stmt, Value
+from .statements import Assign, If, Return, SetItem, Stmt, Value, walk
 from .typer import TypedProgram
 
 
@@ -38,4 +38,7 @@ def excel_value(typed: TypedProgram, printed: Callable[[Any, dict], str], subst:
                 raise NotLive("a loop is written as values")
         return last if last is not None else "NA()"
 
-    return run(list(typed.body), dict(subst), None)
+    # a local read where its assignment did not run (under a false `if`) has no value: #N/A,
+    # as the engine's error there
+    unset = {st.name: "NA()" for st in walk(typed.body) if isinstance(st, Assign)}
+    return run(list(typed.body), {**unset, **subst}, None)

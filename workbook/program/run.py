@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..engine import runtime as rt
-from ..errors import LimitError, TemplateError
+from ..errors import InputError, LimitError, TemplateError
 from ..language.typed import is_runtime
 from ..limits_time import check_time
 from .statements import (
@@ -271,10 +271,11 @@ def compile_program(
     # a local made by its elements when the program runs is the number 0 until its first
     # element is set (Mathcad's start of a local): rows(v) is 0, so v[rows(v) + 1] appends
     made = {s.name for s in walk(typed.body) if isinstance(s, SetItem) and is_runtime(s.grow)}
+    assigned = frozenset(s.name for s in walk(typed.body) if isinstance(s, Assign))
 
     def run(env: dict):
         steps[0] = 0
-        local = dict(env)
+        local = _Locals(env, assigned, name)
         for n in made:
             local.setdefault(n, 0.0)
         try:
@@ -288,6 +289,24 @@ def compile_program(
         return _result(out)
 
     return run
+
+
+class _Locals(dict):
+    """A program run's names: a local read before any line gave it a value (its assignment
+    under an ``if`` that was false) is an error of the program, not a missing key."""
+
+    def __init__(self, env: dict, assigned: frozenset, program: str):
+        super().__init__(env)
+        self.assigned, self.program = assigned, program
+
+    def __missing__(self, key):
+        if key in self.assigned:
+            raise InputError(
+                f"the program of '{self.program}' reads the local '{key}' before any line "
+                f"gave it a value (its assignment did not run: an 'if' that was false?)",
+                definition=self.program,
+            )
+        raise KeyError(key)
 
 
 def _result(value):
