@@ -356,6 +356,22 @@ def series(of, lo, hi, kind: str) -> np.ndarray | None:
     return _each(kind, of.var, prepared, one)
 
 
+#: digits of diff's reference
+DIFF_DIGITS = 50
+
+
+def derivative(of, order: int, x) -> np.ndarray:
+    """The reference of diff(EXPR, X, N) at the points ``x``: ``mpmath.diff`` (finite
+    differences at 50 digits, steps chosen by mpmath) on EXPR's mpmath form, not SymPy's
+    formula of the derivative; refused (ReferenceFailed) without an mpmath form."""
+    try:
+        mp_form(of.evaluator, context(DIFF_DIGITS), of.body)
+    except NoMpForm as err:
+        raise ReferenceFailed(f"mpmath diff: {err} has no mpmath form") from None
+    prepared = _prepared(of, "diff", DIFF_DIGITS, x)
+    return _each("diff", of.var, prepared, lambda ctx, g, at, i: ctx.diff(g, ctx.mpf(at[0]), order))
+
+
 # -- roots inside the rounding noise: polished in extended precision ----------------------------
 #: rows of one call polished at most (a table of multiple roots keeps its noise-limited
 #: estimates beyond that)
