@@ -321,6 +321,10 @@ def _root_numpy(of, a, b=None):
 
     shape = np.broadcast_shapes(of.shape, np.shape(a), *(() if b is None else (np.shape(b),)))
     polish_roots(of, res, shape, tol)
+    from .rounding import root_rounding
+
+    # EXPR's rounding over the slope, where the polish did not certify the row
+    root_rounding(of, shape, res, np.abs(np.asarray(b, dtype=float) - a) if b is not None else a)
     odestates.add_root_error(of, shape, res)  # the states' global error, over the slope
     of.record("root", res)
     return _out(res.value)
@@ -446,8 +450,16 @@ def _extremum_numpy(name: str):
             a,
             b,
         )
+        from .rounding import extremum_rounding
+
+        shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
         if where:
-            res = Result(res.where, res.where_error, evaluations=res.evaluations, notes=res.notes)
+            res = Result(
+                res.where, res.where_error, res.where, evaluations=res.evaluations, notes=res.notes
+            )
+        extremum_rounding(of, shape, a, b, res, where)  # EXPR's own rounding near it
+        if where:
+            res.where = None
         else:  # the states' global error where the extremum is
             odestates.add_value_error(of, np.shape(res.value), res.where, res)
         if "assumes" in res.notes:
