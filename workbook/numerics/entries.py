@@ -345,11 +345,12 @@ def _integral_numpy(of, a, b):
         return _out(res.value)
     shape = np.broadcast_shapes(of.shape, np.shape(a), np.shape(b))
     breaks = of.breaks(shape) + _kinks_located(of, shape, a, b)
+    poles = _poles_located(of, shape, a, b)
     if reference():
         from . import mpref
         from . import reference as ref
 
-        values = mpref.integral(of, a, b, breaks)
+        values = mpref.integral(of, a, b, breaks + poles)
         if values is None:
             values = _solve(
                 of,
@@ -369,7 +370,8 @@ def _integral_numpy(of, a, b):
             b,
             (rest[-2],),
             tol,
-            breaks=rest[:-2],
+            breaks=rest[: len(breaks)],
+            poles=rest[len(breaks) : -2],
             var=var,
             unit=unit,
             label=rest[-1],
@@ -379,6 +381,7 @@ def _integral_numpy(of, a, b):
         a,
         b,
         *breaks,
+        *poles,
     )
     rounding.integral_rounding(of, shape, a, b, res)  # EXPR's own rounding joins the estimate
     odestates.add_integral_error(of, shape, a, b, res)  # and the ODE states' global error
@@ -386,12 +389,13 @@ def _integral_numpy(of, a, b):
     return _out(res.value)
 
 
-def _kinks_located(of, shape, a, b) -> list[np.ndarray]:
+def _kinks_located(of, shape, a, b, switches=None) -> list[np.ndarray]:
     """Break points where a sub-tree whose zeros are kinks of EXPR (abs(sin(x)), min of two
-    curves) is 0, found by interval arithmetic (numerics.features.kink_points)."""
+    curves) is 0, found by interval arithmetic (numerics.features.kink_points); or, given
+    ``switches`` (:meth:`Bound.poles`), where a singular sub-tree is."""
     from .features import kink_points
 
-    switches = of.switches(shape)
+    switches = of.switches(shape) if switches is None else switches
     if not switches:
         return []
     a, b = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
@@ -403,6 +407,38 @@ def _kinks_located(of, shape, a, b) -> list[np.ndarray]:
     out = []
     for g, h in switches:
         out += [p.reshape(shape) for p in kink_points(g, h, lo, hi, min_width)]
+    return out
+
+
+#: a located zero of a singular sub-tree is a pole where |the sub-tree| there is below this
+#: share of its largest |value| at the ends and middle (not a touching zero's estimate)
+POLE_ZERO = 1e-10
+
+
+def _poles_located(of, shape, a, b) -> list[np.ndarray]:
+    """Points where a singular sub-tree of EXPR (a denominator, tan's cosine, ...) is 0 inside
+    [A, B], located as the kinks are; a point whose sub-tree is not 0 there (the middle of an
+    unresolved box beside a touching zero) is left out (the row's lower bound instead)."""
+    pairs = of.poles(shape)
+    if not pairs:
+        return []
+    lo, hi = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
+    rows = np.arange(lo.size, dtype=float)
+    out = []
+    for g, h in pairs:
+        for p in _kinks_located(of, shape, a, b, [(g, h)]):
+            p = np.ravel(p)
+            with np.errstate(all="ignore"):
+                at = np.abs(np.broadcast_to(np.asarray(h(p, rows), float), p.shape))
+                size = np.max(
+                    [
+                        np.abs(np.broadcast_to(np.asarray(h(x, rows), float), p.shape))
+                        for x in (lo, (lo + hi) / 2, hi)
+                    ],
+                    axis=0,
+                )
+            keep = at <= POLE_ZERO * np.where(np.isfinite(size), size, 0.0)
+            out.append(np.where(keep, p, np.minimum(lo, hi)).reshape(shape))
     return out
 
 

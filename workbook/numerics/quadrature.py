@@ -63,6 +63,7 @@ def integrate(
     label: Callable[[int], str] | None = None,
     enclose: Callable | None = None,
     singular: Sequence[Callable] = (),
+    poles: Sequence = (),
 ) -> Result:
     """The integral of ``f(x, *args)`` from a to b for every row.
 
@@ -73,10 +74,15 @@ def integrate(
     is split there too. The error estimate is the sum of the pieces' (QUADPACK's, or
     tanh-sinh's). ``singular``: ``h(x, *args)`` per sub-tree of f whose zeros are singular
     points of f (:mod:`workbook.numerics.singular`); a row where one is 0 just outside a
-    piece has a second tanh-sinh computation (see :func:`_tanhsinh`).
+    piece has a second tanh-sinh computation (see :func:`_tanhsinh`). ``poles``: points (per
+    row) where a singular sub-tree is 0, break points too; a piece between two singular
+    points is split once more (see :func:`_asymmetric`).
     """
-    shape, (a, b, *rest) = rows(a, b, *args, *breaks)
+    shape, (a, b, *rest) = rows(a, b, *args, *breaks, *poles)
     args, brk = rest[: len(args)], rest[len(args) :]
+    brk, pole = brk[: len(breaks)], brk[len(breaks) :]
+    pole = _snapped(pole, [a, b, *brk], np.abs(b - a))
+    brk = [*brk, *pole]
     n = a.size
     if n == 0:
         return Result(np.empty(shape), np.empty(shape))
@@ -97,15 +103,30 @@ def integrate(
                 pts[k - 1] = np.where(close, pts[k], pts[k - 1])
     else:
         pts = np.vstack([lo, hi])
+    pts = _asymmetric(f, pts, args, pole, lo, hi)
     left, right = pts[:-1], pts[1:]  # (pieces, rows)
     if _every_row_slow(f, left, right, args, tol, n):
         value, error, pending, evals = np.zeros(n), np.zeros(n), np.ones(n, dtype=bool), 0
     else:
         value, error, pending, evals = _adaptive(f, left, right, args, tol, n)
     if pending.any():
-        v, e, ev = _tanhsinh(
-            f, left[:, pending], right[:, pending], args, pending, tol, n, label, unit, singular
+        pl, pr, at = _split_at_singular_middles(
+            f, left[:, pending], right[:, pending], args, pending
         )
+        if at is None and pole:
+            inside = np.vstack(pole)[:, pending]
+            inside = inside[(inside > lo[pending]) & (inside < hi[pending])]
+            at = float(inside[0]) if inside.size else None
+        try:
+            v, e, ev = _tanhsinh(f, pl, pr, args, pending, tol, n, label, unit, singular)
+        except NumericsError as err:
+            if at is None:
+                raise
+            raise NumericsError(
+                f"{err.message}; the integrand is singular at {var} = {num(at)}{_u(unit)}, "
+                "inside the interval: the integral diverges beside it (a principal value, "
+                "where the two sides cancel, is not an integral)"
+            ) from None
         value[pending], error[pending] = v, e
         evals = max(evals, ev)
     # the integrand's size, for the rows whose estimate the check would report against their
@@ -115,6 +136,50 @@ def integrate(
     return Result(
         (sign * value).reshape(shape), error.reshape(shape), evaluations=evals, notes=notes
     )
+
+
+#: where a piece between two singular points is split (a fraction of it, not its middle)
+ASYMMETRIC = 0.381966011250105
+
+
+#: a pole this close (relative to the interval) to a break point or an end is that point
+SNAP = 1e-9
+
+
+def _snapped(pole: list, points: list, width: np.ndarray) -> list:
+    """The poles, each moved onto a break point or an end within SNAP of the interval (a
+    zero found by a root search beside the same point read from the tree: two break points
+    a few ulps apart make a piece tanh-sinh cannot integrate)."""
+    out = []
+    for p in pole:
+        p = p.copy()
+        for q in points:
+            near = np.abs(p - q) <= SNAP * width + 16 * np.spacing(np.abs(q))
+            p = np.where(near, q, p)
+        out.append(p)
+    return out
+
+
+def _asymmetric(f, pts, args, pole, lo, hi) -> np.ndarray:
+    """The break points ``pts`` (points, rows), with one more inside each piece whose two
+    ends are singular (a pole located there, or f not finite there). An integrand odd about
+    the middle of such a piece (x/(x^2 - 0.25) on [-0.5, 0.5], tan(x) between its poles)
+    is 0 at every symmetric rule, Gauss-Kronrod's or tanh-sinh's, with an estimate of 0:
+    the principal value of a divergent integral. Split off the middle, each piece has one
+    singular end, where a divergent integral does not converge (and is refused)."""
+    if pts.shape[0] < 2:
+        return pts
+    with np.errstate(all="ignore"):
+        fp = np.broadcast_to(np.asarray(call(f, pts, [g[None, :] for g in args]), float), pts.shape)
+    singular = ~np.isfinite(fp)
+    for p in pole:
+        inside = ((p > lo) & (p < hi))[None, :]
+        singular |= inside & (np.abs(pts - p[None, :]) <= 16 * np.spacing(np.abs(p[None, :])))
+    both = singular[:-1] & singular[1:] & (pts[1:] > pts[:-1])
+    if not both.any():
+        return pts
+    extra = np.where(both, pts[:-1] + ASYMMETRIC * (pts[1:] - pts[:-1]), pts[:-1])
+    return np.sort(np.vstack([pts, extra]), axis=0)
 
 
 #: interior points where the integrand's size is sampled (an end may be singular)
@@ -208,6 +273,41 @@ def _adaptive(f, left, right, args, tol, n):
             np.concatenate([row, row]),
         )
     return value, error, pending, evals
+
+
+#: times a piece whose middle is not finite is split there (a singular point at a middle
+#: of the halves too)
+MIDDLE_SPLITS = 4
+
+
+def _split_at_singular_middles(f, left, right, args, pending):
+    """The pieces (pieces, rows) of the pending rows, each split at its middle where f is
+    not finite there. tanh-sinh's nodes are symmetric about the middle and SciPy's drops a
+    node where f is not finite: at an interior singularity in the middle (1/(x - 0.5) on
+    [0, 1]) the two sides cancel, and it converges to the principal value 0, which is no
+    integral. As an end of two pieces the singular point is tanh-sinh's strength: an
+    integrable one converges, a divergent one does not (and is refused). Also returns the
+    first point split at (None: none)."""
+    args = [g[None, pending] for g in args]
+    first = None
+    for _ in range(MIDDLE_SPLITS):
+        mid = (left + right) / 2.0
+        with np.errstate(all="ignore"):
+            fm = np.broadcast_to(np.asarray(call(f, mid, args), dtype=float), mid.shape)
+        bad = ~np.isfinite(fm) & (mid > left) & (mid < right)
+        if not bad.any():
+            break
+        first = float(mid[bad][0]) if first is None else first
+        # each bad piece ends at its middle; its other half is a new piece (empty elsewhere)
+        extra_left = np.where(bad, mid, right)
+        extra_right = right.copy()
+        right = np.where(bad, mid, right)
+        left = np.vstack([left, extra_left])
+        right = np.vstack([right, extra_right])
+        # the empty pieces keep their row's order (left <= right per row after sorting)
+        order = np.argsort(left, axis=0, kind="stable")
+        left, right = np.take_along_axis(left, order, 0), np.take_along_axis(right, order, 0)
+    return left, right, first
 
 
 def _tanhsinh(f, left, right, args, pending, tol, n, label, unit, singular=()):
