@@ -437,7 +437,8 @@ def _poles_located(of, shape, a, b) -> list[np.ndarray]:
                     ],
                     axis=0,
                 )
-            keep = at <= POLE_ZERO * np.where(np.isfinite(size), size, 0.0)
+            size = np.where(np.isfinite(size), size, 0.0)
+            keep = (at <= POLE_ZERO * size) & (size > 0)  # not a sub-tree that is 0 throughout
             out.append(np.where(keep, p, np.minimum(lo, hi)).reshape(shape))
     return out
 

@@ -83,7 +83,25 @@ class Kinks(Visitor):
         elif self._interpolant(t, aliases):  # linear between the points: a kink at each
             xs, _, f = self._interpolant(t, aliases)
             self.found += [ty.TConst(t.args[2].unit, value=float(x) / f) for x in xs]
+        elif t.func == "integral" and len(t.args) == 4:
+            self._bound_crossings(t, aliases, subst)
         self._children(t, aliases, subst)
+
+    def _bound_crossings(self, t: ty.TFunc, aliases, subst) -> None:
+        """An inner integral whose bound is the variable times f: its integrand's break
+        points c (free of the variable) are kinks of the integral in the variable, at c/f
+        (its derivative in the bound is the integrand there: a beam's moment, integrated
+        twice, has a kink in its slope where the load is)."""
+        inner = Kinks(self.typer)
+        inner.visit(t.args[0], {t.args[1].name: 1.0}, None)
+        for end in t.args[2:]:
+            f = self._linear(end, aliases)
+            if not f:
+                continue
+            for c in inner.found:
+                outer = self._outer(c, aliases, subst)
+                if outer is not None:
+                    self.found.append(ty.TScale(outer.unit, child=outer, factor=1.0 / f))
 
     def _interpolant(self, t: ty.T, aliases):
         """(X, Y, f) if ``t`` is linterp(X, Y, x) of the variable times f, else None."""

@@ -15,6 +15,7 @@ would be thrown away. Either way every row ends with its error estimate below th
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -294,7 +295,9 @@ def _split_at_singular_middles(f, left, right, args, pending):
         mid = (left + right) / 2.0
         with np.errstate(all="ignore"):
             fm = np.broadcast_to(np.asarray(call(f, mid, args), dtype=float), mid.shape)
-        bad = ~np.isfinite(fm) & (mid > left) & (mid < right)
+        # (a piece of a few doubles has no middle to split at: its nodes are its ends)
+        room = 64 * np.spacing(np.abs(mid))
+        bad = np.isinf(fm) & (mid - left > room) & (right - mid > room)  # a pole, not NaN
         if not bad.any():
             break
         first = float(mid[bad][0]) if first is None else first
@@ -319,18 +322,29 @@ def _tanhsinh(f, left, right, args, pending, tol, n, label, unit, singular=()):
     scale = size if not tol.atol else np.ones(idx.size)
 
     def run(lo, hi, cols, minlevel=2):
-        with np.errstate(all="ignore"):
-            res = tanhsinh(
-                lambda x, inverse, *a: f(x, *a) * inverse,
-                lo,
-                hi,
-                args=(1.0 / scale[None, cols], *[g[:, cols] for g in args]),
-                rtol=max(tol.rtol, 1e-15),
-                # the integrand is divided by the row's size: a piece's error is allowed its
-                # share of the tolerance of the whole row, as in the Gauss-Kronrod pass (and a
-                # piece where f is 0 converges at once)
-                atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
-                minlevel=minlevel,
+        try:
+            with np.errstate(all="ignore"):
+                res = tanhsinh(
+                    lambda x, inverse, *a: f(x, *a) * inverse,
+                    lo,
+                    hi,
+                    args=(1.0 / scale[None, cols], *[g[:, cols] for g in args]),
+                    rtol=max(tol.rtol, 1e-15),
+                    # the integrand is divided by the row's size: a piece's error is allowed
+                    # its share of the tolerance of the whole row, as in the Gauss-Kronrod
+                    # pass (and a piece where f is 0 converges at once)
+                    atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
+                    minlevel=minlevel,
+                )
+        except NumericsError:
+            # f refused at one of tanh-sinh's nodes: an inner integral at a node a few
+            # doubles from an end (its interval [0, x] for x = 2e-323 holds 4 doubles, its
+            # nodes fall on its singular end); QAGS's nodes keep away from the ends
+            res = SimpleNamespace(
+                integral=np.zeros(lo.shape),
+                error=np.zeros(lo.shape),
+                nfev=np.zeros(lo.shape, dtype=int),
+                status=np.full(lo.shape, -3),
             )
         status = np.array(res.status)
         for p, i in np.argwhere(status != 0):  # QUADPACK's QAGS where tanh-sinh gives up
@@ -450,12 +464,13 @@ def _rounding(f, left, right, args) -> tuple[np.ndarray, np.ndarray]:
     out = np.zeros(left.shape[1])
     top = np.zeros(left.shape[1])
     for end, inward in ((left, 1.0), (right, -1.0)):
-        d = 4 * np.spacing(np.abs(end))
-        with np.errstate(all="ignore"):
-            fv = np.abs(
-                np.broadcast_to(np.asarray(f(end + inward * d, *args), dtype=float), end.shape)
-            )
+        # (not below 1e-280: an inner integral over [0, x] is not computed for x a few
+        # subnormal doubles, whose interval holds no nodes but its ends)
+        d = np.maximum(4 * np.spacing(np.abs(end)), 1e-280)
         inside = right > left
+        at = np.where(inside, end + inward * d, end)  # (an empty piece: not beyond its end)
+        with np.errstate(all="ignore"):
+            fv = np.abs(np.broadcast_to(np.asarray(f(at, *args), dtype=float), end.shape))
         out += np.where(np.isfinite(fv) & inside, 2 * d * fv, 0.0).sum(axis=0)
         top = np.maximum(
             top, np.where(inside, np.where(np.isfinite(fv), fv, np.inf), 0.0).max(axis=0)
