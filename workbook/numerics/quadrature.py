@@ -347,6 +347,12 @@ def _tanhsinh(f, left, right, args, pending, tol, n, label, unit, singular=()):
                 status=np.full(lo.shape, -3),
             )
         status = np.array(res.status)
+        # an empty piece (a row with fewer break points repeats its lower bound) is 0, also
+        # where f has no value at that point (sqrt(x)*ln(x) at 0)
+        empty = np.broadcast_to(lo == hi, status.shape)
+        if empty.any():
+            res.integral, res.error = np.array(res.integral), np.array(res.error)
+            res.integral[empty], res.error[empty], status[empty] = 0.0, 0.0, 0
         for p, i in np.argwhere(status != 0):  # QUADPACK's QAGS where tanh-sinh gives up
             done = quadpack(f, lo[p, i], hi[p, i], [g[:, [cols[i]]] for g in args], tol)
             if done is not None:
