@@ -385,7 +385,7 @@ CASES = [
 ]
 
 
-def _run(case: Case, folder: Path) -> tuple[str, float, float, bool]:
+def run_case(case: Case, folder: Path) -> tuple[str, float, float, bool]:
     """(refusal or "", relative error, relative estimate, warned)."""
     defs = case.defs
     line = f'out = "{case.expr}"\n'
@@ -430,7 +430,7 @@ def main(argv: list[str]) -> int:
         for case in CASES:
             if quick and case.slow:
                 continue
-            refused, err, est, warned = _run(case, Path(tmp))
+            refused, err, est, warned = run_case(case, Path(tmp))
             v = verdict(refused, err, est, warned, case.exact is not None)
             key = v.split(":")[0].split(" (")[0] if not v.startswith("refused (right)") else v
             counts[key] = counts.get(key, 0) + 1
