@@ -337,6 +337,11 @@ def _kinks_located(of, shape, a, b, switches=None) -> list[np.ndarray]:
 POLE_ZERO = 1e-10
 
 
+#: a call of more rows than this is searched for poles on POLE_PROBE rows spread over it
+#: first, and entirely only when one of them has one (as the features of an integrand)
+POLE_ROWS, POLE_PROBE = 2_000, 32
+
+
 def _poles_located(of, shape, a, b) -> list[np.ndarray]:
     """Points where a singular sub-tree of EXPR (a denominator, tan's cosine, ...) is 0 inside
     [A, B], located as the kinks are; a point whose sub-tree is not 0 there (the middle of an
@@ -344,24 +349,45 @@ def _poles_located(of, shape, a, b) -> list[np.ndarray]:
     pairs = of.poles(shape)
     if not pairs:
         return []
-    lo, hi = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
-    rows = np.arange(lo.size, dtype=float)
+    a, b = (np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for v in (a, b))
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    if lo.size > POLE_ROWS:
+        sel = np.unique(np.linspace(0, lo.size - 1, POLE_PROBE).astype(np.intp))
+        probe = _poles_at(pairs, lo[sel], hi[sel], sel)
+        if not any(np.any((p > lo[sel]) & (p < hi[sel])) for p in probe):
+            return []
+    return [p.reshape(shape) for p in _poles_at(pairs, lo, hi, np.arange(lo.size))]
+
+
+def _poles_at(pairs, lo, hi, rows) -> list[np.ndarray]:
+    """:func:`_poles_located` on the flat rows ``rows`` of the call (lo, hi: theirs)."""
+    from .features import kink_points
+
+    span = np.maximum(np.abs(lo), np.abs(hi))
+    min_width = np.maximum(1e-6 * (hi - lo), 64 * np.spacing(span))
+    at_rows = np.arange(lo.size, dtype=float)
     out = []
     for g, h in pairs:
-        for p in _kinks_located(of, shape, a, b, [(g, h)]):
-            p = np.ravel(p)
+
+        def enclose(p, q, r, g=g):
+            return g(p, q, rows[np.asarray(r).astype(np.intp)])
+
+        def value(x, r, h=h):
+            return h(x, rows[np.asarray(r).astype(np.intp)])
+
+        for p in kink_points(enclose, value, lo, hi, min_width):
             with np.errstate(all="ignore"):
-                at = np.abs(np.broadcast_to(np.asarray(h(p, rows), float), p.shape))
+                there = np.abs(np.broadcast_to(np.asarray(value(p, at_rows), float), p.shape))
                 size = np.max(
                     [
-                        np.abs(np.broadcast_to(np.asarray(h(x, rows), float), p.shape))
+                        np.abs(np.broadcast_to(np.asarray(value(x, at_rows), float), p.shape))
                         for x in (lo, (lo + hi) / 2, hi)
                     ],
                     axis=0,
                 )
             size = np.where(np.isfinite(size), size, 0.0)
-            keep = (at <= POLE_ZERO * size) & (size > 0)  # not a sub-tree that is 0 throughout
-            out.append(np.where(keep, p, np.minimum(lo, hi)).reshape(shape))
+            keep = (there <= POLE_ZERO * size) & (size > 0)  # not a sub-tree 0 throughout
+            out.append(np.where(keep, p, lo))
     return out
 
 

@@ -152,7 +152,7 @@ def integral_rounding(of, shape, a, b, result) -> None:
 #: rows' addition)
 POINT_ROWS = 4
 #: a root's rounding is checked at the root and these relative offsets from it
-ROOT_OFFSETS = np.array([0.0, -2e-9, -1e-9, 1e-9, 2e-9])
+ROOT_OFFSETS = np.array([0.0, -1e-9, 1e-9])
 #: an extremum's rounding is checked at its place and this far (relative to the interval)
 #: to each side (the search compares values around it)
 EXTREMUM_OFFSETS = (0.0, -1e-6, 1e-6, -1e-3, 1e-3)
@@ -181,18 +181,19 @@ def _derivative(of, prepared, env, x: float, h: float, order: int) -> float | No
     from .mpform import NoValue
 
     ctx, form = prepared
+    steps = (-1, 1) if order == 1 else (-1, 0, 1)
     try:
-        g = [form({**env, of.var: ctx.mpf(x) + k * ctx.mpf(h)}) for k in (-1, 0, 1)]
+        g = [form({**env, of.var: ctx.mpf(x) + k * ctx.mpf(h)}) for k in steps]
     except (NoValue, ZeroDivisionError, ValueError, TypeError, KeyError):
         return None
     if any(isinstance(v, str) for v in g):
         return None
-    d = (g[2] - g[0]) / (2 * h) if order == 1 else (g[2] - 2 * g[1] + g[0]) / h**2
+    d = (g[-1] - g[0]) / (2 * h) if order == 1 else (g[2] - 2 * g[1] + g[0]) / h**2
     return abs(float(d))
 
 
-def _checked_rows(n: int) -> np.ndarray:
-    return np.unique(np.linspace(0, n - 1, min(n, POINT_ROWS)).astype(np.intp))
+def _checked_rows(n: int, most: int = POINT_ROWS) -> np.ndarray:
+    return np.unique(np.linspace(0, n - 1, min(n, most)).astype(np.intp))
 
 
 def _spread(n: int, rows: np.ndarray, add: np.ndarray) -> np.ndarray:
@@ -223,7 +224,8 @@ def root_rounding(of, shape, result, span: float | np.ndarray) -> None:
     todo = np.flatnonzero(~certified & np.isfinite(value))
     if not todo.size:
         return
-    rows = todo[_checked_rows(todo.size)]
+    # (2 rows of a table over 2,000 rows: the engine's own cost per row is what it is held to)
+    rows = todo[_checked_rows(todo.size, 2 if n > 2_000 else POINT_ROWS)]
     # the residual's rounding at the root and beside it (it varies from double to double;
     # the sign change is wherever the noise crosses)
     near = value[rows, None] * (1 + ROOT_OFFSETS[None, :])
