@@ -470,13 +470,16 @@ def _rounding(f, left, right, args) -> tuple[np.ndarray, np.ndarray]:
     out = np.zeros(left.shape[1])
     top = np.zeros(left.shape[1])
     for end, inward in ((left, 1.0), (right, -1.0)):
-        # (not below 1e-280: an inner integral over [0, x] is not computed for x a few
-        # subnormal doubles, whose interval holds no nodes but its ends)
-        d = np.maximum(4 * np.spacing(np.abs(end)), 1e-280)
+        d = 4 * np.spacing(np.abs(end))
         inside = right > left
         at = np.where(inside, end + inward * d, end)  # (an empty piece: not beyond its end)
-        with np.errstate(all="ignore"):
-            fv = np.abs(np.broadcast_to(np.asarray(f(at, *args), dtype=float), end.shape))
+        try:
+            with np.errstate(all="ignore"):
+                fv = np.abs(np.broadcast_to(np.asarray(f(at, *args), dtype=float), end.shape))
+        except NumericsError:
+            # an inner integral over [0, x] for x a few subnormal doubles (its interval holds
+            # no nodes but its ends): no value there, as where f overflows
+            fv = np.full(end.shape, np.inf)
         out += np.where(np.isfinite(fv) & inside, 2 * d * fv, 0.0).sum(axis=0)
         top = np.maximum(
             top, np.where(inside, np.where(np.isfinite(fv), fv, np.inf), 0.0).max(axis=0)
