@@ -170,8 +170,12 @@ def _asymmetric(f, pts, args, pole, lo, hi) -> np.ndarray:
     singular end, where a divergent integral does not converge (and is refused)."""
     if pts.shape[0] < 2:
         return pts
-    with np.errstate(all="ignore"):
-        fp = np.broadcast_to(np.asarray(call(f, pts, [g[None, :] for g in args]), float), pts.shape)
+    try:
+        with np.errstate(all="ignore"):
+            fp = call(f, pts, [g[None, :] for g in args])
+        fp = np.broadcast_to(np.asarray(fp, float), pts.shape)
+    except NumericsError:  # (an inner integral refused at a break point: the poles decide)
+        fp = np.zeros(pts.shape)
     singular = ~np.isfinite(fp)
     for p in pole:
         inside = ((p > lo) & (p < hi))[None, :]
@@ -293,8 +297,11 @@ def _split_at_singular_middles(f, left, right, args, pending):
     first = None
     for _ in range(MIDDLE_SPLITS):
         mid = (left + right) / 2.0
-        with np.errstate(all="ignore"):
-            fm = np.broadcast_to(np.asarray(call(f, mid, args), dtype=float), mid.shape)
+        try:
+            with np.errstate(all="ignore"):
+                fm = np.broadcast_to(np.asarray(call(f, mid, args), dtype=float), mid.shape)
+        except NumericsError:  # (an inner integral refused there: tanh-sinh will say so)
+            break
         # (a piece of a few doubles has no middle to split at: its nodes are its ends)
         room = 64 * np.spacing(np.abs(mid))
         bad = np.isinf(fm) & (mid - left > room) & (right - mid > room)  # a pole, not NaN

@@ -5,7 +5,9 @@ nothing of what numpy's doubles lose inside EXPR (``cos(1e-4*x) - 1`` is 5e-9 co
 the difference of two numbers near 1, with an absolute error near 1e-16 whatever the rule).
 :func:`discrepancy` evaluates EXPR at given points both ways, numpy and its mpmath form
 (:mod:`workbook.numerics.mpform`, the same tree and the same double constants), and gives
-per row the difference; the built-ins add what it costs them to their estimate.
+per row the difference; the built-ins add what it costs them to their estimate: an
+integral the width times it, a root it over the slope (:func:`root_rounding`), an extremum
+twice it, and its place through the curvature (:func:`extremum_rounding`).
 
 Only some rows spread over a call are checked (an mpmath evaluation is ~1e4 times a numpy
 one): the others take the difference of the nearest checked rows.
