@@ -84,7 +84,7 @@ KNOWN_ELSEWHERE = {
     # its interval gets a second tanh-sinh computation)
     ("numerics/singular.py", ("ln", "log10", "sqrt")),
     # the step functions whose jumps an integral is split at (zeros of sin(pi u))
-    ("numerics/kinks.py", ("ceil", "floor", "trunc")),
+    ("numerics/switches.py", ("ceil", "floor", "trunc")),
     # the trigonometric functions whose argument the angle warnings look at (a slip of theta
     # in degrees times pi/180, a bare number of degrees read as radians)
     ("engine/angle_slips.py", ("cos", "sin", "tan")),

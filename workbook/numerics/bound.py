@@ -104,7 +104,7 @@ class Bound:
         """(g, h) per sub-tree whose zeros are kinks or jumps of EXPR (numerics.kinks.
         switching) and that has interval enclosures: ``g(lo, hi, row) -> (F, D)`` and
         ``h(x, row)`` its values, as :meth:`enclosure` and :meth:`over`."""
-        from .kinks import switching
+        from .switches import switching
 
         return self._pairs(switching(self.body, self.var), shape)
 
