@@ -19,6 +19,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..errors import WorkbookError
 from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
 from .estimates import ESTIMATE_LIMIT
 from .kronrod import gk21
@@ -170,13 +171,20 @@ def _asymmetric(f, pts, args, pole, lo, hi) -> np.ndarray:
     singular end, where a divergent integral does not converge (and is refused)."""
     if pts.shape[0] < 2:
         return pts
-    try:
-        with np.errstate(all="ignore"):
-            fp = call(f, pts, [g[None, :] for g in args])
-        fp = np.broadcast_to(np.asarray(fp, float), pts.shape)
-    except NumericsError:  # (an inner integral refused at a break point: the poles decide)
-        fp = np.zeros(pts.shape)
-    singular = ~np.isfinite(fp)
+    singular = np.zeros(pts.shape, dtype=bool)
+    # the ends and the inner break points apart: EXPR may refuse a value at an end (a
+    # declared limit broken by a root's rounding there) or an inner integral at a break
+    # point; then the poles decide there
+    for part in (slice(0, 1), slice(1, -1), slice(-1, None)):
+        at = pts[part]
+        if not at.size:
+            continue
+        try:
+            with np.errstate(all="ignore"):
+                fp = call(f, at, [g[None, :] for g in args])
+            singular[part] = ~np.isfinite(np.broadcast_to(np.asarray(fp, float), at.shape))
+        except WorkbookError:
+            continue
     for p in pole:
         inside = ((p > lo) & (p < hi))[None, :]
         singular |= inside & (np.abs(pts - p[None, :]) <= 16 * np.spacing(np.abs(p[None, :])))
@@ -300,7 +308,7 @@ def _split_at_singular_middles(f, left, right, args, pending):
         try:
             with np.errstate(all="ignore"):
                 fm = np.broadcast_to(np.asarray(call(f, mid, args), dtype=float), mid.shape)
-        except NumericsError:  # (an inner integral refused there: tanh-sinh will say so)
+        except WorkbookError:  # (an inner integral refused there: tanh-sinh will say so)
             break
         # (a piece of a few doubles has no middle to split at: its nodes are its ends)
         room = 64 * np.spacing(np.abs(mid))
