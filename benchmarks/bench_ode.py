@@ -21,62 +21,15 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _timing import ROOT, Result, alternate, median, ms, report  # noqa: E402
+from ode_problems import PROBLEMS, robertson  # noqa: E402
 
 TEMPLATE = ROOT / "tests" / "data" / "robertson.toml"
 COUPLING = ROOT / "templates" / "advance-coupling.toml"
 TARGET = 1.5  # engine "auto" / the fastest fitting SciPy method called directly
 CHECK_TARGET = 2.0  # check / (one solve + its error estimate)
 RTOL, ATOL = 1e-6, 1e-9
-
-
-def kepler(t, y):
-    x, yy, vx, vy = y
-    r3 = (x * x + yy * yy) ** 1.5
-    return np.array([vx, vy, -x / r3, -yy / r3])
-
-
-def robertson(t, y):
-    y1, y2, y3 = y
-    return np.array(
-        [-0.04 * y1 + 1e4 * y2 * y3, 0.04 * y1 - 1e4 * y2 * y3 - 3e7 * y2**2, 3e7 * y2**2]
-    )
-
-
-def hires(t, y):
-    y1, y2, y3, y4, y5, y6, y7, y8 = y
-    return np.array(
-        [
-            -1.71 * y1 + 0.43 * y2 + 8.32 * y3 + 0.0007,
-            1.71 * y1 - 8.75 * y2,
-            -10.03 * y3 + 0.43 * y4 + 0.035 * y5,
-            8.32 * y2 + 1.71 * y3 - 1.12 * y4,
-            -1.745 * y5 + 0.43 * y6 + 0.43 * y7,
-            -280 * y6 * y8 + 0.69 * y4 + 1.71 * y5 - 0.43 * y6 + 0.69 * y7,
-            280 * y6 * y8 - 1.81 * y7,
-            -280 * y6 * y8 + 1.81 * y7,
-        ]
-    )
-
-
-def vdp(t, y):
-    return np.array([y[1], 1000.0 * (1 - y[0] ** 2) * y[1] - y[0]])
-
-
-E = 0.5
-PROBLEMS = {  # name: (f, span, y0, stiff)
-    "Kepler, e = 0.5, 50 periods": (
-        kepler, (0.0, 100 * np.pi), [1 - E, 0, 0, np.sqrt((1 + E) / (1 - E))], False
-    ),
-    "Robertson to t = 40": (robertson, (0.0, 40.0), [1.0, 0.0, 0.0], True),
-    "HIRES to t = 321.8122": (
-        hires, (0.0, 321.8122), [1, 0, 0, 0, 0, 0, 0, 0.0057], True
-    ),
-    "Van der Pol, mu = 1000, to t = 3000": (vdp, (0.0, 3000.0), [2.0, 0.0], True),
-}  # fmt: skip
 
 
 def _problem_row(name: str, f, span, y0, stiff: bool, reps: int) -> Result:

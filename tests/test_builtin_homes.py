@@ -62,8 +62,9 @@ KNOWN_ELSEWHERE = {
     # the numerical methods with an error estimate (bench) and their live Excel forms
     (
         "numerics/bench.py",
-        ("argmax", "argmin", "integral", "maximum", "minimum", "product", "root", "sum"),
+        ("argmax", "argmin", "diff", "integral", "maximum", "minimum", "product", "root", "sum"),
     ),
+    ("numerics/bench.py", ("det", "eigenvals", "eigenvecs", "inverse", "lsolve")),
     ("numerics/live.py", ("argmax", "argmin", "maximum", "minimum")),
     # interval arithmetic of the one-argument built-ins (root counts, global extrema,
     # features of integrands): a back end whose rules could be a field of the entry
@@ -83,6 +84,8 @@ KNOWN_ELSEWHERE = {
     # the functions singular where their argument is 0 (an integrand nearly singular beside
     # its interval gets a second tanh-sinh computation)
     ("numerics/singular.py", ("ln", "log10", "sqrt")),
+    # the step functions whose jumps an integral is split at (zeros of sin(pi u))
+    ("numerics/switches.py", ("ceil", "floor", "trunc")),
     # the trigonometric functions whose argument the angle warnings look at (a slip of theta
     # in degrees times pi/180, a bare number of degrees read as radians)
     ("engine/angle_slips.py", ("cos", "sin", "tan")),

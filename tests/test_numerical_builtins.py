@@ -632,11 +632,11 @@ def test_a_root_in_a_table_column_is_live_as_bisection_steps(tmp_path):
     stated = re.search(r"by ([0-9.e+-]+) ", ws.cell(2, live).comment.text)
     assert stated and float(stated.group(1)) < 1e-10
     # the cached value of every step cell is what the formulas compute (the same steps)
-    from workbook.numerics.entries import _bisection
+    from workbook.numerics.excelforms import bisection
 
     steps = wb["Solver rows"]
     f = lambda x, i: colebrook(x, np.array(re_values)[i.astype(int)])  # noqa: E731
-    want = _bisection(f, np.full(6, 0.005), np.full(6, 0.1), np.arange(6.0))
+    want = bisection(f, np.full(6, 0.005), np.full(6, 0.1), np.arange(6.0))
     cached = openpyxl_values(path)["Solver rows"]
     assert steps.cell(3, 2).value.startswith("=1/SQRT((0.005))")
     for r in range(6):

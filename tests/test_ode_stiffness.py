@@ -4,6 +4,9 @@ the Kepler orbit's period (it returns to its start) and SciPy's Radau at tight t
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -11,50 +14,9 @@ from scipy.integrate import solve_ivp
 from workbook.engine import ode
 from workbook.engine.odeauto import auto_run, jacobian
 
-E = 0.5
-KEPLER_Y0 = [1 - E, 0.0, 0.0, np.sqrt((1 + E) / (1 - E))]
-
-
-def kepler(t, y):
-    x, yy, vx, vy = y
-    r3 = (x * x + yy * yy) ** 1.5
-    return np.array([vx, vy, -x / r3, -yy / r3])
-
-
-def robertson(t, y):
-    y1, y2, y3 = y
-    return np.array(
-        [-0.04 * y1 + 1e4 * y2 * y3, 0.04 * y1 - 1e4 * y2 * y3 - 3e7 * y2**2, 3e7 * y2**2]
-    )
-
-
-def hires(t, y):
-    y1, y2, y3, y4, y5, y6, y7, y8 = y
-    return np.array(
-        [
-            -1.71 * y1 + 0.43 * y2 + 8.32 * y3 + 0.0007,
-            1.71 * y1 - 8.75 * y2,
-            -10.03 * y3 + 0.43 * y4 + 0.035 * y5,
-            8.32 * y2 + 1.71 * y3 - 1.12 * y4,
-            -1.745 * y5 + 0.43 * y6 + 0.43 * y7,
-            -280 * y6 * y8 + 0.69 * y4 + 1.71 * y5 - 0.43 * y6 + 0.69 * y7,
-            280 * y6 * y8 - 1.81 * y7,
-            -280 * y6 * y8 + 1.81 * y7,
-        ]
-    )
-
-
-HIRES_Y0 = [1, 0, 0, 0, 0, 0, 0, 0.0057]
-
-
-def vdp(t, y):
-    return np.array([y[1], 1000.0 * (1 - y[0] ** 2) * y[1] - y[0]])
-
-
-def late(t, y):
-    """y1 follows cos t at a rate that switches from 1 to 1e4 around t = 5."""
-    k = 1 + 1e4 / (1 + np.exp(-10 * (t - 5)))
-    return np.array([-k * (y[0] - np.cos(t)) - np.sin(t), y[0]])
+# the problems are the benchmark's (benchmarks/bench_ode.py times the same ones)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from ode_problems import HIRES_Y0, KEPLER_Y0, hires, kepler, late, robertson, vdp  # noqa: E402
 
 
 @pytest.mark.slow

@@ -142,7 +142,7 @@ def _check_regular(m, what: str):
 def inverse(m):
     mm, cond = _check_regular(m, "inverse()")
     out = np.linalg.inv(mm)
-    linalg.solved("inverse", cond, out)
+    linalg.solved("inverse", cond, out, mm)
     return _first(out)
 
 
@@ -168,7 +168,7 @@ def lsolve(m, v):
     elif extra < 0:
         mm = mm.reshape((1,) * -extra + mm.shape)
     out = np.linalg.solve(mm, vv)
-    linalg.solved("lsolve", cond, out)
+    linalg.solved("lsolve", cond, out, mm, vv)
     return _first(out)
 
 

@@ -27,7 +27,9 @@ from ..language import typed as ty
 from ._common import current, reference_methods, sheet_tolerance
 
 #: built-ins whose values come from an iterative method with an error estimate
-NUMERICAL = ("root", "integral", "maximum", "minimum", "argmax", "argmin", "sum", "product")
+NUMERICAL = ("root", "integral", "maximum", "minimum", "argmax", "argmin", "sum", "product", "diff")
+#: built-ins computed on values (no EXPR), with an estimate from the condition number
+LINEAR = ("lsolve", "inverse", "det", "eigenvals", "eigenvecs")
 #: the relative accuracy the reference methods in doubles are trusted to
 REFERENCE_ACCURACY = 1e-12
 #: ... and the mpmath reference (its value is rounded to a double, and the arithmetic of the
@@ -105,6 +107,8 @@ def uses(sheet, t: ty.T) -> set[str]:
         n = stack.pop()
         if isinstance(n, ty.TFunc) and n.func in NUMERICAL and len(n.args) > 1:
             found.add(n.func)  # sum(v) of a vector (one argument) has no estimate
+        if isinstance(n, ty.TFunc) and n.func in LINEAR:
+            found.add(n.func)
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
             stack.append(sheet.typer.function(n.name).body)

@@ -104,12 +104,23 @@ class Bound:
         """(g, h) per sub-tree whose zeros are kinks or jumps of EXPR (numerics.kinks.
         switching) and that has interval enclosures: ``g(lo, hi, row) -> (F, D)`` and
         ``h(x, row)`` its values, as :meth:`enclosure` and :meth:`over`."""
+        from .switches import switching
+
+        return self._pairs(switching(self.body, self.var), shape)
+
+    def poles(self, shape: tuple[int, ...]) -> list[tuple[Callable, Callable]]:
+        """(g, h) as :meth:`switches`, per sub-tree whose zeros are singular points of EXPR
+        (numerics.singular: a denominator, a power's base, tan's cosine, ...)."""
+        from .singular import singular_arguments
+
+        return self._pairs(singular_arguments(self.evaluator.typer, self.body, self.var), shape)
+
+    def _pairs(self, subtrees, shape) -> list[tuple[Callable, Callable]]:
         from .intervals import Iv, NoEnclosure, enclosure
-        from .kinks import switching
 
         flat, env, var = self._flat(shape), self.env, self.var
         out = []
-        for u in switching(self.body, var):
+        for u in subtrees:
             if not ty.parameters(u) <= {var, *env}:
                 continue
             try:

@@ -22,8 +22,11 @@ ROUNDING = 100 * np.finfo(float).eps
 CERTIFIED_TO_SCALE = frozenset({"maximum", "minimum"})
 
 #: The position of a smooth extremum is known only to about the square root of the rounding
-#: of its expression (docs/numerics.md): its estimate is information, not a warning.
+#: of its expression (docs/numerics.md): its estimate is information, not a warning, unless
+#: the rounding of EXPR spot-checked beside it (numerics.rounding) makes it more than
+#: ESTIMATE_LIMIT times that square root (or the tolerance) of the interval's width.
 POSITIONS = frozenset({"argmax", "argmin"})
+POSITION_FLOOR = float(np.finfo(float).eps) ** 0.5
 
 
 def estimate_findings(sheet) -> list:
@@ -40,7 +43,10 @@ def estimate_findings(sheet) -> list:
         # a result computed outside a definition or a column (a writer's live form, a report)
         # repeats one of theirs; counting it would make the findings depend on what was
         # written before the check
-        if where is None or builtin in POSITIONS or not np.size(result.error):
+        if where is None or not np.size(result.error):
+            continue
+        if builtin in POSITIONS:
+            _position(worst, where, builtin, result, rtol)
             continue
         size = float(np.max(np.abs(result.value), initial=0.0))
         scale = float(result.notes.get("scale", 0.0))  # EXPR's size on the interval
@@ -72,6 +78,20 @@ def estimate_findings(sheet) -> list:
             )
         )
     return out
+
+
+def _position(worst: dict, where: str, builtin: str, result, rtol: float) -> None:
+    """An argmax's or argmin's estimate, relative to the interval's width, where EXPR's
+    rounding made it larger than POSITION_FLOOR allows (else no warning: see POSITIONS)."""
+    span = float(result.notes.get("span", 0.0))
+    if span <= 0:
+        return
+    err = float(np.max(np.abs(result.error), initial=0.0))
+    relative = err / span
+    if relative <= ESTIMATE_LIMIT * max(rtol, POSITION_FLOOR):
+        return
+    if relative > worst.get((where, builtin), (-1.0,))[0]:
+        worst[(where, builtin)] = (relative, err, span, "its place, against the interval's width")
 
 
 def assumption_findings(sheet) -> list:

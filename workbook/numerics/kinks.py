@@ -83,7 +83,25 @@ class Kinks(Visitor):
         elif self._interpolant(t, aliases):  # linear between the points: a kink at each
             xs, _, f = self._interpolant(t, aliases)
             self.found += [ty.TConst(t.args[2].unit, value=float(x) / f) for x in xs]
+        elif t.func == "integral" and len(t.args) == 4:
+            self._bound_crossings(t, aliases, subst)
         self._children(t, aliases, subst)
+
+    def _bound_crossings(self, t: ty.TFunc, aliases, subst) -> None:
+        """An inner integral whose bound is the variable times f: its integrand's break
+        points c (free of the variable) are kinks of the integral in the variable, at c/f
+        (its derivative in the bound is the integrand there: a beam's moment, integrated
+        twice, has a kink in its slope where the load is)."""
+        inner = Kinks(self.typer)
+        inner.visit(t.args[0], {t.args[1].name: 1.0}, None)
+        for end in t.args[2:]:
+            f = self._linear(end, aliases)
+            if not f:
+                continue
+            for c in inner.found:
+                outer = self._outer(c, aliases, subst)
+                if outer is not None:
+                    self.found.append(ty.TScale(outer.unit, child=outer, factor=1.0 / f))
 
     def _interpolant(self, t: ty.T, aliases):
         """(X, Y, f) if ``t`` is linterp(X, Y, x) of the variable times f, else None."""
@@ -156,37 +174,3 @@ def breaks(typer, body: ty.T, var: str) -> list[ty.T]:
     k = Kinks(typer)
     k.visit(body, {var: 1.0}, None)
     return k.found
-
-
-def switching(body: ty.T, var: str) -> list[ty.T]:
-    """Typed sub-trees of ``body`` (outside the sheet's functions) that depend on ``var`` and
-    whose zeros are where EXPR may have a kink or a jump: the argument of ``abs`` and
-    ``sign``, the difference of the two arguments of ``min`` and ``max``, and of the two
-    sides of a comparison (a piecewise condition). Their zeros are found numerically
-    (:func:`workbook.numerics.features.kink_points`); the linear cases are also found
-    above, exactly."""
-    from ..functions.registry import REGISTRY
-
-    found: list[ty.T] = []
-    stack = [body]
-    while stack:
-        t = stack.pop()
-        entry = REGISTRY.get(t.func) if isinstance(t, ty.TFunc) else None
-        if entry is not None and entry.binds:
-            continue  # another built-in's own variable: its own business
-        stack.extend(ty.children(t))
-        if isinstance(t, ty.TFunc) and t.func in ("abs", "sign") and len(t.args) == 1:
-            pairs = [(t.args[0], None)]
-        elif isinstance(t, ty.TFunc) and t.func in ("min", "max") and len(t.args) == 2:
-            pairs = [(t.args[0], t.args[1])]
-        elif isinstance(t, ty.TCompare):
-            pairs = list(zip(t.operands, t.operands[1:]))
-        else:
-            continue
-        for x, y in pairs:
-            if x.shape is not None or (y is not None and y.shape is not None):
-                continue
-            u = x if y is None else ty.TBinary(x.unit, op="-", left=x, right=y)
-            if var in ty.parameters(u):
-                found.append(u)
-    return found

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import record, recording
+from ._common import record, recording, reference, reference_note, reference_values
 
 EPS = np.finfo(float).eps
 
@@ -22,26 +22,37 @@ DEFECTIVE = 1e6
 COMPLEX = 10.0
 
 
-def solved(what: str, cond: np.ndarray, x: np.ndarray) -> None:
+def solved(what: str, cond: np.ndarray, x: np.ndarray, m=None, v=None) -> None:
     """lsolve's or inverse's estimate: the condition number times eps times the largest
-    |element| of the result (per range point; matrix axes last in ``x``)."""
+    |element| of the result (per range point; matrix axes last in ``x``). Inside
+    ``workbook bench``'s reference, the mpmath solution of ``m`` (and ``v``) is logged."""
+    if reference() and m is not None:
+        from .mpmatrix import solution
+
+        reference_values(what, solution(m, v, x.shape))
+        reference_note("mpmath", 1, 1)
     if not recording():
         return
     size = np.max(np.abs(x), axis=(-2, -1))
-    record(what, x, cond * EPS * size * np.ones_like(size), relative=True)
+    record(what, x, cond * EPS * size * np.ones_like(size), relative=True, body=what)
 
 
 def determinant(m: np.ndarray, value) -> None:
     """det's estimate: n eps times the largest singular value times the product of the n - 1
     largest (the change of det by a perturbation of eps |M|; |det| cond eps where M is
     regular, and finite where it is singular). Matrix axes last in ``m``."""
+    if reference():
+        from .mpmatrix import determinant as exact
+
+        reference_values("det", exact(m))
+        reference_note("mpmath", 1, 1)
     if not recording():
         return
     n = m.shape[-1]
     with np.errstate(all="ignore"):
         s = np.linalg.svd(m, compute_uv=False)
         error = n * EPS * s[..., 0] * np.prod(s[..., : n - 1], axis=-1)
-    record("det", value, error, relative=True)
+    record("det", value, error, relative=True, body="det")
 
 
 def eigen_errors(m: np.ndarray, lam: np.ndarray, vec: np.ndarray) -> tuple:
@@ -91,6 +102,12 @@ def real_eigenvalues(m: np.ndarray, lam: np.ndarray, vec: np.ndarray, what: str)
     # the estimate is never below the imaginary part dropped (a multiple eigenvalue split
     # into a pair by rounding): the imaginary part is compared with the rounding above
     error = np.maximum(error, np.abs(lam.imag))
+    if reference():
+        from .mpmatrix import eigen
+
+        values, vectors = eigen(m, lam.real, vec.real)
+        reference_values(what, vectors if what == "eigenvecs" else values)
+        reference_note("mpmath", 1, 1)
     if recording():
         notes = {}
         if np.any(multiple):
@@ -101,6 +118,7 @@ def real_eigenvalues(m: np.ndarray, lam: np.ndarray, vec: np.ndarray, what: str)
                 f"{float(error.ravel()[k]):.3g} (eps^(1/m) of the matrix's norm)"
             )
         notes["relative"] = True
+        notes["body"] = what
         if what == "eigenvecs":
             record(what, vec.real, vector_errors(m, lam, error), **notes)
         else:

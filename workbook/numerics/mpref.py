@@ -356,6 +356,22 @@ def series(of, lo, hi, kind: str) -> np.ndarray | None:
     return _each(kind, of.var, prepared, one)
 
 
+#: digits of diff's reference
+DIFF_DIGITS = 50
+
+
+def derivative(of, order: int, x) -> np.ndarray:
+    """The reference of diff(EXPR, X, N) at the points ``x``: ``mpmath.diff`` (finite
+    differences at 50 digits, steps chosen by mpmath) on EXPR's mpmath form, not SymPy's
+    formula of the derivative; refused (ReferenceFailed) without an mpmath form."""
+    try:
+        mp_form(of.evaluator, context(DIFF_DIGITS), of.body)
+    except NoMpForm as err:
+        raise ReferenceFailed(f"mpmath diff: {err} has no mpmath form") from None
+    prepared = _prepared(of, "diff", DIFF_DIGITS, x)
+    return _each("diff", of.var, prepared, lambda ctx, g, at, i: ctx.diff(g, ctx.mpf(at[0]), order))
+
+
 # -- roots inside the rounding noise: polished in extended precision ----------------------------
 #: rows of one call polished at most (a table of multiple roots keeps its noise-limited
 #: estimates beyond that)
@@ -373,7 +389,7 @@ def polish_roots(of, result, shape, tol) -> int:
     has an inner integral); of a larger call, only the rows whose estimate is above the
     tolerance. Rows without an mpmath form,
     or where no sign change is found, keep their value and estimate. Returns the number of
-    rows changed."""
+    rows changed; ``result.notes["certified"]`` marks the rows checked or polished."""
     from ..language import typed as ty
 
     value = np.ravel(result.value).copy()
@@ -383,6 +399,7 @@ def polish_roots(of, result, shape, tol) -> int:
     # an inner integral costs an mpmath quadrature per evaluation: only noisy rows then
     check_all = value.size <= POLISH_ROWS and not _has_integral(of.evaluator, of.body)
     rows = np.flatnonzero(finite if check_all else noisy)
+    certified = result.notes["certified"] = np.zeros(value.size, dtype=bool)
     if not rows.size or rows.size > POLISH_ROWS:
         return 0
     ctx = context(ROOT_DIGITS)
@@ -408,8 +425,12 @@ def polish_roots(of, result, shape, tol) -> int:
             x = _checked_root(ctx, g, value[i], error[i], bool(noisy[i]))
         except (NoValue, Unconverged, ZeroDivisionError):
             continue
+        if x is True:  # certain within its estimate at 60 digits
+            certified[i] = True
+            continue
         if x is None:
             continue
+        certified[i] = True
         value[i] = float(x)
         error[i] = max(abs(float(x - ctx.mpf(value[i]))), np.spacing(abs(value[i])))
         done += 1
@@ -458,15 +479,15 @@ def _has_integral(evaluator, body) -> bool:
 
 
 def _checked_root(ctx, g, v: float, e: float, polish: bool):
-    """None where the root is certain within e and need not be polished; else the root
-    polished in mpmath (None too where no sign change is found near v)."""
+    """True where the root is certain within e and need not be polished; else the root
+    polished in mpmath (None where no sign change is found near v, or two)."""
     d = max(e, 4 * float(np.spacing(abs(v))), float(np.finfo(float).tiny))
     certain = True
     for _ in range(40):
         lo, hi = ctx.mpf(v) - ctx.mpf(d), ctx.mpf(v) + ctx.mpf(d)
         glo, ghi = g(lo), g(hi)
         if glo == 0 or ghi == 0:
-            return None if certain and not polish else (lo if glo == 0 else hi)
+            return True if certain and not polish else (lo if glo == 0 else hi)
         if (glo > 0) != (ghi > 0):
             break
         certain = False
@@ -474,7 +495,7 @@ def _checked_root(ctx, g, v: float, e: float, polish: bool):
     else:
         return None
     if certain and not polish:
-        return None
+        return True
     # two roots within the noise (a cluster the doubles cannot tell apart): the value keeps
     # its estimate, which covers them both
     xs = [lo + (hi - lo) * k / 64 for k in range(65)]

@@ -15,9 +15,11 @@ would be thrown away. Either way every row ends with its error estimate below th
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from types import SimpleNamespace
 
 import numpy as np
 
+from ..errors import WorkbookError
 from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
 from .estimates import ESTIMATE_LIMIT
 from .kronrod import gk21
@@ -63,6 +65,7 @@ def integrate(
     label: Callable[[int], str] | None = None,
     enclose: Callable | None = None,
     singular: Sequence[Callable] = (),
+    poles: Sequence = (),
 ) -> Result:
     """The integral of ``f(x, *args)`` from a to b for every row.
 
@@ -73,10 +76,15 @@ def integrate(
     is split there too. The error estimate is the sum of the pieces' (QUADPACK's, or
     tanh-sinh's). ``singular``: ``h(x, *args)`` per sub-tree of f whose zeros are singular
     points of f (:mod:`workbook.numerics.singular`); a row where one is 0 just outside a
-    piece has a second tanh-sinh computation (see :func:`_tanhsinh`).
+    piece has a second tanh-sinh computation (see :func:`_tanhsinh`). ``poles``: points (per
+    row) where a singular sub-tree is 0, break points too; a piece between two singular
+    points is split once more (see :func:`_asymmetric`).
     """
-    shape, (a, b, *rest) = rows(a, b, *args, *breaks)
+    shape, (a, b, *rest) = rows(a, b, *args, *breaks, *poles)
     args, brk = rest[: len(args)], rest[len(args) :]
+    brk, pole = brk[: len(breaks)], brk[len(breaks) :]
+    pole = _snapped(pole, [a, b, *brk], np.abs(b - a))
+    brk = [*brk, *pole]
     n = a.size
     if n == 0:
         return Result(np.empty(shape), np.empty(shape))
@@ -97,15 +105,30 @@ def integrate(
                 pts[k - 1] = np.where(close, pts[k], pts[k - 1])
     else:
         pts = np.vstack([lo, hi])
+    pts = _asymmetric(f, pts, args, pole, lo, hi)
     left, right = pts[:-1], pts[1:]  # (pieces, rows)
     if _every_row_slow(f, left, right, args, tol, n):
         value, error, pending, evals = np.zeros(n), np.zeros(n), np.ones(n, dtype=bool), 0
     else:
         value, error, pending, evals = _adaptive(f, left, right, args, tol, n)
     if pending.any():
-        v, e, ev = _tanhsinh(
-            f, left[:, pending], right[:, pending], args, pending, tol, n, label, unit, singular
+        pl, pr, at = _split_at_singular_middles(
+            f, left[:, pending], right[:, pending], args, pending
         )
+        if at is None and pole:
+            inside = np.vstack(pole)[:, pending]
+            inside = inside[(inside > lo[pending]) & (inside < hi[pending])]
+            at = float(inside[0]) if inside.size else None
+        try:
+            v, e, ev = _tanhsinh(f, pl, pr, args, pending, tol, n, label, unit, singular)
+        except NumericsError as err:
+            if at is None:
+                raise
+            raise NumericsError(
+                f"{err.message}; the integrand is singular at {var} = {num(at)}{_u(unit)}, "
+                "inside the interval: the integral diverges beside it (a principal value, "
+                "where the two sides cancel, is not an integral)"
+            ) from None
         value[pending], error[pending] = v, e
         evals = max(evals, ev)
     # the integrand's size, for the rows whose estimate the check would report against their
@@ -115,6 +138,61 @@ def integrate(
     return Result(
         (sign * value).reshape(shape), error.reshape(shape), evaluations=evals, notes=notes
     )
+
+
+#: where a piece between two singular points is split (a fraction of it, not its middle)
+ASYMMETRIC = 0.381966011250105
+
+
+#: a pole this close (relative to the interval) to a break point or an end is that point
+SNAP = 1e-9
+
+
+def _snapped(pole: list, points: list, width: np.ndarray) -> list:
+    """The poles, each moved onto a break point or an end within SNAP of the interval (a
+    zero found by a root search beside the same point read from the tree: two break points
+    a few ulps apart make a piece tanh-sinh cannot integrate)."""
+    out = []
+    for p in pole:
+        p = p.copy()
+        for q in points:
+            near = np.abs(p - q) <= SNAP * width + 16 * np.spacing(np.abs(q))
+            p = np.where(near, q, p)
+        out.append(p)
+    return out
+
+
+def _asymmetric(f, pts, args, pole, lo, hi) -> np.ndarray:
+    """The break points ``pts`` (points, rows), with one more inside each piece whose two
+    ends are singular (a pole located there, or f not finite there). An integrand odd about
+    the middle of such a piece (x/(x^2 - 0.25) on [-0.5, 0.5], tan(x) between its poles)
+    is 0 at every symmetric rule, Gauss-Kronrod's or tanh-sinh's, with an estimate of 0:
+    the principal value of a divergent integral. Split off the middle, each piece has one
+    singular end, where a divergent integral does not converge (and is refused)."""
+    if pts.shape[0] < 2:
+        return pts
+    singular = np.zeros(pts.shape, dtype=bool)
+    # the ends and the inner break points apart: EXPR may refuse a value at an end (a
+    # declared limit broken by a root's rounding there) or an inner integral at a break
+    # point; then the poles decide there
+    for part in (slice(0, 1), slice(1, -1), slice(-1, None)):
+        at = pts[part]
+        if not at.size:
+            continue
+        try:
+            with np.errstate(all="ignore"):
+                fp = call(f, at, [g[None, :] for g in args])
+            singular[part] = ~np.isfinite(np.broadcast_to(np.asarray(fp, float), at.shape))
+        except WorkbookError:
+            continue
+    for p in pole:
+        inside = ((p > lo) & (p < hi))[None, :]
+        singular |= inside & (np.abs(pts - p[None, :]) <= 16 * np.spacing(np.abs(p[None, :])))
+    both = singular[:-1] & singular[1:] & (pts[1:] > pts[:-1])
+    if not both.any():
+        return pts
+    extra = np.where(both, pts[:-1] + ASYMMETRIC * (pts[1:] - pts[:-1]), pts[:-1])
+    return np.sort(np.vstack([pts, extra]), axis=0)
 
 
 #: interior points where the integrand's size is sampled (an end may be singular)
@@ -210,6 +288,46 @@ def _adaptive(f, left, right, args, tol, n):
     return value, error, pending, evals
 
 
+#: times a piece whose middle is not finite is split there (a singular point at a middle
+#: of the halves too)
+MIDDLE_SPLITS = 4
+
+
+def _split_at_singular_middles(f, left, right, args, pending):
+    """The pieces (pieces, rows) of the pending rows, each split at its middle where f is
+    not finite there. tanh-sinh's nodes are symmetric about the middle and SciPy's drops a
+    node where f is not finite: at an interior singularity in the middle (1/(x - 0.5) on
+    [0, 1]) the two sides cancel, and it converges to the principal value 0, which is no
+    integral. As an end of two pieces the singular point is tanh-sinh's strength: an
+    integrable one converges, a divergent one does not (and is refused). Also returns the
+    first point split at (None: none)."""
+    args = [g[None, pending] for g in args]
+    first = None
+    for _ in range(MIDDLE_SPLITS):
+        mid = (left + right) / 2.0
+        try:
+            with np.errstate(all="ignore"):
+                fm = np.broadcast_to(np.asarray(call(f, mid, args), dtype=float), mid.shape)
+        except WorkbookError:  # (an inner integral refused there: tanh-sinh will say so)
+            break
+        # (a piece of a few doubles has no middle to split at: its nodes are its ends)
+        room = 64 * np.spacing(np.abs(mid))
+        bad = np.isinf(fm) & (mid - left > room) & (right - mid > room)  # a pole, not NaN
+        if not bad.any():
+            break
+        first = float(mid[bad][0]) if first is None else first
+        # each bad piece ends at its middle; its other half is a new piece (empty elsewhere)
+        extra_left = np.where(bad, mid, right)
+        extra_right = right.copy()
+        right = np.where(bad, mid, right)
+        left = np.vstack([left, extra_left])
+        right = np.vstack([right, extra_right])
+        # the empty pieces keep their row's order (left <= right per row after sorting)
+        order = np.argsort(left, axis=0, kind="stable")
+        left, right = np.take_along_axis(left, order, 0), np.take_along_axis(right, order, 0)
+    return left, right, first
+
+
 def _tanhsinh(f, left, right, args, pending, tol, n, label, unit, singular=()):
     from scipy.integrate import tanhsinh
 
@@ -219,20 +337,37 @@ def _tanhsinh(f, left, right, args, pending, tol, n, label, unit, singular=()):
     scale = size if not tol.atol else np.ones(idx.size)
 
     def run(lo, hi, cols, minlevel=2):
-        with np.errstate(all="ignore"):
-            res = tanhsinh(
-                lambda x, inverse, *a: f(x, *a) * inverse,
-                lo,
-                hi,
-                args=(1.0 / scale[None, cols], *[g[:, cols] for g in args]),
-                rtol=max(tol.rtol, 1e-15),
-                # the integrand is divided by the row's size: a piece's error is allowed its
-                # share of the tolerance of the whole row, as in the Gauss-Kronrod pass (and a
-                # piece where f is 0 converges at once)
-                atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
-                minlevel=minlevel,
+        try:
+            with np.errstate(all="ignore"):
+                res = tanhsinh(
+                    lambda x, inverse, *a: f(x, *a) * inverse,
+                    lo,
+                    hi,
+                    args=(1.0 / scale[None, cols], *[g[:, cols] for g in args]),
+                    rtol=max(tol.rtol, 1e-15),
+                    # the integrand is divided by the row's size: a piece's error is allowed
+                    # its share of the tolerance of the whole row, as in the Gauss-Kronrod
+                    # pass (and a piece where f is 0 converges at once)
+                    atol=tol.atol or ATOL_SHARE * max(tol.rtol, 1e-15),
+                    minlevel=minlevel,
+                )
+        except NumericsError:
+            # f refused at one of tanh-sinh's nodes: an inner integral at a node a few
+            # doubles from an end (its interval [0, x] for x = 2e-323 holds 4 doubles, its
+            # nodes fall on its singular end); QAGS's nodes keep away from the ends
+            res = SimpleNamespace(
+                integral=np.zeros(lo.shape),
+                error=np.zeros(lo.shape),
+                nfev=np.zeros(lo.shape, dtype=int),
+                status=np.full(lo.shape, -3),
             )
         status = np.array(res.status)
+        # an empty piece (a row with fewer break points repeats its lower bound) is 0, also
+        # where f has no value at that point (sqrt(x)*ln(x) at 0)
+        empty = np.broadcast_to(lo == hi, status.shape)
+        if empty.any():
+            res.integral, res.error = np.array(res.integral), np.array(res.error)
+            res.integral[empty], res.error[empty], status[empty] = 0.0, 0.0, 0
         for p, i in np.argwhere(status != 0):  # QUADPACK's QAGS where tanh-sinh gives up
             done = quadpack(f, lo[p, i], hi[p, i], [g[:, [cols[i]]] for g in args], tol)
             if done is not None:
@@ -351,11 +486,15 @@ def _rounding(f, left, right, args) -> tuple[np.ndarray, np.ndarray]:
     top = np.zeros(left.shape[1])
     for end, inward in ((left, 1.0), (right, -1.0)):
         d = 4 * np.spacing(np.abs(end))
-        with np.errstate(all="ignore"):
-            fv = np.abs(
-                np.broadcast_to(np.asarray(f(end + inward * d, *args), dtype=float), end.shape)
-            )
         inside = right > left
+        at = np.where(inside, end + inward * d, end)  # (an empty piece: not beyond its end)
+        try:
+            with np.errstate(all="ignore"):
+                fv = np.abs(np.broadcast_to(np.asarray(f(at, *args), dtype=float), end.shape))
+        except NumericsError:
+            # an inner integral over [0, x] for x a few subnormal doubles (its interval holds
+            # no nodes but its ends): no value there, as where f overflows
+            fv = np.full(end.shape, np.inf)
         out += np.where(np.isfinite(fv) & inside, 2 * d * fv, 0.0).sum(axis=0)
         top = np.maximum(
             top, np.where(inside, np.where(np.isfinite(fv), fv, np.inf), 0.0).max(axis=0)

@@ -1,7 +1,8 @@
 """Where an integrand may be singular, read from its typed tree.
 
-A denominator, the base of a power whose exponent is negative or not whole, and the
-argument of ``sqrt``, ``ln`` and ``log10`` are singular where they are 0 (the function or
+A denominator, the base of a power whose exponent is negative or not whole, the
+argument of ``sqrt``, ``ln`` and ``log10``, and the cosine of ``tan``'s argument are
+singular where they are 0 (the function or
 one of its derivatives is unbounded there). Such a zero just outside an interval (or just
 inside a piece, past a break point) is what tanh-sinh's error estimate misses: it stops at
 its first levels with an estimate far below its error (1/sqrt(t + 1e-3) over [0, 0.79]:
@@ -43,6 +44,8 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
                 continue  # another built-in's own variable: its own business
             if t.func in ("sqrt", "ln", "log10") and len(t.args) == 1:
                 _keep(t.args[0], var, found)
+            if t.func == "tan" and len(t.args) == 1:  # its poles: the zeros of cos
+                _keep(ty.TFunc(t.unit, func="cos", args=t.args), var, found)
         elif isinstance(t, ty.TBinary) and t.left.shape is None and t.right.shape is None:
             if t.op == "/":
                 _keep(t.right, var, found)
