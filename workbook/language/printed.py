@@ -10,6 +10,7 @@ from pathlib import Path
 from ..errors import TemplateError, WorkbookError
 from ..limits import MAX_CSV_BYTES, file_beside, read_text
 from . import units as un
+from .csvcells import unescaped
 from .spec import PrintedSpec
 
 
@@ -49,16 +50,12 @@ def _number_or_text(cell: str) -> float | str:
     """A printed value: a number, else a text (compared as text with what the sheet gives);
     a text that a writer escaped for spreadsheets (a leading apostrophe before = + - @) is
     read without its apostrophe."""
-    from ..outputs.atomic import csv_text
-
     try:
         return float(cell)
     except ValueError:
         if not cell.strip():
             raise
-        if cell.startswith("'") and csv_text(cell[1:]) == cell:
-            return cell[1:]
-        return cell
+        return unescaped(cell)
 
 
 def read_printed(spec: PrintedSpec) -> list[PrintedRow]:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..language import expr as ex
-from ..outputs.atomic import csv_text
+from ..language.csvcells import csv_text
 from .functions import language_functions
 from .symbols import Sym
 from .tomldoc import Document, is_one_line, one_line

@@ -14,6 +14,7 @@ import zipfile
 from pathlib import Path
 
 from ..errors import InputError
+from ..language.csvcells import csv_text
 from ..limits import writable_target
 
 
@@ -231,19 +232,3 @@ def write_csv(frame, path: Path) -> None:
 
 def _csv_cell(value):
     return csv_text(value) if isinstance(value, str) else value
-
-
-# The characters that make a spreadsheet read a cell as a formula (with the full-width forms
-# some spreadsheets also accept), and the ones that may come before them unnoticed.
-_FORMULA_STARTS = frozenset("=+-@\uff1d\uff0b\uff0d\uff20")
-_CONTROL_STARTS = frozenset("\t\r\n")
-
-
-def csv_text(text: str) -> str:
-    """``text`` safe for a CSV cell that a spreadsheet opens: a text whose first character
-    that is not a space is = + - @ (or their full-width forms), or that starts with a tab, CR
-    or LF, gets a leading apostrophe."""
-    first = text.lstrip(" \t\r\n\u00a0\u3000")[:1]
-    if text[:1] in _CONTROL_STARTS or first in _FORMULA_STARTS:
-        return "'" + text
-    return text
