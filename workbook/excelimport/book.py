@@ -7,7 +7,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .cells import FormulaProblem, FormulaTranslator, parse_formula
+from .cells import FormulaProblem, FormulaTranslator, parse_formula, text_problem
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .vba import Module, Procedure, is_event, read_modules
@@ -749,11 +749,11 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                     repr(float(cell.value)) if isinstance(cell.value, float) else str(cell.value),
                     note,
                 )
-            elif isinstance(cell.value, str) and not ('"' in cell.value or "\\" in cell.value):
+            elif isinstance(cell.value, str) and text_problem(cell.value) is None:
                 tr.texts[name] = (cell, cell.value)
             else:  # never a stand-in value: the formulas that read it are left out
                 what = (
-                    "a text with a quote or a backslash"
+                    text_problem(cell.value)
                     if isinstance(cell.value, str)
                     else (f"a {type(cell.value).__name__}, not a number")
                 )

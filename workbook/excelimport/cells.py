@@ -25,6 +25,16 @@ MAX_LOOKUP_ROWS = 200
 _PLAIN_REF = re.compile(r"(?:'?([^'!]+)'?!)?\$?([A-Za-z]{1,3})\$?(\d+)")
 
 
+def text_problem(text: str) -> str | None:
+    """Why a text cannot be a text literal of the language (None when it can): a quote or a
+    backslash, or a ``^``, which the language's parser reads as ``**`` even in a text."""
+    if '"' in text or "\\" in text:
+        return "a text with a quote or a backslash"
+    if "^" in text:
+        return "a text with a ^ (the language's text would read it as **)"
+    return None
+
+
 class FormulaProblem(Exception):
     """A formula this translation does not take (the reason is the message)."""
 
@@ -179,10 +189,10 @@ class FormulaTranslator:
                 return "1" if text.upper() == "TRUE" else "0"
             return text
         if kind == "String":
-            value = token.attr.get("expr", token.name)
             value = token.name
-            if '"' in value or "\\" in value:
-                raise FormulaProblem("a text with a quote or a backslash")
+            problem = text_problem(value)
+            if problem:
+                raise FormulaProblem(problem)
             return f'"{value}"'
         if kind == "Range":
             return self.reference(token)
@@ -210,7 +220,22 @@ class FormulaTranslator:
         c1, c2 = _col(attr["c1"]), _col(attr["c2"])
         if r1 < 1 or (r2 - r1 + 1) * (c2 - c1 + 1) > MAX_RANGE_CELLS:
             raise FormulaProblem(f"a reference to whole rows or columns ({token.name})")
+        if attr.get("anchor") == "#" or str(attr.get("ref", "")).endswith("#"):
+            return self.spill(sheet, r1, c1, token.name)
         return Ref(sheet, min(r1, r2), min(c1, c2), max(r1, r2), max(c1, c2))
+
+    def spill(self, sheet: str, row: int, col: int, text: str) -> Ref:
+        """``C496#`` (``ANCHORARRAY``): the cells of the array formula whose first cell is
+        C496, as Excel saved its extent; never the anchor cell alone."""
+        from openpyxl.utils.cell import range_boundaries
+
+        cell = self.book.cell(sheet, row, col)
+        if cell is None or cell.array is None:
+            raise FormulaProblem(f"the spilled range {text} of a cell that is no array formula")
+        c1, r1, c2, r2 = range_boundaries(cell.array)
+        if (r1, c1) != (row, col):
+            raise FormulaProblem(f"the spilled range {text} of a cell inside an array formula")
+        return Ref(sheet, r1, c1, r2, c2)
 
     def reference(self, token) -> str:
         if self.is_name_formula(token):

@@ -1,0 +1,91 @@
+"""`workbook import`: Excel's own semantics where a translation could go wrong silently — a
+spilled range (``C1#``, ``ANCHORARRAY``) is every cell of the array, a text the language
+cannot hold is listed, and the CSV of cached texts follows the one rule of
+``outputs.atomic.csv_text`` (workbooks the tests build, with the values Excel would cache)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+xlsxwriter = pytest.importorskip("xlsxwriter")
+
+from workbook.cli import main  # noqa: E402
+from workbook.excelimport.writer import csv_text, uncompared  # noqa: E402
+
+
+def _check(path, tmp_path, capsys) -> tuple[dict, str]:
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--out", str(out)]) == 0
+    toml = next(out.glob("*.toml"))
+    capsys.readouterr()
+    main(["check", str(toml), "--json"])
+    return json.loads(capsys.readouterr().out), toml.read_text(encoding="utf-8")
+
+
+@pytest.mark.slow
+def test_a_spilled_range_is_every_cell_of_the_array(tmp_path, capsys):
+    path = tmp_path / "spill.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    for r, row in enumerate([[1, 2, 5], [3, 4, -6]]):
+        ws.write_row(r, 0, row)
+    # [[1, 2], [3, 4]] * [5, -6] = [-7, -9], shown in E1:E2
+    ws.write_array_formula("E1:E2", "{=MMULT(A1:B2,C1:C2)}", None, -7)
+    ws.write_number("E2", -9)
+    ws.write_formula("F1", "=MIN(_xlfn.ANCHORARRAY(E1))", None, -9)  # =MIN(E1#)
+    ws.write_formula("F2", "=MAX(_xlfn.ANCHORARRAY(E1))", None, -7)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "ANCHORARRAY" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 4, 0)
+
+
+@pytest.mark.slow
+def test_a_spilled_range_of_a_plain_cell_is_listed(tmp_path, capsys):
+    path = tmp_path / "nospill.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_number("A1", 3)
+    ws.write_formula("B1", "=MIN(_xlfn.ANCHORARRAY(A1))", None, 3)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "the spilled range" in text and "no array formula" in text
+    assert (report["printed"], report["failed"], report["not_computable"]) == (1, 0, 1)
+
+
+@pytest.mark.slow
+def test_a_text_with_a_caret_is_listed_never_altered(tmp_path, capsys):
+    path = tmp_path / "caret.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_string("A1", "As (in^2)")
+    ws.write_formula("B1", "=A1", None, "As (in^2)")
+    ws.write_formula("B2", '="m^2"', None, "m^2")
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "a text with a ^" in text
+    assert (report["printed"], report["failed"], report["not_computable"]) == (2, 0, 2)
+
+
+@pytest.mark.parametrize(
+    ("text", "escaped"),
+    [
+        ("=cmd|' /C calc'!A0", True),
+        ("-", True),  # Excel reads a cell that starts with - as a formula
+        ("+5", True),
+        (" @SUM(A1)", True),
+        ("\tx", True),
+        ("DL", False),
+        ("5 - 3", False),
+    ],
+)
+def test_cached_texts_follow_the_csv_rule_of_the_outputs(text, escaped):
+    assert (csv_text(text) == "'" + text) is escaped
+    assert (uncompared(text) is not None) is escaped
+
+
+def test_a_cached_text_on_two_lines_is_one_csv_line():
+    assert csv_text("a\nb") == "a b"
+    assert uncompared("a\nb") is not None
