@@ -89,3 +89,39 @@ def test_cached_texts_follow_the_csv_rule_of_the_outputs(text, escaped):
 def test_a_cached_text_on_two_lines_is_one_csv_line():
     assert csv_text("a\nb") == "a b"
     assert uncompared("a\nb") is not None
+
+
+@pytest.mark.slow
+def test_texts_joined_as_excel_writes_them(tmp_path, capsys):
+    path = tmp_path / "joins.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("J")
+    ws.write_number("A1", 12.34567)
+    ws.write_string("A2", "kips")
+    ws.write_number("A3", 0.00001)
+    ws.write_number("A4", 2)
+    ws.write_formula("B1", '=ROUND(A1,2)&" "&A2', None, "12.35 kips")
+    ws.write_formula("B2", '=IF(A4<>0,IF(A4=1," + "&A2," + "&A4&" "&A2),"")', None, " + 2 kips")
+    ws.write_formula("B3", '=CONCATENATE("x = ",A1/3)', None, "x = 4.11522333333333")
+    ws.write_formula("B4", '=_xlfn.CONCAT(A1:A2,C9,"!")', None, "12.34567kips!")  # C9 empty
+    ws.write_formula("B5", '="d = "&A3', None, "d = 1E-05")  # Excel's exponent: refused
+    ws.write_formula("B6", '="ok? "&(A4>1)', None, "ok? TRUE")  # TRUE/FALSE: refused
+    ws.write_formula("B7", '="a"&CHAR(10)&"b"', None, "a\nb")  # a line break: refused
+    ws.write_formula("B8", '=LEN(B1)&""', None, "10")  # LEN not mapped: refused
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "concat(" in text and "num2str(" in text
+    assert "joins TRUE/FALSE" in text and "CHAR(10)" in text
+    # B1, B3, B4 reproduced; B2 (" + 2 kips") is escaped in the CSV, so not compared; B5 has
+    # no value (Excel writes 1E-05, num2str another text); B6 to B8 listed
+    assert (report["printed"], report["reproduced"], report["failed"]) == (8, 3, 0)
+    assert report["not_computable"] == 5
+
+
+def test_num2str_of_a_number_that_is_not_finite_has_no_text(tmp_path):
+    import workbook
+
+    path = tmp_path / "t.toml"
+    path.write_text('[definitions.t]\nexpr = "concat(\\"x = \\", num2str(1/0))"\n')
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        workbook.load(str(path)).evaluate("t")

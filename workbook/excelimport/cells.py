@@ -344,7 +344,9 @@ class FormulaTranslator:
         if op in ("=", "<>", "<", ">", "<=", ">="):
             return f"(1 if {self.condition(('op', op, args))} otherwise 0)"
         if op == "&":
-            raise FormulaProblem("joins texts (&)")
+            from .joins import join
+
+            return join(self, [("op", op, args)])
         raise FormulaProblem(f"the operator {op}")
 
     def condition(self, node) -> str:
@@ -397,6 +399,10 @@ class FormulaTranslator:
             return self.count_if(args)
         if upper == "VLOOKUP":
             return self.vlookup(args)
+        if upper in ("CONCATENATE", "_XLFN.CONCAT", "CONCAT", "CHAR"):
+            from .joins import join
+
+            return join(self, [("fn", name, args)])
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
