@@ -125,3 +125,43 @@ def test_num2str_of_a_number_that_is_not_finite_has_no_text(tmp_path):
     path.write_text('[definitions.t]\nexpr = "concat(\\"x = \\", num2str(1/0))"\n')
     with pytest.raises(workbook.WorkbookError, match="not a finite number"):
         workbook.load(str(path)).evaluate("t")
+
+
+@pytest.mark.slow
+def test_match_index_and_hlookup_as_excel_finds_them(tmp_path, capsys):
+    path = tmp_path / "lookups.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("L")
+    for r, (key, name, value) in enumerate(
+        [(10, "Steel", 1.5), (20, "Wood", 2.5), (30, "Ice", 3.5)]
+    ):
+        ws.write_row(r, 0, [key, name, value])  # A1:C3
+    ws.write_row(4, 0, [3, 2, 1])  # A5:C5, descending
+    ws.write_row(5, 0, [7, 8, 9])  # A6:C6
+    ws.write_string("E1", "wood")
+    ws.write_number("E2", 25)
+    ws.write_formula("F1", "=MATCH(20,A1:A3,0)", None, 2)
+    ws.write_formula("F2", "=MATCH(E2,A1:A3)", None, 2)  # the last key at most 25
+    ws.write_formula("F3", "=MATCH(2.5,A5:C5,-1)", None, 1)  # the last key at least 2.5
+    ws.write_formula("F4", "=MATCH(E1,B1:B3,0)", None, 2)  # texts without case
+    ws.write_formula("F5", "=INDEX(C1:C3,MATCH(E2,A1:A3,1))", None, 2.5)
+    ws.write_formula("F6", "=INDEX(A1:C3,3,2)", None, "Ice")
+    ws.write_formula("F7", "=HLOOKUP(2,A5:C6,2,FALSE)", None, 8)
+    ws.write_formula("F8", "=INDEX(C1:C3,MATCH(E1,B1:B3,0))", None, 2.5)
+    ws.write_formula("F9", '=MATCH("W*",B1:B3,0)', None, 2)  # a pattern: listed
+    ws.write_formula("F10", "=MATCH(F6,B1:B3,0)", None, 3)  # a text not known: listed
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "a text with a pattern" in text and "an exact one of a text" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (10, 8, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    names = {d.note.split(": ", 1)[-1]: n for n, d in sheet.spec.definitions.items()}
+    size = next(n for n, i in sheet.spec.inputs.items() if "E2" in i.note)
+    for x, position in ((35, 3), (10, 1)):
+        assert sheet.with_inputs(**{size: x}).evaluate(names["=MATCH(E2,A1:A3)"]).magnitude == (
+            position
+        )
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        sheet.with_inputs(**{size: 5}).evaluate(names["=MATCH(E2,A1:A3)"])  # #N/A in Excel

@@ -399,6 +399,10 @@ class FormulaTranslator:
             return self.count_if(args)
         if upper == "VLOOKUP":
             return self.vlookup(args)
+        if upper in ("MATCH", "INDEX", "HLOOKUP"):
+            from . import lookups
+
+            return getattr(lookups, upper.lower())(self, args)
         if upper in ("CONCATENATE", "_XLFN.CONCAT", "CONCAT", "CHAR"):
             from .joins import join
 
