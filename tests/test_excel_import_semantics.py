@@ -165,3 +165,24 @@ def test_match_index_and_hlookup_as_excel_finds_them(tmp_path, capsys):
         )
     with pytest.raises(workbook.WorkbookError, match="not a finite number"):
         sheet.with_inputs(**{size: 5}).evaluate(names["=MATCH(E2,A1:A3)"])  # #N/A in Excel
+
+
+@pytest.mark.slow
+def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_path, capsys):
+    path = tmp_path / "iferror.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("E")
+    ws.write_row(0, 0, [6, 0, 3])  # A1:C1
+    ws.write_formula("D1", "=IFERROR((A1/B1)*(C1-1),0)", None, 0)
+    ws.write_formula("D2", "=IFERROR(A1/(C1-1),-1)", None, 3)
+    ws.write_formula("D3", "=IFERROR(A1*C1,5)", None, 18)
+    ws.write_formula("D4", "=IFERROR(SQRT(-A1),5)", None, 5)  # other errors: listed
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "the language has no error value to catch" in text.replace("\n# ", " ")
+    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 3, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR((A1/B1)" in d.note)
+    assert sheet.with_inputs(B1=2).evaluate(name).magnitude == 6.0

@@ -399,6 +399,8 @@ class FormulaTranslator:
             return self.count_if(args)
         if upper == "VLOOKUP":
             return self.vlookup(args)
+        if upper == "IFERROR":
+            return self.if_error(args)
         if upper in ("MATCH", "INDEX", "HLOOKUP"):
             from . import lookups
 
@@ -410,6 +412,41 @@ class FormulaTranslator:
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
+
+    def if_error(self, args) -> str:
+        """``IFERROR(x, alt)`` where x is numbers and cells joined by + - * /: x's error is a
+        division by zero, so the value is alt where a divisor is 0 (a cell of x that is an
+        error value leaves the whole formula without a value, never another number)."""
+        if len(args) != 2:
+            raise FormulaProblem(f"IFERROR with {len(args)} arguments")
+        divisors: list[str] = []
+        self.arithmetic_only(args[0], divisors)
+        x, alt = self.value(args[0], 1), self.value(args[1], 1)
+        if not divisors:
+            return x
+        zero = " or ".join(f"{d} == 0" for d in dict.fromkeys(divisors))
+        return f"({alt} if {zero} otherwise {x})"
+
+    def arithmetic_only(self, node, divisors: list[str]) -> None:
+        """Refuse what IFERROR's error could come from other than a division by zero; the
+        divisors (translated) are gathered."""
+        kind, name, payload = node
+        if kind == "leaf" and name == "Number" and payload.name.upper() not in ("TRUE", "FALSE"):
+            return
+        if kind == "leaf" and name == "Range" and not self.is_name_formula(payload):
+            if not self.ref_of(payload).single:
+                raise FormulaProblem("IFERROR of a range")
+            return
+        if kind == "op" and name in ("+", "-", "*", "/", "u-", "u+"):
+            for a in payload:
+                self.arithmetic_only(a, divisors)
+            if name == "/":
+                divisors.append(self.value(payload[1], 3))
+            return
+        raise FormulaProblem(
+            "IFERROR of other than + - * / of numbers and cells (the language has no error "
+            "value to catch)"
+        )
 
     def offset(self, args) -> str:
         """``OFFSET(cell, rows, columns)``: the cell it reached when Excel computed it (from
