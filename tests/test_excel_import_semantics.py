@@ -186,3 +186,39 @@ def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_pa
     sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
     name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR((A1/B1)" in d.note)
     assert sheet.with_inputs(B1=2).evaluate(name).magnitude == 6.0
+
+
+SUB = """Attribute VB_Name = "Macros"
+Sub Fill()
+    Range("B2").Value = 5
+    Sheets("S").Cells(3, 2) = 7
+    If Range("B4") = 1 Then Range("C9") = 0
+End Sub
+"""
+
+
+@pytest.mark.slow
+def test_a_value_a_sub_writes_is_not_computable_with_the_sub_named(tmp_path, capsys):
+    path = tmp_path / "macro.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_number("A1", 1)
+    ws.write_formula("B2", "=A1*2", None, 5)  # the Sub wrote 5 over the formula's 2
+    ws.write_number("B3", 7)  # written by the Sub, read by a formula
+    ws.write_formula("B4", "=A1", None, 1)  # compared in a condition, never written
+    ws.write_formula("B5", "=B3+1", None, 8)
+    wb.close()
+    bas = tmp_path / "Macros.bas"
+    bas.write_text(SUB, encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    capsys.readouterr()
+    main(["check", str(out / "macro.toml"), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    text = (out / "macro.toml").read_text(encoding="utf-8")
+    assert "written by the macro Sub Fill (its value is the macro's result" in text.replace(
+        "\n# ", " "
+    )
+    assert "S!B3; written by the macro Sub Fill" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
+    assert report["not_computable"] == 1

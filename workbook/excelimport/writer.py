@@ -345,7 +345,7 @@ def _not_translated_rows(tr: Translation, skip: dict, counts: dict, reasons: dic
                 for key in d.run.keys():
                     reasons.setdefault(f"{key[0]}!{_addr(key[1], key[2])}", why)
     for what, why in tr.listed:
-        reasons.setdefault(what.split(" ")[0], why)
+        reasons.setdefault(what.split(" (")[0], why)  # "Sheet 1!B3 (name)": the cell
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     out.write("# Excel's cached values of formula cells not translated (not computable)\n")
