@@ -7,9 +7,10 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .cells import FormulaProblem, FormulaTranslator, parse_formula
+from .cells import FormulaProblem, FormulaTranslator, parse_formula, text_problem
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
+from .subwrites import cells_written
 from .vba import Module, Procedure, is_event, read_modules
 from .vbamembers import record_types
 from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
@@ -50,6 +51,9 @@ class Translation:
     runs: dict[tuple[str, int, int], Run] = field(default_factory=dict)  # cell -> its run
     vectors: dict[str, str] = field(default_factory=dict)  # name -> vector literal
     ranges: dict[str, str] = field(default_factory=dict)  # matrix literal of a range -> name
+    #: cells whose value a VBA Sub writes -> the Sub's name
+    written: dict[tuple[str, int, int], str] = field(default_factory=dict)
+    unparsed: dict[tuple[str, int, int], str] = field(default_factory=dict)  # cell -> why
 
 
 def language_reserved() -> set[str]:
@@ -72,8 +76,18 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
     reserved = language_reserved()
     _collect_functions(tr, reserved)
     cells = _formula_cells(tr)
+    tr.written = cells_written(modules, list(book.sheets))
     parsed = {}
     for cell in cells:
+        sub = tr.written.get(_key(cell))
+        if sub is not None:  # its cached value may be the macro's: no formula computes it
+            why = (
+                f"written by the macro Sub {sub} (its value is the macro's result, which no "
+                "formula computes)"
+            )
+            tr.unparsed[_key(cell)] = why
+            tr.listed.append((cell.ref, why))
+            continue
         try:
             parsed[_key(cell)] = parse_formula(cell.formula)
         except FormulaProblem as exc:
@@ -648,7 +662,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
         d = Definition(run.name if run else tr.cell_names[key], cell, run=run)
         by_key[key] = d
         if key not in parsed:
-            d.problem = "cannot parse the formula"
+            d.problem = tr.unparsed.get(key, "cannot parse the formula")
             continue
         if cell.array is not None and cell.array_master != (cell.row, cell.col):
             master = by_key.get((cell.sheet, *cell.array_master))
@@ -744,16 +758,18 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             elif isinstance(cell.value, (int, float)):
                 unit = proposed_unit(label, cell.number_format)
                 note = where + (f"; unit proposed: {unit}" if unit else "")
+                if k in tr.written:
+                    note += f"; written by the macro Sub {tr.written[k]}"
                 tr.inputs[name] = (
                     cell,
                     repr(float(cell.value)) if isinstance(cell.value, float) else str(cell.value),
                     note,
                 )
-            elif isinstance(cell.value, str) and not ('"' in cell.value or "\\" in cell.value):
+            elif isinstance(cell.value, str) and text_problem(cell.value) is None:
                 tr.texts[name] = (cell, cell.value)
             else:  # never a stand-in value: the formulas that read it are left out
                 what = (
-                    "a text with a quote or a backslash"
+                    text_problem(cell.value)
                     if isinstance(cell.value, str)
                     else (f"a {type(cell.value).__name__}, not a number")
                 )

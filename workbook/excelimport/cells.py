@@ -25,6 +25,16 @@ MAX_LOOKUP_ROWS = 200
 _PLAIN_REF = re.compile(r"(?:'?([^'!]+)'?!)?\$?([A-Za-z]{1,3})\$?(\d+)")
 
 
+def text_problem(text: str) -> str | None:
+    """Why a text cannot be a text literal of the language (None when it can): a quote or a
+    backslash, or a ``^``, which the language's parser reads as ``**`` even in a text."""
+    if '"' in text or "\\" in text:
+        return "a text with a quote or a backslash"
+    if "^" in text:
+        return "a text with a ^ (the language's text would read it as **)"
+    return None
+
+
 class FormulaProblem(Exception):
     """A formula this translation does not take (the reason is the message)."""
 
@@ -179,10 +189,10 @@ class FormulaTranslator:
                 return "1" if text.upper() == "TRUE" else "0"
             return text
         if kind == "String":
-            value = token.attr.get("expr", token.name)
             value = token.name
-            if '"' in value or "\\" in value:
-                raise FormulaProblem("a text with a quote or a backslash")
+            problem = text_problem(value)
+            if problem:
+                raise FormulaProblem(problem)
             return f'"{value}"'
         if kind == "Range":
             return self.reference(token)
@@ -210,7 +220,22 @@ class FormulaTranslator:
         c1, c2 = _col(attr["c1"]), _col(attr["c2"])
         if r1 < 1 or (r2 - r1 + 1) * (c2 - c1 + 1) > MAX_RANGE_CELLS:
             raise FormulaProblem(f"a reference to whole rows or columns ({token.name})")
+        if attr.get("anchor") == "#" or str(attr.get("ref", "")).endswith("#"):
+            return self.spill(sheet, r1, c1, token.name)
         return Ref(sheet, min(r1, r2), min(c1, c2), max(r1, r2), max(c1, c2))
+
+    def spill(self, sheet: str, row: int, col: int, text: str) -> Ref:
+        """``C496#`` (``ANCHORARRAY``): the cells of the array formula whose first cell is
+        C496, as Excel saved its extent; never the anchor cell alone."""
+        from openpyxl.utils.cell import range_boundaries
+
+        cell = self.book.cell(sheet, row, col)
+        if cell is None or cell.array is None:
+            raise FormulaProblem(f"the spilled range {text} of a cell that is no array formula")
+        c1, r1, c2, r2 = range_boundaries(cell.array)
+        if (r1, c1) != (row, col):
+            raise FormulaProblem(f"the spilled range {text} of a cell inside an array formula")
+        return Ref(sheet, r1, c1, r2, c2)
 
     def reference(self, token) -> str:
         if self.is_name_formula(token):
@@ -319,7 +344,9 @@ class FormulaTranslator:
         if op in ("=", "<>", "<", ">", "<=", ">="):
             return f"(1 if {self.condition(('op', op, args))} otherwise 0)"
         if op == "&":
-            raise FormulaProblem("joins texts (&)")
+            from .joins import join
+
+            return join(self, [("op", op, args)])
         raise FormulaProblem(f"the operator {op}")
 
     def condition(self, node) -> str:
@@ -372,9 +399,54 @@ class FormulaTranslator:
             return self.count_if(args)
         if upper == "VLOOKUP":
             return self.vlookup(args)
+        if upper == "IFERROR":
+            return self.if_error(args)
+        if upper in ("MATCH", "INDEX", "HLOOKUP"):
+            from . import lookups
+
+            return getattr(lookups, upper.lower())(self, args)
+        if upper in ("CONCATENATE", "_XLFN.CONCAT", "CONCAT", "CHAR"):
+            from .joins import join
+
+            return join(self, [("fn", name, args)])
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
+
+    def if_error(self, args) -> str:
+        """``IFERROR(x, alt)`` where x is numbers and cells joined by + - * /: x's error is a
+        division by zero, so the value is alt where a divisor is 0 (a cell of x that is an
+        error value leaves the whole formula without a value, never another number)."""
+        if len(args) != 2:
+            raise FormulaProblem(f"IFERROR with {len(args)} arguments")
+        divisors: list[str] = []
+        self.arithmetic_only(args[0], divisors)
+        x, alt = self.value(args[0], 1), self.value(args[1], 1)
+        if not divisors:
+            return x
+        zero = " or ".join(f"{d} == 0" for d in dict.fromkeys(divisors))
+        return f"({alt} if {zero} otherwise {x})"
+
+    def arithmetic_only(self, node, divisors: list[str]) -> None:
+        """Refuse what IFERROR's error could come from other than a division by zero; the
+        divisors (translated) are gathered."""
+        kind, name, payload = node
+        if kind == "leaf" and name == "Number" and payload.name.upper() not in ("TRUE", "FALSE"):
+            return
+        if kind == "leaf" and name == "Range" and not self.is_name_formula(payload):
+            if not self.ref_of(payload).single:
+                raise FormulaProblem("IFERROR of a range")
+            return
+        if kind == "op" and name in ("+", "-", "*", "/", "u-", "u+"):
+            for a in payload:
+                self.arithmetic_only(a, divisors)
+            if name == "/":
+                divisors.append(self.value(payload[1], 3))
+            return
+        raise FormulaProblem(
+            "IFERROR of other than + - * / of numbers and cells (the language has no error "
+            "value to catch)"
+        )
 
     def offset(self, args) -> str:
         """``OFFSET(cell, rows, columns)``: the cell it reached when Excel computed it (from

@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from .cells import text_problem
 from .functions import VBA
 from .vba import Procedure, split_top
 from .vbaerrors import cut_error_handler
@@ -774,8 +775,9 @@ class Translator(Members):
             text = node[1]
             return text if not text.startswith(".") else "0" + text
         if kind == "str":
-            if '"' in node[1] or "\\" in node[1]:
-                raise NotTranslated("a text with a quote or a backslash")
+            problem = text_problem(node[1])
+            if problem:
+                raise NotTranslated(problem)
             return f'"{node[1]}"'
         if kind == "id":
             return self.name(node[1])

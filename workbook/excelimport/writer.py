@@ -13,6 +13,7 @@ from pathlib import Path
 from ..errors import WorkbookError
 from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
+from ..language.csvcells import csv_text as spreadsheet_text
 from .book import Definition, Translation
 from .runs import ROW
 
@@ -53,30 +54,18 @@ def _sheet_name(path: Path) -> str:
     return name or "imported"
 
 
-#: the first characters by which a spreadsheet opening a CSV reads a cell as a formula
-_LIVE = ("=", "+", "-", "@", "\t", "\r", "|", "%")
-#: after a leading + or -, what a formula needs to call anything (a function, a link)
-_CALLS = re.compile(r"[A-Za-z(|!=@]")
-
-
-def _live(text: str) -> bool:
-    if text.startswith(("+", "-")):
-        return _CALLS.search(text) is not None
-    return text.startswith(_LIVE)
-
-
 def csv_text(text: str) -> str:
     """A text from the imported file as a CSV cell that no spreadsheet reads as a formula
-    (``=cmd|' /C calc'!A0`` is written ``'=cmd|' /C calc'!A0``), on one line."""
-    text = text.replace("\r", " ").replace("\n", " ")
-    return "'" + text if _live(text) else text
+    (``=cmd|' /C calc'!A0`` is written ``'=cmd|' /C calc'!A0``: the rule of
+    ``language.csvcells.csv_text``), on one line."""
+    return spreadsheet_text(text.replace("\r", " ").replace("\n", " "))
 
 
 def uncompared(text: str) -> str | None:
     """Why a cached text is not compared (None: it is): one that a spreadsheet would read as a
     formula or that spans lines (written escaped, so the comparison would be with the escaped
     text), or one that the printed values would read as a number."""
-    if _live(text) or "\n" in text or "\r" in text:
+    if spreadsheet_text(text) != text or "\n" in text or "\r" in text:
         return "a text a spreadsheet reads as a formula: escaped, not compared"
     try:
         float(text)
@@ -356,7 +345,7 @@ def _not_translated_rows(tr: Translation, skip: dict, counts: dict, reasons: dic
                 for key in d.run.keys():
                     reasons.setdefault(f"{key[0]}!{_addr(key[1], key[2])}", why)
     for what, why in tr.listed:
-        reasons.setdefault(what.split(" ")[0], why)
+        reasons.setdefault(what.split(" (")[0], why)  # "Sheet 1!B3 (name)": the cell
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     out.write("# Excel's cached values of formula cells not translated (not computable)\n")

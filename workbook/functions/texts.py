@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NotLive, NotSymbolic, TemplateError
+from ..errors import DomainError, NotLive, NotSymbolic, TemplateError
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..limits import check_text_length
@@ -54,6 +54,8 @@ def number_text(x: float) -> str:
 
 
 def _num2str(x):
+    if not np.all(np.isfinite(np.asarray(x, dtype=float))):  # never the text "inf" or "nan"
+        raise DomainError("num2str(x): x is not a finite number, and has no text")
     if np.ndim(x) == 0:
         return number_text(x)
     return np.frompyfunc(number_text, 1, 1)(np.asarray(x, dtype=float))

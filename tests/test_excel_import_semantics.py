@@ -1,0 +1,224 @@
+"""`workbook import`: Excel's own semantics where a translation could go wrong silently — a
+spilled range (``C1#``, ``ANCHORARRAY``) is every cell of the array, a text the language
+cannot hold is listed, and the CSV of cached texts follows the one rule of
+``language.csvcells.csv_text`` (workbooks the tests build, with the values Excel would cache)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+xlsxwriter = pytest.importorskip("xlsxwriter")
+
+from workbook.cli import main  # noqa: E402
+from workbook.excelimport.writer import csv_text, uncompared  # noqa: E402
+
+
+def _check(path, tmp_path, capsys) -> tuple[dict, str]:
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--out", str(out)]) == 0
+    toml = next(out.glob("*.toml"))
+    capsys.readouterr()
+    main(["check", str(toml), "--json"])
+    return json.loads(capsys.readouterr().out), toml.read_text(encoding="utf-8")
+
+
+@pytest.mark.slow
+def test_a_spilled_range_is_every_cell_of_the_array(tmp_path, capsys):
+    path = tmp_path / "spill.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    for r, row in enumerate([[1, 2, 5], [3, 4, -6]]):
+        ws.write_row(r, 0, row)
+    # [[1, 2], [3, 4]] * [5, -6] = [-7, -9], shown in E1:E2
+    ws.write_array_formula("E1:E2", "{=MMULT(A1:B2,C1:C2)}", None, -7)
+    ws.write_number("E2", -9)
+    ws.write_formula("F1", "=MIN(_xlfn.ANCHORARRAY(E1))", None, -9)  # =MIN(E1#)
+    ws.write_formula("F2", "=MAX(_xlfn.ANCHORARRAY(E1))", None, -7)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "ANCHORARRAY" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 4, 0)
+
+
+@pytest.mark.slow
+def test_a_spilled_range_of_a_plain_cell_is_listed(tmp_path, capsys):
+    path = tmp_path / "nospill.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_number("A1", 3)
+    ws.write_formula("B1", "=MIN(_xlfn.ANCHORARRAY(A1))", None, 3)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "the spilled range" in text and "no array formula" in text
+    assert (report["printed"], report["failed"], report["not_computable"]) == (1, 0, 1)
+
+
+@pytest.mark.slow
+def test_a_text_with_a_caret_is_listed_never_altered(tmp_path, capsys):
+    path = tmp_path / "caret.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_string("A1", "As (in^2)")
+    ws.write_formula("B1", "=A1", None, "As (in^2)")
+    ws.write_formula("B2", '="m^2"', None, "m^2")
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "a text with a ^" in text
+    assert (report["printed"], report["failed"], report["not_computable"]) == (2, 0, 2)
+
+
+@pytest.mark.parametrize(
+    ("text", "escaped"),
+    [
+        ("=cmd|' /C calc'!A0", True),
+        ("-", True),  # Excel reads a cell that starts with - as a formula
+        ("+5", True),
+        (" @SUM(A1)", True),
+        ("\tx", True),
+        ("DL", False),
+        ("5 - 3", False),
+    ],
+)
+def test_cached_texts_follow_the_csv_rule_of_the_outputs(text, escaped):
+    assert (csv_text(text) == "'" + text) is escaped
+    assert (uncompared(text) is not None) is escaped
+
+
+def test_a_cached_text_on_two_lines_is_one_csv_line():
+    assert csv_text("a\nb") == "a b"
+    assert uncompared("a\nb") is not None
+
+
+@pytest.mark.slow
+def test_texts_joined_as_excel_writes_them(tmp_path, capsys):
+    path = tmp_path / "joins.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("J")
+    ws.write_number("A1", 12.34567)
+    ws.write_string("A2", "kips")
+    ws.write_number("A3", 0.00001)
+    ws.write_number("A4", 2)
+    ws.write_formula("B1", '=ROUND(A1,2)&" "&A2', None, "12.35 kips")
+    ws.write_formula("B2", '=IF(A4<>0,IF(A4=1," + "&A2," + "&A4&" "&A2),"")', None, " + 2 kips")
+    ws.write_formula("B3", '=CONCATENATE("x = ",A1/3)', None, "x = 4.11522333333333")
+    ws.write_formula("B4", '=_xlfn.CONCAT(A1:A2,C9,"!")', None, "12.34567kips!")  # C9 empty
+    ws.write_formula("B5", '="d = "&A3', None, "d = 1E-05")  # Excel's exponent: refused
+    ws.write_formula("B6", '="ok? "&(A4>1)', None, "ok? TRUE")  # TRUE/FALSE: refused
+    ws.write_formula("B7", '="a"&CHAR(10)&"b"', None, "a\nb")  # a line break: refused
+    ws.write_formula("B8", '=LEN(B1)&""', None, "10")  # LEN not mapped: refused
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "concat(" in text and "num2str(" in text
+    assert "joins TRUE/FALSE" in text and "CHAR(10)" in text
+    # B1, B3, B4 reproduced; B2 (" + 2 kips") is escaped in the CSV, so not compared; B5 has
+    # no value (Excel writes 1E-05, num2str another text); B6 to B8 listed
+    assert (report["printed"], report["reproduced"], report["failed"]) == (8, 3, 0)
+    assert report["not_computable"] == 5
+
+
+def test_num2str_of_a_number_that_is_not_finite_has_no_text(tmp_path):
+    import workbook
+
+    path = tmp_path / "t.toml"
+    path.write_text('[definitions.t]\nexpr = "concat(\\"x = \\", num2str(1/0))"\n')
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        workbook.load(str(path)).evaluate("t")
+
+
+@pytest.mark.slow
+def test_match_index_and_hlookup_as_excel_finds_them(tmp_path, capsys):
+    path = tmp_path / "lookups.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("L")
+    for r, (key, name, value) in enumerate(
+        [(10, "Steel", 1.5), (20, "Wood", 2.5), (30, "Ice", 3.5)]
+    ):
+        ws.write_row(r, 0, [key, name, value])  # A1:C3
+    ws.write_row(4, 0, [3, 2, 1])  # A5:C5, descending
+    ws.write_row(5, 0, [7, 8, 9])  # A6:C6
+    ws.write_string("E1", "wood")
+    ws.write_number("E2", 25)
+    ws.write_formula("F1", "=MATCH(20,A1:A3,0)", None, 2)
+    ws.write_formula("F2", "=MATCH(E2,A1:A3)", None, 2)  # the last key at most 25
+    ws.write_formula("F3", "=MATCH(2.5,A5:C5,-1)", None, 1)  # the last key at least 2.5
+    ws.write_formula("F4", "=MATCH(E1,B1:B3,0)", None, 2)  # texts without case
+    ws.write_formula("F5", "=INDEX(C1:C3,MATCH(E2,A1:A3,1))", None, 2.5)
+    ws.write_formula("F6", "=INDEX(A1:C3,3,2)", None, "Ice")
+    ws.write_formula("F7", "=HLOOKUP(2,A5:C6,2,FALSE)", None, 8)
+    ws.write_formula("F8", "=INDEX(C1:C3,MATCH(E1,B1:B3,0))", None, 2.5)
+    ws.write_formula("F9", '=MATCH("W*",B1:B3,0)', None, 2)  # a pattern: listed
+    ws.write_formula("F10", "=MATCH(F6,B1:B3,0)", None, 3)  # a text not known: listed
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "a text with a pattern" in text and "an exact one of a text" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (10, 8, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    names = {d.note.split(": ", 1)[-1]: n for n, d in sheet.spec.definitions.items()}
+    size = next(n for n, i in sheet.spec.inputs.items() if "E2" in i.note)
+    for x, position in ((35, 3), (10, 1)):
+        assert sheet.with_inputs(**{size: x}).evaluate(names["=MATCH(E2,A1:A3)"]).magnitude == (
+            position
+        )
+    with pytest.raises(workbook.WorkbookError, match="not a finite number"):
+        sheet.with_inputs(**{size: 5}).evaluate(names["=MATCH(E2,A1:A3)"])  # #N/A in Excel
+
+
+@pytest.mark.slow
+def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_path, capsys):
+    path = tmp_path / "iferror.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("E")
+    ws.write_row(0, 0, [6, 0, 3])  # A1:C1
+    ws.write_formula("D1", "=IFERROR((A1/B1)*(C1-1),0)", None, 0)
+    ws.write_formula("D2", "=IFERROR(A1/(C1-1),-1)", None, 3)
+    ws.write_formula("D3", "=IFERROR(A1*C1,5)", None, 18)
+    ws.write_formula("D4", "=IFERROR(SQRT(-A1),5)", None, 5)  # other errors: listed
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "the language has no error value to catch" in text.replace("\n# ", " ")
+    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 3, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR((A1/B1)" in d.note)
+    assert sheet.with_inputs(B1=2).evaluate(name).magnitude == 6.0
+
+
+SUB = """Attribute VB_Name = "Macros"
+Sub Fill()
+    Range("B2").Value = 5
+    Sheets("S").Cells(3, 2) = 7
+    If Range("B4") = 1 Then Range("C9") = 0
+End Sub
+"""
+
+
+@pytest.mark.slow
+def test_a_value_a_sub_writes_is_not_computable_with_the_sub_named(tmp_path, capsys):
+    path = tmp_path / "macro.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_number("A1", 1)
+    ws.write_formula("B2", "=A1*2", None, 5)  # the Sub wrote 5 over the formula's 2
+    ws.write_number("B3", 7)  # written by the Sub, read by a formula
+    ws.write_formula("B4", "=A1", None, 1)  # compared in a condition, never written
+    ws.write_formula("B5", "=B3+1", None, 8)
+    wb.close()
+    bas = tmp_path / "Macros.bas"
+    bas.write_text(SUB, encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    capsys.readouterr()
+    main(["check", str(out / "macro.toml"), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    text = (out / "macro.toml").read_text(encoding="utf-8")
+    assert "written by the macro Sub Fill (its value is the macro's result" in text.replace(
+        "\n# ", " "
+    )
+    assert "S!B3; written by the macro Sub Fill" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
+    assert report["not_computable"] == 1

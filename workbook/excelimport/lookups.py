@@ -1,0 +1,209 @@
+"""Excel's MATCH, INDEX and HLOOKUP as chains of conditions over the cells they read.
+
+``MATCH(x, keys, 0)`` is the position of the first key equal to x, ``MATCH(x, keys[, 1])`` of
+the last key at most x and ``MATCH(x, keys, -1)`` of the last key at least x — Excel's answers
+where the keys ascend (descend), so those chains are guarded by the keys ascending (descending)
+strictly: elsewhere, and where nothing matches (#N/A), the value is an error. Keys are constant
+cells; texts are compared by Excel's rule (without case) only where x is a text written in the
+formula or a constant text cell (whose case and patterns, ``*`` ``?`` ``~``, are then known);
+an empty key cell never matches. ``INDEX(range, i[, j])`` is the cell at (i, j), a chain over
+i and j: an index outside the range is an error (#REF!). ``HLOOKUP`` is VLOOKUP by rows."""
+
+from __future__ import annotations
+
+import re
+
+from .cells import FormulaProblem, Ref
+
+#: cells that one lookup reads at most (a chain of as many conditions)
+MAX_LOOKUP_CELLS = 200
+
+
+def _range(ft, node, what: str) -> Ref:
+    if node[0] != "leaf" or node[1] != "Range" or ft.is_name_formula(node[2]):
+        raise FormulaProblem(f"{what} of other than a range")
+    ref = ft.ref_of(node[2])
+    if (ref.r2 - ref.r1 + 1) * (ref.c2 - ref.c1 + 1) > MAX_LOOKUP_CELLS:
+        raise FormulaProblem(f"{what} over more than {MAX_LOOKUP_CELLS} cells")
+    return ref
+
+
+def _cells(ref: Ref) -> list[tuple[int, int]]:
+    return [(r, c) for r in range(ref.r1, ref.r2 + 1) for c in range(ref.c1, ref.c2 + 1)]
+
+
+def _literal(node) -> float | None:
+    """The number written in the formula (TRUE 1, FALSE 0), else None."""
+    if node[0] == "leaf" and node[1] == "Number":
+        word = node[2].name.upper()
+        return 1.0 if word == "TRUE" else 0.0 if word == "FALSE" else float(node[2].name)
+    if node[0] == "op" and node[1] == "u-":
+        inner = _literal(node[2][0])
+        return None if inner is None else -inner
+    return None
+
+
+def match(ft, args) -> str:
+    """``MATCH(x, keys[, type])`` as a chain giving the position (from 1)."""
+    if len(args) not in (2, 3):
+        raise FormulaProblem(f"MATCH with {len(args)} arguments")
+    kind = 1.0 if len(args) == 2 else _literal(args[2])
+    if kind not in (-1.0, 0.0, 1.0):
+        raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
+    ref = _range(ft, args[1], "MATCH")
+    if ref.r1 != ref.r2 and ref.c1 != ref.c2:
+        raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
+    keys = _keys(ft, ref, args[0], exact=kind == 0)
+    return _chain(ft, args[0], keys, kind, [str(k) for k in range(1, len(_cells(ref)) + 1)])
+
+
+def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
+    """(position, the key's name or None for an empty cell) of the cells of ``ref``; texts
+    only for an exact match of a known text x."""
+    seen = _known_text(ft, x_node)
+    out: list[tuple[int, str | None]] = []
+    folded: dict[str, str] = {}
+    for k, (r, c) in enumerate(_cells(ref), start=1):
+        cell = ft.book.cell(ref.sheet, r, c)
+        if cell is None or cell.value is None:
+            out.append((k, None))
+            continue
+        if cell.formula is not None:
+            raise FormulaProblem("a lookup whose keys are formula cells")
+        value = cell.value
+        if isinstance(value, bool):
+            raise FormulaProblem("a lookup whose keys hold TRUE/FALSE")
+        if isinstance(value, str):
+            if not exact or seen is None:
+                raise FormulaProblem(
+                    "a lookup of texts other than an exact one of a text the formula shows"
+                )
+            low = value.casefold()
+            if low in folded and folded[low] != value:
+                raise FormulaProblem("a lookup whose texts differ only by case")
+            folded[low] = value
+            # Excel's rule applied here: the key whose text equals x's without case
+            out.append((k, '"1"' if low == seen.casefold() else '"0"'))
+            continue
+        if seen is not None:
+            out.append((k, '"0"'))  # a text never equals a number
+            continue
+        ft.out.refs.append(Ref(ref.sheet, r, c, r, c))
+        out.append((k, ft.name_of(ref.sheet, r, c)))
+    return out
+
+
+def _known_text(ft, node) -> str | None:
+    """The text x is, when the formula writes it or it is a constant text cell (None if x is
+    not a known text); a pattern is refused."""
+    text = None
+    if node[0] == "leaf" and node[1] == "String":
+        text = node[2].name
+    elif node[0] == "leaf" and node[1] == "Range" and not ft.is_name_formula(node[2]):
+        ref = ft.ref_of(node[2])
+        cell = ft.book.cell(ref.sheet, ref.r1, ref.c1) if ref.single else None
+        if cell is not None and cell.formula is None and isinstance(cell.value, str):
+            text = cell.value
+    if text is not None and re.search(r"[*?~]", text):
+        raise FormulaProblem("a lookup of a text with a pattern (* ? ~)")
+    return text
+
+
+def _chain(ft, x_node, keys, kind: float, results: list[str], none: str = "1/0") -> str:
+    """The chain of conditions: ``results[k - 1]`` where key k is the match (``none``, an
+    error value of the results' kind, where there is no such result, as Excel's #REF!)."""
+    pick = [results[k - 1] if k <= len(results) else none for k in range(1, len(keys) + 1)]
+    present = [(k, name) for k, name in keys if name is not None]
+    if _known_text(ft, x_node) is not None:  # a constant text: the match is known here
+        if kind != 0:
+            raise FormulaProblem("an approximate lookup of a text")
+        return next((pick[k - 1] for k, name in present if name == '"1"'), none)
+    x = ft.value(x_node, 3)
+    if kind == 0:
+        text = none
+        for k, name in reversed(present):
+            text = f"({pick[k - 1]} if {x} == {name} otherwise {text})"
+        return text
+    if len(present) != len(keys):
+        raise FormulaProblem("an approximate lookup over empty cells")
+    op, order = (">=", "<") if kind == 1 else ("<=", ">")
+    text = none
+    for k, name in present:
+        text = f"({pick[k - 1]} if {x} {op} {name} otherwise {text})"
+    names = [name for _, name in present]
+    guard = " and ".join(f"{a} {order} {b}" for a, b in zip(names, names[1:])) or "1 == 1"
+    return f"({text} if {guard} otherwise {none})"
+
+
+def _no_value(ft, ref: Ref) -> str:
+    """An error value of the kind of the cells of ``ref``: ``num2str(1/0)`` (a text that has
+    no value) where every cell holds a text, else ``1/0``."""
+    values = [getattr(ft.book.cell(ref.sheet, r, c), "value", None) for r, c in _cells(ref)]
+    return "num2str(1/0)" if all(isinstance(v, str) for v in values) else "1/0"
+
+
+def index(ft, args) -> str:
+    """``INDEX(range, i[, j])``: the cell at row i and column j of the range (of a row or a
+    column, i counts along it), a chain over the indices."""
+    if len(args) not in (2, 3):
+        raise FormulaProblem(f"INDEX with {len(args)} arguments")
+    ref = _range(ft, args[0], "INDEX")
+    rows, cols = ref.r2 - ref.r1 + 1, ref.c2 - ref.c1 + 1
+    if len(args) == 2 and rows > 1 and cols > 1:
+        raise FormulaProblem("INDEX of a block by one index (a whole row in Excel)")
+    if any(a[0] == "leaf" and a[1] == "Empty" for a in args[1:]):
+        raise FormulaProblem("INDEX of a whole row or column")
+    cells = []
+    for r, c in _cells(ref):
+        ft.out.refs.append(Ref(ref.sheet, r, c, r, c))
+        cells.append(ft.name_of(ref.sheet, r, c))
+    pos = args[1]
+    if len(args) == 2 and pos[0] == "fn" and pos[1].upper() == "MATCH" and len(pos[2]) in (2, 3):
+        m = pos[2]  # INDEX(range, MATCH(x, keys, type)): one chain over the keys
+        kind = 1.0 if len(m) == 2 else _literal(m[2])
+        if kind not in (-1.0, 0.0, 1.0):
+            raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
+        keys_ref = _range(ft, m[1], "MATCH")
+        if keys_ref.r1 != keys_ref.r2 and keys_ref.c1 != keys_ref.c2:
+            raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
+        keys = _keys(ft, keys_ref, m[0], exact=kind == 0)
+        return _chain(ft, m[0], keys, kind, cells, _no_value(ft, ref))
+    fixed = [_literal(a) for a in args[1:]]
+    if None not in fixed:  # INDEX(range, 3, 2): the cell itself
+        at = (fixed + [1.0])[:2] if cols == 1 or len(fixed) == 2 else [1.0, fixed[0]]
+        if any(v != int(v) or v < 1 for v in at) or at[0] > rows or at[1] > cols:
+            raise FormulaProblem("INDEX outside its range (#REF! in Excel)")
+        return cells[(int(at[0]) - 1) * cols + int(at[1]) - 1]
+    i = ft.value(args[1], 3)
+    j = ft.value(args[2], 3) if len(args) == 3 else None
+    text = _no_value(ft, ref)
+    for (r, c), name in reversed(list(zip(_cells(ref), cells))):
+        dr, dc = r - ref.r1 + 1, c - ref.c1 + 1
+        cond = f"{i} == {dr if cols == 1 or j is not None else dc}"
+        if j is not None:
+            cond += f" and {j} == {dc}"
+        text = f"({name} if {cond} otherwise {text})"
+    return text
+
+
+def hlookup(ft, args) -> str:
+    """``HLOOKUP(x, table, k[, exact])``: the k-th row's cell below the matching key of the
+    first row (an exact match, or the approximate one guarded by the keys ascending)."""
+    if len(args) not in (3, 4):
+        raise FormulaProblem(f"HLOOKUP with {len(args)} arguments")
+    ref = _range(ft, args[1], "HLOOKUP")
+    k = _literal(args[2])
+    if k is None or k != int(k) or not 1 <= k <= ref.r2 - ref.r1 + 1:
+        raise FormulaProblem("HLOOKUP of a row not written as a number of its table")
+    exact = len(args) == 4 and _literal(args[3]) == 0
+    if len(args) == 4 and not exact and _literal(args[3]) is None:
+        raise FormulaProblem("HLOOKUP whose match type is not written in the formula")
+    keys_ref = Ref(ref.sheet, ref.r1, ref.c1, ref.r1, ref.c2)
+    keys = _keys(ft, keys_ref, args[0], exact=exact)
+    row = ref.r1 + int(k) - 1
+    results = []
+    for c in range(ref.c1, ref.c2 + 1):
+        ft.out.refs.append(Ref(ref.sheet, row, c, row, c))
+        results.append(ft.name_of(ref.sheet, row, c))
+    none = _no_value(ft, Ref(ref.sheet, row, ref.c1, row, ref.c2))
+    return _chain(ft, args[0], keys, 0.0 if exact else 1.0, results, none)
