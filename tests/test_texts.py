@@ -91,3 +91,17 @@ def test_num2str_is_written_as_its_value_with_a_comment(sheet, tmp_path):
 def test_refused_at_load(tmp_path, line, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
         workbook.load(write_template(tmp_path, SHEET.replace("#BAD", line)))
+
+
+def test_a_caret_inside_a_text_is_a_caret(tmp_path):
+    """`^` is the power operator outside texts only: "As (in^2)" keeps its `^`."""
+    sheet = workbook.load(
+        write_template(
+            tmp_path,
+            '[inputs]\nx = "3"\n[definitions]\n'
+            'label = "concat(\\"As (in^2) = \\", num2str(x^2))"\n'
+            "unit_text = \"'m^2' if x^2 > 4 otherwise 'mm^2'\"\n",
+        )
+    )
+    assert sheet.evaluate("label") == "As (in^2) = 9"
+    assert sheet.evaluate("unit_text") == "m^2"

@@ -7,7 +7,8 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .cells import FormulaProblem, FormulaTranslator, parse_formula, text_problem
+from .cells import FormulaTranslator, parse_formula
+from .formula_terms import FormulaProblem, text_problem
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .subwrites import cells_written

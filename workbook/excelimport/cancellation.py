@@ -29,7 +29,8 @@ def scale(book, cell, depth: int = 0, seen: dict | None = None) -> float:
     seen[key] = own
     if cell.formula is None or depth >= MAX_DEPTH:
         return own
-    from .cells import FormulaProblem, parse_formula
+    from .cells import parse_formula
+    from .formula_terms import FormulaProblem
 
     try:
         tree = parse_formula(cell.formula).tree

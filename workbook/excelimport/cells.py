@@ -12,6 +12,7 @@ import re
 from dataclasses import dataclass, field
 
 from .aggregates import AGGREGATES, aggregate
+from .formula_terms import FormulaProblem, Ref, text_problem
 from .functions import EXCEL, VOLATILE
 
 #: a prefix that calls into an add-in or another workbook: [1]!f( or 'Book.xlam'!f(
@@ -23,20 +24,6 @@ MAX_RANGE_CELLS = 100_000
 MAX_LOOKUP_ROWS = 200
 #: a formula that is one cell's reference: =D63, =Sheet2!$B$4, ='Load table'!C7
 _PLAIN_REF = re.compile(r"(?:'?([^'!]+)'?!)?\$?([A-Za-z]{1,3})\$?(\d+)")
-
-
-def text_problem(text: str) -> str | None:
-    """Why a text cannot be a text literal of the language (None when it can): a quote or a
-    backslash, or a ``^``, which the language's parser reads as ``**`` even in a text."""
-    if '"' in text or "\\" in text:
-        return "a text with a quote or a backslash"
-    if "^" in text:
-        return "a text with a ^ (the language's text would read it as **)"
-    return None
-
-
-class FormulaProblem(Exception):
-    """A formula this translation does not take (the reason is the message)."""
 
 
 @dataclass
@@ -87,19 +74,6 @@ def parse_formula(text: str) -> Parsed:
     except Exception as exc:  # noqa: BLE001 - the parser's own errors
         raise FormulaProblem(f"cannot parse the formula ({type(exc).__name__})") from None
     return Parsed(builder.stack[0], linked)
-
-
-@dataclass
-class Ref:
-    sheet: str
-    r1: int
-    c1: int
-    r2: int
-    c2: int
-
-    @property
-    def single(self) -> bool:
-        return self.r1 == self.r2 and self.c1 == self.c2
 
 
 @dataclass

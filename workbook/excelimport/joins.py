@@ -10,7 +10,7 @@ known from the formula, and texts with line breaks (``CHAR(10)``) are refused.""
 from __future__ import annotations
 
 from .aggregates import AGGREGATES
-from .cells import FormulaProblem, text_problem
+from .formula_terms import FormulaProblem, Ref, text_problem
 from .functions import EXCEL, EXCEL_VARIADIC
 
 #: operators whose value is a number (their operands are numbers, or the sheet refuses them)
@@ -101,8 +101,6 @@ def _cell_piece(ft, sheet: str, row: int, col: int, out: list[str], token=None) 
     if token is not None:
         name = ft.reference(token)
     else:
-        from .cells import Ref
-
         ft.out.refs.append(Ref(sheet, row, col, row, col))
         name = ft.name_of(sheet, row, col)
     if isinstance(value, str):

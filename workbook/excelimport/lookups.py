@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from .cells import FormulaProblem, Ref
+from .formula_terms import FormulaProblem, Ref
 
 #: cells that one lookup reads at most (a chain of as many conditions)
 MAX_LOOKUP_CELLS = 200

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from .cells import text_problem
+from .formula_terms import text_problem
 from .functions import VBA
 from .vba import Procedure, split_top
 from .vbaerrors import cut_error_handler

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import WorkbookError
+from ..language.csvcells import csv_text as spreadsheet_text
 from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
-from ..language.csvcells import csv_text as spreadsheet_text
 from .book import Definition, Translation
 from .runs import ROW
 

@@ -132,7 +132,7 @@ def parse(text: str, *, what: str = "expression") -> Node:
         raise TemplateError(f"{what}: expected an expression as text, got {type(text).__name__}")
     if len(text) > MAX_TEXT:
         raise LimitError(f"{what}: expression is {len(text)} characters long (limit {MAX_TEXT})")
-    source = text.replace("^", "**").strip()
+    source = _powers(text).strip()
     if not source:
         raise TemplateError(f"{what}: empty expression")
     if source.count("(") > MAX_DEPTH:
@@ -154,6 +154,30 @@ def parse(text: str, *, what: str = "expression") -> Node:
     except (RecursionError, MemoryError):
         raise LimitError(f"{what}: expression nested too deeply (limit {MAX_DEPTH})") from None
     return _convert(tree.body, _short(text), what, 0)
+
+
+def _powers(text: str) -> str:
+    """``^`` as Python's ``**``, outside text literals: a text ``"As (in^2)"`` keeps its
+    ``^``."""
+    if "^" not in text:
+        return text
+    out, quote, i = [], None, 0
+    while i < len(text):
+        c = text[i]
+        if quote:
+            if c == "\\" and i + 1 < len(text):  # an escaped character stays in the text
+                out.append(text[i : i + 2])
+                i += 2
+                continue
+            if c == quote:
+                quote = None
+        elif c in "\"'":
+            quote = c
+        elif c == "^":
+            c = "**"
+        out.append(c)
+        i += 1
+    return "".join(out)
 
 
 def _otherwise_as_else(source: str) -> str:
