@@ -7,7 +7,7 @@ moment the event with the new rendering is received:
 
 - a formula: the last definition with a formula (where a person writes) is multiplied by a
   factor new at each repetition (1.501, 1.502, ...), the file written as an editor writes
-  it; the time includes the watcher noticing the change (it polls every 40 ms and reports a
+  it; the time includes the watcher noticing the change (it polls every 10 ms and reports a
   change that held for one more poll);
 - an input: the first input that is a quantity is sent from the form (POST /input) at a
   value new at each repetition (1.011, 1.012, ... times its own).

@@ -260,8 +260,13 @@ def test_incremental_reuses_what_an_edit_does_not_reach(tmp_path):
     live = LiveSheet(path)
     assert live.refresh().error is None
     edited = SHEET.replace('expr = "A*L"', 'expr = "3*A*L"')
+    typed_before = dict(live.sheet.typer.scalars)
     update = live.rebuild(edited, {})
     assert update.error is None and update.recomputed == {"V"}
+    # the typing of what the edit does not reach is taken over, the edited one is new
+    assert live.sheet.typer.scalars["A"] is typed_before["A"]
+    assert live.sheet.typer.scalars["V"] is not typed_before["V"]
+    assert live.pieces[("definition", "A")] in update.html
     assert {("value", "A"), ("value", "r1")} <= set(live.sheet.reused)
     assert ("value", "V") not in live.sheet.reused
     update = live.set_inputs({"R": "4 mm"})

@@ -26,13 +26,16 @@ from typing import Any
 import numpy as np
 
 from ..compute.computed import compute
+from ..compute.declared_checks import placeholders
 from ..engine.sheet import Sheet
 from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language.template import parse_spec
-from ..language.typecheck import dependencies
+from ..language.typecheck import Typer, dependencies
+from ..language.typedsheet import TypedSheet, printed_rows
 from ..outputs.report.charts import chart_svg
 from ..outputs.report.html import Document
+from .watch import stamp
 
 try:
     import tomllib
@@ -54,11 +57,33 @@ class ReusingSheet(Sheet):
     """A Sheet that takes the values of unchanged definitions, solutions and tables from the
     Sheet before an edit (``reuse``) and remembers what it computes (``seen``), for the next."""
 
-    def __init__(self, spec, values=None, typer=None, parts=None, *, reuse=None):
+    def __init__(self, spec, values=None, typer=None, parts=None, *, reuse=None, retype=None):
         self.reused: dict[Any, Any] = dict(reuse or {})
         self.seen: dict[Any, Any] = {}
         self.known: dict[str, Any] = {}  # definition name -> its value, once known
-        super().__init__(spec, values, typer, parts)
+        # each file of printed values as it was before this Sheet read it (:func:`.watch.stamp`)
+        self.printed_stamps = {p.file: stamp(p.file) for p in spec.printed}
+        if typer is not None or retype is None:
+            super().__init__(spec, values, typer, parts)
+            return
+        old, dirty = retype  # the Sheet before the edit, and what the edit reaches
+        units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+        typer = seeded_typer(old.typer, Typer(spec, units), dirty)
+        super().__init__(spec, values, typer, parts, seeded_trees(old, spec, dirty))
+        self.check_units()  # a Sheet given a typer does not: the unchanged are looked up
+
+    def evaluate(self, name, *args, **kwargs):
+        """As :meth:`Sheet.evaluate`; the value of a definition (a check's printed value of
+        a function at an argument, among others) reused when nothing it reads changed."""
+        if not isinstance(name, str) or name not in self.spec.definitions:
+            return super().evaluate(name, *args, **kwargs)
+        try:
+            key = ("evaluate", (name, args, tuple(sorted(kwargs.items()))))
+            hash(key)
+        except TypeError:  # an array argument: computed
+            return super().evaluate(name, *args, **kwargs)
+        self.reads.add(name)
+        return self._take(key, lambda: Sheet.evaluate(self, name, *args, **kwargs))
 
     def _take(self, key, make):
         if key in self.reused:
@@ -121,6 +146,32 @@ class LiveDocument(Document):
         self.drawn = drawn
         self.pending = False
         self.shown: dict[str, str] = {}
+        # the last rendering's pieces: a definition's (by name) and the checks' (by the
+        # report they show); ``dirty``: the definitions an edit reaches (None: all)
+        self.last: dict[str, Any] = {}
+        self.dirty: set[str] | None = None
+        self.made: dict[str, Any] = {}
+
+    def definition(self, d) -> str:
+        """As :meth:`Document.definition`; the last rendering's when the edit did not reach
+        ``d`` (its text, and the values it shows, are as they were)."""
+        key = ("definition", d.name)
+        if self.dirty is not None and d.name not in self.dirty and key in self.last:
+            out = self.last[key]
+        else:
+            out = super().definition(d)
+        self.made[key] = out
+        return out
+
+    def checks(self) -> str:
+        """As :meth:`Document.checks`; the last rendering's when the report is the same."""
+        try:
+            key = ("checks", repr(self.sheet.check_report()))
+        except WorkbookError:
+            return super().checks()
+        out = self.last[key] if key in self.last else super().checks()
+        self.made[key] = out
+        return out
 
     def charts(self) -> str:
         if not self.spec.charts:
@@ -162,10 +213,13 @@ def _chart_key(computed, chart) -> str | None:
     return h.hexdigest()
 
 
-def render_body(computed, charts: dict, drawn: dict | None = None) -> LiveDocument:
+def render_body(
+    computed, charts: dict, drawn: dict | None = None, last: dict | None = None, dirty=None
+) -> LiveDocument:
     """The report of a computed sheet as the live page shows it: the document (its ``text``
-    the body; see :class:`LiveDocument` for ``drawn``)."""
+    the body; see :class:`LiveDocument` for ``drawn``, ``last`` and ``dirty``)."""
     doc = LiveDocument(computed, charts, drawn)
+    doc.last, doc.dirty = last or {}, dirty
     with np.errstate(all="ignore"):
         doc.text = doc.body()
     return doc
@@ -205,6 +259,13 @@ def changed_names(old_raw: dict, new_raw: dict, old_values: dict, new_values: di
     return out
 
 
+def only_entries_changed(old_raw: dict, new_raw: dict) -> bool:
+    """Did an edit change inputs and definitions only (what the typing of the unchanged
+    definitions can be taken over for)?"""
+    keys = (set(old_raw) | set(new_raw)) - {"inputs", "definitions"}
+    return all(old_raw.get(k) == new_raw.get(k) for k in keys)
+
+
 def stopped_by(spec, err) -> list[str]:
     """The definitions of ``spec`` an error stops: its own and every one that reads it."""
     name = getattr(err, "definition", None)
@@ -232,9 +293,12 @@ def _reads(raw_entry, dirty: set[str]) -> bool:
     return bool(words & dirty)
 
 
-def reusable(old: ReusingSheet, new_spec, new_raw, old_raw, changed: set[str]) -> dict:
-    """The values of ``old`` that the Sheet of ``new_spec`` may take as they are."""
-    dirty = downstream(new_spec, changed)
+def reusable(
+    old: ReusingSheet, new_spec, new_raw, old_raw, changed: set[str], dirty: set[str] | None = None
+) -> dict:
+    """The values of ``old`` that the Sheet of ``new_spec`` may take as they are (``dirty``:
+    what is downstream of ``changed``, when known)."""
+    dirty = downstream(new_spec, changed) if dirty is None else dirty
     out = {}
     old_tables = _entries(old_raw, "tables")
     new_tables = _entries(new_raw, "tables")
@@ -244,6 +308,9 @@ def reusable(old: ReusingSheet, new_spec, new_raw, old_raw, changed: set[str]) -
             if name in dirty or name not in new_spec.definitions:
                 continue
             if name not in old.spec.definitions or isinstance(value, BaseException):
+                continue
+        elif kind == "evaluate":
+            if name[0] in dirty or name[0] not in new_spec.definitions:
                 continue
         elif kind == "solve":
             block = next((b for b in new_spec.solves if b.index == name), None)
@@ -259,6 +326,61 @@ def reusable(old: ReusingSheet, new_spec, new_raw, old_raw, changed: set[str]) -
                 continue
         out[key] = value
     return out
+
+
+def seeded_typer(old: Typer, new: Typer, dirty: set[str]) -> Typer:
+    """``new`` with the typed definitions of ``old`` that the edit does not reach: their
+    text, and the text and units of everything they read, are as they were."""
+    spec = new.spec
+    for name, body in old.scalars.items():
+        if name not in dirty and name in spec.definitions:
+            new.scalars[name] = body
+    for key, f in old.functions.items():
+        name = key.split("@", 1)[0]  # a specialization (``f@2x1``) belongs to its function
+        if name not in dirty and name in spec.definitions:
+            new.functions[key] = f
+            if key in old.recursive:
+                new.recursive.add(key)
+    new.derivatives.update(old.derivatives)  # by the typed tree they were found for
+    return new
+
+
+def seeded_trees(old, spec, dirty: set[str]) -> TypedSheet:
+    """The trees :class:`Sheet` types at load besides the definitions' (a scalar in the unit
+    it is shown in, a printed value's formula), taken from ``old`` where the edit does not
+    reach them."""
+    trees = TypedSheet()
+    for name, d in spec.definitions.items():
+        if name not in dirty and not d.is_function and name in old.full_spec.definitions:
+            key = ("scalar", name)
+            t = old.typed.get(None, key)
+            if t is not None:
+                trees.keep(None, key, t)
+    for p, new_p in zip(old.full_spec.printed, spec.printed):
+        if p.read is not None and stamp(p.file) == old.printed_stamps.get(p.file):
+            new_p.read = p.read  # the file of printed values is as it was read
+        try:
+            rows = printed_rows(p)
+        except WorkbookError:
+            continue
+        for row in rows:
+            if row.name in dirty or row.name not in spec.definitions:
+                continue
+            at = None if np.isnan(row.at) else row.at
+            key = ("printed", row.name, at, bool(p.argument), row.unit)
+            t = old.typed.get(None, key)
+            if t is not None:
+                trees.keep(None, key, t)
+    for c, new_c in zip(old.full_spec.checks, spec.checks):  # [[checks]] as they were
+        pieces = [(e, u) for text in (c.what, c.note) for e, u in placeholders(text)]
+        nodes = [c.value, c.ok, *(c.parsed.get(e) for e, _ in pieces)]
+        if any(n is not None and ex.names(n) & dirty for n in nodes):
+            continue
+        for key in ("value", "ok", *(("placeholder", e, u) for e, u in pieces)):
+            t = old.typed.get(c, key)
+            if t is not None:
+                trees.keep(new_c, key, t)
+    return trees
 
 
 def _solve_reads(spec, block) -> set[str]:
@@ -290,6 +412,7 @@ class LiveSheet:
         self.overrides: dict[str, str] = {}  # input name -> the text the form gave
         self.charts: dict[str, str] = {}  # chart digest -> its SVG
         self.drawn: dict[str, str] = {}  # chart name -> the SVG on the page
+        self.pieces: dict = {}  # the last rendering's pieces (:class:`LiveDocument`)
         self.pending = False  # a chart on the page is the last drawing, to be drawn again
         self.version = 0
         self.lock = threading.Lock()  # one computation at a time
@@ -340,22 +463,27 @@ class LiveSheet:
                     overrides = {n: v for n, v in overrides.items() if old.get(n) == new.get(n)}
             values = _input_values(spec, overrides, self.path)
             seconds["parse"] = time.perf_counter() - t0
-            reuse, changed = {}, None
+            reuse, changed, dirty, retype = {}, None, None, None
             if self.incremental and self.sheet is not None and raw is not None:
                 old_values = {n: str(v) for n, v in self.sheet.values.items()}
                 new_values = {n: str(v) for n, v in values.items()}
                 changed = changed_names(self.raw, raw, old_values, new_values)
                 if changed is not None:
-                    reuse = reusable(self.sheet, spec, raw, self.raw, changed)
+                    dirty = downstream(spec, changed)
+                    reuse = reusable(self.sheet, spec, raw, self.raw, changed, dirty)
+                    if typer is None and only_entries_changed(self.raw, raw):
+                        retype = (self.sheet, dirty)
             t1 = time.perf_counter()
-            sheet = ReusingSheet(spec, values, typer, reuse=reuse)
+            sheet = ReusingSheet(spec, values, typer, reuse=reuse, retype=retype)
             seconds["type"] = time.perf_counter() - t1
             t2 = time.perf_counter()
             computed = compute(sheet)
             seconds["compute"] = time.perf_counter() - t2
             t3 = time.perf_counter()
             drawn = self.drawn if self.incremental and self.drawn else None
-            doc = render_body(computed, self.charts if self.incremental else {}, drawn)
+            kept = dirty if retype is not None or typer is not None else None
+            last = self.pieces if self.incremental else {}
+            doc = render_body(computed, self.charts if self.incremental else {}, drawn, last, kept)
             html = doc.text
             seconds["render"] = time.perf_counter() - t3
         except WorkbookError as err:
@@ -367,11 +495,11 @@ class LiveSheet:
         if len(self.charts) > 64:
             self.charts.clear()
         self.raw, self.sheet, self.computed, self.html = raw or {}, sheet, computed, html
-        self.drawn, self.pending = doc.shown, doc.pending
+        self.drawn, self.pending, self.pieces = doc.shown, doc.pending, doc.made
         self.overrides = overrides
         self.error = None
         self.version += 1
-        recomputed = None if changed is None else downstream(spec, changed)
+        recomputed = dirty
         return Update(html, None, seconds, recomputed)
 
     def draw_charts(self) -> Update | None:
