@@ -13,6 +13,11 @@ from pathlib import Path
 
 from ..errors import LimitError, WorkbookError
 
+try:
+    import tomllib
+except ImportError:  # Python 3.10
+    import tomli as tomllib
+
 #: Seconds the values of a document's scalar definitions may take, all together, before the
 #: rest is left unchecked (their errors are diagnostics too: a domain error, a limit).
 VALUES_BUDGET = 2.0
@@ -54,6 +59,7 @@ class Document:
     sheet: object = None
     problems: list[Problem] = field(default_factory=list)
     values: dict[str, object] = field(default_factory=dict)  # name -> quantity or error
+    raw: dict | None = None  # the TOML the text reads as
     seconds: float = 0.0
     lock: threading.Lock = field(default_factory=threading.Lock)  # one evaluation at a time
     stale: bool = False  # a newer text has come: its values are no longer wanted
@@ -63,17 +69,29 @@ class Document:
         return self.text.splitlines()
 
 
-def load(text: str, path: Path) -> Document:
-    """Load ``text`` as the worksheet at ``path`` (the files it names are read beside it)."""
-    from ..engine.sheet import Sheet
+def load(text: str, path: Path, previous: Document | None = None) -> Document:
+    """Load ``text`` as the worksheet at ``path`` (the files it names are read beside it),
+    typed (not computed). With ``previous`` (the last good load of the same document), only
+    what the edit reaches is typed again: the definitions whose text, and whose inputs' and
+    definitions' texts, did not change keep their typing and the values already computed
+    (:func:`workbook.serve.incremental.successor`)."""
     from ..language.template import MAX_TEMPLATE_BYTES, parse_spec
+    from ..serve.incremental import successor
 
     t0 = time.perf_counter()
     doc = Document(text, path)
     try:
         if len(text.encode("utf-8")) > MAX_TEMPLATE_BYTES:
             raise LimitError(f"template text is larger than {MAX_TEMPLATE_BYTES:,} bytes")
-        doc.sheet = Sheet(parse_spec(text, path, path.stem))
+        spec = parse_spec(text, path, path.stem)
+        try:
+            doc.raw = tomllib.loads(text)
+        except tomllib.TOMLDecodeError:  # parse_spec has said it; not reached
+            doc.raw = None
+        old = previous.sheet if previous is not None else None
+        old_raw = previous.raw if previous is not None else {}
+        values = {n: i.value for n, i in spec.inputs.items()}
+        doc.sheet = successor(old, old_raw or {}, spec, doc.raw, values)[0]
     except WorkbookError as err:
         doc.problems.append(problem(doc.lines, err))
     except RecursionError:

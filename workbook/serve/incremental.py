@@ -302,7 +302,7 @@ def reusable(
     out = {}
     old_tables = _entries(old_raw, "tables")
     new_tables = _entries(new_raw, "tables")
-    for key, value in old.seen.items():
+    for key, value in list(old.seen.items()):  # another thread may be adding to it
         kind, name = key
         if kind == "value":
             if name in dirty or name not in new_spec.definitions:
@@ -332,16 +332,16 @@ def seeded_typer(old: Typer, new: Typer, dirty: set[str]) -> Typer:
     """``new`` with the typed definitions of ``old`` that the edit does not reach: their
     text, and the text and units of everything they read, are as they were."""
     spec = new.spec
-    for name, body in old.scalars.items():
+    for name, body in dict(old.scalars).items():  # copies: values may be typing more
         if name not in dirty and name in spec.definitions:
             new.scalars[name] = body
-    for key, f in old.functions.items():
+    for key, f in dict(old.functions).items():
         name = key.split("@", 1)[0]  # a specialization (``f@2x1``) belongs to its function
         if name not in dirty and name in spec.definitions:
             new.functions[key] = f
             if key in old.recursive:
                 new.recursive.add(key)
-    new.derivatives.update(old.derivatives)  # by the typed tree they were found for
+    new.derivatives.update(dict(old.derivatives))  # by the typed tree they were found for
     return new
 
 
@@ -394,6 +394,26 @@ def _solve_reads(spec, block) -> set[str]:
         if n in spec.definitions or n in spec.inputs:
             deps |= dependencies(spec, ex.Name(n))
     return deps
+
+
+def successor(old: ReusingSheet | None, old_raw: dict, spec, raw: dict | None, values, typer=None):
+    """The Sheet of ``spec`` (its TOML ``raw``, its input ``values``) after an edit of the
+    one that gave ``old`` (None: none to reuse), taking from it what the edit does not reach;
+    with ``typer``, the same text with other input values. Returns the Sheet, what the edit
+    reached (None: everything) and, when the typing of the rest was taken over (or kept),
+    the same set (else None)."""
+    reuse, changed, dirty, retype = {}, None, None, None
+    if old is not None and raw is not None:
+        old_values = {n: str(v) for n, v in old.values.items()}
+        new_values = {n: str(v) for n, v in values.items()}
+        changed = changed_names(old_raw, raw, old_values, new_values)
+        if changed is not None:
+            dirty = downstream(spec, changed)
+            reuse = reusable(old, spec, raw, old_raw, changed, dirty)
+            if typer is None and only_entries_changed(old_raw, raw):
+                retype = (old, dirty)
+    sheet = ReusingSheet(spec, values, typer, reuse=reuse, retype=retype)
+    return sheet, dirty, dirty if retype is not None or typer is not None else None
 
 
 class LiveSheet:
@@ -463,25 +483,15 @@ class LiveSheet:
                     overrides = {n: v for n, v in overrides.items() if old.get(n) == new.get(n)}
             values = _input_values(spec, overrides, self.path)
             seconds["parse"] = time.perf_counter() - t0
-            reuse, changed, dirty, retype = {}, None, None, None
-            if self.incremental and self.sheet is not None and raw is not None:
-                old_values = {n: str(v) for n, v in self.sheet.values.items()}
-                new_values = {n: str(v) for n, v in values.items()}
-                changed = changed_names(self.raw, raw, old_values, new_values)
-                if changed is not None:
-                    dirty = downstream(spec, changed)
-                    reuse = reusable(self.sheet, spec, raw, self.raw, changed, dirty)
-                    if typer is None and only_entries_changed(self.raw, raw):
-                        retype = (self.sheet, dirty)
             t1 = time.perf_counter()
-            sheet = ReusingSheet(spec, values, typer, reuse=reuse, retype=retype)
+            old = self.sheet if self.incremental else None
+            sheet, dirty, kept = successor(old, self.raw, spec, raw, values, typer)
             seconds["type"] = time.perf_counter() - t1
             t2 = time.perf_counter()
             computed = compute(sheet)
             seconds["compute"] = time.perf_counter() - t2
             t3 = time.perf_counter()
             drawn = self.drawn if self.incremental and self.drawn else None
-            kept = dirty if retype is not None or typer is not None else None
             last = self.pieces if self.incremental else {}
             doc = render_body(computed, self.charts if self.incremental else {}, drawn, last, kept)
             html = doc.text
