@@ -368,3 +368,19 @@ def test_the_benchmark_runs():
     assert all(0 < t[0] <= t[1] for ts in m["times"].values() for t in ts)
     ((name, times),) = bench_serve.measure_lsp(["concave-cam"], 1)
     assert name == "concave-cam" and len(times) == 1 and times[0][0] > 0
+
+
+@pytest.mark.parametrize("name", _templates())
+def test_downstream_is_what_reads_the_change(name):
+    """What an edit reaches, followed backwards from the change, is every input and
+    definition whose (transitive) dependencies include it."""
+    import workbook
+    from workbook.language import expr as ex
+    from workbook.language.typecheck import dependencies
+    from workbook.serve.incremental import downstream
+
+    spec = workbook.load(workbook.list_templates()[name]).full_spec
+    names = [*spec.inputs, *spec.definitions]
+    for changed in (names[:1], names[len(names) // 2 : len(names) // 2 + 1], names[-2:]):
+        want = set(changed) | {n for n in names if dependencies(spec, ex.Name(n)) & set(changed)}
+        assert downstream(spec, set(changed)) == want, changed

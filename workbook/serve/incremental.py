@@ -31,10 +31,11 @@ from ..engine.sheet import Sheet
 from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language.template import parse_spec
-from ..language.typecheck import Typer, dependencies
+from ..language.typecheck import Typer, dependencies, solve_expressions
 from ..language.typedsheet import TypedSheet, printed_rows
 from ..outputs.report.charts import chart_svg
 from ..outputs.report.html import Document
+from ..program.statements import names as program_names
 from .watch import stamp
 
 try:
@@ -275,14 +276,56 @@ def stopped_by(spec, err) -> list[str]:
 
 
 def downstream(spec, changed: set[str]) -> set[str]:
-    """Every input and definition that reads (transitively) one of ``changed``."""
+    """Every input and definition that reads (transitively) one of ``changed`` (the reads of
+    each name found once, then followed backwards from ``changed``)."""
+    names = [*spec.inputs, *spec.definitions]
+    nodes = names + [u for block in spec.solves for u in block.unknowns]
+    readers: dict[str, set[str]] = {}
     out = set(changed)
-    for name in [*spec.inputs, *spec.definitions]:
+    for name in nodes:
         try:
-            if dependencies(spec, ex.Name(name)) & changed:
-                out.add(name)
+            reads = direct_reads(spec, name)
         except (WorkbookError, RecursionError):
-            out.add(name)
+            out.add(name)  # cannot be followed: taken as reached
+            continue
+        for m in reads:
+            readers.setdefault(m, set()).add(name)
+    todo = list(out)
+    while todo:
+        for r in readers.get(todo.pop(), ()):
+            if r not in out:
+                out.add(r)
+                todo.append(r)
+    known = set(names)
+    return {n for n in out if n in known or n in changed}
+
+
+def direct_reads(spec, name: str) -> set[str]:
+    """The names that the entry ``name`` reads itself (one step of
+    :func:`workbook.language.typecheck.dependencies`): a definition's formulas, program or
+    ODE, an unknown's [[solve]] equations."""
+    out: set[str] = set()
+    block = spec.solve_of(name) if name not in spec.inputs else None
+    if block is not None:
+        out |= {
+            m
+            for node in solve_expressions(block)
+            for m in ex.names(node)
+            if m not in block.parameters
+        }
+    d = spec.definitions.get(name)
+    if d is None:
+        return out
+    local: set[str] = set(d.params)
+    if d.program is not None:
+        return out | (program_names(d.program) - local)
+    bodies = d.expressions()
+    if d.ode is not None:
+        o = spec.odes[d.ode[0]]
+        local |= {o.var} | {st.name for st in o.states}
+        bodies = o.expressions()
+    for body in bodies:
+        out |= {m for m in ex.names(body) if m not in local}
     return out
 
 
