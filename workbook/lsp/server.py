@@ -12,6 +12,7 @@ from lsprotocol import types as lsp
 from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
+from ..serve.collector import no_collection
 from ..version import __version__
 from . import document, features
 
@@ -35,7 +36,8 @@ class WorkbookServer(LanguageServer):
         if text is None:
             text = self.workspace.get_text_document(uri).source
         path = Path(to_fs_path(uri) or "sheet.toml")
-        doc = document.load(text, path, self.good.get(uri))
+        with no_collection():  # the collector resumes after the load
+            doc = document.load(text, path, self.good.get(uri))
         self.documents[uri] = doc
         if doc.sheet is not None:
             self.good[uri] = doc

@@ -19,6 +19,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..errors import InputError, WorkbookError
 from . import page
+from .collector import freeze_loaded, no_collection
 from .incremental import LiveSheet, stopped_by
 from .watch import Watcher
 
@@ -87,10 +88,12 @@ class Site:
         live = self.sheets.get(path.name)
         if live is None:
             return
-        with live.lock:
-            update = live.refresh()
+        with no_collection():  # the collector resumes once the page has the numbers
+            with live.lock:
+                update = live.refresh()
+            if update is not None:
+                self.push(live)
         if update is not None:
-            self.push(live)
             self.draw(live)
 
     def draw(self, live: LiveSheet) -> None:
@@ -102,10 +105,10 @@ class Site:
 
     def set_inputs(self, live: LiveSheet, changes: dict[str, str]) -> str | None:
         """Compute again with inputs from the form; the error (a refused value), if any."""
-        with live.lock:
+        with no_collection(), live.lock:
             update = live.set_inputs(changes)
-        if update.html is not None or (update.error is not None and live.error is update.error):
-            self.push(live)  # a value refused at its field leaves the page as it is
+            if update.html is not None or (update.error is not None and live.error is update.error):
+                self.push(live)  # a value refused at its field leaves the page as it is
         if update.html is not None:
             threading.Thread(target=self.draw, args=(live,), daemon=True).start()
         return page.error_text(update.error)
@@ -171,6 +174,7 @@ class Site:
         return f"wrote {', '.join(changes)} into {live.path.name}"
 
     def start(self) -> None:
+        freeze_loaded()
         self.watcher.start()
 
     def stop(self) -> None:
