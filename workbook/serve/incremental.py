@@ -345,7 +345,10 @@ def reusable(
     out = {}
     old_tables = _entries(old_raw, "tables")
     new_tables = _entries(new_raw, "tables")
-    for key, value in list(old.seen.items()):  # another thread may be adding to it
+    # what ``old`` computed, and what it was given and did not come to ask for (the values
+    # a language server had not finished when the next change came): both hold for it
+    # (copies: another thread may be adding to them)
+    for key, value in {**dict(old.reused), **dict(old.seen)}.items():
         kind, name = key
         if kind == "value":
             if name in dirty or name not in new_spec.definitions:
