@@ -5,7 +5,11 @@ column, else the formula's string)."""
 
 from __future__ import annotations
 
+import contextlib
+import multiprocessing
+import os
 import re
+import signal
 import threading
 import time
 from dataclasses import dataclass, field
@@ -139,6 +143,41 @@ def compute_values(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem
             if p not in found:
                 found.append(p)
     return found
+
+
+def values_apart(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem] | None:
+    """:func:`compute_values` in a child process (forked: it has the document as it is), so
+    that the typing of the next change does not share the interpreter with a long value (an
+    ODE, a block); None when a newer text came first (the child is stopped) or the child
+    failed. Where a process cannot be forked, computed here."""
+    if not hasattr(os, "fork"):
+        return compute_values(doc, budget)
+    receive, send = multiprocessing.Pipe(duplex=False)
+    pid = os.fork()
+    if pid == 0:  # the child: answers through the pipe, writes nothing else, never returns
+        status = 0
+        try:
+            receive.close()
+            doc.lock = threading.Lock()  # another thread of the parent may have held it
+            send.send(compute_values(doc, budget))
+        except BaseException:  # noqa: BLE001 - the parent is told by the closed pipe
+            status = 1
+        finally:
+            os._exit(status)  # no buffer of the parent's (its stdout) is flushed twice
+    send.close()
+    try:
+        while not doc.stale:
+            if receive.poll(0.02):
+                try:
+                    return receive.recv()
+                except (EOFError, OSError):
+                    return None
+        return None
+    finally:
+        receive.close()
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
 
 
 def problem(lines: list[str], err: WorkbookError) -> Problem:

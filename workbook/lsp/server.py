@@ -87,8 +87,8 @@ async def _changed(ls: WorkbookServer, uri: str, version: int | None) -> None:
     await asyncio.sleep(QUIET)
     if not _latest(ls, uri, version) or ls.documents.get(uri) is not doc:
         return
-    more = await loop.run_in_executor(None, document.compute_values, doc)
-    if _latest(ls, uri, version) and ls.documents.get(uri) is doc:
+    more = await loop.run_in_executor(None, document.values_apart, doc)
+    if more is not None and _latest(ls, uri, version) and ls.documents.get(uri) is doc:
         ls.publish(uri, doc.problems + more, version)  # again, even when nothing was added
 
 
