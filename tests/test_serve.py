@@ -8,6 +8,7 @@ import json
 import math
 import re
 import shutil
+import subprocess
 import threading
 import time
 import urllib.error
@@ -66,7 +67,7 @@ class Served:
             headers={"Content-Type": "application/json"},
             method="POST",
         )
-        with urllib.request.urlopen(req, timeout=60) as r:
+        with urllib.request.urlopen(req, timeout=240) as r:
             return json.loads(r.read())
 
     def close(self) -> None:
@@ -384,3 +385,31 @@ def test_downstream_is_what_reads_the_change(name):
     for changed in (names[:1], names[len(names) // 2 : len(names) // 2 + 1], names[-2:]):
         want = set(changed) | {n for n in names if dependencies(spec, ex.Name(n)) & set(changed)}
         assert downstream(spec, set(changed)) == want, changed
+
+
+def test_the_pdf_is_not_written_outside_the_served_folder(served, tmp_path):
+    outside = tmp_path.parent / (tmp_path.name + "-elsewhere")
+    outside.mkdir()
+    (tmp_path / "reports").symlink_to(outside, target_is_directory=True)
+    served.get("/sheet/live.toml").close()
+    reply = served.post("/write-pdf", {}, sheet="live.toml")
+    assert "leads outside the served folder" in reply["error"]
+    assert list(outside.iterdir()) == []
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not shutil.which("chromium"), reason="chromium needed")
+def test_the_pdf_button_prints_the_report_with_the_forms_inputs(served, tmp_path):
+    served.get("/sheet/live.toml").close()
+    served.post("/input", {"R": "2.5 mm"}, sheet="live.toml")
+    reply = served.post("/write-pdf", {}, sheet="live.toml")
+    pdf, html = tmp_path / "reports" / "live.pdf", tmp_path / "reports" / "live.html"
+    assert reply == {"message": f"wrote {html}, {pdf}"}
+    assert pdf.read_bytes().startswith(b"%PDF") and pdf.stat().st_size > 1000
+    assert "--set R=&quot;2.5 mm&quot;" in html.read_text(encoding="utf-8")  # its command
+    assert abs(_value(html.read_text(encoding="utf-8"), "A") - math.pi * 2.5**2) < 1e-3
+    if shutil.which("pdftotext"):
+        text = subprocess.run(
+            ["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True
+        ).stdout
+        assert "Live test" in text

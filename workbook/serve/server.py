@@ -3,7 +3,8 @@ form's requests, on 127.0.0.1 only, each request carrying the random token of th
 
 Every worksheet the server reads or writes is a ``.toml`` file directly inside the served
 folder (its path resolved, links followed, must stay there); the workbook it writes goes
-beside it (for an installed template: ``reports/NAME.xlsx`` in the current folder).
+beside it (for an installed template: ``reports/NAME.xlsx`` in the current folder), the PDF of
+the report in the folder ``reports`` of the served folder.
 """
 
 from __future__ import annotations
@@ -157,6 +158,27 @@ class Site:
         command = f"workbook run {live.path.name} {sets}".strip()
         write_workbook(compute(sheet, excel=True, command=command), target)
         return target
+
+    def write_pdf(self, live: LiveSheet) -> list[Path]:
+        """The report of the page's sheet (its inputs as the form has them) printed by
+        Chromium (``workbook report --pdf``): ``reports/NAME.pdf`` and its HTML, in a folder
+        ``reports`` of the served folder (for an installed template: of the current one)."""
+        from ..outputs.report import write_report
+
+        with live.lock:
+            computed, overrides = live.computed, dict(live.overrides)
+        if computed is None:
+            raise InputError(f"{live.path.name} has no good load to print")
+        folder = self.out or self.folder / "reports"
+        if self.out is None and (folder.is_symlink() or folder.resolve().parent != self.folder):
+            raise InputError(f"{folder} leads outside the served folder; nothing is written")
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot make {folder}: {exc.strerror or exc}") from None
+        sets = " ".join(f'--set {n}="{v}"' for n, v in overrides.items())
+        command = f"workbook report {live.path.name} --pdf {sets}".strip()
+        return write_report(computed, folder / f"{live.name}.html", pdf=True, command=command)
 
     def save_inputs(self, live: LiveSheet) -> str:
         from .writeback import save_inputs
@@ -319,6 +341,9 @@ class Handler(BaseHTTPRequestHandler):
                 self._json({"error": self.site.set_inputs(live, data)})
             elif path == "/write-xlsx":
                 self._json({"message": f"wrote {self.site.write_xlsx(live)}"})
+            elif path == "/write-pdf":
+                written = self.site.write_pdf(live)
+                self._json({"message": "wrote " + ", ".join(map(str, written))})
             elif path == "/save-inputs":
                 self._json({"message": self.site.save_inputs(live)})
             else:
