@@ -206,7 +206,22 @@ def test_every_template_page_shows_the_engines_numbers(browser, tmp_path):
                 ), (name, n)
                 checked += 1
             assert checked or not computed.scalars, name
-            browser.save_screenshot(str(tmp_path / f"{name}.png"))
+            shot = tmp_path / f"{name}.png"
+            assert browser.save_screenshot(str(shot)), name
+            _assert_not_blank(shot, name)
     finally:
         proc.send_signal(signal.SIGINT)
         assert proc.wait(timeout=60) == 0
+
+
+def _assert_not_blank(png: Path, name: str) -> None:
+    """The screenshot shows something: more than one colour, and dark pixels (text) on it."""
+    from PIL import Image
+
+    with Image.open(png) as im:
+        grey = im.convert("L")
+        assert grey.size == (1200, 900) or grey.size[0] > 600, (name, grey.size)
+        low, high = grey.getextrema()
+        assert high - low > 100, (name, low, high)  # not all one colour
+        dark = sum(grey.histogram()[:100])
+        assert dark > 500, (name, dark)  # text: dark pixels on the light page
