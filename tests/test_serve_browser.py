@@ -134,10 +134,13 @@ def test_live_page_follows_the_file_and_the_form(browser, tmp_path):
         assert v == pytest.approx(math.pi * 4 * 30, rel=1e-5)
         # the file edited in another program: the page shows the new number, no reload
         marker = browser.execute_script("window.wbMarker = 1; return window.wbMarker;")
+        browser.execute_script("window.wbA = document.getElementById('def-A');")
         path.write_text(SHEET.replace('expr = "A*L"', 'expr = "2*A*L"'), encoding="utf-8")
         v = _wait(browser, lambda: (x := _number(_shown(browser, "V"))) != v and x)
         assert v == pytest.approx(2 * math.pi * 4 * 30, rel=1e-5)
         assert browser.execute_script("return window.wbMarker;") == marker  # not reloaded
+        # only what changed is replaced: the element of A, which did not, is the same one
+        assert browser.execute_script("return document.getElementById('def-A') === window.wbA;")
         # an edit that breaks it: the error at its line, the last numbers stay
         path.write_text(SHEET.replace('expr = "A*L"', 'expr = "A + L"'), encoding="utf-8")
         banner = browser.find_element(By.ID, "wb-error")
