@@ -479,6 +479,7 @@ class LiveSheet:
         self.charts: dict[str, str] = {}  # chart digest -> its SVG
         self.drawn: dict[str, str] = {}  # chart name -> the SVG on the page
         self.pieces: dict = {}  # the last rendering's pieces (:class:`LiveDocument`)
+        self.seconds: dict[str, float] = {}
         self.pending = False  # a chart on the page is the last drawing, to be drawn again
         self.version = 0
         self.lock = threading.Lock()  # one computation at a time
@@ -554,6 +555,7 @@ class LiveSheet:
         self.drawn, self.pending, self.pieces = doc.shown, doc.pending, doc.made
         self.overrides = overrides
         self.error = None
+        self.seconds = seconds  # how long the last good update's stages took
         self.version += 1
         recomputed = dirty
         return Update(html, None, seconds, recomputed)
