@@ -7,9 +7,13 @@ compares the TOML entries of the new text with the old, names what changed (inpu
 definitions), follows the dependency graph (:func:`workbook.language.typecheck.dependencies`)
 to everything downstream, and hands the values of everything else to the new Sheet
 (:class:`ReusingSheet`): scalar definitions, ``[[solve]]`` solutions, range tables and block
-tables whose formulas read nothing that changed. An edit outside the sections it can follow
+tables whose formulas read nothing that changed, and the values its checks asked for. When
+only inputs and definitions changed, the typing of what the edit does not reach is taken over
+too (:func:`seeded_typer`, :func:`seeded_trees`). An edit outside the sections it can follow
 (``[sheet]``, ``[arguments]``, ``[blocks]``, ``[[solve]]``, ``[[ode]]``, ``[data]``, ...) is
-computed in full. Charts whose data did not change are not drawn again (:class:`LiveDocument`).
+computed in full. Charts whose data did not change are not drawn again, nor definitions the
+edit does not reach rendered again (:class:`LiveDocument`). The language server loads its
+texts through :func:`successor` as well.
 """
 
 from __future__ import annotations
