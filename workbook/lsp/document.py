@@ -17,11 +17,6 @@ from pathlib import Path
 
 from ..errors import LimitError, WorkbookError
 
-try:
-    import tomllib
-except ImportError:  # Python 3.10
-    import tomli as tomllib
-
 #: Seconds the values of a document's scalar definitions may take, all together, before the
 #: rest is left unchecked (their errors are diagnostics too: a domain error, a limit).
 VALUES_BUDGET = 2.0
@@ -79,7 +74,7 @@ def load(text: str, path: Path, previous: Document | None = None) -> Document:
     what the edit reaches is typed again: the definitions whose text, and whose inputs' and
     definitions' texts, did not change keep their typing and the values already computed
     (:func:`workbook.serve.incremental.successor`)."""
-    from ..language.template import MAX_TEMPLATE_BYTES, parse_spec
+    from ..language.template import MAX_TEMPLATE_BYTES, parse_spec, read_toml
     from ..serve.incremental import successor
 
     t0 = time.perf_counter()
@@ -87,11 +82,8 @@ def load(text: str, path: Path, previous: Document | None = None) -> Document:
     try:
         if len(text.encode("utf-8")) > MAX_TEMPLATE_BYTES:
             raise LimitError(f"template text is larger than {MAX_TEMPLATE_BYTES:,} bytes")
-        spec = parse_spec(text, path, path.stem)
-        try:
-            doc.raw = tomllib.loads(text)
-        except tomllib.TOMLDecodeError:  # parse_spec has said it; not reached
-            doc.raw = None
+        doc.raw = read_toml(text, str(path))  # read once: the spec is built from it
+        spec = parse_spec(text, path, path.stem, doc.raw)
         old = previous.sheet if previous is not None else None
         old_raw = previous.raw if previous is not None else {}
         values = {n: i.value for n, i in spec.inputs.items()}

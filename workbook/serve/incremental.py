@@ -34,18 +34,13 @@ from ..compute.declared_checks import placeholders
 from ..engine.sheet import Sheet
 from ..errors import WorkbookError
 from ..language import expr as ex
-from ..language.template import parse_spec
+from ..language.template import parse_spec, read_toml
 from ..language.typecheck import Typer, dependencies, solve_expressions
 from ..language.typedsheet import TypedSheet, printed_rows
 from ..outputs.report.charts import chart_svg
 from ..outputs.report.html import Document
 from ..program.statements import names as program_names
 from .watch import stamp
-
-try:
-    import tomllib
-except ImportError:  # Python 3.10
-    import tomli as tomllib
 
 #: Top-level sections whose entries are compared one by one; an edit anywhere else is
 #: computed in full.
@@ -521,14 +516,11 @@ class LiveSheet:
         seconds: dict[str, float] = {}
         t0 = time.perf_counter()
         try:
-            raw = tomllib.loads(text)
-        except tomllib.TOMLDecodeError:
-            raw = None
-        try:
-            if typer_from is not None:
-                spec, typer = typer_from.full_spec, typer_from.typer
+            if typer_from is not None:  # the same text: its TOML is the one read last
+                spec, typer, raw = typer_from.full_spec, typer_from.typer, self.raw
             else:
-                spec, typer = parse_spec(text, self.path, self.path.stem), None
+                raw = read_toml(text, str(self.path))  # read once: the spec is built from it
+                spec, typer = parse_spec(text, self.path, self.path.stem, raw), None
                 if raw is not None and self.raw:  # an input edited in the file: its value wins
                     old, new = _entries(self.raw, "inputs"), _entries(raw, "inputs")
                     overrides = {n: v for n, v in overrides.items() if old.get(n) == new.get(n)}
