@@ -30,7 +30,7 @@ document (the same edited formula) is sent and the time until its diagnostics ar
 is taken (the load's publication: the text typed; the values' publication follows from a
 child process, 0.2 s after the last change), 0.3 s apart as between keystrokes.
 
-    python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick] [--no-lsp]
+    python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick] [--no-lsp] [--no-serve]
 """
 
 from __future__ import annotations
@@ -342,6 +342,7 @@ def main(argv=None) -> int:
     ap.add_argument("--only", action="append", default=[])
     ap.add_argument("--quick", action="store_true", help="2 repetitions of concave-cam")
     ap.add_argument("--no-lsp", action="store_true", help="leave out the language server")
+    ap.add_argument("--no-serve", action="store_true", help="the language server only")
     args = ap.parse_args(argv)
     names = args.only or list(workbook.list_templates())
     if args.quick:
@@ -354,7 +355,7 @@ def main(argv=None) -> int:
     )
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     missed = 0
-    for name in names:
+    for name in [] if args.no_serve else names:
         solvers = _edits(workbook.list_templates()[name])[3]
         m = measure(name, args.solver_repeats if solvers else args.repeats)
         for edit in ("formula", "input"):

@@ -26,7 +26,6 @@ class WorkbookServer(LanguageServer):
         self.documents: dict[str, document.Document] = {}
         self.good: dict[str, document.Document] = {}
         self.versions: dict[str, int] = {}
-        self.locks: dict[str, asyncio.Lock] = {}
 
     def analyse(self, uri: str, text: str | None = None) -> document.Document:
         """Load the document's ``text`` (None: the workspace's), typed, not computed."""
@@ -59,8 +58,8 @@ server = WorkbookServer()
 #: Seconds a change waits for the next one: of rapid changes, only the last is checked.
 DEBOUNCE = 0.02
 #: Seconds without a change before the values are computed (their errors follow the load's
-#: diagnostics): the typing of the next change does not share the processor with them.
-QUIET = 0.2
+#: diagnostics): while a person types, keystrokes apart by less do not start them.
+QUIET = 0.5
 
 
 def _latest(ls: WorkbookServer, uri: str, version: int) -> bool:
@@ -70,18 +69,17 @@ def _latest(ls: WorkbookServer, uri: str, version: int) -> bool:
 async def _changed(ls: WorkbookServer, uri: str, version: int | None) -> None:
     version = version or 0
     ls.versions[uri] = version
+    current = ls.documents.get(uri)
+    if current is not None:
+        current.stale = True  # the values of the last text, if being computed, stop now
     await asyncio.sleep(DEBOUNCE)
     if not _latest(ls, uri, version):
         return  # a newer change came: its diagnostics are the ones wanted
-    loop = asyncio.get_running_loop()
-    text = ls.workspace.get_text_document(uri).source
-    async with ls.locks.setdefault(uri, asyncio.Lock()):  # one load of a document at a time
-        if not _latest(ls, uri, version):
-            return
-        doc = await loop.run_in_executor(None, ls.analyse, uri, text)
-    if not _latest(ls, uri, version):
-        return
+    # loaded here, between two messages (tens of ms): a thread of its own would wait for the
+    # interpreter all the same, and a busy machine's scheduler once more
+    doc = ls.analyse(uri)
     ls.publish(uri, doc.problems, version)
+    loop = asyncio.get_running_loop()
     if doc.sheet is None:
         return
     await asyncio.sleep(QUIET)

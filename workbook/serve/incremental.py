@@ -34,7 +34,7 @@ from ..compute.declared_checks import placeholders
 from ..engine.sheet import Sheet
 from ..errors import WorkbookError
 from ..language import expr as ex
-from ..language.template import parse_spec, read_toml
+from ..language.template import column_node, parse_spec, read_toml
 from ..language.typecheck import Typer, dependencies, solve_expressions
 from ..language.typedsheet import TypedSheet, printed_rows
 from ..outputs.report.charts import chart_svg
@@ -416,6 +416,12 @@ def seeded_trees(old, spec, dirty: set[str]) -> TypedSheet:
             t = old.typed.get(None, key)
             if t is not None:
                 trees.keep(None, key, t)
+    for (col, var), new_col in _column_pairs(old.full_spec, spec):  # tables' and charts'
+        if ex.names(column_node(spec, new_col, var)) & dirty:
+            continue
+        t = old.typed.get(col, ("column", var))
+        if t is not None:
+            trees.keep(new_col, ("column", var), t)
     for c, new_c in zip(old.full_spec.checks, spec.checks):  # [[checks]] as they were
         pieces = [(e, u) for text in (c.what, c.note) for e, u in placeholders(text)]
         nodes = [c.value, c.ok, *(c.parsed.get(e) for e, _ in pieces)]
@@ -426,6 +432,25 @@ def seeded_trees(old, spec, dirty: set[str]) -> TypedSheet:
             if t is not None:
                 trees.keep(new_c, key, t)
     return trees
+
+
+def _column_pairs(old_spec, spec):
+    """Each column of a range table and each series' x and y over a range in ``old_spec``
+    with its range variable, beside the same one of ``spec`` (whose tables and charts have
+    the same text)."""
+    for t_old, t_new in zip(old_spec.tables, spec.tables):
+        if t_old.range is not None:
+            for a, b in zip(t_old.columns, t_new.columns):
+                yield (a, t_old.range.var), b
+    for c_old, c_new in zip(old_spec.charts, spec.charts):
+        for s_old, s_new in zip(c_old.series, c_new.series):
+            rng = s_old.range or c_old.range
+            if s_old.table is not None or rng is None:
+                continue
+            yield (s_old.y, rng.var), s_new.y
+            x_old, x_new = s_old.x or c_old.x, s_new.x or c_new.x
+            if x_old is not None and x_new is not None:
+                yield (x_old, rng.var), x_new
 
 
 def _solve_reads(spec, block) -> set[str]:
