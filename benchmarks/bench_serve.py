@@ -28,7 +28,7 @@ The language server's diagnostics time is measured too: `workbook lsp` is starte
 process and spoken to over its stdin and stdout; for every template, a change of the
 document (the same edited formula) is sent and the time until its diagnostics are received
 is taken (the load's publication: the text typed; the values' publication follows from a
-child process, 0.2 s after the last change), 0.3 s apart as between keystrokes.
+child process, 0.5 s after the last change), 0.3 s apart as between keystrokes.
 
     python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick] [--no-lsp] [--no-serve]
 """
