@@ -7,7 +7,7 @@ moment the event with the new rendering is received:
 
 - a formula: the last definition with a formula (where a person writes) is multiplied by a
   factor new at each repetition (1.501, 1.502, ...), the file written as an editor writes
-  it; the time includes the watcher noticing the change (it polls every 40 ms and reports a
+  it; the time includes the watcher noticing the change (it polls every 10 ms and reports a
   change that held for one more poll);
 - an input: the first input that is a quantity is sent from the form (POST /input) at a
   value new at each repetition (1.011, 1.012, ... times its own).
@@ -15,16 +15,22 @@ moment the event with the new rendering is received:
 Each is measured with the incremental compute (the server's default) and with every edit
 computed in full (`Site(incremental=False)`, the baseline: parse, type, compute and render
 everything, no chart kept), alternately, each server on its own copy of the folder. The p50
-and p95 of
-the repetitions are printed, with the target of 300 ms for a sheet without solver built-ins
-(numerical built-ins, blocks, [[solve]], [[ode]]).
+and p95 of the repetitions are printed, with the target of 300 ms for a sheet without solver
+built-ins (numerical built-ins, blocks, [[solve]], [[ode]]); for a sheet with them, the p95
+of (edit-to-numbers time / the update's compute stage), target <= 1.2 (or the p95 within
+300 ms: an edit that reaches no solver leaves a compute stage of a few ms), where the stage is
+the solvers' time and that of whatever else the edit reached (the solvers' time alone is not
+separated), so the ratio says what the live page adds to the computation. The CPU time of
+the process and the load average (os.getloadavg) are printed beside the wall times: the
+machine may be shared.
 
 The language server's diagnostics time is measured too: `workbook lsp` is started as a
 process and spoken to over its stdin and stdout; for every template, a change of the
 document (the same edited formula) is sent and the time until its diagnostics are received
-is taken (the load's publication; the values' follows).
+is taken (the load's publication: the text typed; the values' publication follows from a
+child process, 0.5 s after the last change), 0.3 s apart as between keystrokes.
 
-    python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick] [--no-lsp]
+    python benchmarks/bench_serve.py [--repeats N] [--only NAME] [--quick] [--no-lsp] [--no-serve]
 """
 
 from __future__ import annotations
@@ -49,6 +55,9 @@ from workbook.serve.server import Site, make_server  # noqa: E402
 
 TARGET_MS = 300.0
 LSP_TARGET_MS = 150.0
+#: A sheet with solver built-ins: the edit-to-page time at most this many times the time of
+#: the update's compute stage (the solvers and whatever else the edit reached).
+SOLVER_FACTOR = 1.2
 
 
 class Page:
@@ -97,21 +106,30 @@ class Page:
                 if time.monotonic() > end:
                     raise TimeoutError("no event")
 
-    def edit_file(self, path: Path, text: str) -> tuple[float, float, float]:
-        """Seconds from the write to the page's new numbers and to its charts drawn, and the
-        CPU seconds of this process (server and listener) until the numbers arrived."""
+    def edit_file(self, path: Path, text: str) -> tuple[float, ...]:
+        """Seconds from the write to the page's new numbers and to its charts drawn, the
+        CPU seconds of this process (server and listener) until the numbers arrived, the
+        seconds of the update's compute stage (what the edit reached, solvers included), and
+        the load average then."""
         version = self.last[1]["version"]
         t0 = (time.perf_counter(), time.process_time())
         path.write_text(text, encoding="utf-8")
         return self._arrived(version, t0)
 
-    def _arrived(self, version: int, t0) -> tuple[float, float, float]:
+    def _arrived(self, version: int, t0) -> tuple[float, ...]:
         first = self.wait(version)
         assert first[1]["error"] is None, first[1]["error"]
+        compute = self.site.sheets[self.sheet].seconds.get("compute", 0.0)
         self.last = self.wait(version, drawn=True)
-        return first[0][0] - t0[0], self.last[0][0] - t0[0], first[0][1] - t0[1]
+        return (
+            first[0][0] - t0[0],
+            self.last[0][0] - t0[0],
+            first[0][1] - t0[1],
+            compute,
+            os.getloadavg()[0],
+        )
 
-    def edit_input(self, name: str, value: str) -> tuple[float, float, float]:
+    def edit_input(self, name: str, value: str) -> tuple[float, ...]:
         version = self.last[1]["version"]
         t0 = (time.perf_counter(), time.process_time())
         req = urllib.request.Request(
@@ -272,7 +290,7 @@ class LspClient:
             ),
             start,
         )
-        return when - t0, self.cpu() - c0
+        return when - t0, self.cpu() - c0, os.getloadavg()[0]
 
     def close(self) -> None:
         self.send({"jsonrpc": "2.0", "id": 2, "method": "shutdown", "params": None})
@@ -324,6 +342,7 @@ def main(argv=None) -> int:
     ap.add_argument("--only", action="append", default=[])
     ap.add_argument("--quick", action="store_true", help="2 repetitions of concave-cam")
     ap.add_argument("--no-lsp", action="store_true", help="leave out the language server")
+    ap.add_argument("--no-serve", action="store_true", help="the language server only")
     args = ap.parse_args(argv)
     names = args.only or list(workbook.list_templates())
     if args.quick:
@@ -331,46 +350,60 @@ def main(argv=None) -> int:
     print(f"load average {os.getloadavg()[0]:.1f} at the start; times in ms")
     print(
         "| template | edit | incremental: numbers p50 | numbers p95 | charts drawn p95 "
-        "| its CPU p50 | full recompute p50 | p95 | its CPU p50 | target (numbers p95) |"
+        "| its CPU p50 | compute stage p50 | full recompute p50 | p95 | its CPU p50 "
+        "| target (numbers p95) | load average |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     missed = 0
-    for name in names:
+    for name in [] if args.no_serve else names:
         solvers = _edits(workbook.list_templates()[name])[3]
         m = measure(name, args.solver_repeats if solvers else args.repeats)
         for edit in ("formula", "input"):
-            inc = [1000 * t[0] for t in m["times"][("incremental", edit)]]
-            drawn = [1000 * t[1] for t in m["times"][("incremental", edit)]]
+            runs = m["times"][("incremental", edit)]
+            inc = [1000 * t[0] for t in runs]
+            drawn = [1000 * t[1] for t in runs]
+            cpu = [1000 * t[2] for t in runs]
+            stage = [1000 * t[3] for t in runs]
             full = [1000 * t[1] for t in m["times"][("full", edit)]]
-            cpu = [1000 * t[2] for t in m["times"][("incremental", edit)]]
             full_cpu = [1000 * t[2] for t in m["times"][("full", edit)]]
-            target = "- (solver built-ins)" if solvers else f"<= {TARGET_MS:g}"
+            loads = [t[4] for t in runs + m["times"][("full", edit)]]
             p95 = _p(inc, 95)
-            if not solvers and p95 > TARGET_MS:
+            if solvers:  # against the compute stage's own time, repetition by repetition
+                ratio = _p([a / max(b, 1e-9) for a, b in zip(inc, stage)], 95)
+                ok = ratio <= SOLVER_FACTOR or p95 <= TARGET_MS
+                target = (
+                    f"{ratio:.2f}x its compute stage (<= {SOLVER_FACTOR:g}x, or p95 "
+                    f"<= {TARGET_MS:g})"
+                )
+            else:
+                ok = p95 <= TARGET_MS
+                target = f"<= {TARGET_MS:g}"
+            if not ok:
                 missed += 1
                 target += " MISSED"
             print(
                 f"| {name} | {edit} `{m[edit]}` | {_p(inc, 50):.0f} | {p95:.0f} | "
-                f"{_p(drawn, 95):.0f} | {_p(cpu, 50):.0f} | {_p(full, 50):.0f} | "
-                f"{_p(full, 95):.0f} | {_p(full_cpu, 50):.0f} | {target} "
-                f"| {len(inc)} repetitions",
+                f"{_p(drawn, 95):.0f} | {_p(cpu, 50):.0f} | {_p(stage, 50):.0f} | "
+                f"{_p(full, 50):.0f} | {_p(full, 95):.0f} | {_p(full_cpu, 50):.0f} | {target} "
+                f"| {min(loads):.1f} to {max(loads):.1f} | {len(inc)} repetitions",
                 flush=True,
             )
     if not args.no_lsp:
         print(
             "\n| template | `workbook lsp`: change to diagnostics p50 | p95 "
-            "| server CPU p50 (10 ms steps) | target |"
+            "| server CPU p50 | server CPU p95 (10 ms steps) | target | load average |"
         )
-        print("| --- | --- | --- | --- | --- |")
+        print("| --- | --- | --- | --- | --- | --- | --- |")
         for name, times in measure_lsp(names, max(args.repeats, 2)):
             ms = [1000 * t[0] for t in times]
             cpu = [1000 * t[1] for t in times]
+            loads = [t[2] for t in times]
             ok = _p(ms, 95) <= LSP_TARGET_MS
             missed += not ok
             print(
                 f"| {name} | {_p(ms, 50):.0f} | {_p(ms, 95):.0f} | {_p(cpu, 50):.0f} "
-                f"| <= {LSP_TARGET_MS:g}"
-                f"{'' if ok else ' MISSED'} | {len(ms)} repetitions",
+                f"| {_p(cpu, 95):.0f} | <= {LSP_TARGET_MS:g}{'' if ok else ' MISSED'} "
+                f"| {min(loads):.1f} to {max(loads):.1f} | {len(ms)} repetitions",
                 flush=True,
             )
     return 1 if missed and not args.quick else 0

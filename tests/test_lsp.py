@@ -365,3 +365,35 @@ def test_limit_exceeded_is_a_diagnostic_at_its_line(client):
     (d,) = client.diagnostics(uri, 1)
     assert d["code"] == "limit exceeded" and d["range"]["start"]["line"] == 4
     assert "nested 250 deep" in d["message"]
+
+
+def test_rapid_changes_are_answered_for_the_last_version(client):
+    path = client.folder / "rapid.toml"
+    path.write_text(SHEET, encoding="utf-8")
+    uri = client.open(path, version=1)
+    assert client.diagnostics(uri, 1) == []
+    bad = SHEET.replace('V = "A*L"', 'V = "A*Lx"')
+    client.change(uri, bad, 2)
+    client.change(uri, SHEET.replace('V = "A*L"', 'V = "A + L"'), 3)
+    (d,) = client.diagnostics(uri, 3)
+    assert d["code"] == "unit error"  # the text of version 3, not of 2
+    client.change(uri, SHEET, 4)
+    while (found := client.diagnostics(uri)) != []:  # nothing of version 2 after 3's
+        assert found[0]["code"] != "template error", found
+
+
+def test_a_change_types_again_only_what_it_reaches(tmp_path):
+    """The load of a changed text takes over the typing of what the change does not reach,
+    and finds the same errors as a load from nothing."""
+    from workbook.lsp.document import load
+
+    path = tmp_path / "inc.toml"
+    first = load(SHEET, path)
+    assert first.problems == [] and first.sheet is not None
+    edited = SHEET.replace('V = "A*L"', 'V = "3*A*L"')
+    second = load(edited, path, first)
+    assert second.sheet.typer.scalars["A"] is first.sheet.typer.scalars["A"]
+    assert second.sheet.typer.scalars["V"] is not first.sheet.typer.scalars["V"]
+    bad = SHEET.replace('V = "A*L"', 'V = "A + L"')
+    assert load(bad, path, second).problems == load(bad, path).problems
+    assert load(bad, path, second).problems[0].kind == "unit error"

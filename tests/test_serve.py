@@ -8,6 +8,7 @@ import json
 import math
 import re
 import shutil
+import subprocess
 import threading
 import time
 import urllib.error
@@ -66,7 +67,7 @@ class Served:
             headers={"Content-Type": "application/json"},
             method="POST",
         )
-        with urllib.request.urlopen(req, timeout=60) as r:
+        with urllib.request.urlopen(req, timeout=240) as r:
             return json.loads(r.read())
 
     def close(self) -> None:
@@ -260,8 +261,13 @@ def test_incremental_reuses_what_an_edit_does_not_reach(tmp_path):
     live = LiveSheet(path)
     assert live.refresh().error is None
     edited = SHEET.replace('expr = "A*L"', 'expr = "3*A*L"')
+    typed_before = dict(live.sheet.typer.scalars)
     update = live.rebuild(edited, {})
     assert update.error is None and update.recomputed == {"V"}
+    # the typing of what the edit does not reach is taken over, the edited one is new
+    assert live.sheet.typer.scalars["A"] is typed_before["A"]
+    assert live.sheet.typer.scalars["V"] is not typed_before["V"]
+    assert live.pieces[("definition", "A")] in update.html
     assert {("value", "A"), ("value", "r1")} <= set(live.sheet.reused)
     assert ("value", "V") not in live.sheet.reused
     update = live.set_inputs({"R": "4 mm"})
@@ -363,3 +369,47 @@ def test_the_benchmark_runs():
     assert all(0 < t[0] <= t[1] for ts in m["times"].values() for t in ts)
     ((name, times),) = bench_serve.measure_lsp(["concave-cam"], 1)
     assert name == "concave-cam" and len(times) == 1 and times[0][0] > 0
+
+
+@pytest.mark.parametrize("name", _templates())
+def test_downstream_is_what_reads_the_change(name):
+    """What an edit reaches, followed backwards from the change, is every input and
+    definition whose (transitive) dependencies include it."""
+    import workbook
+    from workbook.language import expr as ex
+    from workbook.language.typecheck import dependencies
+    from workbook.serve.incremental import downstream
+
+    spec = workbook.load(workbook.list_templates()[name]).full_spec
+    names = [*spec.inputs, *spec.definitions]
+    for changed in (names[:1], names[len(names) // 2 : len(names) // 2 + 1], names[-2:]):
+        want = set(changed) | {n for n in names if dependencies(spec, ex.Name(n)) & set(changed)}
+        assert downstream(spec, set(changed)) == want, changed
+
+
+def test_the_pdf_is_not_written_outside_the_served_folder(served, tmp_path):
+    outside = tmp_path.parent / (tmp_path.name + "-elsewhere")
+    outside.mkdir()
+    (tmp_path / "reports").symlink_to(outside, target_is_directory=True)
+    served.get("/sheet/live.toml").close()
+    reply = served.post("/write-pdf", {}, sheet="live.toml")
+    assert "leads outside the served folder" in reply["error"]
+    assert list(outside.iterdir()) == []
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not shutil.which("chromium"), reason="chromium needed")
+def test_the_pdf_button_prints_the_report_with_the_forms_inputs(served, tmp_path):
+    served.get("/sheet/live.toml").close()
+    served.post("/input", {"R": "2.5 mm"}, sheet="live.toml")
+    reply = served.post("/write-pdf", {}, sheet="live.toml")
+    pdf, html = tmp_path / "reports" / "live.pdf", tmp_path / "reports" / "live.html"
+    assert reply == {"message": f"wrote {html}, {pdf}"}
+    assert pdf.read_bytes().startswith(b"%PDF") and pdf.stat().st_size > 1000
+    assert "--set R=&quot;2.5 mm&quot;" in html.read_text(encoding="utf-8")  # its command
+    assert abs(_value(html.read_text(encoding="utf-8"), "A") - math.pi * 2.5**2) < 1e-3
+    if shutil.which("pdftotext"):
+        text = subprocess.run(
+            ["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True
+        ).stdout
+        assert "Live test" in text

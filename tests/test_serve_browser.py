@@ -134,10 +134,13 @@ def test_live_page_follows_the_file_and_the_form(browser, tmp_path):
         assert v == pytest.approx(math.pi * 4 * 30, rel=1e-5)
         # the file edited in another program: the page shows the new number, no reload
         marker = browser.execute_script("window.wbMarker = 1; return window.wbMarker;")
+        browser.execute_script("window.wbA = document.getElementById('def-A');")
         path.write_text(SHEET.replace('expr = "A*L"', 'expr = "2*A*L"'), encoding="utf-8")
         v = _wait(browser, lambda: (x := _number(_shown(browser, "V"))) != v and x)
         assert v == pytest.approx(2 * math.pi * 4 * 30, rel=1e-5)
         assert browser.execute_script("return window.wbMarker;") == marker  # not reloaded
+        # only what changed is replaced: the element of A, which did not, is the same one
+        assert browser.execute_script("return document.getElementById('def-A') === window.wbA;")
         # an edit that breaks it: the error at its line, the last numbers stay
         path.write_text(SHEET.replace('expr = "A*L"', 'expr = "A + L"'), encoding="utf-8")
         banner = browser.find_element(By.ID, "wb-error")
@@ -206,7 +209,22 @@ def test_every_template_page_shows_the_engines_numbers(browser, tmp_path):
                 ), (name, n)
                 checked += 1
             assert checked or not computed.scalars, name
-            browser.save_screenshot(str(tmp_path / f"{name}.png"))
+            shot = tmp_path / f"{name}.png"
+            assert browser.save_screenshot(str(shot)), name
+            _assert_not_blank(shot, name)
     finally:
         proc.send_signal(signal.SIGINT)
         assert proc.wait(timeout=60) == 0
+
+
+def _assert_not_blank(png: Path, name: str) -> None:
+    """The screenshot shows something: more than one colour, and dark pixels (text) on it."""
+    from PIL import Image
+
+    with Image.open(png) as im:
+        grey = im.convert("L")
+        assert grey.size == (1200, 900) or grey.size[0] > 600, (name, grey.size)
+        low, high = grey.getextrema()
+        assert high - low > 100, (name, low, high)  # not all one colour
+        dark = sum(grey.histogram()[:100])
+        assert dark > 500, (name, dark)  # text: dark pixels on the light page

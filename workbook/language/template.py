@@ -119,12 +119,25 @@ def load_spec(path: Path, name: str | None = None) -> SheetSpec:
     return parse_spec(text, path, name)
 
 
-def parse_spec(text: str, path: Path, name: str | None = None) -> SheetSpec:
+def parse_spec(
+    text: str, path: Path, name: str | None = None, data: dict | None = None
+) -> SheetSpec:
     """Read and validate a template's text; ``path`` names it in messages and is where
-    files it names ([data] CSV) are found."""
+    files it names ([data] CSV) are found. ``data``: what :func:`read_toml` gave for
+    ``text``, when the caller has read it already (it is not changed)."""
     file = str(path)
+    if data is None:
+        data = read_toml(text, file)
     try:
-        data = tomllib.loads(text)
+        return _build(path, name or path.stem, text, data)
+    except WorkbookError as err:
+        raise err.located(file=file) from None
+
+
+def read_toml(text: str, file: str) -> dict:
+    """The TOML of a template's text; a syntax error names its line."""
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         line = getattr(exc, "lineno", None)
         if line is None:
@@ -133,10 +146,6 @@ def parse_spec(text: str, path: Path, name: str | None = None) -> SheetSpec:
         raise TemplateError(f"TOML syntax: {exc}", file=file, line=line) from None
     except RecursionError:  # tomllib recurses into nested arrays and inline tables
         raise LimitError("TOML arrays or tables nested too deeply", file=file) from None
-    try:
-        return _build(path, name or path.stem, text, data)
-    except WorkbookError as err:
-        raise err.located(file=file) from None
 
 
 def spec_from_data(data: dict, path: Path, name: str) -> SheetSpec:

@@ -12,7 +12,12 @@ def main() -> int:
     import warnings
 
     warnings.simplefilter("ignore", RuntimeWarning)
+    from ..engine.sheet import Sheet  # noqa: F401 - imported before the freeze
+    from ..language import units
+    from ..serve.collector import freeze_loaded
     from .server import server
 
+    units.registry()
+    freeze_loaded()
     server.start_io()
     return 0

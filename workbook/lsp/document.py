@@ -5,7 +5,11 @@ column, else the formula's string)."""
 
 from __future__ import annotations
 
+import contextlib
+import multiprocessing
+import os
 import re
+import signal
 import threading
 import time
 from dataclasses import dataclass, field
@@ -54,6 +58,7 @@ class Document:
     sheet: object = None
     problems: list[Problem] = field(default_factory=list)
     values: dict[str, object] = field(default_factory=dict)  # name -> quantity or error
+    raw: dict | None = None  # the TOML the text reads as
     seconds: float = 0.0
     lock: threading.Lock = field(default_factory=threading.Lock)  # one evaluation at a time
     stale: bool = False  # a newer text has come: its values are no longer wanted
@@ -63,17 +68,26 @@ class Document:
         return self.text.splitlines()
 
 
-def load(text: str, path: Path) -> Document:
-    """Load ``text`` as the worksheet at ``path`` (the files it names are read beside it)."""
-    from ..engine.sheet import Sheet
-    from ..language.template import MAX_TEMPLATE_BYTES, parse_spec
+def load(text: str, path: Path, previous: Document | None = None) -> Document:
+    """Load ``text`` as the worksheet at ``path`` (the files it names are read beside it),
+    typed (not computed). With ``previous`` (the last good load of the same document), only
+    what the edit reaches is typed again: the definitions whose text, and whose inputs' and
+    definitions' texts, did not change keep their typing and the values already computed
+    (:func:`workbook.serve.incremental.successor`)."""
+    from ..language.template import MAX_TEMPLATE_BYTES, parse_spec, read_toml
+    from ..serve.incremental import successor
 
     t0 = time.perf_counter()
     doc = Document(text, path)
     try:
         if len(text.encode("utf-8")) > MAX_TEMPLATE_BYTES:
             raise LimitError(f"template text is larger than {MAX_TEMPLATE_BYTES:,} bytes")
-        doc.sheet = Sheet(parse_spec(text, path, path.stem))
+        doc.raw = read_toml(text, str(path))  # read once: the spec is built from it
+        spec = parse_spec(text, path, path.stem, doc.raw)
+        old = previous.sheet if previous is not None else None
+        old_raw = previous.raw if previous is not None else {}
+        values = {n: i.value for n, i in spec.inputs.items()}
+        doc.sheet = successor(old, old_raw or {}, spec, doc.raw, values)[0]
     except WorkbookError as err:
         doc.problems.append(problem(doc.lines, err))
     except RecursionError:
@@ -121,6 +135,41 @@ def compute_values(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem
             if p not in found:
                 found.append(p)
     return found
+
+
+def values_apart(doc: Document, budget: float = VALUES_BUDGET) -> list[Problem] | None:
+    """:func:`compute_values` in a child process (forked: it has the document as it is), so
+    that the typing of the next change does not share the interpreter with a long value (an
+    ODE, a block); None when a newer text came first (the child is stopped) or the child
+    failed. Where a process cannot be forked, computed here."""
+    if not hasattr(os, "fork"):
+        return compute_values(doc, budget)
+    receive, send = multiprocessing.Pipe(duplex=False)
+    pid = os.fork()
+    if pid == 0:  # the child: answers through the pipe, writes nothing else, never returns
+        status = 0
+        try:
+            receive.close()
+            doc.lock = threading.Lock()  # another thread of the parent may have held it
+            send.send(compute_values(doc, budget))
+        except BaseException:  # noqa: BLE001 - the parent is told by the closed pipe
+            status = 1
+        finally:
+            os._exit(status)  # no buffer of the parent's (its stdout) is flushed twice
+    send.close()
+    try:
+        while not doc.stale:
+            if receive.poll(0.02):
+                try:
+                    return receive.recv()
+                except (EOFError, OSError):
+                    return None
+        return None
+    finally:
+        receive.close()
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
 
 
 def problem(lines: list[str], err: WorkbookError) -> Problem:

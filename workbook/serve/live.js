@@ -16,9 +16,41 @@
     return path + "?token=" + encodeURIComponent(token) + "&sheet=" + encodeURIComponent(sheet);
   }
 
+  // Only the parts of the report that changed are replaced (a section, a definition, a
+  // table, a chart): the browser lays out again what is new, not the whole page.
+  function same(a, b) {
+    return a.nodeType === b.nodeType && (a.nodeType === 1 ? a.outerHTML === b.outerHTML
+      : a.textContent === b.textContent);
+  }
+
+  function shell(e) {
+    return e.cloneNode(false).outerHTML;
+  }
+
+  function morph(old, fresh, depth) {
+    const a = Array.from(old.childNodes);
+    const b = Array.from(fresh.childNodes);
+    if (a.length !== b.length) {
+      old.replaceChildren.apply(old, b);
+      return;
+    }
+    for (let i = 0; i < a.length; i += 1) {
+      if (same(a[i], b[i])) {
+        continue;
+      }
+      if (depth > 0 && a[i].nodeType === 1 && b[i].nodeType === 1 && shell(a[i]) === shell(b[i])) {
+        morph(a[i], b[i], depth - 1);
+      } else {
+        old.replaceChild(b[i], a[i]);
+      }
+    }
+  }
+
   function show(state) {
     if (state.html !== null) {
-      report.innerHTML = state.html;
+      const fresh = document.createElement("template");
+      fresh.innerHTML = state.html;
+      morph(report, fresh.content, 2);
     }
     report.querySelectorAll(".wb-stopped").forEach(function (e) {
       e.classList.remove("wb-stopped");

@@ -97,6 +97,7 @@ def sheet_page(live, token: str) -> str:
         f"<div id='wb-error'{'' if error else ' hidden'}>{escape(error)}</div>"
         f"<form id='wb-inputs'>{inputs_form(live.sheet)}</form>"
         "<button type='button' data-action='write-xlsx'>Write the workbook (xlsx)</button> "
+        "<button type='button' data-action='write-pdf'>Print the report (PDF)</button> "
         "<button type='button' data-action='save-inputs'>Write the inputs to the file</button>"
         "<span id='wb-status'></span></div>\n"
         f"<main class='workbook-report' id='wb-report'>{live.html}</main>"

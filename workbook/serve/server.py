@@ -3,7 +3,8 @@ form's requests, on 127.0.0.1 only, each request carrying the random token of th
 
 Every worksheet the server reads or writes is a ``.toml`` file directly inside the served
 folder (its path resolved, links followed, must stay there); the workbook it writes goes
-beside it (for an installed template: ``reports/NAME.xlsx`` in the current folder).
+beside it (for an installed template: ``reports/NAME.xlsx`` in the current folder), the PDF of
+the report in the folder ``reports`` of the served folder.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 from ..errors import InputError, WorkbookError
 from . import page
+from .collector import freeze_loaded, no_collection
 from .incremental import LiveSheet, stopped_by
 from .watch import Watcher
 
@@ -87,10 +89,12 @@ class Site:
         live = self.sheets.get(path.name)
         if live is None:
             return
-        with live.lock:
-            update = live.refresh()
+        with no_collection():  # the collector resumes once the page has the numbers
+            with live.lock:
+                update = live.refresh()
+            if update is not None:
+                self.push(live)
         if update is not None:
-            self.push(live)
             self.draw(live)
 
     def draw(self, live: LiveSheet) -> None:
@@ -102,10 +106,10 @@ class Site:
 
     def set_inputs(self, live: LiveSheet, changes: dict[str, str]) -> str | None:
         """Compute again with inputs from the form; the error (a refused value), if any."""
-        with live.lock:
+        with no_collection(), live.lock:
             update = live.set_inputs(changes)
-        if update.html is not None or (update.error is not None and live.error is update.error):
-            self.push(live)  # a value refused at its field leaves the page as it is
+            if update.html is not None or (update.error is not None and live.error is update.error):
+                self.push(live)  # a value refused at its field leaves the page as it is
         if update.html is not None:
             threading.Thread(target=self.draw, args=(live,), daemon=True).start()
         return page.error_text(update.error)
@@ -155,6 +159,27 @@ class Site:
         write_workbook(compute(sheet, excel=True, command=command), target)
         return target
 
+    def write_pdf(self, live: LiveSheet) -> list[Path]:
+        """The report of the page's sheet (its inputs as the form has them) printed by
+        Chromium (``workbook report --pdf``): ``reports/NAME.pdf`` and its HTML, in a folder
+        ``reports`` of the served folder (for an installed template: of the current one)."""
+        from ..outputs.report import write_report
+
+        with live.lock:
+            computed, overrides = live.computed, dict(live.overrides)
+        if computed is None:
+            raise InputError(f"{live.path.name} has no good load to print")
+        folder = self.out or self.folder / "reports"
+        if self.out is None and (folder.is_symlink() or folder.resolve().parent != self.folder):
+            raise InputError(f"{folder} leads outside the served folder; nothing is written")
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot make {folder}: {exc.strerror or exc}") from None
+        sets = " ".join(f'--set {n}="{v}"' for n, v in overrides.items())
+        command = f"workbook report {live.path.name} --pdf {sets}".strip()
+        return write_report(computed, folder / f"{live.name}.html", pdf=True, command=command)
+
     def save_inputs(self, live: LiveSheet) -> str:
         from .writeback import save_inputs
 
@@ -171,6 +196,7 @@ class Site:
         return f"wrote {', '.join(changes)} into {live.path.name}"
 
     def start(self) -> None:
+        freeze_loaded()
         self.watcher.start()
 
     def stop(self) -> None:
@@ -315,6 +341,9 @@ class Handler(BaseHTTPRequestHandler):
                 self._json({"error": self.site.set_inputs(live, data)})
             elif path == "/write-xlsx":
                 self._json({"message": f"wrote {self.site.write_xlsx(live)}"})
+            elif path == "/write-pdf":
+                written = self.site.write_pdf(live)
+                self._json({"message": "wrote " + ", ".join(map(str, written))})
             elif path == "/save-inputs":
                 self._json({"message": self.site.save_inputs(live)})
             else:
