@@ -23,6 +23,10 @@ pytestmark = [
 DATA = Path(__file__).parent / "data"
 RELATIVE = 1e-9
 MARKED = ("FFD9D9D9", "FFFCE4D6")  # frozen, reads a frozen value
+# sheets of helper cells (a root's steps): which columns are live, and so where their steps
+# go, can differ at the edited inputs (a root met in only some rows of a table is written as
+# numbers); the cells of the other sheets are where a person reads, and keep their place
+HELPERS = ("Solver rows", "Solver steps")
 
 
 def _numeric_inputs(sheet) -> list[str]:
@@ -62,13 +66,21 @@ def unmarked_differences(original: Path, recalculated: Path, engine: Path) -> li
     """Formula cells of ``original`` whose value recalculated by LibreOffice differs from the
     engine's at the edited inputs (``engine``: the engine's workbook at those inputs) and
     that are not marked frozen or reading a frozen value."""
-    formulas = formula_values(original)
+    formulas, theirs = formula_values(original), formula_values(engine)
     got, want = cell_values(recalculated), cell_values(engine)
     book = openpyxl.load_workbook(original)
+    moved = {
+        h
+        for h in HELPERS
+        if {k: f for k, (f, _) in formulas.items() if k[0] == h}
+        != {k: f for k, (f, _) in theirs.items() if k[0] == h}
+    }
     bad = []
     for (sheet, cell), (formula, _) in formulas.items():
         if sheet in ("About", "Checks"):  # Checks: printed values at the sheet's own inputs
             continue
+        if sheet in moved:
+            continue  # another layout of the helper cells: their readers are compared
         a, b = got.get((sheet, cell)), want.get((sheet, cell))
         numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (a, b))
         if numbers:
@@ -102,22 +114,10 @@ def test_each_input_edited_by_ten_percent(tmp_path, text, sheet_from):
         assert not bad, f"{name} +10 %: {len(bad)} cells differ, e.g. {bad[:5]}"
 
 
-SHEETS = [*workbook.list_templates(), *sorted(str(p) for p in DATA.glob("*.toml"))]
-# after the edit, cells of its 'Dynamics' sheet and their 'Solver rows' recalculate in
-# LibreOffice to other values than the engine's at the edited inputs; the cause is not found
-UNEXPLAINED = {"advance-coupling"}
+SHEETS = [*workbook.list_templates(), *sorted(str(p) for p in DATA.glob("**/*.toml"))]
 
 
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="see UNEXPLAINED"))
-        if Path(n).stem in UNEXPLAINED
-        else n
-        for n in SHEETS
-    ],
-    ids=[Path(n).stem for n in SHEETS],
-)
+@pytest.mark.parametrize("name", SHEETS, ids=[Path(n).stem for n in SHEETS])
 def test_every_sheet_with_its_inputs_edited(tmp_path, name):
     sheet = workbook.load(name)
     bad = _check(sheet, tmp_path, _numeric_inputs(sheet))

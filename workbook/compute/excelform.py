@@ -655,20 +655,29 @@ class ExcelLayout:
         inputs, formulas ``=FIRST+i*(SECOND-FIRST)`` and ``=LAST`` (the engine's values), so
         the table follows an edited input as long as the number of rows stays the same."""
         fmt, n = self.fmt["number"], len(values)
-        bounds = self._live_bounds(spec.range) if n > 1 else None
-        if bounds is None:
+        bounds = self._live_bounds(spec.range)
+        if bounds is None or isinstance(bounds, str):
             for i in range(n):
                 ws.write_number(first + i, 0, float(values[i]), fmt)
+            if bounds is not None:  # bounds that follow the inputs, written as numbers
+                ws.write_comment(first - 1, 0, f"Values, not formulas: {bounds}")
+                self.not_live.append(f"{spec.name}.{spec.range.var}")
+                self.freeze(ws, first, 0, n, 1, f"{spec.name}.{spec.range.var}")
             return
         lo, second, hi = bounds
-        if second is not None:
-            step = f"(({second})-({lo}))"
+        if spec.range.points is not None:  # log-spaced: FIRST*(LAST/FIRST)^(i/(n-1))
+            inner = [f"=({lo})*(({hi})/({lo}))^({i}/{n - 1})" for i in range(1, n - 1)]
         else:
-            step = "1" if values[-1] >= values[0] else "(-1)"
+            if second is not None:
+                step = f"(({second})-({lo}))"
+            else:
+                step = "1" if values[-1] >= values[0] else "(-1)"
+            inner = [f"=({lo})+{i}*{step}" for i in range(1, n - 1)]
         ws.write_formula(first, 0, f"=({lo})", fmt, float(values[0]))
-        for i in range(1, n - 1):
-            ws.write_formula(first + i, 0, f"=({lo})+{i}*{step}", fmt, float(values[i]))
-        ws.write_formula(first + n - 1, 0, f"=({hi})", fmt, float(values[-1]))
+        for i, text in enumerate(inner, start=1):
+            ws.write_formula(first + i, 0, text, fmt, float(values[i]))
+        if n > 1:
+            ws.write_formula(first + n - 1, 0, f"=({hi})", fmt, float(values[-1]))
         self.formula_cells += n
         ws.write_comment(
             first - 1,
@@ -678,11 +687,10 @@ class ExcelLayout:
             "regenerate (workbook run --inputs edited.xlsx).",
         )
 
-    def _live_bounds(self, rng) -> tuple[str, str | None, str] | None:
-        """Excel texts of a range's bounds in the variable's unit, or None when the bounds are
-        constants (written as numbers) or cannot be live formulas."""
-        if rng.points is not None:  # log-spaced: its values are numbers, not FIRST+i*STEP
-            return None
+    def _live_bounds(self, rng) -> tuple[str, str | None, str] | str | None:
+        """Excel texts of a range's bounds in the variable's unit; None when the bounds are
+        constants (written as numbers); the reason when they follow the inputs but cannot be
+        live formulas (the column is then written as numbers and marked frozen)."""
         nodes = (rng.first, rng.second, rng.last)
         # a bound that names no input or definition names none through them either
         names = set().union(*(ex.names(x) for x in nodes if x))
@@ -693,8 +701,8 @@ class ExcelLayout:
                 None if t is None else self.printer.formula(t, {})[1:]
                 for t in self.sheet.range_bounds(rng, f"range {rng.text}")
             ]
-        except NotLive:
-            return None
+        except NotLive as why:
+            return str(why)
         return texts[0], texts[1], texts[2]
 
     def _write_column(
