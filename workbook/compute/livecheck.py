@@ -433,6 +433,23 @@ def _resolver(inputs: _Inputs, refs: list[str], here: str, row_of, read: list[fl
     return resolve
 
 
+def _first_disagreement(log: CellLog, f: Formula, got: np.ndarray, scale: float):
+    """(computed, cached) of the first cell of ``f``'s block whose value ``got`` (a value or
+    an array) disagrees with the cached one; None when all agree."""
+    if got.ndim < 2:
+        got = got.reshape(1, -1) if got.ndim == 1 else got.reshape(1, 1)
+    for i in range(f.last_row - f.row + 1):
+        for j in range(f.last_col - f.col + 1):
+            cached = log.values.get((f.sheet, f.row + i, f.col + j))
+            try:
+                value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
+            except IndexError:
+                value = None
+            if cached is not None and not _agrees(value, cached, scale):
+                return value, cached
+    return None
+
+
 def check(log: CellLog, everything: bool = True) -> Outcome:
     """Compute the formulas of ``log`` independently (every one with ``everything``, else
     all but the :func:`plain` ones); the ones that disagree with the engine's (cached)
@@ -486,25 +503,13 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
             skipped(err, 1)
             continue
         checked += 1
-        rows, cols = f.last_row - f.row + 1, f.last_col - f.col + 1
-        if got.ndim < 2:
-            got = got.reshape(1, -1) if got.ndim == 1 else got.reshape(1, 1)
-        for i in range(rows):
-            for j in range(cols):
-                cached = log.values.get((f.sheet, f.row + i, f.col + j))
-                try:
-                    value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
-                except IndexError:
-                    value = None
-                if cached is not None and not _agrees(value, cached, max(read, default=0.0)):
-                    if _complex_error(f.text, value):
-                        skipped(ValueError(COMPLEX_ERROR), 1)
-                        break
-                    refusals.append(Refusal(f.sheet, f.row, f.col, f.text, value, cached, by=by[0]))
-                    break
-            else:
-                continue
-            break
+        wrong = _first_disagreement(log, f, got, max(read, default=0.0))
+        if wrong is None:
+            continue
+        if _complex_error(f.text, wrong[0]):
+            skipped(ValueError(COMPLEX_ERROR), 1)
+        else:
+            refusals.append(Refusal(f.sheet, f.row, f.col, f.text, *wrong, by=by[0]))
 
     for c in log.columns:
         template = str(SENTINEL).join(c.pieces)
