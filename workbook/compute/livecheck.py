@@ -147,7 +147,7 @@ class CellLog:
 
 
 class RecordingSheet:
-    """An Excel sheet being laid out (:class:`workbook.compute.excelform.FormSheet`) that records
+    """An Excel sheet being laid out (:class:`workbook.compute.excelsheets.FormSheet`) that records
     what is written into a :class:`CellLog`, and writes a refused formula as its cached value
     with a comment."""
 
