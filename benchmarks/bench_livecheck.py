@@ -16,6 +16,7 @@ line)."""
 from __future__ import annotations
 
 import argparse
+import gc
 import subprocess
 import sys
 import tempfile
@@ -103,6 +104,7 @@ def _pair(sheet, path: Path, reps: int) -> tuple[float, float]:
     from workbook.outputs.xlsx import write_workbook
 
     report_ = sheet.check()
+    gc.collect()  # each sheet from a collected heap: what the sheets before left is garbage
 
     def write(verify: bool) -> None:
         computed = compute(sheet, report=report_, excel=True, verify=verify)
