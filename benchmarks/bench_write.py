@@ -61,7 +61,7 @@ class Raw:
 
     def __init__(self, sheet):
         from workbook.compute.excel import ExcelPrinter, excel_name
-        from workbook.compute.excelform import ROW_TOKEN
+        from workbook.compute.excelsheets import ROW_TOKEN
         from workbook.language import units as un
         from workbook.language.units import header
 

@@ -18,7 +18,6 @@ import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
 import bench_import  # noqa: E402
 import bench_livecheck  # noqa: E402
-import bench_livecheck_all  # noqa: E402
 import bench_load  # noqa: E402
 import bench_ode  # noqa: E402
 import bench_write  # noqa: E402
@@ -31,8 +30,7 @@ FULL = {
     "load": lambda: bench_load.run(reps=5),
     "builtins": lambda: bench_builtins.run(n=10_000, reps=5),
     "ode": lambda: bench_ode.run(reps=7),
-    "livecheck": lambda: bench_livecheck.run(n=1_000, reps=5),
-    "livecheck-all": lambda: bench_livecheck_all.run(n=10_000, reps=5),
+    "livecheck": lambda: bench_livecheck.run(n=1_000, rows=10_000, reps=5),
     "import": lambda: bench_import.run(reps=3),
 }
 QUICK = {
@@ -42,8 +40,7 @@ QUICK = {
     "load": lambda: bench_load.run(reps=1),
     "builtins": lambda: bench_builtins.run(n=200, reps=1),
     "ode": lambda: bench_ode.run(reps=1),
-    "livecheck": lambda: bench_livecheck.run(n=20, reps=1),
-    "livecheck-all": lambda: bench_livecheck_all.run(n=20, reps=1, templates=["concave-cam"]),
+    "livecheck": lambda: bench_livecheck.run(n=20, rows=20, reps=1, templates=["concave-cam"]),
     "import": lambda: bench_import.run(reps=1, only={"wind-load"}),
 }
 

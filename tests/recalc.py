@@ -93,3 +93,18 @@ def cell_values(xlsx: Path) -> dict[tuple[str, str], object]:
         for c in row
         if c.value is not None
     }
+
+
+def agree(a, b, relative: float = 1e-9) -> bool:
+    """Two cell values the same to ``relative``: numbers, complex texts (``3+4i``: Excel keeps
+    15 digits of each part, so the last may differ) by their modulus, other texts exactly."""
+    from workbook.functions.complexes import parse_text
+
+    numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (a, b))
+    if numbers:
+        return abs(a - b) <= relative * max(abs(a), abs(b)) + 1e-300
+    if isinstance(a, str) and isinstance(b, str) and a != b and a[-1:] in "ij":
+        za, zb = parse_text(a), parse_text(b)
+        if za is not None and zb is not None:
+            return abs(za - zb) <= relative * max(abs(za), abs(zb)) + 1e-300
+    return str(a) == str(b)

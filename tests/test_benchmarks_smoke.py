@@ -25,7 +25,6 @@ import bench_coldstart  # noqa: E402
 import bench_evaluate  # noqa: E402
 import bench_import  # noqa: E402
 import bench_livecheck  # noqa: E402
-import bench_livecheck_all  # noqa: E402
 import bench_load  # noqa: E402
 import bench_write  # noqa: E402
 
@@ -45,12 +44,7 @@ def test_import_bench_tiny():
 
 @pytest.mark.slow
 def test_livecheck_bench_tiny():
-    _check(bench_livecheck.run(n=20, reps=1), 3)
-
-
-@pytest.mark.slow
-def test_livecheck_all_bench_tiny():
-    _check(bench_livecheck_all.run(n=20, reps=1, templates=["concave-cam"]), 2)
+    _check(bench_livecheck.run(n=20, rows=20, reps=1, templates=["concave-cam"]), 4)
 
 
 @pytest.mark.slow

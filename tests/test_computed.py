@@ -33,6 +33,8 @@ STAGES_BEFORE = (
     "workbook/compute/declared_checks.py",
     "workbook/compute/excel.py",
     "workbook/compute/excelform.py",
+    "workbook/compute/excelchecks.py",
+    "workbook/compute/solversteps.py",
     "workbook/compute/livecheck.py",
     "workbook/blocks/",
 )

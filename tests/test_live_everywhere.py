@@ -230,3 +230,55 @@ def test_frozen_values_and_the_live_cells_that_read_them_are_marked(tmp_path, sh
     from workbook.roundtrip import read_inputs
 
     assert set(read_inputs(sheet_from(FROZEN), out)) <= {"a", "n"}
+
+
+# two tables read g(x), a root, at their own rows: a single-row table over an input
+TWO_TABLES = """
+[inputs]
+k = "2"
+xa = "3"
+xb = "5"
+
+[arguments]
+x = { unit = "" }
+u = { unit = "" }
+
+[definitions]
+"g(x)" = "root(u^3 + k*u - x, u, 0, 10)"
+
+[[tables]]
+name = "many"
+range = "x := 1, 2 .. xb"
+columns = ["g"]
+
+[[tables]]
+name = "one"
+range = "x := xa .. xa"
+columns = ["g(x)", "2*g(x)"]
+sheet = "One"
+
+[[tables]]
+name = "log"
+range = "x := logspace(xa, xb*10, 5)"
+columns = ["x^2"]
+sheet = "Log"
+"""
+
+
+def test_each_table_reads_its_own_rows_steps_and_ranges_over_inputs_are_live(tmp_path, sheet_from):
+    """The printed text of a call is reused only with the same helper cells: the second
+    table's root reads its own bisection steps, not the first table's; a single-row range
+    and a log-spaced range whose bounds are inputs are formulas, so they follow an edit."""
+    sheet = sheet_from(TWO_TABLES)
+    form = sheet.computed(excel=True).excel
+    assert not form.refusals, [r.why for r in form.refusals]
+    out = sheet.write_xlsx(tmp_path / "two.xlsx")
+    book = openpyxl.load_workbook(out)
+    one, log = book["One"], book["Log"]
+    assert one["A3"].value == "=(xa)"
+    assert log["A3"].value == "=(xa)" and log["A7"].value == "=(xb*10)"
+    assert log["A5"].value.startswith("=(xa)*((xb*10)/(xa))^(")
+    first = book["Listing"]["B3"].value
+    assert "Solver rows" in first and "Solver rows" in one["B3"].value
+    steps = {c.value for c in book["Solver rows"][3] if isinstance(c.value, str)}
+    assert any("'One'!$A$3" in s for s in steps) and any("'Listing'!$A$3" in s for s in steps)

@@ -180,7 +180,7 @@ def test_plain_formulas_are_those_of_scalar_arithmetic(text, expected):
 def test_references_and_numbers_become_inputs_of_one_compiled_formula():
     generic, refs = livecheck.generic("=R1_*$A$3^2+'Solver steps'!$B$4+SUM({1,2})")
     assert generic == "=R1_*_REF_0_^_REF_1_+_REF_2_+SUM({1,2})"  # in the order they stand
-    assert refs == ["A3", "2", "'Solver steps'!B4"]
+    assert refs == ("A3", "2", "'Solver steps'!B4")
 
 
 def test_loads_reads_template_text_and_names_it_in_messages(sheet_from, tmp_path):

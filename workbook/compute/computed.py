@@ -6,7 +6,7 @@ definitions (each with its typed tree in the unit it is shown in), the [[solve]]
 the tables (range tables as :class:`TableData` of :class:`Column`, block and family tables
 as DataFrames), the data of every chart series (and the x column of each over a range), the
 check report (printed values, findings, estimate warnings) and, when asked, the workbook's
-Excel form (:class:`workbook.compute.excelform.ExcelForm`: every cell with its formula or value,
+Excel form (:class:`workbook.compute.excelsheets.ExcelForm`: every cell with its formula or value,
 helper cells, live-form notes, charts and defined names, checked by
 :mod:`workbook.compute.livecheck`). The renderers (:mod:`workbook.outputs.xlsx`,
 :mod:`workbook.outputs.report`,
@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from ..language.template import ChartSpec, ColumnSpec, SeriesSpec, SheetSpec
     from ..language.typed import T
     from .checks import Report
-    from .excelform import ExcelForm
+    from .excelsheets import ExcelForm
 
 
 @dataclass

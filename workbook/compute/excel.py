@@ -113,7 +113,8 @@ class ExcelPrinter(Visitor):
         self.ranges: dict[tuple[str, str], str] = {}
         self._context = PrintContext()
         self._array = False  # set while one formula is printed when it computes with arrays
-        self._calls: dict[tuple, tuple[str, int]] = {}  # (function, argument texts) -> printed
+        # (function, argument texts, helper cells) -> printed
+        self._calls: dict[tuple, tuple[str, int]] = {}
 
     @contextlib.contextmanager
     def context(self, **changes) -> Iterator[ExcelPrinter]:
@@ -275,7 +276,9 @@ class ExcelPrinter(Visitor):
                 "its values are written as numbers"
             )
         inner = {p: self._wrap(a, s, ATOM - 1) for p, a in zip(f.params, t.args)}
-        key = (t.name, tuple(inner.values()))
+        # the helper cells in the key: a body with a root prints references to the helper
+        # block of its context (a table's row-wise steps), which another table cannot reuse
+        key = (t.name, tuple(inner.values()), self.helpers)
         if key not in self._calls:
             text, level = self.visit(f.body, inner)
             if len(text) > MAX_FORMULA:

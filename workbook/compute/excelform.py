@@ -16,14 +16,12 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..engine import runtime as rt
 from ..errors import LimitError, WorkbookError
-from ..functions.constants import CONSTANTS, shadowed
 from ..functions.excel_names import ExcelNames
 from ..functions.matrix import numbers
 from ..language import expr as ex
@@ -34,128 +32,18 @@ from ..limits import MAX_TABLE_CELLS
 from ..outputs import style
 from ..outputs.xlsx import chart_label, write_labels
 from ..version import __version__
-from . import frozen
-from . import verdicts as V
-from .checks import tolerances
+from . import excelchecks, frozen
 from .excel import ExcelPrinter, NotLive, cell_value
-from .livecheck import RELATIVE, ROWS_CHECKED, CellLog, RecordingSheet
+from .excelsheets import MAX_COLS, ROW_TOKEN, ColumnCells, ExcelForm, cells_text, col_letter
+from .livecheck import CellLog, RecordingSheet
+from .solversteps import HelperCells, RowSteps
 
 MAX_ROWS = 1_048_576  # rows of an Excel sheet
-MAX_COLS = 16_384
-ROW_TOKEN = "\x00"
 PROGRESS_CELLS = 200_000  # a table with more cells than this reports its progress on stderr
 #: Cells of one vector or matrix written as a block (a 4,000,000-cell identity(2000) took
 #: 55 s and 700 MB to write); beyond it, or beyond Excel's grid, it is refused, never cut.
 MAX_ARRAY_CELLS = 500_000
 MAX_CELL_TEXT = 32_767  # characters of one Excel cell
-
-
-class FormSheet:
-    """One Excel sheet of the form: what is written into it goes to the form's list of
-    xlsxwriter calls (sheet index, method, arguments, index of the format among the arguments
-    or -1), in the order written; a format is its role in :data:`workbook.outputs.style.FORMATS`."""
-
-    def __init__(self, name: str, index: int, ops: list):
-        self.name, self.index, self._ops = name, index, ops
-
-    def _op(self, method: str, args: tuple, at: int = -1) -> int:
-        at = at if at >= 0 and args[at] is not None else -1
-        self._ops.append((self.index, method, args, at))
-        return 0
-
-    def write_string(self, row, col, text, fmt=None):
-        return self._op("write_string", (row, col, text, fmt), 3)
-
-    def write_number(self, row, col, number, fmt=None):
-        return self._op("write_number", (row, col, number, fmt), 3)
-
-    def write_boolean(self, row, col, value, fmt=None):
-        return self._op("write_boolean", (row, col, value, fmt), 3)
-
-    def write_formula(self, row, col, formula, fmt=None, value=0):
-        return self._op("write_formula", (row, col, str(formula), fmt, value), 3)
-
-    def write_array_formula(
-        self, first_row, first_col, last_row, last_col, formula, fmt=None, value=0
-    ):
-        args = (first_row, first_col, last_row, last_col, str(formula), fmt, value)
-        return self._op("write_array_formula", args, 5)
-
-    def write_formula_column(self, first, col, pieces, values, fmt=None, array=False, label=""):
-        """A formula down a column: ``pieces`` joined by each row's number (1-based), the
-        cached ``values`` a row."""
-        return self._op("formula_column", (first, col, pieces, values, fmt, array, label), 4)
-
-    def write_comment(self, row, col, text):
-        return self._op("write_comment", (row, col, text))
-
-    def set_column(self, first, last, width):
-        return self._op("set_column", (first, last, width))
-
-    def data_validation(self, first_row, first_col, last_row, last_col, options):
-        return self._op("data_validation", (first_row, first_col, last_row, last_col, options))
-
-    def freeze_panes(self, row, col):
-        return self._op("freeze_panes", (row, col))
-
-    def insert_chart(self, row, col, chart):
-        return self._op("insert_chart", (row, col, chart))
-
-
-class ChartForm:
-    """A chart of the form: its options and the calls that style it, in order."""
-
-    def __init__(self, options: dict):
-        self.options = options
-        self.calls: list[tuple[str, tuple, dict]] = []
-
-    def __getattr__(self, method: str):
-        if method.startswith("_"):
-            raise AttributeError(method)
-
-        def call(*args, **kwargs):
-            self.calls.append((method, args, kwargs))
-
-        return call
-
-
-@dataclass
-class ExcelForm:
-    """A workbook before it is written: its Excel sheets in order, defined names, document
-    properties; what the live-cell check found, and counts for the About sheet."""
-
-    properties: dict = field(default_factory=dict)
-    sheets: list[FormSheet] = field(default_factory=list)
-    ops: list[tuple[int, str, tuple, int]] = field(default_factory=list)  # see FormSheet
-    names: list[tuple[str, str]] = field(default_factory=list)
-    formula_cells: int = 0
-    not_live: list[str] = field(default_factory=list)
-    refusals: list = field(default_factory=list)  # livecheck.Refusal: written as values
-    verified: object = None  # livecheck.Outcome, when checked
-
-    # the calls of xlsxwriter's Workbook the layout makes
-    def set_properties(self, properties: dict) -> None:
-        self.properties = dict(properties)
-
-    def add_worksheet(self, name: str) -> FormSheet:
-        sheet = FormSheet(name, len(self.sheets), self.ops)
-        self.sheets.append(sheet)
-        return sheet
-
-    def define_name(self, name: str, ref: str) -> None:
-        self.names.append((name, ref))
-
-    def add_chart(self, options: dict) -> ChartForm:
-        return ChartForm(options)
-
-
-@dataclass
-class ColumnCells:
-    sheet: str
-    col: int
-    first_row: int  # 0-based
-    last_row: int
-    title: str
 
 
 def _write_value(ws, row: int, col: int, value: float | str, fmt) -> None:
@@ -166,28 +54,13 @@ def _write_value(ws, row: int, col: int, value: float | str, fmt) -> None:
         ws.write_number(row, col, value, fmt)
 
 
-def _col_letter(col: int) -> str:
-    letters = ""
-    col += 1
-    while col:
-        col, rem = divmod(col - 1, 26)
-        letters = chr(65 + rem) + letters
-    return letters
-
-
 def _ref(sheet: str, col: int, row: int, absolute: bool = True) -> str:
     d = "$" if absolute else ""
-    return f"'{sheet}'!{d}{_col_letter(col)}{d}{row + 1}"
+    return f"'{sheet}'!{d}{col_letter(col)}{d}{row + 1}"
 
 
 def _range_ref(c: ColumnCells) -> list:
     return [c.sheet, c.first_row, c.col, c.last_row, c.col]
-
-
-def _cells_text(c: ColumnCells) -> str:
-    """``'Design'!$E$3:$E$103``: the absolute range of a column, for a formula."""
-    col = _col_letter(c.col)
-    return f"'{c.sheet}'!${col}${c.first_row + 1}:${col}${c.last_row + 1}"
 
 
 class ExcelLayout:
@@ -420,7 +293,7 @@ class ExcelLayout:
             ws.write_string(row, 1, f"{un.typeset(t.unit) or '1'}   {d.text}   {d.note}".strip())
             top = row + 1
             self._write_block(ws, top, t, value, d.name)
-            last = f"{_col_letter(c)}${top + r}"
+            last = f"{col_letter(c)}${top + r}"
             self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
             row = top + r + 1
         self.rows["Matrices"] = row
@@ -480,7 +353,7 @@ class ExcelLayout:
         )
         self.freeze(ws, top, 1, r, c, d.name)
         self.not_live.append(d.name)
-        last = f"{_col_letter(c)}${top + r}"
+        last = f"{col_letter(c)}${top + r}"
         self._define(ws, row, d.name, f"=Matrices!$B${top + 1}:${last}")
         return top + r + 1
 
@@ -607,7 +480,7 @@ class ExcelLayout:
                 if (t.name, col.text) in self.planned:  # the same text in another unit:
                     continue  # max_over(t, col) reads the first
                 self.planned[(t.name, col.text)] = cells
-                self.printer.ranges[(t.name, col.text)] = _cells_text(cells)
+                self.printer.ranges[(t.name, col.text)] = cells_text(cells)
             rows[t.sheet] = first + n + 2
 
     def write_range_table(self, spec, data=None) -> None:
@@ -655,20 +528,29 @@ class ExcelLayout:
         inputs, formulas ``=FIRST+i*(SECOND-FIRST)`` and ``=LAST`` (the engine's values), so
         the table follows an edited input as long as the number of rows stays the same."""
         fmt, n = self.fmt["number"], len(values)
-        bounds = self._live_bounds(spec.range) if n > 1 else None
-        if bounds is None:
+        bounds = self._live_bounds(spec.range)
+        if bounds is None or isinstance(bounds, str):
             for i in range(n):
                 ws.write_number(first + i, 0, float(values[i]), fmt)
+            if bounds is not None:  # bounds that follow the inputs, written as numbers
+                ws.write_comment(first - 1, 0, f"Values, not formulas: {bounds}")
+                self.not_live.append(f"{spec.name}.{spec.range.var}")
+                self.freeze(ws, first, 0, n, 1, f"{spec.name}.{spec.range.var}")
             return
         lo, second, hi = bounds
-        if second is not None:
-            step = f"(({second})-({lo}))"
+        if spec.range.points is not None:  # log-spaced: FIRST*(LAST/FIRST)^(i/(n-1))
+            inner = [f"=({lo})*(({hi})/({lo}))^({i}/{n - 1})" for i in range(1, n - 1)]
         else:
-            step = "1" if values[-1] >= values[0] else "(-1)"
+            if second is not None:
+                step = f"(({second})-({lo}))"
+            else:
+                step = "1" if values[-1] >= values[0] else "(-1)"
+            inner = [f"=({lo})+{i}*{step}" for i in range(1, n - 1)]
         ws.write_formula(first, 0, f"=({lo})", fmt, float(values[0]))
-        for i in range(1, n - 1):
-            ws.write_formula(first + i, 0, f"=({lo})+{i}*{step}", fmt, float(values[i]))
-        ws.write_formula(first + n - 1, 0, f"=({hi})", fmt, float(values[-1]))
+        for i, text in enumerate(inner, start=1):
+            ws.write_formula(first + i, 0, text, fmt, float(values[i]))
+        if n > 1:
+            ws.write_formula(first + n - 1, 0, f"=({hi})", fmt, float(values[-1]))
         self.formula_cells += n
         ws.write_comment(
             first - 1,
@@ -678,11 +560,10 @@ class ExcelLayout:
             "regenerate (workbook run --inputs edited.xlsx).",
         )
 
-    def _live_bounds(self, rng) -> tuple[str, str | None, str] | None:
-        """Excel texts of a range's bounds in the variable's unit, or None when the bounds are
-        constants (written as numbers) or cannot be live formulas."""
-        if rng.points is not None:  # log-spaced: its values are numbers, not FIRST+i*STEP
-            return None
+    def _live_bounds(self, rng) -> tuple[str, str | None, str] | str | None:
+        """Excel texts of a range's bounds in the variable's unit; None when the bounds are
+        constants (written as numbers); the reason when they follow the inputs but cannot be
+        live formulas (the column is then written as numbers and marked frozen)."""
         nodes = (rng.first, rng.second, rng.last)
         # a bound that names no input or definition names none through them either
         names = set().union(*(ex.names(x) for x in nodes if x))
@@ -693,8 +574,8 @@ class ExcelLayout:
                 None if t is None else self.printer.formula(t, {})[1:]
                 for t in self.sheet.range_bounds(rng, f"range {rng.text}")
             ]
-        except NotLive:
-            return None
+        except NotLive as why:
+            return str(why)
         return texts[0], texts[1], texts[2]
 
     def _write_column(
@@ -927,229 +808,12 @@ class ExcelLayout:
         pad = 0.05 * (hi - lo or 1.0)
         return _nice(lo - pad, floor=True), _nice(hi + pad, floor=False)
 
-    # -- checks and about ------------------------------------------------------------------
+    # -- checks and about (excelchecks) ----------------------------------------------------
     def write_checks(self, report) -> None:
-        ws = self.ws("Checks")
-        heads = [
-            "Source",
-            "Name",
-            "At",
-            "Unit",
-            "Printed",
-            "Computed",
-            "Abs error",
-            "Rel error",
-            "Tolerance",
-            "Verdict",
-            "Note",
-        ]
-        write_labels(ws, 0, 0, heads, self.fmt["header"])
-        ws.set_column(0, 0, 34)
-        ws.set_column(4, 8, 12)
-        ws.set_column(9, 9, 10)
-        ws.set_column(10, 10, 80)
-        row = 1
-        for r in report.rows:
-            ws.write_string(row, 0, r.source)
-            ws.write_string(row, 1, r.name)
-            if r.at is not None:
-                ws.write_number(row, 2, r.at)
-            ws.write_string(row, 3, r.unit)
-            if isinstance(r.printed, str):  # a printed text and what the sheet gives
-                ws.write_string(row, 4, r.printed)
-                ws.write_string(row, 5, r.computed_text or "")
-            else:
-                ws.write_number(row, 4, r.printed, self.fmt["number"])
-            live = False
-            if r.computed is not None:
-                live = self._write_checked_value(ws, row, r)
-            E, F = f"E{row + 1}", f"F{row + 1}"
-            if r.computed is not None:
-                ws.write_formula(
-                    row, 6, f"=ABS({F}-{E})", self.fmt["sci"], abs(r.computed - r.printed)
-                )
-                if r.printed != 0:
-                    ws.write_formula(
-                        row,
-                        7,
-                        f"=ABS({F}-{E})/ABS({E})",
-                        self.fmt["pct"],
-                        abs(r.computed - r.printed) / abs(r.printed),
-                    )
-                self.formula_cells += 1 + (r.printed != 0)
-            bound, rel = tolerances(r.printed, r.tolerance, r.rel_tolerance)
-            shown = []
-            if bound is not None:
-                shown.append(f"{r.tolerance if r.tolerance is not None else bound:g}")
-            if rel is not None:
-                shown.append(f"{100 * rel:g}%")
-            tol_text = " or ".join(shown)
-            ws.write_string(row, 8, tol_text)
-            fmt = self.fmt["pass"] if r.verdict in V.NOT_FAILED else self.fmt["fail"]
-            if live and r.role == "check" and r.verdict in ("pass", "FAIL"):
-                # the engine's own test (checks.within): within the absolute OR the relative bound
-                tests = []
-                if bound is not None:
-                    tests.append(f"G{row + 1}<={bound!r}")
-                if rel is not None:
-                    tests.append(f"G{row + 1}<={rel!r}*ABS({E})")
-                test = tests[0] if len(tests) == 1 else f"OR({','.join(tests)})"
-                ws.write_formula(row, 9, f'=IF({test},"pass","FAIL")', fmt, r.verdict)
-                self.formula_cells += 1
-            else:
-                ws.write_string(row, 9, r.verdict, fmt)
-            ws.write_string(row, 10, r.note)
-            row += 1
-        if report.findings:
-            row += 1
-            ws.write_string(row, 0, "Findings", self.fmt["title"])
-            write_labels(
-                ws,
-                row + 1,
-                0,
-                ["Topic", "What", "", "Unit", "Value", "", "", "", "", "Verdict", "Note"],
-                self.fmt["header"],
-            )
-            row += 2
-            for f in report.findings:
-                ws.write_string(row, 0, f.topic)
-                ws.write_string(row, 1, f.what, self.fmt["wrap"])
-                ws.write_string(row, 3, f.unit)
-                if f.value is not None and math.isfinite(f.value):
-                    ws.write_number(row, 4, float(f.value), self.fmt["number"])
-                fmt = self.fmt["fail"] if f.verdict in V.FINDING_FLAGGED else self.fmt["pass"]
-                ws.write_string(row, 9, f.verdict, fmt)
-                ws.write_string(row, 10, f.note, self.fmt["wrap"])
-                row += 1
-        if self.live_forms:
-            row = self._write_live_forms(ws, row + 1)
-        if report.unused_inputs:
-            row += 1
-            ws.write_string(
-                row,
-                0,
-                "Inputs that no output uses: " + ", ".join(report.unused_inputs),
-                self.fmt["note"],
-            )
-        ws.freeze_panes(1, 0)
-
-    def _write_live_forms(self, ws, row: int) -> int:
-        """Each live approximate form (an integral's Gauss-Legendre sum, a root's bisection
-        chain, an extremum's golden-section steps) and its difference from the engine's value
-        at the written inputs; for a scalar the live value and the difference are formulas."""
-        ws.write_string(row, 0, "Live forms of numerical built-ins", self.fmt["title"])
-        heads = ["Where", "What", "Form", "", "Engine", "Live", "Difference", "Relative"]
-        write_labels(ws, row + 1, 0, heads + ["", "", "Note"], self.fmt["header"])
-        row += 2
-        for where, what, diff, engine in self.live_forms:
-            ws.write_string(row, 0, where)
-            ws.write_string(row, 1, what, self.fmt["wrap"])
-            ws.write_string(row, 2, ", ".join(f"{f}()" for f in diff.forms))
-            if engine is not None:
-                ws.write_number(row, 4, engine, self.fmt["number"])
-                ws.write_formula(row, 5, f"={where}", self.fmt["number"], diff.value)
-                ws.write_formula(
-                    row, 6, f"=ABS(F{row + 1}-E{row + 1})", self.fmt["sci"], diff.largest
-                )
-                note = "engine: its value at the inputs written here; live: the cell as it is now"
-            else:
-                ws.write_number(row, 6, diff.largest, self.fmt["sci"])
-                note = "largest over the column at the inputs written here"
-            ws.write_number(row, 7, diff.relative, self.fmt["sci"])
-            ws.write_string(row, 10, note, self.fmt["wrap"])
-            self.formula_cells += 2 if engine is not None else 0
-            row += 1
-        return row
-
-    def _write_checked_value(self, ws, row, r) -> bool:
-        """Computed value as a live formula: the function at the printed argument, in its unit."""
-        try:
-            t = self.sheet.typed_printed(r.name, r.at, r.argument, r.unit)
-            self._write_cell_plain(ws, row, 5, t, r.computed)
-            return True
-        except NotLive:
-            ws.write_number(row, 5, r.computed, self.fmt["number"])
-            return False
-        except WorkbookError:
-            ws.write_number(row, 5, r.computed, self.fmt["number"])
-            return False
-
-    def _write_cell_plain(self, ws, row, col, t, value):
-        formula = self.printer.formula(t, {})
-        ws.write_formula(row, col, formula, self.fmt["number"], value)
-        self.formula_cells += 1
-
-    def _checked_text(self) -> str:
-        """What the independent check of the live formulas did (livecheck.py)."""
-        v = self.verified
-        if v is None:
-            return "not checked"
-        text = (
-            f"{v.checked} formula computations, every formula cell ({ROWS_CHECKED} rows of "
-            "each table column), by an evaluator independent of the engine and of the "
-            "formula printer (its own reader of Excel formulas; the formulas package for the "
-            f"functions that reader lacks), agree with the engine to {RELATIVE:g} relative"
-        )
-        if v.plain:
-            text += f"; {v.plain} of scalar arithmetic only, or helper cells, are not computed"
-        if v.refusals:
-            text += f"; {len(v.refusals)} that did not are values, with a comment"
-        if v.unchecked:
-            text += "; not computed by it: " + "; ".join(
-                f"{n} cells ({why})" for why, n in sorted(v.unchecked.items())
-            )
-        return text
+        excelchecks.write_checks(self, report)
 
     def write_about(self) -> None:
-        ws = self.ws("About")
-        spec = self.sheet.spec
-        ws.set_column(0, 0, 22)
-        ws.set_column(1, 1, 110)
-        rows = [
-            ("Worksheet", spec.title),
-            ("Template", spec.name),
-            ("Source", spec.source),
-            ("Description", spec.description),
-            ("Engine", f"workbook {__version__}"),
-            ("Regenerate with", self.command),
-            ("Live formulas", f"{self.formula_cells} cells recalculate when an input changes"),
-            ("Values, not formulas", ", ".join(sorted(set(self.not_live))) or "none"),
-            ("Formulas checked", self._checked_text()),
-            (
-                "Units",
-                "Every column header names its unit; input cells are in the unit beside them.",
-            ),
-            ("Macros", "none"),
-        ]
-        if self.names.renamed:
-            rows.append(
-                (
-                    "Renamed for Excel",
-                    "; ".join(f"{k} is {v}" for k, v in self.names.renamed.items())
-                    + " (Excel's defined names ignore case and must not read as cells or "
-                    "functions)",
-                )
-            )
-        own = shadowed(spec)
-        if own:
-            rows.append(
-                (
-                    "Built-in constants",
-                    "; ".join(f"{n} is this worksheet's own, not {CONSTANTS[n].doc}" for n in own),
-                )
-            )
-        for name, part in self.sheet.full_spec.parts.items():
-            state = (
-                "included"
-                if name in self.sheet.parts
-                else f"left out (not computed); add it with --part {name}"
-            )
-            rows.append((f"Part {name}", f"{part.title}: {state}"))
-        rows += [(str(k), str(v)) for k, v in spec.meta.get("about", {}).items()]
-        ws.write_string(0, 0, spec.title, self.fmt["title"])
-        for i, (k, v) in enumerate(rows, start=2):
-            ws.write_string(i, 0, k, self.fmt["header"])
-            ws.write_string(i, 1, v, self.fmt["wrap"])
+        excelchecks.write_about(self)
 
 
 #: Formulas that give an error value, for a failed row written as a value.
@@ -1224,173 +888,6 @@ def _lay_out(computed, sheet, command: str | None, report, refused: dict) -> Exc
     w.write_results()
     w.write_checks(report)
     return w
-
-
-class HelperCells:
-    """Cells of the 'Solver steps' sheet that a live form needs (a root's bisection steps).
-
-    ``helpers(title, rows, headers)`` reserves a block under a title and returns a
-    :class:`HelperBlock`, whose cells are live formulas with cached values;
-    ``helpers.value(t, env)`` is the engine's value of a typed tree, for those values."""
-
-    SHEET = "Solver steps"
-
-    def __init__(self, writer, what: str, typed: ty.T | None = None):
-        self.writer, self.what, self.typed = writer, what, typed
-        self._chains: dict | None = None
-
-    def chain(self, expr: ty.T) -> dict:
-        """The engine's steps of the live form of ``expr`` in this definition (or NotLive)."""
-        if self.typed is None:
-            raise NotLive("no helper cells here")
-        if self._chains is None:
-            self._chains = _recorded_chains(self.writer, self.typed, {})
-        return _one_chain(self._chains, expr, ())
-
-    def value(self, t: ty.T, env: dict) -> float:
-        """The engine's value of a typed tree (for a helper cell's cached value)."""
-        return float(self.writer.sheet.evaluator.compile(t)(env))
-
-    def __call__(self, title: str, rows: int, headers: list[str]) -> HelperBlock:
-        ws = self.writer.ws(self.SHEET)
-        start = self.writer.rows[self.SHEET]
-        ws.write_string(start, 0, f"{self.what}: {title}", self.writer.fmt["title"])
-        write_labels(ws, start + 1, 1, headers, self.writer.fmt["header"])
-        self.writer.rows[self.SHEET] = start + rows + 3
-        return HelperBlock(ws, self.SHEET, start + 2)
-
-
-class RowSteps:
-    """Helper cells of the live roots and extrema of one table column: blocks of columns on
-    the sheet 'Solver rows' whose row i is the table's row i, so that one formula a column,
-    with the table's row number (``ROW_TOKEN``) filled in, serves every row.
-
-    ``chain(expr)`` is the engine's bisection chain of the root of EXPR in every row (the
-    cached values); ``block(title, headers)`` reserves a block (NotLive beyond
-    ``MAX_CELLS``); the blocks are written by :meth:`write` once the column's formula is
-    printed (a column that is not live leaves no helper cells)."""
-
-    per_row = True
-    SHEET = "Solver rows"
-    FIRST_COL = 1  # B
-    #: helper cells of all row-wise blocks of a workbook (543 table rows of one root, 361 of
-    #: one extremum)
-    MAX_CELLS = 100_000
-
-    def __init__(self, writer, table_sheet: str, first: int, n: int, var_ref, typed, env):
-        self.writer, self.first, self.n = writer, first, n
-        self.var_ref, self.typed, self.env = var_ref, typed, env
-        self.table_ref = f"'{table_sheet}'!{var_ref}"  # the variable seen from the steps sheet
-        self.blocks: list[RowBlock] = []
-        self._chains: dict | None = None
-
-    def chain(self, expr: ty.T) -> dict:
-        """The engine's steps of the live form of ``expr`` (a root's, an extremum's), every
-        row (or NotLive)."""
-        if self._chains is None:
-            self._chains = _recorded_chains(self.writer, self.typed, self.env)
-        return _one_chain(self._chains, expr, (self.n,))
-
-    def block(self, title: str, headers: list[str]) -> RowBlock:
-        col = self.writer.step_col + sum(len(b.headers) for b in self.blocks)
-        cells = self.n * len(headers) + self.writer.step_cells
-        cells += sum(self.n * len(b.headers) for b in self.blocks)
-        if cells > self.MAX_CELLS or col + len(headers) > MAX_COLS:
-            rows = self.MAX_CELLS // len(headers)
-            raise NotLive(
-                f"a root or extremum in a table column is live as {len(headers)} helper cells a "
-                f"row on the "
-                f"sheet '{self.SHEET}', up to {self.MAX_CELLS:,} cells in a workbook ({rows} "
-                f"rows of one root); this table has {self.n:,} rows: its values are written "
-                "as numbers"
-            )
-        block = RowBlock(self, col, title, headers)
-        self.blocks.append(block)
-        return block
-
-    def write(self) -> None:
-        """Write the reserved blocks (the column's formula is printed: it is live)."""
-        if not self.blocks:
-            return
-        w = self.writer
-        ws = w.ws(self.SHEET)
-        for b in self.blocks:
-            ws.write_string(self.first - 2, b.col, b.title, w.fmt["title"])
-            write_labels(ws, self.first - 1, b.col, b.headers, w.fmt["header"])
-            for j, (formula, values) in enumerate(b.cells):
-                pieces = formula.replace(self.var_ref, self.table_ref).split(ROW_TOKEN)
-                values = np.broadcast_to(np.asarray(values, dtype=float), (self.n,)).tolist()
-                w.log.column(ws.name, b.col + j, self.first, self.n, pieces)
-                for i in range(self.n):
-                    row = self.first + i
-                    ws.write_formula(row, b.col + j, str(row + 1).join(pieces), None, values[i])
-            w.step_col = b.col + len(b.headers)
-            w.step_cells += self.n * len(b.headers)
-            w.formula_cells += self.n * len(b.headers)
-
-
-def _recorded_chains(writer, typed: ty.T, env: dict) -> dict:
-    """The steps of every live root and extremum met evaluating ``typed`` in ``env`` with
-    the live forms (workbook.numerics), by id of their EXPR."""
-    from ..numerics import live_forms, recording_chains
-
-    with recording_chains() as found:
-        try:
-            fn = writer.sheet.evaluator.compile(typed)
-            fn(env)  # the engine's values of extrema, to compare with their live forms
-            with live_forms():
-                fn(env)
-        except WorkbookError as err:
-            why = f"the live form's steps leave the expression's domain ({err.message})"
-            raise NotLive(why) from None
-    return found
-
-
-def _one_chain(found: dict, expr: ty.T, shape: tuple) -> dict:
-    """The one chain of ``expr`` in ``found``, each array of ``shape`` or one value."""
-    got = found.get(id(expr), [])
-    arrays = []
-    if len(got) == 1:
-        for v in got[0][1].values():
-            arrays.extend(v if isinstance(v, list) else [v])
-    if len(got) != 1 or any(np.shape(v) not in ((), (1,), shape) for v in arrays):
-        raise NotLive(
-            "a root or extremum solved more than once for each value of this formula (called "
-            "twice, or inside another built-in): its values are written as numbers"
-        )
-    if not all(np.isfinite(v).all() for v in arrays):
-        raise NotLive("the live form's steps leave the expression's domain")
-    engine = found.get(("engine", id(expr)))
-    return {**got[0][1], "engine": engine[0] if engine and len(engine) == 1 else None}
-
-
-class RowBlock:
-    """Columns of 'Solver rows' for one root or extremum of a table column: ``ref(j)`` is column j's
-    cell in the current table row; ``write(j, formula, values)`` sets its formula (in the
-    row's terms) and the cached value of every row."""
-
-    def __init__(self, steps: RowSteps, col: int, title: str, headers: list[str]):
-        self.steps, self.col, self.title, self.headers = steps, col, title, headers
-        self.cells: list[tuple[str, object]] = [("", 0.0)] * len(headers)
-
-    def ref(self, j: int) -> str:
-        return f"'{self.steps.SHEET}'!${_col_letter(self.col + j)}${ROW_TOKEN}"
-
-    def write(self, j: int, formula: str, values) -> None:
-        self.cells[j] = (formula, values)
-
-
-class HelperBlock:
-    """A block of helper cells: ``ref(i, j)`` is the absolute reference of row i, column j."""
-
-    def __init__(self, ws, sheet: str, first: int):
-        self.ws, self.sheet, self.first = ws, sheet, first
-
-    def ref(self, i: int, j: int) -> str:
-        return f"'{self.sheet}'!${_col_letter(j + 1)}${self.first + i + 1}"
-
-    def write(self, i: int, j: int, formula: str, value: float) -> None:
-        self.ws.write_formula(self.first + i, j + 1, formula, None, value)
 
 
 def _nested_text(value) -> str:

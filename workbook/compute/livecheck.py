@@ -17,6 +17,7 @@ last included; when one row disagrees, the whole column is refused.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass, field
@@ -135,6 +136,7 @@ class CellLog:
     columns: list[Column] = field(default_factory=list)
     names: dict[str, str] = field(default_factory=dict)  # NAME (upper) -> "=Sheet!$B$3"
     in_columns: set[tuple[str, int, int]] = field(default_factory=set)
+    sheets: dict[str, str] = field(default_factory=dict)  # NAME (upper) -> Name
 
     def column(self, sheet: str, col: int, first: int, n: int, pieces: list[str]) -> Column:
         """Register a formula written down a column (its cells are checked as one)."""
@@ -145,13 +147,14 @@ class CellLog:
 
 
 class RecordingSheet:
-    """An Excel sheet being laid out (:class:`workbook.compute.excelform.FormSheet`) that records
+    """An Excel sheet being laid out (:class:`workbook.compute.excelsheets.FormSheet`) that records
     what is written into a :class:`CellLog`, and writes a refused formula as its cached value
     with a comment."""
 
     def __init__(self, ws, log: CellLog, refused: dict[tuple[str, int, int], str]):
         self._ws, self._log, self._refused = ws, log, refused
         self.name = ws.name
+        log.sheets.setdefault(ws.name.upper(), ws.name)
 
     def __getattr__(self, name):
         return getattr(self._ws, name)
@@ -237,9 +240,7 @@ class _Inputs:
 
     def __init__(self, log: CellLog, raw: bool = False):
         self.log, self.raw = log, raw
-        self.sheets = {}
-        for sheet, _, _ in log.values:
-            self.sheets.setdefault(sheet.upper(), sheet)
+        self.sheets = log.sheets
 
     def value(self, key: str, here: str, depth: int = 0):
         m = _REF.match(key)
@@ -285,7 +286,8 @@ _NUMBER = re.compile(r"(?<![\w.$])\d+(?:\.\d*)?(?:E[+-]?\d+)?(?![\w.(])")
 _CONSTANTS = re.compile(r'(\{[^{}]*\}|"(?:[^"]|"")*")')  # array constants and texts
 
 
-def generic(text: str) -> tuple[str, list[str]]:
+@functools.lru_cache(maxsize=2048)
+def generic(text: str) -> tuple[str, tuple[str, ...]]:
     """The formula with its cell references and numbers (outside array constants and texts)
     replaced by names _REF_0_, _REF_1_, ...; and what they stand for: formulas that differ
     only in the cells they read or in a constant (a sample's position) share one
@@ -298,7 +300,7 @@ def generic(text: str) -> tuple[str, list[str]]:
         refs.append((m[2] or "") + m[3].replace("$", "") if m[3] is not None else m[0])
         return f"_REF_{len(refs) - 1}_"
 
-    return _GENERIC.sub(one, text), refs
+    return _GENERIC.sub(one, text), tuple(refs)
 
 
 #: one pass over a formula: a constant (group 1), a reference (groups 2 and 3) or a number
@@ -307,10 +309,17 @@ _GENERIC = re.compile(
 )
 
 
-def _compile(text: str):
-    import formulas
+@functools.lru_cache(maxsize=4096)
+def compiled(text: str):
+    """A generic formula (:func:`generic`) compiled, by the check's own reader of Excel
+    formulas or else the formulas package; kept for the process: the formulas of a sheet
+    written again (``workbook serve`` at each edit) are not read again."""
+    try:
+        return xleval.compile_formula(text)
+    except xleval.Unsupported:  # the formulas package computes the rest
+        import formulas
 
-    return formulas.Parser().ast(text)[1].compile()
+        return formulas.Parser().ast(text)[1].compile()
 
 
 def plain(text: str, sheet: str, arrays: frozenset[str] = frozenset()) -> bool:
@@ -424,6 +433,23 @@ def _resolver(inputs: _Inputs, refs: list[str], here: str, row_of, read: list[fl
     return resolve
 
 
+def _first_disagreement(log: CellLog, f: Formula, got: np.ndarray, scale: float):
+    """(computed, cached) of the first cell of ``f``'s block whose value ``got`` (a value or
+    an array) disagrees with the cached one; None when all agree."""
+    if got.ndim < 2:
+        got = got.reshape(1, -1) if got.ndim == 1 else got.reshape(1, 1)
+    for i in range(f.last_row - f.row + 1):
+        for j in range(f.last_col - f.col + 1):
+            cached = log.values.get((f.sheet, f.row + i, f.col + j))
+            try:
+                value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
+            except IndexError:
+                value = None
+            if cached is not None and not _agrees(value, cached, scale):
+                return value, cached
+    return None
+
+
 def check(log: CellLog, everything: bool = True) -> Outcome:
     """Compute the formulas of ``log`` independently (every one with ``everything``, else
     all but the :func:`plain` ones); the ones that disagree with the engine's (cached)
@@ -432,7 +458,6 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
     refusals: list[Refusal] = []
     unchecked: dict[str, int] = {}
     checked = 0
-    compiled: dict[str, object] = {}
     # the magnitudes of the values the formula being computed reads: a result near zero (a
     # difference of near terms) is compared at their scale, its rounding is not an error
     read: list[float] = []
@@ -441,12 +466,7 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
 
     def run(text: str, here: str, row_of=None):
         text_g, refs = generic(text)
-        fn = compiled.get(text_g)
-        if fn is None:
-            try:
-                fn = compiled[text_g] = xleval.compile_formula(text_g)
-            except xleval.Unsupported:  # the formulas package computes the rest
-                fn = compiled[text_g] = _compile(text_g)
+        fn = compiled(text_g)
         if not hasattr(fn, "inputs"):
             by[0] = XLEVAL
             return fn(_resolver(raw, refs, here, row_of, read, memo))
@@ -483,25 +503,13 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
             skipped(err, 1)
             continue
         checked += 1
-        rows, cols = f.last_row - f.row + 1, f.last_col - f.col + 1
-        if got.ndim < 2:
-            got = got.reshape(1, -1) if got.ndim == 1 else got.reshape(1, 1)
-        for i in range(rows):
-            for j in range(cols):
-                cached = log.values.get((f.sheet, f.row + i, f.col + j))
-                try:
-                    value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
-                except IndexError:
-                    value = None
-                if cached is not None and not _agrees(value, cached, max(read, default=0.0)):
-                    if _complex_error(f.text, value):
-                        skipped(ValueError(COMPLEX_ERROR), 1)
-                        break
-                    refusals.append(Refusal(f.sheet, f.row, f.col, f.text, value, cached, by=by[0]))
-                    break
-            else:
-                continue
-            break
+        wrong = _first_disagreement(log, f, got, max(read, default=0.0))
+        if wrong is None:
+            continue
+        if _complex_error(f.text, wrong[0]):
+            skipped(ValueError(COMPLEX_ERROR), 1)
+        else:
+            refusals.append(Refusal(f.sheet, f.row, f.col, f.text, *wrong, by=by[0]))
 
     for c in log.columns:
         template = str(SENTINEL).join(c.pieces)

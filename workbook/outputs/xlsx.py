@@ -1,7 +1,7 @@
 """Write a computed sheet's Excel form as an xlsx file: live formulas with cached values,
 native charts.
 
-The form (:class:`workbook.compute.excelform.ExcelForm`, made by
+The form (:class:`workbook.compute.excelsheets.ExcelForm`, made by
 :func:`workbook.compute.computed.compute`) holds every cell, chart and defined name; this module
 only writes them with xlsxwriter. It neither types nor evaluates: what a cell holds was decided, and
 checked, before."""
