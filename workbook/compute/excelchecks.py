@@ -8,11 +8,11 @@ import math
 
 from ..errors import WorkbookError
 from ..functions.constants import CONSTANTS, shadowed
-from ..outputs.xlsx import write_labels
 from ..version import __version__
 from . import verdicts as V
 from .checks import tolerances
 from .excel import NotLive
+from .excelsheets import write_labels
 from .livecheck import RELATIVE, ROWS_CHECKED
 
 

@@ -30,11 +30,19 @@ from ..language import units as un
 from ..language.uses import names_used
 from ..limits import MAX_TABLE_CELLS
 from ..outputs import style
-from ..outputs.xlsx import chart_label, write_labels
 from ..version import __version__
 from . import excelchecks, frozen
 from .excel import ExcelPrinter, NotLive, cell_value
-from .excelsheets import MAX_COLS, ROW_TOKEN, ColumnCells, ExcelForm, cells_text, col_letter
+from .excelsheets import (
+    MAX_COLS,
+    ROW_TOKEN,
+    ColumnCells,
+    ExcelForm,
+    cells_text,
+    chart_label,
+    col_letter,
+    write_labels,
+)
 from .livecheck import CellLog, RecordingSheet
 from .solversteps import HelperCells, RowSteps
 

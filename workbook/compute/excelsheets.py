@@ -134,3 +134,29 @@ def cells_text(c: ColumnCells) -> str:
     """``'Design'!$E$3:$E$103``: the absolute range of a column, for a formula."""
     col = col_letter(c.col)
     return f"'{c.sheet}'!${col}${c.first_row + 1}:${col}${c.last_row + 1}"
+
+
+def write_labels(ws, row: int, col: int, texts, fmt=None) -> None:
+    """Write texts as text cells: a title like "=1+1" or "http://..." stays text, never a
+    formula or a link (xlsxwriter's ``write``/``write_row`` would convert them)."""
+    for j, text in enumerate(texts):
+        ws.write_string(row, col + j, str(text), fmt)
+
+
+CHART_LABEL_COLUMN = 15  # column P of a charts sheet holds the labels that need a cell
+
+
+def chart_label(ws, sheet_name: str, text: str, row: int, header_fmt=None):
+    """A chart title, axis title or series name as xlsxwriter takes it, and the next free row
+    of the label column. xlsxwriter reads a text that starts with '=' or looks like a
+    reference (``Sheet!A1``, a path to another workbook before ``!A1``, ``cmd|' /C calc'!A0``)
+    as a formula: a link to another workbook, a DDE call or another cell. Such a text is
+    written into a text cell of ``ws`` (column P, below a header) and the chart refers to that
+    cell, so it shows exactly as written; any other text is given as it is."""
+    if not (text.startswith("=") or "!" in text):
+        return text, row
+    if row == 0:
+        ws.write_string(0, CHART_LABEL_COLUMN, "Chart labels", header_fmt)
+        row = 1
+    ws.write_string(row, CHART_LABEL_COLUMN, text)
+    return [sheet_name, row, CHART_LABEL_COLUMN], row + 1

@@ -9,9 +9,8 @@ import numpy as np
 
 from ..errors import WorkbookError
 from ..language import typed as ty
-from ..outputs.xlsx import write_labels
 from .excel import NotLive
-from .excelsheets import MAX_COLS, ROW_TOKEN, col_letter
+from .excelsheets import MAX_COLS, ROW_TOKEN, col_letter, write_labels
 
 
 class HelperCells:

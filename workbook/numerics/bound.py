@@ -29,9 +29,14 @@ class Bound:
         self.body, self.fn, self.env = body, fn, env
         self.var, self.var_param = var.name, var
         self.unit_text = un.pretty(var.unit)
-        used = ty.parameters(body) - {self.var} | set(evaluator.env_keys)
+        used = self.names_read = ty.parameters(body) - {self.var} | set(evaluator.env_keys)
         self.arrays = {k: np.asarray(env[k]) for k in used if k in env and np.ndim(env[k]) > 0}
         self.shape = np.broadcast_shapes(*(a.shape for a in self.arrays.values()))
+
+    #: the names EXPR reads from the call's environment besides the variable: its parameters
+    #: and, in a vectorised sweep, the swept inputs' cases (under their own keys); what an
+    #: mpmath form of EXPR is evaluated with
+    names_read: set[str]
 
     def __call__(self, value):
         return self.fn({**self.env, self.var: value})

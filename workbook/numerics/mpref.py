@@ -233,7 +233,6 @@ def _flat(of, shape) -> dict[str, np.ndarray]:
 
 def _prepared(of, name: str, digits: int, *bounds):
     """(ctx, form, shape, flat bounds, row environments) or None without an mpmath form."""
-    from ..language import typed as ty
     from .reference import ROWS as SCIPY_ROWS
 
     ctx = context(digits)
@@ -246,7 +245,7 @@ def _prepared(of, name: str, digits: int, *bounds):
         return None
     flat = [np.broadcast_to(np.asarray(b, dtype=float), shape).reshape(-1) for b in bounds]
     arrays = _flat(of, shape)
-    used = ty.parameters(of.body) - {of.var}
+    used = of.names_read
     fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
     rows = _rows(n)
 
@@ -390,7 +389,6 @@ def polish_roots(of, result, shape, tol) -> int:
     tolerance. Rows without an mpmath form,
     or where no sign change is found, keep their value and estimate. Returns the number of
     rows changed; ``result.notes["certified"]`` marks the rows checked or polished."""
-    from ..language import typed as ty
 
     value = np.ravel(result.value).copy()
     error = np.ravel(result.error).copy()
@@ -408,7 +406,7 @@ def polish_roots(of, result, shape, tol) -> int:
     except NoMpForm:
         return 0
     arrays = _flat(of, shape)
-    used = ty.parameters(of.body) - {of.var}
+    used = of.names_read
     fixed = {k: float(np.asarray(v)) for k, v in of.env.items() if k in used and k not in arrays}
     done = 0
     f = of.over(shape)

@@ -67,7 +67,6 @@ def discrepancy(
     by default ROWS, or more where BUDGET mpmath evaluations allow; ``only``: the rows
     checked, the others NaN). Rows not checked take the largest difference of the nearest
     checked rows (interpolated along the call)."""
-    from ..language import typed as ty
     from .mpform import NoValue
 
     prepared = prepared or form_of(of)
@@ -78,7 +77,7 @@ def discrepancy(
     xs = np.broadcast_to(xs, (n, xs.shape[-1]))
     fs = np.broadcast_to(fs, xs.shape)
     arrays = {k: np.broadcast_to(a, shape).reshape(-1) for k, a in of.arrays.items()}
-    used = ty.parameters(of.body) - {of.var}
+    used = of.names_read
     fixed = {}
     for k, v in of.env.items():
         if k in used and k not in arrays:
@@ -163,10 +162,9 @@ EXTREMUM_OFFSETS = (0.0, -1e-6, 1e-6, -1e-3, 1e-3)
 def _row_env(of, shape):
     """``env(row)``: the environment of EXPR's mpmath form at a flat row (None: an input
     that is not a number)."""
-    from ..language import typed as ty
 
     arrays = {k: np.broadcast_to(a, shape).reshape(-1) for k, a in of.arrays.items()}
-    used = ty.parameters(of.body) - {of.var}
+    used = of.names_read
     fixed = {}
     for k, v in of.env.items():
         if k in used and k not in arrays:

@@ -180,13 +180,12 @@ def _form_agrees(of, prepared, form, shape, xs, order: int) -> bool:
     """The derivative's mpmath form agrees with a central difference of EXPR's mpmath form
     (at 80 digits, steps of 1e-12 and 1e-10 relative) at the first row: the form computes
     the derivative the doubles are compared with."""
-    from ..language import typed as ty
 
     ctx, body = prepared
-    used = ty.parameters(of.body) - {of.var}
+    used = of.names_read
     env = {}
     for k, v in of.env.items():
-        if k in used or k.startswith("\x00"):  # a sweep's cases are read under their own keys
+        if k in used:
             env[k] = float(np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1)[0])
     # at twice the digits: EXPR's own cancellation (1 - cos x at 1e-8 loses 16 digits) and
     # the difference's (10 more) are what the check must see through

@@ -33,7 +33,7 @@ def write(result: SweepResult, path: Path, *, force: bool = False, command: str 
 def _write_xlsx(result: SweepResult, path: Path, command: str) -> None:
     import xlsxwriter
 
-    from ..outputs.xlsx import chart_label, write_labels
+    from ..compute.excelsheets import chart_label, write_labels
     from ..version import __version__
 
     df = result.table
