@@ -76,22 +76,16 @@ def discrepancy(
     n = math.prod(shape)
     xs = np.broadcast_to(xs, (n, xs.shape[-1]))
     fs = np.broadcast_to(fs, xs.shape)
-    arrays = {k: np.broadcast_to(a, shape).reshape(-1) for k, a in of.arrays.items()}
-    used = of.names_read
-    fixed = {}
-    for k, v in of.env.items():
-        if k in used and k not in arrays:
-            try:
-                fixed[k] = float(np.asarray(v))
-            except (TypeError, ValueError):
-                return None
+    row_env = _row_env(of, shape)
+    if row_env is None:
+        return None
     most = most or max(ROWS, BUDGET // max(xs.shape[-1], 1))
     rows = np.arange(n) if n <= most else np.unique(np.linspace(0, n - 1, most).astype(np.intp))
     if only is not None:
         rows = np.asarray(only, dtype=np.intp)
     out = np.full(xs.shape, np.nan)
     for i in rows:
-        env = {**fixed, **{k: float(a[i]) for k, a in arrays.items()}}
+        env = row_env(i)
         for j, (x, f) in enumerate(zip(xs[i], fs[i])):
             out[i, j] = 0.0
             if not np.isfinite(f):
