@@ -265,6 +265,27 @@ sheet = "Log"
 """
 
 
+def test_a_table_computed_at_other_inputs_is_marked_frozen(tmp_path, sheet_from):
+    """A `vary` table's values were computed at other values of an input: they are numbers,
+    grey, and listed as frozen on the Inputs sheet."""
+    text = (
+        '[inputs]\nk = "2000 N/m"\nm = "0.5 kg"\nx0 = "10 mm"\n[arguments]\nt = { unit = "s" }\n'
+        '[definitions]\n"x(t)" = { expr = "x0*cos(sqrt(k/m)*t)", unit = "mm" }\n'
+        '[[tables]]\nname = "family"\nrange = "t := 0, 0.05 .. 0.1"\n'
+        'vary = { k = ["1000 N/m", "4000 N/m"] }\ncolumns = { x = "mm" }\n'
+    )
+    book = openpyxl.load_workbook(sheet_from(text).write_xlsx(tmp_path / "family.xlsx"))
+    grey = [
+        c.value
+        for row in book["Listing"].iter_rows()
+        for c in row
+        if c.fill.fill_type and c.fill.fgColor.rgb == "FFD9D9D9"
+    ]
+    assert len(grey) == 3 * 3 and all(isinstance(v, (int, float)) for v in grey)
+    notes = [str(r[0]) for r in book["Inputs"].iter_rows(values_only=True) if r[0]]
+    assert any(t.startswith("Frozen (grey): family.t [s], family.x k=1000 N/m") for t in notes)
+
+
 def test_each_table_reads_its_own_rows_steps_and_ranges_over_inputs_are_live(tmp_path, sheet_from):
     """The printed text of a call is reused only with the same helper cells: the second
     table's root reads its own bisection steps, not the first table's; a single-row range

@@ -680,6 +680,8 @@ class ExcelLayout:
             self.block_columns[(spec.name, str(name))] = ColumnCells(
                 spec.sheet, j, first, first + n - 1, str(name)
             )
+            if n:  # values of a solver block or of other inputs: they cannot follow an edit
+                self.freeze(ws, first, j, n, 1, f"{spec.name}.{name}")
         ws.set_column(0, max(0, len(df.columns) - 1), 14)
         self.rows[spec.sheet] = first + n + 2
 
