@@ -116,6 +116,15 @@ class Page:
         path.write_text(text, encoding="utf-8")
         return self._arrived(version, t0)
 
+    def edit_file_broken(self, path: Path, text: str) -> float:
+        """Seconds from writing a text that does not load to the page's error banner."""
+        version = self.last[1]["version"]
+        t0 = time.perf_counter()
+        path.write_text(text, encoding="utf-8")
+        self.last = when, data = self.wait(version)
+        assert data["error"] is not None, "the broken text loaded"
+        return when[0] - t0
+
     def _arrived(self, version: int, t0) -> tuple[float, ...]:
         first = self.wait(version)
         assert first[1]["error"] is None, first[1]["error"]
@@ -185,6 +194,7 @@ def measure(name: str, repeats: int) -> dict:
         text = paths["full"].read_text(encoding="utf-8")
         unit = f"{q.units:~}"
         times: dict[tuple[str, str], list[float]] = {}
+        errors: list[float] = []
         try:
             for mode in paths:
                 pages[mode] = Page(paths[mode].parent, src.name, mode == "incremental")
@@ -198,13 +208,29 @@ def measure(name: str, repeats: int) -> dict:
                     f = page.edit_file(paths[mode], _edited(text, d, r2))
                     value = f"{float(q.magnitude) * (1.01 + r2 / 1000)!r} {unit}".strip()
                     i = page.edit_input(inp.name, value)
+                    if mode == "incremental":  # an edit that breaks the sheet, then mended
+                        broken = _edited(text, d, r2).replace(
+                            f"({d.text})*", f"({d.text})*no_such_name_{r2}*", 1
+                        )
+                        e = page.edit_file_broken(paths[mode], broken)
+                        page.edit_file(paths[mode], _edited(text, d, r2))
+                        page.edit_input(inp.name, value)
+                        if r:
+                            errors.append(e)
                     if r:
                         times.setdefault((mode, "formula"), []).append(f)
                         times.setdefault((mode, "input"), []).append(i)
         finally:
             for p in pages.values():
                 p.close()
-    return {"name": name, "formula": d.name, "input": inp.name, "solvers": solvers, "times": times}
+    return {
+        "name": name,
+        "formula": d.name,
+        "input": inp.name,
+        "solvers": solvers,
+        "times": times,
+        "errors": errors,
+    }
 
 
 class LspClient:
@@ -355,6 +381,7 @@ def main(argv=None) -> int:
     )
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     missed = 0
+    errors = []
     for name in [] if args.no_serve else names:
         solvers = _edits(workbook.list_templates()[name])[3]
         m = measure(name, args.solver_repeats if solvers else args.repeats)
@@ -386,6 +413,21 @@ def main(argv=None) -> int:
                 f"{_p(drawn, 95):.0f} | {_p(cpu, 50):.0f} | {_p(stage, 50):.0f} | "
                 f"{_p(full, 50):.0f} | {_p(full, 95):.0f} | {_p(full_cpu, 50):.0f} | {target} "
                 f"| {min(loads):.1f} to {max(loads):.1f} | {len(inc)} repetitions",
+                flush=True,
+            )
+        errors.append((name, m["formula"], [1000 * t for t in m["errors"]]))
+    if errors:
+        print(
+            "\n| template | an edit that breaks the sheet (an unknown name in the formula): "
+            "to the error on the page p50 | p95 | target |"
+        )
+        print("| --- | --- | --- | --- |")
+        for name, formula, ms in errors:
+            ok = _p(ms, 95) <= TARGET_MS
+            missed += not ok
+            print(
+                f"| {name} (`{formula}`) | {_p(ms, 50):.0f} | {_p(ms, 95):.0f} "
+                f"| <= {TARGET_MS:g}{'' if ok else ' MISSED'} | {len(ms)} repetitions",
                 flush=True,
             )
     if not args.no_lsp:
