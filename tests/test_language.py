@@ -20,7 +20,6 @@ def test_the_reference_has_runnable_examples():
     assert len(RUNNABLE) >= 10
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("text", RUNNABLE, ids=[f"example{i}" for i in range(len(RUNNABLE))])
 def test_example(tmp_path, text):
     path = tmp_path / "example.toml"
