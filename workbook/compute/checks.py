@@ -10,7 +10,7 @@ import pint
 from ..errors import DomainError, LimitError, TemplateError, UnitError, WorkbookError
 from ..language import units as un
 from ..language.printed import PrintedRow, read_commented_csv, read_printed  # noqa: F401 - re-exported
-from ..language.template import PrintedSpec
+from ..language.spec import PrintedSpec
 from . import verdicts as V
 from .findings import Finding
 

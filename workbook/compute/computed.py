@@ -38,7 +38,7 @@ if TYPE_CHECKING:
     import pint
 
     from ..engine.sheet import Sheet
-    from ..language.template import ChartSpec, ColumnSpec, SeriesSpec, SheetSpec
+    from ..language.spec import ChartSpec, ColumnSpec, SeriesSpec, SheetSpec
     from ..language.typed import T
     from .checks import Report
     from .excelsheets import ExcelForm

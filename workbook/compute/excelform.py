@@ -725,7 +725,7 @@ class ExcelLayout:
                 )
                 return xcells, found[-1]
         # not in any table: write a chart data block
-        from ..language.template import TableSpec
+        from ..language.spec import TableSpec
 
         target = "Chart data"
         name = f"{chart.name}_{len(self.columns)}"
