@@ -455,12 +455,37 @@ def test_a_real_full_or_read_only_disk(tmp_path, options, message):
 # -- signals while writing -------------------------------------------------------------------
 
 
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_an_interrupt_raised_where_python_drops_it_is_raised_again(sig):
+    # a weakref callback is where Python prints an exception and goes on: the interrupt
+    # raised there comes back as the same signal at the next point that can raise
+    import weakref
+
+    from workbook.outputs.atomic import Terminated, sigterm_as_interrupt
+
+    class Referent:
+        pass
+
+    expected = Terminated if sig == signal.SIGTERM else KeyboardInterrupt
+
+    def dropped(_ref):
+        raise expected
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(expected), sigterm_as_interrupt():
+            thing = Referent()
+            ref = weakref.ref(thing, dropped)
+            del thing
+            for _ in range(1000):
+                time.sleep(0.001)
+            pytest.fail("the interrupt was lost")
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert ref() is None
+
+
 @pytest.mark.slow  # writes a table of 200,000 rows several times, in new processes
-# A known bug, not yet fixed: a signal whose KeyboardInterrupt Python raises inside a weakref
-# callback is printed ("Exception ignored in ... weakref.py ... KeyboardInterrupt") and lost,
-# so the run goes on (exit 0 with that traceback on stderr) or a .partial folder is left;
-# seen at 0.6 of the writing time on some runs, not on others.
-@pytest.mark.xfail(strict=False, reason="a signal raised inside a weakref callback is lost")
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_a_signal_at_any_point_of_writing_changes_nothing(tmp_path, sig):
     import subprocess

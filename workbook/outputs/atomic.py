@@ -8,6 +8,7 @@ import os
 import re
 import shutil
 import signal
+import sys
 import tempfile
 import threading
 import zipfile
@@ -26,25 +27,62 @@ class Terminated(KeyboardInterrupt):
 @contextlib.contextmanager
 def sigterm_as_interrupt():
     """Within the block, SIGTERM raises :class:`Terminated` in the main thread (by default it
-    ends the process at once, leaving ``.NAME.partial`` folders beside the targets). A process
-    forked meanwhile (a sweep's worker) still ends at once on SIGTERM."""
+    ends the process at once, leaving ``.NAME.partial`` folders beside the targets), and
+    Ctrl-C raises KeyboardInterrupt as usual. A process forked meanwhile (a sweep's worker)
+    still ends at once on SIGTERM.
+
+    Python prints and drops an exception raised where nothing can catch it (a weakref
+    callback, ``__del__``, the garbage collector): an interrupt raised there would be lost,
+    and the command would go on or leave ``.partial`` folders. Within the block such an
+    interrupt is not printed: the same signal is sent again, and handled at the next point
+    where it can raise (held, like any signal, while outputs are moved into place)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     pid = os.getpid()
+    in_hook = False
 
-    def on_term(signum, frame):
-        if os.getpid() != pid:
-            signal.signal(signal.SIGTERM, signal.SIG_DFL)
-            os.kill(os.getpid(), signal.SIGTERM)
+    def send_again(signum: int) -> None:
+        # from another thread, so that the handler runs after the code that dropped it
+        threading.Timer(0.001, os.kill, (pid, signum)).start()
+
+    def on_signal(signum, frame):
+        if os.getpid() != pid:  # a forked worker ends at once, as by default
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
             return
-        raise Terminated
+        if in_hook:  # raised here it would be dropped again
+            send_again(signum)
+            return
+        raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
 
-    previous = signal.signal(signal.SIGTERM, on_term)
+    previous_hook = sys.unraisablehook
+
+    def hook(unraisable):
+        nonlocal in_hook
+        exc = unraisable.exc_value
+        if not isinstance(exc, KeyboardInterrupt) or os.getpid() != pid:
+            previous_hook(unraisable)
+            return
+        in_hook = True
+        try:
+            send_again(signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT)
+        finally:
+            in_hook = False
+
+    previous_term = signal.signal(signal.SIGTERM, on_signal)
+    # Ctrl-C only where Python's own handler is in force (not where it is ignored)
+    previous_int = signal.getsignal(signal.SIGINT)
+    if previous_int is signal.default_int_handler:
+        signal.signal(signal.SIGINT, on_signal)
+    sys.unraisablehook = hook
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        sys.unraisablehook = previous_hook
+        signal.signal(signal.SIGTERM, previous_term)
+        if previous_int is signal.default_int_handler:
+            signal.signal(signal.SIGINT, previous_int)
 
 
 #: Signals held while outputs are moved into place and temporary files removed: a signal
