@@ -1,4 +1,4 @@
-"""The ODE test problems that benchmarks/bench_ode.py times and tests/test_ode_stiffness.py
+"""The ODE test problems that benchmarks/bench_ode.py times and tests/numerics/test_ode_stiffness.py
 checks method "auto" on (the test imports this module by a path insert): a Kepler orbit
 (not stiff: a saddle pair of +-4 at the perihelion), Robertson's kinetics, HIRES, Van der
 Pol at mu = 1000 (stiff), and a rate that switches on at t = 5 (stiff from there)."""

@@ -16,7 +16,7 @@ nor evaluate, and the Sheet is not changed by them.
 This module imports no Sheet (it reads the one it is given; :mod:`workbook.engine.sheet` builds on
 it, with the Column and TableData it fills), and the Excel form reads what it needs of the
 charts from the ComputedSheet: the package's import graph has no cycle
-(tests/test_layers.py).
+(tests/project/test_layers.py).
 
 A value that cannot be computed is kept as its error: the report and the notebook show it,
 the workbook raises it where it would have been written.

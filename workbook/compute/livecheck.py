@@ -326,8 +326,8 @@ def plain(text: str, sheet: str, arrays: frozenset[str] = frozenset()) -> bool:
     """A formula the default check leaves out: scalar arithmetic only (no array constant, no
     range, no defined name of a vector or matrix (``arrays``, upper case), no function but
     :data:`SCALAR`), which the engine and the printer compute by the same operations in the
-    same order (tests/test_excel_golden.py checks the printer's scalar forms against the same
-    evaluator); and a helper cell of a root's bisection or an extremum's golden-section
+    same order (tests/outputs/test_excel_golden.py checks the printer's scalar forms against
+    the same evaluator); and a helper cell of a root's bisection or an extremum's golden-section
     steps, whose cached value is the engine's own step of the same form (the cell that reads
     the last step is checked)."""
     if sheet in HELPER_SHEETS:

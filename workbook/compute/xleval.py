@@ -9,7 +9,7 @@ divisor, ``ROUND`` rounds half away from zero, ``SUM`` and ``MAX`` skip text in 
 operations on arrays go element by element. It shares nothing with the printer or the
 engine. A formula that uses anything else raises :class:`Unsupported` when it is
 compiled, and the check computes it with the `formulas` package instead
-(:mod:`workbook.compute.livecheck`); tests/test_live_everywhere.py computes every formula
+(:mod:`workbook.compute.livecheck`); tests/outputs/test_live_everywhere.py computes every formula
 of the templates both ways.
 """
 

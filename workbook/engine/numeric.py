@@ -36,7 +36,7 @@ Fn = Callable[[Env], object]
 
 _CMP = rt.COMPARE
 # Powers by products and square roots (x^1.5, x^3 and x^4 in Evaluator._power_by_parts):
-# several times faster than np.power, within 2 ulp (tests/test_numeric_golden.py, mpmath).
+# several times faster than np.power, within 2 ulp (tests/numerics/test_numeric_golden.py, mpmath).
 _POWERS = {
     2.0: np.square,
     0.5: np.sqrt,

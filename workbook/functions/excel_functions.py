@@ -7,8 +7,8 @@ Dynamic-array functions (FILTER, SEQUENCE...) spill and are written as dynamic a
 Everything that needs a list of Excel functions derives it from :data:`FUNCTIONS`: the defined
 names a workbook must not use (:data:`workbook.functions.excel_names.RESERVED`) and the functions
 whose formulas the writer passes to xlsxwriter unchanged (:data:`CLASSIC`).
-tests/test_excel_functions.py checks the table against xlsxwriter's rewriting and openpyxl's list of
-functions."""
+tests/outputs/test_excel_functions.py checks the table against xlsxwriter's rewriting and
+openpyxl's list of functions."""
 
 from __future__ import annotations
 

@@ -54,7 +54,8 @@ SHEET_KEYS = (
     "origin",
     "complex",
     "time_limit",
-)  # every key the engine reads from [sheet] (SheetSpec.meta); tests/test_harden.py checks it
+)  # every key the engine reads from [sheet] (SheetSpec.meta); checked by
+# tests/hardening/test_harden.py
 
 INPUT_KEYS = ("value", "unit", "note", "options", "min", "max", "positive", "label")
 

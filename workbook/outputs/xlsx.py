@@ -31,8 +31,8 @@ def classic_formulas_as_they_are(ws) -> None:
     "_xlfn."; that costs ~70 % of the time of writing a table of formulas. A formula that
     calls only classic functions (:data:`workbook.functions.excel_functions.CLASSIC`) is written as
     it is; any other goes through xlsxwriter's own rewriting, as before.
-    tests/test_formula_shortcut.py proves every template's worksheets identical with and without
-    this; pyproject.toml bounds xlsxwriter to the versions checked."""
+    tests/outputs/test_formula_shortcut.py proves every template's worksheets identical with and
+    without this; pyproject.toml bounds xlsxwriter to the versions checked."""
     original = getattr(ws, "_prepare_formula", None)
     if original is None or getattr(ws, "use_future_functions", False):
         return
