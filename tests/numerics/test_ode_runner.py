@@ -75,7 +75,7 @@ def test_an_explicit_method_on_a_stiff_system_stops_at_its_budget():
     start = time.perf_counter()
     with pytest.raises(LimitError, match="time budget") as info:
         ode.solve(f, 0, 100, [0.0], name="st", states=("y",), method="RK45", max_time=0.3)
-    assert time.perf_counter() - start < 5
+    assert time.perf_counter() - start < 5  # a hang guard (the budget is 0.3 s), not a timing claim
     assert "Radau" in str(info.value)  # says what to do
     with pytest.raises(LimitError, match="step cap"):
         ode.solve(f, 0, 100, [0.0], name="st", states=("y",), method="RK45", max_steps=50)

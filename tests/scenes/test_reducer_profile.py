@@ -391,16 +391,6 @@ def test_export_profile_csv(sheet, tmp_path):
     assert ok.exists()
 
 
-@pytest.mark.slow
-def test_check_is_quick(sheet):
-    import time
-
-    s = sheet.with_inputs(rp="4.5 mm")  # a new Sheet: nothing cached
-    t = time.perf_counter()
-    s.check()
-    assert time.perf_counter() - t < 5
-
-
 # -- LibreOffice recalculation -----------------------------------------------------------------
 
 
