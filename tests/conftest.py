@@ -7,8 +7,9 @@ import pytest
 import workbook
 
 TESTS = Path(__file__).parent
-DATA = TESTS / "data"
-sys.path.insert(0, str(TESTS))
+sys.path.insert(0, str(TESTS))  # the tests' own modules: helpers
+
+from helpers.sheets import write_template  # noqa: E402
 
 # Run from a source checkout without installing (python -m pytest): the tests' subprocesses
 # start in temporary folders, so they find the package through PYTHONPATH.
@@ -24,29 +25,6 @@ def concave():
     import workbook
 
     return workbook.load("concave-cam")
-
-
-# The smallest sheet with an input, an argument and a function: tests add tables and charts.
-SINE = """
-[inputs]
-R = "10 mm"
-
-[arguments]
-phi = { unit = "deg" }
-
-[definitions]
-"y(phi)" = "R*sin(phi)"
-"""
-
-SINE_TABLE = (
-    SINE
-    + """
-[[tables]]
-name = "t"
-range = "phi := 0, 10 .. 90"
-columns = { y = "mm" }
-"""
-)
 
 
 @pytest.fixture(scope="module")
@@ -69,22 +47,3 @@ def sheet_from(tmp_path):
         return workbook.loads(text, name=name, folder=tmp_path, parts=parts)
 
     return load
-
-
-def write_template(tmp_path: Path, text: str, name: str = "t.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(text, encoding="utf-8")
-    return path
-
-
-def fuzz_settings(examples: int):
-    """Hypothesis settings of the property tests: reproducible, no deadline, no database."""
-    from hypothesis import HealthCheck, settings
-
-    return settings(
-        max_examples=examples,
-        derandomize=True,
-        deadline=None,
-        database=None,
-        suppress_health_check=list(HealthCheck),
-    )

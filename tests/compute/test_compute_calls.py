@@ -9,8 +9,8 @@ import sys
 import warnings
 
 import pytest
-from conftest import write_template
 from helpers.paths import ROOT
+from helpers.sheets import write_template
 
 import workbook
 from workbook.language import expr as ex

@@ -125,7 +125,7 @@ def rendered_without_evaluation(sheet, tmp_path) -> None:
 
 @pytest.mark.slow
 def test_rendering_a_small_sheet_makes_no_call_into_typing_or_evaluation(tmp_path):
-    from conftest import write_template
+    from helpers.sheets import write_template
 
     sheet = workbook.load(write_template(tmp_path, SMALL))
     rendered_without_evaluation(sheet, tmp_path)
@@ -173,7 +173,7 @@ def test_the_computed_sheet_holds_values_not_the_engine(concave):
 def test_a_value_that_fails_is_kept_as_its_error(tmp_path):
     """The report shows the error of a definition; the workbook raises it where it would
     have been written (exit 2 for bad input)."""
-    from conftest import write_template
+    from helpers.sheets import write_template
 
     from workbook.errors import WorkbookError
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import SINE_TABLE, write_template
+from helpers.sheets import SINE_TABLE, write_template
 
 import workbook
 from workbook import sweep as sw

@@ -1,5 +1,8 @@
-"""Worksheet texts several test modules compute: ratios of units in cells, frozen cells,
-hard numerics, an AC circuit in complex numbers."""
+"""Worksheets several test modules compute (ratios of units in cells, frozen cells, hard
+numerics, an AC circuit in complex numbers, the smallest sheet with a function), written to a
+folder by :func:`write_template`, and the property tests' Hypothesis settings."""
+
+from pathlib import Path
 
 RATIOS = """
 [sheet]
@@ -116,3 +119,46 @@ name = "sweep"
 range = "fr := 10 Hz, 20 Hz .. 100 Hz"
 columns = { "Zf(fr)" = "ohm", "abs(Zf(fr))" = "ohm", "arg(Zf(fr))" = "deg" }
 """
+
+
+# The smallest sheet with an input, an argument and a function: tests add tables and charts.
+SINE = """
+[inputs]
+R = "10 mm"
+
+[arguments]
+phi = { unit = "deg" }
+
+[definitions]
+"y(phi)" = "R*sin(phi)"
+"""
+
+SINE_TABLE = (
+    SINE
+    + """
+[[tables]]
+name = "t"
+range = "phi := 0, 10 .. 90"
+columns = { y = "mm" }
+"""
+)
+
+
+def write_template(tmp_path: Path, text: str, name: str = "t.toml") -> Path:
+    """``text`` written as ``tmp_path/name``: the path to load."""
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def fuzz_settings(examples: int):
+    """Hypothesis settings of the property tests: reproducible, no deadline, no database."""
+    from hypothesis import HealthCheck, settings
+
+    return settings(
+        max_examples=examples,
+        derandomize=True,
+        deadline=None,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+    )

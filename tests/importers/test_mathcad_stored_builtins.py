@@ -11,8 +11,8 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import write_template
 from helpers.paths import SHARED
+from helpers.sheets import write_template
 
 import workbook
 

@@ -13,7 +13,7 @@ import math
 import formulas
 import openpyxl
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import UnitError

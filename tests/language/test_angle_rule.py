@@ -9,7 +9,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 

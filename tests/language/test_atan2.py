@@ -10,7 +10,7 @@ import formulas
 import mpmath
 import openpyxl
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main

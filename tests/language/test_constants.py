@@ -8,7 +8,7 @@ import formulas
 import openpyxl
 import pytest
 import scipy.constants
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import TemplateError

@@ -8,7 +8,7 @@ import io
 import os
 
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main

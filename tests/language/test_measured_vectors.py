@@ -10,7 +10,7 @@ import formulas
 import numpy as np
 import openpyxl
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 from scipy import stats
 
 import workbook

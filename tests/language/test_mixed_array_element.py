@@ -3,7 +3,7 @@ when evaluated on its own: a text, or a number (a text element was an internal e
 
 from __future__ import annotations
 
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import openpyxl
 import pytest
-from conftest import fuzz_settings
+from helpers.sheets import fuzz_settings
 from hypothesis import given
 from hypothesis import strategies as st
 

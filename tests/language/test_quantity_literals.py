@@ -8,7 +8,7 @@ import math
 import formulas
 import pytest
 import report_parse as rp
-from conftest import write_template
+from helpers.sheets import write_template
 from recalc import formula_values
 
 import workbook

@@ -17,7 +17,7 @@ import formulas
 import numpy as np
 import pint
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 from recalc import formula_values
 
 import workbook

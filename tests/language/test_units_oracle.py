@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pint
 import pytest
-from conftest import fuzz_settings
+from helpers.sheets import fuzz_settings
 from hypothesis import given
 from hypothesis import strategies as st
 

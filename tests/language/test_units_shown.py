@@ -7,7 +7,7 @@ import sys
 
 import openpyxl
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.language import units as un

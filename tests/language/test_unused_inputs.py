@@ -4,7 +4,7 @@ only an input nothing reads is listed as unused (check) and labelled so (Inputs 
 from __future__ import annotations
 
 import openpyxl
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 

@@ -9,7 +9,7 @@ import re
 import mpmath
 import numpy as np
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook import WorkbookError

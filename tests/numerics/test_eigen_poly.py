@@ -9,7 +9,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook import WorkbookError

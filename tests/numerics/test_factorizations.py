@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 import sympy
-from conftest import write_template
 from helpers.paths import SHARED
+from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import WorkbookError

@@ -7,7 +7,7 @@ from __future__ import annotations
 import mpmath
 import numpy as np
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import WorkbookError

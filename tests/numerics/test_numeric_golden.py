@@ -13,7 +13,7 @@ import math
 import mpmath
 import numpy as np
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.functions.distributions import NAMES as DISTRIBUTIONS

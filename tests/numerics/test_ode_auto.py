@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import DATA, write_template
+from helpers.paths import DATA
+from helpers.sheets import write_template
 from scipy.integrate import solve_ivp
 
 import workbook

@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main

@@ -10,7 +10,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import sympy
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook import WorkbookError

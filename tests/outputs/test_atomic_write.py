@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import SINE
+from helpers.sheets import SINE
 
 from workbook.cli import main
 from workbook.compute import excelform

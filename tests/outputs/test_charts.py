@@ -6,7 +6,7 @@ import zipfile
 import numpy as np
 import openpyxl
 import pytest
-from conftest import SINE, write_template
+from helpers.sheets import SINE, write_template
 
 import workbook
 

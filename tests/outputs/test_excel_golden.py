@@ -15,7 +15,7 @@ import re
 
 import formulas
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 from recalc import formula_values
 
 import workbook

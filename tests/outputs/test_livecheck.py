@@ -203,7 +203,7 @@ class _NoChanges(list):
 
 
 def test_writing_a_chart_leaves_the_sheets_tables_as_they_are(tmp_path, sheet_from):
-    from conftest import SINE
+    from helpers.sheets import SINE
 
     chart = """
 [[charts]]

@@ -2,7 +2,7 @@
 and the tables as DataFrames."""
 
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.outputs import notebook

@@ -10,7 +10,7 @@ import re
 import numpy as np
 import pytest
 import report_parse as rp
-from conftest import SINE_TABLE, write_template
+from helpers.sheets import SINE_TABLE, write_template
 
 import workbook
 from workbook.cli import main

@@ -9,7 +9,7 @@ import shutil
 import numpy as np
 import openpyxl
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main

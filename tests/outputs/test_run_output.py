@@ -7,7 +7,7 @@ import html
 import re
 
 import pytest
-from conftest import write_template
+from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main, matrix_lines

@@ -140,7 +140,7 @@ def test_every_test_module_is_in_a_stage_folder_and_imports_no_other():
     importing = []
     for path in found:
         for line in path.read_text(encoding="utf-8").splitlines():
-            if re.match(r"\s*(from|import)\s+test_\w+", line):
+            if re.match(r"\s*(from|import)\s+(test_\w+|conftest)\b", line):
                 importing.append(f"{path.name}: {line.strip()}")
     assert importing == [], "a test module imports another (shared code goes to tests/helpers)"
     readme = (ROOT / "README.md").read_text(encoding="utf-8")

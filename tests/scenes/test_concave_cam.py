@@ -5,7 +5,7 @@ import csv
 import numpy as np
 import pint
 import pytest
-from conftest import DATA
+from helpers.paths import DATA
 
 import workbook
 

@@ -540,7 +540,7 @@ columns = { f = "mm" }
 
 
 def test_max_over_and_min_over(tmp_path):
-    from conftest import write_template
+    from helpers.sheets import write_template
 
     s = workbook.load(write_template(tmp_path, AGG % "max_over(t, f) - min_over(t, f)"))
     x = np.linspace(0, 1, 11)
@@ -560,7 +560,7 @@ def test_max_over_and_min_over(tmp_path):
     ],
 )
 def test_max_over_errors(tmp_path, expr, message):
-    from conftest import write_template
+    from helpers.sheets import write_template
 
     from workbook.errors import TemplateError
 
