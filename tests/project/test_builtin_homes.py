@@ -73,15 +73,6 @@ KNOWN_ELSEWHERE = {
         "numerics/intervals.py",
         ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),
     ),
-    # the same functions in mpmath (workbook bench's reference, roots polished): another back
-    # end whose rules could be a field of the entry
-    (
-        "numerics/mpform.py",
-        (
-            "abs", "acos", "asin", "atan", "ceil", "cos", "cosh", "cot", "csc", "exp", "floor",
-            "ln", "log10", "sec", "sign", "sin", "sinh", "sqrt", "tan", "tanh",
-        ),
-    ),
     # the functions singular where their argument is 0 (an integrand nearly singular beside
     # its interval gets a second tanh-sinh computation)
     ("numerics/singular.py", ("ln", "log10", "sqrt")),

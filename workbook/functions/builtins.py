@@ -20,6 +20,8 @@ whose
 * ``domain``: the arguments' restricted domains (:class:`Domain`), explained by
   :mod:`workbook.engine.analysis` when a value is not finite;
 * ``doc``: one line for the documentation;
+* ``mpmath``: a function of one argument, the name of its mpmath function of the same meaning
+  (the reference evaluator, :mod:`workbook.numerics.mpform`); "" when it has none there;
 * ``mathml``: how a report writes a call (:mod:`workbook.outputs.report.mathml`): MathML in which
   ``{0}``, ``{1}``... are the arguments, ``{0:group}`` the argument bracketed unless it is a
   product or tighter, ``{args}`` all of them with commas; a call whose arguments the template
@@ -160,11 +162,18 @@ _simple(
     "SIN",
     lambda sp, x: sp.sin(x),
     "sine (argument in radians)",
+    mpmath="sin",
     **_TRIG,
     **_complex("IMSIN"),
 )
-_simple("cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", **_TRIG, **_complex("IMCOS"))
-_simple("tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", **_TRIG, **_classic(im_tan))
+_simple(
+    "cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", mpmath="cos", **_TRIG,
+    **_complex("IMCOS"),
+)  # fmt: skip
+_simple(
+    "tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", mpmath="tan", **_TRIG,
+    **_classic(im_tan),
+)  # fmt: skip
 
 
 def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
@@ -183,6 +192,7 @@ for _name, _of, _excel, _what in (
         _reciprocal(_excel),
         lambda sp, x, name=_name: getattr(sp, name)(x),
         f"{_what}, 1/{_excel.lower()}(x)",
+        mpmath=_name,
         **_TRIG,
     )
 _simple(
@@ -192,6 +202,7 @@ _simple(
     lambda sp, x: sp.asin(x),
     "arc sine",
     domain=_inverse_domain("asin"),
+    mpmath="asin",
     mathml=mathml_call("arcsin"),
 )
 _simple(
@@ -201,10 +212,17 @@ _simple(
     lambda sp, x: sp.acos(x),
     "arc cosine",
     domain=_inverse_domain("acos"),
+    mpmath="acos",
     mathml=mathml_call("arccos"),
 )
 _simple(
-    "atan", np.arctan, "ATAN", lambda sp, x: sp.atan(x), "arc tangent", mathml=mathml_call("arctan")
+    "atan",
+    np.arctan,
+    "ATAN",
+    lambda sp, x: sp.atan(x),
+    "arc tangent",
+    mathml=mathml_call("arctan"),
+    mpmath="atan",
 )
 _simple(
     "atan2",
@@ -221,6 +239,7 @@ _simple(
     "SINH",
     lambda sp, x: sp.sinh(x),
     "hyperbolic sine",
+    mpmath="sinh",
     **_TRIG,
     **_classic(im_sinh),
 )
@@ -230,6 +249,7 @@ _simple(
     "COSH",
     lambda sp, x: sp.cosh(x),
     "hyperbolic cosine",
+    mpmath="cosh",
     **_TRIG,
     **_classic(im_cosh),
 )
@@ -239,6 +259,7 @@ _simple(
     "TANH",
     lambda sp, x: sp.tanh(x),
     "hyperbolic tangent",
+    mpmath="tanh",
     **_TRIG,
     complex="complex",
     complex_excel=classic(im_tanh),
@@ -252,9 +273,13 @@ _simple(
     _sqrt_unit,
     (_SQRT,),
     mathml="<msqrt>{0}</msqrt>",
+    mpmath="sqrt",
     **_complex("IMSQRT"),
 )
-_simple("exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", **_complex("IMEXP"))
+_simple(
+    "exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", mpmath="exp",
+    **_complex("IMEXP"),
+)  # fmt: skip
 _simple(
     "ln",
     np.log,
@@ -262,6 +287,7 @@ _simple(
     lambda sp, x: sp.log(x),
     "natural logarithm",
     domain=_log_domain("ln"),
+    mpmath="ln",
     **_complex("IMLN"),
 )
 _simple(
@@ -271,6 +297,7 @@ _simple(
     lambda sp, x: sp.log(x, 10),
     "logarithm base 10",
     domain=_log_domain("log10"),
+    mpmath="log10",
     **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
 )
@@ -282,10 +309,11 @@ _simple(
     "absolute value (of a complex number: its modulus)",
     same_unit,
     mathml=mathml_fence("|", "|"),
+    mpmath="fabs",
     complex="real",
     complex_excel=im_call("IMABS"),
 )
-_simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit)
+_simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit, mpmath="sign")
 
 
 # -- floor, ceil, round and trunc: of plain numbers only ----------------------------------------
@@ -322,6 +350,7 @@ register(
         lambda sp, x: sp.floor(x),
         doc="largest integer not above",
         mathml=mathml_fence("\u230a", "\u230b"),
+        mpmath="floor",
     )
 )
 register(
@@ -334,6 +363,7 @@ register(
         lambda sp, x: sp.ceiling(x),
         doc="smallest integer not below",
         mathml=mathml_fence("\u2308", "\u2309"),
+        mpmath="ceil",
     )
 )
 

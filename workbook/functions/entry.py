@@ -71,6 +71,8 @@ class Builtin:
     complex: str = ""
     # the Excel formula when an argument is complex (Excel's IM* functions); None: not live
     complex_excel: Callable[..., tuple[str, int]] | None = None
+    # the name of the mpmath function of one argument with numpy's meaning ("" if none)
+    mpmath: str = ""
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""

@@ -20,6 +20,7 @@ import operator
 from collections.abc import Callable
 
 from ..engine.runtime import COMPARE
+from ..functions.entry import ENTRIES  # as registered: the registry imports this one's users
 from ..language import typed as ty
 from ..language.visitor import Visitor
 
@@ -56,29 +57,9 @@ def _real(ctx, v):
 
 
 def _functions(ctx) -> dict[str, Callable]:
-    """The plain built-ins of one argument (numpy's meaning, in mpmath)."""
-    return {
-        "sin": ctx.sin,
-        "cos": ctx.cos,
-        "tan": ctx.tan,
-        "sec": ctx.sec,
-        "csc": ctx.csc,
-        "cot": ctx.cot,
-        "asin": ctx.asin,
-        "acos": ctx.acos,
-        "atan": ctx.atan,
-        "sinh": ctx.sinh,
-        "cosh": ctx.cosh,
-        "tanh": ctx.tanh,
-        "exp": ctx.exp,
-        "sqrt": ctx.sqrt,
-        "ln": ctx.ln,
-        "log10": ctx.log10,
-        "abs": abs,
-        "sign": ctx.sign,
-        "floor": ctx.floor,
-        "ceil": ctx.ceil,
-    }
+    """The plain built-ins of one argument (numpy's meaning, in mpmath): each entry's own (by
+    the time a typed tree is compiled here, the typer has read the complete registry)."""
+    return {e.name: getattr(ctx, e.mpmath) for e in ENTRIES.values() if e.mpmath}
 
 
 # -- an integral in mpmath: EXPR's inner integral, and the reference's (mpref) ------------
