@@ -97,12 +97,18 @@ def _run(args: list[str], timeout: float) -> tuple[int, str, str, float]:
     return done.returncode, done.stdout, done.stderr, time.monotonic() - start
 
 
-def measure(book: Path, timeout: float = 900.0) -> dict:
-    """Import and check one workbook in subprocesses; the counts of the check."""
+def measure(book: Path, timeout: float = 900.0, time_limit: float | None = None) -> dict:
+    """Import and check one workbook in subprocesses; the counts of the check.
+
+    ``time_limit`` is given to both commands as ``--time-limit`` (seconds of CPU): the
+    default budget is a hang guard sized for the machine it was set on, and a count of the
+    values reproduced should not depend on how fast the machine is.
+    """
     row: dict = {"workbook": book.name, "folder": book.parent.name}
     row["vba"] = [p.name for p in addins(book)]
+    limit = [] if time_limit is None else ["--time-limit", f"{time_limit:g}"]
     with tempfile.TemporaryDirectory() as tmp:
-        args = ["import", str(book), "--out", tmp, "--force"]
+        args = ["import", str(book), "--out", tmp, "--force", *limit]
         for addin in addins(book):
             args += ["--vba", str(addin)]
         code, out, err, seconds = _run(args, timeout)
@@ -112,7 +118,7 @@ def measure(book: Path, timeout: float = 900.0) -> dict:
             row["error"] = (err.strip().splitlines() or [""])[-1][:300]
             return row
         toml = next(Path(tmp).glob("*.toml"))
-        code, out, err, seconds = _run(["check", str(toml), "--json"], timeout)
+        code, out, err, seconds = _run(["check", str(toml), "--json", *limit], timeout)
         row.update(check_exit=code, check_seconds=round(seconds, 1))
         try:
             counts = json.loads(out)

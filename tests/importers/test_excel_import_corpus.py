@@ -67,7 +67,7 @@ def test_corpus_workbook(book):
     sys.path.insert(0, str(ROOT / "scripts"))
     from excel_import_table import measure
 
-    row = measure(book)
+    row = measure(book, time_limit=800)
     assert row["import_exit"] == 0, row.get("error")
     assert row["check_exit"] in (0, 1), row.get("error")
     assert row["wrong"] <= KNOWN_WRONG.get(book.name, 0)
