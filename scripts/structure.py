@@ -18,7 +18,7 @@ MAX_FUNCTION_LINES = 100
 MAX_MODULE_LINES = 1000
 #: The project's own top-level modules and packages (a private name of a third-party package
 #: is that package's affair).
-OWN = ("workbook", "tests", "helpers", "conftest", "test_", "mathcad_xml", "recalc", "scripts")
+OWN = ("workbook", "tests", "helpers", "conftest", "test_", "scripts")
 
 
 def module_name(path: Path) -> str:

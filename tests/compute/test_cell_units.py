@@ -11,9 +11,9 @@ from pathlib import Path
 
 import openpyxl
 import pytest
+from helpers.recalc import formula_values
 from helpers.recalculated import formulas_recalculated, mismatches
 from helpers.sheets import RATIOS
-from recalc import formula_values
 
 from workbook.compute import cellunit
 from workbook.language import units as un

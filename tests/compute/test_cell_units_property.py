@@ -9,10 +9,10 @@ from __future__ import annotations
 import os
 
 import pytest
+from helpers.recalc import recalculate, soffice
 from helpers.recalculated import differences, mismatches, xleval_recalculated
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from recalc import recalculate, soffice
 
 POWERS = ["W", "kW", "MW", "mW"]
 LENGTHS = ["mm", "cm", "m", "km", "um"]

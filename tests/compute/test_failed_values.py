@@ -178,7 +178,7 @@ def test_libreoffice_recalculates_the_error_cells_as_written(tmp_path):
     """LibreOffice's own evaluation of the written formulas gives the same error values in the
     failed rows (#DIV/0! for 1/0; for sqrt(-1) an error value too) and the engine's numbers in
     the others."""
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -140,7 +140,7 @@ ratio = "Rp/rp"
 @pytest.mark.slow  # starts LibreOffice
 @pytest.mark.slow
 def test_names_equal_but_for_case_recalculate_to_the_engine_values(tmp_path):
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     sheet = workbook.load(write(tmp_path / "case.toml", CASE_SHEET))
     path = sheet.write_xlsx(tmp_path / "case.xlsx")

@@ -1,7 +1,7 @@
 """Hostile worksheets: each is refused at load or stopped by a documented limit, with a message.
 
 Every case runs the real command line in a fresh process (forked from one interpreter that
-imported the engine, tests/guard_server.py) with an address-space limit
+imported the engine, tests/helpers/guard_server.py) with an address-space limit
 (RLIMIT_AS), a CPU-time limit and a wall-clock timeout. An audit hook (PEP 578) installed
 before the command runs records every file opened for writing, every file read outside the
 Python installation, the package and the case's folder, every import of a module that could

@@ -7,9 +7,9 @@ import math
 from pathlib import Path
 
 import openpyxl
-from recalc import agree, cell_values, formula_values, recalculate
 
 import workbook
+from helpers.recalc import agree, cell_values, formula_values, recalculate
 
 RELATIVE = 1e-9
 MARKED = ("FFD9D9D9", "FFFCE4D6")  # frozen, reads a frozen value

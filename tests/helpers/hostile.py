@@ -1,5 +1,5 @@
 """Hostile worksheets run by the real command line in a fresh guarded process (forked from
-one interpreter that imported the engine, tests/guard_server.py), with its memory, CPU and
+one interpreter that imported the engine, tests/helpers/guard_server.py), with its memory, CPU and
 wall-clock limits; and a sheet with a one-argument program."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import time
 
-from guard_server import SERVER_INSTANCE
+from helpers.guard_server import SERVER_INSTANCE
 
 MEMORY = 1536 * 2**20  # bytes of address space for one run
 CPU_SECONDS = 60

@@ -1,4 +1,4 @@
-"""Mathcad worksheets for the importer's tests beside tests/mathcad_xml.py: a region of any
+"""Mathcad worksheets for the importer's tests beside tests/helpers/mathcad_xml.py: a region of any
 body, a worksheet without settings, Prime's identifiers, and the check's JSON."""
 
 from __future__ import annotations
@@ -6,8 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from mathcad_xml import ML
-
+from helpers.mathcad_xml import ML
 from workbook.cli import main
 
 

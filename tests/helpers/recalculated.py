@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import openpyxl
 from openpyxl.utils import get_column_letter
-from recalc import cell_values, formula_values
+
+from helpers.recalc import cell_values, formula_values
 
 #: The relative difference allowed between a cell's cached value and its recalculation.
 RELATIVE = 1e-9

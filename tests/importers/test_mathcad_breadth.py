@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import pytest
-from mathcad_xml import apply as _apply
-from mathcad_xml import check_sheet as _check
-from mathcad_xml import define as _define
-from mathcad_xml import evaluate as _eval
-from mathcad_xml import ident as _id
-from mathcad_xml import import_sheet as _import
-from mathcad_xml import index as _index
-from mathcad_xml import matrix as _matrix
-from mathcad_xml import real as _real
+from helpers.mathcad_xml import apply as _apply
+from helpers.mathcad_xml import check_sheet as _check
+from helpers.mathcad_xml import define as _define
+from helpers.mathcad_xml import evaluate as _eval
+from helpers.mathcad_xml import ident as _id
+from helpers.mathcad_xml import import_sheet as _import
+from helpers.mathcad_xml import index as _index
+from helpers.mathcad_xml import matrix as _matrix
+from helpers.mathcad_xml import real as _real
 
 
 def _vectorize(body: str) -> str:

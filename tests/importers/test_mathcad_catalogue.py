@@ -10,8 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers.paths import SHARED
-from mathcad_xml import (
+from helpers.mathcad_xml import (
     apply,
     array_cells,
     call,
@@ -28,6 +27,7 @@ from mathcad_xml import (
     real,
     shown,
 )
+from helpers.paths import SHARED
 
 from workbook.cli import main
 

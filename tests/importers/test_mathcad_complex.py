@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import cmath
 
-from mathcad_xml import (
+from helpers.mathcad_xml import (
     apply,
     check_sheet,
     define,
@@ -119,7 +119,7 @@ def test_a_complex_result_over_a_range(tmp_path, capsys):
 
 def test_the_functions_of_complex_numbers(tmp_path, capsys):
     """Z := 3 + 4i; Re(Z) = 3, Im(Z) = 4, arg(Z) = atan2(4, 3) (Mathcad's names)."""
-    from mathcad_xml import call
+    from helpers.mathcad_xml import call
 
     z = 3 + 4j
     import_sheet(

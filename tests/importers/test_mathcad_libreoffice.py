@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 from helpers.paths import SHARED
+from helpers.recalc import recalculate, soffice
 from helpers.recalculated import assert_same
-from recalc import recalculate, soffice
 
 from workbook.cli import main
 

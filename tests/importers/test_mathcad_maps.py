@@ -641,7 +641,16 @@ def test_every_unit_name_of_both_corpora_is_mapped():
 def test_g_is_the_acceleration_of_gravity_and_gm_the_gram(tmp_path, capsys):
     """Mathcad's unit list: g is the acceleration of gravity (9.80665 m/s^2) and gm the gram;
     W := 2 kg·g = 19.6133 N, m := 500 gm = 0.5 kg."""
-    from mathcad_xml import apply, check_sheet, define, evaluate, ident, import_sheet, real, united
+    from helpers.mathcad_xml import (
+        apply,
+        check_sheet,
+        define,
+        evaluate,
+        ident,
+        import_sheet,
+        real,
+        united,
+    )
 
     kg_g = apply("mult", apply("mult", real(2), ident("kg")), ident("g"))
     import_sheet(

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from mathcad_xml import (
+from helpers.mathcad_xml import (
     apply,
     call,
     check_sheet,
@@ -124,7 +124,7 @@ def test_a_chain_of_equations_in_a_solve_block_is_two_equations(tmp_path, capsys
 def test_a_range_whose_bounds_index_a_vector_at_origin_1(tmp_path, capsys):
     """ORIGIN 1; P := [9; 16]; x := P[1], P[1] + 1 .. 12; 2x = [18; 20; 22; 24]: the range's
     bounds are computed at import at the worksheet's origin (P[1] is 9, never 16)."""
-    from mathcad_xml import evaluate, index, matrix, real
+    from helpers.mathcad_xml import evaluate, index, matrix, real
 
     first = index(ident("P"), real(1))
     rng = (

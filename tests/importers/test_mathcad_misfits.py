@@ -5,7 +5,7 @@ the worksheet is still compared (``check --json`` exits 0 or 1, never 2)."""
 from __future__ import annotations
 
 import pytest
-from mathcad_xml import (
+from helpers.mathcad_xml import (
     apply,
     check_sheet,
     define,

@@ -8,12 +8,12 @@ import json
 import pytest
 from helpers.mathcad import bare_worksheet as _worksheet
 from helpers.mathcad import region as _region
+from helpers.mathcad_xml import apply as _apply
+from helpers.mathcad_xml import evaluate as _eval
+from helpers.mathcad_xml import ident as _id
+from helpers.mathcad_xml import real as _real
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from mathcad_xml import apply as _apply
-from mathcad_xml import evaluate as _eval
-from mathcad_xml import ident as _id
-from mathcad_xml import real as _real
 
 from workbook.cli import main
 from workbook.language import expr as ex

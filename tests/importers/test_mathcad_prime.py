@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 from helpers.mathcad import check_json as _check
 from helpers.mathcad import prime_ident as _id
+from helpers.mathcad_xml import prime_package as _package
+from helpers.mathcad_xml import prime_region as _region
+from helpers.mathcad_xml import prime_result as _result
 from helpers.paths import SHARED
-from mathcad_xml import prime_package as _package
-from mathcad_xml import prime_region as _region
-from mathcad_xml import prime_result as _result
 
 from workbook.cli import main
 

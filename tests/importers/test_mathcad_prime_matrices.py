@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 from helpers.mathcad import check_json as _check
 from helpers.mathcad import prime_ident as _id
-from mathcad_xml import PRIME_RESULTS as RESULTS
-from mathcad_xml import PRIME_WS as WS
-from mathcad_xml import prime_region as _region
-from mathcad_xml import prime_result as _result
+from helpers.mathcad_xml import PRIME_RESULTS as RESULTS
+from helpers.mathcad_xml import PRIME_WS as WS
+from helpers.mathcad_xml import prime_region as _region
+from helpers.mathcad_xml import prime_result as _result
 
 from workbook.cli import main
 

@@ -7,22 +7,22 @@ from __future__ import annotations
 import json
 
 import pytest
-from mathcad_xml import ML
-from mathcad_xml import apply as _apply
-from mathcad_xml import call as _call
-from mathcad_xml import define as _define
-from mathcad_xml import evaluate as _eval
-from mathcad_xml import for_loop as _for
-from mathcad_xml import function as _function
-from mathcad_xml import ident as _id
-from mathcad_xml import if_then as _if
-from mathcad_xml import index as _index
-from mathcad_xml import local as _local
-from mathcad_xml import matrix as _matrix
-from mathcad_xml import otherwise as _otherwise
-from mathcad_xml import program as _program
-from mathcad_xml import real as _real
-from mathcad_xml import worksheet as _worksheet
+from helpers.mathcad_xml import ML
+from helpers.mathcad_xml import apply as _apply
+from helpers.mathcad_xml import call as _call
+from helpers.mathcad_xml import define as _define
+from helpers.mathcad_xml import evaluate as _eval
+from helpers.mathcad_xml import for_loop as _for
+from helpers.mathcad_xml import function as _function
+from helpers.mathcad_xml import ident as _id
+from helpers.mathcad_xml import if_then as _if
+from helpers.mathcad_xml import index as _index
+from helpers.mathcad_xml import local as _local
+from helpers.mathcad_xml import matrix as _matrix
+from helpers.mathcad_xml import otherwise as _otherwise
+from helpers.mathcad_xml import program as _program
+from helpers.mathcad_xml import real as _real
+from helpers.mathcad_xml import worksheet as _worksheet
 
 from workbook.cli import main
 

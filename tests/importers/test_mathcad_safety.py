@@ -241,7 +241,7 @@ def test_stored_texts_that_a_spreadsheet_would_run_are_escaped_and_still_reprodu
     reads them back without it: both are reproduced."""
     import csv
 
-    from mathcad_xml import check_sheet, define, evaluate, ident, import_sheet
+    from helpers.mathcad_xml import check_sheet, define, evaluate, ident, import_sheet
 
     def text(t: str) -> str:
         return f"<ml:str>{t}</ml:str>"

@@ -9,7 +9,7 @@ from __future__ import annotations
 import mpmath
 import numpy as np
 import pytest
-from mathcad_xml import (
+from helpers.mathcad_xml import (
     apply,
     array_cells,
     call,

@@ -5,7 +5,7 @@ side or an operator's operand (a tree missing a part is never translated by gues
 from __future__ import annotations
 
 import pytest
-from mathcad_xml import (
+from helpers.mathcad_xml import (
     define,
     evaluate,
     ident,

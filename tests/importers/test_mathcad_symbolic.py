@@ -4,7 +4,17 @@ of numbers, is compared as a stored result of its expression; one with keywords 
 
 from __future__ import annotations
 
-from mathcad_xml import ML, apply, at, check_sheet, define, ident, import_sheet, matrix, real
+from helpers.mathcad_xml import (
+    ML,
+    apply,
+    at,
+    check_sheet,
+    define,
+    ident,
+    import_sheet,
+    matrix,
+    real,
+)
 
 
 def symbolic(rid: int, expr: str, found: str, keywords: str = "") -> str:

@@ -170,7 +170,7 @@ def test_the_workbook_recalculates_every_sum_to_the_engine(tmp_path):
 
 @pytest.mark.slow
 def test_libreoffice_recalculates_the_sums(tmp_path):
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

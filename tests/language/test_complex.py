@@ -345,7 +345,7 @@ def test_every_complex_formula_agrees_with_the_formulas_package(ac_book):
     the engine, from the inputs): each complex formula cell against the engine's cached
     value, to 1e-12 (the formulas package writes a complex text with 17 digits a part)."""
     from formulas.tokens.operand import XlError
-    from recalc import formula_values
+    from helpers.recalc import formula_values
 
     path, _, _ = ac_book
     recalculated = _recalculated(path)

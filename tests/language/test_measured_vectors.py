@@ -129,7 +129,7 @@ bad = "sum(x) + 1 m"
 
 @pytest.mark.slow
 def test_libreoffice_recalculates_the_regression(sheet, tmp_path):
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -7,9 +7,9 @@ import math
 
 import formulas
 import pytest
-import report_parse as rp
+from helpers import report_parse as rp
+from helpers.recalc import formula_values
 from helpers.sheets import write_template
-from recalc import formula_values
 
 import workbook
 from workbook.errors import WorkbookError
@@ -210,7 +210,7 @@ def test_a_percentage_in_a_formula_is_live_in_excel(tmp_path):
 def test_libreoffice_recalculates_literals_constants_and_a_log_range(tmp_path):
     """The quantities, g, e and pi, and a logspace table, recalculated by LibreOffice."""
     import numpy as np
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -17,8 +17,8 @@ import formulas
 import numpy as np
 import pint
 import pytest
+from helpers.recalc import formula_values
 from helpers.sheets import write_template
-from recalc import formula_values
 
 import workbook
 from workbook.errors import UnitError
@@ -236,7 +236,7 @@ columns = { "T1 + x*(T2 - T1)" = "degF" }
 @pytest.mark.slow
 def test_libreoffice_recalculates_the_temperature_sheet(rod, tmp_path):
     import openpyxl
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -180,7 +180,7 @@ EXCEL_CASES = {
 @pytest.fixture(scope="module")
 def golden(tmp_path_factory):
     formulas = pytest.importorskip("formulas")
-    from recalc import formula_values
+    from helpers.recalc import formula_values
 
     tmp = tmp_path_factory.mktemp("dist_xl")
     text = TEMPLATE + "".join(f'{k} = "{v}"\n' for k, v in EXCEL_CASES.items())
@@ -290,7 +290,7 @@ def test_the_normal_density_is_the_derivative_of_its_probability(tmp_path):
 def test_libreoffice_recalculates_the_distributions(tmp_path):
     """Every distribution cell recalculated by LibreOffice (which reads the _xlfn. names)
     agrees with the engine; a fraction of degrees of freedom from a cell is #N/A there too."""
-    from recalc import cell_values, formula_values, recalculate, soffice
+    from helpers.recalc import cell_values, formula_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -147,7 +147,7 @@ def test_a_condition_in_a_program_on_a_local_vector_is_one_number(tmp_path):
 
 @pytest.mark.slow
 def test_libreoffice_recalculation_reproduces_the_engine(sheet, tmp_path):
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -126,7 +126,7 @@ g = "round(B/(1 mm)) + trunc(B/(1 cm))"
 @pytest.mark.slow
 def test_libreoffice_agrees(tmp_path):
     import openpyxl
-    from recalc import recalculate, soffice
+    from helpers.recalc import recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

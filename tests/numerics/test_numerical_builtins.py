@@ -6,7 +6,7 @@ import mpmath
 import numpy as np
 import pytest
 from helpers.paths import DATA as TEST_DATA
-from recalc import cell_values, formula_values, recalculate, soffice
+from helpers.recalc import cell_values, formula_values, recalculate, soffice
 from scipy.optimize import brentq
 
 import workbook

@@ -152,7 +152,7 @@ def test_excel_forms_agree_with_the_formulas_package(tmp_path):
     """Every live formula recalculated by `formulas` (which has no COMBIN: checked by
     LibreOffice below) agrees with the engine."""
     formulas = pytest.importorskip("formulas")
-    from recalc import formula_values
+    from helpers.recalc import formula_values
 
     sheet, path = _workbook(tmp_path)
     cells = formula_values(path)
@@ -174,7 +174,7 @@ def test_excel_forms_agree_with_the_formulas_package(tmp_path):
 
 @pytest.mark.slow
 def test_libreoffice_recalculates_the_special_functions(tmp_path):
-    from recalc import cell_values, formula_values, recalculate, soffice
+    from helpers.recalc import cell_values, formula_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

@@ -7,7 +7,7 @@ import math
 
 import pytest
 from helpers.paths import DATA
-from recalc import cell_values, recalculate, soffice
+from helpers.recalc import cell_values, recalculate, soffice
 
 from workbook.facade import Sheet
 from workbook.language.template import load_spec

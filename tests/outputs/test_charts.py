@@ -54,7 +54,7 @@ def series_refs(path) -> list[tuple[str, str]]:
 
 def numbers(path, ref: str) -> np.ndarray:
     """The cached values of a range like 'Chart data'!$B$3:$B$15."""
-    from recalc import cell_values
+    from helpers.recalc import cell_values
 
     sheet, rng = ref.split("!")
     ws = openpyxl.load_workbook(path)[sheet.strip("'")]

@@ -6,8 +6,8 @@ import shutil
 
 import openpyxl
 import pytest
+from helpers.recalc import cell_values, formula_values, recalculate, soffice
 from helpers.sheets import AC
-from recalc import cell_values, formula_values, recalculate, soffice
 
 import workbook
 from workbook.functions.complexes import parse_text

@@ -15,8 +15,8 @@ import re
 
 import formulas
 import pytest
+from helpers.recalc import formula_values
 from helpers.sheets import write_template
-from recalc import formula_values
 
 import workbook
 from workbook.functions.distributions import NAMES as DISTRIBUTIONS

@@ -5,8 +5,8 @@ import shutil
 
 import openpyxl
 import pytest
+from helpers.recalc import cell_values, formula_values, recalculate, soffice
 from helpers.recalculated import assert_same
-from recalc import cell_values, formula_values, recalculate, soffice
 
 if soffice() is None and os.environ.get("CI"):
     raise RuntimeError("CI must run the LibreOffice recalculation tests: install libreoffice-calc")

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from helpers.edited import check_edited, numeric_inputs
 from helpers.paths import DATA
+from helpers.recalc import soffice
 from helpers.sheets import FROZEN, RATIOS
-from recalc import soffice
 
 import workbook
 

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 from helpers.paths import DATA
+from helpers.recalc import recalculate, soffice
 from helpers.recalculated import differences
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from recalc import recalculate, soffice
 
 import workbook
 

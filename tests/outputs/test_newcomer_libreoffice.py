@@ -11,7 +11,7 @@ import openpyxl
 import pytest
 from helpers.edited import MARKED, check_edited, numeric_inputs
 from helpers.paths import DATA
-from recalc import agree, cell_values, formula_values, recalculate, soffice
+from helpers.recalc import agree, cell_values, formula_values, recalculate, soffice
 
 import workbook
 

@@ -9,7 +9,7 @@ import re
 
 import numpy as np
 import pytest
-import report_parse as rp
+from helpers import report_parse as rp
 from helpers.sheets import SINE_TABLE, write_template
 
 import workbook

@@ -7,7 +7,7 @@ import os
 import shutil
 
 import pytest
-from chromium import measure, pdf_pages, pdf_text, screenshots
+from helpers.chromium import measure, pdf_pages, pdf_text, screenshots
 
 import workbook
 from workbook.compute.computed import compute

@@ -204,7 +204,7 @@ def test_the_parts_that_are_not_formulas_are_regenerated(tmp_path):
 
 @pytest.mark.slow
 def test_a_workbook_saved_by_libreoffice_reads_back(tmp_path, generated, concave):
-    recalc = pytest.importorskip("recalc")
+    recalc = pytest.importorskip("helpers.recalc")
     if recalc.soffice() is None:
         pytest.skip("LibreOffice is not installed")
     edited = edit(generated, tmp_path / "edited.xlsx", R3=45)

@@ -463,7 +463,7 @@ def test_workbook_writes(written):
 def test_live_formulas_recalculate_in_libreoffice(tmp_path, written):
     """The closed forms, matrix entries and mode estimates are live: LibreOffice gets the
     engine's numbers."""
-    recalc = pytest.importorskip("recalc")
+    recalc = pytest.importorskip("helpers.recalc")
     if recalc.soffice() is None:
         pytest.skip("LibreOffice is not installed")
     cached = recalc.formula_values(written)

@@ -387,7 +387,7 @@ def test_workbook_charts_show_unworn_and_worn(name, tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_workbook_recalculates_in_libreoffice(name, tmp_path):
-    from recalc import cell_values, formula_values, recalculate, soffice
+    from helpers.recalc import cell_values, formula_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
@@ -444,7 +444,7 @@ def test_brake_workbook_follows_edited_inputs_in_libreoffice(tmp_path):
     import shutil
 
     import openpyxl
-    from recalc import cell_values, formula_values, recalculate, soffice
+    from helpers.recalc import cell_values, formula_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

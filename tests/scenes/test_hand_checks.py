@@ -430,7 +430,7 @@ def test_workbook_holds_the_findings_and_tables(tmp_path, concave):
 
 @pytest.mark.slow
 def test_geometry_workbook_recalculates_in_libreoffice(tmp_path, geometry):
-    from recalc import cell_values, formula_values, recalculate, soffice
+    from helpers.recalc import cell_values, formula_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")

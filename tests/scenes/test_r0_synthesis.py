@@ -457,9 +457,9 @@ def test_workbook_has_no_macro_and_live_r0(tmp_path, sheet):
 def _recalc():
     pytest.importorskip("openpyxl")
     try:
-        from recalc import cell_values, formula_values, recalculate, soffice
+        from helpers.recalc import cell_values, formula_values, recalculate, soffice
     except ImportError:
-        pytest.skip("tests/recalc.py is not there")
+        pytest.skip("tests/helpers/recalc.py is not there")
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
     return cell_values, formula_values, recalculate
@@ -509,7 +509,7 @@ def test_changing_alpha_max_in_excel_moves_r0(tmp_path, sheet, alpha_max, H):
         got = values[("Definitions", _definitions(path)[name])]
         assert got == pytest.approx(mm(changed.evaluate(name)), rel=1e-12), name
     # Fig. 4's range of radii (r4_lo .. r4_hi, from r0) is live too: its first and last rows
-    from recalc import formula_values
+    from helpers.recalc import formula_values
 
     cells = {f: key for key, (f, _) in formula_values(path).items() if key[0] == "Chart data"}
     for bound in ("r4_lo", "r4_hi"):

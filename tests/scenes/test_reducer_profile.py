@@ -395,7 +395,7 @@ def test_export_profile_csv(sheet, tmp_path):
 
 
 def _lo():
-    from recalc import soffice
+    from helpers.recalc import soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
@@ -407,7 +407,7 @@ def test_libreoffice_recalculates_the_live_profile(sheet, tmp_path):
     import shutil
 
     import openpyxl
-    from recalc import cell_values, formula_values, recalculate
+    from helpers.recalc import cell_values, formula_values, recalculate
 
     path = sheet.write_xlsx(tmp_path / "rp.xlsx")
     cached = formula_values(path)

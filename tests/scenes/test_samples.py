@@ -158,7 +158,7 @@ def test_refusals(tmp_path, expr, message):
 def test_excel_forms_recalculate_in_libreoffice(tmp_path):
     """The workbook's live formulas (VAR.S, CORREL, COVARIANCE.P, SLOPE(y, x), ...), recalculated
     by LibreOffice, give the engine's values."""
-    from recalc import cell_values, recalculate, soffice
+    from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
