@@ -143,5 +143,7 @@ def test_every_test_module_is_in_a_stage_folder_and_imports_no_other():
             if re.match(r"\s*(from|import)\s+(test_\w+|conftest)\b", line):
                 importing.append(f"{path.name}: {line.strip()}")
     assert importing == [], "a test module imports another (shared code goes to tests/helpers)"
+    loose = sorted(p.name for p in tests.glob("*.py") if p.name != "conftest.py")
+    assert loose == [], "shared test code lives in tests/helpers, not at the tests root"
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert all(f"`{name}/`" in readme for name in TEST_FOLDERS), "README lists the test folders"
