@@ -160,7 +160,7 @@ def test_names_alike_but_for_case_are_renamed_as_by_the_scan():
 
 
 def _assign_by_scan(syms) -> None:
-    """writer._assign's choice of identifiers, each number tried from the first."""
+    """writer.assign_identifiers's choice of identifiers, each number tried from the first."""
     reserved = set(writer.language_functions()) | {"pi"}
     taken, lower = {}, set()
 
@@ -217,7 +217,7 @@ def test_imported_names_are_chosen_as_by_the_scan():
             for _ in range(random.randint(1, 40))
         ]
         mine, theirs = copy.deepcopy(syms), copy.deepcopy(syms)
-        writer._assign(types.SimpleNamespace(syms=mine))
+        writer.assign_identifiers(types.SimpleNamespace(syms=mine))
         _assign_by_scan(theirs)
         assert [s.final for s in mine] == [s.final for s in theirs]
 

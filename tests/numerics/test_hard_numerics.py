@@ -102,7 +102,7 @@ def test_the_count_of_roots_is_proven_by_interval_arithmetic():
     hi = lo + rng.uniform(0, 2, 500)
     box = iv.Iv(lo, hi)
     for name, f in (("sin", np.sin), ("cos", np.cos), ("exp", np.exp), ("tanh", np.tanh)):
-        enc, slope = iv._RULES[name]
+        enc, slope = iv.UNARY_RULES[name]
         x = lo + rng.uniform(0, 1, 500) * (hi - lo)
         e = enc(box)
         assert np.all((e.lo <= f(x)) & (f(x) <= e.hi)), name
@@ -351,12 +351,12 @@ def test_two_roots_inside_the_noise_are_not_polished_into_one():
 
     ctx = mpref.context(60)
     assert (
-        mpref._checked_root(
+        mpref.checked_root(
             ctx, lambda x: (x - 1) * ((x - 1) ** 3 - _MP("1e-12")), 1.00005, 1e-3, True
         )
         is None
     )
-    x = mpref._checked_root(ctx, lambda x: (x - 1) ** 3, 1.00001, 1e-4, True)
+    x = mpref.checked_root(ctx, lambda x: (x - 1) ** 3, 1.00001, 1e-4, True)
     assert abs(x - 1) < _MP("1e-39")
 
 

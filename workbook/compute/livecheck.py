@@ -356,7 +356,9 @@ def _first(result):
     return a.ravel()[0] if a.size else None
 
 
-def _agrees(got, cached, scale: float) -> bool:
+def agrees(got, cached, scale: float) -> bool:
+    """The independent evaluator's value ``got`` agrees with the engine's ``cached`` one
+    (numbers within the check's relative tolerance of ``scale``; texts and booleans equal)."""
     if isinstance(cached, str) and _complex_agree(got, cached):
         return True
     if isinstance(cached, (str, bool, np.bool_)):
@@ -380,7 +382,7 @@ COMPLEX_ERROR = "an IM* function the formulas package does not compute here"
 _IM_CALL = re.compile(r"(?<![\w.])(?:_xlfn\.)?(?:IM[A-Z0-9]+|COMPLEX)\(")
 
 
-def _complex_error(text: str, got) -> bool:
+def complex_error(text: str, got) -> bool:
     """An Excel error value computed for a formula of complex numbers: not checkable."""
     from formulas.tokens.operand import XlError
 
@@ -445,7 +447,7 @@ def _first_disagreement(log: CellLog, f: Formula, got: np.ndarray, scale: float)
                 value = got[min(i, got.shape[0] - 1), min(j, got.shape[1] - 1)]
             except IndexError:
                 value = None
-            if cached is not None and not _agrees(value, cached, scale):
+            if cached is not None and not agrees(value, cached, scale):
                 return value, cached
     return None
 
@@ -506,7 +508,7 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
         wrong = _first_disagreement(log, f, got, max(read, default=0.0))
         if wrong is None:
             continue
-        if _complex_error(f.text, wrong[0]):
+        if complex_error(f.text, wrong[0]):
             skipped(ValueError(COMPLEX_ERROR), 1)
         else:
             refusals.append(Refusal(f.sheet, f.row, f.col, f.text, *wrong, by=by[0]))
@@ -531,8 +533,8 @@ def check(log: CellLog, everything: bool = True) -> Outcome:
                 skipped(err, c.n)
                 break
             checked += 1
-            if not _agrees(got, cached_all[i], max([scale, *read])):
-                if _complex_error(template, got):
+            if not agrees(got, cached_all[i], max([scale, *read])):
+                if complex_error(template, got):
                     skipped(ValueError(COMPLEX_ERROR), c.n)
                     break
                 text = str(row + 1).join(c.pieces)

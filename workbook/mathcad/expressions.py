@@ -372,7 +372,7 @@ class ExprTranslator(Visitor):
                         )
             if isinstance(node, ex.Index):
                 raise Untranslatable("a vectorised expression with an index")
-            for child in ex._CHILDREN.visit(node):
+            for child in ex.children(node):
                 scan(child)
 
         scan(tree)

@@ -28,9 +28,9 @@ from .reader import (
     MNode,
     Region,
     Worksheet,
-    _local,
-    _ns,
+    local_tag,
     read_bounded,
+    tag_namespace,
 )
 from .units import FORMULA_UNITS
 
@@ -109,20 +109,20 @@ def parse_bytes(data: bytes, path: Path) -> Worksheet:
     if root.tag != f"{{{WS50}}}worksheet":
         raise InputError(
             f"{path}: not a Mathcad Prime worksheet (the root element of mathcad/worksheet.xml "
-            f"is {_local(root.tag)}, expected worksheet in the namespace {WS50})"
+            f"is {local_tag(root.tag)}, expected worksheet in the namespace {WS50})"
         )
     results: dict[str, object] = {}
     if package.has("mathcad/result.xml"):
         rroot = _xml(package.read("mathcad/result.xml"), path, "mathcad/result.xml")
         for data_el in rroot:
-            if isinstance(data_el.tag, str) and _local(data_el.tag) == "resultData":
+            if isinstance(data_el.tag, str) and local_tag(data_el.tag) == "resultData":
                 results[data_el.get("result-id", "")] = data_el
     ws = Worksheet(path)
     ws.generator = "Mathcad Prime"
     if package.has("mathcad/settings/calculation.xml"):
         calc = _xml(package.read("mathcad/settings/calculation.xml"), path, "calculation.xml")
         for el in calc.iter():
-            if isinstance(el.tag, str) and _local(el.tag) == "builtInVariables":
+            if isinstance(el.tag, str) and local_tag(el.tag) == "builtInVariables":
                 origin = el.get("array-origin", "0")
                 if not re.fullmatch(r"-?[0-9]{1,6}", origin.strip()):
                     raise InputError(f"{path}: array-origin {origin[:40]!r} is not a whole number")
@@ -139,9 +139,9 @@ def parse_bytes(data: bytes, path: Path) -> Worksheet:
 def _xml(data: bytes, path: Path, part: str):
     from lxml import etree
 
-    from .reader import _DTD
+    from .reader import DECLARES_DTD
 
-    if _DTD.search(data):
+    if DECLARES_DTD.search(data):
         raise InputError(f"{path}: the part {part} declares a DTD or entities; refused unread")
     parser = etree.XMLParser(
         resolve_entities=False,
@@ -175,7 +175,7 @@ def _text_parts(package: _Package) -> dict[str, str]:
     return {
         el.get("Id", ""): el.get("Target", "")
         for el in root.iter()
-        if isinstance(el.tag, str) and _local(el.tag) == "Relationship"
+        if isinstance(el.tag, str) and local_tag(el.tag) == "Relationship"
     }
 
 
@@ -198,13 +198,13 @@ class _Regions:
     def collect(self, regions_el, out: list[Region]) -> None:
         """Regions in the file's order (Prime writes them in reading order)."""
         for el in regions_el:
-            if not isinstance(el.tag, str) or _local(el.tag) != "region":
+            if not isinstance(el.tag, str) or local_tag(el.tag) != "region":
                 continue
             kids = [c for c in el if isinstance(c.tag, str)]
             if not kids:
                 continue
             content = kids[0]
-            tag = _local(content.tag)
+            tag = local_tag(content.tag)
             if tag == "math":
                 out.append(self.math(el, content))
             elif tag == "text":
@@ -243,7 +243,7 @@ class _Regions:
             return
         parts: dict[str, list[Region]] = {"guess-value": [], "constraint": [], "solver": []}
         for r in inner:
-            if not isinstance(r.tag, str) or _local(r.tag) != "region":
+            if not isinstance(r.tag, str) or local_tag(r.tag) != "region":
                 continue
             kind = r.get("solve-block-category", "constraint")
             collected: list[Region] = []
@@ -274,7 +274,7 @@ class _Regions:
 
     def math(self, el, content, suffix: str = "") -> Region:
         base = self._base(el, suffix)
-        body = [c for c in content if isinstance(c.tag, str) and _ns(c.tag) == ML50]
+        body = [c for c in content if isinstance(c.tag, str) and tag_namespace(c.tag) == ML50]
         if not body:
             return Region(kind="math", math=None, **base)
         node = _node(body[-1])
@@ -297,8 +297,8 @@ def _first(node: MNode, tag: str) -> MNode | None:
 def _node(el) -> MNode:
     """A math50 element as the translator reads Mathcad 15's: names with their subscripts,
     ``scale`` as a product, Prime's keywords as Mathcad 15's operators."""
-    tag = _local(el.tag)
-    attrs = {_local(k): v for k, v in el.attrib.items()}
+    tag = local_tag(el.tag)
+    attrs = {local_tag(k): v for k, v in el.attrib.items()}
     if tag == "id":
         text, subscript = _name(el)
         if subscript:
@@ -308,7 +308,9 @@ def _node(el) -> MNode:
         if attrs.get("labels") == "CONSTANT":
             return _constant(text, subscript, attrs, el.sourceline)
         return MNode("id", attrs, text, [], el.sourceline)
-    children = [_node(c) for c in el if isinstance(c.tag, str) and _ns(c.tag) in (ML50, UNITS, "")]
+    children = [
+        _node(c) for c in el if isinstance(c.tag, str) and tag_namespace(c.tag) in (ML50, UNITS, "")
+    ]
     children = [c for c in children if c.tag != "display"]
     if tag == "scale":
         tag = "mult"
@@ -501,7 +503,7 @@ def _name(el) -> tuple[str, str]:
     sub: list[str] = []
 
     def walk(e, in_sub: bool) -> None:
-        here = in_sub or _local(e.tag) == "Subscript"
+        here = in_sub or local_tag(e.tag) == "Subscript"
         if e.text:
             (sub if here else base).append(e.text)
         for c in e:
@@ -520,7 +522,7 @@ def _attach_result(evaluation: MNode, stored) -> None:
     if stored is None:
         return
     result_el = next(
-        (c for c in stored if isinstance(c.tag, str) and _local(c.tag) == "result"), None
+        (c for c in stored if isinstance(c.tag, str) and local_tag(c.tag) == "result"), None
     )
     if result_el is None or not len(result_el):
         return  # an engine error, or nothing stored: Mathcad showed no value

@@ -114,7 +114,7 @@ def parse_bytes(data: bytes, path: Path) -> Worksheet:
     if root is None or root.tag != f"{{{WS}}}worksheet":
         raise InputError(
             f"{path}: not a Mathcad 11-15 XML worksheet (the root element is "
-            f"{_local(root.tag) if root is not None else 'missing'}, expected worksheet in "
+            f"{local_tag(root.tag) if root is not None else 'missing'}, expected worksheet in "
             f"the namespace {WS})"
         )
     if root.getroottree().docinfo.internalDTD is not None:
@@ -128,7 +128,8 @@ def parse_bytes(data: bytes, path: Path) -> Worksheet:
     return _worksheet(root, path)
 
 
-_DTD = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
+#: A document type or entity declaration, refused before any XML parser sees the file.
+DECLARES_DTD = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
 
 
 def _screen(data: bytes, path: Path) -> None:
@@ -140,32 +141,34 @@ def _screen(data: bytes, path: Path) -> None:
     head = data[:4096].lstrip(b"\xef\xbb\xbf \t\r\n")
     if not head.startswith(b"<"):
         raise InputError(f"{path}: not a Mathcad XML worksheet (it does not start with '<')")
-    if _DTD.search(data):
+    if DECLARES_DTD.search(data):
         raise InputError(
             f"{path}: declares a DTD or entities (<!DOCTYPE/<!ENTITY); Mathcad worksheets have "
             "none, and such a file is refused unread (entity expansion is never done)"
         )
 
 
-def _local(tag) -> str:
+def local_tag(tag) -> str:
+    """An element's or attribute's name without its ``{namespace}``."""
     tag = str(tag)
     return tag.rsplit("}", 1)[-1]
 
 
-def _ns(tag) -> str:
+def tag_namespace(tag) -> str:
+    """The namespace of a ``{namespace}name`` tag ('' for none)."""
     tag = str(tag)
     return tag[1:].split("}", 1)[0] if tag.startswith("{") else ""
 
 
 def _node(el) -> MNode:
-    if _local(el.tag) == "provenance":  # an expression pasted from another worksheet
-        inner = [c for c in el if isinstance(c.tag, str) and _ns(c.tag) == ML]
+    if local_tag(el.tag) == "provenance":  # an expression pasted from another worksheet
+        inner = [c for c in el if isinstance(c.tag, str) and tag_namespace(c.tag) == ML]
         if inner:
             return _node(inner[-1])
     children = [_node(c) for c in el if isinstance(c.tag, str)]
     return MNode(
-        _local(el.tag),
-        {_local(k): v for k, v in el.attrib.items()},
+        local_tag(el.tag),
+        {local_tag(k): v for k, v in el.attrib.items()},
         (el.text or ""),
         children,
         el.sourceline,
@@ -187,7 +190,7 @@ def _own_text(el):
     if el.text:
         yield el.text
     for child in el:
-        if isinstance(child.tag, str) and _local(child.tag) != "region":
+        if isinstance(child.tag, str) and local_tag(child.tag) != "region":
             yield from _own_text(child)
         if child.tail:
             yield child.tail
@@ -258,20 +261,20 @@ def _region(el, dy: float = 0.0, dx: float = 0.0) -> Region:
     base = dict(id=rid, line=el.sourceline, top=top, left=left)
     kids = [c for c in el if isinstance(c.tag, str)]
     for c in kids:
-        tag = _local(c.tag)
+        tag = local_tag(c.tag)
         if tag == "text":
             return Region(kind="text", text=_text_of(c), **base)
         if tag == "math":
-            body = [x for x in c if isinstance(x.tag, str) and _ns(x.tag) == ML]
-            while body and _local(body[0].tag) == "provenance":  # pasted from another file
-                body = [x for x in body[0] if isinstance(x.tag, str) and _ns(x.tag) == ML]
+            body = [x for x in c if isinstance(x.tag, str) and tag_namespace(x.tag) == ML]
+            while body and local_tag(body[0].tag) == "provenance":  # pasted from another file
+                body = [x for x in body[0] if isinstance(x.tag, str) and tag_namespace(x.tag) == ML]
             math = _node(body[-1]) if body else None
             return Region(kind="math", math=math, disabled=c.get("disable-calc") == "true", **base)
         if tag == "plot":
             return Region(kind="plot", plot=_node(c), **base)
         if tag == "reference":
             link = el.find(f"{{{WS}}}link")
-            origin = next((x for x in c if _local(x.tag) == "originRef"), None)
+            origin = next((x for x in c if local_tag(x.tag) == "originRef"), None)
             href = (link.get("href") if link is not None else None) or (
                 origin.get("href", "") if origin is not None else ""
             )
@@ -279,11 +282,13 @@ def _region(el, dy: float = 0.0, dx: float = 0.0) -> Region:
         if tag == "picture":
             return Region(kind="picture", **base)
         if tag == "component":  # a data table, spreadsheet...: the names it defines
-            outputs = next((x for x in c if _local(x.tag) == "outputs"), None)
+            outputs = next((x for x in c if local_tag(x.tag) == "outputs"), None)
             names = [
-                _node(x) for x in (outputs if outputs is not None else ()) if _local(x.tag) == "id"
+                _node(x)
+                for x in (outputs if outputs is not None else ())
+                if local_tag(x.tag) == "id"
             ]
             attrs = {k: v for k, v in c.attrib.items() if isinstance(k, str)}
             return Region(kind="component", outputs=names, component=attrs, **base)
-    tag = _local(kids[0].tag) if kids else "empty"
+    tag = local_tag(kids[0].tag) if kids else "empty"
     return Region(kind=tag if tag in ("area",) else "other", text=tag, **base)

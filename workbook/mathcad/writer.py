@@ -51,7 +51,7 @@ def pretty_quantity(text: str) -> str:
     return f"{number} {pretty_unit(unit)}" if unit and "/ (" not in text else text
 
 
-def _assign(tr: Translation) -> None:
+def assign_identifiers(tr: Translation) -> None:
     """Choose every symbol's identifier: unique, not a built-in, arguments apart from the
     names of inputs and definitions (shared by arguments of the same unit)."""
     from ..functions.registry import CONSTANTS
@@ -163,7 +163,7 @@ def render(tr: Translation, name: str, src: Path) -> Rendered:
 def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]:
     """The worksheet as a TOML document (its data, not yet written as text) and its CSV files;
     the document's text is left to :meth:`Document.text`, once the engine has typed it."""
-    _assign(tr)
+    assign_identifiers(tr)
     _list_unknown_units(tr)
     mapping = {s.token(): s.final for s in tr.syms}
     out = Rendered(name, "")

@@ -235,7 +235,7 @@ def row_text(label: Callable[[int], str] | None, i: int, n: int) -> str:
     return f" (row {i + 1} of {n})" if n > 1 else ""
 
 
-def _u(unit: str) -> str:
+def unit_suffix(unit: str) -> str:
     """' mm' after a number in messages, or nothing for a plain number."""
     return f" {unit}" if unit else ""
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import NumericsError, _u, num
+from ._common import NumericsError, num
+from ._common import unit_suffix as _u
 
 
 def check_data(xs: np.ndarray, ys: np.ndarray, what: str) -> None:

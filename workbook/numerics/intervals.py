@@ -235,7 +235,8 @@ def _sign(a: Iv) -> Iv:
     return Iv(lo, hi)
 
 
-_RULES = _unary_rules()
+#: function name -> (its interval enclosure, the enclosure of its derivative)
+UNARY_RULES = _unary_rules()
 
 #: a value and its derivative in the variable (None: 0, the node does not depend on it)
 Pair = tuple[Iv, Iv | None]
@@ -310,7 +311,7 @@ class Enclosure(Visitor):
                     return power(v, n), dv
 
                 return const_power
-            log = _RULES["ln"]
+            log = UNARY_RULES["ln"]
 
             def general_power(env):  # exp(y ln x)
                 (x, dx), (y, dy) = left(env), right(env)
@@ -348,7 +349,7 @@ class Enclosure(Visitor):
         return binary
 
     def visit_TFunc(self, t):
-        rule = _RULES.get(t.func)
+        rule = UNARY_RULES.get(t.func)
         if t.func in ("min", "max") and len(t.args) == 2:
             return self._min_max(t)
         if rule is None or len(t.args) != 1:

@@ -420,7 +420,7 @@ def polish_roots(of, result, shape, tol) -> int:
             probe = value[i] + np.array([-1.0, 1.0]) * max(0.1 * abs(value[i]), 1e-3)
             if not _same_function(ctx, g, f, probe, i):
                 continue
-            x = _checked_root(ctx, g, value[i], error[i], bool(noisy[i]))
+            x = checked_root(ctx, g, value[i], error[i], bool(noisy[i]))
         except (NoValue, Unconverged, ZeroDivisionError):
             continue
         if x is True:  # certain within its estimate at 60 digits
@@ -476,7 +476,7 @@ def _has_integral(evaluator, body) -> bool:
     return False
 
 
-def _checked_root(ctx, g, v: float, e: float, polish: bool):
+def checked_root(ctx, g, v: float, e: float, polish: bool):
     """True where the root is certain within e and need not be polished; else the root
     polished in mpmath (None where no sign change is found near v, or two)."""
     d = max(e, 4 * float(np.spacing(abs(v))), float(np.finfo(float).tiny))

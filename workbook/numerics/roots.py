@@ -8,7 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WorkbookError
-from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, _u, call, num, row_text, rows
+from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, call, num, row_text, rows
+from ._common import unit_suffix as _u
 
 
 def _tolerances(tol: Tolerance) -> dict:
