@@ -168,6 +168,40 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
     mapping = {s.token(): s.final for s in tr.syms}
     out = Rendered(name, "")
     doc = Document()
+    _header(tr, src, doc)
+    doc.blank()
+    doc.table("sheet")
+    doc.pair("name", name)
+    doc.pair("title", tr.title or name)
+    doc.pair("source", "Mathcad worksheet " + src.name)
+    if tr.origin:
+        doc.pair("origin", int(tr.origin))
+    doc.blank()
+    solves, charts = _definitions(tr, mapping, out, doc)
+    for item in solves:
+        _solve(item, mapping, out, doc)
+    printed, tables = _printed_files(tr, name, mapping, out)
+    for table in tables:
+        _write_table(table, doc)
+        out.table_of[table["name"]] = table["region"]
+    for item in charts:
+        _chart(item, mapping, doc, out)
+    for fname, title, arg, from_solve, absolute in printed:
+        doc.blank()
+        doc.array_table("printed")
+        doc.pair("file", fname)
+        doc.pair("title", title)
+        if arg:
+            doc.pair("argument", arg)
+        # Mathcad's solver stops at its TOL: its roots are that close
+        doc.pair("rel_tolerance", tr.solve_tolerance if from_solve else REL_TOLERANCE)
+        doc.pair("tolerance", absolute)
+    return doc, out
+
+
+def _header(tr: Translation, src: Path, doc: Document) -> None:
+    """The comments that open the worksheet: where it came from, what was not translated or
+    left out, and the names that changed."""
     doc.comment(
         f"Imported from {src.name} by `workbook import`: Mathcad's definitions in order, its"
     )
@@ -208,14 +242,11 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
                 line = " "
             line += piece
         doc.comment(line)
-    doc.blank()
-    doc.table("sheet")
-    doc.pair("name", name)
-    doc.pair("title", tr.title or name)
-    doc.pair("source", "Mathcad worksheet " + src.name)
-    if tr.origin:
-        doc.pair("origin", int(tr.origin))
-    doc.blank()
+
+
+def _definitions(tr: Translation, mapping: dict, out: Rendered, doc: Document):
+    """The [inputs], [arguments] and [definitions] sections, written to ``doc`` in Mathcad's
+    order, with the text regions as comments; the solve blocks and charts, to write after."""
     inputs, definitions = _Section("inputs"), _Section("definitions")
     arguments = _Section("arguments")
     notes: list[str] = []
@@ -230,7 +261,6 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
                 continue
             seen_args.add(sym.final)
             arguments.pair(sym.final, {"unit": pretty_unit(sym.unit)})
-    tables: list = []
     solves: list = []
     charts: list = []
     for item in tr.items:
@@ -268,24 +298,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             key = item.sym.final
             if item.params:
                 key = f"{key}({', '.join(p.final for p in item.params)})"
-            multiline = False
-            if item.program is not None:
-                lines = []
-                for indent, parts in item.program:
-                    text = "".join(p if isinstance(p, str) else _text(p, mapping) for p in parts)
-                    lines.append(" " * indent + text)
-                value = {"program": "\n".join(lines) + "\n"}
-                multiline = True
-            elif item.pieces is not None:
-                pieces = [
-                    f"{_text(v, mapping)} if {_text(c, mapping)}"
-                    if c is not None
-                    else f"{_text(v, mapping)} otherwise"
-                    for v, c in item.pieces
-                ]
-                value = {"pieces": pieces}
-            else:
-                value = {"expr": _text(item.body, mapping)}
+            value, multiline = _definition_value(item, mapping)
             if item.unit:
                 value["unit"] = pretty_unit(item.unit)
             value["note"] = note
@@ -295,9 +308,33 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         definitions.comment(note)
     for section in (inputs, arguments, definitions):
         section.write(doc)
-    for item in solves:
-        _solve(item, mapping, out, doc)
-    # printed values: one CSV per argument (scalars: no argument)
+    return solves, charts
+
+
+def _definition_value(item, mapping: dict) -> tuple[dict, bool]:
+    """A definition's value table (a program, pieces or an expression), and whether it is
+    written over several lines."""
+    if item.program is not None:
+        lines = []
+        for indent, parts in item.program:
+            text = "".join(p if isinstance(p, str) else _text(p, mapping) for p in parts)
+            lines.append(" " * indent + text)
+        return {"program": "\n".join(lines) + "\n"}, True
+    if item.pieces is not None:
+        pieces = [
+            f"{_text(v, mapping)} if {_text(c, mapping)}"
+            if c is not None
+            else f"{_text(v, mapping)} otherwise"
+            for v, c in item.pieces
+        ]
+        return {"pieces": pieces}, False
+    return {"expr": _text(item.body, mapping)}, False
+
+
+def _printed_files(tr: Translation, name: str, mapping: dict, out: Rendered):
+    """Mathcad's stored results as printed-value CSV files in ``out`` (one per argument, per
+    solve-block dependence and per round-off size): each file's [[printed]] entry and the
+    tables over the arguments."""
     groups: dict[tuple[str, bool, str], list[list[str]]] = {}
     solved = _from_solve_blocks(tr)
     for res in tr.results:
@@ -323,6 +360,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
             val = csv_text(value) if isinstance(value, str) else repr(float(value))
             rows.append([sym_name, at_text, val, pretty_unit(res.unit) if res.unit else ""])
     printed: list[tuple] = []
+    tables: list = []
     round_off = {r.region: r.round_off for r in tr.results if r.round_off}
     for (arg, from_solve, own), rows in groups.items():
         kind = ".solve" if from_solve else (f".round-off-{own}" if own else "")
@@ -339,22 +377,7 @@ def document(tr: Translation, name: str, src: Path) -> tuple[Document, Rendered]
         table = _table_for(tr, arg, mapping)
         if table:
             tables.append(table)
-    for table in tables:
-        _write_table(table, doc)
-        out.table_of[table["name"]] = table["region"]
-    for item in charts:
-        _chart(item, mapping, doc, out)
-    for fname, title, arg, from_solve, absolute in printed:
-        doc.blank()
-        doc.array_table("printed")
-        doc.pair("file", fname)
-        doc.pair("title", title)
-        if arg:
-            doc.pair("argument", arg)
-        # Mathcad's solver stops at its TOL: its roots are that close
-        doc.pair("rel_tolerance", tr.solve_tolerance if from_solve else REL_TOLERANCE)
-        doc.pair("tolerance", absolute)
-    return doc, out
+    return printed, tables
 
 
 def _misfit_rows(res) -> list[list[str]]:
