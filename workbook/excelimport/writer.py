@@ -118,22 +118,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
                 "expr": f'"{text}"',
                 "note": f"{cell.ref} (text)",
             }
-    for info in tr.functions.values():
-        if info.problem or info.final in skip:
-            continue
-        params = list(info.params) + list(info.given.values())
-        for p in params:
-            arguments.setdefault(p, {"unit": ""})
-        key = f"{info.final}({', '.join(params)})" if params else info.final
-        definitions[key] = {
-            "program": info.program + "\n",
-            "note": f"VBA Function {info.proc.name} (module {info.proc.module})"
-            + (
-                f"; left out, without effect on its value: {', '.join(sorted(info.dropped))}"
-                if info.dropped
-                else ""
-            ),
-        }
+    _vba_functions(tr, skip, arguments, definitions)
     rows = []
     run_rows: list = []
     tables: dict = {}
@@ -186,7 +171,45 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
     for text, rname in tr.ranges.items():
         if rname not in skip and rname in used:
             definitions[rname] = {"expr": text, "note": "the cells of a range that formulas read"}
-    # cells of an array formula: the function NAME_at(k) gives element k of NAME
+    at_rows = _array_elements(tr, elements, arguments, definitions)
+    if inputs:
+        doc["inputs"] = inputs
+    if arguments:
+        doc["arguments"] = arguments
+    if definitions:
+        doc["definitions"] = definitions
+    if tables:
+        doc["tables"] = list(tables.values())
+    files, printed, counts = _printed_files(tr, name, skip, rows, at_rows, run_rows)
+    if printed:
+        doc["printed"] = printed
+    toml = "\n".join(_head(tr, skip)) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
+    return toml, files, counts
+
+
+def _vba_functions(tr: Translation, skip: dict, arguments: dict, definitions: dict) -> None:
+    """Each translated VBA Function as a program definition, its parameters as arguments."""
+    for info in tr.functions.values():
+        if info.problem or info.final in skip:
+            continue
+        params = list(info.params) + list(info.given.values())
+        for p in params:
+            arguments.setdefault(p, {"unit": ""})
+        key = f"{info.final}({', '.join(params)})" if params else info.final
+        definitions[key] = {
+            "program": info.program + "\n",
+            "note": f"VBA Function {info.proc.name} (module {info.proc.module})"
+            + (
+                f"; left out, without effect on its value: {', '.join(sorted(info.dropped))}"
+                if info.dropped
+                else ""
+            ),
+        }
+
+
+def _array_elements(tr: Translation, elements, arguments: dict, definitions: dict) -> list:
+    """The cells of array formulas: the function NAME_at(k) gives element k of NAME; the
+    printed rows of the cells' cached values."""
     at_rows = []
     made = set()
     masters = {d.name: d for d in tr.definitions}
@@ -209,17 +232,12 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             arguments["k_at"] = {"unit": "", "note": "the position of a cell in its array formula"}
         if cached is not None:
             at_rows.append((fn, str(d.element[1]), cached, d.cell.ref))
-    if inputs:
-        doc["inputs"] = inputs
-    if arguments:
-        doc["arguments"] = arguments
-    if definitions:
-        doc["definitions"] = definitions
-    if tables:
-        doc["tables"] = list(tables.values())
-    files, printed, counts = _printed_files(tr, name, skip, rows, at_rows, run_rows)
-    if printed:
-        doc["printed"] = printed
+    return at_rows
+
+
+def _head(tr: Translation, skip: dict) -> list[str]:
+    """The comment lines that open the worksheet: what it holds, whether Excel's cached
+    values may be stale, and what was not translated."""
     head = [
         f"# Imported from {tr.path.name} by `workbook import`: inputs from the constant cells",
         "# that formulas read, definitions from formula cells, functions from VBA Functions,",
@@ -240,8 +258,7 @@ def render(tr: Translation, skip: dict[str, str]) -> tuple[str, str, dict]:
             head += _comment(f"  {what}: {why}")
         if len(listed) > 400:
             head.append(f"#   ... and {len(listed) - 400} more")
-    toml = "\n".join(head) + "\n\n" + tomli_w.dumps(doc, multiline_strings=True)
-    return toml, files, counts
+    return head
 
 
 def _printed_files(tr: Translation, name: str, skip: dict, rows, at_rows, run_rows):
