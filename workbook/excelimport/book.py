@@ -517,7 +517,7 @@ def _runs(tr: Translation, cells: list[Cell], parsed, reserved: set[str]) -> Non
         for k, key in enumerate(run.keys()):
             tr.cell_names[key] = f"{run.name}({k})"
             tr.runs[key] = run
-    for span in valid:
+    for span in sorted(valid, key=lambda s: (s[0], s[2], s[1])):  # names as on every run
         run = spans[span]
         columns = {}
         for key, (sheet, col, offset) in run.moving.items():
@@ -622,7 +622,7 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
         for info in tr.functions.values():
             if info.problem:
                 continue
-            for callee in info.calls:
+            for callee in sorted(info.calls):  # sorted: the same reason on every run
                 other = tr.functions.get(callee)
                 if other is not None and other.problem:
                     info.problem = f"calls {other.proc.name}, not translated"
