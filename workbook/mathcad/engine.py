@@ -29,111 +29,147 @@ from .writer import Rendered
 def refusals(data: dict, rendered: Rendered, folder: Path, results=()) -> dict[str, str]:
     """Region id (or ``"REGION/trace N"`` for one trace of a plot) -> why the engine refuses
     it, for the worksheet ``data`` (a TOML document's data) rendered as ``rendered``."""
-    from ..engine.sheet import Sheet
     from ..language.template import spec_from_data
 
     path = folder / f"{rendered.name}.toml"
     spec = spec_from_data(data, path, rendered.name)
-    input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-    sheet = Sheet(spec, typer=tc.Typer(spec, input_units))  # typed here, element by element
-    typer = sheet.typer
-    refused: dict[str, str] = {}
-    bad: set[str] = set()  # definitions and unknowns refused
+    check = _Refusals(spec, rendered)
+    check.solve_blocks()
+    later = check.definitions()
+    check.tables()
+    traces = check.chart_types()
+    check.functions(later)
+    check.chart_values(traces)
+    _mark_misfits(spec, check.typer, results, check.bad)
+    return check.refused
 
-    def region_of(err: WorkbookError, fallback: str | None) -> str:
+
+class _Refusals:
+    """The engine's refusals of a translated worksheet, region by region: each part typed
+    (and a chart's traces computed) as `workbook run` will, unless it reads a part refused."""
+
+    def __init__(self, spec, rendered: Rendered) -> None:
+        from ..engine.sheet import Sheet
+
+        self.spec, self.rendered = spec, rendered
+        input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+        self.sheet = Sheet(spec, typer=tc.Typer(spec, input_units))  # typed element by element
+        self.typer = self.sheet.typer
+        self.refused: dict[str, str] = {}
+        self.bad: set[str] = set()  # definitions and unknowns refused
+
+    def _region_of(self, err: WorkbookError, fallback: str | None) -> str:
         name = err.definition or ""
         if name.startswith("solve "):  # a [[solve]] block: the region of its first unknown
             name = name[len("solve ") :].split(",")[0].strip()
-        region = rendered.region_of.get(name, fallback)
+        region = self.rendered.region_of.get(name, fallback)
         if region is None:
             raise WorkbookError(f"the translated worksheet does not load: {err.message}")
         return region
 
-    def refuse(err: WorkbookError, fallback: str | None, names=()) -> None:
-        region = region_of(err, fallback)
-        refused.setdefault(region, f"the engine refuses it: {err.message}")
-        bad.update(n for n, r in rendered.region_of.items() if r == region)
-        bad.update(names)
+    def _refuse(self, err: WorkbookError, fallback: str | None, names=()) -> None:
+        region = self._region_of(err, fallback)
+        self.refused.setdefault(region, f"the engine refuses it: {err.message}")
+        self.bad.update(n for n, r in self.rendered.region_of.items() if r == region)
+        self.bad.update(names)
 
-    def needs_refused(*nodes: ex.Node) -> bool:
-        return bool(bad) and any(tc.dependencies(spec, n) & bad for n in nodes if n is not None)
+    def _needs_refused(self, *nodes: ex.Node) -> bool:
+        return bool(self.bad) and any(
+            tc.dependencies(self.spec, n) & self.bad for n in nodes if n is not None
+        )
 
-    def series_nodes(s, var: str) -> list[ex.Node]:
-        return [sheet.column_node(col, var) for col in (s.x, s.y) if col is not None]
+    def _series_nodes(self, s, var: str) -> list[ex.Node]:
+        return [self.sheet.column_node(col, var) for col in (s.x, s.y) if col is not None]
 
-    for block in spec.solves:
-        if needs_refused(*tc.solve_expressions(block)):
-            continue
-        try:
-            from ..language.given_find import typed_equations
+    def solve_blocks(self) -> None:
+        from ..language.given_find import typed_equations
 
-            sheet.check_not_circular(block)
-            typed_equations(typer, block)
-        except WorkbookError as err:
-            unknowns = list(block.unknowns)  # a dict of the unknowns, in order
-            refuse(err, rendered.region_of.get(unknowns[0]), unknowns)
-    later = []
-    for name, d in spec.definitions.items():
-        if name in bad or needs_refused(ex.Name(name)):
-            continue
-        try:
-            typer.function(name) if d.is_function else typer.scalar(name)
-        except WorkbookError as err:
-            if d.is_function:
-                later.append(name)
-            else:
-                refuse(err, rendered.region_of.get(name), [name])
-        except RecursionError:
-            refuse(
-                WorkbookError("definitions and expressions nested too deeply for the engine"),
-                rendered.region_of.get(name),
-                [name],
-            )
-    for t in spec.tables:
-        for col in t.columns if t.range is not None else []:
-            node = sheet.column_node(col, t.range.var)
-            if needs_refused(node):
+        for block in self.spec.solves:
+            if self._needs_refused(*tc.solve_expressions(block)):
                 continue
             try:
-                sheet.typed_column(col, t.range.var, f"table {t.name}")
+                self.sheet.check_not_circular(block)
+                typed_equations(self.typer, block)
             except WorkbookError as err:
-                refuse(err, rendered.table_of.get(t.name))
-    traces: list[tuple] = []  # (chart, series, region, trace number) to draw
-    for c in spec.charts:
-        region, numbers = rendered.chart_of[c.name]
-        for s, n in zip(c.series, numbers, strict=True):
-            rng = s.range or c.range
-            what = f"chart {c.name}"
-            if needs_refused(*series_nodes(s, rng.var)):
+                unknowns = list(block.unknowns)  # a dict of the unknowns, in order
+                self._refuse(err, self.rendered.region_of.get(unknowns[0]), unknowns)
+
+    def definitions(self) -> list[str]:
+        """Type every definition; the functions refused at first, to type again last."""
+        later = []
+        for name, d in self.spec.definitions.items():
+            if name in self.bad or self._needs_refused(ex.Name(name)):
                 continue
             try:
-                sheet.typed_column(s.y, rng.var, what)
+                self.typer.function(name) if d.is_function else self.typer.scalar(name)
             except WorkbookError as err:
-                if err.definition in rendered.region_of:
-                    refuse(err, None)
+                if d.is_function:
+                    later.append(name)
                 else:
-                    refused[f"{region}/trace {n}"] = f"the engine refuses it: {err.message}"
+                    self._refuse(err, self.rendered.region_of.get(name), [name])
+            except RecursionError:
+                self._refuse(
+                    WorkbookError("definitions and expressions nested too deeply for the engine"),
+                    self.rendered.region_of.get(name),
+                    [name],
+                )
+        return later
+
+    def tables(self) -> None:
+        for t in self.spec.tables:
+            for col in t.columns if t.range is not None else []:
+                node = self.sheet.column_node(col, t.range.var)
+                if self._needs_refused(node):
+                    continue
+                try:
+                    self.sheet.typed_column(col, t.range.var, f"table {t.name}")
+                except WorkbookError as err:
+                    self._refuse(err, self.rendered.table_of.get(t.name))
+
+    def chart_types(self) -> list[tuple]:
+        """Type every trace; the (chart, series, range, region, trace number) to draw."""
+        traces: list[tuple] = []
+        for c in self.spec.charts:
+            region, numbers = self.rendered.chart_of[c.name]
+            for s, n in zip(c.series, numbers, strict=True):
+                rng = s.range or c.range
+                if self._needs_refused(*self._series_nodes(s, rng.var)):
+                    continue
+                try:
+                    self.sheet.typed_column(s.y, rng.var, f"chart {c.name}")
+                except WorkbookError as err:
+                    if err.definition in self.rendered.region_of:
+                        self._refuse(err, None)
+                    else:
+                        self.refused[f"{region}/trace {n}"] = (
+                            f"the engine refuses it: {err.message}"
+                        )
+                    continue
+                traces.append((c, s, rng, region, n))
+        return traces
+
+    def functions(self, later: list[str]) -> None:
+        """The functions typed at numbers, or by a call with vectors or matrices."""
+        for name in later:
+            if self._needs_refused(ex.Name(name)):
                 continue
-            traces.append((c, s, rng, region, n))
-    for name in later:  # typed at numbers, or by a call with vectors or matrices
-        if needs_refused(ex.Name(name)):
-            continue
-        try:
-            typer.function(name)
-        except WorkbookError as err:
-            refuse(err, rendered.region_of.get(name), [name])
-    for c, s, rng, region, n in traces:  # computed as `workbook run` will draw them
-        if needs_refused(*series_nodes(s, rng.var)):
-            continue
-        try:
-            values = sheet.range_values(rng, f"chart {c.name}")
-            for col in (s.x, s.y):
-                if col is not None:
-                    sheet.column(col, rng.var, values, f"chart {c.name}")
-        except WorkbookError as err:
-            refused[f"{region}/trace {n}"] = f"the engine cannot draw it: {err.message}"
-    _mark_misfits(spec, typer, results, bad)
-    return refused
+            try:
+                self.typer.function(name)
+            except WorkbookError as err:
+                self._refuse(err, self.rendered.region_of.get(name), [name])
+
+    def chart_values(self, traces: list[tuple]) -> None:
+        """Each trace computed as `workbook run` will draw it."""
+        for c, s, rng, region, n in traces:
+            if self._needs_refused(*self._series_nodes(s, rng.var)):
+                continue
+            try:
+                values = self.sheet.range_values(rng, f"chart {c.name}")
+                for col in (s.x, s.y):
+                    if col is not None:
+                        self.sheet.column(col, rng.var, values, f"chart {c.name}")
+            except WorkbookError as err:
+                self.refused[f"{region}/trace {n}"] = f"the engine cannot draw it: {err.message}"
 
 
 def _mark_misfits(spec, typer, results: list[Result], bad: set[str]) -> None:
