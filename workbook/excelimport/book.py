@@ -704,7 +704,16 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
         except Exception as exc:  # noqa: BLE001 - a formula the translation did not foresee
             d.problem = f"not translated ({type(exc).__name__}: {exc})"
         tr.definitions.append(d)
-    # inputs are bounded: a formula that would take the count past MAX_INPUTS is listed
+    _bound_inputs(tr, formula_keys)
+    _spread_problems(tr, by_key)
+    for d in tr.definitions:
+        if d.problem:
+            tr.listed.append((f"{d.cell.ref} ={d.cell.formula[:60]}", d.problem))
+    _constant_inputs(tr, formula_keys)
+
+
+def _bound_inputs(tr: Translation, formula_keys: set) -> None:
+    """Inputs are bounded: a formula that would take the count past MAX_INPUTS is listed."""
     constants: set = set()
     for d in tr.definitions:
         if d.problem:
@@ -714,7 +723,10 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
             d.problem = f"reads more constant cells than the {MAX_INPUTS:,} inputs imported"
             continue
         constants |= new
-    # a formula reading a formula cell that is not translated is not translated either
+
+
+def _spread_problems(tr: Translation, by_key: dict) -> None:
+    """A formula reading a formula cell that is not translated is not translated either."""
     by_name = {}
     for d in tr.definitions:
         by_name.setdefault(d.name, d)
@@ -736,10 +748,12 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                     d.problem = f"reads {other.name} ({other.cell.ref}), not translated"
                     changed = True
                     break
-    for d in tr.definitions:
-        if d.problem:
-            tr.listed.append((f"{d.cell.ref} ={d.cell.formula[:60]}", d.problem))
-    # inputs: the constant cells translated formulas read
+
+
+def _constant_inputs(tr: Translation, formula_keys: set) -> None:
+    """The inputs: the constant cells that translated formulas read (a number, a flag or a
+    text; any other value leaves out the formulas that read it)."""
+    book = tr.book
     for d in tr.definitions:
         if d.problem:
             continue
