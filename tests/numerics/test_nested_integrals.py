@@ -3,6 +3,7 @@ outer variable: against mpmath at 50 digits."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import mpmath
@@ -81,3 +82,61 @@ def test_a_beam_by_double_integration_of_a_piecewise_moment(tmp_path):
         assert err <= 1e-10 * abs(float(want)), (name, v, want)
         assert err <= max(_outer_error(s, name), 1e-17), (name, err)
     assert not [f for f in estimate_findings(s) if f.topic.startswith("estimate")]
+
+
+def _counting_spot_checks(monkeypatch) -> list[int]:
+    """The evaluations of integrands each rounding spot check makes, recorded as it runs."""
+    from workbook.numerics import mpform, rounding
+
+    counts: list[int] = []
+    spend, check = mpform._spend, rounding.discrepancy
+
+    def counted(*args, **kwargs):
+        calls = [0]
+
+        def spending():
+            calls[0] += 1
+            spend()
+
+        monkeypatch.setattr(mpform, "_spend", spending)
+        try:
+            return check(*args, **kwargs)
+        finally:
+            monkeypatch.setattr(mpform, "_spend", spend)
+            counts.append(calls[0])
+
+    monkeypatch.setattr(rounding, "discrepancy", counted)
+    return counts
+
+
+def _nested(depth: int, leaf: str) -> str:
+    """integral(integral(...(leaf in u1)..., u1, 0, s1)..., s_depth, 0, y): depth integrals."""
+    body = leaf
+    for k in range(1, depth + 1):
+        body = f"integral({body}, u{k}, 0, u{k + 1})"
+    return body.replace(f"u{depth + 1}", "y")
+
+
+@pytest.mark.slow
+def test_a_nested_integral_is_spot_checked_within_its_bound(tmp_path, monkeypatch):
+    """The spot check of an integral's own rounding evaluates its integrand in mpmath; an
+    integral inside it costs hundreds of evaluations at each point checked, so the check stops
+    at INNER_EVALUATIONS in all (nested twice, it is left out, not run for minutes)."""
+    from workbook.numerics.rounding import INNER_EVALUATIONS
+
+    counts = _counting_spot_checks(monkeypatch)
+    plain = "".join(f"{v} = {{ unit = '' }}\n" for v in ("y", "u1", "u2"))
+    path = tmp_path / "nested.toml"
+    path.write_text(
+        f"[arguments]\n{plain}[definitions]\n"
+        f'"g(y)" = "{_nested(1, "y*cos(u1)")}"\nK = "integral(g(y), y, 0, 1)"\n'
+        f'"h(y)" = "{_nested(2, "exp(u1/2)")}"\nJ = "integral(h(y), y, 0, 1)"\n',
+        encoding="utf-8",
+    )
+    s = workbook.load(path)
+    # K = int_0^1 y sin(y) dy = sin 1 - cos 1; J = 8 (e^(1/2) - 1) - 5
+    assert s.evaluate("K").magnitude == pytest.approx(math.sin(1) - math.cos(1), rel=1e-12)
+    assert s.evaluate("J").magnitude == pytest.approx(8 * math.expm1(0.5) - 5, rel=1e-12)
+    assert counts and max(counts) <= INNER_EVALUATIONS + 1
+    assert any(0 < n <= INNER_EVALUATIONS for n in counts)  # K's, with one inner integral
+    assert INNER_EVALUATIONS + 1 in counts  # J's, with two: stopped, and left out

@@ -16,8 +16,10 @@ reference's integral in :mod:`workbook.numerics.mpref` (which builds on this mod
 
 from __future__ import annotations
 
+import contextvars
 import operator
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 from ..engine.runtime import COMPARE
 from ..functions.entry import ENTRIES  # as registered: the registry imports this one's users
@@ -46,6 +48,35 @@ class NoValue(ArithmeticError):
 
 class Unconverged(ArithmeticError):
     """The mpmath method did not reach its accuracy."""
+
+
+class TooCostly(ArithmeticError):
+    """The integrands of EXPR's integrals ran past the evaluations allowed
+    (:func:`evaluations`): an integral nested in an integral, checked at many points."""
+
+
+#: evaluations of integrands left to the mpmath forms of this context (None: no bound)
+_LEFT: contextvars.ContextVar[list[int] | None] = contextvars.ContextVar("left", default=None)
+
+
+@contextmanager
+def evaluations(most: int) -> Iterator[None]:
+    """Within: the integrands of the integrals in mpmath forms are evaluated at most ``most``
+    times in all, then :class:`TooCostly` is raised (an inner integral costs hundreds of
+    evaluations at every point of the outer one: nested twice, millions)."""
+    token = _LEFT.set([most])
+    try:
+        yield
+    finally:
+        _LEFT.reset(token)
+
+
+def _spend() -> None:
+    left = _LEFT.get()
+    if left is not None:
+        left[0] -= 1
+        if left[0] < 0:
+            raise TooCostly("the integrals' integrands evaluated more often than allowed")
 
 
 def _real(ctx, v):
@@ -103,10 +134,12 @@ def _inside(g, x, lo, hi):
     """g at a node of a piece; 0 at a node that rounds to an end (a singular end's nodes
     come closer to it than the precision: they weigh less than 1e-16 of an integrable
     singularity's integral, below the reference's accuracy)."""
+    _spend()
     return 0 if x in (lo, hi) else g(x)
 
 
 def _abs_or_zero(g, x):
+    _spend()
     try:
         return abs(g(x))
     except (NoValue, ZeroDivisionError):

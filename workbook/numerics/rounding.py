@@ -11,7 +11,9 @@ twice it, and its place through the curvature (:func:`extremum_rounding`).
 
 Only some rows spread over a call are checked (an mpmath evaluation is ~1e4 times a numpy
 one): the others take the difference of the nearest checked rows.
-Where EXPR has no mpmath form, or a point has no value in mpmath, nothing is added.
+Where EXPR has no mpmath form, or a point has no value in mpmath, nothing is added; nor
+where EXPR's own integrals cost more than INNER_EVALUATIONS evaluations of their integrands
+in one check (an integral nested twice).
 """
 
 from __future__ import annotations
@@ -27,6 +29,10 @@ DIGITS = 40
 #: of one call at most beyond them (a table of few points a row checks more rows)
 ROWS = 8
 BUDGET = 256
+#: evaluations of the integrands of EXPR's own integrals in one spot check at most (one inner
+#: integral at every point checked fits; an integral nested twice does not, and is not
+#: checked: its inner integrals' estimates hold their rounding)
+INNER_EVALUATIONS = 20_000
 
 
 _CONTEXT: list = []
@@ -67,7 +73,7 @@ def discrepancy(
     by default ROWS, or more where BUDGET mpmath evaluations allow; ``only``: the rows
     checked, the others NaN). Rows not checked take the largest difference of the nearest
     checked rows (interpolated along the call)."""
-    from .mpform import NoValue
+    from .mpform import NoValue, TooCostly, evaluations
 
     prepared = prepared or form_of(of)
     if prepared is None:
@@ -84,19 +90,22 @@ def discrepancy(
     if only is not None:
         rows = np.asarray(only, dtype=np.intp)
     out = np.full(xs.shape, np.nan)
-    for i in rows:
-        env = row_env(i)
-        for j, (x, f) in enumerate(zip(xs[i], fs[i])):
-            out[i, j] = 0.0
-            if not np.isfinite(f):
-                continue
-            try:
-                exact = form({**env, of.var: ctx.mpf(float(x))})
-            except (NoValue, ZeroDivisionError, ValueError, TypeError):
-                continue
-            if isinstance(exact, str):
-                return None
-            out[i, j] = abs(float(ctx.mpf(float(f)) - exact))
+    with evaluations(INNER_EVALUATIONS):
+        for i in rows:
+            env = row_env(i)
+            for j, (x, f) in enumerate(zip(xs[i], fs[i])):
+                out[i, j] = 0.0
+                if not np.isfinite(f):
+                    continue
+                try:
+                    exact = form({**env, of.var: ctx.mpf(float(x))})
+                except (NoValue, ZeroDivisionError, ValueError, TypeError):
+                    continue
+                except TooCostly:
+                    return None
+                if isinstance(exact, str):
+                    return None
+                out[i, j] = abs(float(ctx.mpf(float(f)) - exact))
     if n > rows.size and only is None:
         # the nearest checked rows' difference (rounding varies along a table: a step size;
         # relative to a row's own value it would blow up beside a zero of EXPR)
