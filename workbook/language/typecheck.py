@@ -276,7 +276,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         return d
 
     def _unknown(self, kind: str, name: str, scope=()) -> TemplateError:
-        """``unknown name 'x'`` with the nearest names a formula of this sheet may use."""
+        """``unknown name 'x'`` with the nearest names a formula of this sheet may use (none
+        for a text that is no name: an imported value's label such as ``Sheet!G4 (not
+        translated)``, named so that no formula reads it, among thousands of others)."""
+        if not ex.is_identifier(name):
+            return TemplateError(f"unknown {kind} '{name}'")
         spec = self.spec
         own = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
         known = {**own, **dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS])}
