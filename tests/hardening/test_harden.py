@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import openpyxl
 import pytest
+from helpers.sheets import SINE
 
 import workbook
 from workbook import WorkbookError
@@ -355,16 +356,9 @@ def test_outputs_that_are_not_regular_files_are_refused(tmp_path):
 
 # -- injection ---------------------------------------------------------------------------------
 
-INJECT = """
-[inputs]
-R = "10 mm"
-
-[arguments]
-phi = { unit = "deg" }
-
-[definitions]
-"y(phi)" = "R*sin(phi)"
-
+INJECT = (
+    SINE
+    + """
 [[tables]]
 name = "t"
 title = "=HYPERLINK(\\"http://x\\")"
@@ -382,6 +376,7 @@ x = { expr = "phi", title = "@x" }
 y_title = "+y"
 series = [{ y = "y", unit = "mm", name = "=A1" }]
 """
+)
 
 
 @pytest.mark.slow
