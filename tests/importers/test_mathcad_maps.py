@@ -11,6 +11,9 @@ import struct
 import pytest
 from helpers.mathcad import bare_worksheet as _worksheet
 from helpers.mathcad import region as _region
+from helpers.mathcad_xml import apply as _apply
+from helpers.mathcad_xml import ident as _id
+from helpers.mathcad_xml import real as _real
 from helpers.paths import SHARED
 
 from workbook.cli import main
@@ -65,19 +68,6 @@ def _eval(rid: int, body: str, result: str) -> str:
         f'<math><ml:eval xmlns:ml="{ML}">{body}<ml:result>{result}</ml:result></ml:eval>'
         "</math></region>"
     )
-
-
-def _real(v) -> str:
-    return f"<ml:real>{v}</ml:real>"
-
-
-def _id(name, sub=None) -> str:
-    s = f' subscript="{sub}"' if sub else ""
-    return f"<ml:id{s}>{name}</ml:id>"
-
-
-def _apply(op, *args) -> str:
-    return f"<ml:apply><ml:{op}/>{''.join(args)}</ml:apply>"
 
 
 @pytest.mark.slow

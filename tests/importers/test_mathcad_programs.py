@@ -16,6 +16,7 @@ from helpers.mathcad_xml import for_loop as _for
 from helpers.mathcad_xml import function as _function
 from helpers.mathcad_xml import ident as _id
 from helpers.mathcad_xml import if_then as _if
+from helpers.mathcad_xml import import_sheet as _import
 from helpers.mathcad_xml import index as _index
 from helpers.mathcad_xml import local as _local
 from helpers.mathcad_xml import matrix as _matrix
@@ -25,14 +26,6 @@ from helpers.mathcad_xml import real as _real
 from helpers.mathcad_xml import worksheet as _worksheet
 
 from workbook.cli import main
-
-
-def _import(tmp_path, capsys, name: str, *regions: str, origin: int = 0) -> str:
-    src = tmp_path / f"{name}.xmcd"
-    src.write_text(_worksheet(*regions, origin=origin), encoding="utf-8")
-    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
-    capsys.readouterr()
-    return (tmp_path / f"{name}.toml").read_text(encoding="utf-8")
 
 
 def _translated(tmp_path, name: str, *regions: str, origin: int = 0):
