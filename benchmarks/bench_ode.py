@@ -10,8 +10,9 @@ output, rtol 1e-6 and atol 1e-9. Then the sheet: tests/data/robertson.toml solve
 Sheet (units, compiled derivatives) against the fastest direct stiff solver (for information:
 a fresh sheet's fixed costs), and ``check`` of that sheet and of templates/advance-coupling.toml
 against solving each [[ode]] once plus its global error estimate (the run at 1000 times
-tighter tolerances). Times are medians of
-alternated runs in process CPU time (the machine is shared).
+tighter tolerances). Last, the coupling's default solver at its stiff case (c2 = 1e10 N/m)
+against the fastest method and tolerance of a study that still reaches the rigid limit. Times
+are medians of alternated runs in process CPU time (the machine is shared).
 """
 
 from __future__ import annotations
@@ -114,11 +115,40 @@ def _check_row(path: Path, reps: int) -> Result:
     )
 
 
+def _default_solver_row(reps: int) -> Result:
+    """The coupling's default method at rtol 1e-5 against the fastest study run (method and
+    rtol) that ends within twice the rigid limit's deflection of the rigid motion."""
+    import workbook
+    from workbook.blocks import coupling as cp
+
+    sheet = workbook.load(COUPLING, parts="all").with_inputs(t_end="0.1 s")
+    df = cp.study(sheet, (1e10,), (1e-3, 1e-4, 1e-5, 1e-6, 1e-7), max_time=2.0, label=None)
+    stiff = sheet.with_inputs(c2="1e10 N/m")
+    case = cp.case(stiff)
+    ok = df[(df["stopped"] == "finished") & (df["deviation from rigid [rad]"] <= 2 * case.delta)]
+    best = ok.loc[ok["run time [s]"].idxmin()]
+    method = str(stiff.evaluate("method_used"))
+    td, tb = alternate(
+        lambda: cp.run(stiff, method, 1e-5, case.t),
+        lambda: cp.run(stiff, best["method"], best["rtol"], case.t),
+        reps=reps,
+        clock=time.process_time,
+    )
+    return Result(
+        "advance-coupling at c2 = 1e10 N/m: default solver / fastest run reaching the rigid limit",
+        median(td) / median(tb),
+        2.0,
+        detail=f"{method} rtol 1e-5 {ms(median(td))}, {best['method']} rtol "
+        f"{best['rtol']:g} {ms(median(tb))}",
+    )
+
+
 def run(reps: int = 5) -> list[Result]:
-    """A ratio per problem, then the sheet's."""
+    """A ratio per problem, then the sheets'."""
     out = [_problem_row(name, *p, reps=reps) for name, p in PROBLEMS.items()]
     out.append(_sheet_row(reps))
-    return out + [_check_row(path, max(1, reps // 2)) for path in (TEMPLATE, COUPLING)]
+    out += [_check_row(path, max(1, reps // 2)) for path in (TEMPLATE, COUPLING)]
+    return out + [_default_solver_row(reps)]
 
 
 def main(argv=None) -> int:

@@ -337,23 +337,17 @@ def test_rigid_limit_and_default_solver_at_c2_1e10(sheet):
 
 
 @pytest.mark.slow
-def test_default_solver_within_2x_of_fastest(sheet):
-    """One study at c2 = 1e10 N/m; the default and the fastest run that reaches the rigid
-    limit are then timed again side by side (best of 3)."""
+def test_default_solver_reaches_the_rigid_limit(sheet):
+    """One study at c2 = 1e10 N/m: the default method at rtol 1e-5 finishes within twice the
+    rigid limit's deflection of the rigid motion (its speed against the fastest such run is
+    measured in benchmarks/bench_ode.py)."""
     p = variant(sheet, t_end=0.1)
     df = cp.study(p, (1e10,), (1e-3, 1e-4, 1e-5, 1e-6, 1e-7), max_time=2.0, label=None)
     stiff = variant(p, 1e10)
-    cs = cp.case(stiff)
-    tol = 2 * cs.delta
+    tol = 2 * cp.case(stiff).delta
     ok = df[(df["stopped"] == "finished") & (df["deviation from rigid [rad]"] <= tol)]
-    assert not ok.empty
-    best = ok.loc[ok["run time [s]"].idxmin()]
     method = str(stiff.evaluate("method_used"))
-    default_rows = ok[(ok["method"] == method) & (ok["rtol"] == 1e-5)]
-    assert not default_rows.empty  # the default reaches the rigid limit
-    t_best = min(cp.run(stiff, best["method"], best["rtol"], cs.t).elapsed for _ in range(3))
-    t_def = min(cp.run(stiff, method, 1e-5, cs.t).elapsed for _ in range(3))
-    assert t_def <= 2 * t_best, (best["method"], best["rtol"], t_best, t_def)
+    assert not ok[(ok["method"] == method) & (ok["rtol"] == 1e-5)].empty, df
 
 
 @pytest.mark.slow
