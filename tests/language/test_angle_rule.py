@@ -171,10 +171,13 @@ def test_a_log_spaced_range_in_the_workbook_recalculates(tmp_path):
 
     sheet = workbook.load(write_template(tmp_path, LOG))
     path = sheet.write_xlsx(tmp_path / "bode.xlsx")
-    ws = openpyxl.load_workbook(path)["Listing"]
+    ws = openpyxl.load_workbook(path, data_only=True)["Listing"]
     header = next(r for r in range(1, 10) if ws.cell(r, 1).value == "f [Hz]")
     xs = [ws.cell(header + 1 + i, 1).value for i in range(7)]
-    np.testing.assert_allclose(xs, np.logspace(1, 7, 7), rtol=1e-14)  # numbers, not FIRST+i*STEP
+    np.testing.assert_allclose(xs, np.logspace(1, 7, 7), rtol=1e-14)  # not FIRST+i*STEP
+    # its points are an input: formulas FIRST*(LAST/FIRST)^(i/(n-1)) and a guard of n
+    formulas_ws = openpyxl.load_workbook(path)["Listing"]
+    assert formulas_ws.cell(header + 2, 1).value.startswith("=(10)*((10000000)/(10))^(1/6)")
     solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
     got = {}
     for key, ranges in solution.items():
@@ -183,6 +186,7 @@ def test_a_log_spaced_range_in_the_workbook_recalculates(tmp_path):
             got[cell.upper()] = ranges.value[0, 0]
     for i, want in enumerate(sheet.table("bode").iloc[:, 1]):
         assert float(got[f"B{header + 1 + i}"]) == pytest.approx(want, rel=1e-12)
+        assert float(got[f"A{header + 1 + i}"]) == pytest.approx(xs[i], rel=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -296,8 +296,10 @@ def test_each_table_reads_its_own_rows_steps_and_ranges_over_inputs_are_live(tmp
     out = sheet.write_xlsx(tmp_path / "two.xlsx")
     book = openpyxl.load_workbook(out)
     one, log = book["One"], book["Log"]
-    assert one["A3"].value == "=(xa)"
-    assert log["A3"].value == "=(xa)" and log["A7"].value == "=(xb*10)"
+    assert one["A3"].value == "=(xa)+$D$1"  # its row-count guard: right of the title
+    assert one["D1"].value.startswith("=IF(AND(")
+    assert log["C1"].value == "=IF((5)=5,0,NA())"
+    assert log["A3"].value == "=(xa)+$C$1" and log["A7"].value == "=(xb*10)+$C$1"
     assert log["A5"].value.startswith("=(xa)*((xb*10)/(xa))^(")
     first = book["Listing"]["B3"].value
     assert "Solver rows" in first and "Solver rows" in one["B3"].value

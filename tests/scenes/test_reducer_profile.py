@@ -412,8 +412,9 @@ def test_libreoffice_recalculates_the_live_profile(sheet, tmp_path):
     path = sheet.write_xlsx(tmp_path / "rp.xlsx")
     cached = formula_values(path)
     listing = {k: v for k, (f, v) in cached.items() if k[0] == "Listing"}
-    # phi itself (its step dphi is an input), a, rho_0, x_0, y_0, x_t, y_t over phi = 0, 2 .. 360
-    assert len(listing) == 181 * 7
+    # phi itself (its step dphi is an input), a, rho_0, x_0, y_0, x_t, y_t over phi = 0, 2 .. 360,
+    # and the range's row-count guard
+    assert len(listing) == 181 * 7 + 1
     new = cell_values(recalculate(path, tmp_path / "lo"))
     bad = [
         k

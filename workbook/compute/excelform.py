@@ -31,7 +31,7 @@ from ..language.uses import names_used
 from ..limits import MAX_TABLE_CELLS
 from ..outputs import style
 from ..version import __version__
-from . import excelchecks, frozen
+from . import excelchecks, frozen, rangeguard
 from .excel import ExcelPrinter, NotLive, cell_value
 from .excelsheets import (
     MAX_COLS,
@@ -508,7 +508,7 @@ class ExcelLayout:
         heads = [un.header(c.title, c.unit, typeset_unit=True) for c in data.columns]
         write_labels(ws, start + 1, 0, heads, self.fmt["header"])
         first = start + 2
-        self._write_range_column(ws, spec, first, data.columns[0].values)
+        self._write_range_column(ws, spec, first, data.columns[0].values, len(data.columns))
         var_ref = f"$A${ROW_TOKEN}"
         report = n * len(data.columns) > PROGRESS_CELLS
         for j, col in enumerate(data.columns[1:], start=1):
@@ -531,10 +531,11 @@ class ExcelLayout:
         ws.set_column(0, len(data.columns) - 1, 13)
         self.rows[spec.sheet] = first + n + 2
 
-    def _write_range_column(self, ws, spec, first: int, values: np.ndarray) -> None:
+    def _write_range_column(self, ws, spec, first: int, values: np.ndarray, width: int) -> None:
         """The range variable's column: numbers for constant bounds; for bounds that depend on
-        inputs, formulas ``=FIRST+i*(SECOND-FIRST)`` and ``=LAST`` (the engine's values), so
-        the table follows an edited input as long as the number of rows stays the same."""
+        inputs, formulas ``=FIRST+i*(SECOND-FIRST)`` and ``=LAST`` (the engine's values) plus
+        a guard cell right of the title (``width`` columns in): the table follows an edited
+        input while the number of rows stays the same, and is ``#N/A`` when it does not."""
         fmt, n = self.fmt["number"], len(values)
         bounds = self._live_bounds(spec.range)
         if bounds is None or isinstance(bounds, str):
@@ -545,46 +546,54 @@ class ExcelLayout:
                 self.not_live.append(f"{spec.name}.{spec.range.var}")
                 self.freeze(ws, first, 0, n, 1, f"{spec.name}.{spec.range.var}")
             return
-        lo, second, hi = bounds
+        lo, second, hi, points = bounds
         if spec.range.points is not None:  # log-spaced: FIRST*(LAST/FIRST)^(i/(n-1))
             inner = [f"=({lo})*(({hi})/({lo}))^({i}/{n - 1})" for i in range(1, n - 1)]
+            count = rangeguard.log_count_formula(points, n)
         else:
             if second is not None:
                 step = f"(({second})-({lo}))"
             else:
                 step = "1" if values[-1] >= values[0] else "(-1)"
             inner = [f"=({lo})+{i}*{step}" for i in range(1, n - 1)]
-        ws.write_formula(first, 0, f"=({lo})", fmt, float(values[0]))
+            count = rangeguard.stepped_count_formula(lo, step, hi, n)
+        ws.write_formula(first - 2, width, count, self.fmt["guard"], 0)
+        guard = xl_rowcol_to_cell(first - 2, width, row_abs=True, col_abs=True)
+        self.formula_cells += 1
+        ws.write_formula(first, 0, f"=({lo})+{guard}", fmt, float(values[0]))
         for i, text in enumerate(inner, start=1):
-            ws.write_formula(first + i, 0, text, fmt, float(values[i]))
+            ws.write_formula(first + i, 0, f"{text}+{guard}", fmt, float(values[i]))
         if n > 1:
-            ws.write_formula(first + n - 1, 0, f"=({hi})", fmt, float(values[-1]))
+            ws.write_formula(first + n - 1, 0, f"=({hi})+{guard}", fmt, float(values[-1]))
         self.formula_cells += n
         ws.write_comment(
-            first - 1,
-            0,
+            first - 2,
+            width,
             f"Live range {spec.range.text}: its bounds follow the inputs, but the number of "
-            f"rows ({n}) was fixed when the workbook was written; if an edit changes it, "
+            f"rows ({n}) was fixed when the workbook was written. This cell counts the range's "
+            "values at the current inputs: while they are as many, it shows 'rows ok'; "
+            "otherwise it is #N/A, and so is the table and every formula that reads it: "
             "regenerate (workbook run --inputs edited.xlsx).",
         )
 
-    def _live_bounds(self, rng) -> tuple[str, str | None, str] | str | None:
-        """Excel texts of a range's bounds in the variable's unit; None when the bounds are
+    def _live_bounds(self, rng) -> tuple[str, str | None, str, str | None] | str | None:
+        """Excel texts of a range's bounds in the variable's unit (and its points, for a
+        log range); None when the bounds are
         constants (written as numbers); the reason when they follow the inputs but cannot be
         live formulas (the column is then written as numbers and marked frozen)."""
-        nodes = (rng.first, rng.second, rng.last)
+        nodes = (rng.first, rng.second, rng.last, rng.points)
         # a bound that names no input or definition names none through them either
         names = set().union(*(ex.names(x) for x in nodes if x))
         if not names & (set(self.sheet.spec.inputs) | set(self.sheet.spec.definitions)):
             return None
+        typed = self.sheet.range_bounds(rng, f"range {rng.text}")
+        if rng.points is not None:
+            typed = [*typed, self.sheet.range_points(rng, f"range {rng.text}")]
         try:
-            texts = [
-                None if t is None else self.printer.formula(t, {})[1:]
-                for t in self.sheet.range_bounds(rng, f"range {rng.text}")
-            ]
+            texts = [None if t is None else self.printer.formula(t, {})[1:] for t in typed]
         except NotLive as why:
             return str(why)
-        return texts[0], texts[1], texts[2]
+        return texts[0], texts[1], texts[2], texts[3] if len(texts) > 3 else None
 
     def _write_column(
         self, ws, table: str, first: int, j: int, col, var: str, var_ref: str, n, var_values

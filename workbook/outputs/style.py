@@ -20,6 +20,8 @@ FORMATS: dict[str, dict] = {
     # a value that does not follow an edit of the inputs, and a live cell that reads one
     "frozen": {"bg_color": "#D9D9D9", "italic": True, "num_format": "General"},
     "stale": {"bg_color": "#FCE4D6", "num_format": "General"},
+    # a live range's row-count guard: 0 while the count holds, shown as a word
+    "guard": {"italic": True, "font_color": "#595959", "num_format": '0;-0;"rows ok"'},
 }
 
 GRIDLINES = {"visible": True, "line": {"color": "#D9D9D9"}}
