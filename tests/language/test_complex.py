@@ -311,7 +311,7 @@ def ac_book(ac, tmp_path_factory):
 
 def test_complex_cells_are_live_im_formulas_with_excel_text(ac, ac_book):
     _, book, cached = ac_book
-    ws, values = book["Definitions"], cached["Definitions"]
+    ws, values = book["Results"], cached["Results"]
     rows = {ws.cell(r, 1).value: r for r in range(2, ws.max_row + 1)}
     formulas = {n: ws.cell(rows[n], 2).value for n in ("Z", "I", "I_mag", "phi", "Zp", "S", "P")}
     assert all(f.startswith("=") for f in formulas.values()), formulas

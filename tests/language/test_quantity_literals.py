@@ -201,7 +201,7 @@ def test_a_percentage_in_a_formula_is_live_in_excel(tmp_path):
     values = [
         float(r.value[0, 0])
         for key, r in solution.items()
-        if key.upper().endswith("DEFINITIONS'!B2") or key.upper().endswith("DEFINITIONS!B2")
+        if key.upper().endswith("RESULTS'!B2") or key.upper().endswith("RESULTS!B2")
     ]
     assert values and math.isclose(values[0], 11.22, rel_tol=1e-12), values
 

@@ -368,7 +368,7 @@ def test_statistics_are_live_and_formulas_agrees(stats, tmp_path):
     import openpyxl
 
     path = stats.write_xlsx(tmp_path / "stats.xlsx")
-    ws = openpyxl.load_workbook(path)["Definitions"]
+    ws = openpyxl.load_workbook(path)["Results"]
     rows = {
         r[0].value: getattr(r[1].value, "text", r[1].value)  # array formulas: their text
         for r in ws.iter_rows(min_row=2)
@@ -381,7 +381,7 @@ def test_statistics_are_live_and_formulas_agrees(stats, tmp_path):
     got = {}
     for key, value in solution.items():
         book_sheet, _, cell = key.rpartition("!")
-        if book_sheet.upper().endswith("DEFINITIONS'") and ":" not in cell:
+        if book_sheet.upper().endswith("RESULTS'") and ":" not in cell:
             got[cell.upper()] = value.value[0, 0]
     checked = 0
     for r in ws.iter_rows(min_row=2):
@@ -423,14 +423,14 @@ def test_reciprocal_trigonometry_against_mpmath_and_formulas(tmp_path):
     for name, value in want.items():
         assert sheet.evaluate(name).magnitude == pytest.approx(float(value), rel=4e-16), name
     path = sheet.write_xlsx(tmp_path / "trig.xlsx")
-    ws = openpyxl.load_workbook(path)["Definitions"]
+    ws = openpyxl.load_workbook(path)["Results"]
     cells = {r[0].value: r[1] for r in ws.iter_rows(min_row=2) if r[0].value in want}
     assert cells["s"].value.startswith("=1/COS(")
     solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
     got = {
         key.rpartition("!")[2].upper(): v.value[0, 0]
         for key, v in solution.items()
-        if key.rpartition("!")[0].upper().endswith("DEFINITIONS'")
+        if key.rpartition("!")[0].upper().endswith("RESULTS'")
     }
     for name, cell in cells.items():
         assert float(got[cell.coordinate]) == pytest.approx(float(want[name]), rel=1e-14), name

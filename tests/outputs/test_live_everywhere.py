@@ -12,8 +12,10 @@ import math
 import numpy as np
 import openpyxl
 import pytest
+from helpers.recalc import formula_values
 from helpers.sheets import FROZEN, RATIOS
 
+import workbook
 from workbook.compute import cellunit, livecheck, xleval
 
 
@@ -305,3 +307,16 @@ def test_each_table_reads_its_own_rows_steps_and_ranges_over_inputs_are_live(tmp
     assert "Solver rows" in first and "Solver rows" in one["B3"].value
     steps = {c.value for c in book["Solver rows"][3] if isinstance(c.value, str)}
     assert any("'One'!$A$3" in s for s in steps) and any("'Listing'!$A$3" in s for s in steps)
+
+
+def test_the_workbook_does_not_depend_on_what_was_evaluated_before(tmp_path, sheet_from):
+    """A definition evaluated through the API before writing is not thereby 'used' by a
+    table: the workbook written after evaluating every definition is the one written
+    without (no Definitions sheet appears)."""
+    text = RATIOS + '[[tables]]\nname = "t"\nrange = "n_row := 0 .. 2"\ncolumns = ["2*n_row"]\n'
+    first = formula_values(sheet_from(text).write_xlsx(tmp_path / "a.xlsx"))
+    asked = sheet_from(text)
+    for name, d in asked.spec.definitions.items():
+        if not d.is_function:
+            asked.evaluate(name)
+    assert formula_values(asked.write_xlsx(tmp_path / "b.xlsx")) == first

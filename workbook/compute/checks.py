@@ -186,6 +186,13 @@ def run_checks(sheet) -> Report:
 
 
 def collect_findings(sheet) -> list[Finding]:
+    """The findings of the sheet's own checks, ODEs, solve blocks, declared checks and
+    [[findings]] blocks; what they evaluate through the sheet counts as used."""
+    with sheet.recording_reads():
+        return _findings(sheet)
+
+
+def _findings(sheet) -> list[Finding]:
     from .. import blocks
     from ..engine.angle_slips import angle_findings
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import cmath
+import contextlib
 import math
 from typing import Any
 
@@ -67,9 +68,12 @@ class Sheet:
         # the trees typed at load besides the definitions' (shared by with_inputs, with_parts)
         self.typed = typed if typed is not None else TypedSheet()
         self._memo: dict[str, object] = {}
-        # names evaluated through this sheet (by blocks, among others): what a block table or
-        # a finding reads counts as used, without a hand-kept list in the template
+        # names evaluated through this sheet by a block table or a finding (within
+        # ``recording_reads``): they count as used, without a hand-kept list in the template;
+        # what a caller of the API evaluates does not, so the workbook is the same whatever
+        # was evaluated before it was written
         self.reads: set[str] = set()
+        self.recording = 0
         self.evaluator = Evaluator(
             self.typer, self.scalar_value, self.describe_call, self._column_values
         )
@@ -273,6 +277,16 @@ class Sheet:
         parts (``with_inputs``, ``with_parts``); a subclass makes one of its own kind."""
         return Sheet(self.full_spec, values, self.typer, parts, self.typed)
 
+    @contextlib.contextmanager
+    def recording_reads(self):
+        """Within the block, the names evaluated through this sheet are added to ``reads``
+        (a block table's and a finding's)."""
+        self.recording += 1
+        try:
+            yield
+        finally:
+            self.recording -= 1
+
     def once(self, key: tuple, make):
         """``make()``, made once per Sheet under ``key`` (a Sheet does not change: other
         inputs or parts are another Sheet)."""
@@ -309,7 +323,7 @@ class Sheet:
 
     def _evaluate(self, name: str, *args, **kwargs) -> pint.Quantity | str:
         Q = un.registry().Quantity
-        if name in self.spec.inputs or name in self.spec.definitions:
+        if self.recording and (name in self.spec.inputs or name in self.spec.definitions):
             self.reads.add(name)
         if name in self.spec.inputs:
             return self.values[name]
@@ -766,7 +780,8 @@ class Sheet:
     def block_table(self, ref: str):
         from .. import blocks
 
-        return blocks.get(ref, "table").func(self)
+        with self.recording_reads():
+            return blocks.get(ref, "table").func(self)
 
     def family_table(self, spec):
         """A table with ``vary = { NAME = [values] }``: its range, then each column at each

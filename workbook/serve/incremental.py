@@ -82,7 +82,8 @@ class ReusingSheet(Sheet):
             hash(key)
         except TypeError:  # an array argument: computed
             return super().evaluate(name, *args, **kwargs)
-        self.reads.add(name)
+        if self.recording:
+            self.reads.add(name)
         return self._take(key, lambda: Sheet.evaluate(self, name, *args, **kwargs))
 
     def _take(self, key, make):
