@@ -15,7 +15,6 @@ import pytest
 from helpers.recalc import formula_values
 from helpers.sheets import FROZEN, RATIOS
 
-import workbook
 from workbook.compute import cellunit, livecheck, xleval
 
 
