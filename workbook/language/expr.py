@@ -216,7 +216,8 @@ def _quantity_literals(source: str) -> str:
     """Each number followed by a unit (``20 mm``, ``9.81 m/s**2``, ``5 W/(m*K)``) as the
     Python ``(20 @ "mm")``, which :func:`_convert` reads as a :class:`Quantity` (``@`` is no
     operator of the language). The unit is the name after the number and what is joined to it
-    without a space by ``*``, ``/``, ``**`` and a power: ``2 m * x`` is 2 m times x."""
+    without a space by ``*``, ``/``, ``**`` and a power: ``2 m * x`` is 2 m times x, and so is
+    ``10 mm*cos(x)`` 10 mm times cos(x) (a name followed by ``(`` is a call, never a unit)."""
     import io
     import tokenize
 
@@ -317,6 +318,8 @@ def _unit_end(tokens, i: int) -> int:
             while tokens[k].string == "(" and joined(k + 1):
                 k, depth = k + 1, depth + 1
             if tokens[k].type != tokenize.NAME or tokens[k].string in _NOT_UNITS:
+                break
+            if joined(k + 1) and tokens[k + 1].string == "(":  # 10 mm*cos(x): a call
                 break
             j = k + 1
         elif tok.string == ")" and depth:
