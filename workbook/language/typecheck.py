@@ -109,6 +109,8 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 body = self.typed_body(d, {})
                 if d.unit is not None:
                     body = self.convert(body, d.unit, _declared(name, d.unit))
+                elif not body.text and un.reduced(body.unit) != body.unit:  # rho*V: kg
+                    body = self.convert(body, un.reduced(body.unit), f"the formula of '{name}'")
             self.scalars[name] = body
         return self.scalars[name]
 

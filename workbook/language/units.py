@@ -244,6 +244,23 @@ def is_compound_ratio(u: pint.Unit) -> bool:
     return not u.dimensionality and ("/" in text or "*" in text) and not is_angle(u)
 
 
+@functools.lru_cache(maxsize=512)
+def reduced(u: pint.Unit) -> pint.Unit:
+    """``u`` with its factors of one dimension combined (``kg*L/m^3`` is ``kg``, ``N*m/mm``
+    is ``N``), as pint's ``to_reduced_units``; ``u`` itself when that leaves as many factors,
+    when it is dimensionless, or when a factor is dimensionless (an angle, a percentage:
+    ``N*m/rad`` is a torsional stiffness) or a temperature with an offset."""
+    ureg = registry()
+    names = to_units_container(u)
+    if not u.dimensionality or len(names) < 2:
+        return u
+    for name in names:
+        if not ureg.Unit(name).dimensionality or ureg.Quantity(0.0, name).to_base_units().magnitude:
+            return u
+    out = ureg.Quantity(1.0, u).to_reduced_units().units
+    return out if len(to_units_container(out)) < len(names) else u
+
+
 #: How a worksheet spells a unit where pint's symbol is not what it types: pint's liter is l.
 _SPELT = {"liter": "L"}
 
