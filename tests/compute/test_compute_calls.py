@@ -144,27 +144,8 @@ def test_a_sheet_is_checked_and_computed_once_through_the_api(tmp_path, monkeypa
     assert calls == {"compute": 3, "check": 2}
 
 
-#: sheets whose computing still types: strict, so that the day it types nothing it is seen
-STILL_TYPED = {
-    "tests/data/numerical-builtins.toml": "a [[solve]] block's equations are typed again when "
-    "it is solved (language/given_find.py)",
-}
-
-
-def every_sheet():
-    return [
-        pytest.param(
-            name,
-            marks=[pytest.mark.xfail(strict=True, reason=STILL_TYPED[name])]
-            if name in STILL_TYPED
-            else [],
-        )
-        for name in compute_calls.sheets()
-    ]
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("name", every_sheet())
+@pytest.mark.parametrize("name", compute_calls.sheets())
 def test_computing_and_writing_types_and_parses_nothing(name):
     found = compute_calls.calls(name)
     assert found["typing"] == 0, found

@@ -95,11 +95,11 @@ class Sheet:
         items = len(self.spec.definitions) + len(self.spec.inputs)
         limits_time.grow_default(limits_time.SECONDS_PER_ITEM * items, f"'{self.file}'")
         for block in self.spec.solves:
-            from ..language.given_find import typed_equations
+            from ..language.given_find import type_block
 
             try:
                 self.check_not_circular(block)
-                typed_equations(self.typer, block)
+                self.typed.keep(block, "solve", type_block(self.typer, block))
             except WorkbookError as err:
                 raise err.located(file=self.file, line=block.line, definition=block.what) from None
         later = []  # functions whose body needs vectors: typed by the calls of the sheet

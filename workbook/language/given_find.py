@@ -162,21 +162,53 @@ def typed_equations(typer, block: SolveSpec) -> list[tuple[ty.T, ty.T]]:
                 f"({un.pretty(right.unit) or '1'})"
             )
         out.append((left, typer.convert(right, left.unit, f"equation {text!r}")))
-    typed_conditions(typer, block)  # checked with the equations, when the sheet is loaded
     return out
+
+
+@dataclass(frozen=True)
+class TypedSolve:
+    """A [[solve]] block's trees, typed once when the sheet is loaded: both sides of every
+    equation (the right in the left's unit), every condition, and every comparison of the
+    conditions as (smaller side, larger side) in one unit."""
+
+    equations: tuple[tuple[ty.T, ty.T], ...]
+    conditions: tuple[tuple[ty.T, str], ...]
+    comparisons: tuple[tuple[ty.T, ty.T], ...]
+
+
+def type_block(typer, block: SolveSpec) -> TypedSolve:
+    """Type a [[solve]] block's equations and conditions (units checked: load time)."""
+    scope = scope_of(typer, block)
+    comparisons = []
+    for node, text in block.conditions:
+        sides = [typer.expression(o, scope, block.what) for o in node.operands]
+        for op, a, b in zip(node.ops, sides, sides[1:]):
+            b = typer.convert(b, a.unit, f"condition {text!r}")
+            comparisons.append((a, b) if op in ("<", "<=") else (b, a))
+    return TypedSolve(
+        tuple(typed_equations(typer, block)),
+        tuple(typed_conditions(typer, block)),
+        tuple(comparisons),
+    )
+
+
+def typed_block(sheet, block: SolveSpec) -> TypedSolve:
+    """The block's trees typed at load (kept in ``sheet.typed``), typed now if they were not."""
+    found = sheet.typed.get(block, "solve")
+    return (
+        found
+        if found is not None
+        else sheet.typed.keep(block, "solve", type_block(sheet.typer, block))
+    )
 
 
 def _violations(sheet, block: SolveSpec, names: list[str], at: dict):
     """x -> how far x is outside each condition (0 inside), relative to the size of the two
     sides at the guess: residuals for the solvers that honour the conditions while solving."""
-    scope = scope_of(sheet.typer, block)
-    pairs = []  # (smaller side, larger side) of every comparison of a chain
-    for node, text in block.conditions:
-        sides = [sheet.typer.expression(o, scope, block.what) for o in node.operands]
-        for op, a, b in zip(node.ops, sides, sides[1:]):
-            b = sheet.typer.convert(b, a.unit, f"condition {text!r}")
-            lo, hi = (a, b) if op in ("<", "<=") else (b, a)
-            pairs.append((sheet.evaluator.compile(lo), sheet.evaluator.compile(hi)))
+    pairs = [  # (smaller side, larger side) of every comparison of a chain
+        (sheet.evaluator.compile(lo), sheet.evaluator.compile(hi))
+        for lo, hi in typed_block(sheet, block).comparisons
+    ]
     guess = dict(zip(names, (q.magnitude for q in block.unknowns.values())), **at)
     with np.errstate(all="ignore"):
         sizes = [abs(float(lo(guess))) + abs(float(hi(guess))) for lo, hi in pairs]
@@ -274,9 +306,9 @@ def solve_block(sheet, block: SolveSpec, at: dict | None = None) -> dict[str, fl
     from ..numerics.given import solve
 
     names = list(block.unknowns)
+    typed = typed_block(sheet, block)
     sides = [
-        (sheet.evaluator.compile(lhs), sheet.evaluator.compile(rhs))
-        for lhs, rhs in typed_equations(sheet.typer, block)
+        (sheet.evaluator.compile(lhs), sheet.evaluator.compile(rhs)) for lhs, rhs in typed.equations
     ]
 
     def values(x):
@@ -307,7 +339,7 @@ def solve_block(sheet, block: SolveSpec, at: dict | None = None) -> dict[str, fl
     found = Solved(zip(names, (float(v) for v in result.value)))
     found.errors = dict(zip(names, (float(e) for e in result.error)))
     found.condition = float(result.notes.get("condition", float("nan")))
-    for cond, text in typed_conditions(sheet.typer, block):
+    for cond, text in typed.conditions:
         if not bool(sheet.evaluator.compile(cond)(dict(found, **at))):
             from ..numerics import NumericsError
 

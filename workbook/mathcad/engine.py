@@ -82,14 +82,14 @@ class _Refusals:
         return [self.sheet.column_node(col, var) for col in (s.x, s.y) if col is not None]
 
     def solve_blocks(self) -> None:
-        from ..language.given_find import typed_equations
+        from ..language.given_find import type_block
 
         for block in self.spec.solves:
             if self._needs_refused(*tc.solve_expressions(block)):
                 continue
             try:
                 self.sheet.check_not_circular(block)
-                typed_equations(self.typer, block)
+                type_block(self.typer, block)
             except WorkbookError as err:
                 unknowns = list(block.unknowns)  # a dict of the unknowns, in order
                 self._refuse(err, self.rendered.region_of.get(unknowns[0]), unknowns)
@@ -353,6 +353,11 @@ class AtImport:
         self.seen = (0, 0)
         # token of a scalar definition -> (its value or None, its unit); None: refused
         self.known: dict[str, tuple | None] = {}
+        # arguments whose unit the end of the translation gave (argument_units): an
+        # expression of them is known by its unit
+        self.settled: set[int] = set()
+        # token of an unknown of a solve block -> its guess (a value with its unit)
+        self.unknowns: dict[str, str] = {}
         # what a worksheet holds -> (spec, typer, identifier of each token, its Sheet or None)
         self.worksheets: dict[frozenset, list] = {}
 
@@ -362,6 +367,9 @@ class AtImport:
         for item in items[self.seen[0] :]:
             if item.sym is not None:
                 self.items[item.sym.token()] = item
+            if item.kind == "solve" and item.solve:
+                for sym, guess in item.solve[0]:  # an unknown has its guess's unit
+                    self.unknowns[sym.token()] = guess
         for k, sym in enumerate(syms[self.seen[1] :], self.seen[1]):
             self.syms[sym.token()] = sym
             self.order[id(sym)] = k
@@ -390,8 +398,15 @@ class AtImport:
                 if not sym.unit and (sym.hint is not None or sym.hint_sym is not None):
                     raise Unknown(name)  # its unit is given at the end
                 syms.add(sym)
+                if ranges and id(sym) in self.settled:  # known by its unit, as a range's
+                    range_syms.append(sym)
                 continue
             item = self.items.get(name)
+            if item is None and name in self.unknowns and not values:
+                # its unit (the guess's) only: its value is the root, not the guess
+                items.append(Item("input", sym=sym, value=self.unknowns[name]))
+                syms.add(sym)
+                continue
             if item is None:
                 raise Unknown(name)
             if item.kind == "range" and ranges and sym.is_range:
@@ -438,7 +453,8 @@ class AtImport:
 
         node = self._sizes(node)
         items, syms, range_syms = self._needs(node, ranges, values)
-        key = frozenset(id(s) for s in syms) | {
+        # an argument's unit is given at the end of the translation: part of the key
+        key = frozenset((id(s), s.unit) if s.kind == "param" else id(s) for s in syms) | {
             (id(i.sym), i.value if i.kind == "input" else id(i)) for i in items
         }
         try:
@@ -479,6 +495,17 @@ class AtImport:
         except Unknown:
             return None
         return None if t.text or t.boolean or ty.is_runtime(t.shape) else t.unit
+
+    def shape(self, node: ex.Node) -> tuple[int, int] | None:
+        """(rows, columns) of ``node`` as the engine types it, or None: a number, not known
+        at import, or an array whose size is known only when it is computed."""
+        try:
+            t = self._typed(node, "an expression at import", True, False)[1]
+        except Unknown:
+            return None
+        if t.text or t.boolean or t.shape is None or ty.is_runtime(t.shape):
+            return None
+        return tuple(t.shape)
 
     def quantity(self, node: ex.Node):
         """The value of ``node`` (a number) as a pint quantity; :class:`Unknown` if it is not
