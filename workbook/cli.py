@@ -301,7 +301,7 @@ def cmd_run(args) -> int:
     if exporter is not None:
         print(f"wrote {args.export}")
     n_checked = sum(r.role == "check" for r in report.rows)
-    from .compute.verdicts import REPRODUCED
+    from .verdicts import REPRODUCED
 
     n_ok = sum(r.role == "check" and r.verdict in REPRODUCED for r in report.rows)
     summary = f"{len(sheet.spec.tables)} tables, {len(sheet.spec.charts)} charts"
@@ -402,7 +402,7 @@ def _element_text(v) -> str:
 
 def _print_findings(report) -> int:
     """Print the findings with verdict warning or fail (stderr); EXIT_CHECK if one fails."""
-    from .compute.verdicts import FINDING_FAILED, FINDING_FLAGGED
+    from .verdicts import FINDING_FAILED, FINDING_FLAGGED
 
     for f in report.findings:
         if f.verdict in FINDING_FLAGGED:

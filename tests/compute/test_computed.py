@@ -25,7 +25,7 @@ STAGES_BEFORE = (
     "workbook/program/",
     "workbook/engine/runtime.py",
     "workbook/engine/sheet.py",
-    "workbook/language/given_find.py",
+    "workbook/engine/solve_blocks.py",
     "workbook/engine/ode.py",
     "workbook/engine/oderun.py",
     "workbook/engine/symbolic.py",

@@ -214,16 +214,16 @@ columns = ["q", "r"]
 def test_a_failed_value_is_computed_once(tmp_path, monkeypatch):
     """A table whose every row needs a [[solve]] that fails asks for it at every halving of
     its rows; the failure is remembered, so the block is solved once."""
-    from workbook.language import given_find
+    from workbook.engine import solve_blocks
 
     calls = []
-    solve_block = given_find.solve_block
+    solve_block = solve_blocks.solve_block
 
     def counted(*args, **kw):
         calls.append(1)
         return solve_block(*args, **kw)
 
-    monkeypatch.setattr(given_find, "solve_block", counted)
+    monkeypatch.setattr(solve_blocks, "solve_block", counted)
     text = """
 [arguments]
 x = { unit = "" }

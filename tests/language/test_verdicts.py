@@ -1,10 +1,10 @@
-"""The two verdict vocabularies (workbook/compute/verdicts.py) cannot be mixed up."""
+"""The two verdict vocabularies (workbook/verdicts.py) cannot be mixed up."""
 
 import pytest
 
-from workbook.compute import verdicts
+from workbook import verdicts
 from workbook.compute.checks import CheckRow
-from workbook.compute.findings import Finding
+from workbook.findings import Finding
 
 
 def _row(verdict: str) -> CheckRow:

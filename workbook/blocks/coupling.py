@@ -16,8 +16,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..compute.findings import Finding
 from ..engine import ode, oderun
+from ..findings import Finding
 from . import bench_block, cached, findings_block, table_block
 
 

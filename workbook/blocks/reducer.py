@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from ..compute.findings import Finding
 from ..errors import InputError, LimitError
+from ..findings import Finding
 from . import cached, export_block, findings_block, table_block
 
 #: The closure finding passes when the traces agree to this distance (mm); no [[checks]] line:

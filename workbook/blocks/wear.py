@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ..compute.findings import Finding
+from ..findings import Finding
 from . import cached, findings_block, input_magnitude, table_block
 
 SG_WINDOW = 15  # points (30 deg at a 2 deg spacing); cubic Savitzky-Golay

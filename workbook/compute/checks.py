@@ -7,12 +7,12 @@ from dataclasses import dataclass, field
 
 import pint
 
+from .. import verdicts as V
 from ..errors import DomainError, LimitError, TemplateError, UnitError, WorkbookError
+from ..findings import Finding
 from ..language import units as un
 from ..language.printed import PrintedRow, read_commented_csv, read_printed  # noqa: F401 - re-exported
 from ..language.spec import PrintedSpec
-from . import verdicts as V
-from .findings import Finding
 
 
 @dataclass
@@ -202,7 +202,7 @@ def _findings(sheet) -> list[Finding]:
 
         out.extend(sheet_findings(sheet))
     if sheet.spec.solves:
-        from ..language.given_find import solve_findings
+        from ..engine.solve_blocks import solve_findings
 
         out.extend(solve_findings(sheet))
     if sheet.spec.checks:

@@ -26,13 +26,13 @@ import numpy as np
 import pint
 
 from ..errors import InputError, TemplateError, WorkbookError
+from ..findings import Finding
 from ..language import expr as ex
 from ..language import typed as ty
 from ..language import units as un
 from ..language.fields import Fields, nearest
+from ..verdicts import FINDING_VERDICTS
 from . import cellunit
-from .findings import Finding
-from .verdicts import FINDING_VERDICTS
 
 CHECK_KEYS = (
     "topic",

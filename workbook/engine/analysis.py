@@ -9,7 +9,7 @@
   leaves its domain (sqrt of a negative, division by zero, asin beyond 1); the numpy back end
   calls it when a function is not finite, so no NaN reaches a table or a workbook.
 
-:func:`findings` turns all of them into :class:`workbook.compute.findings.Finding` lines for
+:func:`findings` turns all of them into :class:`workbook.findings.Finding` lines for
 ``workbook check`` and the Checks sheet. Findings are information; only a relation that
 cannot be evaluated has the verdict ``fail``.
 """
@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..compute.findings import Finding
 from ..errors import WorkbookError
+from ..findings import Finding
 from ..functions.registry import REGISTRY
 from ..language import typed as ty
 from ..language import units as un

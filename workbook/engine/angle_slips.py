@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ..compute.findings import Finding
+from ..findings import Finding
 from ..language import typed as ty
 from ..language.unitrules import angle_in
 

@@ -831,8 +831,8 @@ def run_sheet(
 
 def sheet_findings(sheet) -> list:
     """One finding per [[ode]]: the method, and why "auto" chose it; a run that failed."""
-    from ..compute.findings import Finding
     from ..errors import WorkbookError
+    from ..findings import Finding
 
     out = []
     for name in sheet.spec.odes:
@@ -854,7 +854,7 @@ def sheet_findings(sheet) -> list:
 def _estimate_finding(sheet, name: str, sol: Solution):
     """The states' global error estimate: a warning when one exceeds ESTIMATE_LIMIT times its
     tolerance (or when there is no estimate), else for information."""
-    from ..compute.findings import Finding
+    from ..findings import Finding
     from ..language import units as un
 
     est = sol.estimate()

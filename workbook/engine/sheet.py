@@ -504,7 +504,7 @@ class Sheet:
     def solution(self, block):
         """The solution of a [[solve]] block without parameters: solved once per sheet, and a
         failure remembered and raised again (with the block's line) instead of solved again."""
-        from ..language.given_find import solve_block
+        from .solve_blocks import solve_block
 
         key = ("solve", block.index)
         if key not in self._memo:
@@ -524,7 +524,7 @@ class Sheet:
 
     def _solved_at(self, name: str, env: dict):
         """An unknown of a [[solve]] block with parameters, at their values in ``env``."""
-        from ..language.given_find import solved_at
+        from .solve_blocks import solved_at
 
         return solved_at(self, self.spec.solve_of(name), name, env)
 

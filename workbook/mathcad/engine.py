@@ -136,7 +136,18 @@ class _Refusals:
                 if self._needs_refused(*self._series_nodes(s, rng.var)):
                     continue
                 try:
-                    self.sheet.typed_column(s.y, rng.var, f"chart {c.name}")
+                    typed = [
+                        self.sheet.typed_column(col, rng.var, f"chart {c.name}")
+                        for col in (s.x, s.y)
+                        if col is not None
+                    ]
+                    if any(t.complex for t in typed):
+                        # `workbook run` draws no points of complex values: the trace is
+                        # left out with that reason
+                        self.refused[f"{region}/trace {n}"] = (
+                            "the engine cannot draw it: a series of complex values"
+                        )
+                        continue
                 except WorkbookError as err:
                     if err.definition in self.rendered.region_of:
                         self._refuse(err, None)

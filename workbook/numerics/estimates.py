@@ -34,7 +34,7 @@ def estimate_findings(sheet) -> list:
     to its largest value (an extremum's: to the larger of that and EXPR's size on the
     interval), exceeds ESTIMATE_LIMIT times ``[sheet] tolerance``; computed from what the sheet
     has evaluated so far (call it after the values)."""
-    from ..compute.findings import Finding
+    from ..findings import Finding
 
     rtol = sheet_tolerance(sheet.spec.meta).rtol
     worst: dict[tuple[str, str], tuple[float, float, float, str]] = {}
@@ -99,7 +99,7 @@ def assumption_findings(sheet) -> list:
     EXPR has a node without an interval extension (the global extremum is then not
     certified): no feature narrower than the samples' spacing h. The values that share one
     h and one cause are named in one warning."""
-    from ..compute.findings import Finding
+    from ..findings import Finding
 
     widest: dict[tuple[str, str], tuple[float, str, str]] = {}
     for builtin, result in sheet.evaluator.records:

@@ -6,12 +6,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from ..language.given_find import METHODS as METHOD_NAMES
 from ._common import DEFAULT, NumericsError, Result, Tolerance, num
 
-#: the methods of a [[solve]] block: Powell's hybrid method (the default), Levenberg-Marquardt
-#: (Mathcad's Find), or the root nearest the guesses; from the same guess they may reach
-#: different roots of a system with several
-METHODS = {"hybrid": "hybr", "levenberg-marquardt": "lm", "nearest": "lm"}
+#: scipy's method of each method of a [[solve]] block
+METHODS = dict(zip(METHOD_NAMES, ("hybr", "lm", "lm"), strict=True))
 
 #: the distances from the guess (in units of the guess's size) of the starts ``nearest`` tries
 _RADII = (0.0, 0.5, 1.0, 2.0, 4.0, 8.0)

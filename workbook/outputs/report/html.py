@@ -16,13 +16,13 @@ from html import escape
 import numpy as np
 import pint
 
-from ...compute.verdicts import NOT_FAILED
 from ...errors import WorkbookError
 from ...functions.complexes import readable
 from ...language import expr as ex
 from ...language import units as un
 from ...language.template import column_node
 from ...language.visitor import UnhandledNode
+from ...verdicts import NOT_FAILED
 from ...version import __version__
 from . import mathml as mm
 from .mathml import Box, MathML
