@@ -357,6 +357,8 @@ class ExprTranslator(Visitor):
                 return n
             return None
 
+        sheet_calls: list[str] = []  # the worksheet's functions called with a vector
+
         def scan(node: ex.Node) -> None:
             n = vector_length(node)
             if n is not None:
@@ -364,18 +366,29 @@ class ExprTranslator(Visitor):
                 return
             if isinstance(node, ex.Call):
                 for a in node.args:
-                    if vector_length(a) is not None and node.func not in ELEMENTWISE:
-                        called = self.tr.mathcad_name(node.func)
-                        raise Untranslatable(
-                            f"a vectorised call of {called} (only functions of one "
-                            "number are applied element by element)"
-                        )
+                    if vector_length(a) is None or node.func in ELEMENTWISE:
+                        continue
+                    if self._sheet_function(node.func):
+                        # Mathcad calls a function of the worksheet once per element
+                        sheet_calls.append(node.func)
+                        continue
+                    called = self.tr.mathcad_name(node.func)
+                    raise Untranslatable(
+                        f"a vectorised call of {called} (only functions of one "
+                        "number are applied element by element)"
+                    )
             if isinstance(node, ex.Index):
                 raise Untranslatable("a vectorised expression with an index")
             for child in ex.children(node):
                 scan(child)
 
         scan(tree)
+        if unknown and sheet_calls:
+            called = self.tr.mathcad_name(sheet_calls[0])
+            raise Untranslatable(
+                f"a vectorised call of {called}, a function of the worksheet, over a vector "
+                "whose length is not known at import"
+            )
         if unknown:  # the language's vectorize, element by element when it is computed
             return ex.Call("vectorize", (tree,))
         if not lengths:
@@ -393,6 +406,13 @@ class ExprTranslator(Visitor):
 
         return ex.Matrix(tuple((element(tree, k),) for k in range(n)))
 
+    def _sheet_function(self, token: str) -> bool:
+        """Is ``token`` (a call's function) a function the worksheet defines?"""
+        if not token.startswith("\x00"):
+            return False
+        sym = next((s for s in self.tr.out.syms if s.token() == token), None)
+        return sym is not None and sym.kind == "func"
+
     def _absval(self, x: ex.Node) -> ex.Node:
         """Mathcad's |x|: abs of a number, but the length of a vector and the determinant of
         a square matrix: ``mag`` (the shape decides at load) where x may be a vector (it
@@ -408,6 +428,10 @@ class ExprTranslator(Visitor):
     def _builtin(self, name: str, mathcad: str, args: list[ex.Node]) -> ex.Node:
         if name not in language_functions():
             raise Untranslatable(f"Mathcad's {mathcad}() has no built-in in the language yet")
+        if name == "sqrt" and self.tr.complex_roots and len(args) == 1:
+            # Mathcad 15's square root of a negative number is imaginary (sqrt(-4) = 2i):
+            # in a definition whose values Mathcad stored as complex, the complex root
+            args = [ex.Binary("+", args[0], ex.Imaginary(0.0))]
         return ex.Call(name, tuple(args))
 
     def _call(self, op: MNode, args: list[MNode]) -> ex.Node:

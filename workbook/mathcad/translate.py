@@ -41,6 +41,10 @@ class Translator(ResultsMixin, SolveMixin):
         self.out = Translation()
         self.note: list[str] = []
         self.calls: dict[Sym, list[tuple[ex.Node, ...]]] = {}  # call sites of each function
+        # names whose values Mathcad stored as complex numbers somewhere (f of f(x) =), and
+        # whether the region being translated defines one (its square roots are complex)
+        self.complex_shown: set[tuple[str, str]] = set()
+        self.complex_roots = False
         self._index: Sym | None = None
         self.region = ""  # the region being translated
         self.given: list[str] | None = None  # regions of the open solve block
@@ -119,6 +123,7 @@ class Translator(ResultsMixin, SolveMixin):
         # Mathcad evaluates global definitions (≡) first, top to bottom, then the others
         first = [r for r in regions if r.math is not None and r.math.tag == "globalDefine"]
         regions = first + [r for r in regions if r not in first]
+        self.complex_shown = _shown_complex(regions)
         for region in regions:
             if region.kind == "text":
                 if region.text:
@@ -149,10 +154,13 @@ class Translator(ResultsMixin, SolveMixin):
             if region.disabled:
                 self.skip(region.id, self.describe(region.math), "disabled in Mathcad")
                 continue
+            self.complex_roots = _defined_key(region.math) in self.complex_shown
             try:
                 self.math(region)
             except Untranslatable as why:
                 self.skip(region.id, self.describe(region.math), str(why))
+            finally:
+                self.complex_roots = False
         self.close_given("a solve block without Find")
         self.argument_units()
         return self.out
@@ -327,10 +335,13 @@ class Translator(ResultsMixin, SolveMixin):
 
     def vector_length_of(self, tree: ex.Node) -> int | None:
         """The length of a vector the worksheet defines by name (None: not a known vector)."""
-        tree = self.written_out(tree)
-        if isinstance(tree, ex.Matrix) and all(len(r) == 1 for r in tree.rows):
-            return len(tree.rows)
-        return None
+        written = self.written_out(tree)
+        if isinstance(written, ex.Matrix) and all(len(r) == 1 for r in written.rows):
+            return len(written.rows)
+        if written is None or not isinstance(tree, ex.Name):
+            return None
+        shape = self.at_import().shape(tree)  # a vector computed from vectors (v * mm)
+        return shape[0] if shape is not None and shape[1] == 1 else None
 
     def argument_units(self) -> None:
         """Mathcad's functions are untyped: an argument takes the unit of the values the
@@ -341,24 +352,67 @@ class Translator(ResultsMixin, SolveMixin):
             u = at.unit(node)
             return None if u is None else ("" if u.dimensionless else str(u))
 
-        for item in self.out.items:
-            if item.kind != "function" or item.sym is None or item.sym.kind == "helper":
-                continue
-            for k, param in enumerate(item.params):
-                if param.unit:
+        functions = [
+            item
+            for item in self.out.items
+            if item.kind == "function" and item.sym is not None and item.sym.kind != "helper"
+        ]
+        bound = [
+            s
+            for s in self.out.syms
+            if s.kind == "param" and (s.hint is not None or s.hint_sym is not None)
+        ]
+        # A call whose argument is a parameter of another function (``σ(z, e, k) :=
+        # σ.c(ε(z, e, k))``) has that parameter's unit, known once that function's own calls
+        # are: the units are passed on from call to call until none changes, and only then is
+        # a parameter still open given the first call's unit as it reads (dimensionless).
+        open_params = {id(p) for item in functions for p in item.params if not p.unit} | {
+            id(s) for s in bound if not s.unit
+        }
+        syms_by_token = {s.token(): s for s in self.out.syms}
+        at.settled |= {
+            id(s) for s in self.out.syms if s.kind == "param" and id(s) not in open_params
+        }
+
+        def settled(node: ex.Node) -> bool:
+            return not any(
+                id(syms_by_token[n]) in open_params for n in ex.names(node) if n in syms_by_token
+            )
+
+        def one_pass(strict: bool) -> bool:
+            changed = False
+            for item in functions:
+                for k, param in enumerate(item.params):
+                    if id(param) not in open_params:
+                        continue
+                    for args in self.calls.get(item.sym, []):
+                        if k < len(args) and (not strict or settled(args[k])):
+                            unit = unit_of(args[k])
+                            if unit is not None:
+                                param.unit = unit
+                                open_params.discard(id(param))
+                                at.settled.add(id(param))
+                                changed = True
+                                break
+            for sym in bound:  # variables bound by root, integral, diff
+                if id(sym) not in open_params:
                     continue
-                for args in self.calls.get(item.sym, []):
-                    if k < len(args):
-                        unit = unit_of(args[k])
-                        if unit is not None:
-                            param.unit = unit
-                            break
-        for sym in self.out.syms:  # variables bound by root, integral, diff
-            if sym.kind == "param" and not sym.unit:
-                if sym.hint is not None:
+                if sym.hint is not None and (not strict or settled(sym.hint)):
                     sym.unit = unit_of(sym.hint) or ""
-                elif sym.hint_sym is not None:
+                elif sym.hint_sym is not None and (
+                    not strict or id(sym.hint_sym) not in open_params
+                ):
                     sym.unit = sym.hint_sym.unit
+                else:
+                    continue
+                open_params.discard(id(sym))
+                at.settled.add(id(sym))
+                changed = True
+            return changed
+
+        while one_pass(strict=True):
+            pass
+        one_pass(strict=False)
 
     def skip(self, region: str, what: str, why: str) -> None:
         self.out.skipped.append(Skipped(region, what, why))
@@ -758,16 +812,60 @@ class Translator(ResultsMixin, SolveMixin):
             for n in names:
                 self.define(_key(n), "var", region.id).broken = str(why)
             raise
-        self.out.items.append(Item("definition", region.id, sym=whole, **parts))
+        own = self._own_parts(rhs, parts, rows, cols)
+        # where each name has its own definition, the whole value (compared where Mathcad
+        # shows it) is a part of the region of its own: the engine may refuse a matrix of
+        # elements of different units without refusing the names
+        at_region = region.id if own is None else f"{region.id}.value"
+        self.out.items.append(Item("definition", at_region, sym=whole, **parts))
         o = self.sheet_origin
         for c in range(cols):
             for r in range(rows):
                 at = (r,) if cols == 1 else (r, c)
                 index = tuple(ex.Number(float(o + a)) for a in at)
-                sym = self.define(_key(names[c * rows + r]), "var", region.id)
+                key = _key(names[c * rows + r])
+                if own is not None:  # the name is its element's own expression or program
+                    try:
+                        part = own(r, c)
+                    except Untranslatable as why:
+                        self.define(key, "var", region.id).broken = str(why)
+                        continue
+                    sym = self.define(key, "var", region.id)
+                    self.out.items.append(Item("definition", region.id, sym=sym, **part))
+                    continue
+                sym = self.define(key, "var", region.id)
                 item = ex.Index(ex.Name(whole.token()), index)
                 self.out.items.append(Item("definition", region.id, sym=sym, body=item))
         return whole
+
+    def _own_parts(self, rhs: MNode, parts: dict, rows: int, cols: int):
+        """[a; b] := value where the value is a matrix written out (``[x; y]``, Find's
+        unknowns) or a program whose one value is such a matrix (its last line, no other
+        ``return``): a function of (row, column) giving each name its element's own
+        definition, so that the names need not share one unit (``[X; Y; j]``, lengths and a
+        count, is three definitions, not one matrix). None: the value is not of that form."""
+        body = parts.get("body")
+        if isinstance(body, ex.Matrix):
+            if len(body.rows) == rows and all(len(row) == cols for row in body.rows):
+                return lambda r, c: {"body": body.rows[r][c]}
+            return None
+        if rhs.tag != "program" or not rhs.children:
+            return None
+        last = rhs.children[-1]
+        value = last.children[0] if last.tag == "return" and len(last.children) == 1 else last
+        if value.tag != "matrix" or matrix_size(value) != (rows, cols):
+            return None
+        if any(n.tag == "return" for c in rhs.children[:-1] for n in tt.walk(c)):
+            return None  # a value returned before the end
+        if len(value.children) != rows * cols:
+            return None
+
+        def own(r: int, c: int) -> dict:
+            element = value.children[c * rows + r]
+            program = MNode(rhs.tag, rhs.attrs, rhs.text, [*rhs.children[:-1], element], rhs.line)
+            return self.program(program, {})
+
+        return own
 
     def element(self, region: Region, key, lhs: MNode, rhs: MNode) -> None:
         """v[k] := value at an index that is not a range variable (Mathcad sets one element
@@ -870,3 +968,38 @@ class Translator(ResultsMixin, SolveMixin):
         self.out.items.append(item)
 
     # -- results --------------------------------------------------------------
+
+
+def _defined_key(node: MNode) -> tuple[str, str] | None:
+    """The name a definition region defines (a function's name), or None."""
+    if node.tag not in ("define", "globalDefine") or not node.children:
+        return None
+    lhs = node.children[0]
+    if lhs.tag == "function" and lhs.children:
+        lhs = lhs.children[0]
+    return _key(lhs) if lhs.tag == "id" else None
+
+
+def _shown_complex(regions: list[Region]) -> set[tuple[str, str]]:
+    """The names (a variable, or the function of ``f(x) =``) of the evaluations whose stored
+    result holds a complex number: Mathcad computed them in complex numbers."""
+    out: set[tuple[str, str]] = set()
+    for region in regions:
+        node = region.math
+        if node is None:
+            continue
+        for n in tt.walk(node):
+            if n.tag != "eval" or not n.children:
+                continue
+            result = n.find("result")
+            if result is None or not any(c.tag == "complex" for c in tt.walk(result)):
+                continue
+            shown = n.children[0]
+            if shown.tag == "apply" and shown.children and shown.children[0].tag == "id":
+                shown = shown.children[0]
+            if shown.tag == "id":
+                out.add(_key(shown))
+            defined = _defined_key(node)
+            if defined is not None and node.children[-1] is n:
+                out.add(defined)  # x := ... = a complex value
+    return out

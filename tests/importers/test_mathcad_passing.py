@@ -1,0 +1,164 @@
+"""Mathcad's untyped functions called from functions, vectorised calls of the worksheet's
+functions, and a matrix of names given a matrix of values of different units."""
+
+from __future__ import annotations
+
+import pytest
+from helpers.mathcad_xml import (
+    apply,
+    call,
+    check_sheet,
+    define,
+    evaluate,
+    function,
+    ident,
+    import_sheet,
+    local,
+    math_region,
+    matrix,
+    program,
+    real,
+    shown,
+    united,
+)
+
+
+def _vectorize(body: str) -> str:
+    return apply("vectorize", body)
+
+
+@pytest.mark.slow
+def test_an_argument_takes_the_unit_passed_on_by_another_function(tmp_path, capsys):
+    """g(z, k) := 1 + k*z is called only by h(z, k) := 2*g(z, k), and h(2 m, K) with
+    K := 3/m: g's z is a length and its k per length (from h's call, whose arguments are
+    h's own), so h(2 m, K) = 2*(1 + 6) = 14, never g typed as of plain numbers and h
+    refused."""
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "passed",
+        function(1, "g", ["z", "k"], apply("plus", real(1), apply("mult", ident("k"), ident("z")))),
+        function(2, "h", ["z", "k"], apply("mult", real(2), call("g", ident("z"), ident("k")))),
+        define(3, ident("K"), apply("div", real(3), ident("m"))),
+        evaluate(4, call("h", apply("mult", real(2), ident("m")), ident("K")), real(14)),
+    )
+    assert "region 1:" not in text and "region 2:" not in text
+    result = check_sheet(tmp_path, capsys, "passed")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (1, 1, 0), result
+
+
+@pytest.mark.slow
+def test_a_vectorised_call_of_a_function_of_the_worksheet(tmp_path, capsys):
+    """c := 2, v := [1; 2; 3]*c (a vector computed, its length 3 known from the engine),
+    f(x, a) := x^2 + a: ->(f(v, 1)) = [5; 17; 37], f called once per element (Mathcad's
+    vectorize applies the worksheet's functions element by element)."""
+    v = apply("mult", matrix(real(1), real(2), real(3)), ident("c"))
+    f = apply("plus", apply("pow", ident("x"), real(2)), ident("a"))
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "vecf",
+        define(1, ident("c"), real(2)),
+        define(2, ident("v"), v),
+        function(3, "f", ["x", "a"], f),
+        evaluate(4, _vectorize(call("f", ident("v"), real(1))), matrix(*map(real, (5, 17, 37)))),
+    )
+    assert "f(v[0], 1)" in text
+    result = check_sheet(tmp_path, capsys, "vecf")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result
+
+
+@pytest.mark.slow
+def test_names_given_a_solve_blocks_unknowns_of_different_units(tmp_path, capsys):
+    """e := 0, k := 0/m; Given e + 1 = 3, k*(2 m) = 8; [e1; k1] := Find(e, k): e1 = 2 and
+    k1 = 4/m are two definitions (the matrix [2; 4/m] has no one unit), so
+    e1 + k1*(1 m) = 6 is computed."""
+    find = f"<ml:apply><ml:Find/>{ident('e')}{ident('k')}</ml:apply>"
+    two_m = apply("mult", real(2), ident("m"))
+    one_m = apply("mult", real(1), ident("m"))
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "parts",
+        define(1, ident("e"), real(0)),
+        define(2, ident("k"), apply("div", real(0), ident("m"))),
+        math_region(3, ident("Given")),
+        math_region(4, apply("equal", apply("plus", ident("e"), real(1)), real(3))),
+        math_region(5, apply("equal", apply("mult", ident("k"), two_m), real(8))),
+        define(6, matrix(ident("e", "1"), ident("k", "1")), find),
+        evaluate(7, apply("plus", ident("e", "1"), apply("mult", ident("k", "1"), one_m)), real(6)),
+    )
+    assert "region 7" not in text.split("[inputs]")[0]
+    result = check_sheet(tmp_path, capsys, "parts")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (1, 1, 0), result
+
+
+@pytest.mark.slow
+def test_names_given_a_program_of_values_of_different_units(tmp_path, capsys):
+    """[X; n] := (j <- 3; X <- 2 m * j; [X; j]): X = 6 m and n = 3, each the program with
+    its last line that name's element (X*n shown as 18 m: 18 in metres, the SI value
+    Mathcad stores)."""
+    body = program(
+        local(ident("j"), real(3)),
+        local(ident("X"), apply("mult", apply("mult", real(2), ident("m")), ident("j"))),
+        f"<ml:return>{matrix(ident('X'), ident('j'))}</ml:return>",
+    )
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "progparts",
+        define(1, matrix(ident("X"), ident("n")), body),
+        evaluate(2, apply("mult", ident("X"), ident("n")), united(18, ("m", 1))),
+        evaluate(3, ident("n"), real(3)),
+    )
+    assert "region 2" not in text.split("[inputs]")[0]
+    result = check_sheet(tmp_path, capsys, "progparts")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result
+
+
+def test_the_whole_matrix_shown_is_still_compared(tmp_path, capsys):
+    """[a; b] := [1; 2] = [1; 2]: each name its element, and the value Mathcad shows
+    compared element by element as before."""
+    import_sheet(
+        tmp_path,
+        capsys,
+        "shownparts",
+        define(
+            1,
+            matrix(ident("a"), ident("b")),
+            shown(matrix(real(1), real(2)), matrix(real(1), real(2))),
+        ),
+        evaluate(2, apply("plus", ident("a"), ident("b")), real(3)),
+    )
+    result = check_sheet(tmp_path, capsys, "shownparts")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result
+
+
+def _stored(z: complex) -> str:
+    return f"<ml:complex>{real(z.real)}<ml:imag>{z.imag!r}</ml:imag></ml:complex>"
+
+
+def test_square_roots_of_negative_numbers_where_mathcad_stored_complex_values(tmp_path, capsys):
+    """f(x) := sqrt(4 - x^2), x := 0 .. 3, f(x) = [2; sqrt(3); 0; sqrt(5) i] as Mathcad 15
+    stores it (cmath's roots): f computes in complex numbers, every part reproduced; g, the
+    same formula whose stored value is real, stays real (its root of a negative number is
+    an error, never a number)."""
+    import cmath
+
+    body = call("sqrt", apply("minus", real(4), apply("pow", ident("x"), real(2))))
+    rng = f"<ml:range>{real(0)}{real(3)}</ml:range>"
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "croots",
+        function(1, "f", ["x"], body),
+        function(2, "g", ["x"], body),
+        define(3, ident("x"), rng),
+        evaluate(
+            4, call("f", ident("x")), matrix(*(_stored(cmath.sqrt(4 - v * v)) for v in range(4)))
+        ),
+        evaluate(5, call("g", real(1)), real(3**0.5)),
+    )
+    assert "sqrt(4 - x^2 + 0i)" in text and "sqrt(4 - x^2)" in text
+    result = check_sheet(tmp_path, capsys, "croots")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (9, 9, 0), result
