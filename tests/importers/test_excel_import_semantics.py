@@ -6,6 +6,7 @@ cannot hold is listed, and the CSV of cached texts follows the one rule of
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -175,16 +176,24 @@ def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_pa
     ws.write_formula("D1", "=IFERROR((A1/B1)*(C1-1),0)", None, 0)
     ws.write_formula("D2", "=IFERROR(A1/(C1-1),-1)", None, 3)
     ws.write_formula("D3", "=IFERROR(A1*C1,5)", None, 18)
-    ws.write_formula("D4", "=IFERROR(SQRT(-A1),5)", None, 5)  # other errors: listed
+    ws.write_formula("D4", "=IFERROR(SQRT(-A1),5)", None, 5)  # a root of a negative number
+    ws.write_formula("D5", "=IFERROR(LN(B1)*2+C1^-1,7)", None, 7)  # a logarithm of 0
+    ws.write_formula("D6", "=IFERROR(B1^0,9)", None, 9)  # 0^0 is #NUM! in Excel
+    ws.write_formula("D7", "=IFERROR(ACOS(A1),5)", None, 5)  # other errors: listed
     wb.close()
     report, text = _check(path, tmp_path, capsys)
     assert "the language has no error value to catch" in text.replace("\n# ", " ")
-    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 3, 0)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (7, 6, 0)
     import workbook
 
     sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
     name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR((A1/B1)" in d.note)
     assert sheet.with_inputs(B1=2).evaluate(name).magnitude == 6.0
+    name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR(LN(B1)" in d.note)
+    expected = math.log(2) * 2 + 1 / 3
+    assert sheet.with_inputs(B1=2).evaluate(name).magnitude == pytest.approx(expected)
+    name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR(B1^0" in d.note)
+    assert sheet.with_inputs(B1=2).evaluate(name).magnitude == 1.0
 
 
 SUB = """Attribute VB_Name = "Macros"

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .cells import FormulaTranslator, parse_formula
 from .formula_terms import FormulaProblem, text_problem
+from .kinds import cell_kind
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .subwrites import cells_written
@@ -90,9 +91,12 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
             tr.listed.append((cell.ref, why))
             continue
         try:
+            if cell.ref in book.formula_problems:
+                raise FormulaProblem(book.formula_problems[cell.ref])
             parsed[_key(cell)] = parse_formula(cell.formula)
         except FormulaProblem as exc:
             tr.listed.append((cell.ref, str(exc)))
+    book.trees = {key: p.tree for key, p in parsed.items()}  # what kind a formula gives
     # which cells formulas read (names are given after, in reading order)
     read: list[tuple[str, int, int]] = []
 
@@ -104,7 +108,13 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
         if _key(cell) in parsed and cell.array_master in (None, (cell.row, cell.col)):
             try:
                 FormulaTranslator(
-                    book, cell.sheet, record, tr.functions, book.names, _block(cell)
+                    book,
+                    cell.sheet,
+                    record,
+                    tr.functions,
+                    book.names,
+                    _block(cell),
+                    seen={cell_kind(cell)},
                 ).translate(parsed[_key(cell)].tree)
             except FormulaProblem:
                 pass
@@ -688,6 +698,8 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 _block(cell),
                 tr.ranges,
                 moving=run.moving if run is not None else None,
+                seen={cell_kind(book.cell(*k)) for k in (run.keys() if run else [key])},
+                rows=run.count if run is not None else 1,
             )
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:

@@ -96,8 +96,15 @@ class FormulaTranslator:
         block=None,
         ranges=None,
         moving: dict | None = None,
+        seen: set | None = None,
+        rows: int = 1,
     ) -> None:
         self.book = book
+        # the kinds ("number", "text", ...) of Excel's cached values of the cells this formula
+        # computes (each row of a filled-down column), and the rows it is filled down over
+        self.seen = seen
+        self.rows = rows
+        self.tails: set[int] = set()  # the nodes whose value is the formula's value
         # a filled-down column: {(sheet, row, col) of the first row: the name that moves}, for
         # the references whose row is relative (``M183``, never ``$M$183``)
         self.moving = moving or {}
@@ -112,6 +119,7 @@ class FormulaTranslator:
         self.out = FormulaText("")
 
     def translate(self, tree) -> FormulaText:
+        self.tails.add(id(tree))
         self.out.text = self.value(tree)
         return self.out
 
@@ -154,6 +162,10 @@ class FormulaTranslator:
             return self.leaf(name, payload)
         if kind == "op":
             return self.operator(name, payload, ctx)
+        if name.upper() == "IF":
+            from .kinds import if_of_kinds
+
+            return if_of_kinds(self, node)
         return self.function(name, payload)
 
     def leaf(self, kind: str, token) -> str:
@@ -327,6 +339,11 @@ class FormulaTranslator:
         kind, name, args = node
         ops = {"=": "==", "<>": "!=", "<": "<", ">": ">", "<=": "<=", ">=": ">="}
         if kind == "op" and name in ops:
+            from .kinds import compared
+
+            found = compared(self, name, args)
+            if found is not None:
+                return found
             return f"{self.value(args[0], 3)} {ops[name]} {self.value(args[1], 3)}"
         if kind == "fn" and name.upper() in ("AND", "OR"):
             joined = f" {name.lower()} ".join(f"({self.condition(a)})" for a in args)
@@ -375,6 +392,8 @@ class FormulaTranslator:
             return self.vlookup(args)
         if upper == "IFERROR":
             return self.if_error(args)
+        if upper == "CONVERT":
+            return self.convert(args)
         if upper in ("MATCH", "INDEX", "HLOOKUP"):
             from . import lookups
 
@@ -387,23 +406,35 @@ class FormulaTranslator:
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
 
+    def convert(self, args) -> str:
+        """``CONVERT(x, "in", "m")`` of units written in the formula: x times Excel's factor
+        (and an offset for temperatures)."""
+        from .convert import convert
+
+        if len(args) != 3 or any(a[0] != "leaf" or a[1] != "String" for a in args[1:]):
+            raise FormulaProblem("CONVERT of units other than texts written in the formula")
+        return convert(self.value(args[0], 4), args[1][2].name, args[2][2].name)
+
     def if_error(self, args) -> str:
-        """``IFERROR(x, alt)`` where x is numbers and cells joined by + - * /: x's error is a
-        division by zero, so the value is alt where a divisor is 0 (a cell of x that is an
-        error value leaves the whole formula without a value, never another number)."""
+        """``IFERROR(x, alt)`` where x is numbers and cells joined by + - * /, ``^`` by a
+        number, ``SQRT``, ``LN``, ``LOG10`` and ``ABS``: each error x can have is a condition on
+        its parts (a divisor 0, a root of a negative number, a logarithm of a number not above
+        0, 0 to a power not above 0, a negative number to a fractional power), and the value
+        is alt where one holds (a cell of x that holds an error value leaves the whole formula
+        without a value, never another number)."""
         if len(args) != 2:
             raise FormulaProblem(f"IFERROR with {len(args)} arguments")
-        divisors: list[str] = []
-        self.arithmetic_only(args[0], divisors)
+        errors: list[str] = []
+        self.arithmetic_only(args[0], errors)
         x, alt = self.value(args[0], 1), self.value(args[1], 1)
-        if not divisors:
+        if not errors:
             return x
-        zero = " or ".join(f"{d} == 0" for d in dict.fromkeys(divisors))
-        return f"({alt} if {zero} otherwise {x})"
+        where = " or ".join(dict.fromkeys(errors))
+        return f"({alt} if {where} otherwise {x})"
 
-    def arithmetic_only(self, node, divisors: list[str]) -> None:
-        """Refuse what IFERROR's error could come from other than a division by zero; the
-        divisors (translated) are gathered."""
+    def arithmetic_only(self, node, errors: list[str]) -> None:
+        """Refuse what IFERROR's error could come from other than the conditions gathered in
+        ``errors`` (each translated: where it holds, Excel's x is an error value)."""
         kind, name, payload = node
         if kind == "leaf" and name == "Number" and payload.name.upper() not in ("TRUE", "FALSE"):
             return
@@ -411,15 +442,41 @@ class FormulaTranslator:
             if not self.ref_of(payload).single:
                 raise FormulaProblem("IFERROR of a range")
             return
-        if kind == "op" and name in ("+", "-", "*", "/", "u-", "u+"):
+        if kind == "op" and name == "^" and len(payload) == 2:
+            power, sign = payload[1], 1.0
+            if power[0] == "op" and power[1] == "u-":
+                power, sign = power[2][0], -1.0
+            p = None
+            if power[0] == "leaf" and power[1] == "Number":
+                if power[2].name.upper() not in ("TRUE", "FALSE"):
+                    p = sign * float(power[2].name)
+            if p is None:
+                raise FormulaProblem("IFERROR of a power other than by a number")
+            self.arithmetic_only(payload[0], errors)
+            base = self.value(payload[0], 3)
+            if p <= 0:
+                errors.append(f"{base} == 0")
+            if p != int(p):
+                errors.append(f"{base} < 0")
+            return
+        if kind == "op" and name in ("+", "-", "*", "/", "u-", "u+", "%"):
             for a in payload:
-                self.arithmetic_only(a, divisors)
+                self.arithmetic_only(a, errors)
             if name == "/":
-                divisors.append(self.value(payload[1], 3))
+                errors.append(f"{self.value(payload[1], 3)} == 0")
+            return
+        guards = {"SQRT": "{} < 0", "LN": "{} <= 0", "LOG10": "{} <= 0", "ABS": None}
+        upper = name.upper() if kind == "fn" else ""
+        if upper == "LOG" and len(payload) == 1:
+            upper = "LOG10"
+        if upper in guards and len(payload) == 1:
+            self.arithmetic_only(payload[0], errors)
+            if guards[upper]:
+                errors.append(guards[upper].format(self.value(payload[0], 3)))
             return
         raise FormulaProblem(
-            "IFERROR of other than + - * / of numbers and cells (the language has no error "
-            "value to catch)"
+            "IFERROR of other than + - * /, ^ by a number, SQRT, LN, LOG10, ABS of numbers and "
+            "cells (the language has no error value to catch)"
         )
 
     def offset(self, args) -> str:

@@ -47,6 +47,10 @@ class Book:
     name_formulas: dict[str, str] = field(default_factory=dict)
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why)
     stale: bool = False  # saved before Excel finished calculating: cached values may be old
+    #: {cell ref: why} of formulas whose structured references (tables) are not read
+    formula_problems: dict[str, str] = field(default_factory=dict)
+    #: {(sheet, row, col): the parsed formula} of the formulas translated
+    trees: dict = field(default_factory=dict)
 
     def cell(self, sheet: str, row: int, col: int) -> Cell | None:
         return self.sheets.get(sheet, {}).get((row, col))
@@ -158,7 +162,35 @@ def _read_xlsx(book: Book, path: Path) -> Book:
                 cell.value = value
         book.sheets[ws.title] = cells
     read_names(book, _defined_names(wb))
+    _structured_references(book, wb)
     return book
+
+
+def _structured_references(book: Book, wb) -> None:
+    """Formulas that read tables by their columns, written with A1 references; a table's
+    bare name is its data (a defined name of that range, unless a defined name has it)."""
+    from openpyxl.utils import get_column_letter
+
+    from .tables import StructuredProblem, read_tables, rewrite
+
+    tables = read_tables(wb)
+    for key, t in tables.items():
+        d1, d2 = t.data
+        if d1 <= d2 and not any(k.casefold() == key for k in book.names):
+            if not any(k.casefold() == key for k in book.name_formulas):
+                corner = f"{get_column_letter(t.c1)}{d1}:{get_column_letter(t.c2)}{d2}"
+                book.names[t.name] = (t.sheet, corner)
+    if not tables:
+        return
+    for cells in book.sheets.values():
+        for cell in cells.values():
+            if cell.formula is None or "[" not in cell.formula:
+                continue
+            row = cell.row if cell.array_master is None else cell.array_master[0]
+            try:
+                cell.formula = rewrite(cell.formula, cell.sheet, row, tables)
+            except StructuredProblem as exc:
+                book.formula_problems[cell.ref] = str(exc)
 
 
 #: a defined name that is one reference: Sheet1!$A$1, 'Load table'!$B$2:$C$9

@@ -1,0 +1,165 @@
+"""`workbook import`: Excel tables' structured references, CONVERT, and texts beside numbers
+(comparisons and IF by Excel's rules) — workbooks the tests build with xlsxwriter, their cached
+values as Excel computes them."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+xlsxwriter = pytest.importorskip("xlsxwriter")
+
+from workbook.cli import main  # noqa: E402
+from workbook.excelimport.convert import convert  # noqa: E402
+from workbook.excelimport.formula_terms import FormulaProblem  # noqa: E402
+from workbook.excelimport.tables import StructuredProblem, Table, rewrite  # noqa: E402
+
+LOADS = Table("Loads", "S", 2, 2, 6, 4, 1, 1, ("Span (m)", "w'k", "M"))
+
+
+@pytest.mark.parametrize(
+    ("formula", "row", "a1"),
+    [
+        ("Loads[[#This Row],[Span (m)]]*2", 4, "$B4*2"),
+        ("SUM(Loads[M])", 9, "SUM($D$3:$D$5)"),
+        ("SUM(loads[m])", 9, "SUM($D$3:$D$5)"),  # without case, as Excel
+        ("Loads[@[w''k]]", 3, "$C3"),  # ' escapes ' in a column name
+        ("SUM(Loads[[#Headers],[Span (m)]:[M]])", 9, "SUM($B$2:$D$2)"),
+        ("SUM(Loads[[#Data],[#Totals],[M]])", 9, "SUM($D$3:$D$6)"),
+        ("Loads[[#Totals],[M]]", 9, "$D$6"),
+        ("SUM(Loads[#All])", 9, "SUM($B$2:$D$6)"),
+        ('"Loads[M]"&Loads[[#This Row],[M]]', 5, '"Loads[M]"&$D5'),  # never inside a text
+    ],
+)
+def test_structured_references_are_the_cells_excel_means(formula, row, a1):
+    assert rewrite(formula, "S", row, {"loads": LOADS}) == a1
+
+
+def test_a_structured_reference_not_read_with_certainty_is_refused():
+    with pytest.raises(StructuredProblem, match="no column"):
+        rewrite("Loads[Width]", "S", 3, {"loads": LOADS})
+    with pytest.raises(StructuredProblem, match="outside its data"):
+        rewrite("Loads[[#This Row],[M]]", "S", 9, {"loads": LOADS})  # implicit intersection
+    assert rewrite("Other[M]", "S", 3, {"loads": LOADS}) == "Other[M]"  # no such table
+
+
+def test_another_sheets_table_is_read_with_its_sheet():
+    assert rewrite("SUM(Loads[M])", "T", 1, {"loads": LOADS}) == "SUM('S'!$D$3:$D$5)"
+
+
+@pytest.mark.parametrize(
+    ("source", "target", "x", "value"),
+    [
+        ("in", "mm", 2.5, 63.5),
+        ("ft", "m", 1.0, 0.3048),
+        ("lbm", "kg", 1.0, 0.45359237),
+        ("psi", "kPa", 1.0, 6.894757293168361),
+        ("cm2", "m2", 3.0, 3e-4),
+        ("gal", "L", 1.0, 3.785411784),
+        ("C", "F", 100.0, 212.0),
+        ("F", "C", -40.0, -40.0),
+        ("kel", "cel", 0.0, -273.15),
+        ("hr", "sec", 2.0, 7200.0),
+        ("HP", "kW", 1.0, 0.7456998715822702),
+    ],
+)
+def test_convert_has_excels_factors(source, target, x, value):
+    assert eval(convert(repr(x), source, target).replace("^", "**")) == pytest.approx(value, 1e-12)
+
+
+@pytest.mark.parametrize(
+    ("source", "target"),
+    [("mmHg", "Pa"), ("m", "kg"), ("C", "m"), ("Km", "m"), ("kin", "m"), ("bar", "Pa")],
+)
+def test_convert_refuses_what_it_does_not_know_or_excel_refuses(source, target):
+    with pytest.raises(FormulaProblem):
+        convert("1", source, target)
+
+
+def _check(path, tmp_path, capsys) -> tuple[dict, str]:
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--out", str(out)]) == 0
+    toml = next(out.glob("*.toml"))
+    capsys.readouterr()
+    main(["check", str(toml), "--json"])
+    return json.loads(capsys.readouterr().out), toml.read_text(encoding="utf-8")
+
+
+@pytest.mark.slow
+def test_a_table_read_by_its_columns(tmp_path, capsys):
+    path = tmp_path / "table.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    data = [[1, 2], [3, 4], [5, 6]]
+    columns = [{"header": "Span (m)"}, {"header": "w'k"}, {"header": "M"}]
+    ws.add_table("B2:D5", {"name": "Loads", "data": data, "columns": columns})
+    for r, (a, b) in enumerate(data):
+        ws.write_formula(2 + r, 3, "=Loads[@[Span (m)]]*Loads[@[w''k]]^2", None, a * b * b)
+    ws.write_formula("F2", "=SUM(Loads[M])", None, 4 + 48 + 180)
+    ws.write_formula("F3", "=SUM(Loads)", None, 1 + 2 + 4 + 3 + 4 + 48 + 5 + 6 + 180)
+    ws.write_formula("F4", '=CONVERT(SUM(Loads[[#Data],[M]])/232,"ft","in")', None, 12)
+    ws.write_formula("F5", "=Loads[[#Totals],[M]]+1", None, 1)  # the table has no totals row
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "SUM($D$3:$D$5)" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (7, 6, 0)
+
+
+@pytest.mark.slow
+def test_texts_beside_numbers_by_excels_rules(tmp_path, capsys):
+    path = tmp_path / "kinds.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write("A1", 2.5)
+    ws.write("A2", "Steel")  # A3 is empty
+    ws.write_formula("B2", '=IF(A1="","",A1*2)', None, 5)  # a number is never ""
+    ws.write_formula("B3", '=IF(A2="steel",1,0)', None, 1)  # texts equal without case
+    ws.write_formula("B4", '=IF(A1<"a",7,8)', None, 7)  # a number orders before a text
+    ws.write_formula("B5", '=IF(A1=0,"-",A1-1)', None, 1.5)  # the number's branch
+    ws.write_formula("B6", '=IF(A1>2,"big",A1)', None, "big")  # the text's branch
+    ws.write_formula("B7", '=A3=""', None, True)  # an empty cell equals ""
+    ws.write_formula("B8", '=IF(A2="STEEL",A1,0)*2', None, 5)
+    ws.write_formula("B9", '=IF(A2&""="steel",1,0)', None, 1)  # a computed text: listed
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "A1*0 == 1" in text and "num2str(1/0)" in text
+    assert "does not tell case apart" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (8, 7, 0)
+
+
+@pytest.mark.slow
+def test_an_if_of_two_kinds_whose_rows_differ_is_listed(tmp_path, capsys):
+    path = tmp_path / "rows.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    for r, x in enumerate([1, 0, 2, 3]):
+        ws.write(r, 0, x)
+        ws.write_formula(r, 1, f'=IF(A{r + 1}=0,"-",10/A{r + 1})', None, "-" if x == 0 else 10 / x)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert report["failed"] == 0
+    assert report["reproduced"] + report["not_computable"] == 4
+
+
+@pytest.mark.slow
+def test_texts_a_formula_can_give_are_compared_without_case(tmp_path, capsys):
+    path = tmp_path / "regime.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_column("A1", [2000, 9000])  # Reynolds numbers; A3 is empty
+    for r, re_ in enumerate([2000, 9000]):
+        n = r + 1
+        regime = "TURBULENT" if re_ > 4000 else "LAMINAR"
+        ws.write_formula(f"B{n}", f'=IF(A{n}>4000,"TURBULENT","LAMINAR")', None, regime)
+        f = 16 / re_ if regime == "LAMINAR" else "n/a"
+        ws.write_formula(f"C{n}", f'=IF(B{n}="laminar",16/A{n},"n/a")', None, f)
+        ws.write_formula(f"D{n}", f'=IF(B{n}<>"Laminar",1,2)', None, 2 if f != "n/a" else 1)
+        ws.write_formula(f"E{n}", f'=IF(B{n}="transition",1,2)', None, 2)
+    ws.write_formula("B3", '=IF(A3="","",A3*2)', None, "")  # Excel caches ""
+    ws.write_formula("C3", '=IF(B3="",0,IF(A1=0,0,A1*3))', None, 0)  # a nested IF
+    ws.write_formula("D3", '=IF(A1="","",IF(A1>0,A1*3,0))', None, 6000)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert 'B1 == \\"LAMINAR\\"' in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (10, 10, 0)
