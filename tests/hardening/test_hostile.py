@@ -19,8 +19,8 @@ from helpers.paths import ROOT
 
 from workbook import limits as file_limits
 from workbook.compute import excelform
-from workbook.engine import numeric, ode, runtime, sheet
-from workbook.language import expr, ranges, template, typecheck
+from workbook.engine import numeric, runtime, sheet
+from workbook.language import expr, odes, ranges, template, typecheck
 from workbook.numerics import derivative
 from workbook.sweep.driver import MAX_SWEEP_POINTS
 from workbook.sweep.grid import MAX_CASES
@@ -219,7 +219,7 @@ def test_limits_are_documented():
         file_limits.MAX_STYLES_BYTES,
         file_limits.MAX_MATRIX_WORK,
         file_limits.MAX_TABLE_CELLS,
-        ode.MAX_STEPS,
+        odes.MAX_STEPS,
     ):
         assert f"{value:,}" in limits or str(value) in limits, value
 

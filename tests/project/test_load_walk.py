@@ -51,9 +51,9 @@ def test_loading_a_template_climbs_back_up_at_most_six_times(name):
 
 
 def test_the_walk_sees_a_callback_as_a_climb():
-    # an [[ode]] section's expressions are typed by the typer, asked from ode.py: one climb
+    # an [[ode]] section's expressions are typed by the typer, asked from odes.py: one climb
     found = _walk("advance-coupling")
-    assert ("workbook.engine.ode", "workbook.language.typecheck") in found.climbs_by_pair()
+    assert ("workbook.language.odes", "workbook.language.typecheck") in found.climbs_by_pair()
 
 
 def test_the_readers_of_measured_data_and_solve_blocks_return_what_they_read(tmp_path):

@@ -20,10 +20,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..language.odes import MAX_STEPS, MAX_TIME
 from .oderun import run_ode
 
-MAX_TIME = 30.0  # wall-clock budget of one run, seconds
-MAX_STEPS = 1_000_000
 #: h times the fastest decay rate where each explicit method's stability region ends on the
 #: negative real axis (measured: RK45 runs held there at 3.1 to 3.4, DOP853 at 6.4).
 STABILITY_LIMIT = {"RK45": 3.3, "DOP853": 6.0}

@@ -342,7 +342,7 @@ class SheetSpec:
     parts: dict[str, PartSpec] = field(default_factory=dict)
     data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
     solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
-    odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.engine.ode.OdeSpec
+    odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.language.odes.OdeSpec
     checks: list[Any] = field(default_factory=list)  # declared_checks.CheckSpec, [[checks]]
 
     def solve_of(self, name: str):

@@ -474,7 +474,7 @@ def _claim_solves(solves, arguments: dict, definitions: dict, claim: _Claims) ->
 
 def _odes(data: dict, text: str, arguments, definitions: dict, claim) -> dict:
     """``[[ode]]`` sections; each state becomes a definition, a function of the time."""
-    from ..engine.ode import parse_spec
+    from .odes import parse_spec
 
     out = {}
     for k, raw in enumerate(_list(data, "ode")):

@@ -893,7 +893,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
     def ode(self, name: str):
         """The typed section ``[[ode]] name`` (units checked once)."""
-        from ..engine.ode import type_ode
+        from .odes import type_ode
 
         cache = self.__dict__.setdefault("_odes", {})
         if name not in cache:
