@@ -138,6 +138,7 @@ def _stored(z: complex) -> str:
     return f"<ml:complex>{real(z.real)}<ml:imag>{z.imag!r}</ml:imag></ml:complex>"
 
 
+@pytest.mark.slow
 def test_square_roots_of_negative_numbers_where_mathcad_stored_complex_values(tmp_path, capsys):
     """f(x) := sqrt(4 - x^2), x := 0 .. 3, f(x) = [2; sqrt(3); 0; sqrt(5) i] as Mathcad 15
     stores it (cmath's roots): f computes in complex numbers, every part reproduced; g, the
@@ -162,3 +163,45 @@ def test_square_roots_of_negative_numbers_where_mathcad_stored_complex_values(tm
     assert "sqrt(4 - x^2 + 0i)" in text and "sqrt(4 - x^2)" in text
     result = check_sheet(tmp_path, capsys, "croots")
     assert (result["printed"], result["reproduced"], result["failed"]) == (9, 9, 0), result
+
+
+@pytest.mark.slow
+def test_shape_tests_and_primes_norm_of_a_vector(tmp_path, capsys):
+    """Prime: v := [3; 4; 12], M := [[1, 2], [3, 4]], a := 2: norm(v) = 13 (its length, as
+    Prime stores it), IsArray(v) = 1, IsScalar(v) = 0, IsScalar(a) = 1, IsArray(a) = 0;
+    norm(M), of a matrix, is not translated (never a guess of which norm)."""
+    from helpers.mathcad_xml import prime_package, prime_region, prime_result
+
+    from workbook.cli import main
+
+    ns = 'xmlns:ml="http://schemas.mathsoft.com/math50"'
+
+    def define_(lhs: str, rhs: str) -> str:
+        return f"<ml:define {ns}>{lhs}{rhs}</ml:define>"
+
+    def eval_(body: str) -> str:
+        return f"<ml:eval {ns}>{body}</ml:eval>"
+
+    regions = [
+        define_(ident("v"), matrix(real(3), real(4), real(12))),
+        define_(ident("M"), matrix(real(1), real(3), real(2), real(4), cols=2)),
+        define_(ident("a"), real(2)),
+        eval_(call("norm", ident("v"))),
+        eval_(call("IsArray", ident("v"))),
+        eval_(call("IsScalar", ident("v"))),
+        eval_(call("IsScalar", ident("a"))),
+        eval_(call("IsArray", ident("a"))),
+        eval_(call("norm", ident("M"))),
+    ]
+    stored = [None, None, None, 13, 1, 0, 1, 0, 5.4649857042190426]
+    src = prime_package(
+        tmp_path / "shapes.mcdx",
+        "".join(prime_region(k + 1, k + 1, r) for k, r in enumerate(regions)),
+        "".join(prime_result(k + 1, real(v)) for k, v in enumerate(stored) if v is not None),
+    )
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    text = (tmp_path / "shapes.toml").read_text(encoding="utf-8")
+    assert "norm() of something that is not a vector" in text
+    result = check_sheet(tmp_path, capsys, "shapes")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (6, 5, 0), result

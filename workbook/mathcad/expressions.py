@@ -37,6 +37,10 @@ def _vector_sum(bvars: list[MNode], args: list[MNode], lam: MNode) -> bool:
     )
 
 
+#: Mathcad's tests of a value's shape: 1 or 0
+SHAPE_TESTS = ("IsArray", "IsScalar")
+
+
 class ExprTranslator(Visitor):
     """Mathcad math element -> expression tree, names resolved in a scope."""
 
@@ -474,6 +478,10 @@ class ExprTranslator(Visitor):
                 f"{text}() where ORIGIN is {self.tr.origin}, and the worksheet's origin (ORIGIN "
                 f"at its first index) is {self.tr.sheet_origin}: its indices would be off"
             )
+        if text in SHAPE_TESTS and not key[1] and len(args) == 1:
+            return self._shape_test(text, args[0])
+        if text == "norm" and not key[1] and len(args) == 1:
+            return self._vector_norm(args[0])
         if text in MATHCAD_FUNCTIONS and not key[1]:
             name, order = MATHCAD_FUNCTIONS[text]
             if order is not None:
@@ -489,6 +497,33 @@ class ExprTranslator(Visitor):
         raise Untranslatable(
             f"{nm.mathcad_text(*key)}() is neither defined before nor a known built-in"
         )
+
+    def _shape_of(self, arg: MNode, what: str) -> tuple[ex.Node, tuple[int, int] | None]:
+        """The translated ``arg`` and its (rows, columns), None for one number, as the engine
+        types it at import; a value whose shape is not known then is untranslatable."""
+        tree = self.value(arg)
+        at = self.tr.at_import()
+        shape = at.shape(tree)
+        if shape is None and at.unit(tree) is None:
+            raise Untranslatable(f"{what} of a value whose shape is not known at import")
+        return tree, shape
+
+    def _shape_test(self, text: str, arg: MNode) -> ex.Node:
+        """Mathcad's IsArray(x) and IsScalar(x): 1 or 0, from x's shape (an array or one
+        number), which the language fixes when the worksheet is loaded."""
+        _, shape = self._shape_of(arg, f"{text}()")
+        array = shape is not None
+        return ex.Number(1.0 if array == (text == "IsArray") else 0.0)
+
+    def _vector_norm(self, arg: MNode) -> ex.Node:
+        """Prime's norm(v) of a vector: its length, the square root of the sum of its
+        elements' squares (the language's norm, of a matrix the Frobenius norm, is that of a
+        vector). Of a matrix or a number it is not translated (which of its norms Prime
+        gives there no stored result shows)."""
+        tree, shape = self._shape_of(arg, "norm()")
+        if shape is None or 1 not in shape:
+            raise Untranslatable("Prime's norm() of something that is not a vector")
+        return self._builtin("norm", "norm", [tree])
 
     def _histogram(self, args: list[MNode]) -> ex.Node:
         """Mathcad's histogram(intervals, data) counts every element of data, a matrix too:
