@@ -343,7 +343,7 @@ class SheetSpec:
     data: dict[str, Any] = field(default_factory=dict)  # column name -> measured.DataColumn
     solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
     odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.language.odes.OdeSpec
-    checks: list[Any] = field(default_factory=list)  # declared_checks.CheckSpec, [[checks]]
+    checks: list[Any] = field(default_factory=list)  # checkspec.CheckSpec, [[checks]]
 
     def solve_of(self, name: str):
         """The [[solve]] block that finds ``name``, or None."""

@@ -17,11 +17,11 @@ from pathlib import Path
 
 import pint
 
-from ..compute.declared_checks import read_check
 from ..errors import InputError, LimitError, TemplateError, WorkbookError
 from ..functions.registry import REGISTRY
 from . import expr as ex
 from . import units as un
+from .checkspec import read_check
 from .fields import Fields, find_line, nearest, value_line
 from .parts import assign_parts
 from .ranges import parse_range

@@ -30,10 +30,10 @@ from typing import Any
 import numpy as np
 
 from ..compute.computed import compute
-from ..compute.declared_checks import placeholders
 from ..engine.sheet import Sheet
 from ..errors import WorkbookError
 from ..language import expr as ex
+from ..language.checkspec import placeholders
 from ..language.template import column_node, parse_spec, read_toml
 from ..language.typecheck import Typer, dependencies, solve_expressions
 from ..language.typedsheet import TypedSheet, printed_rows
