@@ -15,7 +15,7 @@ from helpers.recalc import formula_values
 from helpers.recalculated import formulas_recalculated, mismatches
 from helpers.sheets import RATIOS
 
-from workbook.compute import cellunit
+from workbook.language import cellunit
 from workbook.language import units as un
 
 RELATIVE = 1e-9

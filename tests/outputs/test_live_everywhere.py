@@ -15,7 +15,8 @@ import pytest
 from helpers.recalc import formula_values
 from helpers.sheets import FROZEN, RATIOS
 
-from workbook.compute import cellunit, livecheck, xleval
+from workbook.compute import livecheck, xleval
+from workbook.language import cellunit
 
 
 def _formulas_package(text: str):

@@ -3,8 +3,8 @@ once after the sheet is loaded and checked.
 
 :func:`compute` is the one stage between evaluation and writing. It evaluates the scalar
 definitions (each with its typed tree in the unit it is shown in), the [[solve]] unknowns,
-the tables (range tables as :class:`TableData` of :class:`Column`, block and family tables
-as DataFrames), the data of every chart series (and the x column of each over a range), the
+the tables (range tables as :class:`workbook.engine.tabledata.TableData`, block and family
+tables as DataFrames), the data of every chart series (and the x column of each over a range), the
 check report (printed values, findings, estimate warnings) and, when asked, the workbook's
 Excel form (:class:`workbook.compute.excelsheets.ExcelForm`: every cell with its formula or value,
 helper cells, live-form notes, charts and defined names, checked by
@@ -13,9 +13,8 @@ helper cells, live-form notes, charts and defined names, checked by
 :mod:`workbook.outputs.notebook`, the CSV writer) read a :class:`ComputedSheet`: they neither type
 nor evaluate, and the Sheet is not changed by them.
 
-This module imports no Sheet (it reads the one it is given; :mod:`workbook.engine.sheet` builds on
-it, with the Column and TableData it fills), and the Excel form reads what it needs of the
-charts from the ComputedSheet: the package's import graph has no cycle
+This module imports no Sheet (it reads the one it is given), and the Excel form reads what it
+needs of the charts from the ComputedSheet: the package's import graph has no cycle
 (tests/project/test_layers.py).
 
 A value that cannot be computed is kept as its error: the report and the notebook show it,
@@ -29,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..engine.tabledata import Column, TableData
 from ..errors import InputError
 from ..language import expr as ex
 from ..language import units as un
@@ -42,31 +42,6 @@ if TYPE_CHECKING:
     from ..language.typed import T
     from .checks import Report
     from .excelsheets import ExcelForm
-
-
-@dataclass
-class Column:
-    """One evaluated table column: values in ``unit``."""
-
-    title: str
-    unit: pint.Unit
-    values: np.ndarray
-    typed: T | None  # None for the range variable itself
-    text: str
-    failed: dict[int, str] = field(default_factory=dict)  # row -> why it has no value (NaN)
-
-    def excel_error(self, row: int) -> str:
-        """The Excel error value of a failed row: #DIV/0! for a division by zero, else #NUM!."""
-        return "#DIV/0!" if "division by zero" in self.failed[row] else "#NUM!"
-
-
-@dataclass
-class TableData:
-    name: str
-    title: str
-    var: str
-    var_unit: pint.Unit
-    columns: list[Column]  # the first is the range variable
 
 
 @dataclass(frozen=True)

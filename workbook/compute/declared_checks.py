@@ -14,11 +14,11 @@ import pint
 
 from ..errors import InputError, TemplateError, WorkbookError
 from ..findings import Finding
+from ..language import cellunit
 from ..language import typed as ty
 from ..language import units as un
 from ..language.checkspec import PERCENT, PLACEHOLDER, CheckSpec, placeholders
 from ..language.fields import nearest
-from . import cellunit
 
 
 # -- load time --------------------------------------------------------------------------------

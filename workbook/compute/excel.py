@@ -17,10 +17,10 @@ import numpy as np
 from ..errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
 from ..functions import complexes, excel_names
 from ..functions.registry import CONSTANTS, REGISTRY
+from ..language import cellunit
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.visitor import Visitor
-from . import cellunit
 
 if TYPE_CHECKING:
     from ..language.typecheck import Typer

@@ -11,8 +11,6 @@ import numpy as np
 import pint
 
 from .. import limits_time
-from ..compute import cellunit
-from ..compute.computed import Column, TableData
 from ..errors import (
     DomainError,
     InputError,
@@ -23,6 +21,7 @@ from ..errors import (
 )
 from ..functions.matrix import numbers
 from ..functions.registry import CONSTANTS
+from ..language import cellunit
 from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
@@ -41,6 +40,7 @@ from ..limits_time import check_time
 from ..numerics import defining
 from . import runtime as rt
 from .numeric import Evaluator
+from .tabledata import Column, TableData
 
 #: Values of a table with ``vary`` (curves x columns x points), checked before any is computed.
 MAX_FAMILY_CELLS = 1_000_000
