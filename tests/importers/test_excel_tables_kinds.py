@@ -163,3 +163,31 @@ def test_texts_a_formula_can_give_are_compared_without_case(tmp_path, capsys):
     report, text = _check(path, tmp_path, capsys)
     assert 'B1 == \\"LAMINAR\\"' in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (10, 10, 0)
+
+
+@pytest.mark.slow
+def test_lookups_of_texts_that_never_change_are_the_cells_excel_finds(tmp_path, capsys):
+    path = tmp_path / "species.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_row("A1", ["(SPECIES)", "(MW)", "(TC, K)"])
+    rows = [["CH4(g)", 16.04, 190.6], ["C2H6(g)", 30.07, 305.3]] + [
+        [f"X{i}", i, i] for i in range(300)
+    ]
+    for r, row in enumerate(rows):
+        ws.write_row(r + 1, 0, row)
+    n = len(rows) + 1
+    ws.write("E1", "c2h6(G)")  # Excel compares texts without case
+    ws.write("F1", "(tc, k)")
+    ws.write_formula("G1", f"=VLOOKUP(E1,A2:C{n},MATCH(F1,A1:C1,0),0)", None, 305.3)
+    ws.write_formula("G2", f'=2*VLOOKUP("CH4(g)",A2:C{n},2,FALSE)', None, 32.08)
+    ws.write_formula("G3", '=HLOOKUP(F1,A1:C3,MATCH("c2h6(g)",A1:A3,0),0)', None, 305.3)
+    ws.write_formula("G4", '=VLOOKUP(E1&"",A2:C3,MATCH(F1&"",A1:C1,0),0)', None, 305.3)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 3, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    name = next(n for n, d in sheet.spec.definitions.items() if "=VLOOKUP(E1,A2" in d.note)
+    assert sheet.with_inputs(C3=300).evaluate(name).magnitude == 300  # the cell stays live

@@ -597,18 +597,29 @@ class FormulaTranslator:
         conditions on x. The approximate match (the default) takes the last row whose first
         cell is at most x, which is Excel's answer where that column ascends: the chain is
         guarded by the column ascending, and x below the first row is an error (#N/A)."""
+        from .statics import found, guarded, position
+
         if len(args) not in (3, 4) or args[1][0] != "leaf" or args[1][1] != "Range":
             raise FormulaProblem("VLOOKUP of other than a table range")
-        k = self.static(args[2]) if args[2][0] == "leaf" and args[2][1] == "Number" else None
+        k, guard = position(self, args[2])
         exact = len(args) == 4 and self.static(args[3]) == 0
-        if k is None or k != int(k):
-            raise FormulaProblem("VLOOKUP of a column not written as a number")
         ref = self.ref_of(args[1][2])
-        if ref.r2 - ref.r1 + 1 > MAX_LOOKUP_ROWS:
-            raise FormulaProblem(f"VLOOKUP in more than {MAX_LOOKUP_ROWS} rows")
         col = ref.c1 + int(k) - 1
         if not ref.c1 <= col <= ref.c2:
             raise FormulaProblem("VLOOKUP of a column outside its table (#REF! in Excel)")
+        if exact:
+            keys = [(ref.sheet, r, ref.c1) for r in range(ref.r1, ref.r2 + 1)]
+            i = found(self, args[0], keys)
+            if i is not None:
+                if i < 0:
+                    return "(1/0)"
+                row = ref.r1 + i
+                self.out.refs.append(Ref(ref.sheet, row, col, row, col))
+                return guarded(self.name_of(ref.sheet, row, col), guard)
+        if ref.r2 - ref.r1 + 1 > MAX_LOOKUP_ROWS:
+            raise FormulaProblem(f"VLOOKUP in more than {MAX_LOOKUP_ROWS} rows")
+        if guard is not None:
+            raise FormulaProblem("VLOOKUP of a number whose column a MATCH computes")
         x = self.value(args[0], 3)
         keys, values = [], []
         for r in range(ref.r1, ref.r2 + 1):

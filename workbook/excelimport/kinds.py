@@ -59,13 +59,25 @@ _DEPTH = 12  # formula cells followed, one reading another, to find what kind on
 def _formula_kind(ft, cell, depth: int) -> str | None:
     """The kind a formula cell gives where Excel cached no value ("" is cached so): read from
     its formula."""
-    tree = getattr(ft.book, "trees", {}).get((cell.sheet, cell.row, cell.col))
+    key = (cell.sheet, cell.row, cell.col)
+    memo = _memo(ft, "kinds")
+    if key in memo:
+        return memo[key]
+    tree = getattr(ft.book, "trees", {}).get(key)
     if tree is None or depth > _DEPTH or cell.array is not None:
         return None
+    memo[key] = None  # a formula that reads itself gives no kind
     try:
-        return kind(_reader(ft, cell.sheet), tree, depth + 1)
+        memo[key] = kind(_reader(ft, cell.sheet), tree, depth + 1)
     except FormulaProblem:
-        return None
+        pass
+    return memo[key]
+
+
+def _memo(ft, what: str) -> dict:
+    """What was found of the formula cells (their kinds, their texts), once per workbook."""
+    memos = ft.book.__dict__.setdefault("kind_memos", {})
+    return memos.setdefault(what, {})
 
 
 def _reader(ft, sheet: str):
@@ -190,13 +202,16 @@ def texts_of(ft, node, depth: int = 0) -> set[str] | None:
                     return None
                 out.add(cell.value)
                 continue
-            tree = getattr(ft.book, "trees", {}).get((cell.sheet, cell.row, cell.col))
-            if tree is None or cell.array is not None:
+            key = (cell.sheet, cell.row, cell.col)
+            memo = _memo(ft, "texts")
+            if key not in memo:
+                tree = getattr(ft.book, "trees", {}).get(key)
+                memo[key] = None
+                if tree is not None and cell.array is None:
+                    memo[key] = texts_of(_reader(ft, cell.sheet), tree, depth + 1)
+            if memo[key] is None:
                 return None
-            found = texts_of(_reader(ft, cell.sheet), tree, depth + 1)
-            if found is None:
-                return None
-            out |= found
+            out |= memo[key]
         return out
     if what == "fn" and name.upper() == "IF" and len(payload) == 3:
         out = set()

@@ -191,13 +191,29 @@ def hlookup(ft, args) -> str:
     first row (an exact match, or the approximate one guarded by the keys ascending)."""
     if len(args) not in (3, 4):
         raise FormulaProblem(f"HLOOKUP with {len(args)} arguments")
-    ref = _range(ft, args[1], "HLOOKUP")
-    k = _literal(args[2])
-    if k is None or k != int(k) or not 1 <= k <= ref.r2 - ref.r1 + 1:
-        raise FormulaProblem("HLOOKUP of a row not written as a number of its table")
+    from .statics import found, guarded, position
+
+    if args[1][0] != "leaf" or args[1][1] != "Range" or ft.is_name_formula(args[1][2]):
+        raise FormulaProblem("HLOOKUP of other than a range")
+    whole = ft.ref_of(args[1][2])
+    k, guard = position(ft, args[2])
+    if not 1 <= k <= whole.r2 - whole.r1 + 1:
+        raise FormulaProblem("HLOOKUP of a row outside its table (#REF! in Excel)")
     exact = len(args) == 4 and _literal(args[3]) == 0
     if len(args) == 4 and not exact and _literal(args[3]) is None:
         raise FormulaProblem("HLOOKUP whose match type is not written in the formula")
+    if exact:
+        keys = [(whole.sheet, whole.r1, c) for c in range(whole.c1, whole.c2 + 1)]
+        i = found(ft, args[0], keys)
+        if i is not None:
+            if i < 0:
+                return "(1/0)"
+            row, col = whole.r1 + int(k) - 1, whole.c1 + i
+            ft.out.refs.append(Ref(whole.sheet, row, col, row, col))
+            return guarded(ft.name_of(whole.sheet, row, col), guard)
+    if guard is not None:
+        raise FormulaProblem("HLOOKUP of a number whose row a MATCH computes")
+    ref = _range(ft, args[1], "HLOOKUP")
     keys_ref = Ref(ref.sheet, ref.r1, ref.c1, ref.r1, ref.c2)
     keys = _keys(ft, keys_ref, args[0], exact=exact)
     row = ref.r1 + int(k) - 1
