@@ -87,10 +87,20 @@ def test_names_given_a_solve_blocks_unknowns_of_different_units(tmp_path, capsys
         math_region(5, apply("equal", apply("mult", ident("k"), two_m), real(8))),
         define(6, matrix(ident("e", "1"), ident("k", "1")), find),
         evaluate(7, apply("plus", ident("e", "1"), apply("mult", ident("k", "1"), one_m)), real(6)),
+        # the same block's values shown: [2; 4/m], a matrix of two units, compared by name
+        define(8, ident("e"), real(0)),
+        math_region(9, ident("Given")),
+        math_region(10, apply("equal", apply("plus", ident("e"), real(1)), real(3))),
+        math_region(11, apply("equal", apply("mult", ident("k"), two_m), real(8))),
+        define(
+            12,
+            matrix(ident("e", "2"), ident("k", "2")),
+            shown(find, matrix(real(2), united(4, ("m", -1)))),
+        ),
     )
     assert "region 7" not in text.split("[inputs]")[0]
     result = check_sheet(tmp_path, capsys, "parts")
-    assert (result["printed"], result["reproduced"], result["failed"]) == (1, 1, 0), result
+    assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result
 
 
 @pytest.mark.slow

@@ -45,6 +45,7 @@ class Translator(ResultsMixin, SolveMixin):
         # whether the region being translated defines one (its square roots are complex)
         self.complex_shown: set[tuple[str, str]] = set()
         self.complex_roots = False
+        self.parts_own = False  # the last [a; b] := value gave each name its own definition
         self._index: Sym | None = None
         self.region = ""  # the region being translated
         self.given: list[str] | None = None  # regions of the open solve block
@@ -496,7 +497,8 @@ class Translator(ResultsMixin, SolveMixin):
                     self.stored_but_broken(region, evaluation, "[...] := ...")
                 raise
             if evaluation is not None:  # [a; b] := value = the value Mathcad shows
-                self.evaluation(region, evaluation, whole)
+                if not self._shown_parts(region, lhs, evaluation):
+                    self.evaluation(region, evaluation, whole)
             return
         if lhs.tag != "id":
             if evaluation is not None:
@@ -813,6 +815,7 @@ class Translator(ResultsMixin, SolveMixin):
                 self.define(_key(n), "var", region.id).broken = str(why)
             raise
         own = self._own_parts(rhs, parts, rows, cols)
+        self.parts_own = own is not None
         # where each name has its own definition, the whole value (compared where Mathcad
         # shows it) is a part of the region of its own: the engine may refuse a matrix of
         # elements of different units without refusing the names
@@ -837,6 +840,26 @@ class Translator(ResultsMixin, SolveMixin):
                 item = ex.Index(ex.Name(whole.token()), index)
                 self.out.items.append(Item("definition", region.id, sym=sym, body=item))
         return whole
+
+    def _shown_parts(self, region: Region, lhs: MNode, evaluation: MNode) -> bool:
+        """[a; b] := value = [x; y] where each name has its own definition and the stored
+        matrix has an element per name: each element compared as that name's shown value
+        (so that a matrix of different units, [0.002; 0.4/m], is compared too). False: the
+        names share the whole value (compared as one matrix)."""
+        result = evaluation.find("result")
+        shown = result.children[0] if result is not None and result.children else None
+        names = lhs.children
+        syms = [self.scope.get(_key(n)) for n in names]
+        if shown is None or shown.tag != "matrix" or matrix_size(shown) != matrix_size(lhs):
+            return False
+        if len(shown.children) != len(names) or any(s is None for s in syms):
+            return False
+        if not self.parts_own:
+            return False
+        for name, sym, element in zip(names, syms, shown.children, strict=True):
+            one = MNode("eval", {}, "", [name, MNode("result", {}, "", [element])])
+            self.evaluation(region, one, sym)
+        return True
 
     def _own_parts(self, rhs: MNode, parts: dict, rows: int, cols: int):
         """[a; b] := value where the value is a matrix written out (``[x; y]``, Find's
