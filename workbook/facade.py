@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from .compute.checks import sheet_report
 from .compute.computed import ComputedSheet, compute
 from .engine import sheet as engine
 from .errors import WorkbookError
@@ -23,6 +24,11 @@ class Sheet(engine.Sheet):
 
     def another(self, values: dict[str, Any], parts) -> Sheet:
         return Sheet(self.full_spec, values, self.typer, parts, self.typed)
+
+    def check(self):
+        """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`,
+        made once per Sheet (the workbook's and the report's Checks read it)."""
+        return sheet_report(self)
 
     def computed(
         self, *, excel: bool = False, command: str | None = None, verify: bool = True

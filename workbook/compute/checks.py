@@ -166,6 +166,12 @@ def _json_number(value: float | str | None) -> float | str | None:
     return None if value is None or not math.isfinite(value) else value
 
 
+def sheet_report(sheet) -> Report:
+    """The sheet's check report, made once per Sheet (the workbook's and the report's Checks
+    read it)."""
+    return sheet.once(("check",), lambda: run_checks(sheet))
+
+
 def run_checks(sheet) -> Report:
     """Compare every printed value with the engine, and collect block findings."""
     report = Report(sheet.name)

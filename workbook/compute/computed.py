@@ -32,6 +32,7 @@ from ..engine.tabledata import Column, TableData
 from ..errors import InputError
 from ..language import expr as ex
 from ..language import units as un
+from .checks import sheet_report
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -164,7 +165,7 @@ def _compute(sheet: Sheet, out: ComputedSheet, report, check: bool, excel: bool)
     spec = sheet.spec
     out.report = report
     if report is None and check and excel:
-        out.report = sheet.check()
+        out.report = sheet_report(sheet)
     for name, d in spec.definitions.items():
         if d.is_function:
             if not excel:  # the report's and the notebook's (the workbook shows none)
@@ -184,7 +185,7 @@ def _compute(sheet: Sheet, out: ComputedSheet, report, check: bool, excel: bool)
             out.series[(chart.name, i)] = _series(sheet, out.tables, chart, s)
     if out.report is None and check:
         try:
-            out.report = sheet.check()
+            out.report = sheet_report(sheet)
         except Exception as err:  # noqa: BLE001 - shown in the report's Checks section
             out.report = err
 

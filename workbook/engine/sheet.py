@@ -828,13 +828,6 @@ class Sheet:
             )
         return self._memo[key]
 
-    def check(self):
-        """Compare with the printed values; returns a :class:`workbook.compute.checks.Report`,
-        made once per Sheet (the workbook's and the report's Checks read it)."""
-        from ..compute.checks import run_checks
-
-        return self.once(("check",), lambda: run_checks(self))
-
     def unused_inputs(self) -> list[str]:
         """Inputs that no table, chart, printed value, check or scalar definition (each is on
         the workbook's Results sheet) needs (in any part), nor anything evaluated through this
