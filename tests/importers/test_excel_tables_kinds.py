@@ -191,3 +191,30 @@ def test_lookups_of_texts_that_never_change_are_the_cells_excel_finds(tmp_path, 
     sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
     name = next(n for n, d in sheet.spec.definitions.items() if "=VLOOKUP(E1,A2" in d.note)
     assert sheet.with_inputs(C3=300).evaluate(name).magnitude == 300  # the cell stays live
+
+
+@pytest.mark.slow
+def test_sumproduct_reads_texts_and_empty_cells_as_excel_does(tmp_path, capsys):
+    path = tmp_path / "sumproduct.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_column("A1", [2, "n/a", 4, 5])  # A2 is a text
+    ws.write_column("B1", [10, 20, 30])  # B4 is empty
+    ws.write_formula("C1", "=A1*3", None, 6)
+    ws.write_formula("D1", "=SUMPRODUCT(A1:A4,B1:B4)", None, 140)  # 2*10 + 0 + 4*30 + 0
+    ws.write_formula("D2", "=SUMPRODUCT(C1:C1,B1:B1)*2", None, 120)
+    ws.write_formula("D3", "=SUMPRODUCT(A1:A4,B1:B3)", None, "#VALUE!")
+    ws.write_formula("D4", "=SUMPRODUCT(A1:A3)", None, 6)
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "different sizes" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 4, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    name = next(
+        n for n, d in sheet.spec.definitions.items() if "=SUMPRODUCT(A1:A4,B1:B4)" in d.note
+    )
+    inputs = {n for n in sheet.spec.inputs}
+    empty = next(n for n in inputs if "B4" in sheet.spec.inputs[n].note)
+    assert sheet.with_inputs(**{empty: 2}).evaluate(name).magnitude == 150

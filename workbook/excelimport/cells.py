@@ -394,6 +394,8 @@ class FormulaTranslator:
             return self.if_error(args)
         if upper == "CONVERT":
             return self.convert(args)
+        if upper == "SUMPRODUCT":
+            return self.sum_product(args)
         if upper in ("MATCH", "INDEX", "HLOOKUP"):
             from . import lookups
 
@@ -405,6 +407,42 @@ class FormulaTranslator:
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")
+
+    def sum_product(self, args) -> str:
+        """``SUMPRODUCT(A, B, ...)`` of ranges of one shape: the sum over their cells of the
+        products, Excel reading a text, an empty cell or TRUE/FALSE as 0 (an empty cell is its
+        input 0; a term with a constant text or TRUE/FALSE is 0 and left out). A formula cell
+        that gives other than a number is refused (an error value there is Excel's value)."""
+        from .kinds import _cell_kind
+
+        refs = [self.ref_of(a[2]) if a[0] == "leaf" and a[1] == "Range" else None for a in args]
+        if not args or None in refs or any(self.is_name_formula(a[2]) for a in args):
+            raise FormulaProblem("SUMPRODUCT of other than ranges")
+        shapes = {(r.r2 - r.r1, r.c2 - r.c1) for r in refs}
+        if len(shapes) != 1:
+            raise FormulaProblem("SUMPRODUCT of ranges of different sizes (#VALUE! in Excel)")
+        (rows, cols) = shapes.pop()
+        terms = []
+        for dr in range(rows + 1):
+            for dc in range(cols + 1):
+                factors = []
+                for ref in refs:
+                    r, c = ref.r1 + dr, ref.c1 + dc
+                    cell = self.book.cell(ref.sheet, r, c)
+                    if cell is not None and cell.formula is not None:
+                        if _cell_kind(self, cell, 0) != "number":
+                            raise FormulaProblem("SUMPRODUCT over a formula that gives no number")
+                    elif cell is not None and not isinstance(cell.value, (int, float)):
+                        factors = None  # a text or TRUE/FALSE: Excel's 0
+                        break
+                    elif cell is not None and isinstance(cell.value, bool):
+                        factors = None
+                        break
+                    self.out.refs.append(Ref(ref.sheet, r, c, r, c))
+                    factors.append(self.name_of(ref.sheet, r, c))
+                if factors:
+                    terms.append("*".join(factors))
+        return "(" + " + ".join(terms) + ")" if terms else "0"
 
     def convert(self, args) -> str:
         """``CONVERT(x, "in", "m")`` of units written in the formula: x times Excel's factor
