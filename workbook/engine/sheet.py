@@ -136,7 +136,7 @@ class Sheet:
                     self.typed_column(s.y, rng.var, f"chart {c.name}")
 
         if self.full_spec.checks:
-            from ..compute.declared_checks import type_checks
+            from ..language.checkspec import type_checks
 
             type_checks(self)
         for d in later:  # typed at numbers, or by a call with vectors or matrices

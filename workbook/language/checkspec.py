@@ -1,5 +1,5 @@
-"""Checks declared in the template (``[[checks]]``), as written: a value, a condition, a line
-of the report; typed at load and computed by :mod:`workbook.compute.declared_checks`.
+"""Checks declared in the template (``[[checks]]``): a value, a condition, a line of the
+report; read and typed at load here, computed by :mod:`workbook.compute.declared_checks`.
 
 A check is a finding written in the worksheet rather than in a solver block::
 
@@ -22,11 +22,15 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from ..errors import TemplateError, WorkbookError
+import pint
+
+from ..errors import InputError, TemplateError, WorkbookError
 from ..verdicts import FINDING_VERDICTS
+from . import cellunit
 from . import expr as ex
+from . import typed as ty
 from . import units as un
-from .fields import Fields
+from .fields import Fields, nearest
 
 CHECK_KEYS = (
     "topic",
@@ -135,3 +139,105 @@ def placeholders(text: str) -> list[tuple[str, str | None]]:
         expression, _, unit = body.rpartition(":") if ":" in body else (body, "", "")
         out.append((expression.strip(), unit.strip() or None))
     return out
+
+
+# -- load time --------------------------------------------------------------------------------
+def type_checks(sheet) -> None:
+    """Type every check of the sheet (all parts), so that a mistake is an error at load."""
+    for spec in sheet.full_spec.checks:
+        try:
+            if not isinstance(spec.example_only, bool):
+                for name in spec.example_only:
+                    if name not in sheet.spec.inputs:
+                        known = sheet.spec.inputs
+                        raise InputError(
+                            f"example_only: '{name}' is not an input{nearest(name, known)}"
+                        )
+            for name, text in spec.inputs.items():
+                try:
+                    sheet.with_inputs(**{name: text})
+                except WorkbookError as err:  # said at the check, not at the input's line
+                    raise type(err)(f"inputs: {err.message}") from None
+            typed_value(sheet, spec)
+            typed_condition(sheet, spec)
+            for piece in (spec.what, spec.note):
+                for expression, unit in placeholders(piece):
+                    typed_placeholder(sheet, spec, expression, unit)
+        except WorkbookError as err:
+            raise err.located(file=sheet.file, line=spec.line, definition=spec.label) from None
+
+
+def typed_value(sheet, spec: CheckSpec):
+    """The typed value and the factor that shows it in its unit (typed at load, then read)."""
+    found = sheet.typed.get(spec, "value")
+    return (
+        found if found is not None else sheet.typed.keep(spec, "value", _value_typed(sheet, spec))
+    )
+
+
+def _value_typed(sheet, spec: CheckSpec):
+    if spec.value is None:
+        return None, None
+    t = sheet.typer.expression(spec.value, {}, spec.label)
+    if getattr(t, "text", False) or getattr(t, "boolean", False) or t.shape:
+        raise TemplateError("value must be one number")
+    shown = un.unit(spec.unit, what=spec.label) if spec.unit is not None else t.unit
+    return t, _factor(t, shown, spec.unit)
+
+
+def typed_condition(sheet, spec: CheckSpec):
+    """The typed condition ``ok`` (typed at load, then read)."""
+    found = sheet.typed.get(spec, "ok")
+    return (
+        found if found is not None else sheet.typed.keep(spec, "ok", _condition_typed(sheet, spec))
+    )
+
+
+def _condition_typed(sheet, spec: CheckSpec):
+    if spec.ok is None:
+        return None
+    t = sheet.typer.expression(spec.ok, {}, spec.label)
+    if not getattr(t, "boolean", False) or t.shape:
+        raise TemplateError("ok must be a condition (a comparison like 'sigma <= f_y')")
+    return t
+
+
+def typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None):
+    """A placeholder's typed tree, factor and unit shown (typed at load, then read)."""
+    key = ("placeholder", expression, unit)
+    found = sheet.typed.get(spec, key)
+    if found is None:
+        found = sheet.typed.keep(spec, key, _placeholder_typed(sheet, spec, expression, unit))
+    return found
+
+
+def _placeholder_typed(sheet, spec: CheckSpec, expression: str, unit: str | None):
+    t = sheet.typer.expression(spec.parsed[expression], {}, spec.label)
+    if getattr(t, "boolean", False) or t.shape:
+        raise TemplateError(f"{{{expression}}} must be one number or a text")
+    if getattr(t, "text", False) or getattr(t, "kind", None) == "choice":  # a choice is text
+        if unit is not None:
+            raise TemplateError(f"{{{expression}}} is a text, it has no unit")
+        return t, None, None
+    if unit == PERCENT:
+        return t, 100 * _factor(t, un.registry().dimensionless, ""), "%"
+    shown = un.unit(unit, what=spec.label) if unit is not None else _shown_unit(t)
+    return t, _factor(t, shown, unit), shown
+
+
+def _shown_unit(t):
+    return cellunit.stored_unit(t)
+
+
+def _factor(t, dst, dst_text: str | None) -> float:
+    """The factor that shows ``t`` in ``dst`` (a bare number shown in degrees is in degrees,
+    as the typer reads it)."""
+    if ty.is_bare(t) and un.is_angle(dst):
+        return 1.0
+    src = t.unit
+    try:
+        return un.factor(src, dst)
+    except (pint.errors.PintError, WorkbookError):  # other dimensions, or an offset (degC)
+        raise TemplateError(
+            f"cannot show {un.dims(src)} ({un.pretty(src)}) in {dst_text!r}"
+        ) from None
