@@ -215,3 +215,26 @@ def test_shape_tests_and_primes_norm_of_a_vector(tmp_path, capsys):
     assert "norm() of something that is not a vector" in text
     result = check_sheet(tmp_path, capsys, "shapes")
     assert (result["printed"], result["reproduced"], result["failed"]) == (6, 5, 0), result
+
+
+@pytest.mark.slow
+def test_elements_shown_one_row_per_value_of_a_range_above_origin(tmp_path, capsys):
+    """i := 1 .. 2, v[i] := 10*i = [10; 20] (Prime shows a row per value of i; v itself is
+    [0; 10; 20]): each row compared with v at that i, v[1] = 10 and v[2] = 20."""
+    from helpers.mathcad_xml import index
+
+    rng = f"<ml:range>{real(1)}{real(2)}</ml:range>"
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "rows",
+        define(1, ident("i"), rng),
+        define(
+            2,
+            index(ident("v"), ident("i")),
+            shown(apply("mult", real(10), ident("i")), matrix(real(10), real(20))),
+        ),
+    )
+    assert "v[2]" in text
+    result = check_sheet(tmp_path, capsys, "rows")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result

@@ -485,6 +485,8 @@ class Translator(ResultsMixin, SolveMixin):
                 raise
             if evaluation is not None:
                 key = _key(target)
+                if self._shown_over_range(region, lhs, evaluation):
+                    return
                 # v[k] := expr = shows the element (one number): the value of expr
                 element = not tt.shows_array(evaluation) and not tt.mentions(rhs, key)
                 self.evaluation(region, evaluation, None if element else self.scope[key])
@@ -755,6 +757,30 @@ class Translator(ResultsMixin, SolveMixin):
         else:
             rows = tuple(tuple(cell(o + r, o + c) for c in range(size[1])) for r in range(size[0]))
         self.out.items.append(Item("definition", region.id, sym=sym, body=ex.Matrix(rows)))
+
+    def _shown_over_range(self, region: Region, lhs: MNode, evaluation: MNode) -> bool:
+        """v[i] := f(i) = over a range i that starts above ORIGIN, shown as one row per value
+        of i (Prime shows the elements the range gives, ``s[i] := ... =`` with i := 1 .. 1 a
+        matrix of one row, where v has the rows 0 and 1): each stored row compared with v at
+        that value of i. False: the stored rows are not one per value of the range."""
+        index = lhs.children[2]
+        if index.tag != "id" or self.range_of(index) is None:
+            return False
+        values = self.range_of(index).range_values or []
+        result = evaluation.find("result")
+        shown = result.children[0] if result is not None and result.children else None
+        if shown is None or shown.tag != "matrix" or matrix_size(shown) != (len(values), 1):
+            return False
+        reach = max(values) - self.origin + 1
+        if len(values) == reach or len(shown.children) != len(values):
+            return False  # the whole vector (Mathcad 15's display)
+        target = lhs.children[1]
+        for value, element in zip(values, shown.children, strict=True):
+            at = MNode("real", {}, repr(float(value)), [])
+            indexed = MNode("apply", {}, "", [MNode("indexer", {}, "", []), target, at])
+            one = MNode("eval", {}, "", [indexed, MNode("result", {}, "", [element])])
+            self.evaluation(region, one, None)
+        return True
 
     def _shifted_index(self, node: MNode) -> tuple[MNode, int] | None:
         """``i + N``, ``N + i`` or ``i - N`` (i a range variable, N a name or number that is
