@@ -476,8 +476,8 @@ def test_chart_labels_are_never_references(tmp_path_factory, texts):
     import openpyxl
     import xlsxwriter
 
+    from workbook.compute import style
     from workbook.compute.excelsheets import chart_label
-    from workbook.outputs import style
 
     texts = [t.replace("\x00", "") or "x" for t in texts]  # no cell or XML holds NUL
     path = tmp_path_factory.mktemp("labels") / "c.xlsx"

@@ -29,9 +29,8 @@ from ..language import typed as ty
 from ..language import units as un
 from ..language.uses import names_used
 from ..limits import MAX_TABLE_CELLS
-from ..outputs import style
 from ..version import __version__
-from . import excelchecks, frozen, rangeguard
+from . import excelchecks, frozen, rangeguard, style
 from .excel import ExcelPrinter, NotLive, cell_value
 from .excelsheets import (
     MAX_COLS,

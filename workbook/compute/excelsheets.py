@@ -15,7 +15,7 @@ ROW_TOKEN = "\x00"
 class FormSheet:
     """One Excel sheet of the form: what is written into it goes to the form's list of
     xlsxwriter calls (sheet index, method, arguments, index of the format among the arguments
-    or -1), in the order written; a format is its role in :data:`workbook.outputs.style.FORMATS`."""
+    or -1), in the order written; a format is its role in :data:`workbook.compute.style.FORMATS`."""
 
     def __init__(self, name: str, index: int, ops: list):
         self.name, self.index, self._ops = name, index, ops

@@ -18,7 +18,7 @@ from xlsxwriter.utility import xl_cell_to_rowcol, xl_rowcol_to_cell
 
 from . import livecheck
 
-#: the style roles (workbook.outputs.style.FORMATS) of the two kinds of marked cells
+#: the style roles (workbook.compute.style.FORMATS) of the two kinds of marked cells
 FROZEN, STALE = "frozen", "stale"
 
 _WRITES = {"write_number": 3, "write_string": 3, "write_boolean": 3, "write_formula": 3}

@@ -12,9 +12,9 @@ import re
 import sys
 from pathlib import Path
 
+from ..compute import style
 from ..errors import InputError
 from ..functions.excel_functions import CLASSIC
-from . import style
 from .atomic import check_target, replacing
 
 #: a workbook with more formula cells than this says so on stderr while it is saved

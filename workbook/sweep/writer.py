@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compute import style
 from ..errors import InputError
-from ..outputs import style
 from .driver import SweepResult
 
 
