@@ -24,6 +24,7 @@ from ..errors import DomainError, InputError, LimitError, WorkbookError
 from ..functions.registry import REGISTRY
 from ..language import typecheck as tc
 from ..language import typed as ty
+from ..language.expr import COMPARE
 from ..language.subtrees import plan
 from ..language.typed import children
 from ..language.visitor import Visitor
@@ -34,7 +35,7 @@ from . import runtime as rt
 Env = dict[str, object]
 Fn = Callable[[Env], object]
 
-_CMP = rt.COMPARE
+_CMP = COMPARE
 # Powers by products and square roots (x^1.5, x^3 and x^4 in Evaluator._power_by_parts):
 # several times faster than np.power, within 2 ulp (tests/numerics/test_numeric_golden.py, mpmath).
 _POWERS = {

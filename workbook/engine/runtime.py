@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import InputError, LimitError
 from ..functions.matrix import power
+from ..language.expr import COMPARE
 from ..limits import ELEMENT_WORK, MAX_ARRAY_ELEMENTS, charge_matrix_work, check_elements
 
 #: Arrays inside arrays at most this deep: a deeper one (``T := [T, 1]`` in a loop) would
@@ -326,17 +327,6 @@ def binary(op: str, a, b, what: str):
     if sa[0] != sa[1] or n != int(n):
         raise InputError(f"{what}: a power of {describe(a)} needs a square matrix and an integer")
     return power(a, int(n))
-
-
-#: The comparison operators by their worksheet symbol (the numpy back end uses them too).
-COMPARE = {
-    "<": operator.lt,
-    "<=": operator.le,
-    ">": operator.gt,
-    ">=": operator.ge,
-    "==": operator.eq,
-    "!=": operator.ne,
-}
 
 
 def compare(op: str, a, b, what: str) -> bool:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 import math
+import operator
 import re
 import warnings
 from dataclasses import dataclass
@@ -18,6 +19,17 @@ from .visitor import Visitor
 
 MAX_TEXT = 20_000
 MAX_DEPTH = 200
+
+#: The comparison operators by their worksheet symbol, as Python's (the back ends and the
+#: mpmath form compare with them)
+COMPARE = {
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "==": operator.eq,
+    "!=": operator.ne,
+}
 
 
 @dataclass(frozen=True)

@@ -21,9 +21,9 @@ import operator
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from ..engine.runtime import COMPARE
 from ..functions.entry import ENTRIES  # as registered: the registry imports this one's users
 from ..language import typed as ty
+from ..language.expr import COMPARE
 from ..language.visitor import Visitor
 
 #: a sheet function nested deeper than this is not expanded
