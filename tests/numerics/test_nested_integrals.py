@@ -89,7 +89,7 @@ def _counting_spot_checks(monkeypatch) -> list[int]:
     from workbook.numerics import mpform, rounding
 
     counts: list[int] = []
-    spend, check = mpform._spend, rounding.discrepancy
+    spend, check = mpform.spend_evaluation, rounding.discrepancy
 
     def counted(*args, **kwargs):
         calls = [0]
@@ -98,11 +98,11 @@ def _counting_spot_checks(monkeypatch) -> list[int]:
             calls[0] += 1
             spend()
 
-        monkeypatch.setattr(mpform, "_spend", spending)
+        monkeypatch.setattr(mpform, "spend_evaluation", spending)
         try:
             return check(*args, **kwargs)
         finally:
-            monkeypatch.setattr(mpform, "_spend", spend)
+            monkeypatch.setattr(mpform, "spend_evaluation", spend)
             counts.append(calls[0])
 
     monkeypatch.setattr(rounding, "discrepancy", counted)

@@ -71,7 +71,8 @@ def evaluations(most: int) -> Iterator[None]:
         _LEFT.reset(token)
 
 
-def _spend() -> None:
+def spend_evaluation() -> None:
+    """Count one evaluation of an integrand against the budget in force (TooCostly past it)."""
     left = _LEFT.get()
     if left is not None:
         left[0] -= 1
@@ -134,12 +135,12 @@ def _inside(g, x, lo, hi):
     """g at a node of a piece; 0 at a node that rounds to an end (a singular end's nodes
     come closer to it than the precision: they weigh less than 1e-16 of an integrable
     singularity's integral, below the reference's accuracy)."""
-    _spend()
+    spend_evaluation()
     return 0 if x in (lo, hi) else g(x)
 
 
 def _abs_or_zero(g, x):
-    _spend()
+    spend_evaluation()
     try:
         return abs(g(x))
     except (NoValue, ZeroDivisionError):
