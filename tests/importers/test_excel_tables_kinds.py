@@ -15,7 +15,7 @@ from workbook.excelimport.convert import convert  # noqa: E402
 from workbook.excelimport.formula_terms import FormulaProblem  # noqa: E402
 from workbook.excelimport.tables import StructuredProblem, Table, rewrite  # noqa: E402
 
-LOADS = Table("Loads", "S", 2, 2, 6, 4, 1, 1, ("Span (m)", "w'k", "M"))
+LOADS = Table("Loads", "S", 2, 2, 6, 5, 1, 1, ("Span (m)", "w'k", "M", "Size "))
 
 
 @pytest.mark.parametrize(
@@ -28,7 +28,9 @@ LOADS = Table("Loads", "S", 2, 2, 6, 4, 1, 1, ("Span (m)", "w'k", "M"))
         ("SUM(Loads[[#Headers],[Span (m)]:[M]])", 9, "SUM($B$2:$D$2)"),
         ("SUM(Loads[[#Data],[#Totals],[M]])", 9, "SUM($D$3:$D$6)"),
         ("Loads[[#Totals],[M]]", 9, "$D$6"),
-        ("SUM(Loads[#All])", 9, "SUM($B$2:$D$6)"),
+        ("SUM(Loads[#All])", 9, "SUM($B$2:$E$6)"),
+        ("Loads[Size ]", 9, "$E$3:$E$5"),  # a name's own spaces are kept
+        ("Loads[[#This Row], [Size ]]", 4, "$E4"),
         ('"Loads[M]"&Loads[[#This Row],[M]]', 5, '"Loads[M]"&$D5'),  # never inside a text
     ],
 )

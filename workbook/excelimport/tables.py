@@ -136,7 +136,8 @@ def _unescape(name: str) -> str:
 def _items(spec: str) -> list[tuple[str, str]]:
     """[(separator before, item)] of a specifier's bracketed items: ``[#Headers],[A]:[B]``."""
     items, i, sep = [], 0, ","
-    spec = spec.strip()
+    if spec.strip().startswith(("[", "@")):  # spaces may stand between items, not in a name
+        spec = spec.strip()
     if spec.startswith("@"):  # [@Col] or [@[Col]]: this row
         items.append((",", "#this row"))
         spec = spec[1:].strip()
