@@ -424,8 +424,10 @@ def test_an_element_defined_from_its_previous_value(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_vectorize_over_a_vector_of_a_length_known_when_computed(tmp_path, capsys):
-    """v := lsolve(M, b) (its length not known at import); →(v·v + 1) is the language's
-    vectorize(v * v + 1): [5; 10]."""
+    """v := g(b), g(x) := 1·x a function of the worksheet (its length not known at import:
+    a function's arguments are typed at the end); →(v·v + 1) is the language's
+    vectorize(v * v + 1): [5; 10]. u := lsolve(M, b) is of a length the engine gives at
+    import: →(u·u + 1) is written out, [u[0] * u[0] + 1, ...]."""
     m = (
         '<ml:matrix rows="2" cols="2"><ml:real>1</ml:real><ml:real>0</ml:real>'
         "<ml:real>0</ml:real><ml:real>1</ml:real></ml:matrix>"
@@ -433,15 +435,35 @@ def test_vectorize_over_a_vector_of_a_length_known_when_computed(tmp_path, capsy
     b = '<ml:matrix rows="2" cols="1"><ml:real>2</ml:real><ml:real>3</ml:real></ml:matrix>'
     square = f"<ml:apply><ml:mult/>{_id('v')}{_id('v')}</ml:apply>"
     body = f"<ml:apply><ml:vectorize/><ml:apply><ml:plus/>{square}{_real(1)}</ml:apply></ml:apply>"
+    u_square = f"<ml:apply><ml:mult/>{_id('u')}{_id('u')}</ml:apply>"
+    u_body = (
+        f"<ml:apply><ml:vectorize/><ml:apply><ml:plus/>{u_square}{_real(1)}</ml:apply></ml:apply>"
+    )
+    g = (
+        f"<ml:function>{_id('g')}<ml:boundVars>{_id('x')}</ml:boundVars></ml:function>"
+        f"<ml:apply><ml:mult/>{_real(1)}{_id('x')}</ml:apply>"
+    )
     regions = (
         _region(1, 1, f"<ml:define>{_id('M')}{m}</ml:define>")
         + _region(2, 2, f"<ml:define>{_id('b')}{b}</ml:define>")
-        + _region(3, 3, f"<ml:define>{_id('v')}{_call('lsolve', _id('M'), _id('b'))}</ml:define>")
+        + _region(7, 7, f"<ml:define>{g}</ml:define>")
+        + _region(3, 3, f"<ml:define>{_id('v')}{_call('g', _id('b'))}</ml:define>")
         + _eval(4, body)
+        + _region(5, 5, f"<ml:define>{_id('u')}{_call('lsolve', _id('M'), _id('b'))}</ml:define>")
+        + _eval(6, u_body)
     )
-    results = _result(1) + _result(2) + _result(3) + _result(4, _stored_matrix([[5], [10]]))
+    results = (
+        _result(1)
+        + _result(2)
+        + _result(3)
+        + _result(4, _stored_matrix([[5], [10]]))
+        + _result(5)
+        + _result(6, _stored_matrix([[5], [10]]))
+        + _result(7)
+    )
     src = _package(tmp_path / "vec.mcdx", regions, results)
     assert main(["import", str(src), "--out", str(tmp_path)]) == 0
-    assert "vectorize(" in (tmp_path / "vec.toml").read_text(encoding="utf-8")
+    text = (tmp_path / "vec.toml").read_text(encoding="utf-8")
+    assert "vectorize(" in text and "u[0] * u[0] + 1" in text
     result = _check(tmp_path / "vec.toml", capsys)
-    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result
+    assert (result["printed"], result["reproduced"], result["failed"]) == (4, 4, 0), result

@@ -367,8 +367,6 @@ class AtImport:
         # arguments whose unit the end of the translation gave (argument_units): an
         # expression of them is known by its unit
         self.settled: set[int] = set()
-        # token of an unknown of a solve block -> its guess (a value with its unit)
-        self.unknowns: dict[str, str] = {}
         # what a worksheet holds -> (spec, typer, identifier of each token, its Sheet or None)
         self.worksheets: dict[frozenset, list] = {}
 
@@ -378,9 +376,6 @@ class AtImport:
         for item in items[self.seen[0] :]:
             if item.sym is not None:
                 self.items[item.sym.token()] = item
-            if item.kind == "solve" and item.solve:
-                for sym, guess in item.solve[0]:  # an unknown has its guess's unit
-                    self.unknowns[sym.token()] = guess
         for k, sym in enumerate(syms[self.seen[1] :], self.seen[1]):
             self.syms[sym.token()] = sym
             self.order[id(sym)] = k
@@ -413,11 +408,6 @@ class AtImport:
                     range_syms.append(sym)
                 continue
             item = self.items.get(name)
-            if item is None and name in self.unknowns and not values:
-                # its unit (the guess's) only: its value is the root, not the guess
-                items.append(Item("input", sym=sym, value=self.unknowns[name]))
-                syms.add(sym)
-                continue
             if item is None:
                 raise Unknown(name)
             if item.kind == "range" and ranges and sym.is_range:

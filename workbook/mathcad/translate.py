@@ -366,7 +366,10 @@ class Translator(ResultsMixin, SolveMixin):
         # A call whose argument is a parameter of another function (``σ(z, e, k) :=
         # σ.c(ε(z, e, k))``) has that parameter's unit, known once that function's own calls
         # are: the units are passed on from call to call until none changes, and only then is
-        # a parameter still open given the first call's unit as it reads (dimensionless).
+        # a parameter still open given the first call's unit as it reads (dimensionless). A
+        # solve block's unknown passes no unit: the blocks whose functions it would type (of
+        # integrals of piecewise functions) took the engine from 20 s to minutes of CPU
+        # to solve, past the check's budget.
         open_params = {id(p) for item in functions for p in item.params if not p.unit} | {
             id(s) for s in bound if not s.unit
         }
