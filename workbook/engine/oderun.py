@@ -82,6 +82,89 @@ def _progress(label: str, solver, t0: float, t1: float, nsteps: int, start: floa
     )
 
 
+class _Points:
+    """The output of a run: the state at every step, or at ``t_eval`` (interpolated from each
+    step's dense output as the steps pass them)."""
+
+    def __init__(self, t0: float, y0: np.ndarray, t_eval) -> None:
+        self.size = len(y0)
+        self.t_eval = None if t_eval is None else np.asarray(t_eval, dtype=float)
+        self.ts: list = []
+        self.ys: list = []
+        self.next = 0
+        if self.t_eval is None:
+            self.ts, self.ys = [t0], [y0.copy()]
+        elif self.t_eval.size and self.t_eval[0] == t0:
+            self.ts.append(self.t_eval[:1])
+            self.ys.append(y0[:, None].copy())
+            self.next = 1
+
+    def record(self, solver) -> None:
+        """Keep what the step just taken gives."""
+        if self.t_eval is None:
+            self.ts.append(solver.t)
+            self.ys.append(solver.y.copy())
+            return
+        hi = np.searchsorted(self.t_eval, solver.t, side="right")
+        if hi > self.next:
+            chunk = self.t_eval[self.next : hi]
+            self.ts.append(chunk)
+            self.ys.append(np.asarray(solver.dense_output()(chunk)).reshape(self.size, -1))
+            self.next = hi
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The times and the states (one row per state)."""
+        if self.t_eval is None:
+            t = np.asarray(self.ts, dtype=float)
+            return t, np.asarray(self.ys, dtype=float).T.reshape(self.size, -1)
+        t = np.concatenate(self.ts) if self.ts else np.empty(0)
+        return t, np.hstack(self.ys) if self.ys else np.empty((self.size, 0))
+
+
+def _solver_class(method: str):
+    """scipy's solver class of ``method``."""
+    from scipy import integrate
+
+    classes = {
+        "RK45": integrate.RK45,
+        "DOP853": integrate.DOP853,
+        "Radau": integrate.Radau,
+        "BDF": integrate.BDF,
+        "LSODA": integrate.LSODA,
+        "RK23": integrate.RK23,
+    }
+    if method not in classes:
+        raise ValueError(f"unknown ODE method {method!r} (known: {', '.join(classes)})")
+    return classes[method]
+
+
+def _over_budget(elapsed: float, nsteps: int, max_time: float, max_steps: int):
+    """(reason, note) of a run past its wall-clock budget or step cap, or None."""
+    if elapsed > max_time:
+        return "time budget", f"stopped after the wall-clock budget of {max_time:g} s"
+    if nsteps >= max_steps:
+        return "step cap", f"stopped after the step cap of {max_steps} steps"
+    return None
+
+
+def _blown_up(solver, blowup: float | None) -> str | None:
+    """Why the state after the step just taken blows up (beyond ``blowup``), or None."""
+    if blowup is None or np.all(np.abs(solver.y) <= blowup):
+        return None
+    k = int(np.argmax(~(np.abs(solver.y) <= blowup)))
+    return (
+        f"state {k} reached {solver.y[k]:.3g} at t = {solver.t:.6g} "
+        f"(beyond {blowup:.3g}: the solution blows up)"
+    )
+
+
+def _solution(knots, pieces):
+    """The run's steps' interpolants as one scipy OdeSolution."""
+    from scipy.integrate import OdeSolution
+
+    return OdeSolution(knots, pieces)
+
+
 def run_ode(
     fun: Callable,
     t_span: Sequence[float],
@@ -112,18 +195,6 @@ def run_ode(
     or exceeds that magnitude. ``watch(solver, nsteps)`` is called after each step; a text it
     returns stops the run ("stiff", the text its note): how "auto" leaves an explicit method.
     """
-    from scipy import integrate
-
-    classes = {
-        "RK45": integrate.RK45,
-        "DOP853": integrate.DOP853,
-        "Radau": integrate.Radau,
-        "BDF": integrate.BDF,
-        "LSODA": integrate.LSODA,
-        "RK23": integrate.RK23,
-    }
-    if method not in classes:
-        raise ValueError(f"unknown ODE method {method!r} (known: {', '.join(classes)})")
     t0, t1 = float(t_span[0]), float(t_span[1])
     y0 = np.asarray(y0, dtype=float)
     options = dict(rtol=rtol, atol=atol, max_step=max_step)
@@ -132,18 +203,8 @@ def run_ode(
     if jac is not None and method in IMPLICIT:
         options["jac"] = jac
     start = time.perf_counter()
-    solver = classes[method](fun, t0, y0, t1, **options)
-    if t_eval is None:
-        ts, ys = [t0], [y0.copy()]
-    else:
-        t_eval = np.asarray(t_eval, dtype=float)
-        ts, ys = [], []
-        if t_eval.size and t_eval[0] == t0:
-            ts.append(t_eval[:1])
-            ys.append(y0[:, None].copy())
-            t_eval_i = 1
-        else:
-            t_eval_i = 0
+    solver = _solver_class(method)(fun, t0, y0, t1, **options)
+    out = _Points(t0, y0, t_eval)
     nsteps = 0
     reason = None
     last_report = start
@@ -155,28 +216,15 @@ def run_ode(
         if solver.status == "failed":
             reason = f"failed: {message}"
             break
-        if blowup is not None and not np.all(np.abs(solver.y) <= blowup):
-            k = int(np.argmax(~(np.abs(solver.y) <= blowup)))
+        blown = _blown_up(solver, blowup)
+        if blown:
             reason = "blow-up"
-            notes.append(
-                f"state {k} reached {solver.y[k]:.3g} at t = {solver.t:.6g} "
-                f"(beyond {blowup:.3g}: the solution blows up)"
-            )
+            notes.append(blown)
             break
         if dense_output:
             pieces.append(solver.dense_output())
             knots.append(solver.t)
-        if t_eval is None:
-            ts.append(solver.t)
-            ys.append(solver.y.copy())
-        else:
-            hi = np.searchsorted(t_eval, solver.t, side="right")
-            if hi > t_eval_i:
-                sol = solver.dense_output()
-                chunk = t_eval[t_eval_i:hi]
-                ts.append(chunk)
-                ys.append(np.asarray(sol(chunk)).reshape(len(y0), -1))
-                t_eval_i = hi
+        out.record(solver)
         if solver.status == "finished":
             reason = "finished"
             break
@@ -187,22 +235,15 @@ def run_ode(
                 notes.append(why)
                 break
         now = time.perf_counter()
-        if now - start > max_time:
-            reason = "time budget"
-            notes.append(f"stopped after the wall-clock budget of {max_time:g} s")
-        elif nsteps >= max_steps:
-            reason = "step cap"
-            notes.append(f"stopped after the step cap of {max_steps} steps")
+        over = _over_budget(now - start, nsteps, max_time, max_steps)
+        if over:
+            reason, note = over
+            notes.append(note)
         elif label and now - last_report >= progress_every:
             _progress(label, solver, t0, t1, nsteps, start)
             last_report = now
     elapsed = time.perf_counter() - start
-    if t_eval is None:
-        t_out = np.asarray(ts, dtype=float)
-        y_out = np.asarray(ys, dtype=float).T.reshape(len(y0), -1)
-    else:
-        t_out = np.concatenate(ts) if ts else np.empty(0)
-        y_out = np.hstack(ys) if ys else np.empty((len(y0), 0))
+    t_out, y_out = out.arrays()
     run = OdeRun(
         method,
         float(rtol),
@@ -220,9 +261,7 @@ def run_ode(
         notes,
     )
     if dense_output and pieces:
-        from scipy.integrate import OdeSolution
-
-        run.sol = OdeSolution(knots, pieces)
+        run.sol = _solution(knots, pieces)
     if label and (elapsed > progress_every or not run.ok):
         print(f"[{label}] {run.summary()}", file=sys.stderr, flush=True)
     return run

@@ -42,7 +42,6 @@ def extremum(
     the bound left is added to the error estimate. Without it, the value assumes no feature
     narrower than the samples' spacing.
     """
-    from scipy.optimize.elementwise import find_minimum
 
     shape, (a, b, *args) = rows(a, b, *args)
     n, k = a.size, OVERSAMPLE * max(int(tol.samples), 2)
@@ -73,31 +72,7 @@ def extremum(
     best_xe = np.zeros(n)
     evaluations = k + 1
     if ri.size:
-        init = (xs[ri, ci - 1], xs[ri, ci], xs[ri, ci + 1])
-        fa = tuple(g[ri] for g in args)
-        # a minimum's place is known to about sqrt(eps) relative at best
-        tols = {"xatol": tol.atol, "xrtol": max(tol.rtol, np.finfo(float).eps ** 0.5)}
-        with np.errstate(all="ignore"):
-            res = find_minimum(
-                lambda x, *p: sgn * np.asarray(f(x, *p)), init, args=fa, tolerances=tols
-            )
-        ok = np.asarray(res.success) | (np.asarray(res.status) == -2)
-        vals = np.where(ok, res.f_x, fs[ri, ci])
-        where = np.where(ok, res.x, xs[ri, ci])
-        span = xs[ri, ci + 1] - xs[ri, ci - 1]
-        werr = np.where(ok, np.abs(res.bracket[1] - res.bracket[0]), span)
-        verr = np.where(ok, np.abs(np.maximum(res.f_bracket[0], res.f_bracket[2]) - res.f_x), 0.0)
-        evaluations += int(np.max(res.nfev))
-        # per row: the best candidate (the first one on ties, as numpy's argmax)
-        order = np.lexsort((where, vals, ri))
-        first = order[np.r_[True, ri[order][1:] != ri[order][:-1]]]
-        rows_c = ri[first]
-        better = vals[first] < best_v[rows_c]
-        take = rows_c[better]
-        best_v[take] = vals[first][better]
-        best_x[take] = where[first][better]
-        best_ve[take] = verr[first][better]
-        best_xe[take] = werr[first][better]
+        evaluations += _refine(f, sgn, xs, fs, ri, ci, args, tol, best_v, best_x, best_ve, best_xe)
     if enclose is not None:
         evaluations += _certify(
             f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, best_xe
@@ -125,6 +100,37 @@ def extremum(
         evaluations=evaluations,
         notes=notes,
     )
+
+
+def _refine(f, sgn, xs, fs, ri, ci, args, tol, best_v, best_x, best_ve, best_xe) -> int:
+    """Refine every interior local minimum of the samples (rows ``ri``, columns ``ci``) of
+    ``sgn*f`` by ``find_minimum`` in one call, and keep each row's best where it beats the
+    ends (in place); returns the evaluations."""
+    from scipy.optimize.elementwise import find_minimum
+
+    init = (xs[ri, ci - 1], xs[ri, ci], xs[ri, ci + 1])
+    fa = tuple(g[ri] for g in args)
+    # a minimum's place is known to about sqrt(eps) relative at best
+    tols = {"xatol": tol.atol, "xrtol": max(tol.rtol, np.finfo(float).eps ** 0.5)}
+    with np.errstate(all="ignore"):
+        res = find_minimum(lambda x, *p: sgn * np.asarray(f(x, *p)), init, args=fa, tolerances=tols)
+    ok = np.asarray(res.success) | (np.asarray(res.status) == -2)
+    vals = np.where(ok, res.f_x, fs[ri, ci])
+    where = np.where(ok, res.x, xs[ri, ci])
+    span = xs[ri, ci + 1] - xs[ri, ci - 1]
+    werr = np.where(ok, np.abs(res.bracket[1] - res.bracket[0]), span)
+    verr = np.where(ok, np.abs(np.maximum(res.f_bracket[0], res.f_bracket[2]) - res.f_x), 0.0)
+    # per row: the best candidate (the first one on ties, as numpy's argmax)
+    order = np.lexsort((where, vals, ri))
+    first = order[np.r_[True, ri[order][1:] != ri[order][:-1]]]
+    rows_c = ri[first]
+    better = vals[first] < best_v[rows_c]
+    take = rows_c[better]
+    best_v[take] = vals[first][better]
+    best_x[take] = where[first][better]
+    best_ve[take] = verr[first][better]
+    best_xe[take] = werr[first][better]
+    return int(np.max(res.nfev))
 
 
 #: rows of one call certified by branch and bound; of a larger table, PROBE rows spread over

@@ -74,28 +74,7 @@ def root_in(
     if enclose is not None and n <= CERTIFY_ROWS:
         proven = _counted(f, enclose, args, lo, hi, xs, fs, tol, var, unit, label)
         count = np.where(proven.one, 1, count)
-    none = np.flatnonzero(count == 0)
-    if none.size:
-        i = none[0]
-        raise NumericsError(
-            f"root(): no sign change of the function in [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
-            f"{row_text(label, i, n)}: sampled at {var} = "
-            + ", ".join(num(x) for x in xs[i])
-            + f" with signs {''.join('+' if v > 0 else '-' for v in fs[i])}"
-            + (f" ({none.size} of {n} rows)" if n > 1 else "")
-            + "; choose bounds on either side of the root"
-        )
-    many = np.flatnonzero(count > 1)
-    if many.size:
-        i = many[0]
-        where = [f"[{num(xs[i, j])}, {num(xs[i, j + 1])}]" for j in np.flatnonzero(change[i])] + [
-            f"{var} = {num(xs[i, j])}" for j in np.flatnonzero(zero[i])
-        ]
-        raise NumericsError(
-            f"root(): more than one root in [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
-            f"{row_text(label, i, n)}: the function changes sign in {', '.join(where)}; "
-            "narrow the bracket to one of them"
-        )
+    _one_root_each(count, change, zero, xs, fs, lo, hi, var, unit, label)
     value = np.empty(n)
     error = np.zeros(n)
     evaluations = k + 1 + evaluations_poles
@@ -129,6 +108,33 @@ def root_in(
         evaluations += int(np.max(res.nfev))
         _not_a_pole(res, todo, fl, fr, xr - xl, lo, hi, var, unit, label, n, unproven)
     return Result(value.reshape(shape), error.reshape(shape), evaluations=evaluations)
+
+
+def _one_root_each(count, change, zero, xs, fs, lo, hi, var, unit, label) -> None:
+    """Refuse the first row whose bracket holds no root or more than one (its samples shown)."""
+    n = lo.size
+    none = np.flatnonzero(count == 0)
+    if none.size:
+        i = none[0]
+        raise NumericsError(
+            f"root(): no sign change of the function in [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
+            f"{row_text(label, i, n)}: sampled at {var} = "
+            + ", ".join(num(x) for x in xs[i])
+            + f" with signs {''.join('+' if v > 0 else '-' for v in fs[i])}"
+            + (f" ({none.size} of {n} rows)" if n > 1 else "")
+            + "; choose bounds on either side of the root"
+        )
+    many = np.flatnonzero(count > 1)
+    if many.size:
+        i = many[0]
+        where = [f"[{num(xs[i, j])}, {num(xs[i, j + 1])}]" for j in np.flatnonzero(change[i])] + [
+            f"{var} = {num(xs[i, j])}" for j in np.flatnonzero(zero[i])
+        ]
+        raise NumericsError(
+            f"root(): more than one root in [{num(lo[i])}, {num(hi[i])}]{_u(unit)}"
+            f"{row_text(label, i, n)}: the function changes sign in {', '.join(where)}; "
+            "narrow the bracket to one of them"
+        )
 
 
 def finite_ends(f, xl, xr, fl, fr, args) -> tuple:
@@ -362,6 +368,24 @@ def _not_a_pole(res, idx, fa, fb, width, lo, hi, var, unit, label, n, which) -> 
         )
 
 
+def _no_sign_change(x0, step, poles, var: str, unit: str, row: str) -> NumericsError:
+    """The error of a search from a guess that found no sign change but at poles or jumps."""
+    seen = poles[np.isfinite(poles)]
+    return NumericsError(
+        f"root(): no sign change found searching from the guess {var} = {num(x0)}"
+        f"{_u(unit)}{row} on either side (up to "
+        f"{num(step * (2.0**_DOUBLINGS - 1))}{_u(unit)} away, or where the "
+        "expression has a value"
+        + (
+            f"; the sign changes at {var} = {', '.join(num(x) for x in seen)} are poles"
+            " or jumps, not roots"
+            if seen.size
+            else ""
+        )
+        + f"); give a bracket: root(EXPR, {var}, A, B)"
+    )
+
+
 def root_near(
     f: Fn,
     guess,
@@ -416,20 +440,7 @@ def root_near(
         found = np.isfinite(brackets[..., 0]).any(axis=0)
         if not found.all():
             i = todo[np.flatnonzero(~found)[0]]
-            seen = poles[:, i][np.isfinite(poles[:, i])]
-            raise NumericsError(
-                f"root(): no sign change found searching from the guess {var} = {num(x0[i])}"
-                f"{_u(unit)}{row_text(label, i, n)} on either side (up to "
-                f"{num(step[i] * (2.0**_DOUBLINGS - 1))}{_u(unit)} away, or where the "
-                "expression has a value"
-                + (
-                    f"; the sign changes at {var} = {', '.join(num(x) for x in seen)} are poles"
-                    " or jumps, not roots"
-                    if seen.size
-                    else ""
-                )
-                + f"); give a bracket: root(EXPR, {var}, A, B)"
-            )
+            raise _no_sign_change(x0[i], step[i], poles[:, i], var, unit, row_text(label, i, n))
         new_poles = np.full((2, n), np.nan)
         for side in (0, 1):  # the sign change on each side, then the nearer root of the two
             at = np.flatnonzero(np.isfinite(brackets[side, :, 0]))
