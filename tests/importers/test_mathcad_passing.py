@@ -238,3 +238,34 @@ def test_elements_shown_one_row_per_value_of_a_range_above_origin(tmp_path, caps
     assert "v[2]" in text
     result = check_sheet(tmp_path, capsys, "rows")
     assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result
+
+
+@pytest.mark.slow
+def test_primes_eigenvalues_from_the_largest_down(tmp_path, capsys):
+    """Prime: M := [[2, 1, 0], [1, 3, 1], [0, 1, 4]], eigenvals(M) = numpy's eigenvalues from
+    the largest down (Prime's order); a Mathcad 15 worksheet's eigenvals(M) stays refused (its
+    order is its solver's)."""
+    import numpy as np
+    from helpers.mathcad_xml import array_cells, prime_package, prime_region, prime_result
+
+    from workbook.cli import main
+
+    m = np.array([[2.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 4.0]])
+    values = sorted(np.linalg.eigvalsh(m), reverse=True)
+    ns = 'xmlns:ml="http://schemas.mathsoft.com/math50"'
+    regions = prime_region(1, 1, f"<ml:define {ns}>{ident('M')}{array_cells(m)}</ml:define>")
+    regions += prime_region(2, 2, f"<ml:eval {ns}>{call('eigenvals', ident('M'))}</ml:eval>")
+    stored = prime_result(2, matrix(*(real(repr(float(v))) for v in values)))
+    src = prime_package(tmp_path / "eig.mcdx", regions, stored)
+    assert main(["import", str(src), "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    result = check_sheet(tmp_path, capsys, "eig")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (3, 3, 0), result
+    text = import_sheet(
+        tmp_path,
+        capsys,
+        "eig15",
+        define(1, ident("M"), array_cells(m)),
+        evaluate(2, call("eigenvals", ident("M")), matrix(*(real(repr(float(v))) for v in values))),
+    )
+    assert "eigenvals() is neither defined before nor a known built-in" in text

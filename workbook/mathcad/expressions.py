@@ -463,6 +463,14 @@ class ExprTranslator(Visitor):
             if values is not None:  # sorted: Prime's order of eigenvalues does not matter
                 inner = self._builtin("eigenvals", "eigenvals", [self.value(values)])
                 return self._builtin("sort", "sort", [inner])
+        if text == "eigenvals" and not key[1] and len(args) == 1 and self.tr.prime:
+            # Prime gives the eigenvalues from the largest down (every result it stored, of
+            # matrices of 2 to 6 rows, symmetric or not): the language's sorted, reversed.
+            # Mathcad 15's order is its solver's (ascending in one worksheet, descending in
+            # another), so eigenvals alone stays refused there. Complex eigenvalues are not
+            # sorted by the language (refused, never reordered another way).
+            inner = self._builtin("eigenvals", "eigenvals", [self.value(args[0])])
+            return self._builtin("reverse", "eigenvals", [self._builtin("sort", "sort", [inner])])
         if text == "rkfixed" and not key[1]:
             from .odes import rkfixed
 

@@ -47,6 +47,7 @@ class Translator(ResultsMixin, SolveMixin):
         self.complex_shown: set[tuple[str, str]] = set()
         self.complex_roots = False
         self.parts_own = False  # the last [a; b] := value gave each name its own definition
+        self.prime = False  # the worksheet is Mathcad Prime's
         self._index: Sym | None = None
         self.region = ""  # the region being translated
         self.given: list[str] | None = None  # regions of the open solve block
@@ -122,6 +123,7 @@ class Translator(ResultsMixin, SolveMixin):
         self.origin = ws.origin
         self.sheet_origin = self.out.origin = tt.first_index_origin(ws.origin, regions)
         self.out.generator = ws.generator
+        self.prime = ws.generator == "Mathcad Prime"
         # Mathcad evaluates global definitions (≡) first, top to bottom, then the others
         first = [r for r in regions if r.math is not None and r.math.tag == "globalDefine"]
         regions = first + [r for r in regions if r not in first]
