@@ -118,10 +118,7 @@ def test_the_load_walk_counts_moves_and_climbs_back_up():
         "workbook.language.template",
     } <= found.rooms
     assert found.climbs <= found.moves
-    assert (
-        found.climbs_by_pair().get(("workbook.compute.declared_checks", "workbook.engine.sheet"))
-        == 1
-    )
+    assert found.climbs_by_pair().get(("workbook.language.checkspec", "workbook.engine.sheet")) == 1
 
 
 # the stage folders of the tests, as README.md lists them
