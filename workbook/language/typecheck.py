@@ -386,8 +386,8 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             head, tail = node.unit[: at - 1], node.unit[at - 1 :]
             raise TemplateError(
                 f"{shown!r}: '{clash}' is read as part of the unit of the number, and it is a "
-                f"name of this sheet; for a product write a space: "
-                f"'{ex.number_text(node.value)} {head} {tail[0]} {tail[1:]}'"
+                f"name of this sheet; to multiply by '{clash}', put spaces around "
+                f"'{tail[0]}': '{ex.number_text(node.value)} {head} {tail[0]} {tail[1:]}'"
             )
         try:
             unit = un.unit(node.unit, what=f"the quantity {shown!r}")
