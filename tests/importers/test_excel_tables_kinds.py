@@ -220,3 +220,22 @@ def test_sumproduct_reads_texts_and_empty_cells_as_excel_does(tmp_path, capsys):
     inputs = {n for n in sheet.spec.inputs}
     empty = next(n for n in inputs if "B4" in sheet.spec.inputs[n].note)
     assert sheet.with_inputs(**{empty: 2}).evaluate(name).magnitude == 150
+
+
+@pytest.mark.slow
+def test_a_text_in_arithmetic_is_an_error_value_where_its_branch_is_not_taken(tmp_path, capsys):
+    path = tmp_path / "blank.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_column("A1", [2])  # A2 is empty
+    ws.write_formula("B1", '=IF(A1="","",A1*3)', None, 6)
+    ws.write_formula("B2", '=IF(A2="","",A2*3)', None, "")  # Excel caches ""
+    ws.write_formula("C1", "=IF(A2=0,0,B1/B2)", None, 0)  # B2 is "" where it is read
+    ws.write_formula("C2", "=B2*2", None, "#VALUE!")
+    ws.write("A4", "x5")
+    ws.write_formula("C4", "=IF(A1>1,1,A4*2)", None, 1)  # a text with a digit: refused
+    wb.close()
+    report, text = _check(path, tmp_path, capsys)
+    assert "(0 if A2 == 0 otherwise B1/(1/0))" not in text  # the whole division is the error
+    assert "otherwise (1/0))" in text
+    assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)

@@ -312,6 +312,11 @@ class FormulaTranslator:
 
     def operator(self, op: str, args, ctx: int) -> str:
         levels = {"+": 3, "-": 3, "*": 4, "/": 4, "^": 5}
+        if op in levels or op in ("u-", "u+", "%"):
+            from .kinds import never_a_number
+
+            if any(never_a_number(self, a) for a in args):
+                return "(1/0)"  # a text in arithmetic: #VALUE! in Excel
         if op in ("u-", "u+"):
             inner = self.value(args[0], 6)
             text = f"-{inner}" if op == "u-" else inner

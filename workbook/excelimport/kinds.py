@@ -227,6 +227,19 @@ def texts_of(ft, node, depth: int = 0) -> set[str] | None:
     return None
 
 
+def never_a_number(ft, node) -> bool:
+    """Whether ``node`` gives a text that Excel never reads as a number in arithmetic (a text
+    without a digit, ``""``, ``"-"``, ``"LAMINAR"``: ``=""*2`` is #VALUE!); a text with a digit
+    may be one (``"5"``, ``"1e3"``, ``"50%"``, a date), by rules of Excel's own."""
+    try:
+        if kind(ft, node) != "text":
+            return False
+        texts = texts_of(ft, node)
+    except FormulaProblem:
+        return False
+    return texts is not None and not any(ch.isdigit() for t in texts for ch in t)
+
+
 def _caseless(text: str | None) -> bool:
     return text is not None and text.lower() == text.upper()
 
