@@ -269,3 +269,24 @@ def test_primes_eigenvalues_from_the_largest_down(tmp_path, capsys):
         evaluate(2, call("eigenvals", ident("M")), matrix(*(real(repr(float(v))) for v in values))),
     )
     assert "eigenvals() is neither defined before nor a known built-in" in text
+
+
+@pytest.mark.slow
+def test_each_element_program_reads_the_names_before_the_matrix_gives_them(tmp_path, capsys):
+    """X := 5 m; [X; n] := (j <- 2; [X*j; X/m]): X becomes 10 m and n is 5, the old X's
+    (Mathcad computes the program once, then gives the names), never 10."""
+    body = program(
+        local(ident("j"), real(2)),
+        matrix(apply("mult", ident("X"), ident("j")), apply("div", ident("X"), ident("m"))),
+    )
+    import_sheet(
+        tmp_path,
+        capsys,
+        "reads",
+        define(1, ident("X"), apply("mult", real(5), ident("m"))),
+        define(2, matrix(ident("X"), ident("n")), body),
+        evaluate(3, ident("n"), real(5)),
+        evaluate(4, ident("X"), united(10, ("m", 1))),
+    )
+    result = check_sheet(tmp_path, capsys, "reads")
+    assert (result["printed"], result["reproduced"], result["failed"]) == (2, 2, 0), result

@@ -785,16 +785,24 @@ class Translator(ResultsMixin, SolveMixin):
         at_region = region.id if own is None else f"{region.id}.value"
         self.out.items.append(Item("definition", at_region, sym=whole, **parts))
         o = self.sheet_origin
+        # every element's definition is translated before any name is given (a program
+        # may read a name of the worksheet that the matrix of names gives anew)
+        owned: dict[tuple[int, int], dict | Untranslatable] = {}
+        for c in range(cols if own is not None else 0):
+            for r in range(rows):
+                try:
+                    owned[r, c] = own(r, c)
+                except Untranslatable as why:
+                    owned[r, c] = why
         for c in range(cols):
             for r in range(rows):
                 at = (r,) if cols == 1 else (r, c)
                 index = tuple(ex.Number(float(o + a)) for a in at)
                 key = _key(names[c * rows + r])
                 if own is not None:  # the name is its element's own expression or program
-                    try:
-                        part = own(r, c)
-                    except Untranslatable as why:
-                        self.define(key, "var", region.id).broken = str(why)
+                    part = owned[r, c]
+                    if isinstance(part, Untranslatable):
+                        self.define(key, "var", region.id).broken = str(part)
                         continue
                     sym = self.define(key, "var", region.id)
                     self.out.items.append(Item("definition", region.id, sym=sym, **part))
