@@ -239,3 +239,20 @@ def test_a_text_in_arithmetic_is_an_error_value_where_its_branch_is_not_taken(tm
     assert "(0 if A2 == 0 otherwise B1/(1/0))" not in text  # the whole division is the error
     assert "otherwise (1/0))" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
+
+
+@pytest.mark.slow
+def test_a_remainder_that_rounds_to_the_divisor_has_no_value(tmp_path, capsys):
+    import math
+
+    path = tmp_path / "mod.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_column("A1", [93.21687266652779, -2.33738085555821e-14, -3.8351626959347677e-13])
+    near = math.atan2(-3.8351626959347677e-13, 93.21687266652779) % (2 * math.pi)
+    ws.write_formula("B1", "=MOD(ATAN2(A1,A2),2*PI())", None, 0)  # Excel's 0, not 2*PI()
+    ws.write_formula("B2", "=MOD(ATAN2(A1,A3),2*PI())", None, near)
+    ws.write_formula("B3", "=MOD(-7,3)", None, 2)
+    wb.close()
+    report, _ = _check(path, tmp_path, capsys)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)

@@ -34,7 +34,13 @@ EXCEL: dict[str, tuple[str, tuple[int, ...]]] = {
     "INT": ("floor({0})", (1,)),
     "TRUNC": ("trunc({0})", (1,)),
     "ROUND": ("round({0}, {1})", (2,)),
-    "MOD": ("({0}) - ({1})*floor(({0})/({1}))", (2,)),  # the sign of the divisor, as Excel
+    # the sign of the divisor, as Excel; a remainder that rounds to the divisor itself
+    # (MOD(-2.5E-16, 2*PI())) Excel gives as 0, a rule not known here for certain: no value
+    "MOD": (
+        "(1/0 if ({0}) - ({1})*floor(({0})/({1})) == ({1}) "
+        "otherwise ({0}) - ({1})*floor(({0})/({1})))",
+        (2,),
+    ),
 }
 
 #: Excel functions that take any number of arguments, each a number or a range: joined
