@@ -83,6 +83,8 @@ KNOWN_ELSEWHERE = {
     ("engine/angle_slips.py", ("cos", "sin", "tan")),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),
+    # Excel's unit names of CONVERT (minute, pint, quart, second), not calls
+    ("excelimport/convert.py", ("min", "pt", "qt", "sec")),
 }  # fmt: skip
 
 
