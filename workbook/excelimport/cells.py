@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass, field
 
 from .aggregates import AGGREGATES, aggregate
-from .formula_terms import FormulaProblem, Ref, text_problem
+from .formula_terms import FormulaProblem, Ref, row_relative, text_problem
 from .functions import EXCEL, VOLATILE
 
 #: a prefix that calls into an add-in or another workbook: [1]!f( or 'Book.xlam'!f(
@@ -240,7 +240,7 @@ class FormulaTranslator:
         """The name of one cell a reference reads: in a filled-down column, the moving name
         when the reference's row is relative and the cell is the one that moves."""
         key = (ref.sheet, ref.r1, ref.c1)
-        if key in self.moving and _row_relative(token):
+        if key in self.moving and row_relative(token):
             ref.moved = True  # type: ignore[attr-defined]
             return self.moving[key]
         return self.name_of(ref.sheet, ref.r1, ref.c1)
@@ -299,7 +299,7 @@ class FormulaTranslator:
             self.out.refs.append(ref)
             if ref.single:
                 key = (ref.sheet, ref.r1, ref.c1)
-                if key in self.moving and _row_relative(node[2]):
+                if key in self.moving and row_relative(node[2]):
                     return [self.single(ref, node[2])]
             names = []
             for r in range(ref.r1, ref.r2 + 1):
@@ -418,7 +418,7 @@ class FormulaTranslator:
         products, Excel reading a text, an empty cell or TRUE/FALSE as 0 (an empty cell is its
         input 0; a term with a constant text or TRUE/FALSE is 0 and left out). A formula cell
         that gives other than a number is refused (an error value there is Excel's value)."""
-        from .kinds import _cell_kind
+        from .kinds import cell_kind_in
 
         refs = [self.ref_of(a[2]) if a[0] == "leaf" and a[1] == "Range" else None for a in args]
         if not args or None in refs or any(self.is_name_formula(a[2]) for a in args):
@@ -435,7 +435,7 @@ class FormulaTranslator:
                     r, c = ref.r1 + dr, ref.c1 + dc
                     cell = self.book.cell(ref.sheet, r, c)
                     if cell is not None and cell.formula is not None:
-                        if _cell_kind(self, cell, 0) != "number":
+                        if cell_kind_in(self, cell, 0) != "number":
                             raise FormulaProblem("SUMPRODUCT over a formula that gives no number")
                     elif cell is not None and not isinstance(cell.value, (int, float)):
                         factors = None  # a text or TRUE/FALSE: Excel's 0
@@ -845,15 +845,6 @@ class FormulaTranslator:
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
-
-
-def _row_relative(token) -> bool:
-    """A reference whose row moves when the formula is filled down (``M183``, ``$M183``)."""
-    source, end = getattr(token, "source", None), getattr(token, "end_match", None)
-    text = source[:end] if isinstance(source, str) and isinstance(end, int) else str(token)
-    text = text.split("!")[-1]  # the parser's name drops the $: its source keeps them
-    m = re.match(r"\$?[A-Za-z]{1,3}(\$?)\d+$", text)
-    return m is not None and not m.group(1)
 
 
 def _holds_number(cell) -> bool:

@@ -3,6 +3,7 @@ cell or a range, and which texts the language's text literals hold."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 
@@ -31,3 +32,23 @@ class Ref:
     @property
     def single(self) -> bool:
         return self.r1 == self.r2 and self.c1 == self.c2
+
+
+def row_relative(token) -> bool:
+    """A reference whose row moves when the formula is filled down (``M183``, ``$M183``)."""
+    source, end = getattr(token, "source", None), getattr(token, "end_match", None)
+    text = source[:end] if isinstance(source, str) and isinstance(end, int) else str(token)
+    text = text.split("!")[-1]  # the parser's name drops the $: its source keeps them
+    m = re.match(r"\$?[A-Za-z]{1,3}(\$?)\d+$", text)
+    return m is not None and not m.group(1)
+
+
+def written_number(node) -> float | None:
+    """The number written in the formula (TRUE 1, FALSE 0), else None."""
+    if node[0] == "leaf" and node[1] == "Number":
+        word = node[2].name.upper()
+        return 1.0 if word == "TRUE" else 0.0 if word == "FALSE" else float(node[2].name)
+    if node[0] == "op" and node[1] == "u-":
+        inner = written_number(node[2][0])
+        return None if inner is None else -inner
+    return None

@@ -20,7 +20,7 @@ cached value: its translation gives that kind or has no value). Then:
 
 from __future__ import annotations
 
-from .formula_terms import FormulaProblem, text_problem
+from .formula_terms import FormulaProblem, row_relative, text_problem
 
 _NUMBER_FUNCTIONS = {
     "ABS", "SQRT", "EXP", "LN", "LOG10", "LOG", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN",
@@ -82,12 +82,11 @@ def _memo(ft, what: str) -> dict:
 
 def _reader(ft, sheet: str):
     """A translator of another cell's formula, to read its parts' kinds and texts."""
-    from .cells import FormulaTranslator
+    # the translator's own class (cells.py imports this module)
+    return type(ft)(ft.book, sheet, lambda *_: "x", ft.functions, ft.defined, seen=set())
 
-    return FormulaTranslator(ft.book, sheet, lambda *_: "x", ft.functions, ft.defined, seen=set())
 
-
-def _cell_kind(ft, cell, depth: int) -> str | None:
+def cell_kind_in(ft, cell, depth: int) -> str | None:
     found = cell_kind(cell)
     if found is None and cell is not None and cell.formula is not None:
         return _formula_kind(ft, cell, depth) or _empty_text(ft)
@@ -122,18 +121,17 @@ def kind(ft, node, depth: int = 0) -> str | None:
             ref = ft.ref_of(payload)
             if not ref.single:
                 return None
-            from .cells import _row_relative
 
             key = (ref.sheet, ref.r1, ref.c1)
-            if key in ft.moving and _row_relative(payload):  # each row of a filled-down column
+            if key in ft.moving and row_relative(payload):  # each row of a filled-down column
                 kinds = {
-                    _cell_kind(ft, ft.book.cell(ref.sheet, ref.r1 + k, ref.c1), depth)
+                    cell_kind_in(ft, ft.book.cell(ref.sheet, ref.r1 + k, ref.c1), depth)
                     for k in range(ft.rows)
                 }
                 if len(kinds) > 1:
                     kinds.discard("error")
             else:
-                kinds = {_cell_kind(ft, ft.book.cell(*key), depth)}
+                kinds = {cell_kind_in(ft, ft.book.cell(*key), depth)}
             return kinds.pop() if len(kinds) == 1 and "error" not in kinds else None
         return None
     if what == "op":
@@ -158,7 +156,7 @@ def kind(ft, node, depth: int = 0) -> str | None:
     return None
 
 
-def _static_text(ft, node) -> str | None:
+def static_text(ft, node) -> str | None:
     """A text written in the formula, or held by a constant text cell (a definition that
     never changes); None otherwise."""
     what, name, payload = node
@@ -189,9 +187,8 @@ def texts_of(ft, node, depth: int = 0) -> set[str] | None:
         ref = ft.ref_of(payload)
         if not ref.single:
             return None
-        from .cells import _row_relative
 
-        rows = ft.rows if (ref.sheet, ref.r1, ref.c1) in ft.moving and _row_relative(payload) else 1
+        rows = ft.rows if (ref.sheet, ref.r1, ref.c1) in ft.moving and row_relative(payload) else 1
         if rows > 50:
             return None
         out: set[str] = set()
@@ -252,7 +249,7 @@ def compared(ft, op: str, args) -> str | None:
         return None
     truths = {"1 == 1": True, "1 == 0": False}
     if ka == kb == "text":
-        sa, sb = _static_text(ft, args[0]), _static_text(ft, args[1])
+        sa, sb = static_text(ft, args[0]), static_text(ft, args[1])
         if op not in ("=", "<>"):
             raise FormulaProblem("an ordering of texts (Excel orders them by rules of its own)")
         if sa is not None and sb is not None:
@@ -277,7 +274,7 @@ def compared(ft, op: str, args) -> str | None:
         raise FormulaProblem("a comparison of texts (Excel's = does not tell case apart)")
     text_first = ka == "text"
     other, ko = (args[1], kb) if text_first else (args[0], ka)
-    text = _static_text(ft, args[0] if text_first else args[1])
+    text = static_text(ft, args[0] if text_first else args[1])
     if ko is None:
         if _caseless(text):
             return None  # the language compares it (and refuses a number beside a text)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from .formula_terms import FormulaProblem, Ref
+from .formula_terms import FormulaProblem, Ref, written_number
 
 #: cells that one lookup reads at most (a chain of as many conditions)
 MAX_LOOKUP_CELLS = 200
@@ -32,22 +32,11 @@ def _cells(ref: Ref) -> list[tuple[int, int]]:
     return [(r, c) for r in range(ref.r1, ref.r2 + 1) for c in range(ref.c1, ref.c2 + 1)]
 
 
-def _literal(node) -> float | None:
-    """The number written in the formula (TRUE 1, FALSE 0), else None."""
-    if node[0] == "leaf" and node[1] == "Number":
-        word = node[2].name.upper()
-        return 1.0 if word == "TRUE" else 0.0 if word == "FALSE" else float(node[2].name)
-    if node[0] == "op" and node[1] == "u-":
-        inner = _literal(node[2][0])
-        return None if inner is None else -inner
-    return None
-
-
 def match(ft, args) -> str:
     """``MATCH(x, keys[, type])`` as a chain giving the position (from 1)."""
     if len(args) not in (2, 3):
         raise FormulaProblem(f"MATCH with {len(args)} arguments")
-    kind = 1.0 if len(args) == 2 else _literal(args[2])
+    kind = 1.0 if len(args) == 2 else written_number(args[2])
     if kind not in (-1.0, 0.0, 1.0):
         raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
     ref = _range(ft, args[1], "MATCH")
@@ -160,7 +149,7 @@ def index(ft, args) -> str:
     pos = args[1]
     if len(args) == 2 and pos[0] == "fn" and pos[1].upper() == "MATCH" and len(pos[2]) in (2, 3):
         m = pos[2]  # INDEX(range, MATCH(x, keys, type)): one chain over the keys
-        kind = 1.0 if len(m) == 2 else _literal(m[2])
+        kind = 1.0 if len(m) == 2 else written_number(m[2])
         if kind not in (-1.0, 0.0, 1.0):
             raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
         keys_ref = _range(ft, m[1], "MATCH")
@@ -168,7 +157,7 @@ def index(ft, args) -> str:
             raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
         keys = _keys(ft, keys_ref, m[0], exact=kind == 0)
         return _chain(ft, m[0], keys, kind, cells, _no_value(ft, ref))
-    fixed = [_literal(a) for a in args[1:]]
+    fixed = [written_number(a) for a in args[1:]]
     if None not in fixed:  # INDEX(range, 3, 2): the cell itself
         at = (fixed + [1.0])[:2] if cols == 1 or len(fixed) == 2 else [1.0, fixed[0]]
         if any(v != int(v) or v < 1 for v in at) or at[0] > rows or at[1] > cols:
@@ -199,8 +188,8 @@ def hlookup(ft, args) -> str:
     k, guard = position(ft, args[2])
     if not 1 <= k <= whole.r2 - whole.r1 + 1:
         raise FormulaProblem("HLOOKUP of a row outside its table (#REF! in Excel)")
-    exact = len(args) == 4 and _literal(args[3]) == 0
-    if len(args) == 4 and not exact and _literal(args[3]) is None:
+    exact = len(args) == 4 and written_number(args[3]) == 0
+    if len(args) == 4 and not exact and written_number(args[3]) is None:
         raise FormulaProblem("HLOOKUP whose match type is not written in the formula")
     if exact:
         keys = [(whole.sheet, whole.r1, c) for c in range(whole.c1, whole.c2 + 1)]

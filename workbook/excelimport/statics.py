@@ -21,10 +21,10 @@ def position(ft, node) -> tuple[int, str | None]:
     """(k, guard): a column or row number written in the formula (guard None), or
     ``MATCH(x, headers, 0)`` over constant texts, as Excel found it (a guard where x is not a
     text that never changes)."""
-    from .kinds import _static_text
-    from .lookups import _literal
+    from .formula_terms import written_number
+    from .kinds import static_text
 
-    written = _literal(node)
+    written = written_number(node)
     if written is not None:
         if written != int(written):
             raise FormulaProblem("a lookup of a column that is not a whole number")
@@ -32,16 +32,16 @@ def position(ft, node) -> tuple[int, str | None]:
     if node[0] == "fn" and node[1].upper() == "MATCH":
         k = int(ft.match(node[2]))
         lookup = node[2][0]
-        return k, None if _static_text(ft, lookup) is not None else ft.guard(node, k)
+        return k, None if static_text(ft, lookup) is not None else ft.guard(node, k)
     raise FormulaProblem("a lookup of a column not written as a number or an exact MATCH")
 
 
 def found(ft, x_node, keys: list[tuple[str, int, int]]) -> int | None:
     """The index of the first key equal to x without case (-1: none, Excel's #N/A), where x is
     a text that never changes; None where it is not one (the lookup is translated otherwise)."""
-    from .kinds import _static_text
+    from .kinds import static_text
 
-    x = _static_text(ft, x_node)
+    x = static_text(ft, x_node)
     if x is None:
         return None
     if len(keys) > MAX_STATIC_KEYS:
