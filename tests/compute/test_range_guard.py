@@ -32,6 +32,7 @@ bounds = st.floats(-1e3, 1e3, allow_nan=False).map(lambda v: round(v, 2))
 steps = st.floats(0.01, 50).map(lambda v: round(v, 2)) | st.sampled_from([0.1, 0.2, 0.3, 1 / 3])
 
 
+@pytest.mark.slow
 @settings(max_examples=300)
 @given(first=bounds, step=steps, written=st.floats(0, 500), edited=st.floats(0, 500))
 def test_the_guard_counts_a_stepped_range_as_the_engine(first, step, written, edited):

@@ -333,6 +333,7 @@ def _corpus_cases() -> list[tuple[Path, str, int]]:
     return out
 
 
+@pytest.mark.slow
 def test_every_corpus_error_is_a_diagnostic_at_its_line(client, tmp_path):
     """Each bad input of tests/bad_inputs/ that names a line is a diagnostic of its kind at
     that line, from the load or from the values that follow it; every kind of error of

@@ -138,6 +138,7 @@ def test_wear_deeper_than_the_lift(valve):
     assert any(x.verdict == "warning" and "opens twice" in x.what for x in f)
 
 
+@pytest.mark.slow
 def test_quadrature_study_against_numpy(valve):
     """The template's trapezoid and Simpson columns against the rules written out with numpy."""
     df = valve.table("quadrature")

@@ -307,6 +307,7 @@ def test_flank_domain_limit(concave):
     assert f[0].value == pytest.approx(math.degrees(math.asin(1 / K)) * math.pi / 3.142, abs=2e-3)
 
 
+@pytest.mark.slow
 def test_extreme_inputs_are_checked(concave):
     found = [f for f in concave.check().findings if f.topic == "extreme inputs"]
     rows = {f.what.split(" (")[0]: f for f in found}
