@@ -9,20 +9,12 @@ import json
 import math
 
 import pytest
+from helpers.excel_import import import_and_check
 
 xlsxwriter = pytest.importorskip("xlsxwriter")
 
 from workbook.cli import main  # noqa: E402
 from workbook.excelimport.writer import csv_text, uncompared  # noqa: E402
-
-
-def _check(path, tmp_path, capsys) -> tuple[dict, str]:
-    out = tmp_path / "out"
-    assert main(["import", str(path), "--out", str(out)]) == 0
-    toml = next(out.glob("*.toml"))
-    capsys.readouterr()
-    main(["check", str(toml), "--json"])
-    return json.loads(capsys.readouterr().out), toml.read_text(encoding="utf-8")
 
 
 @pytest.mark.slow
@@ -38,7 +30,7 @@ def test_a_spilled_range_is_every_cell_of_the_array(tmp_path, capsys):
     ws.write_formula("F1", "=MIN(_xlfn.ANCHORARRAY(E1))", None, -9)  # =MIN(E1#)
     ws.write_formula("F2", "=MAX(_xlfn.ANCHORARRAY(E1))", None, -7)
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "ANCHORARRAY" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (4, 4, 0)
 
@@ -51,7 +43,7 @@ def test_a_spilled_range_of_a_plain_cell_is_listed(tmp_path, capsys):
     ws.write_number("A1", 3)
     ws.write_formula("B1", "=MIN(_xlfn.ANCHORARRAY(A1))", None, 3)
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "the spilled range" in text and "no array formula" in text
     assert (report["printed"], report["failed"], report["not_computable"]) == (1, 0, 1)
 
@@ -65,7 +57,7 @@ def test_a_text_with_a_caret_is_kept_as_it_is(tmp_path, capsys):
     ws.write_formula("B1", "=A1", None, "As (in^2)")
     ws.write_formula("B2", '="m^2"', None, "m^2")
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert (report["printed"], report["failed"], report["not_computable"]) == (2, 0, 0)
 
 
@@ -109,7 +101,7 @@ def test_texts_joined_as_excel_writes_them(tmp_path, capsys):
     ws.write_formula("B7", '="a"&CHAR(10)&"b"', None, "a\nb")  # a line break: refused
     ws.write_formula("B8", '=LEN(B1)&""', None, "10")  # LEN not mapped: refused
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "concat(" in text and "num2str(" in text
     assert "joins TRUE/FALSE" in text and "CHAR(10)" in text
     # B1, B3, B4 reproduced; B2 (" + 2 kips") is escaped in the CSV, so not compared; B5 has
@@ -151,7 +143,7 @@ def test_match_index_and_hlookup_as_excel_finds_them(tmp_path, capsys):
     ws.write_formula("F9", '=MATCH("W*",B1:B3,0)', None, 2)  # a pattern: listed
     ws.write_formula("F10", "=MATCH(F6,B1:B3,0)", None, 3)  # a text not known: listed
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "a text with a pattern" in text and "an exact one of a text" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (10, 8, 0)
     import workbook
@@ -181,7 +173,7 @@ def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_pa
     ws.write_formula("D6", "=IFERROR(B1^0,9)", None, 9)  # 0^0 is #NUM! in Excel
     ws.write_formula("D7", "=IFERROR(ACOS(A1),5)", None, 5)  # other errors: listed
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "the language has no error value to catch" in text.replace("\n# ", " ")
     assert (report["printed"], report["reproduced"], report["failed"]) == (7, 6, 0)
     import workbook

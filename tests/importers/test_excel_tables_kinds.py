@@ -4,13 +4,11 @@ values as Excel computes them."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
+from helpers.excel_import import import_and_check
 
 xlsxwriter = pytest.importorskip("xlsxwriter")
 
-from workbook.cli import main  # noqa: E402
 from workbook.excelimport.convert import convert  # noqa: E402
 from workbook.excelimport.formula_terms import FormulaProblem  # noqa: E402
 from workbook.excelimport.tables import StructuredProblem, Table, rewrite  # noqa: E402
@@ -79,15 +77,6 @@ def test_convert_refuses_what_it_does_not_know_or_excel_refuses(source, target):
         convert("1", source, target)
 
 
-def _check(path, tmp_path, capsys) -> tuple[dict, str]:
-    out = tmp_path / "out"
-    assert main(["import", str(path), "--out", str(out)]) == 0
-    toml = next(out.glob("*.toml"))
-    capsys.readouterr()
-    main(["check", str(toml), "--json"])
-    return json.loads(capsys.readouterr().out), toml.read_text(encoding="utf-8")
-
-
 @pytest.mark.slow
 def test_a_table_read_by_its_columns(tmp_path, capsys):
     path = tmp_path / "table.xlsx"
@@ -103,7 +92,7 @@ def test_a_table_read_by_its_columns(tmp_path, capsys):
     ws.write_formula("F4", '=CONVERT(SUM(Loads[[#Data],[M]])/232,"ft","in")', None, 12)
     ws.write_formula("F5", "=Loads[[#Totals],[M]]+1", None, 1)  # the table has no totals row
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "SUM($D$3:$D$5)" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (7, 6, 0)
 
@@ -124,7 +113,7 @@ def test_texts_beside_numbers_by_excels_rules(tmp_path, capsys):
     ws.write_formula("B8", '=IF(A2="STEEL",A1,0)*2', None, 5)
     ws.write_formula("B9", '=IF(A2&""="steel",1,0)', None, 1)  # a computed text: listed
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "A1*0 == 1" in text and "num2str(1/0)" in text
     assert "does not tell case apart" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (8, 7, 0)
@@ -139,7 +128,7 @@ def test_an_if_of_two_kinds_whose_rows_differ_is_listed(tmp_path, capsys):
         ws.write(r, 0, x)
         ws.write_formula(r, 1, f'=IF(A{r + 1}=0,"-",10/A{r + 1})', None, "-" if x == 0 else 10 / x)
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert report["failed"] == 0
     assert report["reproduced"] + report["not_computable"] == 4
 
@@ -162,7 +151,7 @@ def test_texts_a_formula_can_give_are_compared_without_case(tmp_path, capsys):
     ws.write_formula("C3", '=IF(B3="",0,IF(A1=0,0,A1*3))', None, 0)  # a nested IF
     ws.write_formula("D3", '=IF(A1="","",IF(A1>0,A1*3,0))', None, 6000)
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert 'B1 == \\"LAMINAR\\"' in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (10, 10, 0)
 
@@ -186,7 +175,7 @@ def test_lookups_of_texts_that_never_change_are_the_cells_excel_finds(tmp_path, 
     ws.write_formula("G3", '=HLOOKUP(F1,A1:C3,MATCH("c2h6(g)",A1:A3,0),0)', None, 305.3)
     ws.write_formula("G4", '=VLOOKUP(E1&"",A2:C3,MATCH(F1&"",A1:C1,0),0)', None, 305.3)
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert (report["printed"], report["reproduced"], report["failed"]) == (4, 3, 0)
     import workbook
 
@@ -208,7 +197,7 @@ def test_sumproduct_reads_texts_and_empty_cells_as_excel_does(tmp_path, capsys):
     ws.write_formula("D3", "=SUMPRODUCT(A1:A4,B1:B3)", None, "#VALUE!")
     ws.write_formula("D4", "=SUMPRODUCT(A1:A3)", None, 6)
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "different sizes" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (4, 4, 0)
     import workbook
@@ -235,7 +224,7 @@ def test_a_text_in_arithmetic_is_an_error_value_where_its_branch_is_not_taken(tm
     ws.write("A4", "x5")
     ws.write_formula("C4", "=IF(A1>1,1,A4*2)", None, 1)  # a text with a digit: refused
     wb.close()
-    report, text = _check(path, tmp_path, capsys)
+    report, text = import_and_check(path, tmp_path, capsys)
     assert "(0 if A2 == 0 otherwise B1/(1/0))" not in text  # the whole division is the error
     assert "otherwise (1/0))" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
@@ -254,5 +243,5 @@ def test_a_remainder_that_rounds_to_the_divisor_has_no_value(tmp_path, capsys):
     ws.write_formula("B2", "=MOD(ATAN2(A1,A3),2*PI())", None, near)
     ws.write_formula("B3", "=MOD(-7,3)", None, 2)
     wb.close()
-    report, _ = _check(path, tmp_path, capsys)
+    report, _ = import_and_check(path, tmp_path, capsys)
     assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
