@@ -169,10 +169,7 @@ def type_checks(sheet) -> None:
 
 def typed_value(sheet, spec: CheckSpec):
     """The typed value and the factor that shows it in its unit (typed at load, then read)."""
-    found = sheet.typed.get(spec, "value")
-    return (
-        found if found is not None else sheet.typed.keep(spec, "value", _value_typed(sheet, spec))
-    )
+    return sheet.typed.kept(spec, "value", lambda: _value_typed(sheet, spec))
 
 
 def _value_typed(sheet, spec: CheckSpec):
@@ -187,10 +184,7 @@ def _value_typed(sheet, spec: CheckSpec):
 
 def typed_condition(sheet, spec: CheckSpec):
     """The typed condition ``ok`` (typed at load, then read)."""
-    found = sheet.typed.get(spec, "ok")
-    return (
-        found if found is not None else sheet.typed.keep(spec, "ok", _condition_typed(sheet, spec))
-    )
+    return sheet.typed.kept(spec, "ok", lambda: _condition_typed(sheet, spec))
 
 
 def _condition_typed(sheet, spec: CheckSpec):
@@ -205,10 +199,7 @@ def _condition_typed(sheet, spec: CheckSpec):
 def typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None):
     """A placeholder's typed tree, factor and unit shown (typed at load, then read)."""
     key = ("placeholder", expression, unit)
-    found = sheet.typed.get(spec, key)
-    if found is None:
-        found = sheet.typed.keep(spec, key, _placeholder_typed(sheet, spec, expression, unit))
-    return found
+    return sheet.typed.kept(spec, key, lambda: _placeholder_typed(sheet, spec, expression, unit))
 
 
 def _placeholder_typed(sheet, spec: CheckSpec, expression: str, unit: str | None):
