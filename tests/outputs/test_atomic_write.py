@@ -145,13 +145,13 @@ def pause(original):
 if stage == "writing":
     xlsx.replay = pause(xlsx.replay)  # the file is being written
 else:
-    import workbook.engine.sheet
-    original = workbook.engine.sheet.Sheet.check
-    def slow_check(self):
+    import workbook.compute.checks
+    original = workbook.compute.checks.run_checks
+    def slow_check(sheet):
         Path("ready").write_text("computing")
         time.sleep(60)
-        return original(self)
-    workbook.engine.sheet.Sheet.check = slow_check
+        return original(sheet)
+    workbook.compute.checks.run_checks = slow_check
 sys.exit(main(["run", "s.toml", "--out", "out.xlsx"]))
 """
 
