@@ -167,9 +167,16 @@ def type_checks(sheet) -> None:
             raise err.located(file=sheet.file, line=spec.line, definition=spec.label) from None
 
 
+def _kept(sheet, spec: CheckSpec, key, make, *args):
+    # made here rather than passed down to the typed sheet as a callback: the typed sheet only
+    # stores, it never calls back up into this stage
+    found = sheet.typed.get(spec, key)
+    return found if found is not None else sheet.typed.keep(spec, key, make(*args))
+
+
 def typed_value(sheet, spec: CheckSpec):
     """The typed value and the factor that shows it in its unit (typed at load, then read)."""
-    return sheet.typed.kept(spec, "value", lambda: _value_typed(sheet, spec))
+    return _kept(sheet, spec, "value", _value_typed, sheet, spec)
 
 
 def _value_typed(sheet, spec: CheckSpec):
@@ -184,7 +191,7 @@ def _value_typed(sheet, spec: CheckSpec):
 
 def typed_condition(sheet, spec: CheckSpec):
     """The typed condition ``ok`` (typed at load, then read)."""
-    return sheet.typed.kept(spec, "ok", lambda: _condition_typed(sheet, spec))
+    return _kept(sheet, spec, "ok", _condition_typed, sheet, spec)
 
 
 def _condition_typed(sheet, spec: CheckSpec):
@@ -199,7 +206,7 @@ def _condition_typed(sheet, spec: CheckSpec):
 def typed_placeholder(sheet, spec: CheckSpec, expression: str, unit: str | None):
     """A placeholder's typed tree, factor and unit shown (typed at load, then read)."""
     key = ("placeholder", expression, unit)
-    return sheet.typed.kept(spec, key, lambda: _placeholder_typed(sheet, spec, expression, unit))
+    return _kept(sheet, spec, key, _placeholder_typed, sheet, spec, expression, unit)
 
 
 def _placeholder_typed(sheet, spec: CheckSpec, expression: str, unit: str | None):

@@ -196,4 +196,9 @@ def type_block(typer, block: SolveSpec) -> TypedSolve:
 
 def typed_block(sheet, block: SolveSpec) -> TypedSolve:
     """The block's trees typed at load (kept in ``sheet.typed``), typed now if they were not."""
-    return sheet.typed.kept(block, "solve", lambda: type_block(sheet.typer, block))
+    found = sheet.typed.get(block, "solve")
+    return (
+        found
+        if found is not None
+        else sheet.typed.keep(block, "solve", type_block(sheet.typer, block))
+    )

@@ -13,7 +13,7 @@ rows of a printed-values file are read once (:func:`printed_rows`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable
+from collections.abc import Hashable
 from typing import Any
 
 from ..errors import WorkbookError
@@ -37,11 +37,6 @@ class TypedSheet:
         """Keep ``tree`` for ``item`` under ``key``; returns it."""
         self._trees[(id(item), key)] = (item, tree)
         return tree
-
-    def kept(self, item: object, key: Hashable, make: Callable[[], Any]) -> Any:
-        """The tree kept for ``item`` under ``key``, made by ``make()`` and kept if none is."""
-        found = self.get(item, key)
-        return found if found is not None else self.keep(item, key, make())
 
     def __len__(self) -> int:
         return len(self._trees)
