@@ -245,3 +245,26 @@ def test_a_remainder_that_rounds_to_the_divisor_has_no_value(tmp_path, capsys):
     wb.close()
     report, _ = import_and_check(path, tmp_path, capsys)
     assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
+
+
+@pytest.mark.slow
+def test_textsplit_of_a_text_that_never_changes_into_a_column(tmp_path, capsys):
+    path = tmp_path / "split.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    pieces = ["x (mm)", "a", "4,1", "", "Ab", "a"]  # an empty piece is kept, case too
+    ws.write("A1", ":".join(pieces))
+    ws.write("B1", "p;q")
+    ws.write_dynamic_array_formula("C1:C6", '=_xlfn.TEXTSPLIT(A1,,":")', None, pieces[0])
+    for k, piece in enumerate(pieces[1:], start=1):
+        ws.write_string(k, 2, piece)  # the cells of the array: Excel's cached values
+    ws.write_dynamic_array_formula("D1:E1", '=_xlfn.TEXTSPLIT(B1,";")', None, "p")
+    ws.write_string(0, 4, "q")  # into a row: listed
+    ws.write_dynamic_array_formula("D3:D4", '=_xlfn.TEXTSPLIT(A1,,":")', None, pieces[0])
+    ws.write_string(3, 3, pieces[1])  # fewer cells than pieces: listed
+    wb.close()
+    report, text = import_and_check(path, tmp_path, capsys)
+    assert "into a row" in text and "not shown in as many cells" in text
+    assert report["failed"] == 0
+    assert report["reproduced"] == 5  # the column's cells but the empty piece (not counted)
+    assert report["printed"] == 9

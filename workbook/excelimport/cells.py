@@ -414,6 +414,10 @@ class FormulaTranslator:
             from .joins import join
 
             return join(self, [("fn", name, args)])
+        if upper == "_XLFN.TEXTSPLIT":
+            from .statics import text_split
+
+            return text_split(self, args)
         if upper == "ARRAY":
             raise FormulaProblem("an array constant")
         raise FormulaProblem(f"the Excel function {upper} (not mapped)")

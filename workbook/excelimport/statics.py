@@ -1,4 +1,4 @@
-"""Lookups whose answer is fixed when the workbook is imported: an exact ``VLOOKUP`` or
+"""What is fixed when the workbook is imported: an exact ``VLOOKUP`` or
 ``HLOOKUP`` of a text that never changes (a text written in the formula or held by a constant
 cell) over keys that are constants, and a column (row) given by ``MATCH(name, headers, 0)``.
 
@@ -6,7 +6,8 @@ Excel compares texts without case; the first key equal to the text is the row (t
 number or an empty key never equals a text, and no key equal to it is ``#N/A`` (an error
 value). The cell found is read by its name, so its value stays live; which cell it is never
 changes, since the texts never do. A ``MATCH`` whose text a formula computes is the position
-Excel found, guarded: where the text computes to another one the value is an error.
+Excel found, guarded: where the text computes to another one the value is an error. And the
+pieces of a text that never changes, cut by ``TEXTSPLIT`` into a column.
 """
 
 from __future__ import annotations
@@ -62,3 +63,41 @@ def found(ft, x_node, keys: list[tuple[str, int, int]]) -> int | None:
 
 def guarded(text: str, guard: str | None) -> str:
     return text if guard is None else f"({text} if {guard} otherwise 1/0)"
+
+
+def text_split(ft, args) -> str:
+    """``TEXTSPLIT(text, , row_delimiter)`` (a column) of a text that never changes, at a
+    delimiter written in the formula, in an array formula of as many cells as pieces: the pieces
+    as Excel cuts them (at every occurrence, left to right, with case; empty pieces kept), texts
+    that never change either. Into a row (``TEXTSPLIT(text, col_delimiter)``) it is refused."""
+    from .formula_terms import text_problem
+    from .kinds import static_text
+
+    if len(args) not in (2, 3):
+        raise FormulaProblem(f"TEXTSPLIT with {len(args)} arguments")
+    seps = [a[2].name if a[:2] == ("leaf", "String") else None for a in args[1:]]
+    given = [a[:2] != ("leaf", "Empty") for a in args[1:]]
+    if given.count(True) != 1 or None in [s for s, g in zip(seps, given) if g]:
+        raise FormulaProblem("TEXTSPLIT other than at one delimiter written in the formula")
+    by_rows = given[-1] and len(args) == 3
+    sep = seps[-1] if by_rows else seps[0]
+    text = static_text(ft, args[0])
+    if text is None:
+        raise FormulaProblem("TEXTSPLIT of a text a formula computes")
+    if not sep:
+        raise FormulaProblem("TEXTSPLIT at an empty delimiter (#VALUE! in Excel)")
+    pieces = text.split(sep)
+    for piece in pieces:
+        problem = text_problem(piece)
+        if problem:
+            raise FormulaProblem(problem)
+    shape = (len(pieces), 1) if by_rows else (1, len(pieces))
+    if shape[0] == 1:  # a row's cells read the array by a condition, whose value is a number
+        raise FormulaProblem("TEXTSPLIT into a row (texts in a row of an array formula)")
+    if ft.block != shape:
+        raise FormulaProblem(
+            f"TEXTSPLIT whose {shape[0]}x{shape[1]} pieces are not shown in as many cells"
+        )
+    quoted = [f'"{p}"' for p in pieces]
+    rows = [[q] for q in quoted] if by_rows else [quoted]
+    return "[" + ", ".join("[" + ", ".join(r) + "]" for r in rows) + "]"
