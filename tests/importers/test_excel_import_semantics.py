@@ -222,3 +222,37 @@ def test_a_value_a_sub_writes_is_not_computable_with_the_sub_named(tmp_path, cap
     assert "S!B3; written by the macro Sub Fill" in text
     assert (report["printed"], report["reproduced"], report["failed"]) == (3, 2, 0)
     assert report["not_computable"] == 1
+
+
+_SPREAD = """
+Function Spread(a As Double, b As Double) As Variant
+    On Error GoTo fail
+    Spread = Ratio(a, b)
+    Exit Function
+fail:
+    If Err.Number = xlErrDiv0 Then
+        Spread = 0
+    Else
+        Err.Raise Err.Number
+    End If
+End Function
+
+Function Ratio(a As Double, b As Double) As Double
+    If b = 0 Then Err.Raise {raised}
+    Ratio = a / b
+End Function
+"""
+
+
+@pytest.mark.parametrize(
+    ("raised", "listed"),
+    [("5", False), ("xlErrNA", False), ("Excel.xlErrDiv0", True), ("2007", True),
+     ("vbObjectError + 7", True)],
+)  # fmt: skip
+def test_a_handler_branch_for_an_error_value_no_raise_gives_is_never_taken(raised, listed):
+    from workbook.excelimport.book import translate_vba
+
+    info = translate_vba(_SPREAD.format(raised=raised))["Spread"]
+    assert (info.problem is not None) == listed
+    if listed:
+        assert "does more than give an error value" in info.problem

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from .formula_terms import text_problem
 from .functions import VBA
 from .vba import Procedure, split_top
-from .vbaerrors import cut_error_handler
+from .vbaerrors import cut_error_handler, raised_errors
 from .vbaexpr import VbaSyntax, parse, strip
 from .vbamembers import Members, NotTranslated
 
@@ -113,7 +113,8 @@ class Translator(Members):
 
     # -- statements --------------------------------------------------------------------
     def translate(self) -> str:
-        body = list(self.prefix) + cut_error_handler(self.proc.name, list(self.proc.lines))
+        raised = raised_errors(f.proc for f in self.functions.values())
+        body = list(self.prefix) + cut_error_handler(self.proc.name, list(self.proc.lines), raised)
         self.body = body
         self.at = 0
         self.assigned = False
