@@ -60,27 +60,12 @@ KNOWN_ELSEWHERE = {
             "log10", "mod", "round", "sign", "sin", "sinh", "sqrt", "tan", "tanh", "trunc",
         ),
     ),
-    # the numerical methods with an error estimate (bench) and their live Excel forms
-    (
-        "numerics/bench.py",
-        ("argmax", "argmin", "diff", "integral", "maximum", "minimum", "product", "root", "sum"),
-    ),
-    ("numerics/bench.py", ("det", "eigenvals", "eigenvecs", "inverse", "lsolve")),
-    ("numerics/live.py", ("argmax", "argmin", "maximum", "minimum")),
     # interval arithmetic of the one-argument built-ins (root counts, global extrema,
     # features of integrands): a back end whose rules could be a field of the entry
     (
         "numerics/intervals.py",
         ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),
     ),
-    # the functions singular where their argument is 0 (an integrand nearly singular beside
-    # its interval gets a second tanh-sinh computation)
-    ("numerics/singular.py", ("ln", "log10", "sqrt")),
-    # the step functions whose jumps an integral is split at (zeros of sin(pi u))
-    ("numerics/switches.py", ("ceil", "floor", "trunc")),
-    # the trigonometric functions whose argument the angle warnings look at (a slip of theta
-    # in degrees times pi/180, a bare number of degrees read as radians)
-    ("engine/angle_slips.py", ("cos", "sin", "tan")),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),
     # Excel's unit names of CONVERT (minute, pint, quart, second), not calls
@@ -245,3 +230,51 @@ def test_a_new_builtin_needs_only_its_entry_and_its_docs_line(tmp_path, acotan):
     assert sorted(documented(text)) != sorted(REGISTRY)
     text = text.replace("Built-in functions: `", "Built-in functions: `acotan ", 1)
     assert sorted(documented(text)) == sorted(REGISTRY)
+
+
+@pytest.fixture
+def stepped():
+    """Built-ins the engine has never heard of, whose entries say where they are singular,
+    jump, have a kink and take an angle."""
+    entries = [
+        register(
+            Builtin(
+                name,
+                1,
+                plain_in,
+                np.floor,
+                excel_call("INT"),
+                lambda sp, x: sp.floor(x),
+                doc="a test's entry",
+                **fields,
+            )
+        )
+        for name, fields in (
+            ("stairs", {"jumps": lambda t: ty.TFunc(t.unit, func="cos", args=t.args)}),
+            ("spike", {"singular": lambda t: (t.args[0],)}),
+            ("vee", {"kinks": lambda t: ((t.args[0], None),)}),
+            ("turn", {"angle": True}),
+        )
+    ]
+    yield entries
+    for entry in entries:
+        del REGISTRY[entry.name]
+
+
+def test_where_a_builtin_jumps_or_is_singular_is_read_from_its_entry(tmp_path, stepped):
+    from workbook.engine.angle_slips import takes_angle
+    from workbook.numerics.singular import singular_arguments
+    from workbook.numerics.switches import switching
+
+    (tmp_path / "s.toml").write_text(
+        '[arguments]\nx = { unit = "" }\n\n[definitions]\n'
+        '"f(x)" = "stairs(x) + spike(x - 1) + vee(x - 2) + turn(x)"\n',
+        encoding="utf-8",
+    )
+    sheet = workbook.load(tmp_path / "s.toml")
+    body = sheet.typer.function("f").body
+    found = switching(body, "x")
+    assert any(isinstance(t, ty.TFunc) and t.func == "cos" for t in found)  # stairs' jumps
+    assert any(isinstance(t, ty.TBinary) and t.op == "-" for t in found)  # vee's kink, x - 2
+    assert [t for t in singular_arguments(sheet.typer, body, "x") if isinstance(t, ty.TBinary)]
+    assert takes_angle("turn") and not takes_angle("stairs")

@@ -13,10 +13,9 @@ from __future__ import annotations
 import math
 
 from ..findings import Finding
+from ..functions.registry import REGISTRY
 from ..language import typed as ty
 from ..language.unitrules import angle_in
-
-TRIGONOMETRIC = ("sin", "cos", "tan")
 
 
 def angle_findings(sheet) -> list[Finding]:
@@ -70,12 +69,19 @@ def _sheet_uses_degrees(sheet) -> bool:
     return any(angle_in(u) == "deg" for u in units)
 
 
+def takes_angle(name: str) -> bool:
+    """True for a built-in whose argument is an angle (sin, cos, tan: the entry says)."""
+    entry = REGISTRY.get(name)
+    return entry is not None and entry.angle
+
+
 def _trig_calls(t: ty.T):
-    """The calls of sin, cos and tan in ``t`` (not inside the bodies of called functions)."""
+    """The calls of sin, cos and tan (the built-ins that take an angle) in ``t`` (not inside
+    the bodies of called functions)."""
     stack = [t]
     while stack:
         n = stack.pop()
-        if isinstance(n, ty.TFunc) and n.func in TRIGONOMETRIC and n.args:
+        if isinstance(n, ty.TFunc) and n.args and takes_angle(n.func):
             yield n
         stack.extend(ty.children(n))
 

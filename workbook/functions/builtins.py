@@ -22,6 +22,13 @@ whose
 * ``doc``: one line for the documentation;
 * ``mpmath``: a function of one argument, the name of its mpmath function of the same meaning
   (the reference evaluator, :mod:`workbook.numerics.mpform`); "" when it has none there;
+* ``singular``, ``jumps``, ``kinks``: where the value is singular, jumps or has a kink, as
+  typed trees that are 0 there (``sqrt``: its argument; ``floor(u)``: ``sin(pi u)``; ``abs``:
+  its argument), read when an integrand is split (:mod:`workbook.numerics.singular`,
+  :mod:`workbook.numerics.switches`); ``angle``: the argument is an angle (the angle warnings);
+* ``estimate``: how the value's error is estimated (``"iterative"`` for root, integral...,
+  ``"condition"`` for lsolve, inverse...: :mod:`workbook.numerics.bench`); ``live_note``: how
+  an approximate live Excel form computes, said beside its cell;
 * ``mathml``: how a report writes a call (:mod:`workbook.outputs.report.mathml`): MathML in which
   ``{0}``, ``{1}``... are the arguments, ``{0:group}`` the argument bracketed unless it is a
   product or tighter, ``{args}`` all of them with commas; a call whose arguments the template
@@ -146,6 +153,45 @@ def mathml_fence(left: str, right: str) -> str:
 _TRIG = {"mathml_powered": True}
 
 
+# -- where a value is singular, jumps or has a kink (read by workbook.numerics) ----------------
+def _argument(t: ty.TFunc) -> tuple[ty.T, ...]:
+    """sqrt, ln, log10: singular where the argument is 0."""
+    return (t.args[0],) if len(t.args) == 1 else ()
+
+
+def _cosine(t: ty.TFunc) -> tuple[ty.T, ...]:
+    """tan: its poles are the zeros of the cosine of its argument."""
+    return (ty.TFunc(t.unit, func="cos", args=t.args),) if len(t.args) == 1 else ()
+
+
+def _wave(wave: str, t: ty.TFunc, u: ty.T) -> ty.TFunc:
+    one = registry().dimensionless
+    return ty.TFunc(one, func=wave, args=(ty.TScale(one, child=u, factor=math.pi),))
+
+
+def _integer_jumps(t: ty.TFunc) -> ty.T | None:
+    """floor, ceil, trunc jump at every integer: the zeros of sin(pi u)."""
+    return _wave("sin", t, t.args[0]) if len(t.args) == 1 else None
+
+
+def _half_jumps(t: ty.TFunc) -> ty.T | None:
+    """round jumps at every half-integer: the zeros of cos(pi u)."""
+    return _wave("cos", t, t.args[0]) if len(t.args) == 1 else None
+
+
+def _mod_jumps(t: ty.TFunc) -> ty.T | None:
+    """mod(a, m) jumps where a/m is an integer: the zeros of sin(pi a/m)."""
+    if len(t.args) != 2 or t.args[1].shape is not None:
+        return None
+    one = registry().dimensionless
+    return _wave("sin", t, ty.TBinary(one, op="/", left=t.args[0], right=t.args[1]))
+
+
+def _argument_kink(t: ty.TFunc) -> tuple:
+    """abs, sign: a kink (or a jump) where the argument is 0."""
+    return ((t.args[0], None),) if len(t.args) == 1 else ()
+
+
 def _complex(function: str) -> dict:
     """The fields of a built-in over the complex plane, Excel's ``function`` its live form."""
     return {"complex": "complex", "complex_excel": im_call(function)}
@@ -163,16 +209,17 @@ _simple(
     lambda sp, x: sp.sin(x),
     "sine (argument in radians)",
     mpmath="sin",
+    angle=True,
     **_TRIG,
     **_complex("IMSIN"),
 )
 _simple(
-    "cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", mpmath="cos", **_TRIG,
-    **_complex("IMCOS"),
+    "cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", mpmath="cos", angle=True,
+    **_TRIG, **_complex("IMCOS"),
 )  # fmt: skip
 _simple(
-    "tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", mpmath="tan", **_TRIG,
-    **_classic(im_tan),
+    "tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", mpmath="tan", angle=True,
+    singular=_cosine, **_TRIG, **_classic(im_tan),
 )  # fmt: skip
 
 
@@ -274,6 +321,7 @@ _simple(
     (_SQRT,),
     mathml="<msqrt>{0}</msqrt>",
     mpmath="sqrt",
+    singular=_argument,
     **_complex("IMSQRT"),
 )
 _simple(
@@ -288,6 +336,7 @@ _simple(
     "natural logarithm",
     domain=_log_domain("ln"),
     mpmath="ln",
+    singular=_argument,
     **_complex("IMLN"),
 )
 _simple(
@@ -298,6 +347,7 @@ _simple(
     "logarithm base 10",
     domain=_log_domain("log10"),
     mpmath="log10",
+    singular=_argument,
     **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
 )
@@ -312,8 +362,12 @@ _simple(
     mpmath="fabs",
     complex="real",
     complex_excel=im_call("IMABS"),
+    kinks=_argument_kink,
 )
-_simple("sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit, mpmath="sign")
+_simple(
+    "sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit, mpmath="sign",
+    kinks=_argument_kink,
+)  # fmt: skip
 
 
 # -- floor, ceil, round and trunc: of plain numbers only ----------------------------------------
@@ -351,6 +405,7 @@ register(
         doc="largest integer not above",
         mathml=mathml_fence("\u230a", "\u230b"),
         mpmath="floor",
+        jumps=_integer_jumps,
     )
 )
 register(
@@ -364,6 +419,7 @@ register(
         doc="smallest integer not below",
         mathml=mathml_fence("\u2308", "\u2309"),
         mpmath="ceil",
+        jumps=_integer_jumps,
     )
 )
 
@@ -388,6 +444,7 @@ _simple(
     rule=_mod_unit,
     domain=(Domain("mod by zero", lambda v: v == 0, "mod(x, {})", arg=1),),
     arity=2,
+    jumps=_mod_jumps,
 )
 
 
@@ -436,6 +493,7 @@ _simple(
         ),
     ),
     arity=(1, 2),
+    jumps=_half_jumps,
 )
 _simple(
     "trunc",
@@ -444,6 +502,7 @@ _simple(
     lambda sp, x: sp.sign(x) * sp.floor(sp.Abs(x)),
     "integer part, toward zero (x a plain number)",
     rule=_integer_unit,
+    jumps=_integer_jumps,
 )
 
 # -- sum(EXPR, I, A, B): a built-in that binds a variable ------------------------------------
@@ -561,6 +620,7 @@ register(
         doc="sum(EXPR, I, A, B): EXPR summed over the integers I = A..B (0 if B < A); "
         "sum(v): the sum of the elements of a vector or matrix",
         binds=(0, 1),
+        estimate="iterative",
         complex="complex",
         complex_excel=_sum_excel,
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",

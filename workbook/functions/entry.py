@@ -73,6 +73,21 @@ class Builtin:
     complex_excel: Callable[..., tuple[str, int]] | None = None
     # the name of the mpmath function of one argument with numpy's meaning ("" if none)
     mpmath: str = ""
+    # where the value is singular, for an integrand's singular points (numerics.singular): the
+    # typed trees, given the typed call, that are 0 there (sqrt: its argument; tan: the cosine)
+    singular: Callable[[ty.TFunc], tuple[ty.T, ...]] | None = None
+    # where a step function jumps (numerics.switches): a smooth tree, given the typed call,
+    # that is 0 at every jump (floor(u): sin(pi u)); None from it: no such tree for this call
+    jumps: Callable[[ty.TFunc], ty.T | None] | None = None
+    # where the value has a kink (numerics.switches): pairs (x, y), given the typed call, whose
+    # difference x - y (x itself when y is None) is 0 there (abs: its argument; max: x - y)
+    kinks: Callable[[ty.TFunc], tuple[tuple[ty.T, ty.T | None], ...]] | None = None
+    angle: bool = False  # takes an angle (sin): the angle warnings read its argument
+    # how its value's error is estimated (numerics.bench): "iterative", a method with an error
+    # estimate (root, integral); "condition", from the values' condition number (lsolve)
+    estimate: str = ""
+    # how an approximate live Excel form computes, said beside its cell ("" when exact)
+    live_note: str = ""
 
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""

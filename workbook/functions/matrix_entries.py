@@ -119,7 +119,7 @@ def not_live(why: str):
     return printed
 
 
-def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, complex=""):
+def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, complex="", estimate=""):
     register(
         Builtin(
             name,
@@ -132,6 +132,7 @@ def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, compl
             arrays=True,
             runtime=runtime,
             sizes=sizes,
+            estimate=estimate,
             complex=complex,
         )
     )
@@ -208,6 +209,7 @@ entry(
     lambda m, shapes: det(m),
     call("MDETERM"),
     "determinant of a square matrix",
+    estimate="condition",
     complex="complex",
 )
 entry(
@@ -217,6 +219,7 @@ entry(
     lambda m, shapes: inverse(m),
     call("MINVERSE"),
     "inverse of a square matrix (a singular one is an error)",
+    estimate="condition",
     complex="complex",
 )
 entry(
@@ -226,6 +229,7 @@ entry(
     lambda m, v, shapes: lsolve(m, v),
     call("MMULT", "MINVERSE({}), {}"),
     "solution x of M x = v",
+    estimate="condition",
     complex="complex",
 )
 
@@ -248,6 +252,7 @@ entry(
     lambda m, shapes: eigenvals(m),
     not_live("eigenvalues have no spreadsheet formula"),
     "eigenvalues of a square matrix, ascending (real ones only)",
+    estimate="condition",
     complex="complex",
 )
 
@@ -272,6 +277,7 @@ entry(
     lambda m, shapes: eigenvecs(m),
     not_live("eigenvectors have no spreadsheet formula"),
     "unit eigenvectors as columns, in the order of eigenvals",
+    estimate="condition",
     complex="complex",
 )
 
@@ -859,6 +865,11 @@ def sympy_reduce(kind: str):
     return hook
 
 
+def _kink_where_equal(t: ty.TFunc) -> tuple:
+    """max, min of two numbers: a kink where the two are equal."""
+    return ((t.args[0], t.args[1]),) if len(t.args) == 2 else ()
+
+
 for kind, excel_name, doc in (
     ("max", "MAX", "largest argument (or element of vectors and matrices)"),
     ("min", "MIN", "smallest argument (or element of vectors and matrices)"),
@@ -874,6 +885,7 @@ for kind, excel_name, doc in (
             doc=doc,
             arrays=True,
             runtime=r_reduce,
+            kinks=_kink_where_equal,
         )
     )
 entry(

@@ -26,10 +26,6 @@ from ..errors import WorkbookError
 from ..language import typed as ty
 from ._common import current, reference_methods, sheet_tolerance
 
-#: built-ins whose values come from an iterative method with an error estimate
-NUMERICAL = ("root", "integral", "maximum", "minimum", "argmax", "argmin", "sum", "product", "diff")
-#: built-ins computed on values (no EXPR), with an estimate from the condition number
-LINEAR = ("lsolve", "inverse", "det", "eigenvals", "eigenvecs")
 #: the relative accuracy the reference methods in doubles are trusted to
 REFERENCE_ACCURACY = 1e-12
 #: ... and the mpmath reference (its value is rounded to a double, and the arithmetic of the
@@ -99,15 +95,24 @@ def _ms(s: float) -> str:
     return f"{1000 * s:.1f} ms" if s < 10 else f"{s:.1f} s"
 
 
+def _estimate(name: str) -> str:
+    """How the error of built-in ``name`` is estimated: "iterative", "condition" or ""."""
+    from ..functions.registry import REGISTRY  # imported here: the registry imports numerics
+
+    entry = REGISTRY.get(name)
+    return entry.estimate if entry is not None else ""
+
+
 def uses(sheet, t: ty.T) -> set[str]:
     """Numerical built-ins a typed tree calls, also through the sheet's functions and scalars."""
     found: set[str] = set()
     stack, seen = [t], set()
     while stack:
         n = stack.pop()
-        if isinstance(n, ty.TFunc) and n.func in NUMERICAL and len(n.args) > 1:
+        estimate = _estimate(n.func) if isinstance(n, ty.TFunc) else ""
+        if estimate == "iterative" and len(n.args) > 1:
             found.add(n.func)  # sum(v) of a vector (one argument) has no estimate
-        if isinstance(n, ty.TFunc) and n.func in LINEAR:
+        if estimate == "condition":
             found.add(n.func)
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)

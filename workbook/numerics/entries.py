@@ -527,6 +527,10 @@ register(
         doc="root(EXPR, X, A, B): the X in [A, B] where EXPR changes sign; "
         "root(EXPR, X, GUESS): a root near GUESS",
         binds=(0, 1),
+        estimate="iterative",
+        live_note="60 bisection steps on the sheet 'Solver steps' (in a table, a chain per table "
+        "row on 'Solver rows'; #N/A when f(A) and f(B) have the same sign; with more than one "
+        "root in [A, B] it may find another one than the engine)",
     )
 )
 register(
@@ -539,10 +543,31 @@ register(
         _integral_sympy,
         doc="integral(EXPR, X, A, B): the definite integral of EXPR for X from A to B",
         binds=(0, 1),
+        estimate="iterative",
+        live_note="a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)",
         mathml="<msubsup><mo>\u222b</mo>{2}{3}</msubsup>{0:group}<mo>\u2062</mo>"
         "<mi mathvariant='normal'>d</mi>{1}",
     )
 )
+
+
+def _extremum_note(name: str) -> str:
+    """How the live Excel form of an extremum computes (said beside its cell)."""
+    return (
+        "samples at 4 x samples + 1 points and 60 golden-section steps around the best "
+        "one, on the sheet 'Solver steps' or, in a table, 'Solver rows' (with two peaks "
+        "nearly as high it may find another one than the engine)"
+        + (
+            "; where the extremum is, the workbook finds to about 1e-6 relative (values of "
+            "EXPR within 1e-12 count as equal in its steps, so that another spreadsheet's "
+            "rounding takes the same steps; the function is flat there), the engine to "
+            "about 1e-8"
+            if name.startswith("arg")
+            else ""
+        )
+    )
+
+
 for _name, _text, _shown in (
     ("maximum", "the largest value of EXPR for X in [A, B]", "max"),
     ("minimum", "the smallest value of EXPR for X in [A, B]", "min"),
@@ -559,6 +584,8 @@ for _name, _text, _shown in (
             _no_sympy(_name),
             doc=f"{_name}(EXPR, X, A, B): {_text} (the global one: see docs/numerics.md)",
             binds=(0, 1),
+            estimate="iterative",
+            live_note=_extremum_note(_name),
             mathml=f"<munder><mi>{_shown}</mi><mrow>{{1}}<mo>\u2208</mo><mrow><mo>[</mo>{{2}}"
             "<mo separator='true'>,</mo>{3}<mo>]</mo></mrow></mrow></munder>{0:group}",
         )
@@ -574,6 +601,7 @@ register(
         doc="diff(EXPR, X) or diff(EXPR, X, N): the (N-th) derivative of EXPR in X, "
         "found symbolically at first use (a formula like any other)",
         binds=(0, 1),
+        estimate="iterative",
         mathml="<mfrac><mi mathvariant='normal'>d</mi><mrow><mi mathvariant='normal'>d</mi>{1}"
         "</mrow></mfrac>{0:group}",
     )
@@ -588,6 +616,7 @@ register(
         _product_sympy,
         doc="product(EXPR, I, A, B): EXPR multiplied over the integers I = A..B (1 if B < A)",
         binds=(0, 1),
+        estimate="iterative",
         mathml="<munderover><mo>\u220f</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
     )
 )

@@ -9,34 +9,20 @@ import numpy as np
 from ..language import typed as ty
 from ._common import live_forms
 
-#: built-ins whose Excel form is live but approximate
-APPROXIMATE = {
-    "integral": "a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)",
-    "root": "60 bisection steps on the sheet 'Solver steps' (in a table, a chain per table "
-    "row on 'Solver rows'; #N/A when f(A) and f(B) have the same sign; with more than one "
-    "root in [A, B] it may find another one than the engine)",
-    **{
-        name: "samples at 4 x samples + 1 points and 60 golden-section steps around the best "
-        "one, on the sheet 'Solver steps' or, in a table, 'Solver rows' (with two peaks "
-        "nearly as high it may find another one than the engine)"
-        + (
-            "; where the extremum is, the workbook finds to about 1e-6 relative (values of "
-            "EXPR within 1e-12 count as equal in its steps, so that another spreadsheet's "
-            "rounding takes the same steps; the function is flat there), the engine to "
-            "about 1e-8"
-            if name.startswith("arg")
-            else ""
-        )
-        for name in ("maximum", "minimum", "argmax", "argmin")
-    },
-}
+
+def _live_note(name: str) -> str:
+    """How the approximate live Excel form of built-in ``name`` computes ("" when exact)."""
+    from ..functions.registry import REGISTRY  # imported here: the registry imports numerics
+
+    entry = REGISTRY.get(name)
+    return entry.live_note if entry is not None else ""
 
 
 def _approximate(sheet, t: ty.T) -> set[str]:
     found, stack, seen = set(), [t], set()
     while stack:
         n = stack.pop()
-        if isinstance(n, ty.TFunc) and n.func in APPROXIMATE:
+        if isinstance(n, ty.TFunc) and _live_note(n.func):
             found.add(n.func)
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
@@ -57,7 +43,7 @@ class Difference:
     @property
     def note(self) -> str:
         """The cell comment: which form, and how far it is from the engine."""
-        forms = "; ".join(f"{name}() is {APPROXIMATE[name]}" for name in self.forms)
+        forms = "; ".join(f"{name}() is {_live_note(name)}" for name in self.forms)
         return (
             f"Live formula: {forms}. At the inputs written here it differs from the engine's "
             f"value by {self.largest:.2g} ({self.relative:.1g} relative); the engine's value "

@@ -23,7 +23,8 @@ _MAX_DEPTH = 20
 
 def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
     """Typed sub-trees of ``body`` that depend on ``var`` and whose zeros are singular points
-    of EXPR (a denominator, a power's base, the argument of sqrt, ln, log10)."""
+    of EXPR (a denominator, a power's base, and what each built-in's entry says: the argument
+    of sqrt, ln, log10, the cosine of tan's)."""
     from ..functions.registry import REGISTRY
 
     found: list[ty.T] = []
@@ -42,10 +43,9 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
                 continue
             if entry is not None and entry.binds:
                 continue  # another built-in's own variable: its own business
-            if t.func in ("sqrt", "ln", "log10") and len(t.args) == 1:
-                _keep(t.args[0], var, found)
-            if t.func == "tan" and len(t.args) == 1:  # its poles: the zeros of cos
-                _keep(ty.TFunc(t.unit, func="cos", args=t.args), var, found)
+            if entry is not None and entry.singular is not None:  # sqrt: its argument
+                for u in entry.singular(t):
+                    _keep(u, var, found)
         elif isinstance(t, ty.TBinary) and t.left.shape is None and t.right.shape is None:
             if t.op == "/":
                 _keep(t.right, var, found)
