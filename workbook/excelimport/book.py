@@ -120,7 +120,6 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
                 pass
             except Exception:  # noqa: BLE001 - listed with its reason when translated below
                 pass
-    book.empties_final = True  # the empty cells told apart from 0 are all found (kinds.py)
     _name_cells(tr, cells, read, reserved)
     _runs(tr, cells, parsed, reserved)
     _name_params(tr, reserved)
@@ -650,12 +649,8 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
     book = tr.book
     used: dict[tuple[str, int, int], None] = {}
 
-    empties = book.__dict__.get("empties", set())
-
     def name_of(sheet, row, col):
         used[(sheet, row, col)] = None
-        if (sheet, row, col) in empties:
-            return "0"  # an empty cell told apart from 0: never an input (kinds.py)
         cell = book.cell(sheet, row, col)
         if cell is not None and cell.array is not None and cell.formula is not None:
             # a cell of a multi-cell array formula shows one element of the array
@@ -732,12 +727,10 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
 def _bound_inputs(tr: Translation, formula_keys: set) -> None:
     """Inputs are bounded: a formula that would take the count past MAX_INPUTS is listed."""
     constants: set = set()
-    empties = tr.book.__dict__.get("empties", set())
     for d in tr.definitions:
         if d.problem:
             continue
-        reads = getattr(d, "reads", [])
-        new = {k for k in reads if k not in formula_keys and k not in empties} - constants
+        new = {k for k in getattr(d, "reads", []) if k not in formula_keys} - constants
         if len(constants) + len(new) > MAX_INPUTS:
             d.problem = f"reads more constant cells than the {MAX_INPUTS:,} inputs imported"
             continue
@@ -773,12 +766,11 @@ def _constant_inputs(tr: Translation, formula_keys: set) -> None:
     """The inputs: the constant cells that translated formulas read (a number, a flag or a
     text; any other value leaves out the formulas that read it)."""
     book = tr.book
-    empties = book.__dict__.get("empties", set())  # read as 0, never inputs (kinds.py)
     for d in tr.definitions:
         if d.problem:
             continue
         for k in getattr(d, "reads", []):
-            if k in formula_keys or k in empties:
+            if k in formula_keys:
                 continue
             name = tr.cell_names.get(k)
             if name is None or name in tr.inputs or name in tr.texts:

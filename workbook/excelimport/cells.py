@@ -301,15 +301,10 @@ class FormulaTranslator:
                 key = (ref.sheet, ref.r1, ref.c1)
                 if key in self.moving and row_relative(node[2]):
                     return [self.single(ref, node[2])]
-            from .kinds import cell_kind, read_as_empty
-
             names = []
             for r in range(ref.r1, ref.r2 + 1):
                 for c in range(ref.c1, ref.c2 + 1):
-                    cell = self.book.cell(ref.sheet, r, c)
-                    if numbers_only and not _holds_number(cell):
-                        if cell_kind(cell) == "empty":  # left out: never an input
-                            read_as_empty(self, ref.sheet, r, c)
+                    if numbers_only and not _holds_number(self.book.cell(ref.sheet, r, c)):
                         continue
                     names.append(self.name_of(ref.sheet, r, c))
             return names
@@ -759,10 +754,6 @@ class FormulaTranslator:
                 r, c = total.r1 + dr, total.c1 + dc
                 add = self.book.cell(total.sheet, r, c)
                 if add is None or add.value is None or isinstance(add.value, (str, bool)):
-                    if add is None or (add.value is None and add.formula is None):
-                        from .kinds import read_as_empty
-
-                        read_as_empty(self, total.sheet, r, c)  # left out: never an input
                     continue  # SUMIF adds numbers only; an empty cell is 0
                 self.out.refs.append(Ref(total.sheet, r, c, r, c))
                 items.append(self.name_of(total.sheet, r, c))

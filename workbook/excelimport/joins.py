@@ -12,7 +12,6 @@ from __future__ import annotations
 from .aggregates import AGGREGATES
 from .formula_terms import FormulaProblem, Ref, text_problem
 from .functions import EXCEL, EXCEL_VARIADIC
-from .kinds import read_as_empty
 
 #: operators whose value is a number (their operands are numbers, or the sheet refuses them)
 _NUMBER_OPS = {"+", "-", "*", "/", "^", "u-", "u+", "%"}
@@ -96,8 +95,6 @@ def _cell_piece(ft, sheet: str, row: int, col: int, out: list[str], token=None) 
     if value is None or value == "":
         if cell is not None and cell.formula is not None:
             raise FormulaProblem("joins a formula cell that shows the empty text")
-        if value is None:  # never an input: 0 would join as "0"
-            read_as_empty(ft, sheet, row, col)
         return  # an empty cell joins as the empty text
     if isinstance(value, bool):
         raise FormulaProblem("joins TRUE/FALSE (Excel writes the word)")

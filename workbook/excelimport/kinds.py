@@ -8,11 +8,8 @@ cached value: its translation gives that kind or has no value). Then:
 - a comparison of a number with a text is Excel's: never equal, and a number orders before
   any text (``=5<"a"`` is TRUE); it is written so that the number is still computed
   (``x*0 == 1`` is false, and an error of x stays an error);
-- an empty cell equals ``""`` and a cell that holds 0 does not: where a formula compares an
-  empty cell with a text (or joins it, or leaves it out of SUM, AVERAGE, a lookup: anything
-  that tells it apart from 0), the cell is never an input, whose 0 would stand for the number
-  too; every formula reads it as 0 and the comparison is decided (``A4=""`` is ``1 == 1``).
-  Any other empty cell is an input 0, as Excel reads it in arithmetic;
+- an empty cell (an input 0, as Excel reads it in arithmetic) equals ``""``: ``A4=""`` is
+  ``A4 == 0``;
 - texts compare without case in Excel: two texts that never change are compared here, and a
   computed text only with a text without letters (``""``, ``"-"``); else the cell is listed;
 - ``IF(c, "", a-b)`` whose branches are a text and a number: the value has the kind of
@@ -101,21 +98,6 @@ def _empty_text(ft) -> str | None:
     formula it computed, none for "" (as openpyxl reads it); in a workbook saved before Excel
     finished calculating, unknown."""
     return None if getattr(ft.book, "stale", True) else "text"
-
-
-def read_as_empty(ft, sheet: str, row: int, col: int) -> None:
-    """Note that the translation tells the empty cell (sheet, row, col) apart from a cell
-    holding 0; while the formulas are first read (``book.empties_final`` unset), else refuse
-    the formula where the first reading did not find it so (the cell may be an input)."""
-    empties = ft.book.__dict__.setdefault("empties", set())
-    key = (sheet, row, col)
-    if getattr(ft.book, "empties_final", False):
-        if key not in empties:
-            raise FormulaProblem(
-                "an empty cell told apart from 0 that other formulas read as an input"
-            )
-        return
-    empties.add(key)
 
 
 def _seen(ft) -> set:
@@ -299,14 +281,13 @@ def compared(ft, op: str, args) -> str | None:
         raise FormulaProblem("a comparison of a text with a value of unknown kind")
     if ko == "bool":
         raise FormulaProblem("a comparison of TRUE/FALSE with a text")
-    if ko == "empty":
-        if op not in ("=", "<>") or text is None or other[:2] != ("leaf", "Range"):
-            raise FormulaProblem("a comparison of an empty cell with a text")
-        ref = ft.ref_of(other[2])
-        read_as_empty(ft, ref.sheet, ref.r1, ref.c1)
-        ft.value(other, 4)  # the cell is read (as 0: it is never an input)
-        return next(t for t, v in truths.items() if v == ((text == "") == (op == "=")))
     x = ft.value(other, 4)
+    if ko == "empty":
+        if op not in ("=", "<>") or text is None:
+            raise FormulaProblem("a comparison of an empty cell with a text")
+        if text == "":
+            return f"{x} == 0" if op == "=" else f"{x} != 0"
+        return f"{x}*0 == 1" if op == "=" else f"{x}*0 == 0"
     if ko != "number":
         return None
     number_first = not text_first

@@ -14,7 +14,6 @@ from __future__ import annotations
 import re
 
 from .formula_terms import FormulaProblem, Ref, written_number
-from .kinds import read_as_empty
 
 #: cells that one lookup reads at most (a chain of as many conditions)
 MAX_LOOKUP_CELLS = 200
@@ -56,8 +55,6 @@ def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
     for k, (r, c) in enumerate(_cells(ref), start=1):
         cell = ft.book.cell(ref.sheet, r, c)
         if cell is None or cell.value is None:
-            if cell is None or cell.formula is None:  # never matched: never an input
-                read_as_empty(ft, ref.sheet, r, c)
             out.append((k, None))
             continue
         if cell.formula is not None:
