@@ -164,19 +164,20 @@ def _cosine(t: ty.TFunc) -> tuple[ty.T, ...]:
     return (ty.TFunc(t.unit, func="cos", args=t.args),) if len(t.args) == 1 else ()
 
 
-def _wave(wave: str, t: ty.TFunc, u: ty.T) -> ty.TFunc:
+def _wave(wave: str, u: ty.T) -> ty.TFunc:
+    """``wave(pi u)``, a smooth tree zero where a step function of u jumps."""
     one = registry().dimensionless
     return ty.TFunc(one, func=wave, args=(ty.TScale(one, child=u, factor=math.pi),))
 
 
 def _integer_jumps(t: ty.TFunc) -> ty.T | None:
     """floor, ceil, trunc jump at every integer: the zeros of sin(pi u)."""
-    return _wave("sin", t, t.args[0]) if len(t.args) == 1 else None
+    return _wave("sin", t.args[0]) if len(t.args) == 1 else None
 
 
 def _half_jumps(t: ty.TFunc) -> ty.T | None:
     """round jumps at every half-integer: the zeros of cos(pi u)."""
-    return _wave("cos", t, t.args[0]) if len(t.args) == 1 else None
+    return _wave("cos", t.args[0]) if len(t.args) == 1 else None
 
 
 def _mod_jumps(t: ty.TFunc) -> ty.T | None:
@@ -184,7 +185,7 @@ def _mod_jumps(t: ty.TFunc) -> ty.T | None:
     if len(t.args) != 2 or t.args[1].shape is not None:
         return None
     one = registry().dimensionless
-    return _wave("sin", t, ty.TBinary(one, op="/", left=t.args[0], right=t.args[1]))
+    return _wave("sin", ty.TBinary(one, op="/", left=t.args[0], right=t.args[1]))
 
 
 def _argument_kink(t: ty.TFunc) -> tuple:
