@@ -374,8 +374,8 @@ _simple(
 # -- floor, ceil, round and trunc: of plain numbers only ----------------------------------------
 def _ratio_of_one_kind(unit) -> bool:
     """A dimensionless unit none of whose factors is dimensionless itself (m/mm, not deg/s*s)."""
-    registry = unit._REGISTRY
-    return all(registry.Unit(name).dimensionality for name in unit._units)
+    ureg = registry()
+    return all(ureg.Unit(name).dimensionality for name, _ in (1 * unit).unit_items())
 
 
 def _integer_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
