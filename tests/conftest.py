@@ -1,3 +1,4 @@
+import gc
 import os
 import sys
 from pathlib import Path
@@ -25,6 +26,16 @@ if Path(workbook.__file__).resolve().parent.parent == _SOURCE.resolve():
     os.environ["PYTHONPATH"] = os.pathsep.join(
         filter(None, [str(_SOURCE), os.environ.get("PYTHONPATH", "")])
     )
+
+
+def pytest_collection_finish(session):
+    """What collection leaves alive (the libraries, the test modules and their tables) lives
+    to the end of the run: frozen out of the garbage collector's sight, each full collection
+    no longer walks it, and a test costs its own work instead of a walk over the heap that the
+    tests collected before it built (measured: the complex-number import tests take 0.7 s each
+    in the whole run without it, 0.05 s with it)."""
+    gc.collect()
+    gc.freeze()
 
 
 @pytest.fixture(scope="session")

@@ -225,6 +225,12 @@ def test_measured_time_section(valve):
     ts_m = float(mag(valve.evaluate("TS_m"), "mm^2*deg"))
     assert ts_m == pytest.approx(_ts_piecewise_linear(phi, h), rel=1e-10)
     assert ts_m == pytest.approx(float(mag(valve.evaluate("TS2"), "mm^2*deg")), rel=2e-3)
+
+
+@pytest.mark.slow
+def test_measured_time_section_is_a_finding_of_the_check(valve):
+    """The check (with its quadrature studies: seconds) reports TS_m as information."""
+    ts_m = float(mag(valve.evaluate("TS_m"), "mm^2*deg"))
     f = [x for x in valve.check().findings if x.what.startswith("time-section of the measured")]
     assert f[0].value == pytest.approx(ts_m) and f[0].verdict == "info"
 
