@@ -52,7 +52,8 @@ class Site:
         self.incremental = incremental  # False: every edit computed in full (the baseline)
         self.sheets: dict[str, LiveSheet] = {}
         self.listeners: dict[str, list[queue.Queue]] = {}
-        self.lock = threading.Lock()
+        self.lock = threading.Lock()  # the sheets: held while a first load computes
+        self.streams = threading.Lock()  # the listeners: held only to change the lists
         self.stopping = threading.Event()
         self.watcher = Watcher(self.file_changed)
 
@@ -127,17 +128,19 @@ class Site:
 
     def push(self, live: LiveSheet) -> None:
         data = self.state(live)
-        for q in list(self.listeners.get(live.path.name, [])):
+        with self.streams:
+            queues = list(self.listeners.get(live.path.name, []))
+        for q in queues:
             q.put(data)
 
     def listen(self, name: str) -> queue.Queue:
         q: queue.Queue = queue.Queue()
-        with self.lock:
+        with self.streams:
             self.listeners.setdefault(name, []).append(q)
         return q
 
     def unlisten(self, name: str, q: queue.Queue) -> None:
-        with self.lock:
+        with self.streams:
             if q in self.listeners.get(name, []):
                 self.listeners[name].remove(q)
 
@@ -200,9 +203,10 @@ class Site:
         self.watcher.start()
 
     def stop(self) -> None:
+        """End the event streams (a first load computing a sheet is not waited for)."""
         self.stopping.set()
         self.watcher.stop()
-        with self.lock:
+        with self.streams:
             for qs in self.listeners.values():
                 for q in qs:
                     q.put(None)
