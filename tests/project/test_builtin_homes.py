@@ -51,15 +51,6 @@ KNOWN_ELSEWHERE = {
     # the sizes read from a matrix written out while importing (its elements may call
     # functions whose units are settled only at the end of the translation)
     ("mathcad/engine.py", ("cols", "length", "rows")),
-    # the built-ins vectorize applies element by element (could be read from the registry:
-    # the entries of plain numbers)
-    (
-        "mathcad/expressions.py",
-        (
-            "abs", "acos", "asin", "atan", "atan2", "ceil", "cos", "cosh", "exp", "floor", "ln",
-            "log10", "mod", "round", "sign", "sin", "sinh", "sqrt", "tan", "tanh", "trunc",
-        ),
-    ),
     # interval arithmetic of the one-argument built-ins (root counts, global extrema,
     # features of integrands): a back end whose rules could be a field of the entry
     (

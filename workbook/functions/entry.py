@@ -89,6 +89,14 @@ class Builtin:
     # how an approximate live Excel form computes, said beside its cell ("" when exact)
     live_note: str = ""
 
+    @property
+    def of_numbers(self) -> bool:
+        """A function of plain numbers (no arrays, texts, sizes, bound variables, [data] columns
+        or run-time hook): called with one vector or matrix, it applies to each element."""
+        return not (
+            self.arrays or self.texts or self.sizes or self.binds or self.runtime or self.data_args
+        )
+
     def check_arity(self, n: int) -> None:
         """Raise a TemplateError if ``n`` arguments do not fit."""
         a = self.arity

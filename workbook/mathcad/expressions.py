@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from ..functions.registry import REGISTRY
 from ..language import expr as ex
 from ..language.visitor import Visitor
 from . import names as nm
@@ -370,7 +371,7 @@ class ExprTranslator(Visitor):
                 return
             if isinstance(node, ex.Call):
                 for a in node.args:
-                    if vector_length(a) is None or node.func in ELEMENTWISE:
+                    if vector_length(a) is None or _of_numbers(node.func):
                         continue
                     if self._sheet_function(node.func):
                         # Mathcad calls a function of the worksheet once per element
@@ -630,11 +631,11 @@ class ExprTranslator(Visitor):
 MAX_WRITTEN_ELEMENTS = 10_000
 
 
-#: Built-ins of one number that vectorize applies element by element.
-ELEMENTWISE = frozenset(
-    {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "ln",
-     "log10", "sqrt", "abs", "floor", "ceil", "round", "trunc", "sign", "atan2", "mod"}
-)  # fmt: skip
+def _of_numbers(name: str) -> bool:
+    """A built-in of numbers: vectorize applies it element by element (the language refuses
+    one of several arguments called with a vector, with its reason)."""
+    entry = REGISTRY.get(name)
+    return entry is not None and entry.of_numbers
 
 
 def whole_at_import(tr: TranslatorContext, node: MNode, what: str) -> int:
