@@ -94,19 +94,31 @@ def test_ordinary_roots_stay_right(tmp_path, expr, exact):
 
 
 def test_the_count_of_roots_is_proven_by_interval_arithmetic():
-    """The enclosures contain the function's values: at random points of random boxes."""
-    from workbook.numerics import intervals as iv
+    """The enclosures contain the function's values: at random points of random boxes, for
+    every built-in whose entry names its enclosures, the value (its numpy form) and the
+    derivative (SymPy's derivative of its SymPy form) inside them."""
+    import sympy as sp
+
+    from workbook.functions import interval_arith as iv
+    from workbook.functions.registry import REGISTRY
 
     rng = np.random.default_rng(1)
     lo = rng.uniform(-3, 3, 500)
     hi = lo + rng.uniform(0, 2, 500)
-    box = iv.Iv(lo, hi)
-    for name, f in (("sin", np.sin), ("cos", np.cos), ("exp", np.exp), ("tanh", np.tanh)):
-        enc, slope = iv.UNARY_RULES[name]
-        x = lo + rng.uniform(0, 1, 500) * (hi - lo)
-        e = enc(box)
-        assert np.all((e.lo <= f(x)) & (f(x) <= e.hi)), name
-    sq = iv.power(box, 2)
+    enclosed = sorted(name for name, entry in REGISTRY.items() if entry.interval)
+    assert {"sin", "cos", "exp", "tanh", "ln", "sqrt", "abs"} <= set(enclosed)
+    t = sp.Symbol("t", real=True)
+    for name in enclosed:
+        entry = REGISTRY[name]
+        a, b = (lo, hi) if name not in ("ln", "log10", "sqrt") else (lo + 3.01, hi + 3.01)
+        x = a + rng.uniform(0, 1, 500) * (b - a)
+        value, slope = entry.interval
+        e, d = value(iv.Iv(a, b)), slope(iv.Iv(a, b))
+        fx = entry.numpy(x)
+        dfx = sp.lambdify(t, sp.diff(entry.sympy(sp, t), t), "numpy")(x) * np.ones_like(x)
+        assert np.all((e.lo <= fx) & (fx <= e.hi)), name
+        assert np.all((d.lo <= dfx) & (dfx <= d.hi)), name
+    sq = iv.power(iv.Iv(lo, hi), 2)
     x = lo + rng.uniform(0, 1, 500) * (hi - lo)
     assert np.all((sq.lo <= x**2) & (x**2 <= sq.hi))
     t = iv.tan(iv.Iv(np.array([1.0, 1.0]), np.array([1.5, 2.0])))

@@ -51,12 +51,6 @@ KNOWN_ELSEWHERE = {
     # the sizes read from a matrix written out while importing (its elements may call
     # functions whose units are settled only at the end of the translation)
     ("mathcad/engine.py", ("cols", "length", "rows")),
-    # interval arithmetic of the one-argument built-ins (root counts, global extrema,
-    # features of integrands): a back end whose rules could be a field of the entry
-    (
-        "numerics/intervals.py",
-        ("abs", "atan", "cos", "cosh", "exp", "ln", "log10", "sin", "sinh", "sqrt", "tan", "tanh"),
-    ),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),
     # Excel's unit names of CONVERT (minute, pint, quart, second), not calls

@@ -76,6 +76,7 @@ from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.unitrules import sum_kind
 from ..language.units import pretty, registry
+from . import interval_arith as ia
 from .complexes import classic, im_call, im_cosh, im_sinh, im_tan, im_tanh
 from .entry import Builtin, Domain, UnitContext, register
 
@@ -210,17 +211,18 @@ _simple(
     lambda sp, x: sp.sin(x),
     "sine (argument in radians)",
     mpmath="sin",
+    interval=(ia.sin, ia.cos),
     angle=True,
     **_TRIG,
     **_complex("IMSIN"),
 )
 _simple(
     "cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", mpmath="cos", angle=True,
-    **_TRIG, **_complex("IMCOS"),
+    interval=(ia.cos, ia.minus_sin), **_TRIG, **_complex("IMCOS"),
 )  # fmt: skip
 _simple(
     "tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", mpmath="tan", angle=True,
-    singular=_cosine, **_TRIG, **_classic(im_tan),
+    singular=_cosine, interval=(ia.tan, ia.tan_slope), **_TRIG, **_classic(im_tan),
 )  # fmt: skip
 
 
@@ -271,6 +273,7 @@ _simple(
     "arc tangent",
     mathml=mathml_call("arctan"),
     mpmath="atan",
+    interval=(ia.atan, ia.atan_slope),
 )
 _simple(
     "atan2",
@@ -288,6 +291,7 @@ _simple(
     lambda sp, x: sp.sinh(x),
     "hyperbolic sine",
     mpmath="sinh",
+    interval=(ia.sinh, ia.cosh),
     **_TRIG,
     **_classic(im_sinh),
 )
@@ -298,6 +302,7 @@ _simple(
     lambda sp, x: sp.cosh(x),
     "hyperbolic cosine",
     mpmath="cosh",
+    interval=(ia.cosh, ia.sinh),
     **_TRIG,
     **_classic(im_cosh),
 )
@@ -308,6 +313,7 @@ _simple(
     lambda sp, x: sp.tanh(x),
     "hyperbolic tangent",
     mpmath="tanh",
+    interval=(ia.tanh, ia.tanh_slope),
     **_TRIG,
     complex="complex",
     complex_excel=classic(im_tanh),
@@ -323,11 +329,12 @@ _simple(
     mathml="<msqrt>{0}</msqrt>",
     mpmath="sqrt",
     singular=_argument,
+    interval=(ia.sqrt, ia.sqrt_slope),
     **_complex("IMSQRT"),
 )
 _simple(
     "exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", mpmath="exp",
-    **_complex("IMEXP"),
+    interval=(ia.exp, ia.exp), **_complex("IMEXP"),
 )  # fmt: skip
 _simple(
     "ln",
@@ -338,6 +345,7 @@ _simple(
     domain=_log_domain("ln"),
     mpmath="ln",
     singular=_argument,
+    interval=(ia.ln, ia.reciprocal),
     **_complex("IMLN"),
 )
 _simple(
@@ -349,6 +357,7 @@ _simple(
     domain=_log_domain("log10"),
     mpmath="log10",
     singular=_argument,
+    interval=(ia.log10, ia.log10_slope),
     **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
 )
@@ -360,6 +369,7 @@ _simple(
     "absolute value (of a complex number: its modulus)",
     same_unit,
     mathml=mathml_fence("|", "|"),
+    interval=(ia.absolute, ia.sign),
     mpmath="fabs",
     complex="real",
     complex_excel=im_call("IMABS"),

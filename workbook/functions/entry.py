@@ -88,6 +88,9 @@ class Builtin:
     estimate: str = ""
     # how an approximate live Excel form computes, said beside its cell ("" when exact)
     live_note: str = ""
+    # the interval enclosures of a one-argument built-in and of its derivative (functions.
+    # interval_arith): root counts, certified extrema and integrands' features read them
+    interval: tuple[Callable, Callable] | None = None
 
     @property
     def of_numbers(self) -> bool:

@@ -63,7 +63,8 @@ class Bound:
         """``g(lo, hi, row) -> (F, D)``: enclosures of EXPR and of its derivative for the
         variable anywhere in [lo, hi] at the flat rows ``row`` (see numerics.intervals); None
         where a node of EXPR has no interval extension."""
-        from .intervals import Iv, NoEnclosure, enclosure
+        from ..functions.interval_arith import Iv
+        from .intervals import NoEnclosure, enclosure
 
         try:
             g = enclosure(self.evaluator, self.body, self.var)
@@ -121,7 +122,8 @@ class Bound:
         return self._pairs(singular_arguments(self.evaluator.typer, self.body, self.var), shape)
 
     def _pairs(self, subtrees, shape) -> list[tuple[Callable, Callable]]:
-        from .intervals import Iv, NoEnclosure, enclosure
+        from ..functions.interval_arith import Iv
+        from .intervals import NoEnclosure, enclosure
 
         flat, env, var = self._flat(shape), self.env, self.var
         out = []

@@ -141,8 +141,8 @@ PROBE = 64
 
 def _certify(f, enclose, args, lo, hi, fs, sgn, tol, best_v, best_x, best_ve, best_xe) -> int:
     """Branch and bound from the samples' best (in place); the evaluations of f it took."""
+    from ..functions.interval_arith import neg
     from .globalmin import global_min
-    from .intervals import neg
 
     n = lo.size
     scale = np.abs(fs).max(axis=1)
