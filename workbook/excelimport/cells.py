@@ -12,6 +12,8 @@ import re
 from dataclasses import dataclass, field
 
 from .aggregates import AGGREGATES, aggregate
+from .criteria import FUNCTIONS as CRITERIA
+from .criteria import criteria_function
 from .formula_terms import FormulaProblem, Ref, row_relative, text_problem
 from .functions import EXCEL, VOLATILE
 
@@ -389,10 +391,8 @@ class FormulaTranslator:
             return f"({self.matrix_product(args)})"
         if upper == "MINVERSE":
             return self.matrix_inverse(args)
-        if upper == "SUMIF":
-            return self.sum_if(args)
-        if upper == "COUNTIF":
-            return self.count_if(args)
+        if upper in CRITERIA:
+            return criteria_function(self, upper, args)
         if upper == "VLOOKUP":
             return self.vlookup(args)
         if upper == "IFERROR":
@@ -689,76 +689,6 @@ class FormulaTranslator:
         ascending = " and ".join(f"{a} <= {b}" for a, b in zip(keys, keys[1:])) or "1 == 1"
         return f"({text} if {ascending} otherwise 1/0)"
 
-    def count_if(self, args) -> str:
-        """``COUNTIF(range, "<>0")``: a comparison with a number, over cells that hold numbers
-        (constants or formulas); an empty or text cell, which Excel matches by rules of its
-        own, is refused."""
-        if len(args) != 2 or args[0][0] != "leaf" or args[0][1] != "Range":
-            raise FormulaProblem("COUNTIF of other than a range and a criterion")
-        op, number = self.numeric_criterion(args[1])
-        ref = self.ref_of(args[0][2])
-        items = []
-        for r in range(ref.r1, ref.r2 + 1):
-            for c in range(ref.c1, ref.c2 + 1):
-                cell = self.book.cell(ref.sheet, r, c)
-                if cell is None or cell.value is None or cell.value == "":
-                    raise FormulaProblem("COUNTIF over an empty cell")
-                if cell.formula is None and not isinstance(cell.value, (int, float)):
-                    raise FormulaProblem("COUNTIF over a cell that holds a text")
-                self.out.refs.append(Ref(ref.sheet, r, c, r, c))
-                items.append(f"(1 if {self.name_of(ref.sheet, r, c)} {op} {number!r} otherwise 0)")
-        return "(" + " + ".join(items) + ")"
-
-    def numeric_criterion(self, node) -> tuple[str, float]:
-        """(operator, number) of a criterion that compares with a number: "<>0", ">=2.5",
-        "=3" or 3, written in the formula."""
-        kind, name, payload = node
-        if kind == "leaf" and name == "Number" and payload.name.upper() not in ("TRUE", "FALSE"):
-            return "==", float(payload.name)
-        if kind != "leaf" or name != "String":
-            raise FormulaProblem("a criterion other than one written in the formula")
-        m = re.fullmatch(
-            r"(<>|<=|>=|=|<|>)?\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)", payload.name
-        )
-        if m is None:
-            raise FormulaProblem(
-                f"the criterion {payload.name!r} (a comparison with a number is translated)"
-            )
-        op = {"<>": "!=", "=": "==", None: "=="}.get(m.group(1), m.group(1))
-        return op, float(m.group(2))
-
-    def sum_if(self, args) -> str:
-        """``SUMIF(range, criterion, sum_range)`` whose criterion is a text cell (a load kind
-        such as "DL") and whose range holds constants: which cells match is Excel's rule
-        (texts equal but for case) applied here, so the sum is of the matching cells' names.
-        Texts are definitions that never change, and a number never equals such a text."""
-        if len(args) not in (2, 3):
-            raise FormulaProblem(f"SUMIF with {len(args)} arguments")
-        refs = [self.ref_of(a[2]) if a[0] == "leaf" and a[1] == "Range" else None for a in args]
-        if None in refs:
-            raise FormulaProblem("SUMIF of other than cell ranges")
-        where, crit = refs[0], refs[1]
-        total = refs[2] if len(refs) == 3 else where
-        shape = (where.r2 - where.r1, where.c2 - where.c1)
-        if (total.r2 - total.r1, total.c2 - total.c1) != shape:
-            raise FormulaProblem("SUMIF whose ranges differ in size")
-        if not crit.single:
-            raise FormulaProblem("SUMIF whose criterion is a range")
-        key = self.criterion(crit)
-        items = []
-        for dr in range(shape[0] + 1):
-            for dc in range(shape[1] + 1):
-                value = self.constant_behind(where.sheet, where.r1 + dr, where.c1 + dc)
-                if not isinstance(value, str) or value.casefold() != key:
-                    continue
-                r, c = total.r1 + dr, total.c1 + dc
-                add = self.book.cell(total.sheet, r, c)
-                if add is None or add.value is None or isinstance(add.value, (str, bool)):
-                    continue  # SUMIF adds numbers only; an empty cell is 0
-                self.out.refs.append(Ref(total.sheet, r, c, r, c))
-                items.append(self.name_of(total.sheet, r, c))
-        return "(" + " + ".join(items) + ")" if items else "0"
-
     def constant_behind(self, sheet: str, row: int, col: int):
         """The constant a cell holds, or that a chain of plain references (``=D63``) leads
         to (None for an empty cell); a cell that computes is refused."""
@@ -768,28 +698,13 @@ class FormulaTranslator:
                 return None if cell is None else cell.value
             m = _PLAIN_REF.fullmatch(cell.formula.strip())
             if m is None:
-                raise FormulaProblem("SUMIF over a range that holds formulas")
+                raise FormulaProblem("a criteria range that holds formulas")
             if m.group(1):
                 sheet = self.book.sheet_named(m.group(1))
                 if sheet is None:
                     raise FormulaProblem(f"a reference to the sheet {m.group(1)}")
             row, col = int(m.group(3)), _col(m.group(2))
-        raise FormulaProblem("SUMIF over a chain of references")
-
-    def criterion(self, ref: Ref) -> str:
-        """The text of a SUMIF criterion cell, folded for Excel's comparison without case."""
-        cell = self.book.cell(ref.sheet, ref.r1, ref.c1)
-        value = None if cell is None else cell.value
-        if cell is None or cell.formula is not None or not isinstance(value, str):
-            raise FormulaProblem("SUMIF whose criterion is not a text cell")
-        text = value.strip()
-        if not text or text != value or re.search(r"[*?~]|^[=<>]", text):
-            raise FormulaProblem(f"SUMIF whose criterion {value!r} is a pattern or an operator")
-        try:
-            float(text)
-        except ValueError:
-            return text.casefold()
-        raise FormulaProblem(f"SUMIF whose criterion {value!r} reads as a number")
+        raise FormulaProblem("a criteria range of a chain of references")
 
     def udf(self, key: str, args) -> str:
         info = self.functions[key]

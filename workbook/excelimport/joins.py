@@ -10,13 +10,14 @@ known from the formula, and texts with line breaks (``CHAR(10)``) are refused.""
 from __future__ import annotations
 
 from .aggregates import AGGREGATES
+from .criteria import FUNCTIONS as CRITERIA
 from .formula_terms import FormulaProblem, Ref, text_problem
 from .functions import EXCEL, EXCEL_VARIADIC
 
 #: operators whose value is a number (their operands are numbers, or the sheet refuses them)
 _NUMBER_OPS = {"+", "-", "*", "/", "^", "u-", "u+", "%"}
 #: Excel functions (beyond EXCEL and AGGREGATES) whose value is a number
-_NUMBER_FUNCTIONS = {"ROUND", "ABS", "MOD", "INT", "TRUNC"}
+_NUMBER_FUNCTIONS = {"ROUND", "ABS", "MOD", "INT", "TRUNC", *CRITERIA}
 #: at most this many pieces in one join
 MAX_PIECES = 200
 

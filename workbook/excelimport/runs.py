@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .criteria import FUNCTIONS as CRITERIA
+
 MIN_RUN = 3
 ROW = "i_row"
 
@@ -85,7 +87,7 @@ def find_runs(book, cells, parsed, ref_of) -> list[Run]:
 
 def _moving(run: Run, parsed, ref_of) -> bool:
     """Find the references that move with the row; False if the run cannot be one function."""
-    if _calls(parsed[(run.sheet, run.first, run.col)].tree, ("SUMIF", "OFFSET", "MATCH")):
+    if _calls(parsed[(run.sheet, run.first, run.col)].tree, (*CRITERIA, "OFFSET", "MATCH")):
         return False  # what they read is found when each cell's formula is translated
     a = _leaves(parsed[(run.sheet, run.first, run.col)].tree)
     b = _leaves(parsed[(run.sheet, run.first + 1, run.col)].tree)
