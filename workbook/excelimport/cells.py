@@ -405,6 +405,10 @@ class FormulaTranslator:
             from . import lookups
 
             return getattr(lookups, upper.lower())(self, args)
+        if upper in ("LEN", "LEFT", "RIGHT", "MID"):
+            from .joins import text_part
+
+            return text_part(self, upper, args)
         if upper in ("CONCATENATE", "_XLFN.CONCAT", "CONCAT", "CHAR"):
             from .joins import join
 

@@ -17,7 +17,9 @@ from .functions import EXCEL, EXCEL_VARIADIC
 #: operators whose value is a number (their operands are numbers, or the sheet refuses them)
 _NUMBER_OPS = {"+", "-", "*", "/", "^", "u-", "u+", "%"}
 #: Excel functions (beyond EXCEL and AGGREGATES) whose value is a number
-_NUMBER_FUNCTIONS = {"ROUND", "ABS", "MOD", "INT", "TRUNC", *CRITERIA}
+_NUMBER_FUNCTIONS = {"ROUND", "ABS", "MOD", "INT", "TRUNC", "LEN", *CRITERIA}
+#: Excel's functions of a text by position, as ``strlen`` and ``substr`` (the first 0)
+TEXT_PARTS = ("LEN", "LEFT", "RIGHT", "MID")
 #: at most this many pieces in one join
 MAX_PIECES = 200
 
@@ -82,6 +84,9 @@ def _pieces(ft, node, out: list[str]) -> None:
         raise FormulaProblem("joins TRUE/FALSE (Excel writes the word)")
     if kind == "fn" and name.upper() == "CHAR":
         out.append(_char(ft, payload))
+        return
+    if kind == "fn" and name.upper() in TEXT_PARTS[1:]:
+        out.append(ft.value(node))
         return
     if _is_number(node):
         out.append(number_piece(ft.value(node, 0)))
@@ -160,3 +165,28 @@ def excel_number_text(x: float) -> str:
     if not 1e-4 <= abs(x) < 1e15:
         raise FormulaProblem(f"joins the number {x!r}, which Excel writes with an exponent")
     return f"{x:.15g}"
+
+
+def text_part(ft, upper: str, args) -> str:
+    """``LEN(s)``, ``LEFT(s[, n])``, ``RIGHT(s[, n])``, ``MID(s, k, n)`` of a text (of a
+    number Excel takes the text it displays, which the formula does not show: refused), as
+    ``strlen`` and ``substr``: MID's first character is 1, substr's 0, and a position or count
+    that is no whole number at least 0 is an error (Excel's #VALUE! below 1 or 0)."""
+    from .kinds import kind
+
+    arities = {"LEN": (1,), "LEFT": (1, 2), "RIGHT": (1, 2), "MID": (3,)}
+    if len(args) not in arities[upper]:
+        raise FormulaProblem(f"{upper} with {len(args)} arguments")
+    if kind(ft, args[0]) != "text":
+        raise FormulaProblem(
+            f"{upper} of other than a text (of a number, Excel's text of its display)"
+        )
+    s = ft.value(args[0], 0)
+    if upper == "LEN":
+        return f"strlen({s})"
+    n = ft.value(args[-1], 0) if len(args) > 1 else "1"
+    if upper == "LEFT":
+        return f"substr({s}, 0, {n})"
+    if upper == "RIGHT":
+        return f"substr({s}, max(strlen({s}) - ({n}), 0), {n})"
+    return f"substr({s}, ({ft.value(args[1], 3)}) - 1, {n})"

@@ -28,9 +28,9 @@ _NUMBER_FUNCTIONS = {
     "TRUNC", "ROUND", "MOD", "MAX", "MIN", "SUM", "AVERAGE", "COUNT", "PRODUCT", "MEDIAN",
     "STDEV", "STDEVP", "VAR", "VARP", "SUMSQ", "_XLFN.STDEV.S", "_XLFN.STDEV.P",
     "_XLFN.VAR.S", "_XLFN.VAR.P", "CONVERT", "MATCH", "SUMIF", "COUNTIF", "MMULT", "SUMIFS",
-    "COUNTIFS", "AVERAGEIF", "AVERAGEIFS",
+    "COUNTIFS", "AVERAGEIF", "AVERAGEIFS", "LEN",
 }  # fmt: skip
-_TEXT_FUNCTIONS = {"CONCATENATE", "CONCAT", "_XLFN.CONCAT", "CHAR"}
+_TEXT_FUNCTIONS = {"CONCATENATE", "CONCAT", "_XLFN.CONCAT", "CHAR", "LEFT", "RIGHT", "MID"}
 _ORDER = {"=", "<>", "<", "<=", ">", ">="}
 #: the error value of each kind, in the language (a definition has one kind)
 _ERROR = {"number": "1/0", "text": "num2str(1/0)"}

@@ -93,3 +93,98 @@ register(
         texts=True,
     )
 )
+
+
+def _text_arg(name: str, t, k: int):
+    if not t.text or t.shape is not None:
+        raise TemplateError(f"{name}(): argument {k} is not a text")
+
+
+def _strlen_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    (s,) = args
+    _text_arg(name, s, 1)
+    return ty.TFunc(ctx.dimensionless, func=name, args=(s,))
+
+
+def _substr_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    s, m, n = args
+    _text_arg(name, s, 1)
+    for k, a in ((2, m), (3, n)):
+        if a.text or a.boolean or a.shape is not None:
+            raise TemplateError(f"substr(S, m, n): argument {k} must be a number")
+    m = ctx.plain(m, "substr(S, m, n): m (a position: a plain number)")
+    n = ctx.plain(n, "substr(S, m, n): n (a count of characters: a plain number)")
+    return ty.TFunc(ctx.dimensionless, func=name, args=(s, m, n), text=True)
+
+
+def _characters(s) -> str:
+    """The text, checked to count as Excel counts it (a character beyond U+FFFF is two for
+    Excel, one here: refused, never another count)."""
+    if not isinstance(s, str):
+        raise DomainError("strlen/substr: the argument is not a text")
+    if any(ord(ch) > 0xFFFF for ch in s):
+        raise DomainError("strlen/substr: a character beyond U+FFFF, which Excel counts as two")
+    return s
+
+
+def _whole(x, what: str) -> int:
+    v = float(x)
+    if not np.isfinite(v) or v != int(v) or v < 0:
+        raise DomainError(f"substr(S, m, n): {what} must be a whole number at least 0, got {v!r}")
+    return int(v)
+
+
+def _strlen_one(s) -> float:
+    return float(len(_characters(s)))
+
+
+def _substr_one(s, m, n) -> str:
+    start = _whole(m, "m")
+    return _characters(s)[start : start + _whole(n, "n")]
+
+
+def _strlen(s):
+    if isinstance(s, str):
+        return _strlen_one(s)
+    return np.frompyfunc(_strlen_one, 1, 1)(s).astype(float)
+
+
+def _substr(s, m, n):
+    if isinstance(s, str) and np.ndim(m) == 0 and np.ndim(n) == 0:
+        return _substr_one(s, m, n)
+    return np.frompyfunc(_substr_one, 3, 1)(s, m, n)
+
+
+def _strlen_excel(args: list[str]) -> tuple[str, int]:
+    return f"LEN({args[0]})", PREC["atom"]
+
+
+def _substr_excel(args: list[str]) -> tuple[str, int]:
+    return f"MID({args[0]}, ({args[1]}) + 1, {args[2]})", PREC["atom"]
+
+
+register(
+    Builtin(
+        "strlen",
+        1,
+        _strlen_unit,
+        _strlen,
+        _strlen_excel,
+        _no_sympy("strlen"),
+        doc="strlen(S): the number of characters of the text S (Mathcad's strlen, Excel's LEN)",
+        texts=True,
+    )
+)
+register(
+    Builtin(
+        "substr",
+        3,
+        _substr_unit,
+        _substr,
+        _substr_excel,
+        _no_sympy("substr"),
+        doc="substr(S, m, n): at most n characters of S from position m, the first 0 "
+        "(Mathcad's substr; Excel's MID(S, m + 1, n))",
+        texts=True,
+    )
+)

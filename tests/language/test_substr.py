@@ -1,0 +1,75 @@
+"""strlen and substr: Mathcad's texts by position (the first 0), their Excel form (LEN, MID)
+computed again by the `formulas` package, and what they refuse."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from helpers.sheets import write_template
+
+import workbook
+from workbook import WorkbookError
+
+SHEET = r"""
+[inputs]
+k = "2"
+L = "2 m"
+
+[definitions]
+word = "\"abcdef\""
+middle = "substr(word, k, 3)"
+tail = "substr(word, 4, 10)"
+beyond = "substr(word, 9, 1)"
+size = "strlen(word)"
+first = "concat(substr(word, 0, 1), \"-\")"
+#BAD
+"""
+
+
+@pytest.fixture(scope="module")
+def sheet(tmp_path_factory):
+    return workbook.load(write_template(tmp_path_factory.mktemp("substr"), SHEET))
+
+
+def test_positions_from_0_and_at_most_n_characters(sheet):
+    assert sheet.evaluate("middle") == "cde"
+    assert sheet.evaluate("tail") == "ef"
+    assert sheet.evaluate("beyond") == ""
+    assert sheet.evaluate("size").magnitude == 6
+    assert sheet.evaluate("first") == "a-"
+
+
+@pytest.mark.parametrize("k", [-1, 1.5])
+def test_a_position_that_is_no_whole_number_at_least_0_is_an_error(sheet, k):
+    with pytest.raises(WorkbookError, match="m must be a whole number at least 0"):
+        sheet.with_inputs(k=k).evaluate("middle")
+
+
+def test_excel_form_is_mid_and_len(sheet):
+    formulas = pytest.importorskip("formulas")
+    from workbook.compute.excel import ExcelPrinter
+
+    printer = ExcelPrinter(sheet.typer, {"k": "2"})
+    for what, start in (("middle", "=MID("), ("tail", "=MID("), ("size", "=LEN(")):
+        text = printer.formula(sheet.typer.scalar(what), {})
+        assert text.startswith(start)
+        fn = formulas.Parser().ast(text)[1].compile()
+        value = fn(*[{"WORD": "abcdef", "K": 2}[name] for name in fn.inputs])
+        expected = sheet.evaluate(what)
+        assert (value if isinstance(expected, str) else float(value)) == (
+            expected if isinstance(expected, str) else expected.magnitude
+        )
+
+
+@pytest.mark.parametrize(
+    "line, message",
+    [
+        ('bad = "strlen(k)"', "strlen(): argument 1 is not a text"),
+        ('bad = "substr(word, \\"a\\", 1)"', "substr(S, m, n): argument 2 must be a number"),
+        ('bad = "substr(word, L, 1)"', "substr(S, m, n): m"),
+    ],
+)
+def test_refused_at_load(tmp_path, line, message):
+    with pytest.raises(WorkbookError, match=re.escape(message)):
+        workbook.load(write_template(tmp_path, SHEET.replace("#BAD", line)))
