@@ -18,6 +18,10 @@ The text is split into statements here and every expression goes through
         return 2*a
     "small" if a < 0              # one-line form, as Mathcad's 'value if condition'
     a otherwise
+    try                           # Prime's try / on error: an error raised in the first
+        a := 1/a                  # block (a division by zero there too) runs the second,
+    on error                      # from where it was raised; a limit is no such error
+        a := 0
 
 The value of a program is the value of the ``return`` that ends it or, without one, of the
 last value line it executed (an expression line, or the value of a one-line ``if`` /

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from .statements import Assign, If, Return, SetItem, Stmt, Value, walk
+from .statements import Assign, If, Return, SetItem, Stmt, Try, Value, walk
 from .typer import TypedProgram
 
 
@@ -17,6 +17,8 @@ def excel_value(typed: TypedProgram, printed: Callable[[Any, dict], str], subst:
 
     if typed.loops:
         raise NotLive("a program with a loop is written as values")
+    if any(isinstance(st, Try) for st in walk(typed.body)):
+        raise NotLive("a program with try / on error is written as values")
 
     def run(stmts: list[Stmt], s: dict, last: str | None) -> str:
         for k, st in enumerate(stmts):

@@ -19,8 +19,10 @@ from .statements import (
     Return,
     SetItem,
     Stmt,
+    Try,
     Value,
     While,
+    walk,
 )
 
 #: Longest program text and deepest block nesting.
@@ -55,6 +57,7 @@ def parse(text: str, *, what: str = "program") -> Program:
     block, rest = _block(lines, 0, lines[0].indent, what, 0)
     if rest != len(lines):  # pragma: no cover - _block consumes everything at top level
         raise TemplateError(f"{what}, line {lines[rest].number}: unexpected indent")
+    _check_tries(block, what)
     _check_loops(block, False, what)
     return Program(block, text)
 
@@ -72,6 +75,16 @@ def _check_loops(block: tuple[Stmt, ...], inside: bool, what: str) -> None:
                 _check_loops(s.otherwise, inside, what)
         elif isinstance(s, (For, While)):
             _check_loops(s.body, True, what)
+        elif isinstance(s, Try):
+            _check_loops(s.body, inside, what)
+            _check_loops(s.handler, inside, what)
+
+
+def _check_tries(block: tuple[Stmt, ...], what: str) -> None:
+    """Every 'try' has its 'on error' block."""
+    for s in walk(block):
+        if isinstance(s, Try) and not s.handler:
+            raise TemplateError(f"{what}, line {s.line}: 'try' without its 'on error' block")
 
 
 def _strip_comment(raw: str, what: str, number: int) -> str:
@@ -103,6 +116,18 @@ def _block(lines: list[_Line], i: int, indent: int, what: str, depth: int):
         where = f"{what}, line {ln.number}"
         head, tail = _keyword(ln.text)
         i += 1
+        if head in ("try", "on error"):
+            if tail.removesuffix(":").strip():
+                raise TemplateError(f"{where}: '{head}' takes nothing after it")
+            body, i = _body(lines, i, ln, what, depth)
+            if head == "try":
+                out.append(Try(ln.number, body, ()))
+            else:
+                prev = out[-1] if out else None
+                if not isinstance(prev, Try) or prev.handler:
+                    raise TemplateError(f"{where}: 'on error' without a 'try' before it")
+                out[-1] = Try(prev.line, prev.body, body)
+            continue
         if head in ("if", "for", "while", "else", "otherwise", "else if"):
             is_header = head != "otherwise" or not tail
             if head == "otherwise" and tail:
@@ -133,7 +158,7 @@ def _block(lines: list[_Line], i: int, indent: int, what: str, depth: int):
         if i < len(lines) and lines[i].indent > indent:
             raise TemplateError(
                 f"{what}, line {lines[i].number}: unexpected indent (only if, else if, "
-                "otherwise, for and while take an indented block)"
+                "otherwise, for, while, try and on error take an indented block)"
             )
         stmt = _simple(ln, where, out)
         if stmt is not None:
@@ -149,7 +174,7 @@ def _body(lines, i, header: _Line, what, depth):
     return _block(lines, i, lines[i].indent, what, depth + 1)
 
 
-_KEYWORDS = re.compile(r"^(else\s+if|if|for|while|else|otherwise)\b\s*(.*)$")
+_KEYWORDS = re.compile(r"^(else\s+if|on\s+error|if|for|while|try|else|otherwise)\b\s*(.*)$")
 
 
 def _keyword(text: str) -> tuple[str | None, str]:

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..engine import runtime as rt
-from ..errors import InputError, LimitError, TemplateError
+from ..errors import InputError, LimitError, TemplateError, WorkbookError
 from ..language.typed import is_runtime
 from ..limits_time import check_time
 from .statements import (
@@ -20,6 +20,7 @@ from .statements import (
     Return,
     SetItem,
     Stmt,
+    Try,
     Value,
     While,
     walk,
@@ -84,6 +85,7 @@ class _Compiler:
             (If, self.if_),
             (For, self.for_),
             (While, self.while_),
+            (Try, self.try_),
         )
 
     def block(self, stmts) -> Callable:
@@ -259,6 +261,26 @@ class _Compiler:
                     continue
 
         return while_
+
+    def try_(self, s) -> Callable:
+        """``try`` / ``on error``: an error of the engine raised in the first block (a value
+        out of its domain, an index out of range, a solver that fails, a division by zero, an
+        overflow or 0/0) runs the second from there, with what the first had set; a limit
+        (the statements, the time, the elements) is no such error and stops the program."""
+        tick = self.tick
+        body, handler = self.block(s.body), self.block(s.handler)
+
+        def try_(env, last):
+            tick(s)
+            try:
+                with np.errstate(divide="raise", over="raise", invalid="raise"):
+                    return body(env, last)
+            except LimitError:
+                raise
+            except (WorkbookError, FloatingPointError):
+                return handler(env, last)
+
+        return try_
 
 
 def compile_program(

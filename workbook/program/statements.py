@@ -74,6 +74,15 @@ class While(Stmt):
 
 
 @dataclass(frozen=True)
+class Try(Stmt):
+    """``try`` over a block, then ``on error`` over a block: the first block runs; if an error
+    is raised in it, the second runs from there (Mathcad Prime's try / on error)."""
+
+    body: tuple[Stmt, ...]
+    handler: tuple[Stmt, ...]
+
+
+@dataclass(frozen=True)
 class Program:
     body: tuple[Stmt, ...]
     text: str
@@ -91,6 +100,9 @@ def walk(block: tuple[Stmt, ...]):
                 yield from walk(s.otherwise)
         elif isinstance(s, (For, While)):
             yield from walk(s.body)
+        elif isinstance(s, Try):
+            yield from walk(s.body)
+            yield from walk(s.handler)
 
 
 def expressions(block: tuple[Stmt, ...]):

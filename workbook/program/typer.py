@@ -22,6 +22,7 @@ from .statements import (
     Return,
     SetItem,
     Stmt,
+    Try,
     Value,
     While,
     expressions,
@@ -316,6 +317,8 @@ class _TypeState:
             return For(s.line, s.var, first, second, last, self.block(s.body))
         if isinstance(s, While):
             return While(s.line, self.cond(s.condition, s), self.block(s.body))
+        if isinstance(s, Try):
+            return Try(s.line, self.block(s.body), self.block(s.handler))
         raise TypeError(s)  # pragma: no cover
 
 
@@ -386,6 +389,9 @@ def growth(program: Program, origin: int) -> dict[str, _Growth]:
                     visit(st.otherwise, loops, why or "it is set under an if", at)
             elif isinstance(st, While):
                 visit(st.body, loops, why or "it is set in a while loop", at)
+            elif isinstance(st, Try):
+                for b in (st.body, st.handler):
+                    visit(b, loops, why or "it is set under a try or on error", at)
             elif isinstance(st, For):
                 bounds = [_number(b) if b is not None else 0.0 for b in (st.first, st.last)]
                 second = _number(st.second) if st.second is not None else None
@@ -475,7 +481,8 @@ def _grown_used_whole(program: Program, grown: dict, growing: set[str]) -> None:
             if not g.first <= k <= g.last:
                 continue
             for st in walk((top,)):
-                exprs = list(expressions((st,))) if not isinstance(st, (If, For, While)) else []
+                compound = (If, For, While, Try)
+                exprs = list(expressions((st,))) if not isinstance(st, compound) else []
                 if isinstance(st, If):
                     exprs = [c for c, _ in st.branches]
                 elif isinstance(st, For):
