@@ -3,8 +3,9 @@
 A program becomes lines of statements (``a := ...``, ``for i in 1 .. n``, ``while ...``,
 ``if ...`` blocks, ``value if condition``, ``value otherwise``, ``return``, ``break``,
 ``continue``), one block indented under its header. Locals are names of their own (never a
-name of the sheet). What the language's programs cannot hold (a loop over a vector,
-try/catch) is untranslatable.
+name of the sheet). Prime's try / on error is ``try`` and ``on error`` over their blocks,
+where what counts as an error is the same in Mathcad and the engine (:func:`unsure_builtin`). What
+the language's programs cannot hold (a loop over a vector) is untranslatable.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 from ..language import expr as ex
 from . import names as nm
 from .reader import MNode
-from .symbols import Sym, Untranslatable, matrix_size, what
+from .symbols import Sym, Untranslatable, matrix_size
 from .symbols import key as name_key
 from .translation import Item
 
@@ -105,6 +106,12 @@ class ProgramTranslator:
                 elif s.tag == "while":
                     read(s.children[0], have)
                     run(_statements(s.children[1]), set(have))
+                elif s.tag == "tryCatch" and len(s.children) == 2:
+                    # the try block may stop at any line: the on error block starts from
+                    # what was given before it
+                    a = run(_statements(s.children[0]), set(have))
+                    b = run(_statements(s.children[1]), set(have))
+                    have = b if a is None else a if b is None else a & b
                 elif s.tag == "localDefine":
                     lhs, rhs = s.children
                     read(rhs, have)
@@ -245,10 +252,64 @@ class ProgramTranslator:
             self._loop_body(body, indent + 4, out)
         elif tag == "program":
             self._block(s.children, indent, out, tail)
-        elif tag in ("tryCatch", "onError"):
-            raise Untranslatable(f"{what(tag)} in a program")
+        elif tag == "tryCatch":
+            self._try(s, indent, out)
+        elif tag == "onError":
+            raise Untranslatable(_ON_ERROR_WHY)
         else:
             out.append((indent, [self._expr(s)]))
+
+    def _try(self, s: MNode, indent: int, out: list[Line]) -> None:
+        """Prime's try / on error: the try block runs; if an error is raised in it, the on
+        error block runs from there. Translated only where the try block (and what it reads
+        of the worksheet) raises an error where Mathcad does (:func:`unsure_builtin`)."""
+        if len(s.children) != 2:
+            raise Untranslatable("a try / on error without its two blocks")
+        body, handler = s.children
+        start = len(out)
+        out.append((indent, ["try"]))
+        self._body(body, indent + 4, out)
+        why = self._unsure([p for _, parts in out[start:] for p in parts if not isinstance(p, str)])
+        if why:
+            raise Untranslatable(f"a try / on error whose try block {why}")
+        out.append((indent, ["on error"]))
+        self._body(handler, indent + 4, out)
+
+    def _unsure(self, trees: list[ex.Node]) -> str:
+        """Why an error raised in ``trees`` (and in the worksheet's definitions and functions
+        they read) may not be Mathcad's: '' where it is."""
+        items = {i.sym.token(): i for i in self.tr.out.items if i.sym is not None}
+        solved = {
+            sym.token(): sym
+            for i in self.tr.out.items
+            if i.kind == "solve"
+            for sym, _ in i.solve[0]
+        }
+        by_token = {sym.token(): sym for sym in self.tr.out.syms}
+        seen: set[str] = set()
+        todo = list(trees)
+        while todo:
+            for node in ex.walk(todo.pop()):
+                name = node.func if isinstance(node, ex.Call) else getattr(node, "id", None)
+                why = unsure_builtin(node.func) if isinstance(node, ex.Call) else ""
+                if why:
+                    return f"calls {node.func}(): {why}"
+                if isinstance(node, ex.Binary) and node.op == "^" and not _whole(node.right):
+                    return (
+                        "raises to a power that is not a whole number written (Mathcad's power "
+                        "of a negative number is complex, the engine's an error)"
+                    )
+                if name in solved:
+                    return (
+                        f"reads {solved[name].mathcad}, a solve block's solution (whether a "
+                        "solver fails is that solver's own)"
+                    )
+                if name in items and name not in seen:
+                    seen.add(name)
+                    todo += _item_trees(items[name])
+                elif name in by_token and by_token[name].kind == "func" and name not in items:
+                    return f"calls {by_token[name].mathcad}, whose body is not known here"
+        return ""
 
     def _loop_body(self, body: MNode, indent: int, out: list[Line]) -> None:
         self.loops += 1
@@ -549,6 +610,47 @@ class ProgramTranslator:
         return tree
 
 
+def unsure_builtin(name: str) -> str:
+    """Why an error a built-in of the language raises may not be where Mathcad raises one
+    ('' where it is): one with a restricted domain (``sqrt`` of a negative number: Mathcad's
+    value is complex, the engine's an error), or one that binds a variable (a solver or a
+    numerical method, whose failure is its own), as the registry's entry says."""
+    from ..functions.registry import REGISTRY
+
+    entry = REGISTRY.get(name)
+    if entry is None:
+        return ""
+    if entry.binds:
+        return "whether a solver or a numerical method fails is its own"
+    if entry.domain:
+        return (
+            f"the engine raises an error at {entry.domain[0].kind}, where Mathcad's value may "
+            "be complex or its error another"
+        )
+    return ""
+
+
+_ON_ERROR_WHY = (
+    "Mathcad 15's on error in a program (which of its operands is the one tried is not shown "
+    "by any worksheet measured)"
+)
+
+
+def _whole(node: ex.Node) -> bool:
+    """A whole number written (``2``, ``-1``)."""
+    if isinstance(node, ex.Unary) and node.op == "-":
+        node = node.operand
+    return isinstance(node, ex.Number) and float(node.value).is_integer()
+
+
+def _item_trees(item: Item) -> list[ex.Node]:
+    """The expressions of a translated definition or function."""
+    out = [item.body] if item.body is not None else []
+    out += [t for piece in item.pieces or [] for t in piece if t is not None]
+    out += [p for _, parts in item.program or [] for p in parts if not isinstance(p, str)]
+    return out
+
+
 _BREAK_WHY = "a break outside any loop (Mathcad stops the program there) before the program's end"
 _CONTINUE_WHY = "a continue outside any loop"
 
@@ -692,6 +794,9 @@ def _targets(body: list[MNode]) -> tuple[dict, set]:
                 visit(_statements(s.children[1]), True)
             elif s.tag == "otherwise":
                 visit(_statements(s.children[0]), True)
+            elif s.tag == "tryCatch":
+                for block in s.children:
+                    visit(_statements(block), True)
             elif s.tag == "program":
                 visit(s.children, inner)
 
