@@ -20,7 +20,6 @@ import zipfile
 from pathlib import Path
 
 from .errors import InputError, LimitError, OutOfBudget
-from .limits_time import within_seconds  # noqa: F401 - the time limits live beside
 
 MAX_CSV_BYTES = 20_000_000  # a printed-values CSV
 MAX_INPUTS_XLSX_BYTES = 200_000_000  # an edited workbook given to --inputs (compressed)

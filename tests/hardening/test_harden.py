@@ -1062,7 +1062,7 @@ def test_a_time_limit_survives_an_alarm_swallowed_by_a_weakref_callback():
     # ignored by Python, and a single alarm let the diff run on for minutes
     import weakref
 
-    from workbook.limits import within_seconds
+    from workbook.limits_time import within_seconds
 
     class Cached:
         pass

@@ -345,13 +345,13 @@ def test_a_time_limit_inside_the_budget_is_the_nearer_of_the_two(monkeypatch):
 
     with limits_time.command_budget(30):
         with pytest.raises(LimitError, match="inner took more than 0.1 s"):
-            with limits.within_seconds(0.1, "inner"):
+            with limits_time.within_seconds(0.1, "inner"):
                 spin(30)
         assert 29 < limits_time.remaining() <= 30  # the budget is still armed (CPU time)
         assert signal.getitimer(signal.ITIMER_REAL)[0] > 0
     with pytest.raises(OutOfBudget, match="ran past the time budget"):
         with limits_time.command_budget(0.2):
-            with limits.within_seconds(30, "inner"):
+            with limits_time.within_seconds(30, "inner"):
                 spin(30)
     assert signal.getitimer(signal.ITIMER_REAL)[0] == 0
 

@@ -11,8 +11,9 @@ from .. import verdicts as V
 from ..errors import DomainError, LimitError, TemplateError, UnitError, WorkbookError
 from ..findings import Finding
 from ..language import units as un
-from ..language.printed import PrintedRow, read_commented_csv, read_printed  # noqa: F401 - re-exported
+from ..language.printed import PrintedRow
 from ..language.spec import PrintedSpec
+from ..language.typedsheet import printed_rows
 
 
 @dataclass
@@ -176,7 +177,7 @@ def run_checks(sheet) -> Report:
     """Compare every printed value with the engine, and collect block findings."""
     report = Report(sheet.name)
     for spec in sheet.spec.printed:
-        for row in read_printed(spec):
+        for row in printed_rows(spec):
             report.rows.append(_check_row(sheet, spec, row))
     report.findings = collect_findings(sheet) + failed_values(sheet)
     if sheet.evaluator.records:  # after the values: their built-ins' estimates

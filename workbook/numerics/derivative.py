@@ -21,7 +21,7 @@ from ..errors import LimitError, NotSymbolic, TemplateError, WorkbookError
 from ..language import typed as ty
 from ..language import units as un
 from ..language.visitor import Visitor
-from ..limits import within_seconds
+from ..limits_time import within_seconds
 
 
 def sympy_functions() -> dict[str, str]:
