@@ -1,4 +1,5 @@
-"""`workbook import`: LEN, LEFT, RIGHT and MID of texts as strlen and substr, each cached value
+"""`workbook import`: LEN, LEFT, RIGHT, MID, UPPER, LOWER and TRIM of texts as strlen, substr,
+strupper, strlower and strtrim, each cached value
 computed by the `formulas` package (an evaluator of Excel's formulas independent of the
 import); of a number (whose text is Excel's display) they are listed."""
 
@@ -26,13 +27,22 @@ FORMULAS = [
     "=MID(A1,20,2)",
     '=LEFT(A1,2)&"-"&RIGHT(A1,2)',
     "=LEN(A2)",
+    "=UPPER(A3)",
+    "=LOWER(A3)",
+    "=TRIM(A3)",
+    '=LEN(TRIM(A3))&" "&LOWER(A2)',
 ]
-TEXTS = {"A1": "Fehler: b", "A2": "DL"}
+TEXTS = {"A1": "Fehler: b", "A2": "DL", "A3": "  Load  case 2 "}
+# TRIM as Excel documents it ("removes all spaces from text except for single spaces between
+# words"): the `formulas` package keeps the inner run of two spaces, so these are written here
+TRIMMED = {"=TRIM(A3)": "Load case 2", '=LEN(TRIM(A3))&" "&LOWER(A2)': "11 dl"}
 
 
 def excel(formula: str):
+    if formula in TRIMMED:
+        return TRIMMED[formula]
     fn = formulas.Parser().ast(formula)[1].compile()
-    cells = {"A1": TEXTS["A1"], "A2": TEXTS["A2"], "B1": 3.0}
+    cells = {**TEXTS, "B1": 3.0}
     value = np.asarray(fn(*[np.array([[cells[k]]], dtype=object) for k in fn.inputs])).ravel()[0]
     return value if isinstance(value, str) else float(value)
 
@@ -45,6 +55,7 @@ def imported(tmp_path_factory):
     ws = wb.add_worksheet("Texts")
     ws.write_string("A1", TEXTS["A1"])
     ws.write_formula("A2", '="D"&"L"', None, TEXTS["A2"])  # a text a formula gives
+    ws.write_string("A3", TEXTS["A3"])
     ws.write_number("B1", 3.0)
     ws.write_number("B2", 12.5)
     for k, f in enumerate(FORMULAS):
@@ -61,9 +72,9 @@ def test_every_cached_value_is_reproduced(imported, capsys):
     assert main(["check", str(imported), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
     counts = {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")}
-    # the eleven formulas but MID(A1,20,2) (an empty text: no cached value), and A2; F1 is
+    # the fifteen formulas but MID(A1,20,2) (an empty text: no cached value), and A2; F1 is
     # listed
-    assert counts == {"printed": 12, "reproduced": 11, "failed": 0, "not_computable": 1}
+    assert counts == {"printed": 16, "reproduced": 15, "failed": 0, "not_computable": 1}
 
 
 def test_a_position_below_1_is_an_error(imported):

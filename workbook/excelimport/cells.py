@@ -405,7 +405,7 @@ class FormulaTranslator:
             from . import lookups
 
             return getattr(lookups, upper.lower())(self, args)
-        if upper in ("LEN", "LEFT", "RIGHT", "MID"):
+        if upper in ("LEN", "LEFT", "RIGHT", "MID", "UPPER", "LOWER", "TRIM"):
             from .joins import text_part
 
             return text_part(self, upper, args)

@@ -18,8 +18,9 @@ from .functions import EXCEL, EXCEL_VARIADIC
 _NUMBER_OPS = {"+", "-", "*", "/", "^", "u-", "u+", "%"}
 #: Excel functions (beyond EXCEL and AGGREGATES) whose value is a number
 _NUMBER_FUNCTIONS = {"ROUND", "ABS", "MOD", "INT", "TRUNC", "LEN", *CRITERIA}
-#: Excel's functions of a text by position, as ``strlen`` and ``substr`` (the first 0)
-TEXT_PARTS = ("LEN", "LEFT", "RIGHT", "MID")
+#: Excel's functions of a text: by position, as ``strlen`` and ``substr`` (the first 0), and
+#: UPPER, LOWER, TRIM as ``strupper``, ``strlower``, ``strtrim``
+TEXT_PARTS = ("LEN", "LEFT", "RIGHT", "MID", "UPPER", "LOWER", "TRIM")
 #: at most this many pieces in one join
 MAX_PIECES = 200
 
@@ -168,22 +169,24 @@ def excel_number_text(x: float) -> str:
 
 
 def text_part(ft, upper: str, args) -> str:
-    """``LEN(s)``, ``LEFT(s[, n])``, ``RIGHT(s[, n])``, ``MID(s, k, n)`` of a text (of a
-    number Excel takes the text it displays, which the formula does not show: refused), as
-    ``strlen`` and ``substr``: MID's first character is 1, substr's 0, and a position or count
-    that is no whole number at least 0 is an error (Excel's #VALUE! below 1 or 0)."""
+    """``LEN(s)``, ``LEFT(s[, n])``, ``RIGHT(s[, n])``, ``MID(s, k, n)``, ``UPPER(s)``,
+    ``LOWER(s)`` and ``TRIM(s)`` of a text (of a number Excel takes the text it displays, which
+    the formula does not show: refused), as ``strlen``, ``substr``, ``strupper``, ``strlower``
+    and ``strtrim``: MID's first character is 1, substr's 0, and a position or count that is no
+    whole number at least 0 is an error (Excel's #VALUE! below 1 or 0)."""
     from .kinds import kind
 
-    arities = {"LEN": (1,), "LEFT": (1, 2), "RIGHT": (1, 2), "MID": (3,)}
-    if len(args) not in arities[upper]:
+    arities = {"LEFT": (1, 2), "RIGHT": (1, 2), "MID": (3,)}
+    if len(args) not in arities.get(upper, (1,)):
         raise FormulaProblem(f"{upper} with {len(args)} arguments")
     if kind(ft, args[0]) != "text":
         raise FormulaProblem(
             f"{upper} of other than a text (of a number, Excel's text of its display)"
         )
     s = ft.value(args[0], 0)
-    if upper == "LEN":
-        return f"strlen({s})"
+    if upper in ("LEN", "UPPER", "LOWER", "TRIM"):
+        short = {"LEN": "len", "UPPER": "upper", "LOWER": "lower", "TRIM": "trim"}[upper]
+        return f"str{short}({s})"
     n = ft.value(args[-1], 0) if len(args) > 1 else "1"
     if upper == "LEFT":
         return f"substr({s}, 0, {n})"

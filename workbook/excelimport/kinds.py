@@ -30,7 +30,10 @@ _NUMBER_FUNCTIONS = {
     "_XLFN.VAR.S", "_XLFN.VAR.P", "CONVERT", "MATCH", "SUMIF", "COUNTIF", "MMULT", "SUMIFS",
     "COUNTIFS", "AVERAGEIF", "AVERAGEIFS", "LEN",
 }  # fmt: skip
-_TEXT_FUNCTIONS = {"CONCATENATE", "CONCAT", "_XLFN.CONCAT", "CHAR", "LEFT", "RIGHT", "MID"}
+_TEXT_FUNCTIONS = {
+    "CONCATENATE", "CONCAT", "_XLFN.CONCAT", "CHAR", "LEFT", "RIGHT", "MID", "UPPER", "LOWER",
+    "TRIM",
+}  # fmt: skip
 _ORDER = {"=", "<>", "<", "<=", ">", ">="}
 #: the error value of each kind, in the language (a definition has one kind)
 _ERROR = {"number": "1/0", "text": "num2str(1/0)"}

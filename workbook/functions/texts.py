@@ -1,7 +1,11 @@
 """Built-ins of texts, as Mathcad names them: ``concat(S1, S2, ...)`` joins texts and
-``num2str(x)`` writes a number as a text (15 significant digits, ``1e-05`` for small ones)."""
+``num2str(x)`` writes a number as a text (15 significant digits, ``1e-05`` for small ones);
+``strlen`` and ``substr`` count and cut a text by position; ``strupper``, ``strlower`` and
+``strtrim`` are Excel's UPPER, LOWER and TRIM."""
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 
@@ -185,6 +189,87 @@ register(
         _no_sympy("substr"),
         doc="substr(S, m, n): at most n characters of S from position m, the first 0 "
         "(Mathcad's substr; Excel's MID(S, m + 1, n))",
+        texts=True,
+    )
+)
+
+
+def _text_of_text_unit(ctx: UnitContext, name: str, args: tuple) -> ty.T:
+    (s,) = args
+    _text_arg(name, s, 1)
+    return ty.TFunc(ctx.dimensionless, func=name, args=(s,), text=True)
+
+
+def _ascii_letters(s) -> str:
+    """The text, checked to hold no letter beyond ASCII (Excel's case of those is its own:
+    ``ß``, ``ǅ``, dotted and dotless i)."""
+    if not isinstance(s, str):
+        raise DomainError("strupper/strlower: the argument is not a text")
+    if any(ord(ch) > 127 and ch.isalpha() for ch in s):
+        raise DomainError(
+            "strupper/strlower: a letter beyond ASCII, whose case Excel may change otherwise"
+        )
+    return s
+
+
+def _elementwise(one):
+    def apply(s):
+        if isinstance(s, str):
+            return one(s)
+        return np.frompyfunc(one, 1, 1)(s)
+
+    return apply
+
+
+def _trim_one(s) -> str:
+    if not isinstance(s, str):
+        raise DomainError("strtrim: the argument is not a text")
+    return re.sub(" +", " ", s).strip(" ")
+
+
+def _excel_of(function: str):
+    def excel(args: list[str]) -> tuple[str, int]:
+        return f"{function}({args[0]})", PREC["atom"]
+
+    return excel
+
+
+register(
+    Builtin(
+        "strupper",
+        1,
+        _text_of_text_unit,
+        _elementwise(lambda s: _ascii_letters(s).upper()),
+        _excel_of("UPPER"),
+        _no_sympy("strupper"),
+        doc="strupper(S): the text S in capitals (Excel's UPPER; a letter beyond ASCII is an "
+        "error)",
+        texts=True,
+    )
+)
+register(
+    Builtin(
+        "strlower",
+        1,
+        _text_of_text_unit,
+        _elementwise(lambda s: _ascii_letters(s).lower()),
+        _excel_of("LOWER"),
+        _no_sympy("strlower"),
+        doc="strlower(S): the text S in small letters (Excel's LOWER; a letter beyond ASCII is "
+        "an error)",
+        texts=True,
+    )
+)
+register(
+    Builtin(
+        "strtrim",
+        1,
+        _text_of_text_unit,
+        _elementwise(_trim_one),
+        _excel_of("TRIM"),
+        _no_sympy("strtrim"),
+        doc="strtrim(S): S without spaces at its ends, each run of spaces inside it one space "
+        "(Excel's TRIM: the space only, not tabs or non-breaking spaces)",
         texts=True,
     )
 )
