@@ -8,7 +8,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import workbook
 from workbook.errors import TemplateError
 from workbook.functions.registry import REGISTRY
 
