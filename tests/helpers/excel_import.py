@@ -3,8 +3,16 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from workbook.cli import main
+
+
+def import_book(path: Path) -> Path:
+    """``workbook import PATH --out FOLDER/out`` (exit 0 asserted): the translated worksheet."""
+    out = path.parent / "out"
+    assert main(["import", str(path), "--out", str(out)]) == 0
+    return out / (path.stem + ".toml")
 
 
 def import_and_check(path, tmp_path, capsys) -> tuple[dict, str]:
@@ -16,3 +24,14 @@ def import_and_check(path, tmp_path, capsys) -> tuple[dict, str]:
     capsys.readouterr()
     main(["check", str(toml), "--json"])
     return json.loads(capsys.readouterr().out), toml.read_text(encoding="utf-8")
+
+
+COUNTS = ("printed", "reproduced", "failed", "not_computable")
+
+
+def check_counts(toml, capsys) -> tuple[int, dict]:
+    """``workbook check TOML --json``: its exit status and its four counts."""
+    capsys.readouterr()
+    status = main(["check", str(toml), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    return status, {k: report[k] for k in COUNTS}

@@ -4,16 +4,15 @@ formulas independent of the import), and the criteria whose match is not certain
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
 xlsxwriter = pytest.importorskip("xlsxwriter")
 formulas = pytest.importorskip("formulas")
 
+from helpers.excel_import import check_counts, import_book  # noqa: E402
+
 import workbook  # noqa: E402
-from workbook.cli import main  # noqa: E402
 
 # A1:A6 numbers (A5 a formula), B1:B6 load kinds (B6 reads B1's text), D1 the kind sought
 NUMBERS = [-1.5, 2.0, -3.0, 4.0, 0.5, -6.0]
@@ -72,16 +71,12 @@ def build(path, numbers=NUMBERS, kinds=KINDS, extra=()):
 def imported(tmp_path_factory):
     folder = tmp_path_factory.mktemp("criteria")
     build(folder / "loads.xlsx", extra=[(f, 0.0) for f, _ in UNCERTAIN])
-    out = folder / "out"
-    assert main(["import", str(folder / "loads.xlsx"), "--out", str(out)]) == 0
-    return out / "loads.toml"
+    return import_book(folder / "loads.xlsx")
 
 
 def test_every_cached_value_is_reproduced(imported, capsys):
-    capsys.readouterr()
-    assert main(["check", str(imported), "--json"]) == 1
-    report = json.loads(capsys.readouterr().out)
-    counts = {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")}
+    status, counts = check_counts(imported, capsys)
+    assert status == 1
     # the twelve formulas and A5's and B6's cells; the five of UNCERTAIN are listed
     assert counts == {"printed": 21, "reproduced": 14, "failed": 0, "not_computable": 7}
 

@@ -5,15 +5,13 @@ import); of a number (whose text is Excel's display) they are listed."""
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
 xlsxwriter = pytest.importorskip("xlsxwriter")
 formulas = pytest.importorskip("formulas")
 
-from workbook.cli import main  # noqa: E402
+from helpers.excel_import import check_counts, import_book  # noqa: E402
 
 FORMULAS = [
     "=LEN(A1)",
@@ -62,16 +60,12 @@ def imported(tmp_path_factory):
         ws.write_formula(k, 3, f, None, excel(f))
     ws.write_formula("F1", "=LEN(B2)", None, 4)  # a number: the text of its display
     wb.close()
-    out = folder / "out"
-    assert main(["import", str(path), "--out", str(out)]) == 0
-    return out / "texts.toml"
+    return import_book(path)
 
 
 def test_every_cached_value_is_reproduced(imported, capsys):
-    capsys.readouterr()
-    assert main(["check", str(imported), "--json"]) == 1
-    report = json.loads(capsys.readouterr().out)
-    counts = {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")}
+    status, counts = check_counts(imported, capsys)
+    assert status == 1
     # the fifteen formulas but MID(A1,20,2) (an empty text: no cached value), and A2; F1 is
     # listed
     assert counts == {"printed": 16, "reproduced": 15, "failed": 0, "not_computable": 1}
