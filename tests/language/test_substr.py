@@ -33,11 +33,6 @@ german = "strupper(\"Maß\")"
 """
 
 
-@pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("substr"), SHEET))
-
-
 def test_positions_from_0_and_at_most_n_characters(sheet):
     assert sheet.evaluate("middle") == "cde"
     assert sheet.evaluate("tail") == "ef"
