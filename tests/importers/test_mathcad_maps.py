@@ -658,3 +658,25 @@ def test_g_is_the_acceleration_of_gravity_and_gm_the_gram(tmp_path, capsys):
     )
     result = check_sheet(tmp_path, capsys, "gravity")
     assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]
+
+
+def test_strlen_and_substr_are_mathcads_text_functions(tmp_path, capsys):
+    """Mathcad's substr(S, m, n) counts positions from 0 whatever ORIGIN is, as the
+    language's; the stored results of both are reproduced."""
+    from helpers.mathcad_xml import check_sheet, define, evaluate, ident, import_sheet, real
+
+    text = "<ml:str>{}</ml:str>".format
+    cut = f"<ml:apply>{ident('substr')}<ml:sequence>{ident('s')}{real(1)}{real(3)}</ml:sequence></ml:apply>"  # noqa: E501
+    size = f"<ml:apply>{ident('strlen')}{ident('s')}</ml:apply>"
+    toml = import_sheet(
+        tmp_path,
+        capsys,
+        "strings",
+        define(1, ident("s"), text("abcdef")),
+        evaluate(2, cut, text("bcd")),
+        evaluate(3, size, real(6)),
+        origin=1,
+    )
+    assert "substr(s, 1, 3)" in toml and "strlen(s)" in toml
+    result = check_sheet(tmp_path, capsys, "strings")
+    assert (result["printed"], result["reproduced"]) == (2, 2), result["failures"]

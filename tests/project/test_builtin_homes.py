@@ -1,7 +1,8 @@
 """A built-in has one home, its registry entry: a new one needs its entry and its line in the
 docs, nothing else (a throwaway entry is picked up by the typer, numpy, the Excel printer and
 writer, SymPy and diff, MathML and the docs check), and no module lists built-ins but the
-modules of entries and the Mathcad importer's map of Mathcad's names (checked here)."""
+modules of entries and the importers' lists of what is the other product's own (checked
+here)."""
 
 from __future__ import annotations
 
@@ -30,9 +31,10 @@ from workbook.outputs.report.mathml import MathML
 
 PACKAGE = ROOT / "workbook"
 
-# The modules of registry entries (matrix.py: what the matrix entries compute, by name); and
-# the importers' maps of Mathcad's and Excel's names to the language's (data about those
-# products, checked against the registry below).
+# The modules of registry entries (matrix.py: what the matrix entries compute, by name); the
+# Mathcad importer's lists of Mathcad's own (the functions it refuses and why, those that count
+# from ORIGIN: Mathcad's names for the built-ins are the entries' ``mathcad`` field); and the
+# Excel importer's map of Excel's names (checked against the registry below).
 HOMES = {
     "functions/builtins.py",
     "functions/distributions.py",
@@ -46,8 +48,6 @@ HOMES = {
 # Lists of built-in names that are still kept elsewhere, each exactly as it is now, so that a
 # new list, or a built-in added to one of these, fails: (module, the built-ins listed).
 KNOWN_ELSEWHERE = {
-    # Mathcad's operators that bind a variable, as the importer translates them
-    ("mathcad/trees.py", ("diff", "integral", "product", "sum")),
     # the sizes read from a matrix written out while importing (its elements may call
     # functions whose units are settled only at the end of the translation)
     ("mathcad/engine.py", ("cols", "length", "rows")),

@@ -215,14 +215,17 @@ _simple(
     angle=True,
     **_TRIG,
     **_complex("IMSIN"),
+    mathcad=("sin",),
 )
 _simple(
     "cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", mpmath="cos", angle=True,
     interval=(ia.cos, ia.minus_sin), **_TRIG, **_complex("IMCOS"),
+    mathcad=("cos",),
 )  # fmt: skip
 _simple(
     "tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", mpmath="tan", angle=True,
     singular=_cosine, interval=(ia.tan, ia.tan_slope), **_TRIG, **_classic(im_tan),
+    mathcad=("tan",),
 )  # fmt: skip
 
 
@@ -243,6 +246,7 @@ for _name, _of, _excel, _what in (
         lambda sp, x, name=_name: getattr(sp, name)(x),
         f"{_what}, 1/{_excel.lower()}(x)",
         mpmath=_name,
+        mathcad=(_name,),
         **_TRIG,
     )
 _simple(
@@ -254,6 +258,7 @@ _simple(
     domain=_inverse_domain("asin"),
     mpmath="asin",
     mathml=mathml_call("arcsin"),
+    mathcad=("asin",),
 )
 _simple(
     "acos",
@@ -264,6 +269,7 @@ _simple(
     domain=_inverse_domain("acos"),
     mpmath="acos",
     mathml=mathml_call("arccos"),
+    mathcad=("acos",),
 )
 _simple(
     "atan",
@@ -274,6 +280,7 @@ _simple(
     mathml=mathml_call("arctan"),
     mpmath="atan",
     interval=(ia.atan, ia.atan_slope),
+    mathcad=("atan",),
 )
 _simple(
     "atan2",
@@ -283,6 +290,7 @@ _simple(
     "angle of the point (x, y), x first: atan2(x, y)",
     rule=_atan2_unit,
     arity=2,
+    mathcad=("atan2", "angle"),
 )
 _simple(
     "sinh",
@@ -294,6 +302,7 @@ _simple(
     interval=(ia.sinh, ia.cosh),
     **_TRIG,
     **_classic(im_sinh),
+    mathcad=("sinh",),
 )
 _simple(
     "cosh",
@@ -305,6 +314,7 @@ _simple(
     interval=(ia.cosh, ia.sinh),
     **_TRIG,
     **_classic(im_cosh),
+    mathcad=("cosh",),
 )
 _simple(
     "tanh",
@@ -317,6 +327,7 @@ _simple(
     **_TRIG,
     complex="complex",
     complex_excel=classic(im_tanh),
+    mathcad=("tanh",),
 )
 _simple(
     "sqrt",
@@ -331,10 +342,13 @@ _simple(
     singular=_argument,
     interval=(ia.sqrt, ia.sqrt_slope),
     **_complex("IMSQRT"),
+    mathcad=("sqrt",),
+    mathcad_operator="sqrt",
 )
 _simple(
     "exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", mpmath="exp",
     interval=(ia.exp, ia.exp), **_complex("IMEXP"),
+    mathcad=("exp",),
 )  # fmt: skip
 _simple(
     "ln",
@@ -347,6 +361,7 @@ _simple(
     singular=_argument,
     interval=(ia.ln, ia.reciprocal),
     **_complex("IMLN"),
+    mathcad=("ln",),
 )
 _simple(
     "log10",
@@ -360,6 +375,7 @@ _simple(
     interval=(ia.log10, ia.log10_slope),
     **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
+    mathcad=("log",),
 )
 _simple(
     "abs",
@@ -374,10 +390,13 @@ _simple(
     complex="real",
     complex_excel=im_call("IMABS"),
     kinks=_argument_kink,
+    mathcad=("abs",),
+    mathcad_operator="absval",
 )
 _simple(
     "sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit, mpmath="sign",
     kinks=_argument_kink,
+    mathcad=("sign",),
 )  # fmt: skip
 
 
@@ -417,6 +436,7 @@ register(
         mathml=mathml_fence("\u230a", "\u230b"),
         mpmath="floor",
         jumps=_integer_jumps,
+        mathcad=("floor",),
     )
 )
 register(
@@ -431,6 +451,7 @@ register(
         mathml=mathml_fence("\u2308", "\u2309"),
         mpmath="ceil",
         jumps=_integer_jumps,
+        mathcad=("ceil",),
     )
 )
 
@@ -456,6 +477,7 @@ _simple(
     domain=(Domain("mod by zero", lambda v: v == 0, "mod(x, {})", arg=1),),
     arity=2,
     jumps=_mod_jumps,
+    mathcad=("mod",),
 )
 
 
@@ -505,6 +527,7 @@ _simple(
     ),
     arity=(1, 2),
     jumps=_half_jumps,
+    mathcad=("round",),
 )
 _simple(
     "trunc",
@@ -514,6 +537,7 @@ _simple(
     "integer part, toward zero (x a plain number)",
     rule=_integer_unit,
     jumps=_integer_jumps,
+    mathcad=("trunc",),
 )
 
 # -- sum(EXPR, I, A, B): a built-in that binds a variable ------------------------------------
@@ -636,5 +660,6 @@ register(
         complex_excel=_sum_excel,
         mathml="<munderover><mo>\u2211</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
         arrays=True,
+        mathcad_operator="summation",
     )
 )

@@ -194,6 +194,7 @@ _entry(
     lambda sp, z: sp.re(z),
     "the real part of a complex number",
     "real",
+    mathcad=("Re",),
 )
 _entry(
     "Im",
@@ -203,6 +204,7 @@ _entry(
     lambda sp, z: sp.im(z),
     "the imaginary part of a complex number",
     "real",
+    mathcad=("Im",),
 )
 _entry(
     "arg",
@@ -212,6 +214,7 @@ _entry(
     lambda sp, z: sp.arg(z),
     "the angle of a complex number, -pi < arg(z) <= pi (in radians)",
     "real",
+    mathcad=("arg",),
 )
 _entry(
     "conj",

@@ -105,6 +105,7 @@ entry(
     lambda m, shapes: cholesky(m),
     not_live("a Cholesky factor has no spreadsheet formula"),
     "cholesky(M): the lower triangular L with L L^T = M, M symmetric positive definite",
+    mathcad=("cholesky",),
 )
 entry(
     "qr",

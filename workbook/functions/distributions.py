@@ -270,6 +270,7 @@ def _register() -> None:
                     _domains(family, kind, name, params),
                     doc=f"{name}({first}, {params}): the {_WHAT[kind].format(family)} of the "
                     f"{what} (Mathcad's {name})",
+                    mathcad=(name,),
                 )
             )
 

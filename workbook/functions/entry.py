@@ -91,6 +91,13 @@ class Builtin:
     # the interval enclosures of a one-argument built-in and of its derivative (functions.
     # interval_arith): root counts, certified extrema and integrands' features read them
     interval: tuple[Callable, Callable] | None = None
+    # Mathcad's names of this built-in (Mathcad 15 and Prime: log10 is Mathcad's ``log``), the
+    # operator element Mathcad writes it as (``absval``, ``summation``), and Mathcad's argument
+    # positions in the order the language takes them (None: the same): the Mathcad importer
+    # reads them
+    mathcad: tuple[str, ...] = ()
+    mathcad_operator: str = ""
+    mathcad_order: tuple[int, ...] | None = None
 
     @property
     def of_numbers(self) -> bool:

@@ -119,7 +119,8 @@ def not_live(why: str):
     return printed
 
 
-def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, complex="", estimate=""):
+def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, complex="", **fields):
+    """A built-in of vectors and matrices (``fields``: the entry's other fields, by name)."""
     register(
         Builtin(
             name,
@@ -132,8 +133,8 @@ def entry(name, arity, rule, numpy, excel, doc, runtime=None, sizes=False, compl
             arrays=True,
             runtime=runtime,
             sizes=sizes,
-            estimate=estimate,
             complex=complex,
+            **fields,
         )
     )
 
@@ -201,6 +202,8 @@ entry(
     "rows and columns swapped",
     runtime=rt_transpose,
     complex="complex",
+    mathcad=("transpose",),
+    mathcad_operator="transpose",
 )
 entry(
     "det",
@@ -211,6 +214,8 @@ entry(
     "determinant of a square matrix",
     estimate="condition",
     complex="complex",
+    mathcad=("det",),
+    mathcad_operator="determinant",
 )
 entry(
     "inverse",
@@ -231,6 +236,7 @@ entry(
     "solution x of M x = v",
     estimate="condition",
     complex="complex",
+    mathcad=("lsolve",),
 )
 
 
@@ -310,6 +316,7 @@ entry(
     lambda m, shapes: rank(m),
     not_live("the rank of a matrix has no spreadsheet formula"),
     "rank of a matrix (the number of independent rows)",
+    mathcad=("rank",),
 )
 
 
@@ -352,6 +359,7 @@ entry(
     lambda m, shapes: factorizations.lu(m),
     not_live("an LU factorization has no spreadsheet formula"),
     "lu(M): augment(P, L, U) with P M = L U (Mathcad's lu: Crout's method, its pivots)",
+    mathcad=("lu",),
 )
 entry(
     "rref",
@@ -360,6 +368,7 @@ entry(
     lambda m, shapes: factorizations.rref(m),
     not_live("the reduced row echelon form has no spreadsheet formula"),
     "rref(M): the reduced row echelon form of M",
+    mathcad=("rref",),
 )
 entry(
     "geninv",
@@ -368,6 +377,7 @@ entry(
     lambda m, shapes: factorizations.geninv(m, SINGULAR_COND),
     not_live("the generalized inverse has no spreadsheet formula"),
     "geninv(M): the left inverse of a matrix of independent columns (Mathcad's geninv)",
+    mathcad=("geninv",),
 )
 
 
@@ -426,7 +436,10 @@ for name, rule, hook, excel, doc in (
     ("Rank", r_rank, samples.rank, not_live("ranks are written as values"),
      "Rank(v): the rank of each element, 1 for the smallest, ties sharing their mean rank"),
 ):  # fmt: skip
-    entry(name, len(inspect.signature(hook).parameters), rule, _hook(hook), excel, doc)
+    # each is Mathcad's function of its name (fit_slope and fit_intercept: slope, intercept)
+    mathcad = (name.removeprefix("fit_"),)
+    entry(name, len(inspect.signature(hook).parameters), rule, _hook(hook), excel, doc,
+          mathcad=mathcad)  # fmt: skip
 
 
 # norms, condition numbers, trace, diagonal, singular values (workbook.functions.norms)
@@ -478,6 +491,7 @@ for kind, what in (
         norm_hook(kind),
         not_live(f"norm{kind}() {values}"),
         f"norm{kind}(M): the {what} of M",
+        mathcad=(f"norm{kind}",),
     )
 for kind, what in (("1", "norm1"), ("2", "norm2"), ("e", "Frobenius norm"), ("i", "normi")):
     entry(
@@ -487,6 +501,7 @@ for kind, what in (("1", "norm1"), ("2", "norm2"), ("e", "Frobenius norm"), ("i"
         cond_hook(kind),
         not_live(f"cond{kind}() {values}"),
         f"cond{kind}(M): the condition number of M in the {what} (singular: an error)",
+        mathcad=(f"cond{kind}",),
     )
 entry(
     "tr",
@@ -495,6 +510,7 @@ entry(
     lambda m, shapes: norms.trace(m),
     not_live(f"tr() {values}"),
     "tr(M): the trace of a square matrix (the sum of its diagonal)",
+    mathcad=("tr",),
 )
 entry(
     "diag",
@@ -503,10 +519,11 @@ entry(
     lambda m, shapes: norms.diag(m),
     not_live(f"diag() {values}"),
     "diag(v): the diagonal matrix of a vector; diag(M): the diagonal of a square matrix",
+    mathcad=("diag",),
 )
 entry("svds", 1, r_svds, lambda m, shapes: norms.singular_values(m),
       not_live(f"svds() {values}"),
-      "svds(M): the singular values of M, largest first")  # fmt: skip
+      "svds(M): the singular values of M, largest first", mathcad=("svds",))  # fmt: skip
 
 
 def r_polyroots(columns: int):
@@ -527,6 +544,8 @@ entry(
     not_live("the roots of a polynomial have no spreadsheet formula"),
     "polyroots(v): the roots of v[0] + v[1]*x + ... + v[n]*x^n, ascending (real ones only)",
     complex="complex",
+    mathcad=("polyroots",),
+    mathcad_operator="polyroots",
 )
 entry(
     "polyrootparts",
@@ -572,6 +591,7 @@ entry(
     not_live("a histogram has no spreadsheet formula here"),
     "histogram(n, data) or histogram(intervals, data): rows (midpoint, count) of each "
     "interval (Mathcad's histogram)",
+    mathcad=("histogram",),
 )
 
 
@@ -611,6 +631,8 @@ entry(
     lambda a, b, shapes: cross(a, b),
     x_cross,
     "cross product of two vectors of 3",
+    mathcad=("cross",),
+    mathcad_operator="crossProduct",
 )
 entry(
     "dot",
@@ -628,6 +650,7 @@ entry(
     call("SQRT", "SUMSQ({})"),
     "length (Euclidean norm) of a vector; of a matrix, the square root of the sum of the "
     "squares of its elements (Frobenius)",
+    mathcad=("norme",),
 )
 
 
@@ -694,6 +717,7 @@ entry(
     not_live("augment() is written as values"),
     "matrices side by side (same rows)",
     runtime=rt_same_unit,
+    mathcad=("augment",),
 )
 entry(
     "stack",
@@ -703,6 +727,7 @@ entry(
     not_live("stack() is written as values"),
     "matrices one above the other (same columns)",
     runtime=rt_same_unit,
+    mathcad=("stack",),
 )
 
 
@@ -767,6 +792,7 @@ entry(
     not_live("submatrix() is written as values"),
     "submatrix(M, first row, last row, first column, last column)",
     runtime=rt_with_origin("same"),
+    mathcad=("submatrix",),
 )
 
 
@@ -795,6 +821,7 @@ entry(
     not_live("csort() is written as values"),
     "csort(M, j): the rows of M sorted by column j, smallest first (Mathcad's csort)",
     runtime=rt_with_origin("same"),
+    mathcad=("csort",),
 )
 
 
@@ -833,6 +860,7 @@ for kind, doc in (
         runtime=rt_with_origin("plain"),
         sizes=True,
         complex="real",
+        mathcad=(kind,),
     )
 
 
@@ -886,6 +914,7 @@ for kind, excel_name, doc in (
             arrays=True,
             runtime=r_reduce,
             kinks=_kink_where_equal,
+            mathcad=(kind,),
         )
     )
 entry(
@@ -896,6 +925,7 @@ entry(
     _excel_list("AVERAGE"),
     "mean of the arguments (or of the elements of vectors and matrices)",
     runtime=r_reduce,
+    mathcad=("mean",),
 )
 
 
@@ -916,6 +946,7 @@ entry(
     not_live("sort() is written as values"),
     "the elements of a vector, smallest first",
     runtime=rt_same_unit,
+    mathcad=("sort",),
 )
 entry(
     "reverse",
@@ -925,6 +956,7 @@ entry(
     not_live("reverse() is written as values"),
     "the elements of a vector, or the rows of a matrix, in reverse order",
     runtime=rt_same_unit,
+    mathcad=("reverse",),
 )
 entry(
     "rsort",
@@ -934,6 +966,7 @@ entry(
     not_live("rsort() is written as values"),
     "rsort(M, i): the columns of M sorted by row i, smallest first (Mathcad's rsort)",
     runtime=rt_with_origin("same"),
+    mathcad=("rsort",),
 )
 
 
@@ -966,6 +999,7 @@ entry(
     lambda n, shapes: np.eye(int(n)),
     x_identity,
     "identity(n): the n x n identity matrix (n known at load)",
+    mathcad=("identity",),
 )
 
 
@@ -989,4 +1023,5 @@ for kind, rule, excel_name, doc in (
         _excel_list(excel_name),
         f"{doc} of the arguments (or of the elements of vectors and matrices)",
         runtime=rule,
+        mathcad=(kind,),
     )

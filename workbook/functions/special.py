@@ -120,16 +120,20 @@ _WHOLE_ORDER = "an order that is not a whole number"
 _ONE = (
     ("gamma", gamma, _excel("GAMMA"), lambda sp, x: sp.gamma(x),
      (Domain("gamma at a pole (0, -1, -2, ...)", _pole, "gamma({})"),),
-     "gamma(x): the gamma function, gamma(n + 1) = n! (Mathcad's Γ)"),
+     "gamma(x): the gamma function, gamma(n + 1) = n! (Mathcad's Γ)",
+     # Γ(a, x), the incomplete gamma function, is not translated: its first argument only
+     {"mathcad": ("Γ",), "mathcad_order": (0,)}),
     ("erf", lambda x: _special().erf(x), _excel("ERF"),
      lambda sp, x: sp.erf(x), (),
-     "erf(x): the error function, 2/sqrt(pi) times the integral of exp(-t^2) from 0 to x"),
+     "erf(x): the error function, 2/sqrt(pi) times the integral of exp(-t^2) from 0 to x",
+     {"mathcad": ("erf",)}),
     ("erfc", lambda x: _special().erfc(x), _excel("ERFC"), lambda sp, x: sp.erfc(x), (),
-     "erfc(x): the complementary error function, 1 - erf(x)"),
+     "erfc(x): the complementary error function, 1 - erf(x)", {"mathcad": ("erfc",)}),
     ("factorial", factorial, _excel("FACT"), lambda sp, n: sp.factorial(n),
      (Domain("factorial of a number that is not a whole number >= 0", _negative_or_not_whole,
              "factorial({})"),),
-     "factorial(n): n! = 1 * 2 * ... * n of a whole number n >= 0 (Mathcad's operator n!)"),
+     "factorial(n): n! = 1 * 2 * ... * n of a whole number n >= 0 (Mathcad's operator n!)",
+     {"mathcad_operator": "factorial"}),
 )  # fmt: skip
 
 _TWO = (
@@ -156,10 +160,13 @@ def _count_domains(name: str) -> tuple[Domain, ...]:
 
 
 def _register() -> None:
-    for name, numpy, excel, sympy, domain, doc in _ONE:
-        register(Builtin(name, 1, _plain_numbers, numpy, excel, sympy, domain, doc))
-    for name, numpy, excel, sympy, doc in _TWO:
-        register(Builtin(name, 2, _plain_numbers, numpy, excel, sympy, _count_domains(name), doc))
+    for name, numpy, excel, sympy, domain, doc, mathcad in _ONE:
+        register(Builtin(name, 1, _plain_numbers, numpy, excel, sympy, domain, doc, **mathcad))
+    for name, numpy, excel, sympy, doc in _TWO:  # Mathcad's functions of the same names
+        register(
+            Builtin(name, 2, _plain_numbers, numpy, excel, sympy, _count_domains(name), doc,
+                    mathcad=(name,))
+        )  # fmt: skip
     for kind, excel, sympy_name, what in _BESSEL:
         name = f"bessel_{kind}"
         domain = [Domain(f"{name} of {_WHOLE_ORDER}", _not_whole, f"{name}({{}}, x)", arg=0)]
@@ -175,6 +182,7 @@ def _register() -> None:
                 lambda sp, n, x, f=sympy_name: getattr(sp, f)(n, x),
                 tuple(domain),
                 f"{name}(n, x): the Bessel function {what}, n a whole number",
+                mathcad=(f"{kind.upper()}n",),  # Jn, Yn, In, Kn
             )
         )
 

@@ -83,6 +83,7 @@ register(
         _no_sympy("concat"),
         doc="concat(S1, S2, ...): the texts joined (Mathcad's concat)",
         texts=True,
+        mathcad=("concat",),
     )
 )
 register(
@@ -95,6 +96,7 @@ register(
         _no_sympy("num2str"),
         doc="num2str(x): the number x as a text, 15 significant digits (Mathcad's num2str)",
         texts=True,
+        mathcad=("num2str",),
     )
 )
 
@@ -177,6 +179,7 @@ register(
         _no_sympy("strlen"),
         doc="strlen(S): the number of characters of the text S (Mathcad's strlen, Excel's LEN)",
         texts=True,
+        mathcad=("strlen",),
     )
 )
 register(
@@ -190,6 +193,7 @@ register(
         doc="substr(S, m, n): at most n characters of S from position m, the first 0 "
         "(Mathcad's substr; Excel's MID(S, m + 1, n))",
         texts=True,
+        mathcad=("substr",),
     )
 )
 

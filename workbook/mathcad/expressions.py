@@ -12,6 +12,7 @@ from . import names as nm
 from . import trees as tt
 from .context import TranslatorContext
 from .functions import (
+    BINDERS,
     FIXED_ORDER,
     MATHCAD_FUNCTIONS,
     OPERATOR_FUNCTIONS,
@@ -155,7 +156,7 @@ class ExprTranslator(Visitor):
             return self._index(args)
         if tag == "matcol" and len(args) == 2:
             return self._column(args)
-        if tag in tt.BINDERS:
+        if tag in BINDERS:
             return self._binder(tag, args)
         if tag == "vectorize" and len(args) == 1:
             return self._vectorize(self.value(args[0]))
@@ -242,7 +243,7 @@ class ExprTranslator(Visitor):
         return tree, ex.Name(sym.token())
 
     def _binder(self, tag: str, args: list[MNode]) -> ex.Node:
-        name = tt.BINDERS[tag]
+        name = BINDERS[tag]
         lam = next((a for a in args if a.tag == "lambda"), None)
         bounds = next((a for a in args if a.tag == "bounds"), None)
         if lam is None or len(lam.children) != 2:

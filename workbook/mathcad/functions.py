@@ -1,63 +1,35 @@
-"""Mathcad's built-in functions, as data: each maps one to one onto a language built-in.
+"""Mathcad's built-in functions and operators, read from the language's registry: an entry
+names the Mathcad functions it is (``mathcad``), the operator element Mathcad writes it as
+(``mathcad_operator``) and Mathcad's argument order (``mathcad_order``). Here is only what is
+Mathcad's own: its solve-block functions, fixed-order Bessel functions, the functions refused
+and why, the writers, the functions that count from ORIGIN.
 
-``name: (language name, argument order)``; the order lists Mathcad's argument positions in
-the order the language takes them (None: Mathcad's order, as ``atan2(x, y)``, x first in
-both). A Mathcad function whose language name is not (yet) a built-in of the language is
-reported as not translated, never dropped.
+A Mathcad function that is no built-in of the language is reported as not translated, never
+dropped.
 """
 
 from __future__ import annotations
 
+from ..functions.registry import REGISTRY
+
+#: ``name: (language name, argument order)``; the order lists Mathcad's argument positions in
+#: the order the language takes them (None: Mathcad's order, as ``atan2(x, y)``, x first in
+#: both). Find, Maximize and Minimize end a solve block (workbook.mathcad.solving): no
+#: built-ins of the language.
 MATHCAD_FUNCTIONS: dict[str, tuple[str, tuple[int, ...] | None]] = {
-    "sin": ("sin", None), "cos": ("cos", None), "tan": ("tan", None),
-    "asin": ("asin", None), "acos": ("acos", None), "atan": ("atan", None),
-    "atan2": ("atan2", None), "angle": ("atan2", None),
-    "sinh": ("sinh", None), "cosh": ("cosh", None), "tanh": ("tanh", None),
-    "exp": ("exp", None), "ln": ("ln", None), "log": ("log10", None),
-    "sqrt": ("sqrt", None), "abs": ("abs", None), "sign": ("sign", None),
-    "floor": ("floor", None), "ceil": ("ceil", None), "min": ("min", None),
-    "max": ("max", None), "mod": ("mod", None), "round": ("round", None),
-    "trunc": ("trunc", None),
-    "sec": ("sec", None), "csc": ("csc", None), "cot": ("cot", None),
-    # numerical methods and arrays (built-ins of the language once they exist)
-    "root": ("root", None), "linterp": ("linterp", None), "interp": ("interp", None),
-    "lspline": ("lspline", None), "pspline": ("pspline", None), "cspline": ("cspline", None),
-    "Find": ("find", None), "Maximize": ("maximize", None), "Minimize": ("minimize", None),
-    "length": ("length", None), "rows": ("rows", None), "cols": ("cols", None),
-    "last": ("last", None), "transpose": ("transpose", None), "det": ("det", None),
-    "stack": ("stack", None), "augment": ("augment", None), "submatrix": ("submatrix", None),
-    "identity": ("identity", None), "mean": ("mean", None), "stdev": ("stdev", None),
-    "var": ("var", None), "median": ("median", None),
-    "norme": ("norm", None), "cross": ("cross", None), "lsolve": ("lsolve", None),
-    "csort": ("csort", None), "rsort": ("rsort", None), "sort": ("sort", None),
-    "reverse": ("reverse", None),
-    "rank": ("rank", None), "polyroots": ("polyroots", None),
-    "lu": ("lu", None), "rref": ("rref", None), "geninv": ("geninv", None),
-    "Var": ("Var", None), "Stdev": ("Stdev", None), "corr": ("corr", None),
-    "cvar": ("cvar", None), "slope": ("fit_slope", None), "intercept": ("fit_intercept", None),
-    "skew": ("skew", None), "kurt": ("kurt", None), "gmean": ("gmean", None),
-    "hmean": ("hmean", None), "Rank": ("Rank", None),
-    "norm1": ("norm1", None), "norm2": ("norm2", None), "normi": ("normi", None),
-    "cond1": ("cond1", None), "cond2": ("cond2", None), "conde": ("conde", None),
-    "condi": ("condi", None), "tr": ("tr", None), "diag": ("diag", None),
-    "svds": ("svds", None),
-    "histogram": ("histogram", None), "concat": ("concat", None), "num2str": ("num2str", None),
-    # probability distributions (workbook.functions.distributions)
-    "dnorm": ("dnorm", None), "pnorm": ("pnorm", None), "qnorm": ("qnorm", None),
-    "dt": ("dt", None), "pt": ("pt", None), "qt": ("qt", None),
-    "dchisq": ("dchisq", None), "pchisq": ("pchisq", None), "qchisq": ("qchisq", None),
-    "pF": ("pF", None), "qF": ("qF", None),
-    "dexp": ("dexp", None), "pexp": ("pexp", None), "qexp": ("qexp", None),
-    "dunif": ("dunif", None), "punif": ("punif", None), "qunif": ("qunif", None),
-    # special functions (workbook.functions.special) and decompositions; Γ(a, x), the
-    # incomplete gamma function, is not translated (one argument only)
-    "Γ": ("gamma", (0,)), "erf": ("erf", None), "erfc": ("erfc", None),
-    "Jn": ("bessel_j", None), "Yn": ("bessel_y", None), "In": ("bessel_i", None),
-    "Kn": ("bessel_k", None), "combin": ("combin", None), "permut": ("permut", None),
-    "cholesky": ("cholesky", None),
-    # complex numbers (docs/language.md, Complex numbers)
-    "Re": ("Re", None), "Im": ("Im", None), "arg": ("arg", None),
-}  # fmt: skip
+    name: (entry.name, entry.mathcad_order) for entry in REGISTRY.values() for name in entry.mathcad
+} | {"Find": ("find", None), "Maximize": ("maximize", None), "Minimize": ("minimize", None)}
+
+#: Mathcad's operators written as elements (``<ml:sqrt/>``, ``<ml:absval/>``) and their
+#: built-in: of one operand, of two, and those that bind a variable (summation, integral)
+_OPERATORS = [e for e in REGISTRY.values() if e.mathcad_operator]
+BINDERS: dict[str, str] = {e.mathcad_operator: e.name for e in _OPERATORS if e.binds}
+OPERATOR_FUNCTIONS: dict[str, str] = {
+    e.mathcad_operator: e.name for e in _OPERATORS if not e.binds and e.arity == 1
+}
+OPERATOR_FUNCTIONS_2: dict[str, str] = {
+    e.mathcad_operator: e.name for e in _OPERATORS if not e.binds and e.arity == 2
+}
 
 #: Mathcad's Bessel functions of a fixed order: ``J0(x)`` is ``bessel_j(0, x)``.
 FIXED_ORDER: dict[str, tuple[str, int]] = {
@@ -115,20 +87,7 @@ ORIGIN_FUNCTIONS: frozenset[str] = frozenset(
     {"submatrix", "last", "csort", "rsort", "lookup", "hlookup", "vlookup", "match"}
 )
 
-#: Mathcad operators written as elements (``<ml:sqrt/>``) and their built-in.
-OPERATOR_FUNCTIONS: dict[str, str] = {
-    "sqrt": "sqrt", "absval": "abs", "transpose": "transpose",
-    "determinant": "det",  # |M| written as the determinant operator
-    "polyroots": "polyroots",  # the keyword form (its method: the roots are the same)
-    "factorial": "factorial",  # n!
-}  # fmt: skip
-
-#: Mathcad operators of two operands written as elements, and their built-in
-OPERATOR_FUNCTIONS_2: dict[str, str] = {"crossProduct": "cross"}
-
 
 def language_functions() -> set[str]:
     """The built-in function names of the language (its registry)."""
-    from ..functions.registry import REGISTRY
-
     return set(REGISTRY)

@@ -24,12 +24,6 @@ COMPARE = {
     "greaterOrEqual": ">=",
     "notEqual": "!=",
 }
-BINDERS = {
-    "summation": "sum",
-    "product": "product",
-    "integral": "integral",
-    "derivative": "diff",
-}
 
 
 def shows_array(evaluation: MNode) -> bool:

@@ -531,6 +531,7 @@ register(
         live_note="60 bisection steps on the sheet 'Solver steps' (in a table, a chain per table "
         "row on 'Solver rows'; #N/A when f(A) and f(B) have the same sign; with more than one "
         "root in [A, B] it may find another one than the engine)",
+        mathcad=("root",),
     )
 )
 register(
@@ -547,6 +548,7 @@ register(
         live_note="a 20-point Gauss-Legendre sum (SUMPRODUCT over constant nodes)",
         mathml="<msubsup><mo>\u222b</mo>{2}{3}</msubsup>{0:group}<mo>\u2062</mo>"
         "<mi mathvariant='normal'>d</mi>{1}",
+        mathcad_operator="integral",
     )
 )
 
@@ -604,6 +606,7 @@ register(
         estimate="iterative",
         mathml="<mfrac><mi mathvariant='normal'>d</mi><mrow><mi mathvariant='normal'>d</mi>{1}"
         "</mrow></mfrac>{0:group}",
+        mathcad_operator="derivative",
     )
 )
 register(
@@ -618,6 +621,7 @@ register(
         binds=(0, 1),
         estimate="iterative",
         mathml="<munderover><mo>\u220f</mo><mrow>{1}<mo>=</mo>{2}</mrow>{3}</munderover>{0:group}",
+        mathcad_operator="product",
     )
 )
 
@@ -769,6 +773,7 @@ for _ends, _name in _SPLINES.items():
             doc=f"{_name}(vx, vy): the second derivatives at the points of a cubic spline "
             f"through them with {_ends} ends, for interp (Mathcad's {_name})",
             data_args=(0, 1),
+            mathcad=(_name,),
         )
     )
 register(
@@ -782,6 +787,7 @@ register(
         doc="interp(vs, vx, vy, x): the spline of lspline, pspline or cspline(vx, vy) at x "
         "(Mathcad's interp)",
         data_args=(1, 2),
+        mathcad=("interp",),
     )
 )
 
@@ -803,5 +809,6 @@ for _kind, _name in _KINDS.items():
                 "cspline(vx, vy): that spline's second derivatives at the points, for interp"
             ),
             data_args=(0, 1),
+            mathcad=(_name,),
         )
     )
