@@ -33,8 +33,8 @@ PACKAGE = ROOT / "workbook"
 
 # The modules of registry entries (matrix.py: what the matrix entries compute, by name); the
 # Mathcad importer's lists of Mathcad's own (the functions it refuses and why, those that count
-# from ORIGIN: Mathcad's names for the built-ins are the entries' ``mathcad`` field); and the
-# Excel importer's map of Excel's names (checked against the registry below).
+# from ORIGIN: Mathcad's names for the built-ins are the entries' ``mathcad`` field, Excel's
+# and VBA's their ``excel_import`` and ``vba`` fields, checked against the registry below).
 HOMES = {
     "functions/builtins.py",
     "functions/distributions.py",
@@ -42,7 +42,6 @@ HOMES = {
     "functions/matrix_entries.py",
     "numerics/entries.py",
     "mathcad/functions.py",
-    "excelimport/functions.py",
 }
 
 # Lists of built-in names that are still kept elsewhere, each exactly as it is now, so that a

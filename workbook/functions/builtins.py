@@ -216,16 +216,20 @@ _simple(
     **_TRIG,
     **_complex("IMSIN"),
     mathcad=("sin",),
+    excel_import=("SIN",),
+    vba=("sin",),
 )
 _simple(
     "cos", np.cos, "COS", lambda sp, x: sp.cos(x), "cosine", mpmath="cos", angle=True,
     interval=(ia.cos, ia.minus_sin), **_TRIG, **_complex("IMCOS"),
     mathcad=("cos",),
+    excel_import=("COS",), vba=("cos",),
 )  # fmt: skip
 _simple(
     "tan", np.tan, "TAN", lambda sp, x: sp.tan(x), "tangent", mpmath="tan", angle=True,
     singular=_cosine, interval=(ia.tan, ia.tan_slope), **_TRIG, **_classic(im_tan),
     mathcad=("tan",),
+    excel_import=("TAN",), vba=("tan",),
 )  # fmt: skip
 
 
@@ -259,6 +263,7 @@ _simple(
     mpmath="asin",
     mathml=mathml_call("arcsin"),
     mathcad=("asin",),
+    excel_import=("ASIN",),
 )
 _simple(
     "acos",
@@ -270,6 +275,7 @@ _simple(
     mpmath="acos",
     mathml=mathml_call("arccos"),
     mathcad=("acos",),
+    excel_import=("ACOS",),
 )
 _simple(
     "atan",
@@ -281,6 +287,8 @@ _simple(
     mpmath="atan",
     interval=(ia.atan, ia.atan_slope),
     mathcad=("atan",),
+    excel_import=("ATAN",),
+    vba=("atn",),
 )
 _simple(
     "atan2",
@@ -291,6 +299,7 @@ _simple(
     rule=_atan2_unit,
     arity=2,
     mathcad=("atan2", "angle"),
+    excel_import=("ATAN2",),
 )
 _simple(
     "sinh",
@@ -303,6 +312,7 @@ _simple(
     **_TRIG,
     **_classic(im_sinh),
     mathcad=("sinh",),
+    excel_import=("SINH",),
 )
 _simple(
     "cosh",
@@ -315,6 +325,7 @@ _simple(
     **_TRIG,
     **_classic(im_cosh),
     mathcad=("cosh",),
+    excel_import=("COSH",),
 )
 _simple(
     "tanh",
@@ -328,6 +339,7 @@ _simple(
     complex="complex",
     complex_excel=classic(im_tanh),
     mathcad=("tanh",),
+    excel_import=("TANH",),
 )
 _simple(
     "sqrt",
@@ -344,11 +356,14 @@ _simple(
     **_complex("IMSQRT"),
     mathcad=("sqrt",),
     mathcad_operator="sqrt",
+    excel_import=("SQRT",),
+    vba=("sqr",),
 )
 _simple(
     "exp", np.exp, "EXP", lambda sp, x: sp.exp(x), "exponential", mpmath="exp",
     interval=(ia.exp, ia.exp), **_complex("IMEXP"),
     mathcad=("exp",),
+    excel_import=("EXP",), vba=("exp",),
 )  # fmt: skip
 _simple(
     "ln",
@@ -362,6 +377,8 @@ _simple(
     interval=(ia.ln, ia.reciprocal),
     **_complex("IMLN"),
     mathcad=("ln",),
+    excel_import=("LN",),
+    vba=("log",),
 )
 _simple(
     "log10",
@@ -376,6 +393,7 @@ _simple(
     **_complex("IMLOG10"),
     mathml="<msub><mi>log</mi><mn>10</mn></msub><mo>\u2061</mo><mrow><mo>(</mo>{0}<mo>)</mo></mrow>",
     mathcad=("log",),
+    excel_import=("LOG10", "LOG"),
 )
 _simple(
     "abs",
@@ -392,11 +410,14 @@ _simple(
     kinks=_argument_kink,
     mathcad=("abs",),
     mathcad_operator="absval",
+    excel_import=("ABS",),
+    vba=("abs",),
 )
 _simple(
     "sign", np.sign, "SIGN", lambda sp, x: sp.sign(x), "-1, 0 or 1", _sign_unit, mpmath="sign",
     kinks=_argument_kink,
     mathcad=("sign",),
+    excel_import=("SIGN",), vba=("sgn",),
 )  # fmt: skip
 
 
@@ -437,6 +458,8 @@ register(
         mpmath="floor",
         jumps=_integer_jumps,
         mathcad=("floor",),
+        excel_import=("INT",),
+        vba=("int",),
     )
 )
 register(
@@ -528,6 +551,7 @@ _simple(
     arity=(1, 2),
     jumps=_half_jumps,
     mathcad=("round",),
+    excel_import=("ROUND",),
 )
 _simple(
     "trunc",
@@ -538,6 +562,8 @@ _simple(
     rule=_integer_unit,
     jumps=_integer_jumps,
     mathcad=("trunc",),
+    excel_import=("TRUNC",),
+    vba=("fix",),
 )
 
 # -- sum(EXPR, I, A, B): a built-in that binds a variable ------------------------------------

@@ -98,6 +98,11 @@ class Builtin:
     mathcad: tuple[str, ...] = ()
     mathcad_operator: str = ""
     mathcad_order: tuple[int, ...] | None = None
+    # Excel's worksheet functions and VBA's own functions that are this built-in, their
+    # arguments in the same order (Excel's LOG of one argument is log10, VBA's Log is ln): the
+    # Excel importer reads them
+    excel_import: tuple[str, ...] = ()
+    vba: tuple[str, ...] = ()
 
     @property
     def of_numbers(self) -> bool:

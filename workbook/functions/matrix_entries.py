@@ -915,6 +915,7 @@ for kind, excel_name, doc in (
             runtime=r_reduce,
             kinks=_kink_where_equal,
             mathcad=(kind,),
+            excel_import=(excel_name,),
         )
     )
 entry(
@@ -926,6 +927,7 @@ entry(
     "mean of the arguments (or of the elements of vectors and matrices)",
     runtime=r_reduce,
     mathcad=("mean",),
+    excel_import=("AVERAGE",),
 )
 
 
