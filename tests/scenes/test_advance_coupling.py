@@ -352,8 +352,10 @@ def test_default_solver_reaches_the_rigid_limit(sheet):
 
 @pytest.mark.slow
 def test_errors_fall_with_rtol_at_moderate_c2(sheet):
+    """The time budget of each run is a guard against a runaway, not a measure: wide enough
+    that a loaded machine (Radau at rtol 1e-9 took 5 s beside other work) gives the error."""
     p = variant(sheet, t_end=0.1)
-    df = cp.study(p, (1e6,), (1e-3, 1e-6, 1e-9), max_time=5.0, label=None)
+    df = cp.study(p, (1e6,), (1e-3, 1e-6, 1e-9), max_time=60.0, label=None)
     for m in oderun.SOLVERS:
         e = df[df["method"] == m].sort_values("rtol", ascending=False)["error [rad]"].to_numpy()
         assert e[-1] < e[0] / 100, (m, e)
