@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import NotLive  # noqa: F401 - raised by this back end, caught by the writer
+from ..errors import NotLive
 from ..functions import complexes, excel_names
 from ..functions.registry import CONSTANTS, REGISTRY
 from ..language import cellunit
