@@ -79,6 +79,7 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
     _collect_functions(tr, reserved)
     cells = _formula_cells(tr)
     tr.written = cells_written(modules, list(book.sheets))
+    book.sub_written = tr.written  # type: ignore[attr-defined]  # IS-functions' certainty
     parsed = {}
     for cell in cells:
         sub = tr.written.get(_key(cell))
@@ -711,6 +712,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 for c in range(ref.c1, ref.c2 + 1)
                 if not getattr(ref, "moved", False)
             ]
+            d.empty_cells = ft.out.empty_cells  # type: ignore[attr-defined]
         except FormulaProblem as exc:
             d.problem = str(exc)
         except Exception as exc:  # noqa: BLE001 - a formula the translation did not foresee
@@ -718,10 +720,32 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
         tr.definitions.append(d)
     _bound_inputs(tr, formula_keys)
     _spread_problems(tr, by_key)
+    _constant_inputs(tr, formula_keys)
+    if _empty_inputs(tr):
+        _spread_problems(tr, by_key)
     for d in tr.definitions:
         if d.problem:
             tr.listed.append((f"{d.cell.ref} ={d.cell.formula[:60]}", d.problem))
-    _constant_inputs(tr, formula_keys)
+
+
+def _empty_inputs(tr: Translation) -> bool:
+    """An IS-function's answer for an empty cell holds while the cell stays empty: where a
+    translated formula reads the cell too, it is an input, which may be given a value, and
+    the formula of the IS-function is listed (its input, if read by it alone, stays unused)."""
+    changed = False
+    for d in tr.definitions:
+        if d.problem:
+            continue
+        for k in getattr(d, "empty_cells", []):
+            name = tr.cell_names.get(k)
+            if name is not None and name in tr.inputs:
+                d.problem = (
+                    f"an IS-function of the empty cell {k[0]}!{_addr(k[1], k[2])}, which is an "
+                    "input of the worksheet (a value given to it would change the answer)"
+                )
+                changed = True
+                break
+    return changed
 
 
 def _bound_inputs(tr: Translation, formula_keys: set) -> None:

@@ -16,6 +16,7 @@ from .criteria import FUNCTIONS as CRITERIA
 from .criteria import criteria_function
 from .formula_terms import FormulaProblem, Ref, row_relative, text_problem
 from .functions import EXCEL, VOLATILE
+from .information import INFORMATION, information
 
 #: a prefix that calls into an add-in or another workbook: [1]!f( or 'Book.xlam'!f(
 _LINK = re.compile(
@@ -83,6 +84,8 @@ class FormulaText:
     text: str
     refs: list[Ref] = field(default_factory=list)
     udfs: set[str] = field(default_factory=set)  # lower-case VBA names called
+    # empty cells an IS-function's answer takes to stay empty (never an input of the sheet)
+    empty_cells: list = field(default_factory=list)
 
 
 class FormulaTranslator:
@@ -359,6 +362,8 @@ class FormulaTranslator:
             return f"not ({self.condition(args[0])})"
         if kind == "leaf" and name == "Number" and args.name.upper() in ("TRUE", "FALSE"):
             return "1 == 1" if args.name.upper() == "TRUE" else "1 == 0"
+        if kind == "fn" and name.upper() in INFORMATION:
+            return information(self, name.upper(), args)
         return f"{self.value(node, 3)} != 0"
 
     def function(self, name: str, args) -> str:
@@ -377,7 +382,7 @@ class FormulaTranslator:
                 raise FormulaProblem("IF without a value for FALSE")
             cond = self.condition(args[0])
             return f"({self.value(args[1], 1)} if {cond} otherwise {self.value(args[2], 1)})"
-        if upper in ("AND", "OR", "NOT"):
+        if upper in ("AND", "OR", "NOT") or upper in INFORMATION:
             return f"(1 if {self.condition(('fn', name, args))} otherwise 0)"
         if upper in AGGREGATES:
             return aggregate(self, upper, args)

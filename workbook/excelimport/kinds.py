@@ -153,6 +153,8 @@ def kind(ft, node, depth: int = 0) -> str | None:
         if id(node) in ft.tails and len(seen) == 1 and seen <= {"number", "text"}:
             return seen.pop()  # its value is of the kind Excel's cached value is
         return None
+    if upper in ("ISBLANK", "ISNUMBER", "ISTEXT", "ISNONTEXT", "ISLOGICAL", "ISERROR", "ISERR"):
+        return "bool"
     if upper in _NUMBER_FUNCTIONS:
         return "number"
     if upper in _TEXT_FUNCTIONS:
