@@ -50,8 +50,6 @@ def information(ft, upper: str, args) -> str:
         return _blank(ft, node)
     if upper in ("ISERROR", "ISERR"):
         return _error(ft, upper, node)
-    from .kinds import kind
-
     if _one_cell(ft, node) is not None:
         cell_kinds = _cell_kinds(ft, node)
         if cell_kinds == {"empty"}:
@@ -72,7 +70,7 @@ def information(ft, upper: str, args) -> str:
                 f"{upper} of a TRUE/FALSE cell (an input of the worksheet, which may be given a "
                 "number)"
             )
-    found = kind(ft, node)
+    found = _sure_kind(ft, node, 0)
     if found is None or found == "empty":
         raise FormulaProblem(f"{upper} of a value whose kind (number, text...) is not known")
     x = ft.value(node, 3)
@@ -93,6 +91,50 @@ def _error(ft, upper: str, node) -> str:
         ) from None
     x = ft.value(node, 3)
     return " or ".join([f"({e})" for e in dict.fromkeys(errors)] + [f"{x} != {x}"])
+
+
+def _sure_kind(ft, node, depth: int) -> str | None:
+    """The kind of value ``node`` always gives, from its form (never from a cached value: a
+    formula such as ``VLOOKUP`` may give a text where it gave a number): a number or text
+    written, arithmetic (a number), ``&`` (a text), a comparison (TRUE/FALSE), a function that
+    gives one kind; of a cell, a constant's own kind, a formula cell's by its formula's form
+    (in every row of a filled-down column); None where it is not sure."""
+    from .kinds import _NUMBER_FUNCTIONS, _TEXT_FUNCTIONS, cell_kind, kind
+
+    what, name, payload = node
+    if depth > 12:
+        return None
+    if what == "leaf" and name == "Range":
+        if _one_cell(ft, node) is None:
+            return None
+        kinds = set()
+        for key in _rows(ft, node):
+            cell = ft.book.cell(*key)
+            if cell is None or cell.formula is None:
+                kinds.add(cell_kind(cell))
+                continue
+            tree = getattr(ft.book, "trees", {}).get(key)
+            if tree is None or cell.array is not None:
+                return None
+            kinds.add(_sure_kind(_reader_of(ft, key[0]), tree, depth + 1))
+        return kinds.pop() if len(kinds) == 1 else None
+    if what == "leaf" or what == "op":
+        return kind(ft, node)
+    upper = name.upper()
+    if upper in _NUMBER_FUNCTIONS:
+        return "number"
+    if upper in _TEXT_FUNCTIONS:
+        return "text"
+    if upper in INFORMATION:
+        return "bool"
+    return None
+
+
+def _reader_of(ft, sheet: str):
+    """A translator of another cell's formula on ``sheet``, to read its form."""
+    from .kinds import _reader
+
+    return _reader(ft, sheet)
 
 
 def _one_cell(ft, node) -> tuple[str, int, int] | None:
