@@ -177,3 +177,15 @@ def derivative(var: str, body: str, degree: str | None = None) -> str:
     lam = f"<ml:lambda><ml:boundVars>{ident(var)}</ml:boundVars>{body}</ml:lambda>"
     order = f"<ml:degree>{degree}</ml:degree>" if degree is not None else ""
     return f"<ml:apply><ml:derivative/>{lam}{order}</ml:apply>"
+
+
+def prime_solve_block(rid: int, guesses: list[str], constraints: list[str], solver: str) -> str:
+    """A Prime solve block (region ``rid``): its guess values, constraints and solver regions
+    (ids and result references from ``rid + 1``), each a math body."""
+    parts = [("guess-value", g) for g in guesses] + [("constraint", c) for c in constraints]
+    inner = "".join(
+        f'<region region-id="{rid + k}" solve-block-category="{kind}">'
+        f'<math resultRef="{rid + k}">{body}</math></region>'
+        for k, (kind, body) in enumerate([*parts, ("solver", solver)], start=1)
+    )
+    return f'<region region-id="{rid}"><solveblock><regions>{inner}</regions></solveblock></region>'

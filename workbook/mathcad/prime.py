@@ -250,6 +250,7 @@ class _Regions:
             self.collect([r], collected)
             parts.setdefault(kind, []).extend(collected)
         given = Region(kind="math", math=MNode("id", {}, "Given", []), **self._base(el, ".given"))
+        given.guesses = [r.math for r in parts["guess-value"] if r.math is not None]
         out += parts["guess-value"] + [given] + parts["constraint"] + parts["solver"]
 
     def text(self, content) -> str:

@@ -53,6 +53,8 @@ class Region:
     outputs: list[MNode] = field(default_factory=list)  # components: the names they define
     component: dict[str, str] = field(default_factory=dict)  # components: their attributes
     areas: tuple = ()  # (top, left) of each area the region is inside, outermost first
+    # a Prime solve block's Given: the definitions of its guess values (they come before it)
+    guesses: list[MNode] = field(default_factory=list)
 
     def order(self) -> tuple:
         """Mathcad's reading order: an area's regions come together, at the area's place

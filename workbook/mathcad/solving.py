@@ -23,6 +23,7 @@ class SolveMixin:
                 self.skip(rid, "a region of a solve block (Given ... Find)", why)
         self.given = None
         self.constraints = []
+        self.guesses = []
 
     def find(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         """Find(x, ...) of a solve block: a [[solve]] block of the language (its unknowns are
@@ -41,6 +42,7 @@ class SolveMixin:
     def solve_block(self, et: ExprTranslator, args: list[MNode], method: str = "") -> ex.Node:
         if not args or any(a.tag != "id" for a in args):
             raise Untranslatable("Find of something that is not a list of names")
+        self.guesses_of_parameters(et)
         # Mathcad's chain a = b = c (a comparison whose left side is one, without brackets)
         # is two equations, a = b and b = c
         eqs = [
@@ -84,6 +86,25 @@ class SolveMixin:
         if len(names) == 1:
             return names[0]
         return ex.Matrix(tuple((n,) for n in names))
+
+    def guesses_of_parameters(self, et: ExprTranslator) -> None:
+        """A Prime solve block that is a function's body (``f(N, M) := Find(e, k)``) whose guess
+        values read the function's parameters (``k := M/(E*I)``): Prime computes them from each
+        call's arguments, and a [[solve]] block's guesses are constants, the same at every call
+        (from another guess the solver may reach another root): refused, with the guess named."""
+        params = {k: s for k, s in et.local.items() if s.kind == "param"}
+        for node in self.guesses:
+            if node.tag not in ("define", "globalDefine") or len(node.children) != 2:
+                continue
+            lhs, rhs = node.children
+            read = [_key(n) for n in tt.walk(rhs) if n.tag == "id" and _key(n) in params]
+            if read:
+                what = nm.mathcad_text(*_key(lhs)) if lhs.tag == "id" else "an unknown"
+                raise Untranslatable(
+                    f"a solve block that is a function's body whose guess of {what} reads the "
+                    f"function's parameter {nm.mathcad_text(*read[0])} (Prime computes it from "
+                    "each call's arguments; a [[solve]] block's guesses are constants)"
+                )
 
     def guess(self, et: ExprTranslator, name: MNode):
         """The value of the name ``name`` before a solve block (its guess), as the engine

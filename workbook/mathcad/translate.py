@@ -52,6 +52,7 @@ class Translator(ResultsMixin, SolveMixin):
         self.region = ""  # the region being translated
         self.given: list[str] | None = None  # regions of the open solve block
         self.constraints: list[MNode] = []
+        self.guesses: list[MNode] = []  # the open solve block's guess values (Prime's)
         self.origin = 0  # Mathcad's ORIGIN where the translation is
         self.sheet_origin = 0  # the worksheet's [sheet] origin
         self.writes = 0  # values written to a file (WRITEPRN and friends) so far
@@ -386,6 +387,7 @@ class Translator(ResultsMixin, SolveMixin):
             self.close_given("a solve block without Find")
             self.given = [region.id]
             self.constraints = []
+            self.guesses = region.guesses
         elif node.tag == "apply" and node.children and node.children[0].tag in tt.COMPARE:
             if self.given is None:  # a comparison shown outside a solve block: nothing
                 self.out.ignored.append(region.id)
