@@ -28,6 +28,11 @@ if Path(workbook.__file__).resolve().parent.parent == _SOURCE.resolve():
     )
 
 
+def pytest_collection(session):
+    """No collection while the tests are collected (what they import stays alive anyway)."""
+    gc.disable()
+
+
 def pytest_collection_finish(session):
     """What collection leaves alive (the libraries, the test modules and their tables) lives
     to the end of the run: frozen out of the garbage collector's sight, each full collection
@@ -36,6 +41,7 @@ def pytest_collection_finish(session):
     in the whole run without it, 0.05 s with it)."""
     gc.collect()
     gc.freeze()
+    gc.enable()
 
 
 @pytest.fixture(scope="session")
