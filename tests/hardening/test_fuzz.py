@@ -516,6 +516,7 @@ def test_chart_labels_are_never_references(tmp_path_factory, texts):
             assert not text.startswith("=") and "!" not in text
 
 
+@pytest.mark.slow
 @fuzz_settings(FAST_EXAMPLES)
 @given(cells=st.lists(labels(), min_size=1, max_size=8), dtype=st.sampled_from([object, "str"]))
 def test_csv_cells_never_run_and_never_forge_rows(tmp_path_factory, cells, dtype):

@@ -1033,6 +1033,7 @@ x = { unit = "" }
 """
 
 
+@pytest.mark.slow
 def test_diff_of_functions_nested_in_themselves_is_bounded(tmp_path, monkeypatch):
     # diff of ten such levels ran in SymPy for more than 60 s (3 levels: more than 120 s)
     from workbook.numerics import derivative

@@ -636,6 +636,7 @@ def test_an_element_set_of_a_number_local_makes_it_a_vector(tmp_path):
     assert workbook.load(path).evaluate("s").magnitude.ravel().tolist() == [0.0, 0.0, 7.0]
 
 
+@pytest.mark.slow
 def test_the_alarm_waits_for_an_import_to_finish(tmp_path, monkeypatch):
     # an alarm raised inside an import left the module half initialised in sys.modules: a
     # later command in the same process failed with an AttributeError (exit 3)

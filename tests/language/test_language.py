@@ -20,7 +20,15 @@ def test_the_reference_has_runnable_examples():
     assert len(RUNNABLE) >= 10
 
 
-@pytest.mark.parametrize("text", RUNNABLE, ids=[f"example{i}" for i in range(len(RUNNABLE))])
+#: an example that says it is slow (it runs to a limit) runs with the slow tests
+SLOW = "a slow test"
+
+
+@pytest.mark.parametrize(
+    "text",
+    [pytest.param(t, marks=pytest.mark.slow) if SLOW in t else t for t in RUNNABLE],
+    ids=[f"example{i}" for i in range(len(RUNNABLE))],
+)
 def test_example(tmp_path, text):
     path = tmp_path / "example.toml"
     path.write_text(text, encoding="utf-8")

@@ -330,6 +330,7 @@ def _untimed(html: str) -> str:
     return re.sub(r"<tr[^>]*>(?:(?!</tr>).)*\d steps,(?:(?!</tr>).)*</tr>", "", html, flags=re.S)
 
 
+@pytest.mark.slow
 def test_a_newcomers_sheet(tmp_path):
     from workbook.scaffold import write_starter
 

@@ -83,6 +83,7 @@ def test_edited_R3_gives_what_with_inputs_gives(tmp_path, generated, concave, ca
     )
 
 
+@pytest.mark.slow
 def test_a_changed_unit_is_converted(tmp_path, generated, concave):
     edited = edit(generated, tmp_path / "cm.xlsx", R3=(4.5, "cm"), omega=(1000, "rpm"))
     sheet = with_inputs_from(concave, edited)

@@ -338,6 +338,7 @@ def _reference_lift(phi_deg):
     return D * (mpmath.cos(x) - mpmath.sqrt(1 - k**2 * mpmath.sin(x) ** 2) / k) - (R1 + RP)
 
 
+@pytest.mark.slow
 def test_stability_of_the_lift(concave):
     df = concave.table("stability").set_index("phi [deg]")
     for phi in (1e-6, 1e-3, 1.0):

@@ -324,6 +324,7 @@ def test_fractional_roller_count_is_refused(sheet):
 # -- the symbolic converter -------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_derivatives_are_those_of_the_profile(sheet):
     """diff(x_t), diff(y_t), and the tangent of (5), against central differences."""
     phi, k, h = np.array([7.0, 33.0, 200.0]), np.array([1.0, 5.0, 11.0]), 1e-5
