@@ -47,7 +47,10 @@ def _serve(folder: Path) -> tuple[subprocess.Popen, str]:
         [
             sys.executable,
             "-c",
-            "import sys; from workbook.cli import main; sys.exit(main())",
+            # Ctrl-C as at a terminal: a test worker (pytest-xdist) or a shell that runs the
+            # tests in the background starts children with SIGINT ignored
+            "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+            "from workbook.cli import main; sys.exit(main())",
             "serve",
             str(folder),
             "--no-browser",
