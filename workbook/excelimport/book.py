@@ -37,6 +37,8 @@ class Definition:
     element: tuple[str, int] | None = None  # (array formula's name, k) of a cell of a block
     run: Run | None = None  # a filled-down column: the definition is a function of the row
     block: tuple[int, int] | None = None  # (rows, columns) of the array formula's cells
+    #: the empty cells an IS-function's answer takes to stay empty (never inputs of the sheet)
+    empty_cells: list = field(default_factory=list)
 
 
 @dataclass
@@ -79,7 +81,7 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
     _collect_functions(tr, reserved)
     cells = _formula_cells(tr)
     tr.written = cells_written(modules, list(book.sheets))
-    book.sub_written = tr.written  # type: ignore[attr-defined]  # IS-functions' certainty
+    book.sub_written = tr.written
     parsed = {}
     for cell in cells:
         sub = tr.written.get(_key(cell))
@@ -712,7 +714,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 for c in range(ref.c1, ref.c2 + 1)
                 if not getattr(ref, "moved", False)
             ]
-            d.empty_cells = ft.out.empty_cells  # type: ignore[attr-defined]
+            d.empty_cells = ft.out.empty_cells
         except FormulaProblem as exc:
             d.problem = str(exc)
         except Exception as exc:  # noqa: BLE001 - a formula the translation did not foresee
@@ -736,7 +738,7 @@ def _empty_inputs(tr: Translation) -> bool:
     for d in tr.definitions:
         if d.problem:
             continue
-        for k in getattr(d, "empty_cells", []):
+        for k in d.empty_cells:
             name = tr.cell_names.get(k)
             if name is not None and name in tr.inputs:
                 d.problem = (

@@ -60,10 +60,7 @@ def information(ft, upper: str, args) -> str:
                 f"{upper} of a cell that is empty in some rows of the filled-down column and "
                 "not in others"
             )
-        written = getattr(ft.book, "sub_written", {})
-        for key in _rows(ft, node):
-            if key in written:
-                raise FormulaProblem(f"{upper} of a cell that the macro Sub {written[key]} writes")
+        _not_written(ft, node, f"{upper} of a cell that the macro Sub {{sub}} writes")
         cell = ft.book.cell(*_one_cell(ft, node))
         if cell is not None and cell.formula is None and isinstance(cell.value, bool):
             raise FormulaProblem(
@@ -206,25 +203,23 @@ def _blank(ft, node) -> str:
             "ISBLANK of a cell that is empty in some rows of the filled-down column and not in "
             "others"
         )
-    written = getattr(ft.book, "sub_written", {})
-    for key in _rows(ft, node):
-        if key in written:
-            raise FormulaProblem(
-                f"ISBLANK of a cell that the macro Sub {written[key]} writes (it may leave it "
-                "empty)"
-            )
+    _not_written(
+        ft, node, "ISBLANK of a cell that the macro Sub {sub} writes (it may leave it empty)"
+    )
     return "1 == 0"  # a formula cell, or a constant: never blank
+
+
+def _not_written(ft, node, message: str) -> None:
+    """Refuse (``message``, its ``{sub}`` the Sub) where a VBA Sub writes a cell of ``node``."""
+    for key in _rows(ft, node):
+        sub = ft.book.sub_written.get(key)
+        if sub is not None:
+            raise FormulaProblem(message.format(sub=sub))
 
 
 def _assume_empty(ft, upper: str, node, truth: str) -> str:
     """An answer that holds while the empty cell stays empty: not a cell a Sub writes, and
     (checked by book.py over the whole worksheet) not an input."""
-    written = getattr(ft.book, "sub_written", {})
-    keys = _rows(ft, node)
-    for key in keys:
-        if key in written:
-            raise FormulaProblem(
-                f"{upper} of an empty cell that the macro Sub {written[key]} writes"
-            )
-    ft.out.empty_cells.extend(keys)
+    _not_written(ft, node, f"{upper} of an empty cell that the macro Sub {{sub}} writes")
+    ft.out.empty_cells.extend(_rows(ft, node))
     return truth

@@ -51,6 +51,9 @@ class Book:
     formula_problems: dict[str, str] = field(default_factory=dict)
     #: {(sheet, row, col): the parsed formula} of the formulas translated
     trees: dict = field(default_factory=dict)
+    #: {(sheet, row, col): the Sub} of the cells the VBA Subs write (set by the translation:
+    #: an IS-function of such a cell is not certain)
+    sub_written: dict = field(default_factory=dict)
 
     def cell(self, sheet: str, row: int, col: int) -> Cell | None:
         return self.sheets.get(sheet, {}).get((row, col))
