@@ -17,6 +17,7 @@ from .criteria import criteria_function
 from .formula_terms import FormulaProblem, Ref, row_relative, text_problem
 from .functions import EXCEL, VOLATILE
 from .information import INFORMATION, information
+from .joins import TEXT_PARTS, text_part
 
 #: a prefix that calls into an add-in or another workbook: [1]!f( or 'Book.xlam'!f(
 _LINK = re.compile(
@@ -410,9 +411,7 @@ class FormulaTranslator:
             from . import lookups
 
             return getattr(lookups, upper.lower())(self, args)
-        if upper in ("LEN", "LEFT", "RIGHT", "MID", "UPPER", "LOWER", "TRIM"):
-            from .joins import text_part
-
+        if upper in TEXT_PARTS:
             return text_part(self, upper, args)
         if upper in ("CONCATENATE", "_XLFN.CONCAT", "CONCAT", "CHAR"):
             from .joins import join
