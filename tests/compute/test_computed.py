@@ -28,7 +28,7 @@ STAGES_BEFORE = (
     "workbook/engine/solve_blocks.py",
     "workbook/engine/ode.py",
     "workbook/engine/oderun.py",
-    "workbook/engine/symbolic.py",
+    "workbook/numerics/symbolic.py",
     "workbook/engine/analysis.py",
     "workbook/compute/declared_checks.py",
     "workbook/compute/excel.py",

@@ -11,8 +11,8 @@ import pytest
 
 from workbook.compute.excel import ExcelPrinter
 from workbook.facade import Sheet
-from workbook.functions.registry import REGISTRY
 from workbook.language.template import load_spec
+from workbook.numerics.registry import REGISTRY
 from workbook.sweep import sweep
 
 LEVELS = 40

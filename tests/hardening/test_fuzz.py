@@ -21,9 +21,9 @@ from hypothesis import strategies as st
 
 from workbook import WorkbookError
 from workbook.engine.sheet import Sheet
-from workbook.functions.registry import REGISTRY
 from workbook.language import expr as ex
 from workbook.language.template import load_spec
+from workbook.numerics.registry import REGISTRY
 
 EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "12000"))
 PER_TEST = EXAMPLES // 2

@@ -12,7 +12,7 @@ from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import TemplateError
-from workbook.functions.registry import CONSTANTS
+from workbook.numerics.registry import CONSTANTS
 
 SHEET = """
 [sheet]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from workbook.errors import TemplateError
-from workbook.functions.registry import REGISTRY
+from workbook.numerics.registry import REGISTRY
 
 OF_NUMBERS = sorted(name for name, entry in REGISTRY.items() if entry.of_numbers)
 #: Arguments in every domain: whole numbers for the counting functions and Bessel orders.

@@ -1,4 +1,4 @@
-"""workbook.engine.symbolic: the typed tree as SymPy, derivatives, exact numbers."""
+"""workbook.numerics.symbolic: the typed tree as SymPy, derivatives, exact numbers."""
 
 import math
 
@@ -8,9 +8,9 @@ import pytest
 import sympy as sp
 
 import workbook
-from workbook.engine import symbolic
 from workbook.engine.analysis import true_pi_sheet
 from workbook.errors import NotSymbolic
+from workbook.numerics import symbolic
 
 
 def test_exact_numbers():

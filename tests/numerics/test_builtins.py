@@ -11,16 +11,16 @@ from helpers.docs import DOC, documented
 
 from workbook import WorkbookError
 from workbook.compute.excel import ExcelPrinter
-from workbook.engine import symbolic
 from workbook.engine.analysis import typed_text
 from workbook.engine.numeric import Evaluator
-from workbook.engine.symbolic import SympyConverter
 from workbook.facade import Sheet
 from workbook.functions.entry import Builtin, register
-from workbook.functions.registry import REGISTRY
 from workbook.language import typed as ty
 from workbook.language.template import load_spec
 from workbook.language.visitor import UnhandledNode
+from workbook.numerics import symbolic
+from workbook.numerics.registry import REGISTRY
+from workbook.numerics.symbolic import SympyConverter
 
 SHEET = """
 [sheet]

@@ -14,7 +14,7 @@ from helpers.sheets import write_template
 import workbook
 from workbook import WorkbookError
 from workbook.functions.distributions import NAMES
-from workbook.functions.registry import REGISTRY
+from workbook.numerics.registry import REGISTRY
 
 mp = mpmath.mp
 

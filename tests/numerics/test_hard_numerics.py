@@ -10,7 +10,7 @@ import pytest
 from helpers.sheets import HARD_SHEET
 
 import workbook
-from workbook.numerics import NumericsError
+from workbook.functions.numerical import NumericsError
 
 mpmath.mp.dps = 50
 
@@ -100,7 +100,7 @@ def test_the_count_of_roots_is_proven_by_interval_arithmetic():
     import sympy as sp
 
     from workbook.functions import interval_arith as iv
-    from workbook.functions.registry import REGISTRY
+    from workbook.numerics.registry import REGISTRY
 
     rng = np.random.default_rng(1)
     lo = rng.uniform(-3, 3, 500)
@@ -298,8 +298,8 @@ def test_kinks_where_a_curve_crosses_zero_are_break_points(tmp_path, expr, exact
 def test_a_near_singular_integrand_over_many_rows_has_an_honest_estimate():
     # SciPy's tanh-sinh alone stops early on 1/sqrt(t + 1e-3) over [0, 0.79] (nearly singular
     # just outside the interval) with an estimate of 4.5e-11 for an error of 6e-8
+    from workbook.functions.numerical import Tolerance
     from workbook.numerics import quadrature
-    from workbook.numerics._common import Tolerance
 
     u = np.sort(np.random.default_rng(1).uniform(0, 1, 21))
     exact = 2 * (np.sqrt(u + 1e-3) - np.sqrt(1e-3))

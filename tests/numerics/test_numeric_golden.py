@@ -17,8 +17,8 @@ from helpers.sheets import write_template
 
 import workbook
 from workbook.functions.distributions import NAMES as DISTRIBUTIONS
-from workbook.functions.registry import REGISTRY
 from workbook.functions.special import NAMES as SPECIAL
+from workbook.numerics.registry import REGISTRY
 
 mp = mpmath.mp
 

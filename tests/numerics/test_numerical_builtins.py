@@ -11,7 +11,7 @@ from scipy.optimize import brentq
 
 import workbook
 from workbook.errors import TemplateError, UnitError, WorkbookError
-from workbook.numerics import NumericsError
+from workbook.functions.numerical import NumericsError
 
 PIPE = TEST_DATA / "pipe-flow.toml"
 EPS, D = 0.05e-3, 0.1

@@ -6,7 +6,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from workbook.numerics import NumericsError, Tolerance
+from workbook.functions.numerical import NumericsError, Tolerance
 from workbook.numerics.extrema import extremum
 from workbook.numerics.given import solve
 from workbook.numerics.interpolate import interpolate

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import workbook
-from workbook.numerics import NumericsError
+from workbook.functions.numerical import NumericsError
 
 mpmath.mp.dps = 50
 

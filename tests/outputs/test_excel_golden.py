@@ -20,8 +20,8 @@ from helpers.sheets import write_template
 
 import workbook
 from workbook.functions.distributions import NAMES as DISTRIBUTIONS
-from workbook.functions.registry import REGISTRY
 from workbook.functions.special import NAMES as SPECIAL
+from workbook.numerics.registry import REGISTRY
 
 REL = 1e-13
 

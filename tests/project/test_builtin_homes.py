@@ -19,14 +19,14 @@ from helpers.paths import ROOT
 
 import workbook
 from workbook.compute.excel import ExcelPrinter
-from workbook.engine import symbolic
 from workbook.functions.builtins import excel_call, plain_in
 from workbook.functions.entry import Builtin, register
 from workbook.functions.excel_functions import stored
-from workbook.functions.registry import REGISTRY
 from workbook.language import typed as ty
 from workbook.mathcad.functions import MATHCAD_FUNCTIONS, OPERATOR_FUNCTIONS
+from workbook.numerics import symbolic
 from workbook.numerics.derivative import sympy_functions
+from workbook.numerics.registry import REGISTRY
 from workbook.outputs.report.mathml import MathML
 
 PACKAGE = ROOT / "workbook"

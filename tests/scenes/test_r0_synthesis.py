@@ -81,7 +81,7 @@ def template_reference_r0(sheet, digits: int = 40) -> float:
     import mpmath
     import sympy as sp
 
-    from workbook.engine import symbolic
+    from workbook.numerics import symbolic
 
     x = symbolic.symbol("x")
     expr = symbolic.to_sympy(sheet, "S0_req", {"x": x}, true_pi=True)

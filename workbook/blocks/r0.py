@@ -141,7 +141,7 @@ def direct_point(sheet):
     the reference tolerance of ``workbook bench`` (1e-14)."""
     import pandas as pd
 
-    from ..numerics import current, sheet_tolerance, tolerance
+    from ..functions.numerical import current, sheet_tolerance, tolerance
     from ..numerics.bench import REFERENCE_RTOL
 
     df = run_bench(sheet, grids=WORKBOOK_GRIDS)

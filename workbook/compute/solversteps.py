@@ -119,7 +119,7 @@ class RowSteps:
 def _recorded_chains(writer, typed: ty.T, env: dict) -> dict:
     """The steps of every live root and extremum met evaluating ``typed`` in ``env`` with
     the live forms (workbook.numerics), by id of their EXPR."""
-    from ..numerics import live_forms, recording_chains
+    from ..functions.numerical import live_forms, recording_chains
 
     with recording_chains() as found:
         try:

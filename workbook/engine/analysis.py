@@ -1,8 +1,8 @@
 """Checks of a hand calculation: derivative relations, joins of piecewise functions, domains.
 
 * :func:`relation_results` differentiates the parent of each ``[[relations]]`` entry
-  symbolically (:mod:`workbook.engine.symbolic`) and compares ``factor * d(parent)/d(var)`` with the
-  hand-derived child over the relation's range (or the hull of the tables that show it).
+  symbolically (:mod:`workbook.numerics.symbolic`) and compares ``factor * d(parent)/d(var)``
+  with the hand-derived child over the relation's range (or the hull of the tables that show it).
 * :func:`join_results` reads the conditions of every one-argument piecewise function as
   intervals: overlaps, gaps, and at each join the jump in value, first and second derivative.
 * :func:`explain_domain` names the sub-expression and the argument interval where a formula
@@ -23,12 +23,12 @@ import numpy as np
 
 from ..errors import WorkbookError
 from ..findings import Finding
-from ..functions.registry import REGISTRY
 from ..language import typed as ty
 from ..language import units as un
 from ..language.expr import PREC
 from ..language.typed import children
 from ..language.visitor import Visitor
+from ..numerics.registry import REGISTRY
 
 #: a relation "holds" when its largest discrepancy is below this fraction of max |child|
 HOLDS = 1e-9
@@ -97,7 +97,7 @@ class RelationResult:
 
 def _relation_values(sheet, child, terms, var, x, unit_child):
     """(child values, derivative values) over x; terms: list of (factor node, unit) and parent."""
-    from . import symbolic
+    from ..numerics import symbolic
 
     factors, parent, order, var_unit = terms
     typer = sheet.typer
@@ -140,7 +140,7 @@ def _derivative_fn(sheet, parent: str, var: str, order: int):
     """
     import sympy as sp
 
-    from . import symbolic
+    from ..numerics import symbolic
 
     own_pi = "pi" in sheet.spec.inputs and not sheet.spec.inputs["pi"].options
     inputs = tuple(sorted((k, str(v)) for k, v in sheet.values.items() if k != "pi"))
@@ -382,7 +382,7 @@ def join_results(sheet, var_unit: str = "rad") -> list[PiecewiseResult]:
 def _analyse_piecewise(sheet, name, res: PiecewiseResult, var_unit: str):
     import sympy as sp
 
-    from . import symbolic
+    from ..numerics import symbolic
 
     body = sheet.typer.function(name).body
     if not isinstance(body, ty.TPiecewise):

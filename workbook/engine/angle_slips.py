@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 
 from ..findings import Finding
-from ..functions.registry import REGISTRY
 from ..language import typed as ty
 from ..language.unitrules import angle_in
+from ..numerics.registry import REGISTRY
 
 
 def angle_findings(sheet) -> list[Finding]:

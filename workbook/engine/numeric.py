@@ -21,7 +21,6 @@ from contextlib import contextmanager
 import numpy as np
 
 from ..errors import DomainError, InputError, LimitError, WorkbookError
-from ..functions.registry import REGISTRY
 from ..language import typecheck as tc
 from ..language import typed as ty
 from ..language.expr import COMPARE
@@ -30,6 +29,7 @@ from ..language.typed import children
 from ..language.visitor import Visitor
 from ..limits import matrix_work
 from ..numerics.bound import Bound
+from ..numerics.registry import REGISTRY
 from . import runtime as rt
 
 Env = dict[str, object]

@@ -20,7 +20,7 @@ from ..errors import (
     WorkbookError,
 )
 from ..functions.matrix import numbers
-from ..functions.registry import CONSTANTS
+from ..functions.numerical import defining
 from ..language import cellunit
 from ..language import expr as ex
 from ..language import typecheck as tc
@@ -37,7 +37,7 @@ from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
 from ..limits_time import check_time
-from ..numerics import defining
+from ..numerics.registry import BUILTINS, CONSTANTS
 from . import runtime as rt
 from .numeric import Evaluator
 from .tabledata import Column, TableData
@@ -64,7 +64,7 @@ class Sheet:
             dict(values) if values is not None else {n: i.value for n, i in spec.inputs.items()}
         )
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-        self.typer = typer or tc.Typer(spec, input_units)
+        self.typer = typer or tc.Typer(spec, input_units, BUILTINS)
         # the trees typed at load besides the definitions' (shared by with_inputs, with_parts)
         self.typed = typed if typed is not None else TypedSheet()
         self._memo: dict[str, object] = {}

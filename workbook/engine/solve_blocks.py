@@ -9,9 +9,9 @@ import numpy as np
 
 from ..errors import LimitError, WorkbookError
 from ..findings import Finding
+from ..functions.numerical import NumericsError, current, sheet_tolerance
 from ..language import units as un
 from ..language.given_find import SolveSpec, typed_block
-from ..numerics import NumericsError, current, sheet_tolerance
 from ..numerics.given import solve
 
 

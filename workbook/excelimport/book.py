@@ -61,7 +61,7 @@ class Translation:
 
 
 def language_reserved() -> set[str]:
-    from ..functions.registry import REGISTRY
+    from ..numerics.registry import REGISTRY
 
     return {n.lower() for n in REGISTRY} | KEYWORDS
 

@@ -7,7 +7,7 @@ function that calls it is listed, never dropped)."""
 
 from __future__ import annotations
 
-from ..functions.registry import REGISTRY
+from ..numerics.registry import REGISTRY
 
 
 def _call(name: str, arity: int | tuple[int, int]) -> tuple[str, tuple[int, ...]]:

@@ -96,7 +96,7 @@ def _sure_kind(ft, node, depth: int) -> str | None:
     written, arithmetic (a number), ``&`` (a text), a comparison (TRUE/FALSE), a function that
     gives one kind; of a cell, a constant's own kind, a formula cell's by its formula's form
     (in every row of a filled-down column); None where it is not sure."""
-    from .kinds import _NUMBER_FUNCTIONS, _TEXT_FUNCTIONS, cell_kind, kind
+    from .kinds import NUMBER_FUNCTIONS, TEXT_FUNCTIONS, cell_kind, kind
 
     what, name, payload = node
     if depth > 12:
@@ -118,9 +118,9 @@ def _sure_kind(ft, node, depth: int) -> str | None:
     if what == "leaf" or what == "op":
         return kind(ft, node)
     upper = name.upper()
-    if upper in _NUMBER_FUNCTIONS:
+    if upper in NUMBER_FUNCTIONS:
         return "number"
-    if upper in _TEXT_FUNCTIONS:
+    if upper in TEXT_FUNCTIONS:
         return "text"
     if upper in INFORMATION:
         return "bool"
@@ -129,9 +129,9 @@ def _sure_kind(ft, node, depth: int) -> str | None:
 
 def _reader_of(ft, sheet: str):
     """A translator of another cell's formula on ``sheet``, to read its form."""
-    from .kinds import _reader
+    from .kinds import cell_reader
 
-    return _reader(ft, sheet)
+    return cell_reader(ft, sheet)
 
 
 def _one_cell(ft, node) -> tuple[str, int, int] | None:

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from .formula_terms import FormulaProblem, row_relative, text_problem
 
-_NUMBER_FUNCTIONS = {
+NUMBER_FUNCTIONS = {
     "ABS", "SQRT", "EXP", "LN", "LOG10", "LOG", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN",
     "ATAN2", "SINH", "COSH", "TANH", "SIGN", "PI", "POWER", "RADIANS", "DEGREES", "INT",
     "TRUNC", "ROUND", "MOD", "MAX", "MIN", "SUM", "AVERAGE", "COUNT", "PRODUCT", "MEDIAN",
@@ -30,7 +30,7 @@ _NUMBER_FUNCTIONS = {
     "_XLFN.VAR.S", "_XLFN.VAR.P", "CONVERT", "MATCH", "SUMIF", "COUNTIF", "MMULT", "SUMIFS",
     "COUNTIFS", "AVERAGEIF", "AVERAGEIFS", "LEN",
 }  # fmt: skip
-_TEXT_FUNCTIONS = {
+TEXT_FUNCTIONS = {
     "CONCATENATE", "CONCAT", "_XLFN.CONCAT", "CHAR", "LEFT", "RIGHT", "MID", "UPPER", "LOWER",
     "TRIM",
 }  # fmt: skip
@@ -72,7 +72,7 @@ def _formula_kind(ft, cell, depth: int) -> str | None:
         return None
     memo[key] = None  # a formula that reads itself gives no kind
     try:
-        memo[key] = kind(_reader(ft, cell.sheet), tree, depth + 1)
+        memo[key] = kind(cell_reader(ft, cell.sheet), tree, depth + 1)
     except FormulaProblem:
         pass
     return memo[key]
@@ -84,7 +84,7 @@ def _memo(ft, what: str) -> dict:
     return memos.setdefault(what, {})
 
 
-def _reader(ft, sheet: str):
+def cell_reader(ft, sheet: str):
     """A translator of another cell's formula, to read its parts' kinds and texts."""
     # the translator's own class (cells.py imports this module)
     return type(ft)(ft.book, sheet, lambda *_: "x", ft.functions, ft.defined, seen=set())
@@ -155,9 +155,9 @@ def kind(ft, node, depth: int = 0) -> str | None:
         return None
     if upper in ("ISBLANK", "ISNUMBER", "ISTEXT", "ISNONTEXT", "ISLOGICAL", "ISERROR", "ISERR"):
         return "bool"
-    if upper in _NUMBER_FUNCTIONS:
+    if upper in NUMBER_FUNCTIONS:
         return "number"
-    if upper in _TEXT_FUNCTIONS:
+    if upper in TEXT_FUNCTIONS:
         return "text"
     return None
 
@@ -211,7 +211,7 @@ def texts_of(ft, node, depth: int = 0) -> set[str] | None:
                 tree = getattr(ft.book, "trees", {}).get(key)
                 memo[key] = None
                 if tree is not None and cell.array is None:
-                    memo[key] = texts_of(_reader(ft, cell.sheet), tree, depth + 1)
+                    memo[key] = texts_of(cell_reader(ft, cell.sheet), tree, depth + 1)
             if memo[key] is None:
                 return None
             out |= memo[key]

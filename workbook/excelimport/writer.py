@@ -398,6 +398,7 @@ def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
     import workbook
     from workbook.language import typecheck as tc
     from workbook.language.template import load_spec
+    from workbook.numerics.registry import BUILTINS
 
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{name}.toml"
@@ -407,7 +408,7 @@ def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
         try:
             spec = load_spec(path)
             units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-            typer = tc.Typer(spec, units)
+            typer = tc.Typer(spec, units, BUILTINS)
         except WorkbookError as err:
             return _located(err, toml)
         found: dict[str, str] = {}

@@ -54,7 +54,7 @@ at those positions must be names of ``[data]`` columns, typed as references of k
 ``data`` (the column's values, in its declared unit); such names are refused elsewhere.
 
 To add a built-in, write its rule and hooks and call :func:`register` at import of the module
-that defines it (a module imported by :mod:`workbook.functions.registry`, the complete registry),
+that defines it (a module imported by :mod:`workbook.numerics.registry`, the complete registry),
 e.g.::
 
     register(Builtin("cbrt", 1, unit_rule=root_unit(3), numpy=np.cbrt,
@@ -640,12 +640,10 @@ def _sum_numpy(fn, a=None, b=None, *, shapes=None):
         # bounds that vary over a table's rows: the term counts only where i is in a row's range
         term = term if same else np.where((lo <= i) & (i <= hi), term, 0 * term)
         out, size = out + term, size + np.abs(term)
-    # EXPR as numerics.bound.Bound: the estimate is kept (of real terms: the rounding check
+    # EXPR as workbook.numerics.bound.Bound: the estimate is kept (of real terms: the rounding check
     # of EXPR runs in real mpmath)
-    if hasattr(fn, "record") and not np.iscomplexobj(out):
-        from ..numerics.series import record_series
-
-        record_series(fn, lo, hi, np.asarray(out, dtype=float), size, np.maximum(hi - lo + 1, 0))
+    if hasattr(fn, "record_series") and not np.iscomplexobj(out):
+        fn.record_series(lo, hi, np.asarray(out, dtype=float), size, np.maximum(hi - lo + 1, 0))
     return out
 
 

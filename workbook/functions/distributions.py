@@ -201,7 +201,7 @@ def _sympy(family: str, kind: str):
 
     why = f"{_NAME[kind]}{family}() has no formula for SymPy"
     if not (family == "norm" or (family == "exp" and kind == "ppf")):
-        convert.refusal = why  # read by workbook.engine.symbolic.refusal, without SymPy
+        convert.refusal = why  # read by workbook.numerics.symbolic.refusal, without SymPy
     return convert
 
 

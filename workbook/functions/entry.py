@@ -1,6 +1,6 @@
 """One built-in function: the :class:`Builtin` record, the registry it is kept in, and
 :func:`register` (the fields are described in :mod:`workbook.functions.builtins`; the complete
-registry, every module's entries registered, is :data:`workbook.functions.registry.REGISTRY`)."""
+registry, every module's entries registered, is :data:`workbook.numerics.registry.REGISTRY`)."""
 
 from __future__ import annotations
 
@@ -29,8 +29,6 @@ class UnitContext(Protocol):
     def plain(self, t: ty.T, where: str) -> ty.T: ...
 
     def meeting(self, values) -> list[ty.T]: ...
-
-    def symbolic_refusal(self, t: ty.T) -> str | None: ...
 
 
 @dataclass(frozen=True)
@@ -130,7 +128,7 @@ class Builtin:
 
 
 # Every built-in function by name, filled as the modules that define entries are imported.
-# Read it as workbook.functions.registry.REGISTRY, which imports all of them first (a module
+# Read it as workbook.numerics.registry.REGISTRY, which imports all of them first (a module
 # reading it from here could see only some).
 ENTRIES: dict[str, Builtin] = {}
 
@@ -141,3 +139,37 @@ def register(entry: Builtin) -> Builtin:
         raise ValueError(f"built-in {entry.name}() is registered twice")
     ENTRIES[entry.name] = entry
     return entry
+
+
+@dataclass(frozen=True)
+class Builtins:
+    """The built-in functions and constants a typer resolves names against (the complete
+    registry is :data:`workbook.numerics.registry.BUILTINS`; the typer imports no registry)."""
+
+    functions: dict[str, Builtin]
+    constants: dict[str, Any]  # name -> workbook.functions.constants.Constant
+    home: str = ""  # "module:name" of the one instance, by which it pickles (a typer does)
+
+    def refuse_functions_named(self, names: dict[str, int | None]) -> None:
+        """A sheet's function, block, column, unknown or ODE state (``names``: name -> line)
+        may not have a built-in function's name."""
+        for name, line in names.items():
+            if name in self.functions:
+                raise TemplateError(
+                    f"'{name}' shadows the built-in function {name}(); choose another name",
+                    line=line,
+                    definition=name,
+                )
+
+    def __reduce__(self):
+        if not self.home:
+            return super().__reduce__()
+        return (_named, (self.home,))
+
+
+def _named(home: str) -> Any:
+    """The object ``home`` (``"module:name"``) names: the registry's instance, unpickled."""
+    import importlib
+
+    module, name = home.split(":")
+    return getattr(importlib.import_module(module), name)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import DomainError, InputError
 from ..limits import ELEMENT_WORK, charge_matrix_work, check_elements
-from ..numerics import linalg
+from . import matrix_estimates
 
 #: A matrix whose condition number exceeds this is singular for inverse and lsolve.
 SINGULAR_COND = 1e14
@@ -120,7 +120,7 @@ def transpose(m):
 def det(m):
     charge_cubic("det", m, "det()")
     value = np.linalg.det(_last(m))
-    linalg.determinant(_last(m), value)
+    matrix_estimates.determinant(_last(m), value)
     return _scalar(value)
 
 
@@ -142,7 +142,7 @@ def _check_regular(m, what: str):
 def inverse(m):
     mm, cond = _check_regular(m, "inverse()")
     out = np.linalg.inv(mm)
-    linalg.solved("inverse", cond, out, mm)
+    matrix_estimates.solved("inverse", cond, out, mm)
     return _first(out)
 
 
@@ -168,7 +168,7 @@ def lsolve(m, v):
     elif extra < 0:
         mm = mm.reshape((1,) * -extra + mm.shape)
     out = np.linalg.solve(mm, vv)
-    linalg.solved("lsolve", cond, out, mm, vv)
+    matrix_estimates.solved("lsolve", cond, out, mm, vv)
     return _first(out)
 
 
@@ -200,7 +200,7 @@ def _real_eigen(m, lam, vec, what: str):
     the refusal of complex eigenvalues."""
     if np.isrealobj(lam):
         lam = lam.astype(complex)
-    real = linalg.real_eigenvalues(m, lam, vec, what.rstrip("()"))
+    real = matrix_estimates.real_eigenvalues(m, lam, vec, what.rstrip("()"))
     if real is None:
         return _real(lam, what)
     return real

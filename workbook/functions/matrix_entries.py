@@ -2,12 +2,10 @@
 numpy hook, Excel form, SymPy form and documentation. What they compute is
 :mod:`workbook.functions.matrix` (and :mod:`workbook.functions.factorizations`,
 :mod:`workbook.functions.norms`,
-:mod:`workbook.functions.samples`); :mod:`workbook.functions.registry` imports this module, which
+:mod:`workbook.functions.samples`); :mod:`workbook.numerics.registry` imports this module, which
 registers them."""
 
 from __future__ import annotations
-
-import inspect
 
 import numpy as np
 
@@ -16,7 +14,7 @@ from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.typed import shape_text
 from ..language.units import pretty
-from . import factorizations, norms, samples
+from . import factorizations, norms
 from .entry import Builtin, register
 from .excel_functions import stored
 from .matrix import (
@@ -49,15 +47,6 @@ from .matrix import (
     stack,
     transpose,
 )
-
-
-def _hook(fn):
-    """A numpy hook of a statistic of samples: the values, then the shapes (not used)."""
-
-    def hook(*values, shapes):
-        return fn(*values)
-
-    return hook
 
 
 def _numbers_as_1x1(values, shapes):
@@ -320,11 +309,6 @@ entry(
 )
 
 
-def r_var_sample(ctx, name, args):
-    need(args, 0, name)
-    return func(args[0].unit ** 2, name, args, None)
-
-
 # factorizations (workbook.functions.factorizations): Mathcad's choices of pivot
 def r_lu(ctx, name, args):
     n = square(args, name)
@@ -379,67 +363,6 @@ entry(
     "geninv(M): the left inverse of a matrix of independent columns (Mathcad's geninv)",
     mathcad=("geninv",),
 )
-
-
-# statistics of samples (workbook.functions.samples): every element of a vector or matrix
-def r_sample(result: str):
-    def rule(ctx, name, args):
-        need(args, 0, name)
-        unit = {"same": args[0].unit, "plain": ctx.dimensionless}[result]
-        return func(unit, name, args, None)
-
-    return rule
-
-
-def r_pair(result: str):
-    def rule(ctx, name, args):
-        n, m = vector(args, 0, name), vector(args, 1, name)
-        if n != m:
-            raise TemplateError(f"{name}(): the vectors have {n} and {m} elements")
-        a, b = args[0].unit, args[1].unit
-        unit = {
-            "plain": ctx.dimensionless,
-            "product": a * b,
-            "ratio": b / a,
-            "second": b,
-        }[result]
-        return func(unit, name, args, None)
-
-    return rule
-
-
-def r_rank(ctx, name, args):
-    return func(ctx.dimensionless, name, args, (vector(args, 0, name), 1))
-
-
-for name, rule, hook, excel, doc in (
-    ("corr", r_pair("plain"), samples.corr, call("CORREL", "{}, {}"),
-     "corr(a, b): Pearson's correlation coefficient of two vectors"),
-    ("cvar", r_pair("product"), samples.cvar, call(stored("COVARIANCE.P"), "{}, {}"),
-     "cvar(a, b): the covariance of two vectors, divided by N (Mathcad's cvar)"),
-    ("fit_slope", r_pair("ratio"), samples.slope, call("SLOPE", "{1}, {0}"),
-     "fit_slope(vx, vy): the slope of the least-squares line (Mathcad's slope)"),
-    ("fit_intercept", r_pair("second"), samples.intercept, call("INTERCEPT", "{1}, {0}"),
-     "fit_intercept(vx, vy): the intercept of the least-squares line (Mathcad's intercept)"),
-    ("skew", r_sample("plain"), samples.skew, call("SKEW"),
-     "skew(v): the sample skewness (Excel's SKEW)"),
-    ("kurt", r_sample("plain"), samples.kurt, call("KURT"),
-     "kurt(v): the sample excess kurtosis (Excel's KURT)"),
-    ("gmean", r_sample("same"), samples.gmean, call("GEOMEAN"),
-     "gmean(v): the geometric mean of positive values"),
-    ("hmean", r_sample("same"), samples.hmean, call("HARMEAN"),
-     "hmean(v): the harmonic mean of positive values"),
-    ("Var", r_var_sample, samples.sample_var, call(stored("VAR.S")),
-     "Var(v): the sample variance (divided by N - 1; var divides by N)"),
-    ("Stdev", r_sample("same"), samples.sample_stdev, call(stored("STDEV.S")),
-     "Stdev(v): the sample standard deviation (divided by N - 1; stdev divides by N)"),
-    ("Rank", r_rank, samples.rank, not_live("ranks are written as values"),
-     "Rank(v): the rank of each element, 1 for the smallest, ties sharing their mean rank"),
-):  # fmt: skip
-    # each is Mathcad's function of its name (fit_slope and fit_intercept: slope, intercept)
-    mathcad = (name.removeprefix("fit_"),)
-    entry(name, len(inspect.signature(hook).parameters), rule, _hook(hook), excel, doc,
-          mathcad=mathcad)  # fmt: skip
 
 
 # norms, condition numbers, trace, diagonal, singular values (workbook.functions.norms)

@@ -1,14 +1,14 @@
 """Error estimates of the linear-algebra built-ins (lsolve, inverse, det, eigenvals,
 eigenvecs): what the rounding of the matrix's elements (one unit in the last place, the
 backward error of LAPACK's factorizations) can move the result by, from the condition
-number; kept with the definition (:func:`workbook.numerics._common.record`), so that a value
+number; kept with the definition (:func:`workbook.functions.numerical.record`), so that a value
 whose estimate is far above the sheet's tolerance is warned of (numerics.estimates)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ._common import record, recording, reference, reference_note, reference_values
+from .numerical import record, recording, reference, reference_note, reference_values
 
 EPS = np.finfo(float).eps
 

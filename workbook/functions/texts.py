@@ -22,7 +22,7 @@ def _no_sympy(name: str):
     def convert(sp, *args):
         raise NotSymbolic(why)
 
-    convert.refusal = why  # read by workbook.engine.symbolic.refusal, without SymPy
+    convert.refusal = why  # read by workbook.numerics.symbolic.refusal, without SymPy
     return convert
 
 

@@ -344,6 +344,9 @@ class SheetSpec:
     solves: list[Any] = field(default_factory=list)  # given_find.SolveSpec, [[solve]] blocks
     odes: dict[str, Any] = field(default_factory=dict)  # name -> workbook.language.odes.OdeSpec
     checks: list[Any] = field(default_factory=list)  # checkspec.CheckSpec, [[checks]]
+    # the names that may not be a built-in function's (functions, blocks, columns, unknowns,
+    # ODE states) -> their line: the typer, which knows the built-ins, refuses them
+    function_names: dict[str, int | None] = field(default_factory=dict)
 
     def solve_of(self, name: str):
         """The [[solve]] block that finds ``name``, or None."""

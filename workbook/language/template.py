@@ -18,7 +18,6 @@ from pathlib import Path
 import pint
 
 from ..errors import InputError, LimitError, TemplateError, WorkbookError
-from ..functions.registry import REGISTRY
 from . import expr as ex
 from . import units as un
 from .checkspec import read_check
@@ -290,6 +289,7 @@ def _build(path: Path, name: str, text: str, data: dict) -> SheetSpec:
         checks=checks,
         solves=solves,
         odes=odes,
+        function_names=claim.functions,
     )
 
 
@@ -336,23 +336,20 @@ def _sheet_options(sheet: dict, text: str) -> None:
 
 class _Claims:
     """The names a worksheet defines, each claimed once by the section that defines it:
-    ``claim(key, section, line, function=True)`` refuses a bad name, a built-in's name (for a
-    function) and a name defined twice."""
+    ``claim(key, section, line, function=True)`` refuses a bad name and a name defined twice,
+    and keeps a function's name with its line (``functions``: the typer refuses a built-in's)."""
 
     def __init__(self):
         self.seen: dict[str, str] = {}
+        self.functions: dict[str, int | None] = {}  # name -> line
 
     def __call__(self, key: str, section: str, line, function: bool = True) -> None:
         if not ex.is_identifier(key):
             raise TemplateError(
                 f"'{key}' is not a valid name (letters, digits, _)", line=line, definition=key
             )
-        if key in REGISTRY and function:
-            raise TemplateError(
-                f"'{key}' shadows the built-in function {key}(); choose another name",
-                line=line,
-                definition=key,
-            )
+        if function:  # the typer refuses a built-in function's name (it knows the built-ins)
+            self.functions[key] = line
         if key in self.seen:
             raise TemplateError(
                 f"'{key}' is defined twice (in [{self.seen[key]}] and [{section}])",

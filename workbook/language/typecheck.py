@@ -11,11 +11,11 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import re
+from typing import TYPE_CHECKING
 
 import pint
 
 from ..errors import LimitError, ShapeError, TemplateError, UnitError, WorkbookError
-from ..functions.registry import CONSTANTS, REGISTRY
 from . import expr as ex
 from . import units as un
 from .complextyping import no_order, real_in_program, real_index, real_only, value_kind
@@ -50,6 +50,9 @@ from .typed import (
 from .unitrules import UnitRules, meeting
 from .visitor import Visitor
 
+if TYPE_CHECKING:  # the registry is above the language: the typer is given it
+    from ..functions.entry import Builtins
+
 #: Most elements of one matrix written out.
 MAX_ELEMENTS = 10_000
 
@@ -64,8 +67,12 @@ class Typer(ArrayTyping, UnitRules, Visitor):
     :mod:`workbook.language.expr` node) in a scope of parameters (name -> binding unit).
     """
 
-    def __init__(self, spec: SheetSpec, input_units: dict[str, pint.Unit | None]):
+    def __init__(
+        self, spec: SheetSpec, input_units: dict[str, pint.Unit | None], builtins: Builtins
+    ):
         self.spec = spec
+        self.builtins = builtins
+        builtins.refuse_functions_named(spec.function_names)
         self.input_units = input_units
         self.scalars: dict[str, T] = {}
         self.functions: dict[str, TypedFunction] = {}
@@ -90,15 +97,6 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         self._assumption_reads = 0  # calls typed by an assumed unit (recursion), counted
 
     # -- public -------------------------------------------------------------------
-    def sympy_converter(self, keep: set[str]):
-        """A :class:`workbook.engine.symbolic.SympyConverter` of this sheet's typed trees (no
-        values: inputs and the definitions in ``keep`` stay symbols)."""
-        from types import SimpleNamespace
-
-        from ..engine.symbolic import SympyConverter
-
-        return SympyConverter(SimpleNamespace(typer=self, values={}), keep=keep)
-
     def scalar(self, name: str) -> T:
         """Typed body of a scalar definition."""
         if name not in self.scalars:
@@ -259,12 +257,6 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         return self.function(name).unit if d.is_function else self.scalar(name).unit
 
     # -- internals ----------------------------------------------------------------
-    def symbolic_refusal(self, t: T) -> str | None:
-        """Why ``t`` has no symbolic form (``diff`` refuses it at load), or None; no SymPy."""
-        from ..engine.symbolic import refusal
-
-        return refusal(self, t)
-
     def where(self) -> dict:
         """File, line and definition being typed (for an error found later, at first use)."""
         name = self._stack[-1] if self._stack else None
@@ -285,10 +277,15 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             return TemplateError(f"unknown {kind} '{name}'")
         spec = self.spec
         own = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
-        known = {**own, **dict.fromkeys([*spec.blocks, *REGISTRY, *CONSTANTS])}
+        known = {
+            **own,
+            **dict.fromkeys([*spec.blocks, *self.builtins.functions, *self.builtins.constants]),
+        }
         hint = nearest(name, known)
         if kind == "name":  # a value is meant: the sheet's names first (R1 is R_1, not Re())
-            values = nearest(name, {k: v for k, v in known.items() if k not in REGISTRY})
+            values = nearest(
+                name, {k: v for k, v in known.items() if k not in self.builtins.functions}
+            )
             hint = values if values or un.is_unit_name(name) else hint
         if kind == "name" and un.is_unit_name(name) and not nearest(name, own):
             # a unit's name: the unit's hint before a built-in's that looks like it (mm, gamma)
@@ -462,9 +459,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             return TRef(body.unit, name=name, kind="definition", **value_kind(body))
         if name in self.spec.arguments:
             raise TemplateError(f"'{name}' is an argument, used here outside a function of {name}")
-        if name in CONSTANTS:  # the sheet's own pi, e or g came first
-            return TRef(un.unit(CONSTANTS[name].unit), name=name, kind="builtin")
-        if name in REGISTRY or name in self.spec.blocks:
+        if name in self.builtins.constants:  # the sheet's own pi, e or g came first
+            return TRef(un.unit(self.builtins.constants[name].unit), name=name, kind="builtin")
+        if name in self.builtins.functions or name in self.spec.blocks:
             raise TemplateError(f"'{name}' is a function: call it as {name}(...)")
         raise self._unknown("name", name, scope)
 
@@ -515,7 +512,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         name = node.func
         if name in AGGREGATES and name not in self.spec.definitions:
             return self._aggregate(node)
-        entry = REGISTRY.get(name)
+        entry = self.builtins.functions.get(name)
         local = name in self.spec.definitions or name in self.spec.blocks
         if name == "vectorize" and not local:
             return self.vectorize(node, scope)
@@ -523,7 +520,11 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             return self._binding_call(node, scope)
         if entry is not None and entry.data_args and name not in self.spec.definitions:
             return self._data_call(node, scope)
-        known = name in self.spec.definitions or name in self.spec.blocks or name in REGISTRY
+        known = (
+            name in self.spec.definitions
+            or name in self.spec.blocks
+            or name in self.builtins.functions
+        )
         args = [self.visit(a, scope) for a in node.args] if known else []  # unknown: say so first
         if not (entry is not None and entry.texts and not local):
             for a in args:
@@ -563,7 +564,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 for a, (p, u) in zip(args, blk.args.items())
             )
             return TBlock(un.unit(blk.returns), name=name, ref=blk.ref, args=conv)
-        if name not in REGISTRY:
+        if name not in self.builtins.functions:
             if name == "log":
                 raise TemplateError(
                     "log() is not accepted (Mathcad's log is base 10, numpy's is natural): "
@@ -572,7 +573,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             if name in self.spec.inputs or name in scope:
                 raise TemplateError(f"'{name}' is a value, not a function; write {name}")
             raise self._unknown("function", name, scope)
-        entry = REGISTRY[name]
+        entry = self.builtins.functions[name]
         entry.check_arity(len(args))
         args = [self.kelvin(a) for a in args]  # abs(T), max(T1, T2): as Mathcad, in kelvin
         if entry.arrays and any(is_runtime(a.shape) for a in args):
@@ -623,7 +624,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
     def _binding_call(self, node: ex.Call, scope) -> T:
         """A built-in that binds a variable: EXPR is typed with the variable in scope."""
-        name, entry = node.func, REGISTRY[node.func]
+        name, entry = node.func, self.builtins.functions[node.func]
         entry.check_arity(len(node.args))
         expr_at, var_at = entry.binds
         var = node.args[var_at]
@@ -661,7 +662,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
 
     def _data_call(self, node: ex.Call, scope) -> T:
         """A built-in reading [data] columns: those arguments are column names (their values)."""
-        name, entry = node.func, REGISTRY[node.func]
+        name, entry = node.func, self.builtins.functions[node.func]
         entry.check_arity(len(node.args))
         args: list[T] = []
         for i, a in enumerate(node.args):

@@ -3,7 +3,7 @@ workbook.language.typecheck).
 
 Every node carries the pint unit its value is in; every unit conversion is an explicit
 :class:`TScale`. The nodes are frozen: back ends (:mod:`workbook.engine.numeric`,
-:mod:`workbook.compute.excel`, :mod:`workbook.engine.symbolic`, :mod:`workbook.engine.analysis`)
+:mod:`workbook.compute.excel`, :mod:`workbook.numerics.symbolic`, :mod:`workbook.engine.analysis`)
 read them and never change them; each back end is a :class:`workbook.language.visitor.Visitor` with
 one ``visit_<Node>`` method per class below."""
 
@@ -95,7 +95,7 @@ class TLogic(T):
 
 @dataclass(frozen=True, eq=False)
 class TFunc(T):
-    """Call of a built-in function (an entry of :data:`workbook.functions.registry.REGISTRY`).
+    """Call of a built-in function (an entry of :data:`workbook.numerics.registry.REGISTRY`).
 
     For a built-in that binds a variable, ``args`` keeps the source order: the typed
     expression, a :class:`TParam` naming the bound variable, then the other arguments.

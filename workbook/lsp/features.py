@@ -9,9 +9,9 @@ import numpy as np
 from lsprotocol import types as lsp
 
 from ..errors import WorkbookError
-from ..functions.registry import CONSTANTS, REGISTRY
 from ..language import template as tp
 from ..language import units as un
+from ..numerics.registry import CONSTANTS, REGISTRY
 from .document import Document, Span, section_at, word_at
 
 #: The keys of each section's entries, as the template reader accepts them.

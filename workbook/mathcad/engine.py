@@ -20,6 +20,7 @@ from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
+from ..numerics.registry import BUILTINS
 from .symbols import Unknown
 from .translation import Item, Result, Skipped, Translation, uses
 from .trees import rename
@@ -53,7 +54,9 @@ class _Refusals:
 
         self.spec, self.rendered = spec, rendered
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-        self.sheet = Sheet(spec, typer=tc.Typer(spec, input_units))  # typed element by element
+        self.sheet = Sheet(
+            spec, typer=tc.Typer(spec, input_units, BUILTINS)
+        )  # typed element by element
         self.typer = self.sheet.typer
         self.refused: dict[str, str] = {}
         self.bad: set[str] = set()  # definitions and unknowns refused
@@ -469,7 +472,7 @@ class AtImport:
                 spec = spec_from_data(doc.data, Path("at-import.toml"), "at-import")
                 input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
                 mapping = {s.token(): s.final for s in part.syms}
-                self.worksheets[key] = [spec, tc.Typer(spec, input_units), mapping, None]
+                self.worksheets[key] = [spec, tc.Typer(spec, input_units, BUILTINS), mapping, None]
             spec, typer, mapping, _ = self.worksheets[key]
             finals = [mapping[s.token()] for s in range_syms]
             scope = {f: spec.arguments[f].binding_unit for f in finals}

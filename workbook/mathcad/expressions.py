@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import math
 
-from ..functions.registry import REGISTRY
 from ..language import expr as ex
 from ..language.visitor import Visitor
+from ..numerics.registry import REGISTRY
 from . import names as nm
 from . import trees as tt
 from .context import TranslatorContext

@@ -10,7 +10,7 @@ dropped.
 
 from __future__ import annotations
 
-from ..functions.registry import REGISTRY
+from ..numerics.registry import REGISTRY
 
 #: ``name: (language name, argument order)``; the order lists Mathcad's argument positions in
 #: the order the language takes them (None: Mathcad's order, as ``atan2(x, y)``, x first in

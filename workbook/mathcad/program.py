@@ -615,7 +615,7 @@ def unsure_builtin(name: str) -> str:
     ('' where it is): one with a restricted domain (``sqrt`` of a negative number: Mathcad's
     value is complex, the engine's an error), or one that binds a variable (a solver or a
     numerical method, whose failure is its own), as the registry's entry says."""
-    from ..functions.registry import REGISTRY
+    from ..numerics.registry import REGISTRY
 
     entry = REGISTRY.get(name)
     if entry is None:

@@ -9,7 +9,7 @@ and solves every row in one call of a SciPy vectorised routine:
 - :func:`quadrature.integrate`: ``scipy.integrate.tanhsinh``, split at given break points;
 - :func:`extrema.extremum`: sampling, then ``scipy.optimize.elementwise.find_minimum`` on
   every local extremum found;
-- :func:`series.reduce`: sums and products over integers;
+- :func:`workbook.numerics.series.reduce`: sums and products over integers;
 - :func:`given.solve`: a Given/Find system (``scipy.optimize.root``);
 - :func:`interpolate.interpolate`: linear and cubic-spline interpolation of measured data;
 - :mod:`gauss`: fixed Gauss-Legendre rules (the integral's live Excel form);
@@ -21,31 +21,3 @@ Every result carries an error estimate; every failure is a :class:`NumericsError
 what was sampled and found. This package knows nothing of worksheets (no typed tree): the
 engine wraps it. SciPy is imported inside the functions, so importing this package is cheap.
 """
-
-from __future__ import annotations
-
-from ._common import (
-    NumericsError,
-    Result,
-    Tolerance,
-    current,
-    defining,
-    live_forms,
-    recording_chains,
-    reference_methods,
-    sheet_tolerance,
-    tolerance,
-)
-
-__all__ = [
-    "NumericsError",
-    "Result",
-    "Tolerance",
-    "current",
-    "defining",
-    "live_forms",
-    "recording_chains",
-    "reference_methods",
-    "sheet_tolerance",
-    "tolerance",
-]

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WorkbookError
+from ..functions.numerical import current, reference_methods, sheet_tolerance
 from ..language import typed as ty
-from ._common import current, reference_methods, sheet_tolerance
 
 #: the relative accuracy the reference methods in doubles are trusted to
 REFERENCE_ACCURACY = 1e-12
@@ -97,7 +97,7 @@ def _ms(s: float) -> str:
 
 def _estimate(name: str) -> str:
     """How the error of built-in ``name`` is estimated: "iterative", "condition" or ""."""
-    from ..functions.registry import REGISTRY  # imported here: the registry imports numerics
+    from .registry import REGISTRY  # imported here: the registry imports numerics
 
     entry = REGISTRY.get(name)
     return entry.estimate if entry is not None else ""

@@ -7,9 +7,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..functions.numerical import Result, Tolerance, current, defined, num, sheet_tolerance
 from ..language import typed as ty
 from ..language import units as un
-from ._common import Result, Tolerance, current, defined, num, sheet_tolerance
 
 
 class Bound:
@@ -175,6 +175,14 @@ class Bound:
         result.notes.setdefault("in", defined())
         result.notes["body"] = self.body  # which call it is (workbook bench's comparison)
         self.evaluator.records.append((name, result))
+
+    def record_series(self, lo, hi, value, absolute, count=None, kind: str = "sum") -> None:
+        """Keep the estimate of a sum or product of this EXPR over i = lo..hi (per row):
+        :func:`workbook.numerics.series.record_series` (a built-in's hook, below the numerics,
+        reaches it through the EXPR it is given)."""
+        from .series import record_series
+
+        record_series(self, lo, hi, value, absolute, count, kind)
 
 
 _NODES = {

@@ -4,7 +4,7 @@ At load the typer gives ``diff`` its unit (EXPR's over X's to the N) and keeps a
 :class:`Pending` record of the call; nothing is differentiated yet, and SymPy is not imported.
 The first back end that needs the derivative (a value, a formula, a check) calls
 :func:`formula`: EXPR's typed tree is printed as SymPy
-(:class:`workbook.engine.symbolic.SympyConverter`, inputs and definitions kept as symbols),
+(:class:`workbook.numerics.symbolic.SympyConverter`, inputs and definitions kept as symbols),
 differentiated, and read back into a typed tree whose leaves are EXPR's own parameters and
 references; it is kept for every later use. Every back end then treats the derivative as any
 other formula: numpy evaluates it, Excel gets it as a live formula.
@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import math
+import types
 import weakref
 from dataclasses import dataclass, field
 
@@ -29,7 +30,7 @@ def sympy_functions() -> dict[str, str]:
     read from the registry: an entry whose SymPy form, given symbols, is one SymPy function of
     exactly those symbols (``Abs(x)``, ``atan2(y, x)``). Plain built-ins come before those of
     vectors (``abs`` before ``mag``, whose SymPy form is ``Abs`` too)."""
-    # workbook.functions.registry.REGISTRY is this dict; it imports this module's entry, so the dict
+    # workbook.numerics.registry.REGISTRY is this dict; it imports this module's entry, so the dict
     # is read from its home. By the time a derivative is read back every entry is registered.
     from ..functions.entry import ENTRIES
 
@@ -150,7 +151,10 @@ def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
         )
     leaves = _leaves(typer, body)
     refs = {n: t for n, t in leaves.items() if isinstance(t, ty.TRef)}
-    conv = typer.sympy_converter(keep=set(refs))
+    from .symbolic import SympyConverter
+
+    # no values: inputs and the definitions it refers to stay symbols
+    conv = SympyConverter(types.SimpleNamespace(typer=typer, values={}), keep=set(refs))
     what = "diff(): SymPy's derivative (a function nested in itself grows it exponentially)"
     with within_seconds(MAX_DIFF_SECONDS, what):
         try:

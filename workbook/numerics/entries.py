@@ -16,10 +16,7 @@ import numpy as np
 
 from ..errors import NotLive, NotSymbolic, TemplateError, UnitError
 from ..functions.entry import Builtin, register
-from ..language import typed as ty
-from ..language import units as un
-from ..language.expr import PREC
-from ._common import (
+from ..functions.numerical import (
     NumericsError,
     Result,
     chains,
@@ -29,6 +26,9 @@ from ._common import (
     reference_values,
     sheet_tolerance,
 )
+from ..language import typed as ty
+from ..language import units as un
+from ..language.expr import PREC
 from .excelforms import (
     EXCEL_NODES,
     bisection,
@@ -135,7 +135,9 @@ def _diff_unit(ctx, name: str, args: tuple) -> ty.T:
             f"diff(): the derivative is a function of {var.name}, which is not an argument "
             f'here: make {var.name} an argument of the definition ("NAME({var.name})")'
         )
-    why = ctx.symbolic_refusal(body)
+    from .symbolic import refusal
+
+    why = refusal(ctx, body)
     if why:
         raise TemplateError(f"diff(): {why}")
     unit = body.unit / un.difference_unit(var.unit) ** order  # per delta_degC, not per degC
@@ -512,7 +514,7 @@ def _no_sympy(name: str):
     def convert(sp, body, var, *rest):
         raise NotSymbolic(why)
 
-    convert.refusal = why  # read by workbook.engine.symbolic.refusal, without SymPy
+    convert.refusal = why  # read by workbook.numerics.symbolic.refusal, without SymPy
     return convert
 
 

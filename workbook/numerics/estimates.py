@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import sheet_tolerance
+from ..functions.numerical import sheet_tolerance
 
 #: An estimate this many times the sheet's tolerance (relative to the value) is reported.
 ESTIMATE_LIMIT = 100.0

@@ -5,7 +5,7 @@ in helper cells (in a table column, one chain a table row on 'Solver rows'); an 
 EXPR at 4 x samples + 1 points, the first best one, then GOLDEN_STEPS golden-section steps;
 an integral as an EXCEL_NODES-point Gauss-Legendre sum; a product written out; diff as its
 formula. :func:`bisection`, :func:`golden` and :func:`live_chain` compute the same steps in
-numpy (the numpy hooks inside :func:`workbook.numerics._common.live_forms`, and the cached
+numpy (the numpy hooks inside :func:`workbook.functions.numerical.live_forms`, and the cached
 values of the step cells).
 """
 
@@ -16,9 +16,9 @@ import math
 import numpy as np
 
 from ..errors import NotLive, WorkbookError
+from ..functions.numerical import chains
 from ..language import typed as ty
 from ..language.expr import PREC
-from ._common import chains
 
 ATOM = PREC["atom"]
 #: bisection steps of a root's live Excel form (a bracket halves 60 times: full precision)

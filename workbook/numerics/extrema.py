@@ -6,8 +6,18 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, call, num, row_text, rows
-from ._common import unit_suffix as _u
+from ..functions.numerical import (
+    DEFAULT,
+    Fn,
+    NumericsError,
+    Result,
+    Tolerance,
+    call,
+    num,
+    row_text,
+    rows,
+)
+from ..functions.numerical import unit_suffix as _u
 
 #: the bracket is sampled at this many times ``Tolerance.samples`` intervals
 OVERSAMPLE = 4

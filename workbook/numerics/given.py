@@ -6,8 +6,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from ..functions.numerical import DEFAULT, NumericsError, Result, Tolerance, num
 from ..language.given_find import METHODS as METHOD_NAMES
-from ._common import DEFAULT, NumericsError, Result, Tolerance, num
 
 #: scipy's method of each method of a [[solve]] block
 METHODS = dict(zip(METHOD_NAMES, ("hybr", "lm", "lm"), strict=True))

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import NumericsError, num
-from ._common import unit_suffix as _u
+from ..functions.numerical import NumericsError, num
+from ..functions.numerical import unit_suffix as _u
 
 
 def check_data(xs: np.ndarray, ys: np.ndarray, what: str) -> None:

@@ -19,9 +19,9 @@ from collections.abc import Callable
 import numpy as np
 
 from ..functions.interval_arith import Iv, add, div, exp, hull, ln, mul, neg, power, scale, sub
-from ..functions.registry import REGISTRY
 from ..language import typed as ty
 from ..language.visitor import Visitor
+from .registry import REGISTRY
 
 #: a sheet function nested deeper than this is not expanded
 _MAX_DEPTH = 20

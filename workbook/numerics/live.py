@@ -6,13 +6,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..functions.numerical import live_forms
 from ..language import typed as ty
-from ._common import live_forms
 
 
 def _live_note(name: str) -> str:
     """How the approximate live Excel form of built-in ``name`` computes ("" when exact)."""
-    from ..functions.registry import REGISTRY  # imported here: the registry imports numerics
+    from .registry import REGISTRY  # imported here: the registry imports numerics
 
     entry = REGISTRY.get(name)
     return entry.live_note if entry is not None else ""

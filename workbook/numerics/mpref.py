@@ -25,7 +25,7 @@ operation in mpmath, not numpy):
 Of a call with more than ``ROWS`` rows, ``ROWS`` rows spread over it are computed (the
 others are NaN, filled with the engine's values by the hooks). EXPR without an mpmath form
 returns None, and the hook falls back to :mod:`workbook.numerics.reference` (other
-algorithms in doubles); :func:`workbook.numerics._common.reference_note` records which.
+algorithms in doubles); :func:`workbook.functions.numerical.reference_note` records which.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ import math
 import mpmath
 import numpy as np
 
-from ._common import reference_note
+from ..functions.numerical import reference_note
 from .mpform import NoMpForm, NoValue, Unconverged, mp_form, quad
 from .reference import ReferenceFailed
 

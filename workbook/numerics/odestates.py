@@ -100,7 +100,7 @@ def root_error(of, shape, x: np.ndarray) -> np.ndarray | None:
 
 def add_root_error(of, shape, result) -> None:
     """Add the states' error to the roots' estimate (in place), where EXPR reads a state."""
-    from ._common import live, reference
+    from ..functions.numerical import live, reference
 
     if live() or reference() or not ode_names(of):
         return
@@ -117,7 +117,7 @@ def add_integral_error(of, shape, a, b, result) -> None:
     """Add the states' error to an integral's estimate (in place): twice the integral of the
     difference (the width times its mean at NODES interior points), where EXPR reads a
     state."""
-    from ._common import live, reference
+    from ..functions.numerical import live, reference
 
     if live() or reference() or not ode_names(of):
         return
@@ -132,7 +132,7 @@ def add_integral_error(of, shape, a, b, result) -> None:
 def add_value_error(of, shape, where, result) -> None:
     """Add the states' error to a maximum's or minimum's estimate (in place): twice the
     difference where it is, where EXPR reads a state."""
-    from ._common import live, reference
+    from ..functions.numerical import live, reference
 
     if live() or reference() or where is None or not ode_names(of):
         return

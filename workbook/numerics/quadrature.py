@@ -20,8 +20,18 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..errors import WorkbookError
-from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, call, num, row_text, rows
-from ._common import unit_suffix as _u
+from ..functions.numerical import (
+    DEFAULT,
+    Fn,
+    NumericsError,
+    Result,
+    Tolerance,
+    call,
+    num,
+    row_text,
+    rows,
+)
+from ..functions.numerical import unit_suffix as _u
 from .estimates import ESTIMATE_LIMIT
 from .kronrod import gk21
 

@@ -25,7 +25,7 @@ import warnings
 import numpy as np
 
 from ..errors import WorkbookError
-from ._common import NumericsError, Result
+from ..functions.numerical import NumericsError, Result
 
 #: points of the dense sampling of an extremum's reference
 DENSE = 4000

@@ -9,18 +9,22 @@ built-in constants (pi, e, g) as :data:`CONSTANTS` (:mod:`workbook.functions.con
 
 from __future__ import annotations
 
-from ..numerics import entries as _numerical  # noqa: F401 - root, integral, ..., diff register
-from . import builtins as _plain  # noqa: F401 - registers the plain built-ins on import
-from . import complexes as _complexes  # noqa: F401 - Re, Im, arg, conj, polar
-from . import decompositions as _decompositions  # noqa: F401 - cholesky, qr, svd
-from . import distributions as _distributions  # noqa: F401 - pnorm, qt, pchisq, ...
-from . import matrix_entries as _matrix  # noqa: F401 - min, max, mean, the vector and matrix built-ins
-from . import special as _special  # noqa: F401 - gamma, erf, Bessel functions, factorial
-from . import texts as _texts  # noqa: F401 - concat, num2str
-from .constants import CONSTANTS
-from .entry import ENTRIES
+from ..functions import builtins as _plain  # noqa: F401 - registers the plain built-ins on import
+from ..functions import complexes as _complexes  # noqa: F401 - Re, Im, arg, conj, polar
+from ..functions import decompositions as _decompositions  # noqa: F401 - cholesky, qr, svd
+from ..functions import distributions as _distributions  # noqa: F401 - pnorm, qt, pchisq, ...
+from ..functions import matrix_entries as _matrix  # noqa: F401 - min, max, mean, the vector and matrix built-ins
+from ..functions import sample_entries as _samples  # noqa: F401 - corr, Var, Stdev, Rank, ...
+from ..functions import special as _special  # noqa: F401 - gamma, erf, Bessel functions, factorial
+from ..functions import texts as _texts  # noqa: F401 - concat, num2str
+from ..functions.constants import CONSTANTS
+from ..functions.entry import ENTRIES, Builtins
+from . import entries as _numerical  # noqa: F401 - root, integral, ..., diff register
 
 #: Every built-in function by name.
 REGISTRY = ENTRIES
 
-__all__ = ["REGISTRY", "CONSTANTS"]
+#: Both, as the typer is given them (the typer, in workbook.language, imports no registry).
+BUILTINS = Builtins(REGISTRY, CONSTANTS, home=f"{__name__}:BUILTINS")
+
+__all__ = ["REGISTRY", "CONSTANTS", "BUILTINS"]

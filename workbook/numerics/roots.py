@@ -8,8 +8,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import WorkbookError
-from ._common import DEFAULT, Fn, NumericsError, Result, Tolerance, call, num, row_text, rows
-from ._common import unit_suffix as _u
+from ..functions.numerical import (
+    DEFAULT,
+    Fn,
+    NumericsError,
+    Result,
+    Tolerance,
+    call,
+    num,
+    row_text,
+    rows,
+)
+from ..functions.numerical import unit_suffix as _u
 
 
 def _tolerances(tol: Tolerance) -> dict:

@@ -50,7 +50,7 @@ def _context():
 
 def form_of(of):
     """(ctx, EXPR's mpmath form) or None where EXPR has none (or inside bench's reference)."""
-    from ._common import live, reference
+    from ..functions.numerical import live, reference
     from .mpform import NoMpForm, mp_form
 
     if live() or reference():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import LimitError
-from ._common import Fn, NumericsError, Result, call, num, rows
+from ..functions.numerical import Fn, NumericsError, Result, call, num, rows
 
 #: most terms of one sum or product (per row times rows)
 MAX_TERMS = 10_000_000
@@ -59,12 +59,12 @@ def record_series(of, lo, hi, value, absolute, count=None, kind: str = "sum") ->
     the additions (n eps sum |term|; a product's n eps |value|) plus EXPR's own rounding,
     checked in mpmath at SPOT_TERMS log-spaced terms (numerics.rounding), each standing for
     the terms around it (a sum's absolute differences add; a product's relative ones)."""
-    from ._common import live, reference
+    from ..functions.numerical import live, reference
     from .rounding import discrepancy, form_of
 
     if reference():  # workbook bench: the reference's values of this call, in mpmath
+        from ..functions.numerical import reference_values
         from . import mpref
-        from ._common import reference_values
 
         ref = mpref.series(of, lo, hi, kind)
         if ref is not None:

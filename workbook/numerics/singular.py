@@ -25,7 +25,7 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
     """Typed sub-trees of ``body`` that depend on ``var`` and whose zeros are singular points
     of EXPR (a denominator, a power's base, and what each built-in's entry says: the argument
     of sqrt, ln, log10, the cosine of tan's)."""
-    from ..functions.registry import REGISTRY
+    from .registry import REGISTRY
 
     found: list[ty.T] = []
     stack = [(body, 0)]

@@ -17,7 +17,7 @@ import weakref
 import numpy as np
 
 from ..errors import WorkbookError
-from ._common import NumericsError, Result, live, num, reference
+from ..functions.numerical import NumericsError, Result, live, num, reference
 
 #: the two one-sided slopes are taken this far (relative) from the point
 SIDE = 1e-9
@@ -48,8 +48,8 @@ def _reference(of, order: int, value):
     """Inside ``workbook bench``'s reference: mpmath's derivative at the points of the first
     call of this diff() (the engine keeps its estimate of the first call only), the formula's
     values at the others and in the rows not computed."""
+    from ..functions.numerical import reference_values
     from . import mpref
-    from ._common import reference_values
 
     done = _CHECKED.setdefault(of.evaluator, set())
     key = ("reference", id(of.body), order)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import NumericsError, num
+from ..functions.numerical import NumericsError, num
 from .interpolate import check_data
 
 

@@ -19,7 +19,7 @@ def switching(body: ty.T, var: str) -> list[ty.T]:
     ``jumps`` and ``kinks``). Their zeros are
     found numerically (:func:`workbook.numerics.features.kink_points`); the linear cases
     are also found above, exactly."""
-    from ..functions.registry import REGISTRY
+    from .registry import REGISTRY
 
     found: list[ty.T] = []
     stack = [body]

@@ -9,7 +9,7 @@ exact ``pi``.
 
 API (kept small on purpose; other scenes use it)::
 
-    from workbook.engine import symbolic
+    from workbook.numerics import symbolic
     expr = symbolic.to_sympy(sheet, "h1")                 # in the symbol phi
     d1 = symbolic.derivative(sheet, "h1", "phi", 1)       # d h1 / d phi (phi in its binding unit)
     f = symbolic.lambdify(sheet, d1, "phi")               # numpy function of phi
@@ -29,7 +29,12 @@ import math
 from fractions import Fraction
 
 from ..errors import NotSymbolic, WorkbookError
-from ..functions.registry import CONSTANTS, REGISTRY
+from ..functions.constants import CONSTANTS
+
+# the registry's dict (workbook.numerics.registry.REGISTRY), read from its home: the registry
+# imports the entry of diff, which imports this module; every entry is registered by the time
+# a tree is converted
+from ..functions.entry import ENTRIES
 from ..language import typed as ty
 from ..language import units as un
 from ..language.visitor import Visitor
@@ -89,7 +94,7 @@ class _Refusal(Visitor):
         return None
 
     def visit_TFunc(self, t, symbols, values):
-        return getattr(REGISTRY[t.func].sympy, "refusal", None)
+        return getattr(ENTRIES[t.func].sympy, "refusal", None)
 
     def visit_TBlock(self, t, symbols, values):
         return f"{t.name}() is a solver block ({t.ref}): it has no formula to differentiate"
@@ -237,7 +242,7 @@ class SympyConverter(Visitor):
 
     def visit_TFunc(self, t, env):
         sp = _sympy()
-        entry = REGISTRY[t.func]
+        entry = ENTRIES[t.func]
         if not entry.binds:
             return entry.sympy(sp, *[self.convert(a, env) for a in t.args])
         expr_at, var_at = entry.binds

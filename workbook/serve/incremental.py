@@ -37,6 +37,7 @@ from ..language.checkspec import placeholders
 from ..language.template import column_node, parse_spec, read_toml
 from ..language.typecheck import Typer, dependencies, solve_expressions
 from ..language.typedsheet import TypedSheet, printed_rows
+from ..numerics.registry import BUILTINS
 from ..outputs.report.charts import chart_svg
 from ..outputs.report.html import Document
 from ..program.statements import names as program_names
@@ -68,7 +69,7 @@ class ReusingSheet(Sheet):
             return
         old, dirty = retype  # the Sheet before the edit, and what the edit reaches
         units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-        typer = seeded_typer(old.typer, Typer(spec, units), dirty)
+        typer = seeded_typer(old.typer, Typer(spec, units, BUILTINS), dirty)
         super().__init__(spec, values, typer, parts, seeded_trees(old, spec, dirty))
         self.check_units()  # a Sheet given a typer does not: the unchanged are looked up
 

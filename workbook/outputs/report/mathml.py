@@ -17,7 +17,9 @@ from html import escape
 
 import numpy as np
 
-from ...functions import registry as bi
+# the registry's dict (workbook.numerics.registry.REGISTRY) read from its home, below the
+# numerics a renderer does not import: a computed sheet's built-ins are all registered
+from ...functions.entry import ENTRIES
 from ...language import expr as ex
 from ...language.visitor import Visitor
 
@@ -440,7 +442,7 @@ class MathML(Visitor):
             exp = self.box(exp_node)
         finally:
             self.inline -= 1
-        entry = bi.REGISTRY.get(base_node.func) if isinstance(base_node, ex.Call) else None
+        entry = ENTRIES.get(base_node.func) if isinstance(base_node, ex.Call) else None
         if (
             entry is not None
             and entry.mathml_powered
@@ -502,7 +504,7 @@ class MathML(Visitor):
 
     def visit_Call(self, node: ex.Call) -> Box:
         func = node.func
-        entry = bi.REGISTRY.get(func)
+        entry = ENTRIES.get(func)
         if entry is None and func in ("max_over", "min_over") and len(node.args) == 2:
             table, column = node.args
             # the largest value of a table's column: max with the table's name below
