@@ -47,9 +47,6 @@ HOMES = {
 # Lists of built-in names that are still kept elsewhere, each exactly as it is now, so that a
 # new list, or a built-in added to one of these, fails: (module, the built-ins listed).
 KNOWN_ELSEWHERE = {
-    # the sizes read from a matrix written out while importing (its elements may call
-    # functions whose units are settled only at the end of the translation)
-    ("mathcad/engine.py", ("cols", "length", "rows")),
     # the words of a sweep output's grammar ("max of X over Y"), not calls
     ("sweep/outputs.py", ("argmax", "argmin", "max", "mean", "min")),
     # Excel's unit names of CONVERT (minute, pint, quart, second), not calls

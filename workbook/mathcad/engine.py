@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language import typecheck as tc
@@ -437,16 +439,21 @@ class AtImport:
         return items, syms, range_syms
 
     def _sizes(self, node: ex.Node) -> ex.Node:
-        """``node`` with rows(M), cols(M) and length(v) of a matrix written out in the
-        translation (by name) as numbers. Kept from the tree, not computed: an element of M may
-        call a function of the sheet, whose arguments' units are only known at the end."""
-        if isinstance(node, ex.Call) and node.func in ("rows", "cols", "length"):
-            if len(node.args) == 1:
-                tree = self.translator.written_out(node.args[0]) or node.args[0]
-                if isinstance(tree, ex.Matrix):
-                    rows, cols = len(tree.rows), len(tree.rows[0])
-                    if node.func != "length" or cols == 1:
-                        return ex.Number(float(cols if node.func == "cols" else rows))
+        """``node`` with the sizes (rows, cols, length: a built-in that reads only the size
+        of its argument, whatever the origin) of a matrix written out in the translation (by
+        name) as numbers. Kept from the tree, not computed: an element of M may call a
+        function of the sheet, whose arguments' units are only known at the end."""
+        entry = BUILTINS.functions.get(node.func) if isinstance(node, ex.Call) else None
+        if entry is not None and entry.sizes and len(node.args) == 1:
+            tree = self.translator.written_out(node.args[0]) or node.args[0]
+            if isinstance(tree, ex.Matrix):
+                shape = (len(tree.rows), len(tree.rows[0]))
+                try:  # at origins 0 and 1: one that depends on the origin (last) stays
+                    at = {float(entry.numpy(np.zeros(shape), o, shapes=[shape])) for o in (0, 1)}
+                except WorkbookError:  # the length of a matrix: typed, and refused, as written
+                    at = set()
+                if len(at) == 1:
+                    return ex.Number(at.pop())
         return ex.map_children(node, self._sizes)
 
     def _typed(self, node: ex.Node, what: str, ranges: bool, values: bool):
