@@ -417,7 +417,7 @@ def test_csv_and_export_overwrite_only_with_force(tmp_path):
 def test_every_sheet_key_the_engine_reads_is_a_known_key():
     import re
 
-    from workbook.language.template import SHEET_KEYS
+    from workbook.language.spec import SHEET_KEYS
 
     source = Path(workbook.__file__).parent
     read = {

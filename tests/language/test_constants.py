@@ -12,7 +12,7 @@ from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import TemplateError
-from workbook.numerics.registry import CONSTANTS
+from workbook.functions.constants import CONSTANTS
 
 SHEET = """
 [sheet]

@@ -16,11 +16,12 @@ import numpy as np
 
 from ..errors import NotLive
 from ..functions import complexes, excel_names
+from ..functions.constants import CONSTANTS
 from ..language import cellunit
 from ..language import typed as ty
 from ..language.expr import PREC
 from ..language.visitor import Visitor
-from ..numerics.registry import CONSTANTS, REGISTRY
+from ..numerics.registry import REGISTRY
 
 if TYPE_CHECKING:
     from ..language.typecheck import Typer

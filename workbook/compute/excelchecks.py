@@ -7,11 +7,10 @@ from __future__ import annotations
 import math
 
 from .. import verdicts as V
-from ..errors import WorkbookError
+from ..errors import NotLive, WorkbookError
 from ..functions.constants import CONSTANTS, shadowed
 from ..version import __version__
 from .checks import tolerances
-from .excel import NotLive
 from .excelsheets import write_labels
 from .livecheck import RELATIVE, ROWS_CHECKED
 

@@ -21,7 +21,7 @@ import numpy as np
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..engine import runtime as rt
-from ..errors import LimitError, WorkbookError
+from ..errors import LimitError, NotLive, WorkbookError
 from ..functions.excel_names import ExcelNames
 from ..functions.matrix import numbers
 from ..language import expr as ex
@@ -31,7 +31,7 @@ from ..language.uses import names_used
 from ..limits import MAX_TABLE_CELLS
 from ..version import __version__
 from . import excelchecks, frozen, rangeguard, style
-from .excel import ExcelPrinter, NotLive, cell_value
+from .excel import ExcelPrinter, cell_value
 from .excelsheets import (
     MAX_COLS,
     ROW_TOKEN,

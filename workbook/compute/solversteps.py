@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import WorkbookError
+from ..errors import NotLive, WorkbookError
 from ..language import typed as ty
-from .excel import NotLive
 from .excelsheets import MAX_COLS, ROW_TOKEN, col_letter, write_labels
 
 

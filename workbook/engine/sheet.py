@@ -19,6 +19,7 @@ from ..errors import (
     TemplateError,
     WorkbookError,
 )
+from ..functions.constants import CONSTANTS
 from ..functions.matrix import numbers
 from ..functions.numerical import defining
 from ..language import cellunit
@@ -37,7 +38,7 @@ from ..language.unitrules import is_scaled_angle
 from ..language.uses import names_used
 from ..limits import exhausted, matrix_work
 from ..limits_time import check_time
-from ..numerics.registry import BUILTINS, CONSTANTS
+from ..numerics.registry import BUILTINS
 from . import runtime as rt
 from .numeric import Evaluator
 from .tabledata import Column, TableData

@@ -13,9 +13,9 @@ from .kinds import cell_kind
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .subwrites import cells_written
-from .vba import Module, Procedure, is_event, read_modules
-from .vbamembers import record_types
-from .vbaprogram import KEYWORDS, FunctionInfo, NotTranslated, Translator
+from .vba import Module, is_event, read_modules
+from .vbamembers import NotTranslated, record_types
+from .vbaprogram import KEYWORDS, FunctionInfo, Translator
 
 #: formulas translated at most (those that call VBA functions first; a multi-cell array
 #: formula counts once)
@@ -833,9 +833,6 @@ def _addr(row: int, col: int) -> str:
     from openpyxl.utils import get_column_letter
 
     return f"{get_column_letter(col)}{row}"
-
-
-__all__ = ["Translation", "translate_book", "Procedure"]
 
 
 def translate_vba(code: str, module: str = "Module1") -> dict[str, FunctionInfo]:

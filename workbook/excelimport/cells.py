@@ -731,7 +731,8 @@ class FormulaTranslator:
             return "(1/0)"
         texts, flags = [], []
         from .vbaexpr import VbaSyntax
-        from .vbaprogram import NotTranslated, default_text
+        from .vbamembers import NotTranslated
+        from .vbaprogram import default_text
 
         for k, p in enumerate(params):
             a = args[k] if k < len(args) else None

@@ -2,10 +2,11 @@
 
 A constant is one :class:`Constant` entry: its value and unit, its Excel text, its SymPy form,
 and how the report writes it. Every consumer (the typer, the numpy evaluator, the Excel and
-SymPy printers, the report) reads :data:`CONSTANTS` through :mod:`workbook.numerics.registry`;
-nothing else lists them. A worksheet may define a name of its own that is also a constant (``e``, an
-eccentricity, is common): then the name is the sheet's everywhere, and the About sheet of the
-workbook says so (:func:`shadowed`)."""
+SymPy printers, the report) reads :data:`CONSTANTS` from here (the typer as
+:data:`workbook.numerics.registry.BUILTINS` gives them); nothing else lists them. A worksheet
+may define a name of its own that is also a constant (``e``, an eccentricity, is common):
+then the name is the sheet's everywhere, and the About sheet of the workbook says so
+(:func:`shadowed`)."""
 
 from __future__ import annotations
 

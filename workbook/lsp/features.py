@@ -9,9 +9,10 @@ import numpy as np
 from lsprotocol import types as lsp
 
 from ..errors import WorkbookError
-from ..language import template as tp
+from ..functions.constants import CONSTANTS
+from ..language import spec as tp
 from ..language import units as un
-from ..numerics.registry import CONSTANTS, REGISTRY
+from ..numerics.registry import REGISTRY
 from .document import Document, Span, section_at, word_at
 
 #: The keys of each section's entries, as the template reader accepts them.

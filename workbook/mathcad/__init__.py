@@ -100,7 +100,8 @@ def _reference_path(path: Path, href: str) -> Path:
 def import_file(src: str | Path, out_dir: str | Path = ".", *, force: bool = False):
     """Translate ``src`` and write ``out_dir/NAME.toml`` and its printed values."""
     from . import engine, writer
-    from .translate import Skipped, Translator
+    from .translate import Translator
+    from .translation import Skipped
 
     src = Path(src)
     if src.suffix.lower() == ".mcdx":

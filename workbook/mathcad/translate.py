@@ -24,10 +24,8 @@ from .solving import SolveMixin
 from .symbols import Sym, Unknown, Untranslatable, matrix_size
 from .symbols import key as _key
 from .symbols import what as _what
-from .translation import Item, Result, Skipped, Translation, uses
+from .translation import Item, Skipped, Translation, uses
 from .units import FORMULA_UNITS
-
-__all__ = ["Item", "Result", "Skipped", "Translation", "Translator", "ExprTranslator"]
 
 
 class Translator(ResultsMixin, SolveMixin):

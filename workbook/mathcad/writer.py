@@ -54,7 +54,7 @@ def pretty_quantity(text: str) -> str:
 def assign_identifiers(tr: Translation) -> None:
     """Choose every symbol's identifier: unique, not a built-in, arguments apart from the
     names of inputs and definitions (shared by arguments of the same unit)."""
-    from ..numerics.registry import CONSTANTS
+    from ..functions.constants import CONSTANTS
 
     reserved = set(language_functions()) | {"pi"}
     # a name left out (untranslated) is never a constant's: its stored results would read

@@ -4,8 +4,9 @@ the numerical ones of :mod:`workbook.numerics.entries`, the complex ones of
 :mod:`workbook.functions.complexes`, the texts of :mod:`workbook.functions.texts`, the vector and
 matrix ones of :mod:`workbook.functions.matrix_entries`, the special functions of
 :mod:`workbook.functions.special` and the decompositions of
-:mod:`workbook.functions.decompositions`. Every back end reads built-ins from here, and the
-built-in constants (pi, e, g) as :data:`CONSTANTS` (:mod:`workbook.functions.constants`)."""
+:mod:`workbook.functions.decompositions`. Every back end reads built-ins from here; the built-in
+constants (pi, e, g) are :data:`workbook.functions.constants.CONSTANTS`, and :data:`BUILTINS`
+holds both."""
 
 from __future__ import annotations
 
@@ -26,5 +27,3 @@ REGISTRY = ENTRIES
 
 #: Both, as the typer is given them (the typer, in workbook.language, imports no registry).
 BUILTINS = Builtins(REGISTRY, CONSTANTS, home=f"{__name__}:BUILTINS")
-
-__all__ = ["REGISTRY", "CONSTANTS", "BUILTINS"]
