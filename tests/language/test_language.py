@@ -79,6 +79,12 @@ def test_example(tmp_path, text):
             found = {f.what: f.verdict for f in sheet.check().findings}
             assert found.get(what) == verdict, (line, found)
             continue
+        if " shown in " in line:  # NAME shown in UNIT: the unit its value is shown in
+            from workbook.language.units import pretty
+
+            name, _, unit = line.partition(" shown in ")
+            assert pretty(sheet.evaluate(name).units) == unit, line
+            continue
         if line.startswith("chart "):
             _, name, _, _, n = line.split()
             assert len(next(c for c in sheet.spec.charts if c.name == name).series) == int(n)

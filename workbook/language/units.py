@@ -248,10 +248,15 @@ def is_compound_ratio(u: pint.Unit) -> bool:
 def reduced(u: pint.Unit) -> pint.Unit:
     """``u`` with its factors of one dimension combined (``kg*L/m^3`` is ``kg``, ``N*m/mm``
     is ``N``), as pint's ``to_reduced_units``; ``u`` itself when that leaves as many factors,
-    when it is dimensionless, or when a factor is dimensionless (an angle, a percentage:
-    ``N*m/rad`` is a torsional stiffness) or a temperature with an offset."""
+    when it is dimensionless, or when a factor is an angle (``N*m/rad`` is a torsional
+    stiffness) or a temperature with an offset. A percentage (or per mille, ppm) beside other
+    factors is a number, as in Mathcad: ``kW/%`` is ``kW`` and ``%^2`` a plain number."""
     ureg = registry()
     names = to_units_container(u)
+    scales = [n for n in names if _is_scale(n)]
+    if scales and (len(names) > 1 or any(names[n] != 1 for n in scales)):
+        u = ureg.Unit(_without(names, scales))
+        names = to_units_container(u)
     if not u.dimensionality or len(names) < 2:
         return u
     for name in names:
@@ -259,6 +264,19 @@ def reduced(u: pint.Unit) -> pint.Unit:
             return u
     out = ureg.Quantity(1.0, u).to_reduced_units().units
     return out if len(to_units_container(out)) < len(names) else u
+
+
+@functools.lru_cache(maxsize=256)
+def _is_scale(name: str) -> bool:
+    """A unit that is a pure number times a scale (percent, permille, ppm), not an angle."""
+    factor, root = registry().get_root_units(name)
+    return root == registry().dimensionless and factor != 1
+
+
+def _without(names, dropped: list[str]) -> str:
+    """The unit text of ``names`` (a units container) without the units ``dropped``."""
+    kept = [f"{n}**{p}" for n, p in names.items() if n not in dropped]
+    return "*".join(kept) or "dimensionless"
 
 
 #: How a worksheet spells a unit where pint's symbol is not what it types: pint's liter is l.
