@@ -276,3 +276,14 @@ def test_python_syntax_warnings_do_not_reach_the_user():
         warnings.simplefilter("always")
         assert ex.parse("1if a > 0 else 2") == ex.parse("1 if a > 0 else 2")
     assert not [w for w in seen if issubclass(w.category, SyntaxWarning)], seen
+
+
+def test_a_units_name_gets_both_hints_when_the_sheet_has_a_name_like_it(sheet_from):
+    """``P1 + kW`` beside an input ``k``: the sheet's name like it, and how a unit is written
+    (the second hint was lost when the first was found)."""
+    text = '[inputs]\nk = "2"\nP1 = "3 kW"\n[definitions]\nP = "P1 + kW"\n'
+    with pytest.raises(workbook.WorkbookError) as err:
+        sheet_from(text)
+    assert "unknown name 'kW' (did you mean k?; a unit is written after a number: 1 kW)" in str(
+        err.value
+    )

@@ -275,21 +275,17 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         translated)``, named so that no formula reads it, among thousands of others)."""
         if not ex.is_identifier(name):
             return TemplateError(f"unknown {kind} '{name}'")
-        spec = self.spec
+        spec, functions = self.spec, self.builtins.functions
         own = dict.fromkeys([*scope, *spec.inputs, *spec.definitions, *spec.arguments])
-        known = {
-            **own,
-            **dict.fromkeys([*spec.blocks, *self.builtins.functions, *self.builtins.constants]),
-        }
+        known = {**own, **dict.fromkeys([*spec.blocks, *functions, *self.builtins.constants])}
         hint = nearest(name, known)
         if kind == "name":  # a value is meant: the sheet's names first (R1 is R_1, not Re())
-            values = nearest(
-                name, {k: v for k, v in known.items() if k not in self.builtins.functions}
-            )
+            values = nearest(name, {k: v for k, v in known.items() if k not in functions})
             hint = values if values or un.is_unit_name(name) else hint
-        if kind == "name" and un.is_unit_name(name) and not nearest(name, own):
-            # a unit's name: the unit's hint before a built-in's that looks like it (mm, gamma)
-            hint = f" (a unit is written after a number: 1 {name})"
+        if kind == "name" and un.is_unit_name(name):  # a unit's: the sheet's names like it, then
+            near = nearest(name, own)[:-1]  # the unit's hint (not a built-in's: mm, gamma)
+            hint = f"{near}; " if near else " ("
+            hint += f"a unit is written after a number: 1 {name})"
         return TemplateError(f"unknown {kind} '{name}'{hint}")
 
     def typed_body(self, d: Definition, scope: dict[str, pint.Unit]) -> T:
