@@ -1,8 +1,8 @@
-"""Random worksheets that mix prefixed units, ratios of them, percentages, degrees,
-temperatures, text results of an inline condition, tables and scalars: each written, its
-every formula cell recalculated from the inputs by the check's own reader of Excel formulas
-(default test, few examples) and by LibreOffice (slow), and compared with the engine to 1e-9
-relative."""
+"""Random worksheets that mix prefixed units, ratios of them, percentages (alone and beside
+units of a dimension), degrees, temperatures, text results of an inline condition, tables and
+scalars: each written, its every formula cell recalculated from the inputs by the check's own
+reader of Excel formulas (default test, few examples) and by LibreOffice (slow), and compared
+with the engine to 1e-9 relative."""
 
 from __future__ import annotations
 
@@ -36,6 +36,8 @@ SCALARS = [
     "q/(1 + r)",
 ]
 DECLARED = ["", "%", None]
+# a percentage beside units of a dimension: its unit is the number it stands for (kW/% is kW)
+WITH_PERCENT = ["P1/p", "P1*p", "L1*p/S1", "p*p*L1", "P1/(p*L1)", "S1*(100 % - p)"]
 
 
 @st.composite
@@ -53,6 +55,7 @@ def sheets(draw):
             f'y{i} = "{expr}"' if unit is None else f'y{i} = {{ expr = "{expr}", unit = "{unit}" }}'
         )
     threshold = value(0.1, 3.0)
+    with_percent = draw(st.sampled_from(WITH_PERCENT))
     column = draw(st.sampled_from(["x*r", "x*s + r", "x*y0", "(x + s)*p", "x*P1/P2"]))
     return f"""
 [inputs]
@@ -79,6 +82,7 @@ T2 = {{ expr = "T1 + dT*rr", unit = "degC" }}
 T3 = {{ expr = "T2", unit = "K" }}
 verdict = "\\"high\\" if r > {threshold} otherwise \\"low\\""
 {chr(10).join(defs)}
+w = "{with_percent}"
 "f(x)" = "{column}"
 "g(x)" = "x*s"
 top = "max_over(T, f)"
