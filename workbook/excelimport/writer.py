@@ -6,12 +6,12 @@ from __future__ import annotations
 import csv
 import io
 import re
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import WorkbookError
 from ..language.csvcells import csv_text as spreadsheet_text
+from ..language.spec import SheetSpec
 from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
 from .book import Definition, Translation
@@ -392,43 +392,43 @@ def _addr(row: int, col: int) -> str:
     return f"{get_column_letter(col)}{row}"
 
 
-def _refusals(toml: str, files: dict, name: str) -> dict[str, str]:
-    """{definition: why} of what the engine refuses at load (empty when the worksheet loads):
-    every definition is typed, so one load finds them all."""
-    import workbook
-    from workbook.language import typecheck as tc
-    from workbook.language.template import load_spec
-    from workbook.numerics.registry import BUILTINS
+def _refusals(toml: str, files: dict, path: Path) -> tuple[dict[str, str], SheetSpec | None]:
+    """({definition: why} of what the engine refuses at load, empty when the worksheet loads;
+    the worksheet's spec when it reads): every definition is typed, so one load finds them
+    all. Read and typed in memory: ``path`` (where it will be written) only names it, and the
+    printed-value files are read from their texts in ``files``."""
+    from ..engine.sheet import Sheet
+    from ..language import typecheck as tc
+    from ..language.printed import printed_from_text
+    from ..language.template import parse_spec
+    from ..numerics.registry import BUILTINS
 
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"{name}.toml"
-        path.write_text(toml, encoding="utf-8")
-        for fname, text in files.items():
-            (Path(tmp) / fname).write_text(text, encoding="utf-8")
+    try:
+        spec = parse_spec(toml, path)
+        for printed in spec.printed:
+            printed.read = printed_from_text(printed, files[printed.file.name])
+        units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
+        typer = tc.Typer(spec, units, BUILTINS)
+    except WorkbookError as err:
+        return _located(err, toml), None
+    found: dict[str, str] = {}
+    for n, d in spec.definitions.items():
+        if d.is_function:
+            continue
         try:
-            spec = load_spec(path)
-            units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
-            typer = tc.Typer(spec, units, BUILTINS)
+            typer.scalar(n)
         except WorkbookError as err:
-            return _located(err, toml)
-        found: dict[str, str] = {}
-        for n, d in spec.definitions.items():
-            if d.is_function:
-                continue
-            try:
-                typer.scalar(n)
-            except WorkbookError as err:
-                culprit = err.definition if err.definition in spec.definitions else n
-                found.setdefault(culprit.split("(")[0], f"the engine refuses it: {err.message}")
-            except RecursionError:
-                found.setdefault(n, "the engine refuses it: nested too deeply")
-        if found:
-            return found
-        try:
-            workbook.load(str(path))
-        except WorkbookError as err:
-            return _located(err, toml)
-    return {}
+            culprit = err.definition if err.definition in spec.definitions else n
+            found.setdefault(culprit.split("(")[0], f"the engine refuses it: {err.message}")
+        except RecursionError:
+            found.setdefault(n, "the engine refuses it: nested too deeply")
+    if found:
+        return found, spec
+    try:  # what the load types besides the definitions: tables, the printed rows' formulas
+        Sheet(spec, typer=typer).check_units()
+    except WorkbookError as err:
+        return _located(err, toml), spec
+    return {}, spec
 
 
 def _located(err: WorkbookError, toml: str) -> dict[str, str]:
@@ -448,17 +448,20 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
 
     name = _sheet_name(tr.path)
     skip: dict[str, str] = {}
+    users: dict | None = None  # of the first spec read: it holds every later one
     for _ in range(MAX_LOAD_ROUNDS):
         toml, files, counts = render(tr, skip)
-        refused = _refusals(toml, files, name)
+        refused, spec = _refusals(toml, files, out_dir / f"{name}.toml")
         if not refused:
             break
+        if users is None and spec is not None:
+            users = _users(spec)
         for what, why in refused.items():
             if what in skip:
                 raise WorkbookError(f"the translated worksheet does not load: {why}")
             skip[what] = why
         for what in refused:
-            _drop_dependents(tr, what, skip)
+            _drop_dependents(users or {}, what, skip)
     else:
         raise WorkbookError(
             f"the translated worksheet still does not load after leaving out {len(skip)} "
@@ -479,26 +482,27 @@ def write(tr: Translation, out_dir: Path, *, force: bool):
     )
 
 
-def _drop_dependents(tr: Translation, name: str, skip: dict[str, str]) -> None:
+def _users(spec: SheetSpec) -> dict[str, dict[str, None]]:
+    """{name: the definitions whose formulas or programs name it, in the worksheet's order} of
+    a translated worksheet, read from its parsed trees (``NAME_at``, the element of an array
+    formula's cell, stands for NAME too)."""
+    from ..language.typecheck import direct_names
+
+    users: dict[str, dict[str, None]] = {}
+    for key, d in spec.definitions.items():
+        for used in direct_names(spec, d):
+            users.setdefault(used, {})[key] = None
+            if used.endswith("_at"):
+                users.setdefault(used[:-3], {})[key] = None
+    return users
+
+
+def _drop_dependents(users: dict[str, dict[str, None]], name: str, skip: dict[str, str]) -> None:
     """Leave out the definitions and functions that use ``name`` (they would be refused
     next), and those that use them."""
-    users: dict[str, list[str]] = {}
-    for d in tr.definitions:
-        if d.problem:
-            continue
-        used = set(_WORD.findall(d.text or "")) | ({d.element[0]} if d.element else set())
-        for u in used | {u[:-3] for u in used if u.endswith("_at")}:  # NAME_at(k) uses NAME
-            users.setdefault(u, []).append(d.name)
-    for text, rname in tr.ranges.items():
-        for u in set(_WORD.findall(text)):
-            users.setdefault(u, []).append(rname)
-    for info in tr.functions.values():
-        if not info.problem:
-            for u in set(_WORD.findall(info.program)):
-                users.setdefault(u, []).append(info.final)
     todo = [name]
     while todo:
-        for user in users.get(todo.pop(), []):
+        for user in users.get(todo.pop(), ()):
             if user not in skip:
                 skip[user] = f"uses {name}, left out"
                 todo.append(user)

@@ -28,7 +28,11 @@ def read_commented_csv(path, what: str):
 
     Returns (header cells or None, [(line number, cells, line text), ...]).
     """
-    text = read_text(Path(path), what=what, max_bytes=MAX_CSV_BYTES)
+    return commented_csv(read_text(Path(path), what=what, max_bytes=MAX_CSV_BYTES), str(path))
+
+
+def commented_csv(text: str, file: str):
+    """:func:`read_commented_csv` of a CSV's text (``file`` names it in messages)."""
     header, rows = None, []
     for number, line in enumerate(text.splitlines(), start=1):
         if not line.strip() or line.lstrip().startswith("#"):
@@ -37,7 +41,7 @@ def read_commented_csv(path, what: str):
             cells = next(csv.reader([line]))
         except csv.Error as exc:
             raise TemplateError(
-                f"cannot read the line as CSV ({exc})", file=str(path), line=number
+                f"cannot read the line as CSV ({exc})", file=file, line=number
             ) from None
         if header is None:
             header = cells
@@ -68,7 +72,16 @@ def read_printed(spec: PrintedSpec) -> list[PrintedRow]:
             what="[[printed]] file",
             max_bytes=MAX_CSV_BYTES,
         )
-    header, lines = read_commented_csv(file, "printed values")
+    return printed_from_lines(spec, read_commented_csv(file, "printed values")[1])
+
+
+def printed_from_text(spec: PrintedSpec, text: str) -> list[PrintedRow]:
+    """The rows of a printed-values CSV given as text (a file written in memory, not read)."""
+    return printed_from_lines(spec, commented_csv(text, str(spec.file))[1])
+
+
+def printed_from_lines(spec: PrintedSpec, lines) -> list[PrintedRow]:
+    """The rows of a printed-values CSV's lines (:func:`commented_csv`), each checked."""
     rows = []
     for number, cells, line in lines:
         if len(cells) != 4:

@@ -966,22 +966,24 @@ def _closure(spec: SheetSpec, todo: list[str]) -> set[str]:
                 if m not in block.parameters
             )
         d = spec.definitions.get(n)
-        if d is None:
-            continue
-        local: set[str] = set(d.params)
-        bodies = d.expressions()
-        if d.program is not None:
-            from ..program.statements import names as program_names
-
-            todo.extend(program_names(d.program) - local)
-            continue
-        if d.ode is not None:
-            o = spec.odes[d.ode[0]]
-            local |= {o.var} | {s.name for s in o.states}
-            bodies = o.expressions()
-        for body in bodies:
-            todo.extend(m for m in ex.names(body) if m not in local)
+        if d is not None:
+            todo.extend(direct_names(spec, d))
     return out
+
+
+def direct_names(spec: SheetSpec, d: Definition) -> set[str]:
+    """The names definition ``d``'s formulas, program or ODE use (not its own parameters)."""
+    local: set[str] = set(d.params)
+    if d.program is not None:
+        from ..program.statements import names as program_names
+
+        return program_names(d.program) - local
+    bodies = d.expressions()
+    if d.ode is not None:
+        o = spec.odes[d.ode[0]]
+        local |= {o.var} | {s.name for s in o.states}
+        bodies = o.expressions()
+    return {m for body in bodies for m in ex.names(body) if m not in local}
 
 
 def solve_expressions(block) -> list[ex.Node]:
