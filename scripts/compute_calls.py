@@ -8,10 +8,11 @@ Each sheet is loaded, then counted (cProfile) while ``compute(sheet, excel=True)
 and its workbook is written, and while ``compute(sheet)`` computes it again for the report and
 the report's HTML is rendered (what ``workbook run`` and ``workbook report`` do after the load).
 The typer is every function of ``workbook/language/typecheck.py`` and of its bases
-(``typearrays.py``, ``unitrules.py``): ``Typer.expression`` types a free expression,
-``Typer.scalar`` and ``Typer.function`` type a definition or return its typed tree when it is
-typed already; "typing" counts the calls that type a tree (``Typer.expression``, a
-``visit_`` method, a conversion, a definition's body). A parse is a call of
+(``typearrays.py``, ``unitrules.py``): after the load the compute stage reads the typed
+definitions (``workbook.language.typeddefs.TypedDefinitions``), which ask the typer only for a
+tree not typed yet, so "typer" counts every call of the typer's code (0: every read found its
+tree); "typing" counts the calls that type a tree (``Typer.expression``, a ``visit_`` method,
+a conversion, a definition's body). A parse is a call of
 ``workbook.language.expr.parse``; a printed-value file read, of ``printed.read_printed``.
 """
 

@@ -1,5 +1,5 @@
-"""The typed stage: after ``load``, computing and writing a sheet types nothing and parses
-nothing (the typed trees are made at load and read), and through the Python API a Sheet is
+"""The typed stage: after ``load``, computing and writing a sheet calls no typer code and
+parses nothing (the typed trees are made at load and read), and through the Python API a Sheet is
 checked and computed once however often it is checked, written and reported
 (scripts/compute_calls.py counts the calls)."""
 
@@ -148,5 +148,6 @@ def test_a_sheet_is_checked_and_computed_once_through_the_api(tmp_path, monkeypa
 @pytest.mark.parametrize("name", compute_calls.sheets())
 def test_computing_and_writing_types_and_parses_nothing(name):
     found = compute_calls.calls(name)
+    assert found["typer"] == 0, found  # the typed trees are read, not asked of the typer
     assert found["typing"] == 0, found
     assert found["parse"] == 0, found

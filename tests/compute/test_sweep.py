@@ -418,7 +418,7 @@ def _vectorisable_outputs(sheet, name: str) -> dict:
     vectorised sweep of it computes."""
     from workbook.errors import WorkbookError
     from workbook.language import expr as ex
-    from workbook.language import typecheck as tc
+    from workbook.language.uses import dependencies
     from workbook.sweep.grid import as_varies
     from workbook.sweep.outputs import as_outputs, type_output
     from workbook.sweep.vector import vector_blockers
@@ -426,7 +426,7 @@ def _vectorisable_outputs(sheet, name: str) -> dict:
     spec, keep = sheet.spec, {}
     varies = as_varies(sheet, {name: [str(sheet.values[name])]})
     for n, d in spec.definitions.items():
-        if d.is_function or name not in tc.dependencies(spec, ex.Name(n)):
+        if d.is_function or name not in dependencies(spec, ex.Name(n)):
             continue
         out = as_outputs(sheet, {n: n})
         try:

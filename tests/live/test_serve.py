@@ -379,7 +379,7 @@ def test_downstream_is_what_reads_the_change(name):
     definition whose (transitive) dependencies include it."""
     import workbook
     from workbook.language import expr as ex
-    from workbook.language.typecheck import dependencies
+    from workbook.language.uses import dependencies
     from workbook.serve.incremental import downstream
 
     spec = workbook.load(workbook.list_templates()[name]).full_spec

@@ -257,5 +257,5 @@ def test_where_a_builtin_jumps_or_is_singular_is_read_from_its_entry(tmp_path, s
     found = switching(body, "x")
     assert any(isinstance(t, ty.TFunc) and t.func == "cos" for t in found)  # stairs' jumps
     assert any(isinstance(t, ty.TBinary) and t.op == "-" for t in found)  # vee's kink, x - 2
-    assert [t for t in singular_arguments(sheet.typer, body, "x") if isinstance(t, ty.TBinary)]
+    assert [t for t in singular_arguments(sheet.defs, body, "x") if isinstance(t, ty.TBinary)]
     assert takes_angle("turn") and not takes_angle("stairs")

@@ -95,7 +95,7 @@ def linear_system(sheet):
     """A, b, g of the template's ode motion, y' = A y + b + g sin(Omega_pump t)."""
 
     def build():
-        fun, t0, t1, y0 = ode.problem(sheet.typer.ode("motion"), sheet.evaluator.compile)
+        fun, t0, t1, y0 = ode.problem(sheet.defs.ode("motion"), sheet.evaluator.compile)
         om = _v(sheet, "Omega_pump", "rad/s")
         return (*oderun.linear_parts(fun, len(y0), om), om, y0)
 

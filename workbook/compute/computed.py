@@ -195,7 +195,7 @@ def _function_unit(sheet: Sheet, name: str, d) -> pint.Unit | None:
     if d.unit is not None:
         return d.unit
     try:
-        return sheet.typer.function(name).unit
+        return sheet.defs.function(name).unit
     except Exception:  # noqa: BLE001 - a function typed only by its calls: no unit shown
         return None
 

@@ -25,6 +25,7 @@ from ..numerics.registry import REGISTRY
 
 if TYPE_CHECKING:
     from ..language.typecheck import Typer
+    from ..language.typeddefs import TypedDefinitions
 
 MAX_FORMULA = 8192  # Excel's limit on formula length
 
@@ -87,6 +88,11 @@ class BoundBody:
         """The typer of the sheet (for a tree built from EXPR: diff's derivative)."""
         return self.printer.typer
 
+    @property
+    def defs(self) -> TypedDefinitions:
+        """The typed definitions of the sheet (what a tree built from EXPR reads)."""
+        return self.printer.defs
+
     def __call__(self, value: str) -> str:
         return self.printer.print(self.typed, {**self.subst, self.var: value})
 
@@ -109,6 +115,7 @@ class ExcelPrinter(Visitor):
 
     def __init__(self, typer: Typer, names: dict[str, str] | None = None):
         self.typer = typer
+        self.defs = typer.defs  # the definitions' typed trees, read
         self.names = names or {}
         # (table, column) -> absolute cell range, filled by the writer for max_over()/min_over()
         self.ranges: dict[tuple[str, str], str] = {}
@@ -268,8 +275,8 @@ class ExcelPrinter(Visitor):
         # arguments reuses its text, and a text beyond Excel's limit stops the printing at
         # once (NotLive: the writer writes the values as numbers), so nested calls such as
         # f_i(x) = (f_{i-1}(x) + f_{i-1}(x))/2 cost the limit, not 2^depth.
-        f = self.typer.function(t.name)
-        if t.name in self.typer.recursive:  # Excel has no recursion
+        f = self.defs.function(t.name)
+        if t.name in self.defs.recursive:  # Excel has no recursion
             raise NotLive(f"{t.name.split('@')[0]}() calls itself; its values are numbers")
         if any(f.shapes) and isinstance(f.body, ty.TProgram):  # loops over a matrix: no formula
             raise NotLive(

@@ -289,7 +289,7 @@ class ExcelLayout:
         row = self.rows.get("Matrices", 0)
         self.on_matrices = getattr(self, "on_matrices", set()) | {d.name for d in defs}
         for d in defs:
-            t = self.sheet.typer.scalar(d.name)
+            t = self.sheet.defs.scalar(d.name)
             if ty.is_runtime(t.shape):
                 row = self._write_runtime(ws, row, d, t)
                 continue
@@ -382,7 +382,7 @@ class ExcelLayout:
     def _shape(self, name: str):
         """(rows, columns) of a definition's value, None for a number (or one in error)."""
         try:
-            return self.sheet.typer.scalar(name).shape
+            return self.sheet.defs.scalar(name).shape
         except WorkbookError:
             return None
 

@@ -14,7 +14,7 @@ import math
 
 from ..findings import Finding
 from ..language import typed as ty
-from ..language.unitrules import angle_in
+from ..language.units import angle_in
 from ..numerics.registry import REGISTRY
 
 

@@ -65,6 +65,7 @@ class Evaluator(Visitor):
         column_values: Callable[[str, str, object], object] | None = None,
     ):
         self.typer = typer
+        self.defs = typer.defs  # the typed definitions, read (the typer types nothing more)
         self.column_values = column_values  # (table, column, unit) -> values, for max_over()
         self.solve_at: Callable | None = None  # (unknown, env) -> values, set by the Sheet
         self.scalar_value = scalar_value  # (name, kind) -> magnitude in the ref's unit
@@ -107,7 +108,7 @@ class Evaluator(Visitor):
     def function(self, name: str) -> Fn:
         """Compiled user function: env of its parameters -> magnitude in its unit."""
         if name not in self._functions:
-            f = self.typer.function(name)
+            f = self.defs.function(name)
             self.plan.update(self.typer)
             compiled: list[Fn] = []
             # a call inside its own body (recursion) reaches the function once it is compiled
@@ -312,7 +313,7 @@ class Evaluator(Visitor):
 
     def visit_TCall(self, t: ty.TCall) -> Fn:
         f = self.function(t.name)
-        params = self.typer.function(t.name).params
+        params = self.defs.function(t.name).params
         args = [self.compile(a) for a in t.args]
         if len(args) == 1:
             p0, a0 = params[0], args[0]
@@ -460,7 +461,7 @@ class Evaluator(Visitor):
         if name not in cache:
             cache[name] = None  # solving: a derivative that asks for the solution is circular
             try:
-                cache[name] = solve_typed(self.typer.ode(name), self.compile)
+                cache[name] = solve_typed(self.defs.ode(name), self.compile)
             except WorkbookError as err:  # a run that failed is remembered, not run again
                 cache[name] = err
                 raise

@@ -502,7 +502,7 @@ def run_sheet(
     not raised (a study records it). ``t_eval`` in the time unit (default: the steps);
     ``jac(t, y)``: the Jacobian for the implicit methods, when the caller knows it (a linear
     system's matrix), else they estimate it by differences."""
-    typed = sheet.typer.ode(name)
+    typed = sheet.defs.ode(name)
     fun, t0, t1, y0 = problem(typed, sheet.evaluator.compile)
     st = settings(typed, sheet.evaluator.compile)
     fun(t0, y0)  # what the derivatives share is computed before the clock starts
@@ -552,7 +552,7 @@ def _estimate_finding(sheet, name: str, sol: Solution):
     topic = f"ode {name}"
     if est.failed:
         return Finding(topic, "no global error estimate", None, "", "warning", est.failed)
-    typed = sheet.typer.ode(name)
+    typed = sheet.defs.ode(name)
     names = flat_names(sol.states, sol.sizes)
     units = [u for u, n in zip(typed.units, typed.sizes) for _ in range(1 if n is None else n)]
     k = est.worst
@@ -578,7 +578,7 @@ def sheet_bench(sheet, quick: bool = False) -> list[dict]:
     """Error against run time of every method on each [[ode]] of the sheet."""
     rows = []
     for name in sheet.spec.odes:
-        fun, t0, t1, y0 = problem(sheet.typer.ode(name), sheet.evaluator.compile)
+        fun, t0, t1, y0 = problem(sheet.defs.ode(name), sheet.evaluator.compile)
         rtols = (1e-3, 1e-6) if quick else (1e-3, 1e-6, 1e-9)
         rows += bench_rows(fun, t0, t1, y0, name=name, rtols=rtols)
     return rows

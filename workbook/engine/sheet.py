@@ -34,8 +34,8 @@ from ..language.spec import ColumnSpec, SheetSpec
 from ..language.template import check_input_value, column_node
 from ..language.typed import TConst
 from ..language.typedsheet import TypedSheet, printed_rows
-from ..language.unitrules import is_scaled_angle
-from ..language.uses import names_used
+from ..language.units import is_scaled_angle
+from ..language.uses import dependencies, names_used
 from ..limits import exhausted, matrix_work
 from ..limits_time import check_time
 from ..numerics.registry import BUILTINS
@@ -66,6 +66,7 @@ class Sheet:
         )
         input_units = {n: (None if i.options else i.unit) for n, i in spec.inputs.items()}
         self.typer = typer or tc.Typer(spec, input_units, BUILTINS)
+        self.defs = self.typer.defs  # the definitions' typed trees, read after the load
         # the trees typed at load besides the definitions' (shared by with_inputs, with_parts)
         self.typed = typed if typed is not None else TypedSheet()
         self._memo: dict[str, object] = {}
@@ -223,7 +224,7 @@ class Sheet:
         for name in used:
             if name not in self.spec.definitions:
                 continue
-            needs = tc.dependencies(self.spec, ex.parse(name, what=name)) & set(block.unknowns)
+            needs = dependencies(self.spec, ex.parse(name, what=name)) & set(block.unknowns)
             if needs:
                 x = sorted(needs)[0]
                 raise TemplateError(
@@ -347,7 +348,7 @@ class Sheet:
                 if args or kwargs:
                     raise InputError(f"'{name}' takes no arguments")
                 return self.scalar_quantity(name)
-            f = self.typer.function(name)
+            f = self.defs.function(name)
             if any(f.shapes):
                 raise InputError(
                     f"{name}() takes vectors or matrices (its body is typed for the shapes of "
@@ -374,7 +375,7 @@ class Sheet:
         t = self.typed.get(None, key)
         if t is None:
             try:
-                t = cellunit.in_cell(self.typer.convert, self.typer.scalar(name), f"'{name}'")
+                t = cellunit.in_cell(self.typer.convert, self.defs.scalar(name), f"'{name}'")
             except WorkbookError as err:  # kept: the workbook and the report show it
                 t = err
             self.typed.keep(None, key, t)
@@ -385,7 +386,7 @@ class Sheet:
     def scalar_quantity(self, name: str) -> pint.Quantity | str:
         """The value of scalar definition ``name`` in the unit it is shown in (a text as
         it is)."""
-        t = self.typer.scalar(name)
+        t = self.defs.scalar(name)
         value = self.scalar_value(name, "definition")
         if t.text or isinstance(value, str):  # a text element of a run-time array, too
             return value
@@ -456,7 +457,7 @@ class Sheet:
         check_time(f"'{name}'")  # names the work, for the budget's alarm
         try:
             with defining(name, self.evaluator.records), matrix_work():
-                value = self.evaluator.compile(self.typer.scalar(name))({})
+                value = self.evaluator.compile(self.defs.scalar(name))({})
         except WorkbookError as err:
             raise err.located(file=self.file, line=d.line, definition=name) from None
         except OutOfBudget as exc:  # the command stops; its message names the definition
@@ -490,7 +491,7 @@ class Sheet:
         """A scalar definition's value outside its declared limits is an error."""
         from .numeric import limits_error, outside_limits
 
-        unit = self.typer.scalar(d.name).unit
+        unit = self.defs.scalar(d.name).unit
         bad, _ = outside_limits(d, unit, value)
         if np.any(bad):
             first = float(np.ravel(value)[int(np.flatnonzero(np.ravel(bad))[0])])

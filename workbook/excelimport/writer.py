@@ -486,7 +486,7 @@ def _users(spec: SheetSpec) -> dict[str, dict[str, None]]:
     """{name: the definitions whose formulas or programs name it, in the worksheet's order} of
     a translated worksheet, read from its parsed trees (``NAME_at``, the element of an array
     formula's cell, stands for NAME too)."""
-    from ..language.typecheck import direct_names
+    from ..language.uses import direct_names
 
     users: dict[str, dict[str, None]] = {}
     for key, d in spec.definitions.items():

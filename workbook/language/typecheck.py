@@ -47,6 +47,7 @@ from .typed import (
     is_zero,
     shape_text,
 )
+from .typeddefs import TypedDefinitions
 from .unitrules import UnitRules, meeting
 from .visitor import Visitor
 
@@ -74,13 +75,15 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         self.builtins = builtins
         builtins.refuse_functions_named(spec.function_names)
         self.input_units = input_units
-        self.scalars: dict[str, T] = {}
-        self.functions: dict[str, TypedFunction] = {}
+        # the typed trees, kept where the compute stage reads them without the typer
+        self.defs = TypedDefinitions(self, spec)
+        self.scalars = self.defs.scalars
+        self.functions = self.defs.functions
         self._stack: list[str] = []
         self.dimensionless = un.registry().dimensionless
         # diff() calls typed so far, by id of EXPR's typed tree: each finds its derivative
         # (SymPy) the first time a back end needs it (workbook.numerics.derivative)
-        self.derivatives: dict[int, object] = {}
+        self.derivatives = self.defs.derivatives
         # the parameters in scope of the binding built-in being typed (diff's variable must
         # be one of them: the derivative is a function of it)
         self.scope: dict[str, pint.Unit] = {}
@@ -90,7 +93,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         # (recursion) reads the unit and shape assumed for it (see specialized)
         self._assumed: dict[str, TypedFunction] = {}
         self._recursive: set[str] = set()
-        self.recursive: set[str] = set()  # specialization keys of functions that call themselves
+        self.recursive = self.defs.recursive  # specialization keys of functions calling themselves
         # typings that failed, by specialization key (("scalar", name) for a scalar): asked
         # again, the same error is raised without typing again (see _remembered)
         self._failed: dict[object, WorkbookError] = {}
@@ -126,9 +129,16 @@ class Typer(ArrayTyping, UnitRules, Visitor):
                 if not any(_key_of(k) == name for k in self.functions):
                     if not isinstance(at_numbers, ShapeError):
                         raise
-                    return self._unspecialized(name, at_numbers)
+                    return self._stand_in(name, self._unspecialized(name, at_numbers))
                 self._at_numbers_fails.add(name)
-        return next(f for k, f in self.functions.items() if _key_of(k) == name)
+        return self._stand_in(
+            name, next(f for k, f in self.functions.items() if _key_of(k) == name)
+        )
+
+    def _stand_in(self, name: str, f: TypedFunction) -> TypedFunction:
+        """``f``, kept as the specialization that stands for function ``name``."""
+        self.defs.stand_ins[name] = f.name
+        return f
 
     def _unspecialized(self, name: str, at_numbers: WorkbookError) -> TypedFunction:
         """A function no formula calls with vectors or matrices, whose body fails at numbers:
@@ -239,6 +249,9 @@ class Typer(ArrayTyping, UnitRules, Visitor):
             del self.functions[k]
         for k in set(self.scalars) - scalars:
             del self.scalars[k]
+        for n, k in list(self.defs.stand_ins.items()):
+            if k not in self.functions:
+                del self.defs.stand_ins[n]
 
     def expression(self, node: ex.Node, scope: dict[str, pint.Unit], what: str) -> T:
         """Type a free expression (a table column, a chart series) in a scope of parameters."""
@@ -892,7 +905,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
         """The typed section ``[[ode]] name`` (units checked once)."""
         from .odes import type_ode
 
-        cache = self.__dict__.setdefault("_odes", {})
+        cache = self.defs.odes
         if name not in cache:
             spec = self.spec.odes[name]
             key = f"ode {name}"
@@ -938,59 +951,6 @@ def column_type(typer: Typer, col, var: str, what: str) -> T:
     if col.unit is not None:
         t = typer.convert(t, col.unit, f"column '{col.text}' shown in {un.pretty(col.unit)}")
     return t
-
-
-def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
-    """Names of inputs/definitions/blocks an expression needs, transitively."""
-    return _closure(spec, [n for n in ex.names(node) if n not in scope])
-
-
-def dependencies_of_all(spec: SheetSpec, nodes: list[ex.Node]) -> set[str]:
-    """Names that any of ``nodes`` needs, transitively (one walk for all of them)."""
-    return _closure(spec, [n for node in nodes for n in ex.names(node)])
-
-
-def _closure(spec: SheetSpec, todo: list[str]) -> set[str]:
-    out: set[str] = set()
-    while todo:
-        n = todo.pop()
-        if n in out:
-            continue
-        out.add(n)
-        block = spec.solve_of(n) if n not in spec.inputs else None
-        if block is not None:  # an unknown of [[solve]]: what its equations use
-            todo.extend(
-                m
-                for node in solve_expressions(block)
-                for m in ex.names(node)
-                if m not in block.parameters
-            )
-        d = spec.definitions.get(n)
-        if d is not None:
-            todo.extend(direct_names(spec, d))
-    return out
-
-
-def direct_names(spec: SheetSpec, d: Definition) -> set[str]:
-    """The names definition ``d``'s formulas, program or ODE use (not its own parameters)."""
-    local: set[str] = set(d.params)
-    if d.program is not None:
-        from ..program.statements import names as program_names
-
-        return program_names(d.program) - local
-    bodies = d.expressions()
-    if d.ode is not None:
-        o = spec.odes[d.ode[0]]
-        local |= {o.var} | {s.name for s in o.states}
-        bodies = o.expressions()
-    return {m for body in bodies for m in ex.names(body) if m not in local}
-
-
-def solve_expressions(block) -> list[ex.Node]:
-    """Every expression of a [[solve]] block: both sides of its equations, its conditions."""
-    return [x for lhs, rhs, _ in block.equations for x in (lhs, rhs)] + [
-        c for c, _ in block.conditions
-    ]
 
 
 def _declared(name: str, unit: pint.Unit) -> str:

@@ -1,5 +1,6 @@
 """The typed sheet: the typed trees of a loaded sheet besides its definitions (which the
-:class:`workbook.language.typecheck.Typer` keeps), typed at load and read by the compute stage.
+typer keeps in :class:`workbook.language.typeddefs.TypedDefinitions`), typed at load and read
+by the compute stage.
 
 Table columns and chart series (in the unit they are shown in), range bounds and a log
 range's number of points, declared checks (value, condition, every placeholder) and the

@@ -9,9 +9,7 @@ down into this module, never back up."""
 
 from __future__ import annotations
 
-import functools
 import math
-import re
 from typing import TYPE_CHECKING
 
 import pint
@@ -20,6 +18,7 @@ from pint.util import to_units_container
 from ..errors import TemplateError, UnitError
 from . import units as un
 from .typed import T, TBinary, TCall, TConst, TRef, TScale, children, is_bare, is_zero
+from .units import angle_in, is_scaled_angle
 
 if TYPE_CHECKING:
     from .spec import SheetSpec
@@ -273,32 +272,6 @@ def sum_kind(unit: pint.Unit) -> str | None:
         return None
     names = [str(n) for n in to_units_container(unit)]
     return "difference" if any(n.startswith("delta_") for n in names) else "kelvin"
-
-
-def is_scaled_angle(unit: pint.Unit) -> bool:
-    """An angle unit other than the radian (deg, grad, arcmin...)."""
-    if unit.dimensionality:
-        return False
-    factor, root = un.registry().get_root_units(unit)
-    return factor != 1 and root == un.registry().radian
-
-
-@functools.lru_cache(maxsize=256)
-def _angle_in(text: str) -> str:
-    reg = un.registry()
-    for name in re.findall(r"[A-Za-z_]+", text):
-        if is_scaled_angle(reg.Unit(name)):
-            return un.pretty(reg.Unit(name))
-    return ""
-
-
-def angle_in(unit: pint.Unit) -> str:
-    """The angle unit other than the radian that ``unit`` has as a factor ('deg' for mm*deg),
-    or '' (also when the angles cancel: deg*min/revolution is a time)."""
-    reg = un.registry()
-    if "radian" not in str(reg.get_root_units(unit)[1]):
-        return ""
-    return _angle_in(str(unit))
 
 
 def _bare_ratio(t: T) -> float | None:

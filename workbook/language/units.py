@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 
 import pint
 from pint.util import to_units_container
@@ -390,3 +391,29 @@ def header(title: str, unit, *, typeset_unit: bool = False) -> str:
     ``typeset_unit``: the unit typeset for people (``"h [W/(m²·K)]"``, see :func:`typeset`)."""
     u = typeset(unit) if typeset_unit else pretty(unit)
     return f"{title} [{u}]" if u else title
+
+
+def is_scaled_angle(unit: pint.Unit) -> bool:
+    """An angle unit other than the radian (deg, grad, arcmin...)."""
+    if unit.dimensionality:
+        return False
+    factor, root = registry().get_root_units(unit)
+    return factor != 1 and root == registry().radian
+
+
+@functools.lru_cache(maxsize=256)
+def _angle_in(text: str) -> str:
+    reg = registry()
+    for name in re.findall(r"[A-Za-z_]+", text):
+        if is_scaled_angle(reg.Unit(name)):
+            return pretty(reg.Unit(name))
+    return ""
+
+
+def angle_in(unit: pint.Unit) -> str:
+    """The angle unit other than the radian that ``unit`` has as a factor ('deg' for mm*deg),
+    or '' (also when the angles cancel: deg*min/revolution is a time)."""
+    reg = registry()
+    if "radian" not in str(reg.get_root_units(unit)[1]):
+        return ""
+    return _angle_in(str(unit))

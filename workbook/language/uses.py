@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from ..errors import WorkbookError
 from . import expr as ex
-from . import typecheck as tc
 from .ranges import RangeSpec
 from .spec import SheetSpec
 from .template import column_node
@@ -52,7 +51,7 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
         roots += [ex.Name(n) for n in printed_names(p)]
     if hand_checks:  # the check report solves every [[solve]] block and [[ode]]
         for block in spec.solves:
-            roots += tc.solve_expressions(block)
+            roots += solve_expressions(block)
         for o in spec.odes.values():
             roots += [ex.Name(s.name) for s in o.states]
         for r in spec.relations:
@@ -67,7 +66,7 @@ def output_roots(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> lis
 def names_used(spec: SheetSpec, *, hand_checks: bool = False, reads=()) -> set[str]:
     """Inputs, definitions and blocks the outputs (and ``reads``) need, transitively."""
     roots = output_roots(spec, hand_checks=hand_checks, reads=reads)
-    return tc.dependencies_of_all(spec, roots)  # one closure: linear in the definitions
+    return dependencies_of_all(spec, roots)  # one closure: linear in the definitions
 
 
 def printed_names(p) -> set[str]:
@@ -76,3 +75,56 @@ def printed_names(p) -> set[str]:
         return {row.name for row in printed_rows(p)}
     except WorkbookError:
         return set()
+
+
+def dependencies(spec: SheetSpec, node: ex.Node, scope=()) -> set[str]:
+    """Names of inputs/definitions/blocks an expression needs, transitively."""
+    return _closure(spec, [n for n in ex.names(node) if n not in scope])
+
+
+def dependencies_of_all(spec: SheetSpec, nodes: list[ex.Node]) -> set[str]:
+    """Names that any of ``nodes`` needs, transitively (one walk for all of them)."""
+    return _closure(spec, [n for node in nodes for n in ex.names(node)])
+
+
+def _closure(spec: SheetSpec, todo: list[str]) -> set[str]:
+    out: set[str] = set()
+    while todo:
+        n = todo.pop()
+        if n in out:
+            continue
+        out.add(n)
+        block = spec.solve_of(n) if n not in spec.inputs else None
+        if block is not None:  # an unknown of [[solve]]: what its equations use
+            todo.extend(
+                m
+                for node in solve_expressions(block)
+                for m in ex.names(node)
+                if m not in block.parameters
+            )
+        d = spec.definitions.get(n)
+        if d is not None:
+            todo.extend(direct_names(spec, d))
+    return out
+
+
+def direct_names(spec: SheetSpec, d) -> set[str]:
+    """The names definition ``d``'s formulas, program or ODE use (not its own parameters)."""
+    local: set[str] = set(d.params)
+    if d.program is not None:
+        from ..program.statements import names as program_names
+
+        return program_names(d.program) - local
+    bodies = d.expressions()
+    if d.ode is not None:
+        o = spec.odes[d.ode[0]]
+        local |= {o.var} | {s.name for s in o.states}
+        bodies = o.expressions()
+    return {m for body in bodies for m in ex.names(body) if m not in local}
+
+
+def solve_expressions(block) -> list[ex.Node]:
+    """Every expression of a [[solve]] block: both sides of its equations, its conditions."""
+    return [x for lhs, rhs, _ in block.equations for x in (lhs, rhs)] + [
+        c for c, _ in block.conditions
+    ]

@@ -22,6 +22,7 @@ from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language import typecheck as tc
 from ..language import typed as ty
+from ..language.uses import dependencies, solve_expressions
 from ..numerics.registry import BUILTINS
 from .symbols import Unknown
 from .translation import Item, Result, Skipped, Translation, uses
@@ -80,7 +81,7 @@ class _Refusals:
 
     def _needs_refused(self, *nodes: ex.Node) -> bool:
         return bool(self.bad) and any(
-            tc.dependencies(self.spec, n) & self.bad for n in nodes if n is not None
+            dependencies(self.spec, n) & self.bad for n in nodes if n is not None
         )
 
     def _series_nodes(self, s, var: str) -> list[ex.Node]:
@@ -90,7 +91,7 @@ class _Refusals:
         from ..language.given_find import type_block
 
         for block in self.spec.solves:
-            if self._needs_refused(*tc.solve_expressions(block)):
+            if self._needs_refused(*solve_expressions(block)):
                 continue
             try:
                 self.sheet.check_not_circular(block)

@@ -220,7 +220,7 @@ class ExprTranslator(Visitor):
         if not isinstance(other, ex.Number) or isinstance(node, ex.Number):
             return node
         unit = self.tr.at_import().unit(node)
-        from ..language.unitrules import angle_in
+        from ..language.units import angle_in
 
         if unit is None or not angle_in(unit):
             return node

@@ -101,7 +101,7 @@ class Bound:
         from .kinks import breaks
 
         out = []
-        for t in breaks(self.evaluator.typer, self.body, self.var):
+        for t in breaks(self.evaluator.defs, self.body, self.var):
             v = np.asarray(self.evaluator.compile(t)(self.env), dtype=float)
             out.append(np.broadcast_to(v, shape))
         return out
@@ -119,7 +119,7 @@ class Bound:
         (numerics.singular: a denominator, a power's base, tan's cosine, ...)."""
         from .singular import singular_arguments
 
-        return self._pairs(singular_arguments(self.evaluator.typer, self.body, self.var), shape)
+        return self._pairs(singular_arguments(self.evaluator.defs, self.body, self.var), shape)
 
     def _pairs(self, subtrees, shape) -> list[tuple[Callable, Callable]]:
         from ..functions.interval_arith import Iv
@@ -156,7 +156,7 @@ class Bound:
 
         flat, env, var = self._flat(shape), self.env, self.var
         out = []
-        for u in singular_arguments(self.evaluator.typer, self.body, var):
+        for u in singular_arguments(self.evaluator.defs, self.body, var):
             if not ty.parameters(u) <= {var, *env}:
                 continue
             fn = self.evaluator.compile(u)

@@ -106,12 +106,12 @@ def pending(typer, body: ty.T, var: ty.TParam, order: int, unit) -> Pending:
     return rec
 
 
-def formula(typer, body: ty.T, var: ty.TParam, order: int) -> ty.T:
+def formula(defs, body: ty.T, var: ty.TParam, order: int) -> ty.T:
     """The typed tree of ``diff(body, var, order)`` (found once; later calls reuse it).
 
     An error of SymPy's derivative (a function with no formula in the worksheet language)
     names the file, line and definition of the diff() call."""
-    rec = typer.derivatives.get(id(body))
+    rec = defs.derivatives.get(id(body))
     if rec is None or rec.body is not body or rec.order != order:
         # a call not met at load (a tree rebuilt by an analysis): no location known
         rec = Pending(body, var, order, body.unit / un.difference_unit(var.unit) ** order)
@@ -119,7 +119,7 @@ def formula(typer, body: ty.T, var: ty.TParam, order: int) -> ty.T:
         raise rec.error
     if rec.tree is None:
         try:
-            rec.tree = derivative(typer, body, var, order, rec.unit)
+            rec.tree = derivative(defs, body, var, order, rec.unit)
         except WorkbookError as err:
             rec.error = err.located(**rec.where)
             raise rec.error from None
@@ -128,8 +128,8 @@ def formula(typer, body: ty.T, var: ty.TParam, order: int) -> ty.T:
 
 def compiled(evaluator, body: ty.T, var: ty.TParam, order: int):
     """The derivative compiled by ``evaluator`` (a numpy closure of an environment)."""
-    tree = formula(evaluator.typer, body, var, order)
-    rec = evaluator.typer.derivatives.get(id(body))
+    tree = formula(evaluator.defs, body, var, order)
+    rec = evaluator.defs.derivatives.get(id(body))
     if rec is None or rec.tree is not tree:
         return evaluator.compile(tree)
     fn = rec.compiled.get(evaluator)
@@ -138,23 +138,23 @@ def compiled(evaluator, body: ty.T, var: ty.TParam, order: int):
     return fn
 
 
-def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
+def derivative(defs, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
     """The ``order``-th derivative of ``body`` with respect to ``var``, in ``unit``."""
     import sympy as sp
 
-    size = inlined_size(typer, body)
+    size = inlined_size(defs, body)
     if size > MAX_DIFF_NODES:  # SymPy's derivative grows with it (a product rule per node)
         raise LimitError(
             f"diff(): the expression is {size:,} nodes with the functions it calls written out "
             f"(limit {MAX_DIFF_NODES:,}); SymPy would take minutes. Differentiate a simpler "
             "function, or give the derivative as a formula"
         )
-    leaves = _leaves(typer, body)
+    leaves = _leaves(defs, body)
     refs = {n: t for n, t in leaves.items() if isinstance(t, ty.TRef)}
     from .symbolic import SympyConverter
 
     # no values: inputs and the definitions it refers to stay symbols
-    conv = SympyConverter(types.SimpleNamespace(typer=typer, values={}), keep=set(refs))
+    conv = SympyConverter(types.SimpleNamespace(typer=defs, values={}), keep=set(refs))
     what = "diff(): SymPy's derivative (a function nested in itself grows it exponentially)"
     with within_seconds(MAX_DIFF_SECONDS, what):
         try:
@@ -165,7 +165,7 @@ def derivative(typer, body: ty.T, var: ty.TParam, order: int, unit) -> ty.T:
         d = sp.diff(expr, symbol, order)
         nodes = {sp.Symbol(n, real=True): t for n, t in leaves.items()}
         nodes[symbol] = var
-        out = _Back(nodes, typer.dimensionless).visit(d)
+        out = _Back(nodes, defs.dimensionless).visit(d)
     return ty.TScale(unit, child=out, factor=1.0)
 
 
@@ -177,7 +177,7 @@ MAX_DIFF_NODES = 1_000
 MAX_DIFF_SECONDS = 10.0
 
 
-def inlined_size(typer, body: ty.T) -> int:
+def inlined_size(defs, body: ty.T) -> int:
     """Nodes of ``body`` with every sheet function it calls written out at each call (what
     SymPy receives); each function's size is counted once, so this is cheap however large."""
     sizes: dict[str, int] = {}
@@ -190,7 +190,7 @@ def inlined_size(typer, body: ty.T) -> int:
             if isinstance(n, ty.TCall):
                 if n.name not in sizes:
                     sizes[n.name] = 0  # a function calling itself: not written out
-                    sizes[n.name] = size(typer.function(n.name).body)
+                    sizes[n.name] = size(defs.function(n.name).body)
                 total += sizes[n.name]
             stack.extend(ty.children(n))
         return total
@@ -198,7 +198,7 @@ def inlined_size(typer, body: ty.T) -> int:
     return size(body)
 
 
-def _leaves(typer, body: ty.T) -> dict[str, ty.T]:
+def _leaves(defs, body: ty.T) -> dict[str, ty.T]:
     """Parameters and references of ``body``, also inside the sheet functions it calls."""
     out: dict[str, ty.T] = {}
     stack, seen = [body], set()
@@ -208,7 +208,7 @@ def _leaves(typer, body: ty.T) -> dict[str, ty.T]:
             out.setdefault(n.name, n)
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
-            stack.append(typer.function(n.name).body)
+            stack.append(defs.function(n.name).body)
         stack.extend(ty.children(n))
     return out
 

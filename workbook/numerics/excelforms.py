@@ -357,4 +357,4 @@ def diff_excel(body, args, consts) -> tuple[str, int]:
     from .derivative import formula
 
     order = int(consts[0]) if consts else 1
-    return body.tree(formula(body.typer, body.typed, body.var_param, order))
+    return body.tree(formula(body.defs, body.typed, body.var_param, order))

@@ -172,9 +172,9 @@ class Enclosure(Visitor):
 
     def visit_TCall(self, t):
         key = t.name
-        if key in self.evaluator.typer.recursive or self.depth > _MAX_DEPTH:
+        if key in self.evaluator.defs.recursive or self.depth > _MAX_DEPTH:
             raise NoEnclosure(key)
-        f = self.evaluator.typer.function(key)
+        f = self.evaluator.defs.function(key)
         args = [self.compile(a) for a in t.args]
         inner = Enclosure(self.evaluator, _CALL)
         inner.depth = self.depth + 1

@@ -26,8 +26,8 @@ class Kinks(Visitor):
     where parameters are the environment's).
     """
 
-    def __init__(self, typer):
-        self.typer = typer
+    def __init__(self, defs):
+        self.defs = defs
         self.found: list[ty.T] = []
 
     def _children(self, t, aliases, subst):
@@ -92,7 +92,7 @@ class Kinks(Visitor):
         points c (free of the variable) are kinks of the integral in the variable, at c/f
         (its derivative in the bound is the integrand there: a beam's moment, integrated
         twice, has a kink in its slope where the load is)."""
-        inner = Kinks(self.typer)
+        inner = Kinks(self.defs)
         inner.visit(t.args[0], {t.args[1].name: 1.0}, None)
         for end in t.args[2:]:
             f = self._linear(end, aliases)
@@ -110,7 +110,7 @@ class Kinks(Visitor):
         f = self._linear(t.args[2], aliases)
         if not f or not all(isinstance(a, ty.TRef) for a in t.args[:2]):
             return None
-        data = self.typer.spec.data
+        data = self.defs.spec.data
         return data[t.args[0].name].values, data[t.args[1].name].values, f
 
     def _crossings(self, lin: ty.T, other: ty.T, aliases, subst) -> None:
@@ -139,7 +139,7 @@ class Kinks(Visitor):
 
     def visit_TCall(self, t: ty.TCall, aliases, subst):
         self._children(t, aliases, subst)
-        f = self.typer.function(t.name)
+        f = self.defs.function(t.name)
         inner, values = {}, {}
         for p, a in zip(f.params, t.args):
             factor = self._linear(a, aliases)
@@ -169,8 +169,8 @@ def substitute(t: ty.T, subst: dict[str, ty.T]) -> ty.T:
     return dataclasses.replace(t, **changes) if changes else t
 
 
-def breaks(typer, body: ty.T, var: str) -> list[ty.T]:
+def breaks(defs, body: ty.T, var: str) -> list[ty.T]:
     """Typed break points of ``body`` in ``var`` (in the variable's unit), possibly repeated."""
-    k = Kinks(typer)
+    k = Kinks(defs)
     k.visit(body, {var: 1.0}, None)
     return k.found

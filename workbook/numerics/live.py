@@ -26,7 +26,7 @@ def _approximate(sheet, t: ty.T) -> set[str]:
             found.add(n.func)
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
-            stack.append(sheet.typer.function(n.name).body)
+            stack.append(sheet.defs.function(n.name).body)
         stack.extend(ty.children(n))
     return found
 

@@ -275,7 +275,7 @@ class MpForm(Visitor):
         # split at the integrand's kinks the tree shows (a beam's piecewise moment): tanh-sinh
         # across a kink is off by far more than the reference's accuracy
         kinks = []
-        for k in breaks(self.evaluator.typer, t.args[0], var):
+        for k in breaks(self.evaluator.defs, t.args[0], var):
             try:
                 kinks.append(self.compile(k))
             except NoMpForm:
@@ -303,14 +303,14 @@ class MpForm(Visitor):
         order = t.args[2] if len(t.args) > 2 else ty.TConst(t.unit, value=1.0)
         if not isinstance(order, ty.TConst):
             raise NoMpForm("diff() of a computed order")
-        tree = formula(self.evaluator.typer, t.args[0], t.args[1], int(order.value))
+        tree = formula(self.evaluator.defs, t.args[0], t.args[1], int(order.value))
         return self.compile(tree)
 
     def visit_TCall(self, t):
-        typer = self.evaluator.typer
-        if t.name in typer.recursive or self.depth > _MAX_DEPTH:
+        defs = self.evaluator.defs
+        if t.name in defs.recursive or self.depth > _MAX_DEPTH:
             raise NoMpForm(f"the recursive function {t.name}")
-        f = typer.function(t.name)
+        f = defs.function(t.name)
         body = MpForm(self.evaluator, self.ctx, self.depth + 1).compile(f.body)
         names, keys = list(f.params), self.evaluator.env_keys  # a sweep's cases go along
         args = [self.compile(a) for a in t.args]

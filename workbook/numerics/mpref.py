@@ -471,7 +471,7 @@ def _has_integral(evaluator, body) -> bool:
             return True
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
-            stack.append(evaluator.typer.function(n.name).body)
+            stack.append(evaluator.defs.function(n.name).body)
         stack.extend(ty.children(n))
     return False
 

@@ -26,7 +26,7 @@ SAFETY = 2.0
 
 def ode_names(of) -> set[str]:
     """The [[ode]] sections whose states EXPR reads (also through the sheet's functions)."""
-    typer = of.evaluator.typer
+    defs = of.evaluator.defs
     found: set[str] = set()
     stack, seen = [of.body], set()
     while stack:
@@ -35,7 +35,7 @@ def ode_names(of) -> set[str]:
             found.add(n.ode)
         if isinstance(n, ty.TCall) and n.name not in seen:
             seen.add(n.name)
-            stack.append(typer.function(n.name).body)
+            stack.append(defs.function(n.name).body)
         stack.extend(ty.children(n))
     return found
 

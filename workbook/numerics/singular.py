@@ -21,7 +21,7 @@ from .kinks import substitute
 _MAX_DEPTH = 20
 
 
-def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
+def singular_arguments(defs, body: ty.T, var: str) -> list[ty.T]:
     """Typed sub-trees of ``body`` that depend on ``var`` and whose zeros are singular points
     of EXPR (a denominator, a power's base, and what each built-in's entry says: the argument
     of sqrt, ln, log10, the cosine of tan's)."""
@@ -37,7 +37,7 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
                 # d/db of integral(g, t, a, b) is g at t = b: g's singular points, at the
                 # bounds, are the inner integral's in the variable
                 inner, bound_var = t.args[0], t.args[1].name
-                for u in singular_arguments(typer, inner, bound_var):
+                for u in singular_arguments(defs, inner, bound_var):
                     for end in t.args[2:]:
                         _keep(substitute(u, {bound_var: end}), var, found)
                 continue
@@ -51,8 +51,8 @@ def singular_arguments(typer, body: ty.T, var: str) -> list[ty.T]:
                 _keep(t.right, var, found)
             elif t.op == "^" and not _whole_positive(t.right):
                 _keep(t.left, var, found)
-        elif isinstance(t, ty.TCall) and depth < _MAX_DEPTH and t.name not in typer.recursive:
-            f = typer.function(t.name)
+        elif isinstance(t, ty.TCall) and depth < _MAX_DEPTH and t.name not in defs.recursive:
+            f = defs.function(t.name)
             stack.append((substitute(f.body, dict(zip(f.params, t.args))), depth + 1))
             continue  # its arguments are inside the substituted body
         stack.extend((c, depth) for c in ty.children(t))

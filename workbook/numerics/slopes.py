@@ -135,8 +135,8 @@ def _record_rounding(of, order, shape, xs, values) -> None:
     if prepared is None:
         return
     ctx = prepared[0]
-    tree = formula(of.evaluator.typer, of.body, of.var_param, order)
-    if inlined_size(of.evaluator.typer, tree) > MP_NODES:
+    tree = formula(of.evaluator.defs, of.body, of.var_param, order)
+    if inlined_size(of.evaluator.defs, tree) > MP_NODES:
         return
     try:
         form = mp_form(of.evaluator, ctx, tree)

@@ -35,8 +35,9 @@ from ..errors import WorkbookError
 from ..language import expr as ex
 from ..language.checkspec import placeholders
 from ..language.template import column_node, parse_spec, read_toml
-from ..language.typecheck import Typer, dependencies, solve_expressions
+from ..language.typecheck import Typer
 from ..language.typedsheet import TypedSheet, printed_rows
+from ..language.uses import dependencies, solve_expressions
 from ..numerics.registry import BUILTINS
 from ..outputs.report.charts import chart_svg
 from ..outputs.report.html import Document

@@ -7,8 +7,8 @@ import numpy as np
 from ..engine.numeric import Evaluator
 from ..errors import InputError, WorkbookError
 from ..language import expr as ex
-from ..language import typecheck as tc
 from ..language import units as un
+from ..language.uses import dependencies
 from .grid import Vary
 from .outputs import Output, reduce_values, type_output
 
@@ -32,7 +32,7 @@ class CaseEvaluator(Evaluator):
     def depends(self, name: str) -> bool:
         """Whether definition ``name`` depends on a swept input."""
         if name not in self._depends:
-            deps = tc.dependencies(self.spec, ex.Name(name))
+            deps = dependencies(self.spec, ex.Name(name))
             self._depends[name] = bool(deps & self.swept)
         return self._depends[name]
 
@@ -68,7 +68,7 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
             why.append(f"{v.name} is a choice")
     swept = {v.name for v in varies}
     for out in outputs:
-        deps = tc.dependencies(sheet.spec, out.node, (out.range.var,) if out.range else ())
+        deps = dependencies(sheet.spec, out.node, (out.range.var,) if out.range else ())
         blocks = sorted(deps & set(sheet.spec.blocks))
         if blocks:
             why.append(f"{out.name} needs the solver block(s) {', '.join(blocks)}")
@@ -94,7 +94,7 @@ def vector_blockers(sheet, outputs: list[Output], varies: list[Vary]) -> list[st
             why.append(f"{out.name} uses the table aggregate {', '.join(aggregates)}()")
         if out.range is not None:
             for node in (out.range.first, out.range.second, out.range.last, out.range.points):
-                if node is not None and tc.dependencies(sheet.spec, node) & swept:
+                if node is not None and dependencies(sheet.spec, node) & swept:
                     why.append(f"the range of {out.name} depends on a swept input")
                     break
     return why
