@@ -4,7 +4,7 @@ what is downstream of the change is computed again.
 A :class:`LiveSheet` holds the last good load of one worksheet (its text, the TOML it parses
 to, the Sheet and the computed sheet) and the values that Sheet computed. On an edit it
 compares the TOML entries of the new text with the old, names what changed (inputs,
-definitions), follows the dependency graph (:func:`workbook.language.typecheck.dependencies`)
+definitions), follows the dependency graph (:func:`workbook.language.uses.dependencies`)
 to everything downstream, and hands the values of everything else to the new Sheet
 (:class:`ReusingSheet`): scalar definitions, ``[[solve]]`` solutions, range tables and block
 tables whose formulas read nothing that changed, and the values its checks asked for. When
@@ -304,7 +304,7 @@ def downstream(spec, changed: set[str]) -> set[str]:
 
 def direct_reads(spec, name: str) -> set[str]:
     """The names that the entry ``name`` reads itself (one step of
-    :func:`workbook.language.typecheck.dependencies`): a definition's formulas, program or
+    :func:`workbook.language.uses.dependencies`): a definition's formulas, program or
     ODE, an unknown's [[solve]] equations."""
     out: set[str] = set()
     block = spec.solve_of(name) if name not in spec.inputs else None
