@@ -71,3 +71,18 @@ def sheet_from(tmp_path):
         return workbook.loads(text, name=name, folder=tmp_path, parts=parts)
 
     return load
+
+
+@pytest.fixture(scope="session")
+def load_text(tmp_path_factory):
+    """``load_text(text)``: a Sheet from template text (workbook.loads), for a module-scoped
+    fixture that loads its sheet once per module (``sheet_from`` is per test); files the text
+    names are read from ``folder`` (by default a folder of the session's)."""
+    import workbook
+
+    session = tmp_path_factory.mktemp("load_text")
+
+    def load(text: str, name: str = "sheet", folder=None, parts=None):
+        return workbook.loads(text, name=name, folder=folder or session, parts=parts)
+
+    return load

@@ -124,10 +124,9 @@ def rendered_without_evaluation(sheet, tmp_path) -> None:
 
 
 @pytest.mark.slow
-def test_rendering_a_small_sheet_makes_no_call_into_typing_or_evaluation(tmp_path):
-    from helpers.sheets import write_template
+def test_rendering_a_small_sheet_makes_no_call_into_typing_or_evaluation(sheet_from, tmp_path):
 
-    sheet = workbook.load(write_template(tmp_path, SMALL))
+    sheet = sheet_from(SMALL)
     rendered_without_evaluation(sheet, tmp_path)
     import openpyxl
 

@@ -115,7 +115,7 @@ def test_the_other_rows_are_the_engines_values(tmp_path, failing):
     assert q.excel_error(1) == "#DIV/0!" and r.excel_error(0) == "#NUM!"
 
 
-def test_a_long_column_finds_each_failed_row(tmp_path):
+def test_a_long_column_finds_each_failed_row(sheet_from):
     """The rows found by halving are exactly those that fail one by one."""
     text = """
 [arguments]
@@ -129,14 +129,14 @@ name = "t"
 range = "x := 5, 6 .. 20004"
 columns = ["f"]
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     col = sheet.table_data("t").columns[1]
     assert sorted(col.failed) == [4567 - 5]
     assert col.values[0] == pytest.approx(1 / 2 + 1 / (5 - 4567), rel=1e-15)
     assert np.isfinite(np.delete(col.values, 4567 - 5)).all()
 
 
-def test_max_over_a_column_with_a_failed_row_is_an_error(tmp_path):
+def test_max_over_a_column_with_a_failed_row_is_an_error(sheet_from):
     text = """
 [arguments]
 x = { unit = "" }
@@ -150,7 +150,7 @@ name = "t"
 range = "x := 0 .. 3"
 columns = ["q"]
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     with pytest.raises(DomainError, match="has no value in 1 row"):
         sheet.evaluate("top")
 
@@ -174,7 +174,7 @@ columns = ["q"]
 
 
 @pytest.mark.slow
-def test_libreoffice_recalculates_the_error_cells_as_written(tmp_path):
+def test_libreoffice_recalculates_the_error_cells_as_written(sheet_from, tmp_path):
     """LibreOffice's own evaluation of the written formulas gives the same error values in the
     failed rows (#DIV/0! for 1/0; for sqrt(-1) an error value too) and the engine's numbers in
     the others."""
@@ -198,7 +198,7 @@ name = "t"
 range = "x := -1, 0 .. 2"
 columns = ["q", "r"]
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     written = sheet.write_xlsx(tmp_path / "t.xlsx")
     ours = cell_values(written)
     theirs = cell_values(recalculate(written, tmp_path / "lo"))
@@ -211,7 +211,7 @@ columns = ["q", "r"]
         assert theirs[(table, cell)] == pytest.approx(ours[(table, cell)], rel=1e-12)
 
 
-def test_a_failed_value_is_computed_once(tmp_path, monkeypatch):
+def test_a_failed_value_is_computed_once(sheet_from, monkeypatch):
     """A table whose every row needs a [[solve]] that fails asks for it at every halving of
     its rows; the failure is remembered, so the block is solved once."""
     from workbook.engine import solve_blocks
@@ -240,7 +240,7 @@ name = "t"
 range = "x := 0 .. 1000"
 columns = ["q"]
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     with pytest.raises(DomainError, match="did not converge"):
         sheet.table("t")
     assert len(calls) == 1

@@ -394,11 +394,11 @@ q = "integral(f(x), x, 0, 10)"
 """
 
 
-def test_numerical_builtins_over_a_swept_input_agree_with_serial(tmp_path):
+def test_numerical_builtins_over_a_swept_input_agree_with_serial(sheet_from):
     """A narrow peak centred at the swept input: the vectorised sweep's interval enclosures,
     feature search and mpmath check read each case's value of a (they read the sheet's a = 1:
     the maximum at a = 7.3 was 0.5, its argmax 5, and every integral 0, silently)."""
-    sheet = workbook.load(write_template(tmp_path, FEATURES))
+    sheet = sheet_from(FEATURES)
     cases = {"a": [1.0, 2.5, 7.3, 9.0]}
     outs = {k: k for k in "rmwq"}
     vector = sw.sweep(sheet, cases, outs, mode="vector")

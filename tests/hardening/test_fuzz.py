@@ -58,10 +58,8 @@ JUNK = ["(", ")", ",", ".", "[", "]", ":", "lambda", " if ", " else ", "'", "__"
 
 
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    path = tmp_path_factory.mktemp("fuzz") / "fuzz.toml"
-    path.write_text(TEMPLATE, encoding="utf-8")
-    return Sheet(load_spec(path))
+def sheet(load_text):
+    return load_text(TEMPLATE, name="fuzz")
 
 
 def expressions():

@@ -1,6 +1,7 @@
 """Worksheets several test modules compute (ratios of units in cells, frozen cells, hard
 numerics, an AC circuit in complex numbers, the smallest sheet with a function), written to a
-folder by :func:`write_template`, and the property tests' Hypothesis settings."""
+folder by :func:`write_template`; the text of a table of definitions (:func:`definitions`);
+the property tests' Hypothesis settings."""
 
 from pathlib import Path
 
@@ -142,6 +143,12 @@ range = "phi := 0, 10 .. 90"
 columns = { y = "mm" }
 """
 )
+
+
+def definitions(values: dict[str, str]) -> str:
+    """The text of a ``[definitions]`` table: one ``name = "expression"`` line a definition
+    (the text for the ``sheet_from`` fixture)."""
+    return "[definitions]\n" + "".join(f'{k} = "{v}"\n' for k, v in values.items())
 
 
 def write_template(tmp_path: Path, text: str, name: str = "t.toml") -> Path:

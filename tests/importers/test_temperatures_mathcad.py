@@ -13,9 +13,7 @@ import math
 import formulas
 import openpyxl
 import pytest
-from helpers.sheets import write_template
 
-import workbook
 from workbook.errors import UnitError
 from workbook.language import units as un
 from workbook.language.unitrules import sum_kind
@@ -72,9 +70,8 @@ INPUTS = (
 )
 
 
-def _sheet(tmp_path, definitions: str):
-    text = f'[sheet]\ntitle = "sums"\n\n[inputs]\n{INPUTS}\n[definitions]\n{definitions}'
-    return workbook.load(write_template(tmp_path, text))
+def _text(definitions: str) -> str:
+    return f'[sheet]\ntitle = "sums"\n\n[inputs]\n{INPUTS}\n[definitions]\n{definitions}'
 
 
 def _in_kelvin(q) -> float:
@@ -97,10 +94,9 @@ ACCEPTED = [
 
 
 @pytest.fixture(scope="module")
-def every_sum(tmp_path_factory):
+def every_sum(load_text):
     """One sheet with every sum the table accepts (r0, r1...: the index in CASES)."""
-    tmp = tmp_path_factory.mktemp("every-sum")
-    return _sheet(tmp, "".join(f'{n} = "{f}"\n' for n, f in ACCEPTED))
+    return load_text(_text("".join(f'{n} = "{f}"\n' for n, f in ACCEPTED)), name="t")
 
 
 @pytest.mark.slow
@@ -109,13 +105,13 @@ def every_sum(tmp_path_factory):
     [(i, *c) for i, c in enumerate(CASES)],
     ids=[f"{a[0]}{op}{b[0]}".replace("*", "x") for op, a, b in CASES],
 )
-def test_a_sum_of_temperatures_is_mathcads(tmp_path, every_sum, i, op, a, b):
+def test_a_sum_of_temperatures_is_mathcads(sheet_from, every_sum, i, op, a, b):
     (left, lk, lkind), (right, rk, rkind) = a, b
     kind = expected_kind(op, lkind, rkind)
     formula = f"{left} {op} {right}"
     if kind is None:
         with pytest.raises(UnitError, match="absolute temperature"):
-            _sheet(tmp_path, f'r = "{formula}"\n')
+            sheet_from(_text(f'r = "{formula}"\n'))
         return
     got = every_sum.evaluate(f"r{i}")
     want = lk + rk if op == "+" else lk - rk
@@ -126,8 +122,8 @@ def test_a_sum_of_temperatures_is_mathcads(tmp_path, every_sum, i, op, a, b):
     assert math.isclose(_in_kelvin(got), want, rel_tol=1e-12, abs_tol=1e-9), (formula, got)
 
 
-def _book(tmp, cases):
-    sheet = _sheet(tmp, "".join(f'{n} = "{f}"\n' for n, f in cases))
+def _book(sheet_from, tmp, cases):
+    sheet = sheet_from(_text("".join(f'{n} = "{f}"\n' for n, f in cases)), name="t")
     return sheet, sheet.write_xlsx(tmp / "sums.xlsx")
 
 
@@ -146,8 +142,8 @@ def _recalculated_by_formulas(path) -> dict[str, object]:
     return values
 
 
-def _check_recalculation(tmp, cases):
-    sheet, path = _book(tmp, cases)
+def _check_recalculation(sheet_from, tmp, cases):
+    sheet, path = _book(sheet_from, tmp, cases)
     rows = _result_rows(path)
     values = _recalculated_by_formulas(path)
     for name, formula in cases:
@@ -157,24 +153,24 @@ def _check_recalculation(tmp, cases):
 
 
 @pytest.mark.slow
-def test_the_workbook_recalculates_to_the_engine(tmp_path):
+def test_the_workbook_recalculates_to_the_engine(sheet_from, tmp_path):
     """The `formulas` package (an independent Excel evaluator) recalculates sums of the
     workbook (one in twelve of the table's) to the engine's number."""
-    _check_recalculation(tmp_path, ACCEPTED[::12])
+    _check_recalculation(sheet_from, tmp_path, ACCEPTED[::12])
 
 
 @pytest.mark.slow
-def test_the_workbook_recalculates_every_sum_to_the_engine(tmp_path):
-    _check_recalculation(tmp_path, ACCEPTED)
+def test_the_workbook_recalculates_every_sum_to_the_engine(sheet_from, tmp_path):
+    _check_recalculation(sheet_from, tmp_path, ACCEPTED)
 
 
 @pytest.mark.slow
-def test_libreoffice_recalculates_the_sums(tmp_path):
+def test_libreoffice_recalculates_the_sums(sheet_from, tmp_path):
     from helpers.recalc import cell_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
-    sheet, path = _book(tmp_path, ACCEPTED)
+    sheet, path = _book(sheet_from, tmp_path, ACCEPTED)
     rows = _result_rows(path)
     values = cell_values(recalculate(path, tmp_path / "lo"))
     for name, formula in ACCEPTED:
@@ -183,7 +179,7 @@ def test_libreoffice_recalculates_the_sums(tmp_path):
         assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (name, formula, got, want)
 
 
-def test_a_wall_and_a_heater_in_degc_with_kelvin_rises(tmp_path):
+def test_a_wall_and_a_heater_in_degc_with_kelvin_rises(sheet_from):
     """Heat transfer as a course writes it: surface temperatures from a heat flux over a film
     coefficient (K), an outlet temperature from a power over m*cp (W/(kg/s*J/(kg*K)) = K),
     88 % of a rise; each against the same arithmetic on plain numbers in kelvin."""
@@ -208,7 +204,7 @@ T_so = { expr = "T_out + q/h_o", unit = "degF" }
 T_2 = "T_in + P/(m_dot*cp)"
 T_3 = "T_in + eta*(T_2 - T_in)"
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     t_in, t_out = 22 + 273.15, -8 + 273.15
     r = 1 / 8 + 0.2 / 0.8 + 1 / 23
     q = (t_in - t_out) / r

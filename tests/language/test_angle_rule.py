@@ -91,8 +91,8 @@ fine = "sin(theta) + cos(1.2) + tan(theta/2)"
 """
 
 
-def test_the_two_slips_are_warnings(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SLIPS))
+def test_the_two_slips_are_warnings(sheet_from):
+    sheet = sheet_from(SLIPS)
     found = {f.what: f for f in sheet.check().findings if f.topic == "angles"}
     assert set(found) == {
         "'a': sin() of an angle in degrees multiplied by pi/180",
@@ -107,9 +107,9 @@ def test_the_two_slips_are_warnings(tmp_path):
     assert sheet.evaluate("b").magnitude == pytest.approx(math.cos(90.0), rel=1e-14)
 
 
-def test_no_warning_without_degrees(tmp_path):
+def test_no_warning_without_degrees(sheet_from):
     text = '[inputs]\nx = { value = "2" }\n\n[definitions]\nb = "cos(90*x)"\nc = "sin(90)"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert not [f for f in sheet.check().findings if f.topic == "angles"]
 
 
@@ -155,8 +155,8 @@ columns = { "gain(f)" = "" }
 """
 
 
-def test_a_log_spaced_range_is_mathcads_logspace(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, LOG))
+def test_a_log_spaced_range_is_mathcads_logspace(sheet_from):
+    sheet = sheet_from(LOG)
     table = sheet.table("bode")
     np.testing.assert_allclose(table.iloc[:, 0], np.logspace(1, 7, 7), rtol=1e-14)
     assert table.iloc[0, 0] == 10.0 and table.iloc[-1, 0] == 1e7  # the bounds exactly
@@ -165,11 +165,11 @@ def test_a_log_spaced_range_is_mathcads_logspace(tmp_path):
     assert len(sheet.with_inputs(n="13").table("bode")) == 13
 
 
-def test_a_log_spaced_range_in_the_workbook_recalculates(tmp_path):
+def test_a_log_spaced_range_in_the_workbook_recalculates(sheet_from, tmp_path):
     import formulas
     import openpyxl
 
-    sheet = workbook.load(write_template(tmp_path, LOG))
+    sheet = sheet_from(LOG)
     path = sheet.write_xlsx(tmp_path / "bode.xlsx")
     ws = openpyxl.load_workbook(path, data_only=True)["Listing"]
     header = next(r for r in range(1, 10) if ws.cell(r, 1).value == "f [Hz]")
@@ -197,10 +197,10 @@ def test_a_log_spaced_range_in_the_workbook_recalculates(tmp_path):
         ("f := logspace(10 Hz, 10 MHz)", r"write logspace\(first, last, points\)"),
     ],
 )
-def test_log_spaced_range_mistakes(tmp_path, range_text, message):
+def test_log_spaced_range_mistakes(sheet_from, range_text, message):
     text = LOG.replace("f := logspace(10 Hz, 10 MHz, n)", range_text)
     with pytest.raises(workbook.WorkbookError, match=message):
-        workbook.load(write_template(tmp_path, text)).table("bode")
+        sheet_from(text).table("bode")
 
 
 def test_a_program_loop_is_not_log_spaced(tmp_path):
@@ -234,17 +234,19 @@ p = "15 %"
         ("-(20 mm/10 mm) + th", "-(a/b) + th"),
     ],
 )
-def test_a_ratio_of_written_quantities_is_radians_as_a_ratio_of_inputs(tmp_path, written, computed):
+def test_a_ratio_of_written_quantities_is_radians_as_a_ratio_of_inputs(
+    sheet_from, written, computed
+):
     # a ratio of literals was folded into a constant that looked bare, and was read as
     # degrees next to an angle: (20 mm / 10 mm) + th was 47 deg, a/b + th 2 rad + 45 deg
     text = RATIOS + f'w = "{written}"\nc = "{computed}"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     w, c = sheet.evaluate("w"), sheet.evaluate("c")
     assert math.isclose(w.to("rad").magnitude, c.to("rad").magnitude, rel_tol=1e-14)
 
 
-def test_bare_numbers_next_to_an_angle_are_still_degrees(tmp_path):
+def test_bare_numbers_next_to_an_angle_are_still_degrees(sheet_from):
     text = RATIOS + 'w = "2 + th"\nv = "(90/2) + th"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert math.isclose(sheet.evaluate("w").to("deg").magnitude, 47.0, rel_tol=1e-14)
     assert math.isclose(sheet.evaluate("v").to("deg").magnitude, 90.0, rel_tol=1e-14)

@@ -12,8 +12,6 @@ import openpyxl
 import pytest
 
 from workbook import WorkbookError
-from workbook.engine.sheet import Sheet
-from workbook.language.template import load_spec
 
 SHEET = """
 [sheet]
@@ -46,13 +44,6 @@ name = "t"
 range = "theta := 0, 30 .. 180"
 columns = { lift = "mm", past = "deg", "theta + 10" = "deg" }
 """
-
-
-@pytest.fixture
-def sheet(tmp_path) -> Sheet:
-    path = tmp_path / "angles.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    return Sheet(load_spec(path))
 
 
 def _mag(q, unit=""):
@@ -96,23 +87,19 @@ def test_the_table_column_uses_degrees(sheet):
         '"bad(theta)" = { expr = "theta/90*R", unit = "m" }',
     ],
 )
-def test_an_angle_divided_by_a_bare_number_and_used_as_a_number_is_refused(tmp_path, definition):
+def test_an_angle_divided_by_a_bare_number_and_used_as_a_number_is_refused(sheet_from, definition):
     text = SHEET.replace("[definitions]\n", f"[definitions]\n{definition}\n")
-    path = tmp_path / "bad.toml"
-    path.write_text(text, encoding="utf-8")
     with pytest.raises(WorkbookError, match="an angle in deg divided by the plain number 90"):
-        Sheet(load_spec(path))
+        sheet_from(text, name="bad")
 
 
-def test_an_angle_divided_by_a_number_stays_an_angle(tmp_path):
+def test_an_angle_divided_by_a_number_stays_an_angle(sheet_from):
     text = SHEET.replace(
         "[definitions]\n",
         '[definitions]\n"halfway(theta)" = { expr = "theta/2", unit = "deg" }\n'
         '"chord(theta)" = { expr = "2*R*sin(theta/2)", unit = "mm" }\n',
     )
-    path = tmp_path / "ok.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = Sheet(load_spec(path))
+    sheet = sheet_from(text, name="ok")
     assert _mag(sheet.evaluate("halfway", 90), "deg") == pytest.approx(45.0, rel=1e-15)
     assert _mag(sheet.evaluate("chord", 60), "mm") == pytest.approx(10.0, rel=1e-15)
 
@@ -183,11 +170,11 @@ at45 = { expr = "linterp(A, Y, 45)", unit = "mm" }
         ("at45", 45.0),
     ],
 )
-def test_a_bare_number_where_an_angle_in_degrees_is_wanted_is_in_degrees(tmp_path, name, expected):
+def test_a_bare_number_where_an_angle_in_degrees_is_wanted_is_in_degrees(
+    sheet_from, tmp_path, name, expected
+):
     """A bound, a guess, a function's argument, the x of linterp: 180 is 180 deg (it was read
     as 180 rad: argmax of sin over [0, 180] gave 5490 deg); pi/2 stays radians."""
     (tmp_path / "angles.csv").write_text("A,Y\n0,0\n90,90\n", encoding="utf-8")
-    path = tmp_path / "slots.toml"
-    path.write_text(SLOTS, encoding="utf-8")
-    sheet = Sheet(load_spec(path))
+    sheet = sheet_from(SLOTS, name="slots")
     assert sheet.evaluate(name).magnitude == pytest.approx(expected, rel=1e-8, abs=1e-9)

@@ -10,8 +10,6 @@ import scipy.linalg as sl
 from helpers.paths import DATA
 
 import workbook
-from workbook.facade import Sheet
-from workbook.language.template import load_spec
 
 RNG = np.random.default_rng(7)
 A = RNG.normal(size=(4, 4))
@@ -26,14 +24,8 @@ def _lit(m: np.ndarray) -> str:
     return "[" + ", ".join("[" + ", ".join(repr(float(x)) for x in r) + "]" for r in m) + "]"
 
 
-def _sheet(tmp_path, body: str, head: str = "") -> Sheet:
-    path = tmp_path / "m.toml"
-    path.write_text(head + body, encoding="utf-8")
-    return Sheet(load_spec(path))
-
-
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
+def sheet(load_text):
     text = f"""
 [inputs]
 k = "3 kN/m"
@@ -85,9 +77,7 @@ name = "diag"
 range = "i := 0 .. 3"
 columns = {{ "A[i, i]" = "", "vi(i)" = "kN" }}
 """
-    path = tmp_path_factory.mktemp("arrays") / "m.toml"
-    path.write_text(text, encoding="utf-8")
-    return Sheet(load_spec(path))
+    return load_text(text, name="m")
 
 
 def _m(sheet, name, unit=""):
@@ -161,18 +151,18 @@ def test_indexing_over_a_range_and_in_tables(sheet):
     np.testing.assert_allclose(t.iloc[:, 2], V[:, 0] * 2)
 
 
-def test_origin_one_counts_from_one(tmp_path):
-    s = _sheet(
-        tmp_path,
-        '[definitions]\nv = "[10, 20, 30]"\nfirst = "v[1]"\nlast_i = "last(v)"\n'
+def test_origin_one_counts_from_one(sheet_from):
+    s = sheet_from(
+        "[sheet]\norigin = 1\n"
+        + '[definitions]\nv = "[10, 20, 30]"\nfirst = "v[1]"\nlast_i = "last(v)"\n'
         'm = "submatrix([[1, 2], [3, 4]], 2, 2, 1, 2)"\n',
-        "[sheet]\norigin = 1\n",
+        name="m",
     )
     assert s.evaluate("first").magnitude == 10
     assert s.evaluate("last_i").magnitude == 3
     np.testing.assert_allclose(s.evaluate("m").magnitude, [[3, 4]])
     with pytest.raises(workbook.WorkbookError, match=r"index 0 is out of range"):
-        _sheet(tmp_path, '[definitions]\nv = "[1, 2]"\nz = "v[0]"\n', "[sheet]\norigin = 1\n")
+        sheet_from("[sheet]\norigin = 1\n" + '[definitions]\nv = "[1, 2]"\nz = "v[0]"\n', name="m")
 
 
 @pytest.mark.parametrize(
@@ -193,33 +183,33 @@ def test_origin_one_counts_from_one(tmp_path):
         ('v = "[1, 2]"\nz = "1/v"', "cannot divide by a vector"),
     ],
 )
-def test_shape_errors_at_load(tmp_path, body, message):
+def test_shape_errors_at_load(sheet_from, body, message):
     with pytest.raises(workbook.WorkbookError, match=message) as info:
-        _sheet(tmp_path, "[definitions]\n" + body + "\n")
+        sheet_from("[definitions]\n" + body + "\n", name="m")
     assert "m.toml" in str(info.value)
 
 
-def test_mixed_dimensions_in_a_matrix_are_refused(tmp_path):
+def test_mixed_dimensions_in_a_matrix_are_refused(sheet_from):
     with pytest.raises(workbook.WorkbookError, match="a matrix has one unit") as info:
-        _sheet(tmp_path, '[inputs]\nL = "1 m"\nF = "2 N"\n[definitions]\nM = "[[L, F]]"\n')
+        sheet_from('[inputs]\nL = "1 m"\nF = "2 N"\n[definitions]\nM = "[[L, F]]"\n', name="m")
     assert "in 'M'" in str(info.value) and "[length]" in str(info.value)
     # a bare 0 fits any unit, and convertible units are converted to the first element's
-    s = _sheet(tmp_path, '[inputs]\nL = "1 m"\nd = "20 mm"\n[definitions]\nM = "[L, 0, d]"\n')
+    s = sheet_from('[inputs]\nL = "1 m"\nd = "20 mm"\n[definitions]\nM = "[L, 0, d]"\n', name="m")
     np.testing.assert_allclose(s.evaluate("M").to("m").magnitude[:, 0], [1, 0, 0.02])
 
 
 @pytest.mark.parametrize("expr", ["inverse(M)", "lsolve(M, [1, 2])"])
-def test_a_singular_matrix_is_an_error_naming_the_definition(tmp_path, expr):
-    s = _sheet(tmp_path, f'[definitions]\nM = "[[1, 2], [2, 4]]"\nz = "{expr}"\n')
+def test_a_singular_matrix_is_an_error_naming_the_definition(sheet_from, expr):
+    s = sheet_from(f'[definitions]\nM = "[[1, 2], [2, 4]]"\nz = "{expr}"\n', name="m")
     with pytest.raises(workbook.WorkbookError, match="singular") as info:
         s.evaluate("z")
     assert "in 'z'" in str(info.value) and "m.toml" in str(info.value)
 
 
-def test_a_computed_index_out_of_range_is_an_error(tmp_path):
-    s = _sheet(
-        tmp_path,
+def test_a_computed_index_out_of_range_is_an_error(sheet_from):
+    s = sheet_from(
         '[arguments]\ni = { unit = "" }\n[definitions]\nv = "[1, 2, 3]"\n"g(i)" = "v[i]"\n',
+        name="m",
     )
     with pytest.raises(workbook.WorkbookError, match="element index 5 is out of range"):
         s.evaluate("g", [0, 5])
@@ -239,7 +229,7 @@ def test_run_prints_matrices_and_texts(tmp_path, capsys):
     assert 'verdict = "OK"' in out
 
 
-def test_eigenparts_against_scipy(tmp_path):
+def test_eigenparts_against_scipy(sheet_from):
     """Complex eigenvalues as rows (Re, Im), by modulus then imaginary part, against
     scipy.linalg.eigvals of the same matrices (a real, a complex and a mixed spectrum)."""
     from scipy.linalg import eigvals
@@ -250,9 +240,7 @@ def test_eigenparts_against_scipy(tmp_path):
         "C": [[0, 1, 0, 0], [-400, -0.2, 5, 0], [0, 0, 0, 1], [3, 0, -9, -0.01]],
     }
     text = "[definitions]\n" + "".join(f'e{k} = "eigenparts({v})"\n' for k, v in cases.items())
-    path = tmp_path / "e.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(path)
+    sheet = sheet_from(text, name="e")
     for k, m in cases.items():
         got = sheet.evaluate(f"e{k}").magnitude
         lam = eigvals(np.array(m, dtype=float))
@@ -264,12 +252,12 @@ def test_eigenparts_against_scipy(tmp_path):
         assert np.all(np.diff(moduli) >= -1e-12)
 
 
-def test_a_formula_ending_in_an_array_constant_keeps_its_brace(tmp_path):
+def test_a_formula_ending_in_an_array_constant_keeps_its_brace(sheet_from, tmp_path):
     """xlsxwriter takes a last '}' for the brace of {=...}: a matrix literal at the end of a
     formula would lose it (=a_*{1,0;0,1); the formula is bracketed instead."""
     import openpyxl
 
-    sheet = _sheet(tmp_path, '[inputs]\na = "2"\n[definitions]\nM = "a*[[1, 2], [3, 4]]"\n')
+    sheet = sheet_from('[inputs]\na = "2"\n[definitions]\nM = "a*[[1, 2], [3, 4]]"\n', name="m")
     out = tmp_path / "m.xlsx"
     sheet.write_xlsx(out)
     ws = openpyxl.load_workbook(out)["Matrices"]

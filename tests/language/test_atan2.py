@@ -10,7 +10,6 @@ import formulas
 import mpmath
 import openpyxl
 import pytest
-from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main
@@ -30,9 +29,9 @@ SHEET = (
 
 
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
+def sheet(load_text, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("atan2")
-    return workbook.load(write_template(tmp, SHEET)), tmp
+    return load_text(SHEET, name="t", folder=tmp), tmp
 
 
 def test_x_comes_first_in_every_quadrant(sheet):
@@ -93,14 +92,14 @@ def test_an_excel_atan2_is_imported_in_its_order(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_symbolic_derivative_that_keeps_atan2_keeps_its_order(tmp_path):
+def test_a_symbolic_derivative_that_keeps_atan2_keeps_its_order(sheet_from):
     """SymPy's atan2 takes y first: a derivative read back from it is the language's
     atan2(x, y) again (d/dx of x*atan2(x, 1) holds atan2(x, 1) itself)."""
     text = (
         '[arguments]\nx = { unit = "" }\n\n[definitions]\n"f(x)" = "x*atan2(x, 1)"\n'
         '"g(x)" = "diff(f(x), x)"\n'
     )
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     for x in (-2.0, -0.3, 0.7, 5.0):
         want = float(mpmath.diff(lambda t: t * mpmath.atan2(1, t), x))
         assert float(sheet.evaluate("g", x).magnitude) == pytest.approx(want, rel=1e-13)

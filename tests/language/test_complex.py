@@ -19,10 +19,8 @@ from workbook.language import expr as ex
 mpmath.mp.dps = 50
 
 
-def _sheet(tmp_path, definitions: str, head: str = ""):
-    path = tmp_path / "c.toml"
-    path.write_text(head + "[definitions]\n" + definitions, encoding="utf-8")
-    return workbook.load(path)
+def _text(definitions: str, head: str = "") -> str:
+    return head + "[definitions]\n" + definitions
 
 
 def _value(sheet, name, unit=None):
@@ -53,7 +51,7 @@ def test_a_unit_after_an_imaginary_number_says_what_to_write():
         ex.parse("3 + 4i ohm")
 
 
-def test_i_and_j_stay_range_variables(tmp_path):
+def test_i_and_j_stay_range_variables(sheet_from):
     text = """[arguments]
 i = { unit = "" }
 
@@ -66,9 +64,7 @@ name = "t"
 range = "i := 0 .. 2"
 columns = { "v[i]*2" = "", "i + 1" = "" }
 """
-    path = tmp_path / "r.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(path)
+    sheet = sheet_from(text, name="r")
     table = sheet.table("t")
     assert list(table.iloc[:, 1]) == [20, 40, 60]
     assert list(table.iloc[:, 2]) == [1, 2, 3]
@@ -111,26 +107,27 @@ MPMATH = [
 
 
 @pytest.mark.parametrize("text,want", CASES, ids=[c[0] for c in CASES])
-def test_arithmetic_against_python_complex(tmp_path, text, want):
-    sheet = _sheet(tmp_path, f'x = "{text}"\ny = "{text} + 0*p"\n', '[inputs]\np = "1"\n')
+def test_arithmetic_against_python_complex(sheet_from, text, want):
+    sheet = sheet_from(_text(f'x = "{text}"\ny = "{text} + 0*p"\n', '[inputs]\np = "1"\n'))
     for name in ("x", "y"):  # folded at load, and computed by numpy
         got = complex(_value(sheet, name))
         assert abs(got - want) <= 1e-15 * max(1.0, abs(want)), (name, got, want)
 
 
 @pytest.mark.parametrize("text,want", MPMATH, ids=[c[0] for c in MPMATH])
-def test_functions_against_mpmath(tmp_path, text, want):
-    sheet = _sheet(tmp_path, f'x = "{text}*p"\n', '[inputs]\np = "1"\n')
+def test_functions_against_mpmath(sheet_from, text, want):
+    sheet = sheet_from(_text(f'x = "{text}*p"\n', '[inputs]\np = "1"\n'))
     got = complex(_value(sheet, "x"))
     ref = complex(want())
     assert abs(got - ref) <= 4e-15 * abs(ref), (got, ref)
 
 
-def test_the_flag_says_which_values_are_complex(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        'z = "p + 2i"\nm = "abs(z)"\na = "arg(z)"\nr = "Re(z)*2"\nc = "conj(z)"\n',
-        '[inputs]\np = "1"\n',
+def test_the_flag_says_which_values_are_complex(sheet_from):
+    sheet = sheet_from(
+        _text(
+            'z = "p + 2i"\nm = "abs(z)"\na = "arg(z)"\nr = "Re(z)*2"\nc = "conj(z)"\n',
+            '[inputs]\np = "1"\n',
+        )
     )
     flags = {n: sheet.typer.scalar(n).complex for n in ("z", "m", "a", "r", "c")}
     assert flags == {"z": True, "m": False, "a": False, "r": False, "c": True}
@@ -186,27 +183,28 @@ def test_units_on_complex_values(ac):
         ),
     ],
 )
-def test_refused_at_load(tmp_path, definitions, error, message):
+def test_refused_at_load(sheet_from, definitions, error, message):
     with pytest.raises(error, match=message):
-        _sheet(tmp_path, definitions + "\n").check_units()
+        sheet_from(_text(definitions + "\n")).check_units()
 
 
-def test_a_real_square_root_of_a_negative_number_stays_a_failure(tmp_path):
-    sheet = _sheet(tmp_path, 'x = "sqrt(-p)"\ny = "sqrt(-p + 0i)"\n', '[inputs]\np = "4"\n')
+def test_a_real_square_root_of_a_negative_number_stays_a_failure(sheet_from):
+    sheet = sheet_from(_text('x = "sqrt(-p)"\ny = "sqrt(-p + 0i)"\n', '[inputs]\np = "4"\n'))
     with pytest.raises(DomainError, match="not a finite number"):
         sheet.evaluate("x")
     assert complex(_value(sheet, "y")) == 2j
 
 
 # -- vectors and matrices against numpy and mpmath ---------------------------------------------
-def test_lsolve_of_a_complex_nodal_system(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        'Y = "[[1/R + 1/(1i*X), -1/(1i*X), 0 S], [-1/(1i*X), 1/(1i*X) + 1i/X + 1/R, -1/R],'
-        ' [0 S, -1/R, 2/R - 1i/X]]"\n'
-        'n = { expr = "lsolve(Y, [V/R, 0 A, 1i*V/X])", unit = "V" }\n'
-        'm = "abs(n[2])"\nd = "det(Y)"\nYi = "inverse(Y)"\nYt = "transpose(Y)"\n',
-        '[inputs]\nR = "10 ohm"\nX = "20 ohm"\nV = "10 V"\n',
+def test_lsolve_of_a_complex_nodal_system(sheet_from):
+    sheet = sheet_from(
+        _text(
+            'Y = "[[1/R + 1/(1i*X), -1/(1i*X), 0 S], [-1/(1i*X), 1/(1i*X) + 1i/X + 1/R, -1/R],'
+            ' [0 S, -1/R, 2/R - 1i/X]]"\n'
+            'n = { expr = "lsolve(Y, [V/R, 0 A, 1i*V/X])", unit = "V" }\n'
+            'm = "abs(n[2])"\nd = "det(Y)"\nYi = "inverse(Y)"\nYt = "transpose(Y)"\n',
+            '[inputs]\nR = "10 ohm"\nX = "20 ohm"\nV = "10 V"\n',
+        )
     )
     y = np.array(
         [
@@ -226,11 +224,12 @@ def test_lsolve_of_a_complex_nodal_system(tmp_path):
     assert np.allclose(_value(sheet, "Yt", "S"), y.T)
 
 
-def test_eigenvalues_and_eigenvectors_of_complex_matrices(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        'A = "[[1, -2, 0], [3, 1, 1], [0, 1, 4]]*(1 + 0i)"\n'
-        'lam = "eigenvals(A)"\nV = "eigenvecs(A)"\nreal = "eigenvals([[0, -1], [1, 0]])"\n',
+def test_eigenvalues_and_eigenvectors_of_complex_matrices(sheet_from):
+    sheet = sheet_from(
+        _text(
+            'A = "[[1, -2, 0], [3, 1, 1], [0, 1, 4]]*(1 + 0i)"\n'
+            'lam = "eigenvals(A)"\nV = "eigenvecs(A)"\nreal = "eigenvals([[0, -1], [1, 0]])"\n',
+        )
     )
     a = np.array([[1, -2, 0], [3, 1, 1], [0, 1, 4]], dtype=float)
     lam = _value(sheet, "lam")[:, 0]
@@ -248,10 +247,11 @@ def test_eigenvalues_and_eigenvectors_of_complex_matrices(tmp_path):
         sheet.evaluate("real")
 
 
-def test_polyroots_with_complex_roots_against_mpmath(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        'x = "polyroots([5, -2, 1]*(1 + 0i))"\ny = "polyroots([2, 1i, -3, 1 + 1i])"\n',
+def test_polyroots_with_complex_roots_against_mpmath(sheet_from):
+    sheet = sheet_from(
+        _text(
+            'x = "polyroots([5, -2, 1]*(1 + 0i))"\ny = "polyroots([2, 1i, -3, 1 + 1i])"\n',
+        )
     )
     assert np.allclose(_value(sheet, "x")[:, 0], [1 - 2j, 1 + 2j], rtol=1e-14)
     got = _value(sheet, "y")[:, 0]
@@ -405,15 +405,13 @@ columns = { "f(x)" = "" }
 """
 
 
-def test_a_piecewise_function_with_a_complex_piece(tmp_path):
+def test_a_piecewise_function_with_a_complex_piece(sheet_from, tmp_path):
     import openpyxl
 
-    path = tmp_path / "p.toml"
-    path.write_text(PIECES, encoding="utf-8")
-    sheet = workbook.load(path)
+    sheet = sheet_from(PIECES, name="p")
     got = sheet.table("t").iloc[:, 1].to_numpy(dtype=complex)
     assert list(got) == [-2, -1, 0, 1 + 1j, 2 + 1j]
-    limited = _sheet(tmp_path, 'z = { expr = "3 + 4i", positive = true }\n')
+    limited = sheet_from(_text('z = { expr = "3 + 4i", positive = true }\n'))
     with pytest.raises(WorkbookError, match="'z' is complex: its limits"):
         limited.evaluate("z")
     book = sheet.write_xlsx(tmp_path / "p.xlsx")
@@ -423,7 +421,7 @@ def test_a_piecewise_function_with_a_complex_piece(tmp_path):
     assert [cached.cell(r, 2).value for r in range(3, 8)] == ["-2", "-1", "0", "1+i", "2+i"]
 
 
-def test_a_chart_of_complex_values_is_refused(tmp_path):
+def test_a_chart_of_complex_values_is_refused(sheet_from, tmp_path):
     text = """[arguments]
 fr = { unit = "Hz" }
 
@@ -436,10 +434,8 @@ range = "fr := 1 Hz .. 5 Hz"
 x = { expr = "fr", title = "f" }
 series = [ { y = "Zf(fr)", unit = "ohm", name = "Z" }, { y = "abs(Zf(fr))", unit = "ohm" } ]
 """
-    path = tmp_path / "ch.toml"
-    path.write_text(text, encoding="utf-8")
     with pytest.raises(WorkbookError, match="a series of complex values has no points"):
-        workbook.load(path).write_xlsx(tmp_path / "ch.xlsx")
+        sheet_from(text, name="ch").write_xlsx(tmp_path / "ch.xlsx")
 
 
 def test_polar_form_on_request(tmp_path, capsys):
@@ -459,13 +455,11 @@ def test_polar_form_on_request(tmp_path, capsys):
         workbook.load(path)
 
 
-def test_the_largest_value_of_a_complex_column_is_refused(tmp_path):
+def test_the_largest_value_of_a_complex_column_is_refused(sheet_from):
     text = AC.replace("[[tables]]", 'top = "max_over(sweep, Zf)"\n\n[[tables]]')
     text = text.replace('columns = { "Zf(fr)" = "ohm"', 'columns = { Zf = "ohm"')
-    path = tmp_path / "m.toml"
-    path.write_text(text, encoding="utf-8")
     with pytest.raises(TemplateError, match="the column is complex"):
-        workbook.load(path).check_units()
+        sheet_from(text, name="m").check_units()
 
 
 def test_a_sweep_of_a_complex_output_is_refused(ac):
@@ -477,26 +471,23 @@ def test_a_sweep_of_a_complex_output_is_refused(ac):
     assert result.table.iloc[2, 1] == pytest.approx(abs(_ac_reference()[0]), rel=1e-12)
 
 
-def test_a_printed_value_of_a_complex_definition_says_to_check_its_parts(tmp_path):
+def test_a_printed_value_of_a_complex_definition_says_to_check_its_parts(sheet_from, tmp_path):
     csv = "name,argument,value,unit\nZ,,10,ohm\nI_mag,,12122.87,mA\n"
     (tmp_path / "printed.csv").write_text(csv, encoding="utf-8")
-    path = tmp_path / "p.toml"
-    path.write_text(AC + '\n[[printed]]\nfile = "printed.csv"\ntolerance = 0.01\n', "utf-8")
-    rows = {r.name: r for r in workbook.load(path).check().rows}
+    sheet = sheet_from(AC + '\n[[printed]]\nfile = "printed.csv"\ntolerance = 0.01\n', name="p")
+    rows = {r.name: r for r in sheet.check().rows}
     assert rows["Z"].verdict == "error" and 'Z_re = "Re(Z)"' in rows["Z"].note
     assert rows["I_mag"].verdict == "pass"
 
 
-def test_a_complex_argument_of_sin_is_no_angle_slip(tmp_path):
+def test_a_complex_argument_of_sin_is_no_angle_slip(sheet_from):
     head = '[arguments]\nphi = { unit = "deg" }\n\n'
-    sheet = _sheet(tmp_path, '"f(phi)" = "sin(phi)"\nx = "sin(10 + 2i)"\ny = "sin(10)"\n', head)
+    sheet = sheet_from(_text('"f(phi)" = "sin(phi)"\nx = "sin(10 + 2i)"\ny = "sin(10)"\n', head))
     warned = [f.what for f in sheet.check().findings if f.topic == "angles"]
     assert any("'y'" in w for w in warned) and not any("'x'" in w for w in warned)
 
 
 @pytest.mark.parametrize("text", ["3 + 4i ohm", "4i", "2.5j V"])
-def test_a_complex_input_value_says_what_to_write(tmp_path, text):
-    path = tmp_path / "i.toml"
-    path.write_text(f'[inputs]\nZ = "{text}"\n[definitions]\nx = "Z"\n', encoding="utf-8")
+def test_a_complex_input_value_says_what_to_write(sheet_from, text):
     with pytest.raises(WorkbookError, match="is a complex number.*R \\+ X\\*1i"):
-        workbook.load(path)
+        sheet_from(f'[inputs]\nZ = "{text}"\n[definitions]\nx = "Z"\n', name="i")

@@ -8,9 +8,7 @@ import formulas
 import openpyxl
 import pytest
 import scipy.constants
-from helpers.sheets import write_template
 
-import workbook
 from workbook.errors import TemplateError
 from workbook.functions.constants import CONSTANTS
 
@@ -34,9 +32,9 @@ at_one = "slope(1)"
 
 
 @pytest.fixture(scope="module")
-def written(tmp_path_factory):
+def written(load_text, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("constants")
-    sheet = workbook.load(write_template(tmp, SHEET))
+    sheet = load_text(SHEET, name="t")
     return sheet, sheet.write_xlsx(tmp / "constants.xlsx")
 
 
@@ -87,8 +85,8 @@ reach = { expr = "R + e", unit = "mm" }
 """
 
 
-def test_a_worksheet_may_define_its_own_e_and_g(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, OWN))
+def test_a_worksheet_may_define_its_own_e_and_g(sheet_from, tmp_path):
+    sheet = sheet_from(OWN)
     assert sheet.evaluate("reach").to("mm").magnitude == pytest.approx(26.0)
     assert sheet.evaluate("g").to("mm").magnitude == pytest.approx(14.0)
     path = sheet.write_xlsx(tmp_path / "own.xlsx")
@@ -98,7 +96,7 @@ def test_a_worksheet_may_define_its_own_e_and_g(tmp_path):
     assert "g is this worksheet's own, not 9.80665 m/s^2" in note
 
 
-def test_an_argument_named_e_is_not_eulers_number_outside_its_function(tmp_path):
+def test_an_argument_named_e_is_not_eulers_number_outside_its_function(sheet_from):
     text = """
 [arguments]
 e = { unit = "" }
@@ -108,4 +106,4 @@ e = { unit = "" }
 wrong = "e + 1"
 """
     with pytest.raises(TemplateError, match="'e' is an argument"):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)

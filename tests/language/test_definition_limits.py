@@ -10,7 +10,6 @@ import os
 import pytest
 from helpers.sheets import write_template
 
-import workbook
 from workbook.cli import main
 from workbook.errors import DomainError, UnitError
 
@@ -48,29 +47,29 @@ def _cli(tmp_path, *args) -> tuple[int, str, str]:
     return code, out.getvalue(), err.getvalue()
 
 
-def test_values_inside_their_limits_are_numbers(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_values_inside_their_limits_are_numbers(sheet_from):
+    sheet = sheet_from(SHEET)
     assert sheet.evaluate("A_port").to("mm^2").magnitude == pytest.approx(1206.3715789784806)
     assert sheet.evaluate("L_max").to("mm").magnitude == 900
 
 
-def test_a_scalar_outside_its_limit_is_an_error_naming_it(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET)).with_inputs(d_stem="50 mm")
+def test_a_scalar_outside_its_limit_is_an_error_naming_it(sheet_from):
+    sheet = sheet_from(SHEET).with_inputs(d_stem="50 mm")
     with pytest.raises(DomainError, match=r"A_port = -706\.858 mm\^2 breaks its declared limit"):
         sheet.evaluate("A_port")
     with pytest.raises(DomainError, match=r"gap = -10 mm breaks its declared limit \(at least 0"):
         sheet.evaluate("gap")
 
 
-def test_a_limit_in_another_unit_is_converted(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET)).with_inputs(L="1.5 m")
+def test_a_limit_in_another_unit_is_converted(sheet_from):
+    sheet = sheet_from(SHEET).with_inputs(L="1.5 m")
     with pytest.raises(DomainError, match=r"L_max = 1500 mm breaks its declared limit"):
         sheet.evaluate("L_max")
     assert sheet.with_inputs(L="1 m").evaluate("L_max").to("mm").magnitude == 1000
 
 
-def test_a_function_names_the_arguments_where_it_breaks_its_limit(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_a_function_names_the_arguments_where_it_breaks_its_limit(sheet_from):
+    sheet = sheet_from(SHEET)
     with pytest.raises(DomainError, match=r"f = -10 mm for x = 50 mm breaks its declared"):
         sheet.evaluate("f", 50)
     col = sheet.table_data("t").columns[1]
@@ -78,10 +77,10 @@ def test_a_function_names_the_arguments_where_it_breaks_its_limit(tmp_path):
     assert col.values[:5].tolist() == [40, 30, 20, 10, 0]
 
 
-def test_a_limit_of_another_dimension_is_refused_at_load(tmp_path):
+def test_a_limit_of_another_dimension_is_refused_at_load(sheet_from):
     text = SHEET.replace('max = "1 m"', 'max = "1 s"')
     with pytest.raises(UnitError, match="the limit 1 s is"):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
 @pytest.mark.slow

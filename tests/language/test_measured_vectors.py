@@ -10,7 +10,6 @@ import formulas
 import numpy as np
 import openpyxl
 import pytest
-from helpers.sheets import write_template
 from scipy import stats
 
 import workbook
@@ -47,11 +46,11 @@ R_op_c = { expr = "cspline(T, R, T_op)", unit = "ohm" }
 
 
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
+def sheet(load_text, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("pt100")
     rows = "\n".join(f"{float(t)!r},{float(r)!r}" for t, r in zip(T, R))
     (tmp / "pt100.csv").write_text(f"# a PT100, measured\nT,R\n{rows}\n", encoding="utf-8")
-    return workbook.load(write_template(tmp, SHEET)), tmp
+    return load_text(SHEET, name="t", folder=tmp), tmp
 
 
 def _expected() -> dict[str, float]:
@@ -113,7 +112,7 @@ def test_the_workbook_recalculates_the_regression(sheet):
         assert math.isclose(got, want, rel_tol=1e-11, abs_tol=1e-12), name
 
 
-def test_a_column_of_another_table_and_a_wrong_unit_are_refused(tmp_path):
+def test_a_column_of_another_table_and_a_wrong_unit_are_refused(sheet_from, tmp_path):
     (tmp_path / "a.csv").write_text("x,y\n0,1\n1,2\n", encoding="utf-8")
     text = """
 [data.a]
@@ -124,7 +123,7 @@ columns = { x = "s", y = "m" }
 bad = "sum(x) + 1 m"
 """
     with pytest.raises(workbook.WorkbookError, match="cannot add"):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
 @pytest.mark.slow

@@ -3,13 +3,9 @@ when evaluated on its own: a text, or a number (a text element was an internal e
 
 from __future__ import annotations
 
-from helpers.sheets import write_template
 
-import workbook
-
-
-def test_the_element_of_a_mixed_array_is_a_text_or_a_number(tmp_path):
+def test_the_element_of_a_mixed_array_is_a_text_or_a_number(sheet_from):
     text = '[arguments]\nk = { unit = "" }\n\n[definitions]\nV = "[1, \'ok\']"\n"f(k)" = "V[k]"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.evaluate("f", 1) == "ok"
     assert sheet.evaluate("f", 0).magnitude == 1.0

@@ -5,7 +5,6 @@ import sys
 
 import openpyxl
 import pytest
-from helpers.sheets import write_template
 
 import workbook
 from workbook.cli import main
@@ -116,18 +115,18 @@ phi = { unit = "deg" }
 """
 
 
-def test_undeclared_part_names_the_line(tmp_path):
+def test_undeclared_part_names_the_line(sheet_from):
     text = BASE + '\n[[tables]]\nname = "t"\npart = "study"\nrange = "phi := 0 .. 9"\n'
     text += 'columns = { y = "mm" }\n'
     with pytest.raises(TemplateError, match="part = 'study' is not declared") as err:
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
     assert err.value.line == text.splitlines().index('name = "t"') + 1
 
 
-def test_bad_part_name(tmp_path):
+def test_bad_part_name(sheet_from):
     text = BASE + '\n[parts]\nall = "everything"\n'
     with pytest.raises(TemplateError, match="not 'all'"):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
 @pytest.mark.parametrize(
@@ -146,18 +145,18 @@ def test_bad_part_name(tmp_path):
         ),
     ],
 )
-def test_a_part_is_checked_at_load_even_when_left_out(tmp_path, extra, message):
+def test_a_part_is_checked_at_load_even_when_left_out(sheet_from, extra, message):
     text = BASE + '\n[parts]\nstudy = "a study"\n\n' + extra
     with pytest.raises(workbook.WorkbookError, match=message):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
-def test_an_input_used_only_by_a_part_is_not_unused(tmp_path):
+def test_an_input_used_only_by_a_part_is_not_unused(sheet_from):
     text = BASE + (
         '\n[parts]\nstudy = "a study"\n\n[[tables]]\nname = "t"\npart = "study"\n'
         'range = "phi := 0 .. 9"\ncolumns = { "y(phi) + S" = "mm" }\n'
     )
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.spec.tables == [] and sheet.unused_inputs() == []
 
 

@@ -10,9 +10,7 @@ import formulas
 import pytest
 from helpers import report_parse as rp
 from helpers.recalc import formula_values
-from helpers.sheets import write_template
 
-import workbook
 from workbook.errors import WorkbookError
 from workbook.language import expr as ex
 from workbook.language import units as un
@@ -113,9 +111,9 @@ def _expected():
 
 
 @pytest.fixture(scope="module")
-def written(tmp_path_factory):
+def written(load_text, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("literals")
-    sheet = workbook.load(write_template(tmp, SHEET))
+    sheet = load_text(SHEET, name="t")
     return sheet, sheet.write_xlsx(tmp / "literals.xlsx")
 
 
@@ -160,13 +158,13 @@ def test_excel_writes_the_number_in_the_unit_the_cell_needs(written):
         ("1e999 MPa", "too large"),
     ],
 )
-def test_mistakes_say_what_to_write(tmp_path, expr, message):
+def test_mistakes_say_what_to_write(sheet_from, expr, message):
     text = (
         SHEET.split("[definitions]")[0]
         + f'[definitions]\nbad = {{ expr = "{expr}", unit = "MPa" }}\n'
     )
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
 @pytest.mark.parametrize(
@@ -190,12 +188,12 @@ def test_percent_between_two_values_is_refused_not_read_as_a_remainder(text):
         ex.parse(text)
 
 
-def test_a_percentage_in_a_formula_is_live_in_excel(tmp_path):
+def test_a_percentage_in_a_formula_is_live_in_excel(sheet_from, tmp_path):
     text = (
         '[inputs]\nP_in = "12 kW"\nloss = "4 %"\n\n[definitions]\n'
         'P_out = { expr = "P_in*(100% - loss - 2.5 %)", unit = "kW" }\n'
     )
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert math.isclose(sheet.evaluate("P_out").to("kW").magnitude, 12 * 0.935, rel_tol=1e-14)
     path = sheet.write_xlsx(tmp_path / "p.xlsx")
     solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
@@ -208,7 +206,7 @@ def test_a_percentage_in_a_formula_is_live_in_excel(tmp_path):
 
 
 @pytest.mark.slow
-def test_libreoffice_recalculates_literals_constants_and_a_log_range(tmp_path):
+def test_libreoffice_recalculates_literals_constants_and_a_log_range(sheet_from, tmp_path):
     """The quantities, g, e and pi, and a logspace table, recalculated by LibreOffice."""
     import numpy as np
     from helpers.recalc import cell_values, recalculate, soffice
@@ -224,7 +222,7 @@ name = "bode"
 range = "f := logspace(10 Hz, 10 kHz, 4)"
 columns = { "1/(1 + f/(1 kHz))" = "" }
 """
-    sheet = workbook.load(write_template(tmp_path, text, "lo.toml"))
+    sheet = sheet_from(text, name="lo")
     path = sheet.write_xlsx(tmp_path / "lo.xlsx")
     import openpyxl
 
@@ -243,7 +241,7 @@ columns = { "1/(1 + f/(1 kHz))" = "" }
     np.testing.assert_allclose(got, table.iloc[:, 1], rtol=1e-12)
 
 
-def test_a_bound_with_a_unit_is_converted_in_an_ode_time_range(tmp_path):
+def test_a_bound_with_a_unit_is_converted_in_an_ode_time_range(sheet_from):
     """t := 0 .. 2 min with t in s runs to 120 s (the unit of the bound was dropped before:
     the run ended at 2 s)."""
     text = """
@@ -263,7 +261,7 @@ states = [{ name = "y", unit = "", initial = "1", derivative = "-k*y" }]
 y_q = "y(tq)"
 y_end = "y(2 min)"
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.evaluate("y_q").magnitude == pytest.approx(math.exp(-10), rel=1e-4)
     assert sheet.evaluate("y_end").magnitude == pytest.approx(math.exp(-12), rel=1e-4)
 

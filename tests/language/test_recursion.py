@@ -6,7 +6,6 @@ from __future__ import annotations
 import openpyxl
 import pytest
 
-import workbook
 from workbook.errors import LimitError, WorkbookError
 
 SHEET = '''
@@ -47,14 +46,8 @@ never = "endless(1)"
 '''
 
 
-def _load(tmp_path, text: str = SHEET):
-    path = tmp_path / "rec.toml"
-    path.write_text(text, encoding="utf-8")
-    return workbook.load(path)
-
-
-def test_recursive_values(tmp_path):
-    s = _load(tmp_path)
+def test_recursive_values(sheet_from):
+    s = sheet_from(SHEET, name="rec")
     f10, fib20, h, d500 = s.evaluate(["f10", "fib20", "h", "d500"])
     assert f10.magnitude == 3628800.0
     assert fib20.magnitude == 6765.0
@@ -63,8 +56,8 @@ def test_recursive_values(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_recursion_too_deep_is_a_limit_naming_the_function(tmp_path):
-    s = _load(tmp_path)
+def test_a_recursion_too_deep_is_a_limit_naming_the_function(sheet_from):
+    s = sheet_from(SHEET, name="rec")
     with pytest.raises(LimitError, match=r"depth\(\) called itself more than 1000 deep"):
         s.evaluate(["too_deep"])
     with pytest.raises(LimitError, match=r"endless\(\) called itself"):
@@ -72,23 +65,25 @@ def test_a_recursion_too_deep_is_a_limit_naming_the_function(tmp_path):
     assert s.evaluate(["d500"])[0].magnitude == 500.0  # the depth count starts again
 
 
-def test_a_formula_calling_itself_without_a_condition_is_circular(tmp_path):
+def test_a_formula_calling_itself_without_a_condition_is_circular(sheet_from):
     text = SHEET.replace('f10 = "fact(10)"', '"loop(n)" = "loop(n) + 1"\nf10 = "fact(10)"')
     with pytest.raises(WorkbookError, match="circular definition: loop -> loop"):
-        _load(tmp_path, text)
+        sheet_from(text, name="rec")
 
 
-def test_a_unit_that_does_not_settle_asks_for_a_declared_unit(tmp_path):
+def test_a_unit_that_does_not_settle_asks_for_a_declared_unit(sheet_from):
     text = SHEET.replace(
         'f10 = "fact(10)"',
         '"grow(x)" = { program = """\nx if x > L\ngrow(x)*x otherwise\n""" }\nf10 = "fact(10)"',
     )
     with pytest.raises(WorkbookError, match=r"grow\(\) calls itself.*declare its unit"):
-        _load(tmp_path, text)
+        sheet_from(text, name="rec")
 
 
-def test_the_workbook_writes_recursive_values_as_numbers(tmp_path):
-    s = _load(tmp_path, SHEET.replace('too_deep = "depth(5000)"\nnever = "endless(1)"\n', ""))
+def test_the_workbook_writes_recursive_values_as_numbers(sheet_from, tmp_path):
+    s = sheet_from(
+        SHEET.replace('too_deep = "depth(5000)"\nnever = "endless(1)"\n', ""), name="rec"
+    )
     out = tmp_path / "rec.xlsx"
     s.write_xlsx(out)
     ws = openpyxl.load_workbook(out)["Results"]
@@ -97,7 +92,7 @@ def test_the_workbook_writes_recursive_values_as_numbers(tmp_path):
     assert "calls itself" in cells["f10"].comment.text
 
 
-def test_mutual_recursion_is_typed_with_the_settled_unit(tmp_path):
+def test_mutual_recursion_is_typed_with_the_settled_unit(sheet_from):
     """even(x) calls odd(x) which calls even(x): odd is typed inside even's attempts and
     must be typed again with the unit that holds (metres here, not the first guess)."""
     text = SHEET.replace(
@@ -106,5 +101,5 @@ def test_mutual_recursion_is_typed_with_the_settled_unit(tmp_path):
         '"across(x)" = { program = """\nx if x < L\ndown(x - L) otherwise\n""" }\n'
         'left = "down(7.5*L)"\nf10 = "fact(10)"',
     )
-    s = _load(tmp_path, text)
+    s = sheet_from(text, name="rec")
     assert s.evaluate(["left"])[0].to("m").magnitude == pytest.approx(1.0)  # 15 m - 7*2 m

@@ -105,10 +105,8 @@ row = "flipped(3)"
 
 
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    path = tmp_path_factory.mktemp("grow") / "grow.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    return workbook.load(path)
+def sheet(load_text):
+    return load_text(SHEET, name="grow")
 
 
 def value(sheet, name):

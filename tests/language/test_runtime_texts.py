@@ -22,16 +22,10 @@ lengths = '[[L, "D"], [3 mm, "L"]]'
 """
 
 
-def sheet(tmp_path, definitions: str):
-    path = tmp_path / "texts.toml"
-    path.write_text(HEAD + definitions, encoding="utf-8")
-    return workbook.load(str(path))
-
-
-def test_a_program_picks_the_numbers_of_one_kind(tmp_path):
-    s = sheet(
-        tmp_path,
-        '''"dead(m)" = { program = """
+def test_a_program_picks_the_numbers_of_one_kind(sheet_from):
+    s = sheet_from(
+        HEAD
+        + '''"dead(m)" = { program = """
 t := 0
 for i in 0 .. rows(m) - 1
     k := m[i, 1]
@@ -43,7 +37,7 @@ total = "dead(loads)"
 kind = "loads[1, 1]"
 same = '1 if loads[2, 1] == "D" otherwise 0'
 other = '1 if loads[1, 1] != "D" otherwise 0'
-''',
+'''
     )
     assert s.evaluate("total").magnitude == 5.5
     assert s.evaluate("kind") == "L"
@@ -51,10 +45,10 @@ other = '1 if loads[1, 1] != "D" otherwise 0'
     assert s.evaluate("other").magnitude == 1
 
 
-def test_the_numbers_keep_their_unit_and_the_texts_stay_texts(tmp_path):
-    s = sheet(
-        tmp_path,
-        '''"pick(u)" = { program = """
+def test_the_numbers_keep_their_unit_and_the_texts_stay_texts(sheet_from):
+    s = sheet_from(
+        HEAD
+        + '''"pick(u)" = { program = """
 u[0, 0]
 """ }
 "kindof(u)" = { program = """
@@ -62,7 +56,7 @@ u[1, 1]
 """ }
 inmetres = "pick(lengths)"
 kind = "kindof(lengths)"
-''',
+'''
     )
     assert s.evaluate("inmetres").to("mm").magnitude == pytest.approx(2.0)
     assert s.evaluate("kind") == "L"
@@ -82,40 +76,40 @@ kind = "kindof(lengths)"
         ("max(loads)", "holding text (the text 'D') where a number is wanted"),
     ],
 )
-def test_any_other_use_of_a_text_is_an_error_naming_it(tmp_path, expr, message):
-    s = sheet(tmp_path, f"out = '{expr}'\n")
+def test_any_other_use_of_a_text_is_an_error_naming_it(sheet_from, expr, message):
+    s = sheet_from(HEAD + f"out = '{expr}'\n")
     with pytest.raises(
         workbook.WorkbookError, match=message.replace("(", r"\(").replace(")", r"\)")
     ):
         s.evaluate("out")
 
 
-def test_a_text_in_a_loop_bound_is_an_error(tmp_path):
-    s = sheet(
-        tmp_path,
-        '''"f(m)" = { program = """
+def test_a_text_in_a_loop_bound_is_an_error(sheet_from):
+    s = sheet_from(
+        HEAD
+        + '''"f(m)" = { program = """
 j := 0
 for i in 0 .. m[0, 1]
     j := i
 j
 """ }
 out = "f(loads)"
-''',
+'''
     )
     with pytest.raises(workbook.WorkbookError, match="the text 'D' where a number is wanted"):
         s.evaluate("out")
 
 
-def test_the_workbook_shows_the_texts(tmp_path):
+def test_the_workbook_shows_the_texts(sheet_from, tmp_path):
     import openpyxl
 
-    s = sheet(
-        tmp_path,
-        '''"kind(m)" = { program = """
+    s = sheet_from(
+        HEAD
+        + '''"kind(m)" = { program = """
 m[0, 1]
 """ }
 out = "kind(loads)"
-''',
+'''
     )
     target = tmp_path / "texts.xlsx"
     s.write_xlsx(target)
@@ -125,22 +119,21 @@ out = "kind(loads)"
     assert "D" in shown
 
 
-def test_a_division_by_zero_of_an_element_is_not_a_finite_number(tmp_path):
-    s = sheet(
-        tmp_path,
-        '''"first(m)" = { program = """
+def test_a_division_by_zero_of_an_element_is_not_a_finite_number(sheet_from):
+    s = sheet_from(
+        HEAD
+        + '''"first(m)" = { program = """
 m[0, 0]
 """ }
 out = "first(loads)/0"
-''',
+'''
     )
     with pytest.raises(workbook.WorkbookError, match="not a finite number"):
         s.evaluate("out")
 
 
-def test_a_condition_over_a_range_gives_elements_of_run_time_arrays(tmp_path):
-    path = tmp_path / "table.toml"
-    path.write_text(
+def test_a_condition_over_a_range_gives_elements_of_run_time_arrays(sheet_from):
+    sheet = sheet_from(
         """
 [arguments]
 m = { plain = true }
@@ -159,8 +152,8 @@ name = "t"
 range = "i := 0 .. 2"
 columns = [{ expr = "g(i)" }, { expr = "h(i)" }]
 """,
-        encoding="utf-8",
+        name="table",
     )
-    table = workbook.load(str(path)).table("t")
+    table = sheet.table("t")
     assert list(table["g(i)"]) == [0.0, 2.0, 4.0]
     assert list(table["h(i)"]) == [1.5, 0.0, 4.0]

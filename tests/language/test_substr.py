@@ -7,9 +7,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from helpers.sheets import write_template
 
-import workbook
 from workbook import WorkbookError
 
 SHEET = r"""
@@ -81,6 +79,6 @@ def test_excel_form_is_mid_and_len(sheet):
         ('bad = "substr(word, L, 1)"', "substr(S, m, n): m"),
     ],
 )
-def test_refused_at_load(tmp_path, line, message):
+def test_refused_at_load(sheet_from, line, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, SHEET.replace("#BAD", line)))
+        sheet_from(SHEET.replace("#BAD", line))

@@ -18,7 +18,6 @@ import numpy as np
 import pint
 import pytest
 from helpers.recalc import formula_values
-from helpers.sheets import write_template
 
 import workbook
 from workbook.errors import UnitError
@@ -45,8 +44,8 @@ def _pint(op: str, a: str, b: str):
         return None
 
 
-def _sheet(tmp_path, a: str, b: str, definitions: str):
-    text = f"""
+def _text(a: str, b: str, definitions: str) -> str:
+    return f"""
 [sheet]
 title = "temperatures"
 
@@ -57,7 +56,6 @@ B = {{ value = "{RIGHT} {b}" }}
 [definitions]
 {definitions}
 """
-    return workbook.load(write_template(tmp_path, text))
 
 
 def _mathcad_sum(op: str, a: str, b: str) -> bool:
@@ -71,7 +69,7 @@ COMBINATIONS = [c for c in itertools.product("+-*/", UNITS, UNITS) if not _mathc
 
 @pytest.mark.slow
 @pytest.mark.parametrize("op,a,b", COMBINATIONS, ids=[f"{a}{o}{b}" for o, a, b in COMBINATIONS])
-def test_arithmetic_of_two_temperatures_is_pints(tmp_path, op, a, b):
+def test_arithmetic_of_two_temperatures_is_pints(sheet_from, op, a, b):
     """Where the language follows pint; kelvin in a sum with an absolute temperature is a
     difference (Mathcad's rule, where pint differs) and is tested against Mathcad's reading
     in test_temperatures_mathcad.py."""
@@ -80,24 +78,24 @@ def test_arithmetic_of_two_temperatures_is_pints(tmp_path, op, a, b):
     refused_here = op == "-" and kinds == ("difference", "absolute")  # pint: meaningless
     if expected is None or refused_here:
         with pytest.raises(UnitError, match="temperature"):
-            _sheet(tmp_path, a, b, f'r = "A {op} B"')
+            sheet_from(_text(a, b, f'r = "A {op} B"'))
         return
-    got = _sheet(tmp_path, a, b, f'r = "A {op} B"').evaluate("r")
+    got = sheet_from(_text(a, b, f'r = "A {op} B"')).evaluate("r")
     if op in "+-":  # an absolute temperature or a difference, as pint says
         assert un.temperature_kind(got.units) == un.temperature_kind(expected.units)
     assert math.isclose(got.magnitude, expected.to(got.units).magnitude, rel_tol=1e-13)
 
 
 @pytest.mark.parametrize("a,b", list(itertools.product(UNITS, UNITS)))
-def test_a_temperature_shown_in_another_unit_is_pints_conversion(tmp_path, a, b):
+def test_a_temperature_shown_in_another_unit_is_pints_conversion(sheet_from, a, b):
     q = un.registry().Quantity(LEFT, a)
     try:
         expected = q.to(b).magnitude
     except pint.DimensionalityError:
         with pytest.raises(UnitError, match="temperature"):
-            _sheet(tmp_path, a, a, f'r = {{ expr = "A", unit = "{b}" }}')
+            sheet_from(_text(a, a, f'r = {{ expr = "A", unit = "{b}" }}'))
         return
-    got = _sheet(tmp_path, a, a, f'r = {{ expr = "A", unit = "{b}" }}').evaluate("r")
+    got = sheet_from(_text(a, a, f'r = {{ expr = "A", unit = "{b}" }}')).evaluate("r")
     assert str(got.units) == str(un.unit(b))
     assert math.isclose(got.magnitude, expected, rel_tol=1e-13)
 
@@ -156,9 +154,9 @@ def _expected():
 
 
 @pytest.fixture(scope="module")
-def rod(tmp_path_factory):
+def rod(load_text, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("rod")
-    sheet = workbook.load(write_template(tmp, SHEET))
+    sheet = load_text(SHEET, name="t")
     path = sheet.write_xlsx(tmp / "rod.xlsx")
     return sheet, path
 
@@ -204,14 +202,14 @@ def test_excel_formulas_are_affine_and_recalculate_to_pint(rod):
         ('"1 if T1 > T2 - T1 otherwise 0"', "difference"),
     ],
 )
-def test_temperature_mistakes_are_refused_with_what_to_write(tmp_path, expr, message):
+def test_temperature_mistakes_are_refused_with_what_to_write(sheet_from, expr, message):
     text = SHEET.split("[definitions]")[0] + f"[definitions]\nbad = {expr}\n"
     with pytest.raises(UnitError, match=message) as err:
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
     assert "bad" in str(err.value)
 
 
-def test_set_and_a_table_column_shown_in_degf(tmp_path):
+def test_set_and_a_table_column_shown_in_degf(sheet_from):
     text = (
         SHEET
         + """
@@ -224,7 +222,7 @@ range = "x := 0, 0.25 .. 1"
 columns = { "T1 + x*(T2 - T1)" = "degF" }
 """
     )
-    sheet = workbook.load(write_template(tmp_path, text)).with_inputs(T1="293.15 K")
+    sheet = sheet_from(text).with_inputs(T1="293.15 K")
     table = sheet.table("heating")
     q = un.registry().Quantity
     t1, t2 = q(20, "degC"), q(85, "degC")
@@ -252,7 +250,7 @@ def test_libreoffice_recalculates_the_temperature_sheet(rod, tmp_path):
         assert math.isclose(float(got), expected.magnitude, rel_tol=1e-12, abs_tol=1e-12), name
 
 
-def test_a_data_column_in_degc_read_at_a_temperature_in_k(tmp_path):
+def test_a_data_column_in_degc_read_at_a_temperature_in_k(sheet_from, tmp_path):
     """linterp over a column in degC at an input in K converts the input affinely (not by a
     factor 1/274.15), and a column of differences in delta_degC gives a difference."""
     (tmp_path / "oil.csv").write_text("T_col,nu,rise\n0,180,0\n40,46,5\n100,10,12\n", "utf-8")
@@ -268,7 +266,7 @@ columns = { T_col = "degC", nu = "mm^2/s", rise = "delta_degC" }
 viscosity = { expr = "linterp(T_col, nu, T)", unit = "mm^2/s" }
 heated = { expr = "T + linterp(T_col, rise, T)", unit = "degC" }
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     t = 333.15 - 273.15  # 60 degC
     nu = 46 + (t - 40) / 60 * (10 - 46)
     assert sheet.evaluate("viscosity").to("mm^2/s").magnitude == pytest.approx(nu, rel=1e-13)
@@ -276,19 +274,19 @@ heated = { expr = "T + linterp(T_col, rise, T)", unit = "degC" }
     assert sheet.evaluate("heated").to("degC").magnitude == pytest.approx(t + rise, rel=1e-13)
 
 
-def test_set_refuses_a_difference_for_an_absolute_temperature(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_set_refuses_a_difference_for_an_absolute_temperature(sheet_from):
+    sheet = sheet_from(SHEET)
     with pytest.raises(workbook.WorkbookError, match="is a temperature difference, but T1 is an"):
         sheet.with_inputs(T1="5 delta_degC")
     assert sheet.with_inputs(T1="68 degF").evaluate("dT").to("K").magnitude == pytest.approx(65)
 
 
-def test_a_sweep_output_shown_in_degf_adds_the_offset(tmp_path):
+def test_a_sweep_output_shown_in_degf_adds_the_offset(sheet_from):
     """A sweep output in degF of a temperature in degC is pint's conversion (it was refused
     as 'cannot show'; a scale factor would have been wrong), in both sweep modes."""
     from workbook import sweep as sw
 
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+    sheet = sheet_from(SHEET)
     q = un.registry().Quantity
     for mode in ("vector", "serial"):
         res = sw.sweep(
@@ -321,10 +319,10 @@ d = { expr = "dcp(40 degC)", unit = "J/K^2" }
 """
 
 
-def test_builtins_over_a_temperature_variable_step_by_differences(tmp_path):
+def test_builtins_over_a_temperature_variable_step_by_differences(sheet_from):
     """integral over T in degC has the unit of cp times delta_degC, diff is per delta_degC
     (both were internal errors: 'offset units in higher order'); against closed forms."""
-    sheet = workbook.load(write_template(tmp_path, OVER_A_TEMPERATURE))
+    sheet = sheet_from(OVER_A_TEMPERATURE)
     heat = 2 * (60 + 0.001 * 60**2 / 2)  # J, the integral of cp from 20 to 80 degC
     assert sheet.evaluate("Q").to("J").magnitude == pytest.approx(heat, rel=1e-13)
     assert sheet.evaluate("Qf").to("J").magnitude == pytest.approx(heat, rel=1e-12)
@@ -341,21 +339,18 @@ def test_a_compound_unit_with_an_offset_temperature_is_a_unit_error():
         un.factor(src, r.Unit("joule") / r.Unit("kelvin") ** 2)
 
 
-def test_a_written_negative_temperature_is_below_zero_and_a_negated_one_is_refused(tmp_path):
+def test_a_written_negative_temperature_is_below_zero_and_a_negated_one_is_refused(sheet_from):
     # -T1 was -25 degC (248.15 K) while -1*T1 was -298.15 K: the same formula, two numbers
     from workbook.errors import UnitError
 
     head = '[inputs]\nT1 = "25 degC"\n\n[definitions]\n'
-    sheet = workbook.load(
-        write_template(
-            tmp_path,
-            head + 'low = { expr = "max(T1 - 40 delta_degC, -10 degC)", unit = "degC" }\n'
-            'd = "-(T1 - 0 degC)"\nk = { expr = "-1*T1", unit = "K" }\n',
-        )
+    sheet = sheet_from(
+        head + 'low = { expr = "max(T1 - 40 delta_degC, -10 degC)", unit = "degC" }\n'
+        'd = "-(T1 - 0 degC)"\nk = { expr = "-1*T1", unit = "K" }\n'
     )
     assert math.isclose(sheet.evaluate("low").magnitude, -10.0, rel_tol=1e-12)
     assert sheet.evaluate("d").to("delta_degC").magnitude == pytest.approx(-25.0, rel=1e-12)
     assert sheet.evaluate("k").magnitude == pytest.approx(-298.15, rel=1e-12)
     for text in ("-T1", "2*(-T1)", "-(T1 + 5 delta_degC)"):
         with pytest.raises(UnitError, match="negative of an absolute temperature"):
-            workbook.load(write_template(tmp_path, head + f'x = "{text}"\n'))
+            sheet_from(head + f'x = "{text}"\n')

@@ -6,9 +6,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from helpers.sheets import write_template
 
-import workbook
 from workbook import WorkbookError
 from workbook.functions.texts import number_text
 
@@ -88,20 +86,17 @@ def test_num2str_is_written_as_its_value_with_a_comment(sheet, tmp_path):
         ('bad = "num2str(n) + 1"', "text"),
     ],
 )
-def test_refused_at_load(tmp_path, line, message):
+def test_refused_at_load(sheet_from, line, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, SHEET.replace("#BAD", line)))
+        sheet_from(SHEET.replace("#BAD", line))
 
 
-def test_a_caret_inside_a_text_is_a_caret(tmp_path):
+def test_a_caret_inside_a_text_is_a_caret(sheet_from):
     """`^` is the power operator outside texts only: "As (in^2)" keeps its `^`."""
-    sheet = workbook.load(
-        write_template(
-            tmp_path,
-            '[inputs]\nx = "3"\n[definitions]\n'
-            'label = "concat(\\"As (in^2) = \\", num2str(x^2))"\n'
-            "unit_text = \"'m^2' if x^2 > 4 otherwise 'mm^2'\"\n",
-        )
+    sheet = sheet_from(
+        '[inputs]\nx = "3"\n[definitions]\n'
+        'label = "concat(\\"As (in^2) = \\", num2str(x^2))"\n'
+        "unit_text = \"'m^2' if x^2 > 4 otherwise 'mm^2'\"\n"
     )
     assert sheet.evaluate("label") == "As (in^2) = 9"
     assert sheet.evaluate("unit_text") == "m^2"

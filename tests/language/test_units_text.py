@@ -7,9 +7,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from helpers.sheets import write_template
 
-import workbook
 from workbook.errors import InputError, LimitError
 from workbook.language import units as un
 
@@ -85,7 +83,7 @@ def test_the_refusal_of_a_repeated_name_no_longer_advises_a_power_for_a_ratio():
     assert un.quantity("3 kN*m/m").to("kN").magnitude == pytest.approx(3.0, rel=1e-15)
 
 
-def test_units_in_formulas(tmp_path):
+def test_units_in_formulas(sheet_from):
     text = """
 [inputs]
 w = "1.2 m"
@@ -96,7 +94,7 @@ Q = { expr = "5 kvar + 200 var", unit = "kvar" }
 k = { expr = "2 m^(1/2)/s * sqrt(w)", unit = "m/s" }
 v = "var([1, 2, 3, 4]*w)"
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.evaluate("M").to("kN*m").magnitude == pytest.approx(3.6, rel=1e-14)
     assert sheet.evaluate("Q").to("kvar").magnitude == pytest.approx(5.2, rel=1e-14)
     assert sheet.evaluate("k").to("m/s").magnitude == pytest.approx(2 * math.sqrt(1.2), rel=1e-14)

@@ -4,9 +4,6 @@ only an input nothing reads is listed as unused (check) and labelled so (Inputs 
 from __future__ import annotations
 
 import openpyxl
-from helpers.sheets import write_template
-
-import workbook
 
 SHEET = """
 [inputs]
@@ -38,14 +35,14 @@ ok = "sigma <= f_y"
 """
 
 
-def test_inputs_of_solves_checks_odes_and_results_are_used(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_inputs_of_solves_checks_odes_and_results_are_used(sheet_from):
+    sheet = sheet_from(SHEET)
     assert sheet.unused_inputs() == ["spare"]
     assert sheet.check().unused_inputs == ["spare"]
 
 
-def test_the_inputs_sheet_labels_only_the_unused_input(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_the_inputs_sheet_labels_only_the_unused_input(sheet_from, tmp_path):
+    sheet = sheet_from(SHEET)
     sheet.write_xlsx(tmp_path / "t.xlsx")
     ws = openpyxl.load_workbook(tmp_path / "t.xlsx")["Inputs"]
     notes = {r[0].value: r[3].value or "" for r in ws.iter_rows(min_row=2) if r[0].value}

@@ -3,8 +3,6 @@ against mpmath at 50 digits written by hand, the fallback named where EXPR has n
 form, and bench on every template and on the hard cases: every "ok" is a row whose reference
 is mpmath, and every estimate is at least a tenth of the difference from it."""
 
-from pathlib import Path
-
 import mpmath
 import pytest
 from helpers.sheets import HARD_SHEET
@@ -14,12 +12,6 @@ from workbook.numerics import bench, mpref
 from workbook.numerics.mpform import NoMpForm, NoValue, mp_form
 
 MP = mpmath.mpf
-
-
-def _sheet(tmp_path: Path, text: str):
-    path = tmp_path / "s.toml"
-    path.write_text(text, encoding="utf-8")
-    return workbook.load(path)
 
 
 FORMS = """
@@ -46,9 +38,9 @@ def _a_by_hand(x):
 
 
 @pytest.mark.parametrize("x", [0.1, 0.5, 0.75, 2.5])
-def test_the_mpmath_form_of_a_tree_is_its_formula_at_32_digits(tmp_path, x):
+def test_the_mpmath_form_of_a_tree_is_its_formula_at_32_digits(sheet_from, x):
     """Sheet functions, a scalar definition, a piecewise value and the plain built-ins."""
-    s = _sheet(tmp_path, FORMS)
+    s = sheet_from(FORMS)
     ctx = mpref.context(32)
     form = mp_form(s.evaluator, ctx, s.typer.function("a").body)
     got = form({"x": x})
@@ -57,9 +49,8 @@ def test_the_mpmath_form_of_a_tree_is_its_formula_at_32_digits(tmp_path, x):
         assert abs(got - want) <= MP("1e-29") * abs(want)
 
 
-def test_no_real_value_and_no_form_are_said(tmp_path):
-    s = _sheet(
-        tmp_path,
+def test_no_real_value_and_no_form_are_said(sheet_from):
+    s = sheet_from(
         '[arguments]\nx = { unit = "" }\n[definitions]\n'
         '"r(x)" = "sqrt(x - 1)"\n"m(x)" = "mod(x, 1)"\n',
     )
@@ -70,9 +61,8 @@ def test_no_real_value_and_no_form_are_said(tmp_path):
         mp_form(s.evaluator, ctx, s.typer.function("m").body)
 
 
-def test_a_formula_without_an_mpmath_form_falls_back_and_says_so(tmp_path):
-    s = _sheet(
-        tmp_path,
+def test_a_formula_without_an_mpmath_form_falls_back_and_says_so(sheet_from):
+    s = sheet_from(
         '[definitions]\nsaw = "integral(pnorm(x, 0, 1), x, 0, 2.5)"\n'
         'sq = "integral(x^2, x, 0, 3)"\n',
     )
@@ -83,11 +73,11 @@ def test_a_formula_without_an_mpmath_form_falls_back_and_says_so(tmp_path):
     assert lines["sq"].difference <= 1e-15
 
 
-def test_the_reference_of_each_call_is_compared_not_the_definition(tmp_path):
+def test_the_reference_of_each_call_is_compared_not_the_definition(sheet_from):
     """A definition that is the difference of an integral and its closed form is rounding
     noise; its error relative to itself says nothing. Each built-in call is compared with
     the reference's call of the same EXPR, relative to that call's size."""
-    s = _sheet(tmp_path, '[definitions]\nd = "integral(sin(x), x, 0, 1) - (1 - cos(1))"\n')
+    s = sheet_from('[definitions]\nd = "integral(sin(x), x, 0, 1) - (1 - cos(1))"\n')
     (line,) = bench.run(s, repeats=1)
     assert line.reference == "mpmath" and line.checked == 1
     assert line.difference <= 1e-15 and line.verdict == "ok"
@@ -132,8 +122,8 @@ def _verdicts_are_honest(where: str, lines) -> None:
 
 
 @pytest.mark.slow
-def test_bench_of_the_hard_cases_against_mpmath(tmp_path):
-    lines = bench.run(_sheet(tmp_path, HARD), repeats=1)
+def test_bench_of_the_hard_cases_against_mpmath(sheet_from):
+    lines = bench.run(sheet_from(HARD), repeats=1)
     _verdicts_are_honest("hard cases", lines)
     ok = {line.what for line in lines if line.verdict == "ok"}
     assert {"peak", "wave", "narrow", "step", "lorentz", "sqrt2", "near", "bump"} <= ok

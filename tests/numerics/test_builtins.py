@@ -13,10 +13,8 @@ from workbook import WorkbookError
 from workbook.compute.excel import ExcelPrinter
 from workbook.engine.analysis import typed_text
 from workbook.engine.numeric import Evaluator
-from workbook.facade import Sheet
 from workbook.functions.entry import Builtin, register
 from workbook.language import typed as ty
-from workbook.language.template import load_spec
 from workbook.language.visitor import UnhandledNode
 from workbook.numerics import symbolic
 from workbook.numerics.registry import REGISTRY
@@ -42,12 +40,6 @@ empty = "sum(I, I, 3, 2)"
 """
 
 
-def _sheet(tmp_path, text=SHEET, **extra) -> Sheet:
-    path = tmp_path / "sums.toml"
-    path.write_text(text, encoding="utf-8")
-    return Sheet(load_spec(path), **extra)
-
-
 def _fourier(x_deg: float, terms: int) -> float:
     """2 mm * sum sin(k x)/k, by mpmath."""
     x = mpmath.radians(x_deg)
@@ -71,8 +63,8 @@ def test_a_name_is_registered_once():
         register(REGISTRY["sin"])
 
 
-def test_sum_against_mpmath(tmp_path):
-    sheet = _sheet(tmp_path)
+def test_sum_against_mpmath(sheet_from):
+    sheet = sheet_from(SHEET)
     x = np.array([0.0, 10.0, 33.0, 90.0, 200.0])
     got = sheet.evaluate("f", x).to("mm").magnitude
     assert got == pytest.approx([_fourier(v, 5) for v in x], rel=1e-14, abs=1e-15)
@@ -85,9 +77,9 @@ def test_sum_against_mpmath(tmp_path):
 
 
 @pytest.mark.slow
-def test_sum_excel_formula_against_the_formulas_package(tmp_path):
+def test_sum_excel_formula_against_the_formulas_package(sheet_from):
     formulas = pytest.importorskip("formulas")
-    sheet = _sheet(tmp_path)
+    sheet = sheet_from(SHEET)
     printer = ExcelPrinter(sheet.typer, {"R": "2", "n": "5"})
     text = printer.formula(sheet.typer.function("f").body, {"x": "33"})
     value = formulas.Parser().ast(text)[1].compile()()
@@ -104,16 +96,16 @@ def test_sum_excel_formula_against_the_formulas_package(tmp_path):
     assert str(formulas.Parser().ast(many)[1].compile()()).startswith("#N/A")
 
 
-def test_sum_in_sympy(tmp_path):
-    sheet = _sheet(tmp_path)
+def test_sum_in_sympy(sheet_from):
+    sheet = sheet_from(SHEET)
     expr = symbolic.to_sympy(sheet, "f")
     fn = symbolic.lambdify(sheet, expr, "x")
     assert fn(33.0) == pytest.approx(_fourier(33.0, 5), rel=1e-13)
     assert symbolic.to_sympy(sheet, "total") == 35
 
 
-def test_the_sheet_with_sums_is_written(tmp_path):
-    sheet = _sheet(tmp_path)
+def test_the_sheet_with_sums_is_written(sheet_from, tmp_path):
+    sheet = sheet_from(SHEET)
     sheet.write_xlsx(tmp_path / "sums.xlsx")
     assert (tmp_path / "sums.xlsx").stat().st_size > 0
 
@@ -129,17 +121,17 @@ def test_the_sheet_with_sums_is_written(tmp_path):
         ("sum(I*R, I, 1, 3) + 1", "cannot add"),
     ],
 )
-def test_sum_errors_at_load(tmp_path, expr, message):
+def test_sum_errors_at_load(sheet_from, expr, message):
     text = SHEET + f'bad = "{expr}"\n'
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        _sheet(tmp_path, text)
+        sheet_from(text)
 
 
 @pytest.mark.parametrize(
     "value, message", [("2.5", "must be an integer"), ("2000000", "limit 1000000")]
 )
-def test_sum_bounds_checked_when_evaluated(tmp_path, value, message):
-    sheet = _sheet(tmp_path).with_inputs(n=float(value))
+def test_sum_bounds_checked_when_evaluated(sheet_from, value, message):
+    sheet = sheet_from(SHEET).with_inputs(n=float(value))
     with pytest.raises(WorkbookError, match=message):
         sheet.evaluate("g", 1.0)
 
@@ -168,10 +160,10 @@ def at_entry():
     del REGISTRY["at"]
 
 
-def test_a_binding_builtin_types_its_variable_in_the_declared_unit(tmp_path, at_entry):
+def test_a_binding_builtin_types_its_variable_in_the_declared_unit(sheet_from, at_entry):
     text = SHEET.replace('n = "5"', 'n = "5"\nquarter = "90 deg"')
     text += 'up = { expr = "at(R*sin(x), x, quarter)", unit = "mm" }\n'
-    sheet = _sheet(tmp_path, text)
+    sheet = sheet_from(text)
     # x is declared in degrees: at x = 90 deg, sin(x) = 1 (the hook got EXPR as a callable)
     assert sheet.evaluate("up").to("mm").magnitude == pytest.approx(2.0, rel=1e-15)
     formulas = pytest.importorskip("formulas")
@@ -181,7 +173,7 @@ def test_a_binding_builtin_types_its_variable_in_the_declared_unit(tmp_path, at_
     assert float(symbolic.to_sympy(sheet, "up")) == pytest.approx(2.0, rel=1e-15)
     bad = SHEET + 'wrong = "at(R*sin(x), x, R)"\n'
     with pytest.raises(WorkbookError, match="at\\(\\): the value"):
-        _sheet(tmp_path, bad)
+        sheet_from(bad)
 
 
 class TOdd(ty.T):
@@ -189,8 +181,8 @@ class TOdd(ty.T):
 
 
 @pytest.mark.parametrize("backend", ["numpy", "excel", "sympy", "text"])
-def test_an_unknown_node_is_refused_by_every_back_end(tmp_path, backend):
-    sheet = _sheet(tmp_path)
+def test_an_unknown_node_is_refused_by_every_back_end(sheet_from, backend):
+    sheet = sheet_from(SHEET)
     node = TOdd(sheet.typer.dimensionless)
     evaluator = Evaluator(sheet.typer, sheet.scalar_value, sheet.describe_call)
     run = {
@@ -203,7 +195,7 @@ def test_an_unknown_node_is_refused_by_every_back_end(tmp_path, backend):
         run()
 
 
-def test_typed_nodes_are_frozen(tmp_path):
-    node = _sheet(tmp_path).typer.scalar("total")
+def test_typed_nodes_are_frozen(sheet_from):
+    node = sheet_from(SHEET).typer.scalar("total")
     with pytest.raises(AttributeError):
         node.unit = None

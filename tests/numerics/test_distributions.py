@@ -108,12 +108,12 @@ def test_every_distribution_is_tested_here():
 
 
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
+def sheet(load_text):
     lines = ["[arguments]", *(f'{v} = {{ unit = "" }}' for v in "uvw"), "", "[definitions]"]
     for name in CASES:
         params = ("u", "v", "w")[: REGISTRY[name].arity]
         lines.append(f'"f_{name}({", ".join(params)})" = "{name}({", ".join(params)})"')
-    return workbook.load(write_template(tmp_path_factory.mktemp("dist"), "\n".join(lines) + "\n"))
+    return load_text("\n".join(lines) + "\n", name="t")
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
@@ -261,10 +261,10 @@ def test_degrees_of_freedom_excel_would_truncate(golden):
         ("pchisq(1)", "takes 2 argument(s), got 1"),
     ],
 )
-def test_arguments_are_plain_numbers(tmp_path, text, message):
+def test_arguments_are_plain_numbers(sheet_from, text, message):
     text = f'[inputs]\nL = "1 m"\nt = "4 s"\n\n[definitions]\nbad = "{text}"\n'
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
 @pytest.mark.parametrize(
@@ -276,10 +276,10 @@ def test_outside_the_domain_is_an_error_not_a_number(tmp_path, text):
         workbook.load(path).evaluate("bad")
 
 
-def test_the_normal_density_is_the_derivative_of_its_probability(tmp_path):
+def test_the_normal_density_is_the_derivative_of_its_probability(sheet_from):
     text = '[arguments]\nu = { unit = "" }\n\n[definitions]\n'
     text += '"slope(u)" = "diff(pnorm(u, 0.3, 1.7), u)"\n"dens(u)" = "dnorm(u, 0.3, 1.7)"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     u = np.array([-2.0, 0.1, 1.3])
     slope = sheet.evaluate("slope", u).magnitude
     assert slope == pytest.approx(sheet.evaluate("dens", u).magnitude, rel=1e-14)
@@ -287,7 +287,7 @@ def test_the_normal_density_is_the_derivative_of_its_probability(tmp_path):
 
 
 @pytest.mark.slow
-def test_libreoffice_recalculates_the_distributions(tmp_path):
+def test_libreoffice_recalculates_the_distributions(sheet_from, tmp_path):
     """Every distribution cell recalculated by LibreOffice (which reads the _xlfn. names)
     agrees with the engine; a fraction of degrees of freedom from a cell is #N/A there too."""
     from helpers.recalc import cell_values, formula_values, recalculate, soffice
@@ -296,7 +296,7 @@ def test_libreoffice_recalculates_the_distributions(tmp_path):
         pytest.skip("LibreOffice is not installed")
     text = TEMPLATE + "".join(f'{k} = "{v}"\n' for k, v in EXCEL_CASES.items())
     text += 'fractional = "pt(x, half)"\n'
-    sheet = workbook.load(write_template(tmp_path, text, "dist.toml"))
+    sheet = sheet_from(text, name="dist")
     path = sheet.write_xlsx(tmp_path / "dist.xlsx")
     cells = formula_values(path)
     again = cell_values(recalculate(path, tmp_path / "out"))

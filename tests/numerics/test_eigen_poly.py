@@ -9,9 +9,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy
-from helpers.sheets import write_template
 
-import workbook
 from workbook import WorkbookError
 
 mp = mpmath.mp
@@ -68,9 +66,9 @@ def test_eigenvec_against_mpmath(sheet, name, matrix, scale):
         assert np.linalg.norm(got) == pytest.approx(1.0, abs=1e-15)
 
 
-def test_eigenvec_of_a_value_that_is_not_an_eigenvalue(tmp_path):
+def test_eigenvec_of_a_value_that_is_not_an_eigenvalue(sheet_from):
     text = SHEET + 'bad = "eigenvec(K, 3*k)"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     with pytest.raises(WorkbookError, match=r"z = 6 is not an eigenvalue of M \(the nearest is"):
         sheet.evaluate("bad")
 
@@ -85,9 +83,9 @@ def test_eigenvec_of_a_value_that_is_not_an_eigenvalue(tmp_path):
         ('bad = "rank(2)"', "must be a matrix"),
     ],
 )
-def test_shapes_and_units_are_checked_at_load(tmp_path, line, message):
+def test_shapes_and_units_are_checked_at_load(sheet_from, line, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, SHEET + line + "\n"))
+        sheet_from(SHEET + line + "\n")
 
 
 def test_rank_against_sympy(sheet):
@@ -134,8 +132,8 @@ def test_polyrootparts_against_mpmath(sheet, name, coefficients):
         ('bad = "polyroots([1, 2, 0])"', "the last coefficient (of the highest power) is 0"),
     ],
 )
-def test_polyroots_errors_when_computed(tmp_path, line, message):
-    sheet = workbook.load(write_template(tmp_path, SHEET + line + "\n"))
+def test_polyroots_errors_when_computed(sheet_from, line, message):
+    sheet = sheet_from(SHEET + line + "\n")
     with pytest.raises(WorkbookError, match=re.escape(message)):
         sheet.evaluate("bad")
 

@@ -12,9 +12,7 @@ import pytest
 import scipy.linalg
 import sympy
 from helpers.paths import SHARED
-from helpers.sheets import write_template
 
-import workbook
 from workbook.errors import WorkbookError
 from workbook.functions.factorizations import geninv, lu, rref
 from workbook.functions.matrix import SINGULAR_COND
@@ -101,19 +99,19 @@ def test_geninv_is_the_left_inverse():
         ("geninv([[1, 2], [2, 4], [3, 6]])", "dependent"),
     ],
 )
-def test_refusals(tmp_path, expr, message):
+def test_refusals(sheet_from, expr, message):
     sheet_text = f'[definitions]\nX = "{expr}"\n'
     with pytest.raises(WorkbookError, match=message):
-        workbook.load(write_template(tmp_path, sheet_text)).evaluate("X")
+        sheet_from(sheet_text).evaluate("X")
 
 
-def test_units(tmp_path):
+def test_units(sheet_from):
     text = (
         "[definitions]\n"
         'R = "rref([[1, 2, 5], [3, 4, 11]] * 1 kN)"\n'
         'G = "geninv([[2, 0], [0, 4], [0, 0]] * 1 m)"\n'
     )
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     r, g = sheet.evaluate("R"), sheet.evaluate("G")
     assert str(r.units) == "dimensionless"
     assert np.allclose(r.magnitude, [[1, 0, 1], [0, 1, 2]])

@@ -6,9 +6,7 @@ import re
 
 import numpy as np
 import pytest
-from helpers.sheets import write_template
 
-import workbook
 from workbook import WorkbookError
 
 DATA = np.random.default_rng(7).normal(0.87, 0.5, 500).round(3)
@@ -67,13 +65,13 @@ def test_given_intervals(sheet):
         ('bad = "histogram(3, 4)"', "argument 2 must be a vector"),
     ],
 )
-def test_checked_at_load(tmp_path, line, message):
+def test_checked_at_load(sheet_from, line, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, SHEET + line + "\n"))
+        sheet_from(SHEET + line + "\n")
 
 
-def test_intervals_that_do_not_increase(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET + 'bad = "histogram([0, 2, 1], d)"\n'))
+def test_intervals_that_do_not_increase(sheet_from):
+    sheet = sheet_from(SHEET + 'bad = "histogram([0, 2, 1], d)"\n')
     with pytest.raises(WorkbookError, match="the interval points must increase"):
         sheet.evaluate("bad")
 

@@ -90,19 +90,16 @@ def test_workbook_inlines_a_call_and_writes_a_program_as_values(sheet, tmp_path)
     assert "called with a vector or matrix" in cell("t").comment.text
 
 
-def _load(tmp_path, definitions: str, inputs: str = 'L = "2 m"\nT = "3 s"\n') -> Sheet:
-    path = tmp_path / "bad.toml"
-    path.write_text(
+def _text(definitions: str, inputs: str = 'L = "2 m"\nT = "3 s"\n') -> str:
+    return (
         f'[inputs]\n{inputs}\n[arguments]\nP = {{ unit = "m" }}\nQ = {{ unit = "m" }}\n'
-        f"\n[definitions]\n{definitions}",
-        encoding="utf-8",
+        f"\n[definitions]\n{definitions}"
     )
-    return Sheet(load_spec(path))
 
 
-def test_index_out_of_range_names_the_call_and_the_definition(tmp_path):
+def test_index_out_of_range_names_the_call_and_the_definition(sheet_from):
     with pytest.raises(TemplateError) as err:
-        _load(tmp_path, '"third(P)" = "P[2]"\ny = "third([1, 2]*L)"\n')
+        sheet_from(_text('"third(P)" = "P[2]"\ny = "third([1, 2]*L)"\n'))
     text = str(err.value)
     assert "in 'third'" in text and "third([1, 2] * L)" in text and "P a vector of 2" in text
     assert "index 2 is out of range" in text and "called in 'y'" in text
@@ -117,9 +114,9 @@ def test_index_out_of_range_names_the_call_and_the_definition(tmp_path):
         ('"f(P)" = "P[0]*nosuch"', "with numbers: P is not a vector or matrix.*with arrays:"),
     ],
 )
-def test_shape_mistakes_are_refused_at_load(tmp_path, body, message):
+def test_shape_mistakes_are_refused_at_load(sheet_from, body, message):
     with pytest.raises(TemplateError, match=message):
-        _load(tmp_path, body + "\n")
+        sheet_from(_text(body + "\n"))
 
 
 @pytest.mark.parametrize(
@@ -130,16 +127,17 @@ def test_shape_mistakes_are_refused_at_load(tmp_path, body, message):
         ('"f(P)" = "sin(P)"\ny = "f([1, 2]*L)"', "dimensionless argument"),
     ],
 )
-def test_unit_mistakes_are_refused_at_load(tmp_path, body, message):
+def test_unit_mistakes_are_refused_at_load(sheet_from, body, message):
     with pytest.raises(UnitError, match=message):
-        _load(tmp_path, body + "\n")
+        sheet_from(_text(body + "\n"))
 
 
-def test_a_condition_in_a_program_on_a_local_vector_is_one_number(tmp_path):
-    sheet = _load(
-        tmp_path,
-        '"loc(P)" = { program = """\nv := [1, -2]*P\nw := 1 if v[1] > 0 otherwise -1\nw\n""" }\n'
-        'y = "loc(L)"\n',
+def test_a_condition_in_a_program_on_a_local_vector_is_one_number(sheet_from):
+    sheet = sheet_from(
+        _text(
+            '"loc(P)" = { program = """\nv := [1, -2]*P\nw := 1 if v[1] > 0 otherwise -1\n'
+            'w\n""" }\ny = "loc(L)"\n'
+        )
     )
     assert np.ndim(sheet.evaluate("y").magnitude) == 0
     assert float(sheet.evaluate("y").magnitude) == -1
@@ -164,19 +162,19 @@ def test_libreoffice_recalculation_reproduces_the_engine(sheet, tmp_path):
     assert twice == pytest.approx(2e3 * np.linalg.norm(A - B), rel=1e-13)
 
 
-def test_a_function_of_vectors_only_is_not_evaluated_with_numbers(tmp_path):
+def test_a_function_of_vectors_only_is_not_evaluated_with_numbers(sheet_from):
     """x0(P) = P[0] is typed for the vectors it is called with: evaluated by name with a
     list (the points of a range, for a function of numbers) it is refused, never indexed."""
     from workbook.errors import InputError
 
-    sheet = _load(tmp_path, '"x0(P)" = "P[0]"\ny = "x0([3, 4]*L)"\n')
+    sheet = sheet_from(_text('"x0(P)" = "P[0]"\ny = "x0([3, 4]*L)"\n'))
     assert float(sheet.evaluate("y").to("m").magnitude) == 6
     with pytest.raises(InputError, match="takes vectors or matrices"):
         sheet.evaluate("x0", [1.0, 2.0, 3.0])
 
 
-def test_a_function_of_vectors_no_formula_calls_is_checked_with_run_time_arrays(tmp_path):
+def test_a_function_of_vectors_no_formula_calls_is_checked_with_run_time_arrays(sheet_from):
     """A library function of vectors that the sheet does not call loads (its units are
     checked with its argument as an array of a size known when called)."""
-    sheet = _load(tmp_path, '"first(P)" = "P[0]*2"\n')
+    sheet = sheet_from(_text('"first(P)" = "P[0]*2"\n'))
     assert sheet.typer.function("first").body.unit == sheet.typer.spec.arguments["P"].unit

@@ -9,9 +9,7 @@ import re
 import mpmath
 import numpy as np
 import pytest
-from helpers.sheets import write_template
 
-import workbook
 from workbook.errors import WorkbookError
 from workbook.functions.builtins import round_numpy
 
@@ -82,11 +80,11 @@ def test_round_of_a_ratio_times_a_step(sheet):
     assert sheet.evaluate("Lr").to("mm").magnitude == pytest.approx(15.0, rel=1e-15)
 
 
-def test_a_ratio_of_units_of_one_kind_is_its_plain_number(tmp_path):
+def test_a_ratio_of_units_of_one_kind_is_its_plain_number(sheet_from):
     """round(b/(1 mm)) with b in metres counts millimetres, as Mathcad does (the ratio m/mm is
     the plain number 1000 times its magnitude); floor and trunc likewise."""
     text = SHEET + 'B = "0.3047 m"\nm = "round(B/(1 mm))"\nk = "trunc(B/(1 cm))"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.evaluate("m").magnitude == 305.0
     assert sheet.evaluate("k").magnitude == 30.0
 
@@ -101,9 +99,9 @@ def test_a_ratio_of_units_of_one_kind_is_its_plain_number(tmp_path):
         ("round(2.5, L)", "the number of decimals needs a dimensionless argument"),
     ],
 )
-def test_a_value_with_a_unit_is_refused(tmp_path, expr, message):
+def test_a_value_with_a_unit_is_refused(sheet_from, expr, message):
     with pytest.raises(WorkbookError, match=message.replace("(", r"\(").replace(")", r"\)")):
-        workbook.load(write_template(tmp_path, SHEET + f'bad = "{expr}"\n'))
+        sheet_from(SHEET + f'bad = "{expr}"\n')
 
 
 LIVE = """
@@ -124,13 +122,13 @@ g = "round(B/(1 mm)) + trunc(B/(1 cm))"
 
 
 @pytest.mark.slow
-def test_libreoffice_agrees(tmp_path):
+def test_libreoffice_agrees(sheet_from, tmp_path):
     import openpyxl
     from helpers.recalc import recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
-    sheet = workbook.load(write_template(tmp_path, LIVE))
+    sheet = sheet_from(LIVE)
     path = sheet.write_xlsx(tmp_path / "live.xlsx")
     written = openpyxl.load_workbook(path)
     cached = openpyxl.load_workbook(path, data_only=True)
@@ -204,8 +202,8 @@ back = "backwards(3)"
 
 
 @pytest.fixture(scope="module")
-def arrays(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("sorts"), ARRAYS))
+def arrays(load_text):
+    return load_text(ARRAYS, name="t")
 
 
 def test_sort_reverse_rsort_of_fixed_arrays(arrays):
@@ -258,9 +256,9 @@ def test_run_time_mistakes_are_errors(arrays, call, message):
         ("rsort([[1, 2], [3, 4]], a)", r"rsort\(\): the row needs a dimensionless"),
     ],
 )
-def test_load_mistakes_are_errors(tmp_path, expr, message):
+def test_load_mistakes_are_errors(sheet_from, expr, message):
     with pytest.raises(WorkbookError, match=message):
-        workbook.load(write_template(tmp_path, ARRAYS + f'bad = "{expr}"\n'))
+        sheet_from(ARRAYS + f'bad = "{expr}"\n')
 
 
 def test_sorted_arrays_are_written_as_values(arrays, tmp_path):
@@ -304,8 +302,8 @@ stdev(w) + 1000*median(w)
 
 
 @pytest.fixture(scope="module")
-def stats(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("stats"), STATS))
+def stats(load_text):
+    return load_text(STATS, name="t")
 
 
 def _population(values):
@@ -335,9 +333,9 @@ def test_identity(stats):
         ("identity(5000)", "more than 2000 rows"),
     ],
 )
-def test_identity_needs_a_size_known_at_load(tmp_path, expr, message):
+def test_identity_needs_a_size_known_at_load(sheet_from, expr, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, STATS + f'bad = "{expr}"\n'))
+        sheet_from(STATS + f'bad = "{expr}"\n')
 
 
 def test_statistics_against_mpmath(stats):
@@ -406,13 +404,13 @@ k = "cot(a) + cot(x)"
 """
 
 
-def test_reciprocal_trigonometry_against_mpmath_and_formulas(tmp_path):
+def test_reciprocal_trigonometry_against_mpmath_and_formulas(sheet_from, tmp_path):
     """sec, csc and cot (Mathcad's) against mpmath at 30 digits; their Excel form 1/COS(...)
     recalculated by the `formulas` package."""
     import formulas
     import openpyxl
 
-    sheet = workbook.load(write_template(tmp_path, RECIPROCAL))
+    sheet = sheet_from(RECIPROCAL)
     mpmath.mp.dps = 30
     a = mpmath.radians(35)
     want = {

@@ -4,22 +4,16 @@ outer variable: against mpmath at 50 digits."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import mpmath
 import numpy as np
 import pytest
 
-import workbook
 from workbook.numerics.estimates import estimate_findings
 
+HEAD = "[sheet]\ntolerance = 1e-10\n[definitions]\n"
+
 mpmath.mp.dps = 50
-
-
-def _sheet(tmp_path: Path, defs: str):
-    path = tmp_path / "s.toml"
-    path.write_text(f"[sheet]\ntolerance = 1e-10\n[definitions]\n{defs}", encoding="utf-8")
-    return workbook.load(path)
 
 
 def _outer_error(s, name: str) -> float:
@@ -27,10 +21,9 @@ def _outer_error(s, name: str) -> float:
 
 
 @pytest.mark.slow
-def test_an_inner_integrand_singular_at_the_variable_bound_is_integrated(tmp_path):
-    s = _sheet(
-        tmp_path,
-        'n1 = "integral(integral(1/sqrt(x - y), y, 0, x), x, 0, 1)"\n'
+def test_an_inner_integrand_singular_at_the_variable_bound_is_integrated(sheet_from):
+    s = sheet_from(
+        HEAD + 'n1 = "integral(integral(1/sqrt(x - y), y, 0, x), x, 0, 1)"\n'
         'n3 = "integral(integral(ln(x - y), y, 0, x), x, 0, 1)"\n',
     )
     # refused before: the outer tanh-sinh's nodes at x = 2e-323, whose inner interval holds
@@ -57,10 +50,10 @@ def _inner(s):
 
 
 @pytest.mark.slow
-def test_a_beam_by_double_integration_of_a_piecewise_moment(tmp_path):
-    s = _sheet(
-        tmp_path,
-        'b1 = "integral(integral(0.7*t if t < 0.3 otherwise 0.3*(1 - t), t, 0, s), s, 0, 1)"\n'
+def test_a_beam_by_double_integration_of_a_piecewise_moment(sheet_from):
+    s = sheet_from(
+        HEAD
+        + 'b1 = "integral(integral(0.7*t if t < 0.3 otherwise 0.3*(1 - t), t, 0, s), s, 0, 1)"\n'
         'b3 = "integral(integral((0.7*t if t < 0.3 otherwise 0.3*(1 - t))*(s - t), t, 0, s),'
         ' s, 0, 1)"\n',
     )
@@ -118,7 +111,7 @@ def _nested(depth: int, leaf: str) -> str:
 
 
 @pytest.mark.slow
-def test_a_nested_integral_is_spot_checked_within_its_bound(tmp_path, monkeypatch):
+def test_a_nested_integral_is_spot_checked_within_its_bound(sheet_from, monkeypatch):
     """The spot check of an integral's own rounding evaluates its integrand in mpmath; an
     integral inside it costs hundreds of evaluations at each point checked, so the check stops
     at INNER_EVALUATIONS in all (nested twice, it is left out, not run for minutes)."""
@@ -126,14 +119,12 @@ def test_a_nested_integral_is_spot_checked_within_its_bound(tmp_path, monkeypatc
 
     counts = _counting_spot_checks(monkeypatch)
     plain = "".join(f"{v} = {{ unit = '' }}\n" for v in ("y", "u1", "u2"))
-    path = tmp_path / "nested.toml"
-    path.write_text(
+    s = sheet_from(
         f"[arguments]\n{plain}[definitions]\n"
         f'"g(y)" = "{_nested(1, "y*cos(u1)")}"\nK = "integral(g(y), y, 0, 1)"\n'
         f'"h(y)" = "{_nested(2, "exp(u1/2)")}"\nJ = "integral(h(y), y, 0, 1)"\n',
-        encoding="utf-8",
+        name="nested",
     )
-    s = workbook.load(path)
     # K = int_0^1 y sin(y) dy = sin 1 - cos 1; J = 8 (e^(1/2) - 1) - 5
     assert s.evaluate("K").magnitude == pytest.approx(math.sin(1) - math.cos(1), rel=1e-12)
     assert s.evaluate("J").magnitude == pytest.approx(8 * math.expm1(0.5) - 5, rel=1e-12)

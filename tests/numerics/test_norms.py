@@ -7,9 +7,8 @@ from __future__ import annotations
 import mpmath
 import numpy as np
 import pytest
-from helpers.sheets import write_template
+from helpers.sheets import definitions
 
-import workbook
 from workbook.errors import WorkbookError
 
 M = [[1, 0, 7], [9, 5, 8], [3, 4, 2]]
@@ -22,24 +21,18 @@ STORED = {  # matrix-functions.mcdx, regions 149 to 161
 }
 
 
-def _sheet(tmp_path, definitions: dict[str, str]):
-    text = "[definitions]\n" + "".join(f'{k} = "{v}"\n' for k, v in definitions.items())
-    return workbook.load(write_template(tmp_path, text))
-
-
 def _value(sheet, name):
     return np.asarray(sheet.evaluate(name).magnitude, dtype=float).reshape(-1)
 
 
-def test_mathcads_stored_values_and_mpmath(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        {
+def test_mathcads_stored_values_and_mpmath(sheet_from):
+    sheet = sheet_from(
+        definitions({
             "M": str(M),
             "n1": "norm1(M)", "n2": "norm2(M)", "ni": "normi(M)", "ne": "norm(M)",
             "sv": "svds(M)", "c1": "cond1(M)", "c2": "cond2(M)", "ce": "conde(M)",
             "ci": "condi(M)", "t": "tr(M)", "d": "diag(M)", "D": "diag([1, 2])",
-        },
+        })
     )  # fmt: skip
     for name, value in STORED.items():
         assert _value(sheet, name) == pytest.approx(value, rel=1e-14), name
@@ -69,6 +62,6 @@ def test_mathcads_stored_values_and_mpmath(tmp_path):
         ("diag([[1, 2, 3], [4, 5, 6]])", "square"),
     ],
 )
-def test_refusals(tmp_path, expr, message):
+def test_refusals(sheet_from, expr, message):
     with pytest.raises(WorkbookError, match=message):
-        _sheet(tmp_path, {"X": expr}).evaluate("X")
+        sheet_from(definitions({"X": expr})).evaluate("X")

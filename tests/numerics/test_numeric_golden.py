@@ -128,8 +128,8 @@ def _params(domains) -> str:
 
 
 @pytest.fixture(scope="module")
-def sheet(tmp_path_factory):
-    return workbook.load(write_template(tmp_path_factory.mktemp("num"), _template()))
+def sheet(load_text):
+    return load_text(_template(), name="t")
 
 
 def _ulps(got: float, want) -> float:

@@ -22,12 +22,6 @@ def pipe():
     return workbook.load(PIPE)
 
 
-def sheet(tmp_path, text: str):
-    path = tmp_path / "s.toml"
-    path.write_text(text, encoding="utf-8")
-    return workbook.load(path)
-
-
 def colebrook(f, re):
     return 1 / np.sqrt(f) + 2 * np.log10(EPS / (3.7 * D) + 2.51 / (re * np.sqrt(f)))
 
@@ -81,10 +75,8 @@ fact = "product(i, i, 1, 5)"
 
 
 @pytest.fixture(scope="module")
-def ext(tmp_path_factory):
-    path = tmp_path_factory.mktemp("ext") / "ext.toml"
-    path.write_text(EXTREMA, encoding="utf-8")
-    return workbook.load(path)
+def ext(load_text):
+    return load_text(EXTREMA, name="ext")
 
 
 def test_global_maximum_and_where_against_mpmath(ext):
@@ -153,18 +145,17 @@ r = { unit = "mm" }
         ('"argmin(r, r, T, R)"', "the lower bound A is [time]"),
     ],
 )
-def test_unit_mistakes_in_bounds_are_refused_at_load(tmp_path, definition, message):
+def test_unit_mistakes_in_bounds_are_refused_at_load(sheet_from, definition, message):
     with pytest.raises(UnitError) as err:
-        sheet(tmp_path, BASE + f"[definitions]\nbad = {definition}\n")
+        sheet_from(BASE + f"[definitions]\nbad = {definition}\n", name="s")
     text = str(err.value)
     assert message in text
     assert "s.toml:8" in text and "'bad'" in text
 
 
-def test_bad_tolerance_is_refused_at_load(tmp_path):
+def test_bad_tolerance_is_refused_at_load(sheet_from):
     with pytest.raises(TemplateError, match="tolerance"):
-        sheet(
-            tmp_path,
+        sheet_from(
             "[sheet]\ntolerance = 0.5\n" + BASE + '[definitions]\nq = "root(r - R, r, 0, R)"\n',
         )
 
@@ -181,16 +172,15 @@ def test_bad_tolerance_is_refused_at_load(tmp_path):
         ("argmin(max(x, 0.5), x, 0, 1)", r"minimum 0.5 is reached all along x = 0 \.\. 0.5"),
     ],
 )
-def test_hard_cases_are_errors_naming_file_line_definition(tmp_path, expr, message):
-    s = sheet(tmp_path, f'[arguments]\nx = {{ unit = "" }}\n[definitions]\nbad = "{expr}"\n')
+def test_hard_cases_are_errors_naming_file_line_definition(sheet_from, expr, message):
+    s = sheet_from(f'[arguments]\nx = {{ unit = "" }}\n[definitions]\nbad = "{expr}"\n', name="s")
     with pytest.raises(NumericsError, match=message) as err:
         s.evaluate("bad")
     assert "s.toml:4" in str(err.value) and "'bad'" in str(err.value)
 
 
-def test_rows_are_named_in_errors(pipe, tmp_path):
-    s = sheet(
-        tmp_path,
+def test_rows_are_named_in_errors(pipe, sheet_from):
+    s = sheet_from(
         '[arguments]\nx = { unit = "" }\nc = { unit = "" }\n'
         '[definitions]\n"g(c)" = "root(x^2 - c, x, 0, 2)"\n',
     )
@@ -225,11 +215,11 @@ q = { unit = "L/s" }
 """
 
 
-def test_interpolation_against_scipy_and_numpy(tmp_path):
+def test_interpolation_against_scipy_and_numpy(sheet_from, tmp_path):
     from scipy.interpolate import make_interp_spline
 
     (tmp_path / "pump.csv").write_text(PUMP)
-    s = sheet(tmp_path, DATA + '"lin(q)" = "linterp(Q, H, q)"\n"cub(q)" = "cspline(Q, H, q)"\n')
+    s = sheet_from(DATA + '"lin(q)" = "linterp(Q, H, q)"\n"cub(q)" = "cspline(Q, H, q)"\n')
     q = np.linspace(0.0, 50 / 3.6, 23)  # L/s, the data's whole range
     qh = q * 3.6  # m^3/h
     xs = np.array([0, 10, 20, 30, 40, 50.0])
@@ -256,10 +246,10 @@ def test_interpolation_against_scipy_and_numpy(tmp_path):
         ),
     ],
 )
-def test_data_mistakes_are_refused_at_load(tmp_path, csv, definition, error, message):
+def test_data_mistakes_are_refused_at_load(sheet_from, tmp_path, csv, definition, error, message):
     (tmp_path / "pump.csv").write_text(csv)
     with pytest.raises(error, match=re.escape(message)) as err:
-        sheet(tmp_path, DATA + f"bad = {definition}\n")
+        sheet_from(DATA + f"bad = {definition}\n", name="s")
     assert "s.toml" in str(err.value)
 
 
@@ -276,8 +266,8 @@ d = { expr = "sqrt(x^2 + y^2)", unit = "mm" }
 """
 
 
-def test_given_find_against_the_closed_form(tmp_path):
-    s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"'))
+def test_given_find_against_the_closed_form(sheet_from, tmp_path):
+    s = sheet_from(SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"'))
     assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-13)
     assert s.evaluate("y").to("m").magnitude == pytest.approx(2 * np.sin(0.3), rel=1e-13)
     assert s.evaluate("d").to("mm").magnitude == pytest.approx(2000, rel=1e-13)
@@ -293,47 +283,45 @@ def test_given_find_against_the_closed_form(tmp_path):
         ('"x + y == R", "2*x"', TemplateError, "an equation is written LEFT == RIGHT"),
     ],
 )
-def test_given_find_mistakes_are_refused_at_load(tmp_path, equations, error, message):
+def test_given_find_mistakes_are_refused_at_load(sheet_from, equations, error, message):
     with pytest.raises(error, match=re.escape(message)) as err:
-        sheet(tmp_path, SOLVE.replace("EQUATIONS", equations))
+        sheet_from(SOLVE.replace("EQUATIONS", equations), name="s")
     assert "s.toml:8" in str(err.value) and "solve x, y" in str(err.value)
 
 
-def test_given_find_with_a_side_that_is_zero(tmp_path):
+def test_given_find_with_a_side_that_is_zero(sheet_from):
     """`EXPR == 0` (common in Mathcad's solve blocks): a residual relative to sides that move
     with x would be a step of +-1 there; a linear system is solved exactly."""
     eqs = '"x + 2*y - R == 0", "x - y == 0"'
-    s = sheet(tmp_path, SOLVE.replace("EQUATIONS", eqs))
+    s = sheet_from(SOLVE.replace("EQUATIONS", eqs))
     assert s.evaluate("x").to("m").magnitude == pytest.approx(2 / 3, rel=1e-12)
     assert s.evaluate("y").to("m").magnitude == pytest.approx(2 / 3, rel=1e-12)
 
 
-def test_given_find_by_levenberg_marquardt(tmp_path):
+def test_given_find_by_levenberg_marquardt(sheet_from):
     """The method Mathcad's Find uses: the same closed form; an unknown method is refused."""
     text = SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"')
-    s = sheet(
-        tmp_path, text.replace("[definitions]", 'method = "levenberg-marquardt"\n[definitions]')
-    )
+    s = sheet_from(text.replace("[definitions]", 'method = "levenberg-marquardt"\n[definitions]'))
     assert s.spec.solves[0].method == "levenberg-marquardt"
     assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-12)
     with pytest.raises(TemplateError, match="one of hybrid, levenberg-marquardt, nearest"):
-        sheet(tmp_path, text.replace("[definitions]", 'method = "newton"\n[definitions]'))
+        sheet_from(text.replace("[definitions]", 'method = "newton"\n[definitions]'))
 
 
-def test_given_find_conditions_are_checked_at_the_root(tmp_path):
+def test_given_find_conditions_are_checked_at_the_root(sheet_from):
     """Mathcad's inequalities beside the equations: the root found must meet them."""
     text = SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2", "y == x*tan(theta)"')
     met = text.replace("[definitions]", 'conditions = ["x > 0 m"]\n[definitions]')
-    s = sheet(tmp_path, met.replace('"x > 0 m"', '"x > 0"'))
+    s = sheet_from(met.replace('"x > 0 m"', '"x > 0"'))
     assert s.evaluate("x").to("m").magnitude == pytest.approx(2 * np.cos(0.3), rel=1e-12)
-    s = sheet(tmp_path, met.replace('"x > 0 m"', '"x < 0"'))
+    s = sheet_from(met.replace('"x > 0 m"', '"x < 0"'))
     with pytest.raises(NumericsError, match="does not meet the condition 'x < 0'"):
         s.evaluate("x")
     with pytest.raises(TemplateError, match="a condition is written LEFT < RIGHT"):
-        sheet(tmp_path, met.replace('"x > 0 m"', '"x == 0"'))
+        sheet_from(met.replace('"x > 0 m"', '"x == 0"'))
 
 
-def test_given_find_levenberg_marquardt_honours_the_conditions(tmp_path):
+def test_given_find_levenberg_marquardt_honours_the_conditions(sheet_from):
     """Levenberg-Marquardt solves with the conditions (Mathcad's Find): x^2 = 4 from the guess
     -1 reaches -2, but with x > 1 the guess is first moved to meet it and the root is 2 (the
     hybrid method reaches -2 and reports the condition unmet)."""
@@ -343,15 +331,15 @@ unknowns = { x = "-1" }
 equations = ["x^2 == 4"]
 method = "levenberg-marquardt"
 """
-    assert sheet(tmp_path, text).evaluate("x").magnitude == pytest.approx(-2, rel=1e-9)
+    assert sheet_from(text).evaluate("x").magnitude == pytest.approx(-2, rel=1e-9)
     cond = text + 'conditions = ["x > 1"]\n'
-    assert sheet(tmp_path, cond).evaluate("x").magnitude == pytest.approx(2, rel=1e-9)
+    assert sheet_from(cond).evaluate("x").magnitude == pytest.approx(2, rel=1e-9)
     hybrid = cond.replace('method = "levenberg-marquardt"', "")
     with pytest.raises(NumericsError, match="does not meet the condition 'x > 1'"):
-        sheet(tmp_path, hybrid).evaluate("x")
+        sheet_from(hybrid).evaluate("x")
 
 
-def test_given_find_fewer_equations_than_unknowns(tmp_path):
+def test_given_find_fewer_equations_than_unknowns(sheet_from):
     """One equation in two unknowns (Mathcad's Find of an underdetermined block): the point
     on the circle that MINPACK's Levenberg-Marquardt reaches from (1 m, 1 m), as scipy's
     leastsq with the residuals padded to two (Mathcad's answer in the worksheets measured);
@@ -360,16 +348,16 @@ def test_given_find_fewer_equations_than_unknowns(tmp_path):
 
     text = SOLVE.replace("EQUATIONS", '"x^2 + y^2 == R^2"').replace('"50 cm"', '"1 m"')
     lm = text.replace("[definitions]", 'method = "levenberg-marquardt"\n[definitions]')
-    s = sheet(tmp_path, lm)
+    s = sheet_from(lm)
     x, y = s.evaluate("x").to("m").magnitude, s.evaluate("y").to("m").magnitude
     want = leastsq(lambda z: [z[0] ** 2 + z[1] ** 2 - 4, 0.0], [1.0, 1.0], xtol=1e-14)[0]
     assert (x, y) == pytest.approx(tuple(want), rel=1e-9)
     assert x**2 + y**2 == pytest.approx(4, rel=1e-9)
     with pytest.raises(TemplateError, match=re.escape('(or fewer, with method = "levenberg')):
-        sheet(tmp_path, text)
+        sheet_from(text)
 
 
-def test_given_find_nearest_root_meeting_the_conditions(tmp_path):
+def test_given_find_nearest_root_meeting_the_conditions(sheet_from):
     """`nearest`: of the roots of sin(phi) = 1/2 (pi/6 and 5 pi/6, plus 2 pi k) with phi < 0,
     the one nearest the guess 0 is 5 pi/6 - 2 pi."""
     text = """
@@ -379,19 +367,19 @@ equations = ["sin(phi) == 0.5"]
 method = "nearest"
 conditions = ["phi < 0"]
 """
-    s = sheet(tmp_path, text)
+    s = sheet_from(text)
     assert s.evaluate("phi").magnitude == pytest.approx(5 * np.pi / 6 - 2 * np.pi, rel=1e-9)
-    s = sheet(tmp_path, text.replace("phi < 0", "phi > 1"))
+    s = sheet_from(text.replace("phi < 0", "phi > 1"))
     assert s.evaluate("phi").magnitude == pytest.approx(5 * np.pi / 6, rel=1e-9)
 
 
-def test_given_find_not_converging_shows_residuals(tmp_path):
-    s = sheet(tmp_path, SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
+def test_given_find_not_converging_shows_residuals(sheet_from):
+    s = sheet_from(SOLVE.replace("EQUATIONS", '"x^2 + R^2 == 0", "y == x"'))
     with pytest.raises(NumericsError, match=r"did not converge.*x\^2 \+ R\^2 == 0: residual"):
         s.evaluate("d")
 
 
-def test_rows_are_solved_in_chunks_with_the_same_results(pipe, tmp_path, monkeypatch):
+def test_rows_are_solved_in_chunks_with_the_same_results(pipe, sheet_from, monkeypatch):
     from workbook.numerics import entries
 
     re_ = np.geomspace(4000, 1e8, 40)
@@ -401,8 +389,7 @@ def test_rows_are_solved_in_chunks_with_the_same_results(pipe, tmp_path, monkeyp
     chunked = pipe.with_inputs()
     assert np.array_equal(chunked.evaluate("friction", re_).magnitude, whole[0])
     assert np.array_equal(chunked.evaluate("Q", R).magnitude, whole[1])
-    s = sheet(
-        tmp_path,
+    s = sheet_from(
         '[arguments]\nx = { unit = "" }\nc = { unit = "" }\n'
         '[definitions]\n"g(c)" = "root(x^2 - c, x, 0, 2)"\n',
     )
@@ -443,11 +430,10 @@ def test_every_builtin_runs_from_a_plain_template(tmp_path, capsys):
         assert line.endswith("ok"), line
 
 
-def test_bounds_of_a_plain_argument_are_in_its_declared_unit(tmp_path):
+def test_bounds_of_a_plain_argument_are_in_its_declared_unit(sheet_from):
     """phi is a plain number of degrees (Mathcad's phi*deg): a bound of 120 deg is 120, not
     2.09 (radians), and a plain 120 is taken as degrees, as range bounds are."""
-    s = sheet(
-        tmp_path,
+    s = sheet_from(
         '[inputs]\nphi_max = "120 deg"\n'
         '[arguments]\nphi = { unit = "deg", plain = true }\npsi = { unit = "deg" }\n'
         '[definitions]\ndeg = "pi/180"\n'
@@ -461,8 +447,7 @@ def test_bounds_of_a_plain_argument_are_in_its_declared_unit(tmp_path):
     want = (1 - np.cos(np.radians(120))) * 180 / np.pi  # per degree of phi
     assert s.evaluate("area").magnitude == pytest.approx(want, rel=1e-13)
     with pytest.raises(UnitError, match=r"the upper bound B is \[length\]"):
-        sheet(
-            tmp_path,
+        sheet_from(
             '[inputs]\nL = "1 m"\n[arguments]\nphi = { unit = "deg", plain = true }\n'
             '[definitions]\nbad = "integral(phi, phi, 0, L)"\n',
         )
@@ -549,11 +534,9 @@ t = {{ unit = "s" }}
         ('"d(t)" = "diff(s(t), omega)"', "already an input"),
     ],
 )
-def test_diff_errors_without_sympy_come_at_load(tmp_path, line, message):
-    path = tmp_path / "d.toml"
-    path.write_text(DIFF.format(line=line), encoding="utf-8")
+def test_diff_errors_without_sympy_come_at_load(sheet_from, line, message):
     with pytest.raises(TemplateError, match=re.escape(message)) as err:
-        workbook.load(path)
+        sheet_from(DIFF.format(line=line), name="d")
     assert err.value.line == 11 and err.value.definition == "d"
     assert "d.toml" in str(err.value)
 
@@ -576,12 +559,10 @@ def test_a_derivative_sympy_cannot_write_back_is_an_error_at_first_use(tmp_path)
     assert main(["run", str(path), "--out", str(tmp_path / "d.xlsx")]) == 2
 
 
-def test_a_derivative_inside_another_function_call(tmp_path):
+def test_a_derivative_inside_another_function_call(sheet_from):
     # diff's variable is the enclosing one: z(u) = v(2*u) is s'(t) at t = 2*u
-    path = tmp_path / "d.toml"
     lines = '"v(t)" = { expr = "diff(s(t), t)", unit = "m/s" }\n"z(t)" = "v(2*t)"'
-    path.write_text(DIFF.format(line=lines), encoding="utf-8")
-    s = workbook.load(path)
+    s = sheet_from(DIFF.format(line=lines))
     t = np.array([0.0, 0.003, 0.02])
     want = 0.01 * 100 * np.cos(100 * 2 * t)
     assert np.allclose(s.evaluate("z", t).to("m/s").magnitude, want, rtol=1e-13, atol=1e-16)
@@ -606,10 +587,10 @@ columns = { friction = "", friction_guess = "" }
 """
 
 
-def _root_table(tmp_path):
+def _root_table(sheet_from, tmp_path):
     import openpyxl
 
-    s = sheet(tmp_path, ROOT_TABLE)
+    s = sheet_from(ROOT_TABLE)
     path = s.write_xlsx(tmp_path / "m.xlsx")
     wb = openpyxl.load_workbook(path)
     ws = next(w for w in wb.worksheets if w.title not in ("Inputs", "Definitions"))
@@ -617,8 +598,8 @@ def _root_table(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_root_in_a_table_column_is_live_as_bisection_steps(tmp_path):
-    s, path, wb, ws = _root_table(tmp_path)
+def test_a_root_in_a_table_column_is_live_as_bisection_steps(sheet_from, tmp_path):
+    s, path, wb, ws = _root_table(sheet_from, tmp_path)
     heads = [c.value for c in ws[2]]
     live, guess = heads.index("friction") + 1, heads.index("friction_guess") + 1
     re_values = [ws.cell(r, 1).value for r in range(3, 9)]
@@ -654,11 +635,11 @@ def openpyxl_values(path) -> dict:
     }
 
 
-def test_a_root_in_a_long_table_column_is_a_number_with_the_limit(tmp_path):
+def test_a_root_in_a_long_table_column_is_a_number_with_the_limit(sheet_from, tmp_path):
     import openpyxl
 
     long = ROOT_TABLE.replace("Re := 4000, 24000 .. 104000", "Re := 4000, 4100 .. 104000")
-    s = sheet(tmp_path, long)
+    s = sheet_from(long)
     path = s.write_xlsx(tmp_path / "m.xlsx")
     ws = next(w for w in openpyxl.load_workbook(path).worksheets if w.title != "Inputs")
     heads = [c.value for c in ws[2]]
@@ -670,8 +651,8 @@ def test_a_root_in_a_long_table_column_is_a_number_with_the_limit(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed")
-def test_a_live_root_column_follows_an_input_change_in_libreoffice(tmp_path):
-    s, path, wb, ws = _root_table(tmp_path)
+def test_a_live_root_column_follows_an_input_change_in_libreoffice(sheet_from, tmp_path):
+    s, path, wb, ws = _root_table(sheet_from, tmp_path)
     heads = [c.value for c in ws[2]]
     col = heads.index("friction") + 1
     stated = float(re.search(r"by ([0-9.e+-]+) ", ws.cell(2, col).comment.text).group(1))
@@ -730,10 +711,10 @@ columns = { top = "", where = "" }
 STATED = r"differs from the engine's value by ([0-9.e+-]+) "
 
 
-def _extrema_book(tmp_path):
+def _extrema_book(sheet_from, tmp_path):
     import openpyxl
 
-    s = sheet(tmp_path, EXTREMA_LIVE)
+    s = sheet_from(EXTREMA_LIVE)
     path = s.write_xlsx(tmp_path / "e.xlsx")
     wb = openpyxl.load_workbook(path)
     return s, path, wb
@@ -756,8 +737,8 @@ def _cells(wb):
 
 
 @pytest.mark.slow
-def test_extrema_are_live_where_close_to_the_engine(tmp_path):
-    s, path, wb = _extrema_book(tmp_path)
+def test_extrema_are_live_where_close_to_the_engine(sheet_from, tmp_path):
+    s, path, wb = _extrema_book(sheet_from, tmp_path)
     for key, (sheet_name, ref, comment) in _cells(wb).items():
         cell = wb[sheet_name][ref].value
         name = key if isinstance(key, str) else key[0]
@@ -772,8 +753,8 @@ def test_extrema_are_live_where_close_to_the_engine(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(soffice() is None, reason="LibreOffice is not installed")
-def test_live_extrema_follow_an_input_change_in_libreoffice(tmp_path):
-    s, path, wb = _extrema_book(tmp_path)
+def test_live_extrema_follow_an_input_change_in_libreoffice(sheet_from, tmp_path):
+    s, path, wb = _extrema_book(sheet_from, tmp_path)
     cells = {
         k: v for k, v in _cells(wb).items() if isinstance(wb[v[0]][v[1]].value, str)
     }  # the live ones
@@ -825,12 +806,12 @@ columns = { friction = "" }
 """
 
 
-def test_the_checks_sheet_lists_each_live_form_and_its_difference(tmp_path):
+def test_the_checks_sheet_lists_each_live_form_and_its_difference(sheet_from, tmp_path):
     """An integral's Gauss-Legendre sum and a column of bisection chains: on the Checks sheet,
     where each is, the engine's value, the live cell and their difference."""
     import openpyxl
 
-    s = sheet(tmp_path, LIVE_FORMS)
+    s = sheet_from(LIVE_FORMS)
     out = s.write_xlsx(tmp_path / "pipe.xlsx")
     ws = openpyxl.load_workbook(out)["Checks"]
     rows = [[c.value for c in row] for row in ws.iter_rows()]

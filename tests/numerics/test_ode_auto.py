@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.paths import DATA
-from helpers.sheets import write_template
 from scipy.integrate import solve_ivp
 
 import workbook
@@ -34,7 +33,7 @@ def test_robertson_turns_stiff_and_auto_goes_on_with_lsoda():
     assert "solved with LSODA" in found[0].what and "RK45 from the start" in found[0].note
 
 
-def test_a_problem_that_is_not_stiff_stays_explicit(tmp_path):
+def test_a_problem_that_is_not_stiff_stays_explicit(sheet_from):
     text = """
 [inputs]
 w = "3 1/s"
@@ -50,7 +49,7 @@ states = [
   { name = "v", unit = "m/s", initial = "0", derivative = "-w^2*x" },
 ]
 """.replace("v*1 s/s", "v")
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     sol = sheet.evaluator.ode_solution("spring")
     assert sol.method == "RK45" and "then stopped" not in sol.choice.reason
     assert sol(0, 50.0) == pytest.approx(np.cos(150.0), abs=1e-4)
@@ -82,7 +81,7 @@ states = [{ name = "y", unit = "", initial = "1", derivative = "r*y^2" }]
 """
 
 
-def test_a_failed_solve_is_remembered_not_repeated(tmp_path, monkeypatch):
+def test_a_failed_solve_is_remembered_not_repeated(sheet_from, monkeypatch):
     calls = []
     solve_typed = ode.solve_typed
 
@@ -91,7 +90,7 @@ def test_a_failed_solve_is_remembered_not_repeated(tmp_path, monkeypatch):
         return solve_typed(*args, **kw)
 
     monkeypatch.setattr(ode, "solve_typed", counted)
-    sheet = workbook.load(write_template(tmp_path, BLOWS_UP))
+    sheet = sheet_from(BLOWS_UP)
     for name in ("a", "b", "c", "a"):
         with pytest.raises(DomainError, match="blows up"):
             sheet.evaluate(name)
@@ -122,11 +121,11 @@ def test_an_implicit_run_over_its_budget_does_not_advise_an_implicit_method():
     assert "wants method" not in str(err.value)
 
 
-def test_a_growing_solution_warns_with_its_error_estimate(tmp_path):
+def test_a_growing_solution_warns_with_its_error_estimate(sheet_from):
     """y' = y^2, y(0) = 1 to t = 0.999999: the exact 1e6 is computed as about 777,669 at the
     default tolerances; the estimate says so instead of nothing."""
     text = BLOWS_UP.replace('T = "2 s"', 'T = "0.999999 s"')
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     value = sheet.evaluate("a").magnitude
     true_error = 1e6 - value
     assert true_error > 1e5  # the run is this far off
@@ -136,7 +135,7 @@ def test_a_growing_solution_warns_with_its_error_estimate(tmp_path):
     assert any(f.what.startswith("global error estimate: y off by up to") for f in warned)
 
 
-def test_an_accurate_run_reports_its_estimate_for_information(tmp_path):
+def test_an_accurate_run_reports_its_estimate_for_information(sheet_from):
     text = """
 [inputs]
 k = "2 1/s"
@@ -151,7 +150,7 @@ rtol = 1e-8
 atol = 1e-12
 states = [{ name = "y", unit = "m", initial = "1", derivative = "-k*y" }]
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     sol = sheet.evaluator.ode_solution("decay")
     est = sol.estimate()
     ts = sol.run.t
@@ -161,7 +160,7 @@ states = [{ name = "y", unit = "m", initial = "1", derivative = "-k*y" }]
     assert f[0].verdict == "info"
 
 
-def test_root_integral_and_extrema_of_a_state_use_its_dense_output(tmp_path):
+def test_root_integral_and_extrema_of_a_state_use_its_dense_output(sheet_from):
     """py = cos(2 t): a root at pi/4, the integral to 1 s sin(2)/2, the maximum on [0.5, 3.5]
     1 at pi (the closed form; the run at rtol 1e-10)."""
     text = """
@@ -190,7 +189,7 @@ states = [
   { name = "pv", unit = "m/s", initial = "0", derivative = "-w^2*py" },
 ]
 """
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     value = {n: sheet.evaluate(n).magnitude for n in ("t0", "I", "top", "at", "low")}
     assert value["t0"] == pytest.approx(np.pi / 4, abs=1e-8)
     assert value["I"] == pytest.approx(np.sin(2) / 2, abs=1e-8)

@@ -8,8 +8,6 @@ import pytest
 
 import workbook
 from workbook.compute.checks import run_checks
-from workbook.facade import Sheet
-from workbook.language.template import load_spec
 
 HEAD = """
 [inputs]
@@ -22,12 +20,6 @@ t = { unit = "s" }
 """
 
 
-def _sheet(tmp_path, text: str) -> Sheet:
-    path = tmp_path / "o.toml"
-    path.write_text(HEAD + text, encoding="utf-8")
-    return Sheet(load_spec(path))
-
-
 def ode(name, states, time="t := 0 .. 3", extra=""):
     rows = ",\n".join(
         f'  {{ name = "{n}", unit = "{u}", initial = "{i}", derivative = "{d}" }}'
@@ -36,11 +28,11 @@ def ode(name, states, time="t := 0 .. 3", extra=""):
     return f'\n[[ode]]\nname = "{name}"\ntime = "{time}"\n{extra}\nstates = [\n{rows}\n]\n'
 
 
-def test_solution_against_the_closed_form_in_a_table(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        ode("decay", [("y", "m", "y0", "-k*y")], extra="rtol = 1e-10\natol = 1e-13")
-        + '\n[[tables]]\nname = "sol"\nrange = "t := 0, 0.25 .. 3"\ncolumns = { y = "mm" }\n',
+def test_solution_against_the_closed_form_in_a_table(sheet_from, tmp_path):
+    sheet = sheet_from(
+        HEAD
+        + ode("decay", [("y", "m", "y0", "-k*y")], extra="rtol = 1e-10\natol = 1e-13")
+        + '\n[[tables]]\nname = "sol"\nrange = "t := 0, 0.25 .. 3"\ncolumns = { y = "mm" }\n'
     )
     table = sheet.table("sol")
     t = table.iloc[:, 0].to_numpy()
@@ -82,13 +74,11 @@ columns = { T = "degF" }
 """
 
 
-def test_a_temperature_state_changes_by_differences(tmp_path):
+def test_a_temperature_state_changes_by_differences(sheet_from):
     """Newton's cooling with T in degC: T' is in delta_degC/s (the derivative was converted to
     degC/s, an internal error) and its atol a difference; T read in degF and K against the
     closed form Ta + (T0 - Ta) exp(-h t)."""
-    path = tmp_path / "cool.toml"
-    path.write_text(COOLING, encoding="utf-8")
-    sheet = Sheet(load_spec(path))
+    sheet = sheet_from(COOLING, name="cool")
     celsius = 20 + 60 * np.exp(-0.05 * np.arange(0, 121, 30.0))
     table = sheet.table("sol")
     np.testing.assert_allclose(table.iloc[:, 1], celsius * 9 / 5 + 32, rtol=1e-10)
@@ -97,10 +87,10 @@ def test_a_temperature_state_changes_by_differences(tmp_path):
     )
 
 
-def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):
-    sheet = _sheet(
-        tmp_path,
-        ode(
+def test_a_stiff_system_makes_auto_take_an_implicit_method(sheet_from):
+    sheet = sheet_from(
+        HEAD
+        + ode(
             "stiff",
             [
                 ("a", "m", "0", "-lam*(a - y0*cos(k*t))"),
@@ -108,7 +98,7 @@ def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):
             ],
             time="t := 0 .. 2",
             extra="rtol = 1e-8\natol = 1e-11",
-        ),
+        )
     )
     sol = sheet.evaluator.ode_solution("stiff")
     assert sol.method == "LSODA"
@@ -120,18 +110,20 @@ def test_a_stiff_system_makes_auto_take_an_implicit_method(tmp_path):
     )  # LSODA's global error at rtol 1e-8 is 1.1e-7 here
 
 
-def test_units_of_derivatives_are_checked_at_load(tmp_path):
+def test_units_of_derivatives_are_checked_at_load(sheet_from):
     with pytest.raises(workbook.WorkbookError, match=r"y' \(ode 'bad'\)") as info:
-        _sheet(tmp_path, ode("bad", [("y", "m", "y0", "k")]))
+        sheet_from(HEAD + ode("bad", [("y", "m", "y0", "k")]), name="o")
     assert "o.toml" in str(info.value) and "cannot be converted" in str(info.value)
     with pytest.raises(workbook.WorkbookError, match="not one of auto"):
-        _sheet(tmp_path, ode("bad", [("y", "m", "y0", "-k*y")], extra='method = "Euler"'))
+        sheet_from(
+            HEAD + ode("bad", [("y", "m", "y0", "-k*y")], extra='method = "Euler"'), name="o"
+        )
     with pytest.raises(workbook.WorkbookError, match="has no declared unit"):
-        _sheet(tmp_path, ode("bad", [("y", "m", "y0", "-k*y")], time="tau := 0 .. 1"))
+        sheet_from(HEAD + ode("bad", [("y", "m", "y0", "-k*y")], time="tau := 0 .. 1"), name="o")
 
 
-def test_a_solution_that_blows_up_is_stopped_and_said_why(tmp_path):
-    sheet = _sheet(tmp_path, ode("boom", [("y", "m", "y0", "y^2/y0*k")], time="t := 0 .. 1"))
+def test_a_solution_that_blows_up_is_stopped_and_said_why(sheet_from):
+    sheet = sheet_from(HEAD + ode("boom", [("y", "m", "y0", "y^2/y0*k")], time="t := 0 .. 1"))
     with pytest.raises(workbook.WorkbookError, match="blows up") as info:
         sheet.evaluate("y", 0.9)
     assert "ode 'boom'" in str(info.value)
@@ -139,8 +131,8 @@ def test_a_solution_that_blows_up_is_stopped_and_said_why(tmp_path):
     assert any(f.verdict == "fail" and "blows up" in f.note for f in report.findings)
 
 
-def test_time_outside_the_range_is_an_error(tmp_path):
-    sheet = _sheet(tmp_path, ode("decay", [("y", "m", "y0", "-k*y")]))
+def test_time_outside_the_range_is_an_error(sheet_from):
+    sheet = sheet_from(HEAD + ode("decay", [("y", "m", "y0", "-k*y")]))
     with pytest.raises(workbook.WorkbookError, match="outside the time range"):
         sheet.evaluate("y", [1, 5])
 
@@ -177,14 +169,12 @@ states = [
 
 
 @pytest.mark.slow
-def test_vector_states_against_the_matrix_exponential(tmp_path):
+def test_vector_states_against_the_matrix_exponential(sheet_from):
     """M x'' + C x' + K x = 0 as two vector states, against expm of the first-order system
     written out here; the method is a choice input and rtol an input."""
     from scipy.linalg import expm
 
-    path = tmp_path / "m.toml"
-    path.write_text(MASS, encoding="utf-8")
-    sheet = Sheet(load_spec(path))
+    sheet = sheet_from(MASS, name="m")
     M, K, C = np.diag([2.0, 1.0]), np.array([[1600.0, -800.0], [-800.0, 800.0]]), 4 * np.eye(2)
     A = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     ts = np.array([0.05, 0.2, 0.5])
@@ -199,26 +189,20 @@ def test_vector_states_against_the_matrix_exponential(tmp_path):
     assert other.evaluator.ode_solution("two_masses").method == "DOP853"
 
 
-def test_vector_state_shapes_and_method_names_are_checked_at_load(tmp_path):
-    path = tmp_path / "m.toml"
-    path.write_text(MASS.replace('derivative = "v"', 'derivative = "v[0]"'), encoding="utf-8")
+def test_vector_state_shapes_and_method_names_are_checked_at_load(sheet_from):
     with pytest.raises(workbook.WorkbookError, match="derivative of 'x' is a number"):
-        Sheet(load_spec(path))
-    path.write_text(MASS.replace('method = "scheme"', 'method = "schema"'), encoding="utf-8")
+        sheet_from(MASS.replace('derivative = "v"', 'derivative = "v[0]"'), name="m")
     with pytest.raises(workbook.WorkbookError, match="not one of auto"):
-        Sheet(load_spec(path))
-    path.write_text(MASS.replace('method = "scheme"', 'method = "tol"'), encoding="utf-8")
+        sheet_from(MASS.replace('method = "scheme"', 'method = "schema"'), name="m")
     with pytest.raises(workbook.WorkbookError, match="must give text"):
-        Sheet(load_spec(path))
+        sheet_from(MASS.replace('method = "scheme"', 'method = "tol"'), name="m")
 
 
 @pytest.mark.slow
-def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
+def test_run_sheet_returns_a_stopped_run_instead_of_raising(sheet_from):
     from workbook.engine import ode as wo
 
-    path = tmp_path / "m.toml"
-    path.write_text(MASS, encoding="utf-8")
-    sheet = Sheet(load_spec(path)).with_inputs(scheme="RK45", tol="1e-9")
+    sheet = sheet_from(MASS, name="m").with_inputs(scheme="RK45", tol="1e-9")
     ts = np.linspace(0, 0.5, 11)
     run = wo.run_sheet(sheet, "two_masses", t_eval=ts)
     assert run.ok and run.method == "RK45" and run.y.shape == (4, 11)
@@ -228,14 +212,12 @@ def test_run_sheet_returns_a_stopped_run_instead_of_raising(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_method_given_by_a_text_definition_is_checked_when_it_is_evaluated(tmp_path):
+def test_a_method_given_by_a_text_definition_is_checked_when_it_is_evaluated(sheet_from):
     text = MASS.replace('method = "scheme"', 'method = "pick"').replace(
         "[definitions]\n",
         '[definitions]\npick = "\\"Radau\\" if tol < 1e-6 otherwise \\"Euler\\""\n',
     )
-    path = tmp_path / "m.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = Sheet(load_spec(path))
+    sheet = sheet_from(text, name="m")
     assert sheet.evaluator.ode_solution("two_masses").method == "Radau"
     with pytest.raises(workbook.WorkbookError, match="'Euler' is not one of auto"):
         sheet.with_inputs(tol="1e-3").evaluate("x", 0.1)

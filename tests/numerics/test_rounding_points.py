@@ -3,21 +3,13 @@ beside the result (numerics.rounding), each case against mpmath at 50 digits."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import mpmath
 import numpy as np
 import pytest
 
-import workbook
+HEAD = "[sheet]\ntolerance = 1e-10\n"
 
 mpmath.mp.dps = 50
-
-
-def _sheet(tmp_path: Path, body: str):
-    path = tmp_path / "s.toml"
-    path.write_text(f"[sheet]\ntolerance = 1e-10\n{body}", encoding="utf-8")
-    return workbook.load(path)
 
 
 def _exp_m1_m(x):
@@ -25,12 +17,11 @@ def _exp_m1_m(x):
 
 
 @pytest.mark.slow
-def test_a_table_of_roots_of_a_cancelling_expression_has_honest_estimates(tmp_path):
+def test_a_table_of_roots_of_a_cancelling_expression_has_honest_estimates(sheet_from):
     # 100 rows: beyond the rows the mpmath polish checks; each row's residual is the
     # difference of numbers near 1, its rounding over the slope x is the root's error
-    s = _sheet(
-        tmp_path,
-        '[arguments]\nx = { unit = "" }\nc = { unit = "" }\n[definitions]\n'
+    s = sheet_from(
+        HEAD + '[arguments]\nx = { unit = "" }\nc = { unit = "" }\n[definitions]\n'
         '"r(c)" = "root((exp(x) - 1 - x) - c, x, 1e-7, 1)"\n'
         '[[tables]]\nname = "t"\nrange = "c := 1e-10, 2e-10 .. 1e-8"\n'
         'columns = { "r(c)" = "" }\n',
@@ -49,8 +40,8 @@ def test_a_table_of_roots_of_a_cancelling_expression_has_honest_estimates(tmp_pa
     assert np.max(np.ravel(res.error) / np.ravel(res.value)) > 1e-8
 
 
-def test_a_root_of_a_cancelling_expression_is_polished(tmp_path):
-    s = _sheet(tmp_path, '[definitions]\ny = "root((exp(x) - 1 - x) - 1e-9, x, 1e-6, 1)"\n')
+def test_a_root_of_a_cancelling_expression_is_polished(sheet_from):
+    s = sheet_from(HEAD + '[definitions]\ny = "root((exp(x) - 1 - x) - 1e-9, x, 1e-6, 1)"\n')
     v = s.evaluate("y").magnitude
     exact = mpmath.findroot(lambda x: _exp_m1_m(x) - mpmath.mpf(1e-9), 4.5e-5)
     (res,) = [r for _, r in s.evaluator.records]
@@ -62,10 +53,10 @@ def _flat_peak(x):
     return mpmath.cos(mpmath.mpf(1e-4) * x) - 1 + mpmath.mpf(1e-9) * mpmath.sin(x)
 
 
-def test_the_place_of_a_cancelling_maximum_has_an_honest_estimate_and_is_warned(tmp_path):
+def test_the_place_of_a_cancelling_maximum_has_an_honest_estimate_and_is_warned(sheet_from):
     expr = "cos(1e-4*x) - 1 + 1e-9*sin(x)"
-    s = _sheet(
-        tmp_path, f'[definitions]\nm = "maximum({expr}, x, 0, 3)"\na = "argmax({expr}, x, 0, 3)"\n'
+    s = sheet_from(
+        HEAD + f'[definitions]\nm = "maximum({expr}, x, 0, 3)"\na = "argmax({expr}, x, 0, 3)"\n'
     )
     where = mpmath.findroot(lambda x: mpmath.diff(_flat_peak, x), 0.0995)
     top = _flat_peak(where)
@@ -81,9 +72,9 @@ def test_the_place_of_a_cancelling_maximum_has_an_honest_estimate_and_is_warned(
     assert "estimate a" in warned, warned
 
 
-def test_a_maximum_of_a_cancelling_expression_is_within_its_estimate(tmp_path):
+def test_a_maximum_of_a_cancelling_expression_is_within_its_estimate(sheet_from):
     # (1 - cos x)/x^2 -> 1/2 at 0, computed as a difference of numbers near 1
-    s = _sheet(tmp_path, '[definitions]\nm = "maximum((1 - cos(x))/x^2, x, 1e-5, 1e-3)"\n')
+    s = sheet_from(HEAD + '[definitions]\nm = "maximum((1 - cos(x))/x^2, x, 1e-5, 1e-3)"\n')
     m = s.evaluate("m").magnitude
     exact = max((1 - mpmath.cos(x)) / x**2 for x in (mpmath.mpf(1e-5), mpmath.mpf(1e-3)))
     (res,) = [r for _, r in s.evaluator.records]

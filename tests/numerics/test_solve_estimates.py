@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from helpers.sheets import write_template
 
-import workbook
 from workbook.cli import main
 
 SHEET = """
@@ -28,8 +27,8 @@ theta = "0.3"
 """
 
 
-def test_an_ill_conditioned_system_warns_with_an_estimate_above_its_error(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_an_ill_conditioned_system_warns_with_an_estimate_above_its_error(sheet_from):
+    sheet = sheet_from(SHEET)
     p = sheet.evaluate("p").magnitude
     solved = sheet.solution(sheet.spec.solves[0])
     assert solved.condition > 1e9  # exact: 4e10 for the relative residuals
@@ -39,8 +38,8 @@ def test_an_ill_conditioned_system_warns_with_an_estimate_above_its_error(tmp_pa
     assert "ill-conditioned" in found["solve p, q"].note
 
 
-def test_a_well_conditioned_system_is_for_information(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+def test_a_well_conditioned_system_is_for_information(sheet_from):
+    sheet = sheet_from(SHEET)
     x = sheet.evaluate("x").to("m").magnitude
     solved = sheet.solution(sheet.spec.solves[1])
     assert solved.condition < 10
@@ -67,13 +66,13 @@ def test_run_prints_the_unknowns_as_results(tmp_path):
     assert "warning: [solve p, q]" in err.getvalue()
 
 
-def test_the_results_sheet_and_the_report_show_the_block(tmp_path):
+def test_the_results_sheet_and_the_report_show_the_block(sheet_from, tmp_path):
     import openpyxl
 
     from workbook.compute.computed import compute
     from workbook.outputs.report import write_report
 
-    sheet = workbook.load(write_template(tmp_path, SHEET))
+    sheet = sheet_from(SHEET)
     sheet.write_xlsx(tmp_path / "s.xlsx")
     rows = {
         r[0]: r
@@ -125,8 +124,8 @@ def freudenstein(th2: np.ndarray, a=40.0, b=120.0, c=80.0, d=100.0) -> np.ndarra
     return np.array([2 * np.arctan2(-big_b + s * root, 2 * big_a) for s in (1, -1)])
 
 
-def test_a_block_with_parameters_is_a_function_over_a_table(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, FOUR_BAR))
+def test_a_block_with_parameters_is_a_function_over_a_table(sheet_from):
+    sheet = sheet_from(FOUR_BAR)
     table = sheet.table("positions")
     th2 = np.radians(table["th2 [deg]"].to_numpy())
     th4 = np.radians(table["th4 [deg]"].to_numpy())
@@ -140,28 +139,28 @@ def test_a_block_with_parameters_is_a_function_over_a_table(tmp_path):
     )
 
 
-def test_an_unknown_of_a_block_with_parameters_is_used_as_a_function(tmp_path):
+def test_an_unknown_of_a_block_with_parameters_is_used_as_a_function(sheet_from):
     from workbook.errors import TemplateError
 
     text = FOUR_BAR.replace('"th4(90 deg)"', '"th4"')
     with pytest.raises(TemplateError, match=r"it is a function, write th4\(th2\)"):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
-def test_inputs_of_a_block_with_parameters_are_used(tmp_path):
+def test_inputs_of_a_block_with_parameters_are_used(sheet_from):
     text = FOUR_BAR.replace('d = "100 mm"', 'd = "100 mm"\nspare = "1 mm"')
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.unused_inputs() == ["spare"]
 
 
-def test_the_estimate_of_an_unknown_in_degc_is_a_difference(tmp_path):
+def test_the_estimate_of_an_unknown_in_degc_is_a_difference(sheet_from, tmp_path):
     import openpyxl
 
     text = (
         '[inputs]\nT0 = "20 degC"\nk = "0.5 1/K"\n\n[[solve]]\nunknowns = { T = "30 degC" }\n'
         'equations = ["k*(T - T0) == 2"]\n\n[definitions]\nTT = { expr = "T", unit = "degC" }\n'
     )
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert sheet.evaluate("T").magnitude == pytest.approx(24.0, rel=1e-12)
     found = {f.topic: f for f in sheet.check().findings}
     assert "degC (error estimate" in found["solve T"].what

@@ -9,9 +9,8 @@ import re
 import mpmath
 import numpy as np
 import pytest
-from helpers.sheets import write_template
+from helpers.sheets import definitions
 
-import workbook
 from workbook import WorkbookError
 from workbook.functions.special import NAMES
 
@@ -32,21 +31,16 @@ CASES = {
 }
 
 
-def _sheet(tmp_path, definitions: dict[str, str]):
-    text = "[definitions]\n" + "".join(f'{k} = "{v}"\n' for k, v in definitions.items())
-    return workbook.load(write_template(tmp_path, text))
-
-
 def test_every_special_function_is_tested_here():
     assert set(CASES) == NAMES
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_special_function_agrees_with_mpmath(tmp_path, name):
+def test_special_function_agrees_with_mpmath(sheet_from, name):
     reference, points, rel = CASES[name]
     defs = {f"v{k}": f"{name}({', '.join(map(str, p))})" for k, p in enumerate(points)}
-    sheet = _sheet(tmp_path, defs)
+    sheet = sheet_from(definitions(defs))
     with mpmath.workdps(50):
         for k, p in enumerate(points):
             want = float(reference(*(mpmath.mpf(str(a)) for a in p)))
@@ -54,8 +48,8 @@ def test_special_function_agrees_with_mpmath(tmp_path, name):
             assert got == pytest.approx(want, rel=rel, abs=1e-300), (name, p)
 
 
-def test_mathcads_fixed_orders_are_the_general_ones(tmp_path):
-    sheet = _sheet(tmp_path, {"a": "bessel_j(1, 2.5) - bessel_j(-1, 2.5)"})
+def test_mathcads_fixed_orders_are_the_general_ones(sheet_from):
+    sheet = sheet_from(definitions({"a": "bessel_j(1, 2.5) - bessel_j(-1, 2.5)"}))
     # J_-1 = -J_1: a negative whole order is defined
     assert float(sheet.evaluate("a").magnitude) == pytest.approx(
         2 * float(mpmath.besselj(1, 2.5)), rel=1e-14
@@ -77,10 +71,9 @@ def test_mathcads_fixed_orders_are_the_general_ones(tmp_path):
         "bessel_k(1, -1)",
     ],
 )
-def test_outside_the_domain_is_an_error_not_a_number(tmp_path, text):
-    path = write_template(tmp_path, f'[definitions]\nbad = "{text}"\n')
+def test_outside_the_domain_is_an_error_not_a_number(sheet_from, text):
     with pytest.raises(WorkbookError, match="not a finite number"):
-        workbook.load(path).evaluate("bad")
+        sheet_from(f'[definitions]\nbad = "{text}"\n').evaluate("bad")
 
 
 @pytest.mark.parametrize(
@@ -91,14 +84,14 @@ def test_outside_the_domain_is_an_error_not_a_number(tmp_path, text):
         ("erf(1, 2)", "takes 1 argument(s), got 2"),
     ],
 )
-def test_arguments_are_plain_numbers(tmp_path, text, message):
+def test_arguments_are_plain_numbers(sheet_from, text, message):
     text = f'[inputs]\nL = "1 m"\n\n[definitions]\nbad = "{text}"\n'
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, text))
+        sheet_from(text)
 
 
-def test_gamma_is_the_factorial_shifted(tmp_path):
-    sheet = _sheet(tmp_path, {"a": "gamma(7)", "b": "factorial(6)", "c": "combin(6, 2) * 2"})
+def test_gamma_is_the_factorial_shifted(sheet_from):
+    sheet = sheet_from(definitions({"a": "gamma(7)", "b": "factorial(6)", "c": "combin(6, 2) * 2"}))
     assert float(sheet.evaluate("a").magnitude) == float(sheet.evaluate("b").magnitude) == 720
     assert float(sheet.evaluate("c").magnitude) == 30
 
@@ -117,10 +110,10 @@ EXCEL_CASES = {
 }
 
 
-def _workbook(tmp_path):
+def _workbook(sheet_from, tmp_path):
     text = '[inputs]\nx = "1.7"\nn = "7"\nk = "2"\n\n[definitions]\n'
     text += "".join(f'{k} = "{v}"\n' for k, (v, _) in EXCEL_CASES.items())
-    sheet = workbook.load(write_template(tmp_path, text, "special.toml"))
+    sheet = sheet_from(text, name="special")
     return sheet, sheet.write_xlsx(tmp_path / "special.xlsx")
 
 
@@ -131,13 +124,13 @@ def _cells_of(cells, function: str) -> list:
     return found[0]
 
 
-def test_excel_forms_are_excels_functions(tmp_path):
+def test_excel_forms_are_excels_functions(sheet_from):
     """Each call is printed as Excel's function (GAMMA with its prefix, BESSELJ x first)."""
     from workbook.compute.excel import ExcelPrinter
 
     text = '[inputs]\nx = "1.7"\nn = "7"\nk = "2"\n\n[definitions]\n'
     text += "".join(f'{k} = "{v}"\n' for k, (v, _) in EXCEL_CASES.items())
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     printer = ExcelPrinter(sheet.typer, {"x": "x_", "n": "n_", "k": "k_"})
     printed = {name: printer.formula(sheet.typer.scalar(name), {}) for name in EXCEL_CASES}
     assert printed["c_gamma"] == "=_xlfn.GAMMA(x_)"
@@ -148,13 +141,13 @@ def test_excel_forms_are_excels_functions(tmp_path):
 
 
 @pytest.mark.slow
-def test_excel_forms_agree_with_the_formulas_package(tmp_path):
+def test_excel_forms_agree_with_the_formulas_package(sheet_from, tmp_path):
     """Every live formula recalculated by `formulas` (which has no COMBIN: checked by
     LibreOffice below) agrees with the engine."""
     formulas = pytest.importorskip("formulas")
     from helpers.recalc import formula_values
 
-    sheet, path = _workbook(tmp_path)
+    sheet, path = _workbook(sheet_from, tmp_path)
     cells = formula_values(path)
     solution = formulas.ExcelModel().loads(str(path)).finish().calculate()
     recalculated = {}
@@ -173,12 +166,12 @@ def test_excel_forms_agree_with_the_formulas_package(tmp_path):
 
 
 @pytest.mark.slow
-def test_libreoffice_recalculates_the_special_functions(tmp_path):
+def test_libreoffice_recalculates_the_special_functions(sheet_from, tmp_path):
     from helpers.recalc import cell_values, formula_values, recalculate, soffice
 
     if soffice() is None:
         pytest.skip("LibreOffice is not installed")
-    sheet, path = _workbook(tmp_path)
+    sheet, path = _workbook(sheet_from, tmp_path)
     cells = formula_values(path)
     values = cell_values(recalculate(path, tmp_path / "out"))
     for name, (_, function) in EXCEL_CASES.items():
@@ -198,17 +191,17 @@ def _matrix(sheet, name):
     return np.asarray(sheet.evaluate(name).magnitude, dtype=float)
 
 
-def test_cholesky_against_mpmath(tmp_path):
-    sheet = _sheet(tmp_path, {"A": str(A), "L": "cholesky(A)"})
+def test_cholesky_against_mpmath(sheet_from):
+    sheet = sheet_from(definitions({"A": str(A), "L": "cholesky(A)"}))
     with mpmath.workdps(50):
         want = np.array(mpmath.cholesky(mpmath.matrix(A)).tolist(), dtype=float)
     assert _matrix(sheet, "L") == pytest.approx(want, rel=1e-14, abs=1e-14)
     assert np.allclose(want, [[2, 0, 0], [6, 1, 0], [-8, 5, 3]])
 
 
-def test_cholesky_keeps_the_square_root_of_the_unit(tmp_path):
+def test_cholesky_keeps_the_square_root_of_the_unit(sheet_from):
     text = '[definitions]\nA = "[[4, 2], [2, 3]] * 1 m^2"\nL = "cholesky(A)"\n'
-    sheet = workbook.load(write_template(tmp_path, text))
+    sheet = sheet_from(text)
     assert str(sheet.evaluate("L").units) == "meter"
 
 
@@ -219,14 +212,13 @@ def test_cholesky_keeps_the_square_root_of_the_unit(tmp_path):
         ("cholesky([[1, 2], [2, 1]])", "not positive definite"),
     ],
 )
-def test_cholesky_refuses(tmp_path, text, message):
-    path = write_template(tmp_path, f'[definitions]\nbad = "{text}"\n')
+def test_cholesky_refuses(sheet_from, text, message):
     with pytest.raises(WorkbookError, match=message):
-        workbook.load(path).evaluate("bad")
+        sheet_from(f'[definitions]\nbad = "{text}"\n').evaluate("bad")
 
 
-def test_qr_is_q_times_r(tmp_path):
-    sheet = _sheet(tmp_path, {"B": str(B), "QR": "qr(B)"})
+def test_qr_is_q_times_r(sheet_from):
+    sheet = sheet_from(definitions({"B": str(B), "QR": "qr(B)"}))
     qr = _matrix(sheet, "QR")
     assert qr.shape == (4, 7)
     q, r = qr[:, :4], qr[:, 4:]
@@ -240,8 +232,8 @@ def test_qr_is_q_times_r(tmp_path):
     assert r[:3] == pytest.approx(want, rel=1e-13, abs=1e-13)
 
 
-def test_svd_against_mpmath(tmp_path):
-    sheet = _sheet(tmp_path, {"B": str(B), "UV": "svd(B)", "s": "svds(B)"})
+def test_svd_against_mpmath(sheet_from):
+    sheet = sheet_from(definitions({"B": str(B), "UV": "svd(B)", "s": "svds(B)"}))
     uv = _matrix(sheet, "UV")
     assert uv.shape == (7, 3)
     u, v, s = uv[:4], uv[4:], _matrix(sheet, "s").reshape(-1)
@@ -261,6 +253,6 @@ def test_svd_against_mpmath(tmp_path):
         ("svd([[1, 2, 3], [4, 5, 6]])", "at least as many rows as columns"),
     ],
 )
-def test_qr_and_svd_refuse(tmp_path, text, message):
+def test_qr_and_svd_refuse(sheet_from, text, message):
     with pytest.raises(WorkbookError, match=message):
-        workbook.load(write_template(tmp_path, f'[definitions]\nbad = "{text}"\n'))
+        sheet_from(f'[definitions]\nbad = "{text}"\n')

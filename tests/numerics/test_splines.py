@@ -10,9 +10,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import sympy
-from helpers.sheets import write_template
 
-import workbook
 from workbook import WorkbookError
 
 XS = ["0", "0.5", "1.1", "2", "3.2", "4"]
@@ -124,9 +122,9 @@ def test_linterp_reads_vectors_of_the_sheet_by_name(sheet):
         ('bad = "interp(N, X, Y, 1 m)"', "interp(vs, vx, vy, x): x"),
     ],
 )
-def test_spline_errors_at_load(tmp_path, line, message):
+def test_spline_errors_at_load(sheet_from, line, message):
     with pytest.raises(WorkbookError, match=re.escape(message)):
-        workbook.load(write_template(tmp_path, SHEET + line + "\n"))
+        sheet_from(SHEET + line + "\n")
 
 
 def test_outside_the_points_is_an_error(sheet):

@@ -6,9 +6,7 @@ import zipfile
 import numpy as np
 import openpyxl
 import pytest
-from helpers.sheets import SINE, write_template
-
-import workbook
+from helpers.sheets import SINE
 
 CIRCLE = (
     SINE
@@ -62,8 +60,8 @@ def numbers(path, ref: str) -> np.ndarray:
     return np.array([values[(ws.title, row[0].coordinate)] for row in ws[rng.replace("$", "")]])
 
 
-def test_series_x_expressions_are_drawn_from_their_own_cells(tmp_path):
-    sheet = workbook.load(write_template(tmp_path, CIRCLE))
+def test_series_x_expressions_are_drawn_from_their_own_cells(sheet_from, tmp_path):
+    sheet = sheet_from(CIRCLE)
     path = sheet.write_xlsx(tmp_path / "c.xlsx")
     (cx, cy), (px, py), (dx, dy) = series_refs(path)
     phi = np.arange(0, 361, 30, dtype=float)

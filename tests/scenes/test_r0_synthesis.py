@@ -545,10 +545,9 @@ columns = { f = "mm" }
 """
 
 
-def test_max_over_and_min_over(tmp_path):
-    from helpers.sheets import write_template
+def test_max_over_and_min_over(sheet_from):
 
-    s = workbook.load(write_template(tmp_path, AGG % "max_over(t, f) - min_over(t, f)"))
+    s = sheet_from(AGG % "max_over(t, f) - min_over(t, f)")
     x = np.linspace(0, 1, 11)
     vals = 2 * (x - 0.3) ** 2
     assert mm(s.evaluate("top")) == pytest.approx(vals.max() - vals.min(), rel=1e-15)
@@ -565,10 +564,9 @@ def test_max_over_and_min_over(tmp_path):
         ("max_over(t)", "write max_over\\(table, column\\)"),
     ],
 )
-def test_max_over_errors(tmp_path, expr, message):
-    from helpers.sheets import write_template
+def test_max_over_errors(sheet_from, expr, message):
 
     from workbook.errors import TemplateError
 
     with pytest.raises(TemplateError, match=message):
-        workbook.load(write_template(tmp_path, AGG % expr))
+        sheet_from(AGG % expr)

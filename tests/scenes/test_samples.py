@@ -12,9 +12,8 @@ import mpmath
 import numpy as np
 import pytest
 from helpers.paths import SHARED
-from helpers.sheets import write_template
+from helpers.sheets import definitions
 
-import workbook
 from workbook.errors import WorkbookError
 
 PRIME = SHARED / "mathcad-prime"
@@ -24,17 +23,12 @@ X = [2.323, 1.988, 3.476, -1.186, 2.425, 2.334, 0.758, 0.25, 3.052, 1.209, 1.186
 Y = [4.1, 3.2, 6.5, -2.0, 4.4, 4.9, 1.1, 0.7, 6.0, 2.2, 2.5, 3.3]
 
 
-def _sheet(tmp_path, definitions: dict[str, str], inputs: str = ""):
-    text = inputs + "[definitions]\n" + "".join(f'{k} = "{v}"\n' for k, v in definitions.items())
-    return workbook.load(write_template(tmp_path, text))
-
-
 def _vector(values) -> str:
     return "[" + ", ".join(repr(v) for v in values) + "]"
 
 
 @needs_corpus
-def test_reproduce_mathcads_stored_values(tmp_path):
+def test_reproduce_mathcads_stored_values(sheet_from):
     lister, sheet = PRIME / "mcdx_results.py", PRIME / "statistics-functions.mcdx"
     out = subprocess.run(
         [sys.executable, str(lister), "--json", str(sheet)],
@@ -46,18 +40,19 @@ def test_reproduce_mathcads_stored_values(tmp_path):
         [float(x) for x in r.split(",")] for r in data.split(":= ", 1)[1].strip("[]").split(";")
     ]
     v1, v2 = [r[1] for r in rows], [r[2] for r in rows]
-    got = _sheet(
-        tmp_path,
-        {
-            "V1": _vector(v1),
-            "V2": _vector(v2),
-            "c": "cvar(V1, V2)",
-            "a": "fit_slope(V1, V2)",
-            "r": "corr(V1, V2)",
-            "R1": "Rank(V1)",
-            "R2": "Rank(V2)",
-            "rr": "corr(Rank(V1), Rank(V2))",
-        },
+    got = sheet_from(
+        definitions(
+            {
+                "V1": _vector(v1),
+                "V2": _vector(v2),
+                "c": "cvar(V1, V2)",
+                "a": "fit_slope(V1, V2)",
+                "r": "corr(V1, V2)",
+                "R1": "Rank(V1)",
+                "R2": "Rank(V2)",
+                "rr": "corr(Rank(V1), Rank(V2))",
+            }
+        )
     )
 
     def stored(text: str):
@@ -77,7 +72,7 @@ def test_reproduce_mathcads_stored_values(tmp_path):
     assert ours("rr")[0] == pytest.approx(stored("corr(Rank1, Rank2) ="), rel=1e-12)
 
 
-def test_against_excels_formulas_in_mpmath(tmp_path):
+def test_against_excels_formulas_in_mpmath(sheet_from):
     mpmath.mp.dps = 50
     x, y = [mpmath.mpf(repr(v)) for v in X], [mpmath.mpf(repr(v)) for v in Y]
     n = len(x)
@@ -102,34 +97,35 @@ def test_against_excels_formulas_in_mpmath(tmp_path):
         "h": sum(1 for b in y if b > 0) / sum(1 / b for b in y if b > 0),
     }
     positive = _vector([v for v in Y if v > 0])
-    got = _sheet(
-        tmp_path,
-        {
+    got = sheet_from(
+        definitions({
             "X": _vector(X), "Y": _vector(Y), "P": positive,
             "v": "Var(X)", "sd": "Stdev(X)", "r": "corr(X, Y)", "c": "cvar(X, Y)",
             "a": "fit_slope(X, Y)", "b": "fit_intercept(X, Y)", "sk": "skew(X)", "ku": "kurt(X)",
             "g": "gmean(P)", "h": "hmean(P)",
-        },
+        })
     )  # fmt: skip
     for name, value in want.items():
         assert float(got.evaluate(name).magnitude) == pytest.approx(float(value), rel=1e-13), name
-    ties = _sheet(tmp_path, {"R": "Rank([3, 1, 3, 2])"})  # equal values share their mean rank
+    # equal values share their mean rank
+    ties = sheet_from(definitions({"R": "Rank([3, 1, 3, 2])"}))
     assert np.array_equal(np.asarray(ties.evaluate("R").magnitude).reshape(-1), [3.5, 1, 3.5, 2])
 
 
-def test_units(tmp_path):
-    got = _sheet(
-        tmp_path,
-        {
-            "x": "[1, 2, 4] * 1 m",
-            "t": "[2, 3, 7] * 1 s",
-            "a": "fit_slope(x, t)",
-            "b": "fit_intercept(x, t)",
-            "c": "cvar(x, t)",
-            "r": "corr(x, t)",
-            "v": "Var(x)",
-            "sd": "Stdev(x)",
-        },
+def test_units(sheet_from):
+    got = sheet_from(
+        definitions(
+            {
+                "x": "[1, 2, 4] * 1 m",
+                "t": "[2, 3, 7] * 1 s",
+                "a": "fit_slope(x, t)",
+                "b": "fit_intercept(x, t)",
+                "c": "cvar(x, t)",
+                "r": "corr(x, t)",
+                "v": "Var(x)",
+                "sd": "Stdev(x)",
+            }
+        )
     )
     assert str(got.evaluate("a").units) == "second / meter"
     assert str(got.evaluate("b").units) == "second"
@@ -149,13 +145,13 @@ def test_units(tmp_path):
         ("Var([5])", "at least 2 values"),
     ],
 )
-def test_refusals(tmp_path, expr, message):
+def test_refusals(sheet_from, expr, message):
     with pytest.raises(WorkbookError, match=message):
-        _sheet(tmp_path, {"X": expr}).evaluate("X")
+        sheet_from(definitions({"X": expr})).evaluate("X")
 
 
 @pytest.mark.slow
-def test_excel_forms_recalculate_in_libreoffice(tmp_path):
+def test_excel_forms_recalculate_in_libreoffice(sheet_from, tmp_path):
     """The workbook's live formulas (VAR.S, CORREL, COVARIANCE.P, SLOPE(y, x), ...), recalculated
     by LibreOffice, give the engine's values."""
     from helpers.recalc import cell_values, recalculate, soffice
@@ -167,7 +163,7 @@ def test_excel_forms_recalculate_in_libreoffice(tmp_path):
         "a": "fit_slope(x, y)", "b": "fit_intercept(x, y)", "sk": "skew(x)", "ku": "kurt(x)",
         "g": "gmean(y)", "h": "hmean(y)",
     }  # fmt: skip
-    sheet = _sheet(tmp_path, {"x": "[1, 2, 3, 4, 10]", "y": "[2, 4, 5, 4, 5]", **names})
+    sheet = sheet_from(definitions({"x": "[1, 2, 3, 4, 10]", "y": "[2, 4, 5, 4, 5]", **names}))
     xlsx = tmp_path / "s.xlsx"
     sheet.write_xlsx(xlsx)
     values = cell_values(recalculate(xlsx, tmp_path / "recalc"))
