@@ -95,12 +95,8 @@ columns = ["x", "f", "g"]
 """
 
 
-def _written(tmp_path, text: str):
-    import workbook
-
-    path = tmp_path / "random.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(path)
+def _written(sheet_from, tmp_path, text: str):
+    sheet = sheet_from(text, name="random")
     refusals: list = []
     out = sheet.write_xlsx(tmp_path / "random.xlsx", force=True, refusals=refusals)
     return out, refusals
@@ -112,8 +108,8 @@ def _written(tmp_path, text: str):
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(text=sheets())
-def test_random_sheets_recalculate_to_the_engine(tmp_path, text):
-    out, refusals = _written(tmp_path, text)
+def test_random_sheets_recalculate_to_the_engine(sheet_from, tmp_path, text):
+    out, refusals = _written(sheet_from, tmp_path, text)
     assert refusals == [], f"{text}\n{[r.where + ': ' + r.disagreement for r in refusals]}"
     bad = mismatches(out, xleval_recalculated(out))  # a chain from the inputs
     assert not bad, f"{text}\n{bad[:5]}"
@@ -127,8 +123,8 @@ def test_random_sheets_recalculate_to_the_engine(tmp_path, text):
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(text=sheets())
-def test_random_sheets_recalculate_in_libreoffice(tmp_path, text):
-    out, refusals = _written(tmp_path, text)
+def test_random_sheets_recalculate_in_libreoffice(sheet_from, tmp_path, text):
+    out, refusals = _written(sheet_from, tmp_path, text)
     assert refusals == [], f"{text}\n{[r.where + ': ' + r.disagreement for r in refusals]}"
     bad = differences(out, recalculate(out, tmp_path / "lo"))
     assert not bad, f"{text}\n{bad[:5]}"

@@ -11,7 +11,6 @@ import pytest
 
 from workbook.compute.excel import ExcelPrinter
 from workbook.facade import Sheet
-from workbook.language.template import load_spec
 from workbook.numerics.registry import REGISTRY
 from workbook.sweep import sweep
 
@@ -21,7 +20,7 @@ LEVELS = 40
 HANG_SECONDS = 60.0
 
 
-def _deep(tmp_path, levels: int = LEVELS) -> Sheet:
+def _deep(sheet_from, levels: int = LEVELS) -> Sheet:
     """f_i(x) = (f_{i-1}(x) + f_{i-1}(x))/2: inlined, 2^levels calls of f0."""
     lines = [
         "[sheet]",
@@ -41,9 +40,7 @@ def _deep(tmp_path, levels: int = LEVELS) -> Sheet:
         'range = "x := 0, 1 .. 4"',
         f'columns = {{ f{levels} = "mm", f3 = "mm" }}',
     ]
-    path = tmp_path / "deep.toml"
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return Sheet(load_spec(path))
+    return sheet_from("\n".join(lines) + "\n", name="deep")
 
 
 def _timed(fn):
@@ -52,8 +49,8 @@ def _timed(fn):
     return out, time.perf_counter() - start
 
 
-def test_nested_calls_are_computed_once(tmp_path):
-    sheet = _deep(tmp_path)
+def test_nested_calls_are_computed_once(sheet_from):
+    sheet = _deep(sheet_from)
     x = np.linspace(0.0, 10.0, 1001)
     got, seconds = _timed(lambda: sheet.evaluate(f"f{LEVELS}", x))
     assert np.array_equal(got.to("mm").magnitude, x + 2.0)  # (y + y)/2 is exact
@@ -61,8 +58,8 @@ def test_nested_calls_are_computed_once(tmp_path):
     assert sheet.evaluate("top").to("mm").magnitude == 4.0
 
 
-def test_nested_calls_in_the_workbook_and_a_sweep(tmp_path):
-    sheet = _deep(tmp_path)
+def test_nested_calls_in_the_workbook_and_a_sweep(sheet_from, tmp_path):
+    sheet = _deep(sheet_from)
     _, seconds = _timed(lambda: sheet.write_xlsx(tmp_path / "deep.xlsx"))
     assert seconds < HANG_SECONDS
     import openpyxl
@@ -80,9 +77,9 @@ def test_nested_calls_in_the_workbook_and_a_sweep(tmp_path):
         assert result.table["top [mm]"].tolist() == pytest.approx(np.linspace(2, 6, 21))
 
 
-def test_a_shallow_formula_against_the_formulas_package(tmp_path):
+def test_a_shallow_formula_against_the_formulas_package(sheet_from):
     formulas = pytest.importorskip("formulas")
-    sheet = _deep(tmp_path)
+    sheet = _deep(sheet_from)
     text = ExcelPrinter(sheet.typer, {"a": "2"}).formula(
         sheet.typer.function("f3").body, {"x": "7"}
     )
@@ -118,10 +115,8 @@ columns = { h = "mm", v = "mm", w = "mm" }
 
 
 @pytest.fixture
-def shared(tmp_path) -> Sheet:
-    path = tmp_path / "shared.toml"
-    path.write_text(SHARED, encoding="utf-8")
-    return Sheet(load_spec(path))
+def shared(sheet_from) -> Sheet:
+    return sheet_from(SHARED, name="shared")
 
 
 def test_sharing_keeps_arguments_apart(shared):

@@ -149,16 +149,14 @@ def test_growth_is_refused_within_the_memory_guard(tmp_path, name):
     assert [p.name for p in tmp_path.rglob("*") if p.is_file()] == ["hostile.toml"]
 
 
-def test_growth_within_the_limit_is_computed(tmp_path):
+def test_growth_within_the_limit_is_computed(sheet_from):
     # the same programs, a few doublings: the values, not refusals
-    path = tmp_path / "g.toml"
-    path.write_text(
+    sheet = sheet_from(
         program("v := [1, 2]\nfor k in 1 .. n\n    v := stack(v, v)\nrows(v)", "p(20)")
         + '\nt = "q(3)"\n"q(n)" = { program = """\nv := [1, 2]\nfor k in 1 .. n\n'
         '    v := [v, v]\nrows(v)\n""" }\n',
-        encoding="utf-8",
+        name="g",
     )
-    sheet = workbook.load(path)
     assert float(sheet.evaluate("s").magnitude) == 2 * 2**20
     assert float(sheet.evaluate("t").magnitude) == 2
 

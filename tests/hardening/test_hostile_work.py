@@ -64,15 +64,13 @@ def test_matrix_work_is_refused_before_it_is_done(tmp_path, monkeypatch):
     assert float(workbook.load(path).evaluate("s")) == pytest.approx(expected, rel=1e-14)
 
 
-def test_matrix_work_of_formulas_and_decompositions_is_counted(tmp_path, monkeypatch):
+def test_matrix_work_of_formulas_and_decompositions_is_counted(sheet_from, monkeypatch):
     monkeypatch.setattr(limits, "MAX_MATRIX_WORK", 4 * 30**3)
     text = (
         '[definitions]\nA = "identity(30) + 1"\nB = "A*A*A*A*A*A*A"\nb = "B[0, 0]"\n'
         'e = "eigenvals(A)[0]"\nd = "det(A)"\n'
     )
-    path = tmp_path / "f.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(path)
+    sheet = sheet_from(text, name="f")
     with pytest.raises(LimitError, match="product of 30 x 30 by 30 x 30") as err:
         sheet.evaluate("b")
     assert (err.value.definition, err.value.line) == ("B", 3)

@@ -6,14 +6,13 @@ from __future__ import annotations
 import pytest
 from helpers.paths import ROOT
 
-import workbook
 from workbook.engine import analysis
 from workbook.errors import DomainError
 
 
 @pytest.fixture
-def sheet():
-    return workbook.loads('[inputs]\nR = "2 mm"\n[definitions]\nA = "pi*R^2"\n')
+def sheet(sheet_from):
+    return sheet_from('[inputs]\nR = "2 mm"\n[definitions]\nA = "pi*R^2"\n')
 
 
 def test_a_worksheet_error_in_the_analysis_is_a_warning(sheet, monkeypatch):

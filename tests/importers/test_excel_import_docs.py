@@ -27,7 +27,7 @@ def examples():
 
 
 @pytest.mark.parametrize("example", examples())
-def test_doc_example(example, tmp_path):
+def test_doc_example(example, sheet_from):
     (info,) = translate_vba(example.group("vba")).values()
     assert info.problem is None
     assert f"{info.final}({', '.join(info.params)})" == example.group("sig")
@@ -47,9 +47,7 @@ def test_doc_example(example, tmp_path):
         "arguments": {p: {"unit": ""} for p in info.params},
         "definitions": definitions,
     }
-    path = tmp_path / "example.toml"
-    path.write_text(tomli_w.dumps(doc, multiline_strings=True), encoding="utf-8")
-    sheet = workbook.load(str(path))
+    sheet = sheet_from(tomli_w.dumps(doc, multiline_strings=True), name="example")
     for name, value in checks:
         if value is None:
             with pytest.raises(workbook.WorkbookError):

@@ -12,9 +12,7 @@ import sys
 import numpy as np
 import pytest
 from helpers.paths import SHARED
-from helpers.sheets import write_template
-
-import workbook
+from helpers.sheets import definitions
 
 PRIME = SHARED / "mathcad-prime"
 pytestmark = pytest.mark.skipif(not PRIME.is_dir(), reason="../shared/mathcad-prime is absent")
@@ -41,10 +39,9 @@ def _matrix(value: dict) -> np.ndarray:
     return np.array(flat).reshape(value["cols"], value["rows"]).T
 
 
-def _evaluate(tmp_path, definitions: dict[str, str]) -> dict[str, np.ndarray]:
-    text = "[definitions]\n" + "".join(f'{k} = "{v}"\n' for k, v in definitions.items())
-    sheet = workbook.load(write_template(tmp_path, text))
-    return {k: np.asarray(sheet.evaluate(k).magnitude, dtype=float) for k in definitions}
+def _evaluate(sheet_from, values: dict[str, str]) -> dict[str, np.ndarray]:
+    sheet = sheet_from(definitions(values))
+    return {k: np.asarray(sheet.evaluate(k).magnitude, dtype=float) for k in values}
 
 
 # the stored expression -> the same in the language, with {a} (the alpha defined above it in
@@ -58,7 +55,7 @@ DISTRIBUTIONS = {
 }
 
 
-def test_distributions_reproduce_mathcads_stored_values(tmp_path):
+def test_distributions_reproduce_mathcads_stored_values(sheet_from):
     alpha = nu = None
     definitions, stored = {}, {}
     for item in _items("statistics-functions.mcdx"):
@@ -72,7 +69,7 @@ def test_distributions_reproduce_mathcads_stored_values(tmp_path):
             definitions[name] = DISTRIBUTIONS[text].format(a=alpha, nu=nu)
             stored[name] = _number(item["value"])
     assert len(definitions) == len(DISTRIBUTIONS)
-    got = _evaluate(tmp_path, definitions)
+    got = _evaluate(sheet_from, definitions)
     for name, value in stored.items():
         assert float(got[name]) == pytest.approx(value, rel=1e-14), definitions[name]
 
@@ -88,7 +85,7 @@ def _same_up_to_sign(got: np.ndarray, want: np.ndarray) -> bool:
     return np.allclose(got, want, rtol=0, atol=1e-13) or np.allclose(got, -want, rtol=0, atol=1e-13)
 
 
-def test_eigenvec_and_rank_reproduce_mathcads_stored_values(tmp_path):
+def test_eigenvec_and_rank_reproduce_mathcads_stored_values(sheet_from):
     items = {item["text"]: item for item in _items("matrix-functions.mcdx")}
     m = next(t for t in items if t.startswith("M := ["))
     definitions = {
@@ -96,7 +93,7 @@ def test_eigenvec_and_rank_reproduce_mathcads_stored_values(tmp_path):
         "e0": "eigenvec(M, eigenvals(M)[3])",  # Mathcad's e is descending: e[0] the largest
         "r": "rank(M)",
     }
-    got = _evaluate(tmp_path, definitions)
+    got = _evaluate(sheet_from, definitions)
     largest = _matrix(items["e := eigenvals(M) ="]["value"])[0, 0]
     assert largest == pytest.approx(np.linalg.eigvalsh(got["M"]).max(), rel=1e-14)
     want = _matrix(items["eigenvec(M, e[0]) ="]["value"])
@@ -104,7 +101,7 @@ def test_eigenvec_and_rank_reproduce_mathcads_stored_values(tmp_path):
     assert float(got["r"]) == _number(items["rank(M) ="]["value"])
 
 
-def test_eigenvec_of_a_covariance_matrix_reproduces_mathcads(tmp_path):
+def test_eigenvec_of_a_covariance_matrix_reproduces_mathcads(sheet_from):
     """Principal axes (matrix-functions.mcdx): T = augment of eigenvec(S1, V[j])."""
     items = {item["text"]: item for item in _items("matrix-functions.mcdx")}
     s1 = _matrix(items["S1 := X^T*X/(rows(D)-1) ="]["value"])
@@ -114,6 +111,6 @@ def test_eigenvec_of_a_covariance_matrix_reproduces_mathcads(tmp_path):
     definitions = {"S": f"[{rows}]"}
     for j, v in enumerate(values):
         definitions[f"x{j}"] = f"eigenvec(S, {float(v)!r})"
-    got = _evaluate(tmp_path, definitions)
+    got = _evaluate(sheet_from, definitions)
     for j in range(3):
         assert _same_up_to_sign(got[f"x{j}"][:, 0], axes[:, j]), j

@@ -13,7 +13,6 @@ from helpers.mathcad_xml import prime_package as _package
 from helpers.mathcad_xml import prime_region as _region
 from helpers.mathcad_xml import prime_result as _result
 
-import workbook
 from workbook.cli import main
 from workbook.errors import LimitError, TemplateError
 
@@ -109,27 +108,27 @@ def test_mathcad_15_on_error_is_listed(tmp_path, capsys):
     assert "Mathcad 15's on error in a program" in text, text
 
 
-def _sheet(program_text: str):
-    return workbook.loads(
+def _text(program_text: str) -> str:
+    return (
         '[arguments]\nx = { unit = "" }\n[definitions]\n'
         f'"f(x)" = {{ program = """\n{program_text}""" }}\n'
     )
 
 
-def test_the_on_error_block_runs_from_where_the_error_was():
+def test_the_on_error_block_runs_from_where_the_error_was(sheet_from):
     """What the try block set before its error stays set; a value line of the try block
     before the error is not the program's value."""
-    sheet = _sheet(
-        "r := 1\ntry\n    r := 2\n    r\n    r := r + 1/x\non error\n    r := r * 10\nr\n"
+    sheet = sheet_from(
+        _text("r := 1\ntry\n    r := 2\n    r\n    r := r + 1/x\non error\n    r := r * 10\nr\n")
     )
     assert sheet.evaluate("f", x=0.5).magnitude == pytest.approx(4.0)
     assert sheet.evaluate("f", x=0).magnitude == pytest.approx(20.0)
 
 
 @pytest.mark.slow
-def test_a_limit_is_no_error_the_program_catches():
+def test_a_limit_is_no_error_the_program_catches(sheet_from):
     """A loop that never ends inside a try block stops the program, as it would outside."""
-    sheet = _sheet("try\n    while x > 0\n        x := x + 1\non error\n    x := 0\nx\n")
+    sheet = sheet_from(_text("try\n    while x > 0\n        x := x + 1\non error\n    x := 0\nx\n"))
     with pytest.raises(LimitError):
         sheet.evaluate("f", x=1)
 
@@ -142,6 +141,6 @@ def test_a_limit_is_no_error_the_program_catches():
         ("try 1/x\non error\n    r := 2\nr\n", "'try' takes nothing after it"),
     ],
 )
-def test_try_without_its_blocks_is_refused(text, message):
+def test_try_without_its_blocks_is_refused(sheet_from, text, message):
     with pytest.raises(TemplateError, match=message):
-        _sheet(text)
+        sheet_from(_text(text))

@@ -9,7 +9,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import workbook
 from workbook.engine import runtime as rt
 from workbook.errors import InputError, WorkbookError
 from workbook.functions.matrix import size
@@ -130,8 +129,8 @@ def test_a_nested_array_of_trains(sheet):
     assert rt.value(second[1, 0]).ravel().tolist() == [20.0, 50.0]
 
 
-def test_linterp_in_a_nested_element(tmp_path):
-    s = _changed(tmp_path, 'where = "at(trains, 2, 15)"', 'where = "at(trains, 2, 35)"')
+def test_linterp_in_a_nested_element(sheet_from):
+    s = _changed(sheet_from, 'where = "at(trains, 2, 15)"', 'where = "at(trains, 2, 35)"')
     assert rt.value(s.scalar_value("where", "definition")) == pytest.approx(30.0, rel=1e-15)
 
 
@@ -164,20 +163,18 @@ def test_csort_sorts_rows_by_a_column(sheet):
     assert value(sheet, "ordered").tolist() == [[1.0, 10.0], [3.0, 30.0]]
 
 
-def _changed(tmp_path, old: str, new: str):
-    path = tmp_path / "grow.toml"
-    path.write_text(SHEET.replace(old, new), encoding="utf-8")
-    return workbook.load(path)
+def _changed(sheet_from, old: str, new: str):
+    return sheet_from(SHEET.replace(old, new), name="grow")
 
 
-def test_units_are_still_checked_at_load(tmp_path):
+def test_units_are_still_checked_at_load(sheet_from):
     with pytest.raises(WorkbookError, match="cannot add"):
-        _changed(tmp_path, 'three = "appended(3)"', 'three = "appended(3) + L"')
+        _changed(sheet_from, 'three = "appended(3)"', 'three = "appended(3) + L"')
 
 
-def test_static_shapes_keep_their_load_errors(tmp_path):
+def test_static_shapes_keep_their_load_errors(sheet_from):
     with pytest.raises(WorkbookError, match="cannot add a vector of 3 to a vector of 2"):
-        _changed(tmp_path, 'three = "appended(3)"', 'three = "[1, 2] + [1, 2, 3]"')
+        _changed(sheet_from, 'three = "appended(3)"', 'three = "[1, 2] + [1, 2, 3]"')
 
 
 def test_the_workbook_shows_values_and_nested_arrays_as_text(sheet, tmp_path):
@@ -257,7 +254,7 @@ def test_set_item_matches_a_list_model(steps):
         rt.index(v, [len(model) + 1], origin=1, what="v")
 
 
-def test_a_table_column_of_run_time_values_is_a_number_a_row(tmp_path):
+def test_a_table_column_of_run_time_values_is_a_number_a_row(sheet_from):
     text = '''
 [sheet]
 name = "col"
@@ -291,9 +288,7 @@ name = "arrays"
 range = "n := 1 .. 3"
 columns = { "whole(n)" = "" }
 '''
-    path = tmp_path / "col.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(path)
+    sheet = sheet_from(text, name="col")
     assert sheet.table("sums")["total(n)"].tolist() == [1.0, 3.0, 6.0, 10.0, 15.0]
     with pytest.raises(WorkbookError, match="whole.*a vector of 1 where a number is wanted"):
         sheet.table("arrays")

@@ -83,18 +83,16 @@ def test_block_is_not_symbolic(tmp_path):
         symbolic.to_sympy(workbook.load("concave-cam"), "nothing_here")
 
 
-def test_a_derivative_called_with_another_argument(tmp_path):
+def test_a_derivative_called_with_another_argument(sheet_from):
     # diff's variable stays the enclosing one: z(t) = v(2*t) is s'(2*t)
-    path = tmp_path / "d.toml"
-    path.write_text(
+    sheet = sheet_from(
         '[inputs]\nA = "10 mm"\nomega = "100 1/s"\n[arguments]\nt = { unit = "s" }\n'
         "[definitions]\n"
         '"s(t)" = { expr = "A*sin(omega*t)^2", unit = "mm" }\n'
         '"v(t)" = { expr = "diff(s(t), t)", unit = "mm/s" }\n'
         '"z(t)" = "v(2*t)"\n',
-        encoding="utf-8",
+        name="d",
     )
-    sheet = workbook.load(path)
     t = symbolic.symbol("t")
     want = sp.diff(10 * sp.sin(100 * t) ** 2, t).subs(t, 2 * t)
     assert sp.simplify(symbolic.to_sympy(sheet, "z") - want) == 0

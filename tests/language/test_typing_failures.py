@@ -6,10 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from workbook.engine.sheet import Sheet
 from workbook.errors import LimitError, WorkbookError
 from workbook.language import typecheck
-from workbook.language.template import load_spec
 
 HEAD = '[inputs]\nR1 = "20 mm"\n\n[arguments]\nx = { unit = "" }\n\n[definitions]\n'
 
@@ -20,7 +18,7 @@ def _chain(n: int) -> str:
     return HEAD + lines + '\n[[tables]]\nname = "t"\nrange = "x := 0 .. 3"\ncolumns = { f0 = "" }\n'
 
 
-def _typings(monkeypatch, tmp_path, text: str):
+def _typings(monkeypatch, sheet_from, text: str):
     """Load ``text``; (the error, how many definition bodies were typed)."""
     calls = []
     real = typecheck.Typer.typed_body
@@ -30,16 +28,14 @@ def _typings(monkeypatch, tmp_path, text: str):
         return real(self, d, scope)
 
     monkeypatch.setattr(typecheck.Typer, "typed_body", counted)
-    path = tmp_path / "sheet.toml"
-    path.write_text(text, encoding="utf-8")
     with pytest.raises(WorkbookError) as caught:
-        Sheet(load_spec(path))
+        sheet_from(text)
     return caught.value, len(calls)
 
 
-def test_a_chain_over_the_limit_is_typed_through_once(monkeypatch, tmp_path):
+def test_a_chain_over_the_limit_is_typed_through_once(monkeypatch, sheet_from):
     n = 3 * typecheck.MAX_CHAIN
-    err, typed = _typings(monkeypatch, tmp_path, _chain(n))
+    err, typed = _typings(monkeypatch, sheet_from, _chain(n))
     assert isinstance(err, LimitError)
     assert f"more than {typecheck.MAX_CHAIN} deep" in err.message
     assert err.definition == f"f{typecheck.MAX_CHAIN}"
@@ -48,12 +44,12 @@ def test_a_chain_over_the_limit_is_typed_through_once(monkeypatch, tmp_path):
     assert typed <= n + 2 * typecheck.MAX_CHAIN, typed
 
 
-def test_a_remembered_error_is_raised_as_it_was_made(monkeypatch, tmp_path):
+def test_a_remembered_error_is_raised_as_it_was_made(monkeypatch, sheet_from):
     """The second pass over a function typed at numbers and with arrays says what failed each
     way, as the first did (the remembered errors are copies: the message rewritten for the
     first raise is not rewritten again)."""
     text = '[inputs]\nL = "2 m"\n[arguments]\nP = { unit = "m" }\n[definitions]\n'
-    err, _ = _typings(monkeypatch, tmp_path, text + '"f(P)" = "P[0]*nosuch"\n')
+    err, _ = _typings(monkeypatch, sheet_from, text + '"f(P)" = "P[0]*nosuch"\n')
     assert err.message == (
         "no formula calls f() with a vector or matrix; with numbers: P is not a vector or "
         "matrix; it cannot be indexed; with arrays: unknown name 'nosuch' (did you mean cosh?)"

@@ -26,7 +26,6 @@ from helpers.sheets import fuzz_settings
 from hypothesis import given
 from hypothesis import strategies as st
 
-import workbook
 from workbook.errors import WorkbookError
 
 PINT = pint.UnitRegistry(autoconvert_offset_to_baseunit=False)
@@ -143,23 +142,22 @@ def by_pint(text: str):
     return value
 
 
-def by_engine(folder, text: str):
+def by_engine(load_text, text: str):
     body = "[inputs]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in INPUTS.items())
-    (folder / "oracle.toml").write_text(f"{body}\n[definitions]\nk = {json.dumps(text)}\n")
-    sheet = workbook.load(folder / "oracle.toml")
+    sheet = load_text(f"{body}\n[definitions]\nk = {json.dumps(text)}\n", name="oracle")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return sheet.evaluate("k")
 
 
-def check(folder, case: Case) -> None:
+def check(load_text, case: Case) -> None:
     text, python = case.text, case.python
     try:
         expected = by_pint(python)
     except (pint.errors.PintError, ValueError, ZeroDivisionError, OverflowError):
         expected = None
     try:
-        got = by_engine(folder, text)
+        got = by_engine(load_text, text)
     except WorkbookError as err:
         assert str(err)
         return
@@ -174,23 +172,18 @@ def check(folder, case: Case) -> None:
     )
 
 
-@pytest.fixture(scope="module")
-def folder(tmp_path_factory):
-    return tmp_path_factory.mktemp("units-oracle")
-
-
 @pytest.mark.slow
 @fuzz_settings(300)
 @given(case=expressions)
-def test_the_engine_agrees_with_pint(folder, case):
-    check(folder, case)
+def test_the_engine_agrees_with_pint(load_text, case):
+    check(load_text, case)
 
 
 @pytest.mark.slow
 @fuzz_settings(5000)
 @given(case=expressions)
-def test_the_engine_agrees_with_pint_many(folder, case):
-    check(folder, case)
+def test_the_engine_agrees_with_pint_many(load_text, case):
+    check(load_text, case)
 
 
 @pytest.mark.parametrize(
@@ -203,8 +196,8 @@ def test_the_engine_agrees_with_pint_many(folder, case):
         ("sin(th)*F", "np.sin(th)*F"),
     ],
 )  # fmt: skip
-def test_known_cases(folder, text, python):
-    got = by_engine(folder, text)
+def test_known_cases(load_text, text, python):
+    got = by_engine(load_text, text)
     env = {name: quantity(value) for name, value in INPUTS.items()}
     expected = eval(python, {"__builtins__": {}}, {**env, "Q": quantity, "np": np})  # noqa: S307
     assert math.isclose(

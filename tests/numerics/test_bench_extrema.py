@@ -9,7 +9,6 @@ import math
 import numpy as np
 import pytest
 
-import workbook
 from workbook.numerics import bench, mpref
 
 SHEET = """
@@ -39,10 +38,8 @@ def test_the_samples_of_a_fast_oscillation_are_made_dense_enough():
 
 
 @pytest.mark.slow
-def test_bench_of_a_maximum_over_24000_periods_is_not_a_false_wrong(tmp_path, monkeypatch):
-    path = tmp_path / "osc.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    sheet = workbook.load(path)
+def test_bench_of_a_maximum_over_24000_periods_is_not_a_false_wrong(sheet_from, monkeypatch):
+    sheet = sheet_from(SHEET, name="osc")
     assert sheet.evaluate("osc").magnitude == pytest.approx(_true_maximum(), rel=1e-10)
     (line,) = bench.run(sheet, repeats=1)
     assert line.verdict == "ok" and line.difference <= 1e-10, line.text()

@@ -9,7 +9,6 @@ import mpmath
 import numpy as np
 import pytest
 
-import workbook
 from workbook.numerics import bench
 
 
@@ -40,10 +39,8 @@ inv = "inverse(A)"
 """
 
 
-def _lines(tmp_path):
-    path = tmp_path / "la.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    sheet = workbook.load(path)
+def _lines(sheet_from):
+    sheet = sheet_from(SHEET, name="la")
     return sheet, {line.what: line for line in bench.run(sheet, repeats=1)}
 
 
@@ -54,8 +51,8 @@ def _error(got, exact) -> float:
 
 
 @pytest.mark.slow
-def test_bench_lines_of_diff_and_linear_algebra_are_independent_and_right(tmp_path):
-    sheet, lines = _lines(tmp_path)
+def test_bench_lines_of_diff_and_linear_algebra_are_independent_and_right(sheet_from):
+    sheet, lines = _lines(sheet_from)
     assert {"d1", "dc", "kink", "xs", "ev", "evec", "dt", "inv"} <= set(lines)
     assert lines["kink"].verdict.startswith("refused by the engine: diff(): the expression has")
     with mpmath.workdps(50):

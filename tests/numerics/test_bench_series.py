@@ -8,7 +8,6 @@ import mpmath
 import numpy as np
 import pytest
 
-import workbook
 from workbook.numerics import bench
 
 SHEET = """
@@ -25,10 +24,8 @@ v = "sum([1, 2, 3])"
 
 
 @pytest.mark.slow
-def test_bench_compares_sums_and_products_with_mpmath(tmp_path):
-    path = tmp_path / "s.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    sheet = workbook.load(path)
+def test_bench_compares_sums_and_products_with_mpmath(sheet_from):
+    sheet = sheet_from(SHEET, name="s")
     lines = {line.what: line for line in bench.run(sheet, repeats=1)}
     assert set(lines) == {"zeta", "canc", "prod"}  # sum(v) of a vector has no estimate
     with mpmath.workdps(50):

@@ -178,14 +178,14 @@ EXCEL_CASES = {
 
 
 @pytest.fixture(scope="module")
-def golden(tmp_path_factory):
+def golden(load_text, tmp_path_factory):
     formulas = pytest.importorskip("formulas")
     from helpers.recalc import formula_values
 
     tmp = tmp_path_factory.mktemp("dist_xl")
     text = TEMPLATE + "".join(f'{k} = "{v}"\n' for k, v in EXCEL_CASES.items())
     text += 'fractional = "pt(x, half)"\nconst_fraction = "qt(p, 2.5)"\n'
-    sheet = workbook.load(write_template(tmp, text, "dist.toml"))
+    sheet = load_text(text, name="dist")
     path = sheet.write_xlsx(tmp / "dist.xlsx")
     cells = formula_values(path)
     solution = formulas.ExcelModel().loads(str(path)).finish().calculate()

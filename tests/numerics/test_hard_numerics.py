@@ -2,8 +2,6 @@
 within its error estimate, or refused with an error naming what is wrong. A pole is not a
 root, two roots closer than the samples are two roots, a narrow peak is not missed."""
 
-from pathlib import Path
-
 import mpmath
 import numpy as np
 import pytest
@@ -15,20 +13,18 @@ from workbook.functions.numerical import NumericsError
 mpmath.mp.dps = 50
 
 
-def value(tmp_path: Path, expr: str, tolerance: float | None = None):
+def value(sheet_from, expr: str, tolerance: float | None = None):
     """(value, largest error estimate of the built-ins) of EXPR in a sheet of its own."""
     head = f"[sheet]\ntolerance = {tolerance}\n" if tolerance else ""
-    path = tmp_path / "s.toml"
-    path.write_text(f'{head}[definitions]\ny = "{expr}"\n', encoding="utf-8")
-    s = workbook.load(path)
+    s = sheet_from(f'{head}[definitions]\ny = "{expr}"\n')
     v = float(s.evaluate("y").magnitude)
     estimates = [float(np.max(r.error)) for _, r in s.evaluator.records if r.error.size]
     return v, max(estimates, default=0.0)
 
 
-def right(tmp_path, expr: str, exact, rel: float = 1e-9):
+def right(sheet_from, expr: str, exact, rel: float = 1e-9):
     """The value is within rel of the exact one and within its estimate (x 1.01)."""
-    v, est = value(tmp_path, expr)
+    v, est = value(sheet_from, expr)
     exact = float(exact)
     assert abs(v - exact) <= rel * max(abs(exact), 1e-300), (v, exact)
     assert abs(v - exact) <= 1.01 * est + 1e-300, (v, exact, est)
@@ -47,16 +43,16 @@ def right(tmp_path, expr: str, exact, rel: float = 1e-9):
         ("root(1/(x - 0.3), x, 0.25)", "poles or jumps, not roots"),
     ],
 )
-def test_roots_that_are_not_one_root_are_refused(tmp_path, expr, message):
+def test_roots_that_are_not_one_root_are_refused(sheet_from, expr, message):
     with pytest.raises(NumericsError, match=message):
-        value(tmp_path, expr)
+        value(sheet_from, expr)
 
 
-def test_a_root_past_a_pole_from_a_guess(tmp_path):
+def test_a_root_past_a_pole_from_a_guess(sheet_from, tmp_path):
     """From 1.5 the pole pi/2 is the nearest sign change of tan; the nearest root is 0."""
-    v, _ = value(tmp_path, "root(tan(x), x, 1.5)")
+    v, _ = value(sheet_from, "root(tan(x), x, 1.5)")
     assert v == 0.0
-    right(tmp_path, "root(tan(x), x, 1.6)", mpmath.pi, rel=1e-12)
+    right(sheet_from, "root(tan(x), x, 1.6)", mpmath.pi, rel=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -66,12 +62,12 @@ def test_a_root_past_a_pole_from_a_guess(tmp_path):
         "root(x^3 - 3*x^2 + 3*x - 1, x, 0.2)",
     ],
 )
-def test_a_root_inside_the_rounding_noise_is_polished_in_mpmath(tmp_path, expr):
+def test_a_root_inside_the_rounding_noise_is_polished_in_mpmath(sheet_from, expr):
     """(x - 1)^3 written out: rounding hides the root within about 1e-5 in doubles. In a
     bracket it was 2.3e-6 off with an estimate of 1e-10 (then a noise-limited estimate of
     2e-5); from a guess it was 6.8e-7 off with an estimate of 1e-10. EXPR's signs are now
     checked in mpmath at 60 digits beside the value, and a multiple root polished there."""
-    v, est = value(tmp_path, expr)
+    v, est = value(sheet_from, expr)
     assert abs(v - 1.0) <= est <= 4 * np.finfo(float).eps
 
 
@@ -89,8 +85,8 @@ def test_a_root_inside_the_rounding_noise_is_polished_in_mpmath(tmp_path, expr):
         ("root(x^2.5 - 2, x, 0, 3)", mpmath.power(2, mpmath.mpf(1) / mpmath.mpf("2.5"))),
     ],
 )
-def test_ordinary_roots_stay_right(tmp_path, expr, exact):
-    right(tmp_path, expr, exact)
+def test_ordinary_roots_stay_right(sheet_from, expr, exact):
+    right(sheet_from, expr, exact)
 
 
 def test_the_count_of_roots_is_proven_by_interval_arithmetic():
@@ -156,25 +152,27 @@ def _max_of(f, a, b, bracket):
         ("x*(1 - x)", lambda x: x * (1 - x), (0, 1), (mpmath.mpf("0.4"), mpmath.mpf("0.6"))),
     ],
 )
-def test_a_maximum_between_the_samples_is_found(tmp_path, expr, f, bounds, bracket):
+def test_a_maximum_between_the_samples_is_found(sheet_from, tmp_path, expr, f, bounds, bracket):
     """The samples (33 on the bracket) miss the peak; branch and bound on the enclosures
     does not. maximum was 0 for the first (true 1) and 0.00092 for the second (true 0.984)."""
     top, where = _max_of(f, *bounds, bracket)
     a, b = bounds
-    right(tmp_path, f"maximum({expr}, x, {a}, {b})", top, rel=1e-9)
-    v, est = value(tmp_path, f"argmax({expr}, x, {a}, {b})")
+    right(sheet_from, f"maximum({expr}, x, {a}, {b})", top, rel=1e-9)
+    v, est = value(sheet_from, f"argmax({expr}, x, {a}, {b})")
     assert abs(v - float(where)) <= max(est, 1e-7 * abs(float(where)))
 
 
-def test_a_minimum_at_a_narrow_dip_in_a_table(tmp_path):
+def test_a_minimum_at_a_narrow_dip_in_a_table(sheet_from):
     """One row per width of the dip: each minimum is -1 at x = 0.4 (the samples see 0)."""
-    path = tmp_path / "s.toml"
-    path.write_text(
-        '[arguments]\nw = { unit = "" }\nx = { unit = "" }\n'
-        '[definitions]\n"m(w)" = "minimum(-exp(-((x - 0.4)/w)^2), x, 0, 1)"\n',
-        encoding="utf-8",
+    got = (
+        sheet_from(
+            '[arguments]\nw = { unit = "" }\nx = { unit = "" }\n'
+            '[definitions]\n"m(w)" = "minimum(-exp(-((x - 0.4)/w)^2), x, 0, 1)"\n',
+            name="s",
+        )
+        .evaluate("m", np.array([1e-1, 1e-3, 1e-5, 1e-6]))
+        .magnitude
     )
-    got = workbook.load(path).evaluate("m", np.array([1e-1, 1e-3, 1e-5, 1e-6])).magnitude
     assert np.allclose(got, -1.0, rtol=1e-9, atol=0)
 
 
@@ -217,17 +215,17 @@ _MP = mpmath.mpf
         ),
     ],
 )
-def test_narrow_and_steep_integrands_are_integrated(tmp_path, expr, exact):
+def test_narrow_and_steep_integrands_are_integrated(sheet_from, expr, exact):
     """A narrow peak between the nodes was 2.4e-118 for 0.0177; steep smooth integrands
     (scipy's quad integrates them) were refused as "singular or divergent?"."""
-    right(tmp_path, expr, exact, rel=1e-8)
+    right(sheet_from, expr, exact, rel=1e-8)
 
 
-def test_an_end_point_singularity_estimate_covers_the_rounding_of_its_nodes(tmp_path):
+def test_an_end_point_singularity_estimate_covers_the_rounding_of_its_nodes(sheet_from):
     """1/sqrt(|x - 0.3|): the nodes beside 0.3 are doubles, which costs about 2e-8; the
     estimate was 2.3e-10 (98 times too small)."""
     exact = 2 * mpmath.sqrt(_MP("0.3")) + 2 * mpmath.sqrt(_MP("0.7"))
-    right(tmp_path, "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)", exact, rel=1e-7)
+    right(sheet_from, "integral(1/sqrt(abs(x - 0.3)), x, 0, 1)", exact, rel=1e-7)
 
 
 EXACT = {
@@ -245,16 +243,14 @@ EXACT = {
 
 
 @pytest.mark.slow
-def test_bench_verdicts_agree_with_mpmath(tmp_path):
+def test_bench_verdicts_agree_with_mpmath(sheet_from):
     """`workbook bench` on the hard cases: its reference is other methods (Brent, QUADPACK,
     dense sampling), never the engine's routine; every "ok" is right against mpmath (50
     digits) within the tolerance, every estimate is at least a tenth of the true error, and
     a line that is not "ok" is one whose error is beyond the tolerance."""
     from workbook.numerics import bench
 
-    path = tmp_path / "hard.toml"
-    path.write_text(HARD_SHEET, encoding="utf-8")
-    sheet = workbook.load(path)
+    sheet = sheet_from(HARD_SHEET, name="hard")
     lines = {line.what: line for line in bench.run(sheet, repeats=1)}
     assert set(lines) == set(EXACT)
     for name, line in lines.items():
@@ -288,11 +284,11 @@ def test_bench_verdicts_agree_with_mpmath(tmp_path):
         ),
     ],
 )
-def test_kinks_where_a_curve_crosses_zero_are_break_points(tmp_path, expr, exact):
+def test_kinks_where_a_curve_crosses_zero_are_break_points(sheet_from, expr, exact):
     """abs, min and max of curves (not only of x - c) kink where the curve crosses 0; the
     crossings are found by interval arithmetic and the integral split there (abs(sin(x)) on
     [0, 10] was refused as singular or divergent)."""
-    right(tmp_path, expr, exact, rel=1e-10)
+    right(sheet_from, expr, exact, rel=1e-10)
 
 
 def test_a_near_singular_integrand_over_many_rows_has_an_honest_estimate():
@@ -320,12 +316,10 @@ proven = "maximum(sin(x), x, 0, 3)"
 """
 
 
-def test_an_extremum_without_enclosures_carries_the_assumption_it_rests_on(tmp_path):
+def test_an_extremum_without_enclosures_carries_the_assumption_it_rests_on(sheet_from):
     from workbook.numerics.estimates import estimate_findings
 
-    path = tmp_path / "a.toml"
-    path.write_text(ASSUMED, encoding="utf-8")
-    s = workbook.load(path)
+    s = sheet_from(ASSUMED, name="a")
     for name in ("m", "q", "proven"):
         s.evaluate(name)
     found = {f.topic: f for f in estimate_findings(s)}
@@ -481,28 +475,26 @@ def test_a_table_of_integrals_nearly_singular_beside_the_interval_has_honest_est
     assert np.all(np.abs(got - exact) <= np.maximum(est, 1e-10 * exact))
 
 
-def test_a_nested_integral_sees_the_inner_integrands_singular_point_at_its_bound(tmp_path):
+def test_a_nested_integral_sees_the_inner_integrands_singular_point_at_its_bound(sheet_from):
     """integral(integral(1/sqrt(t + 1e-3), t, 0, u), u, 0, 1): the outer integrand's
     derivative is 1/sqrt(u + 1e-3), nearly singular beside [0, 1]; it was 1.8e-11 off with
     an estimate of 2.4e-12."""
     d = _MP(1e-3)
     exact = 2 * (_MP(2) / 3 * ((1 + d) ** 1.5 - d**1.5) - mpmath.sqrt(d))
-    right(tmp_path, "integral(integral(1/sqrt(t + 1e-3), t, 0, u), u, 0, 1)", exact, rel=1e-12)
+    right(sheet_from, "integral(integral(1/sqrt(t + 1e-3), t, 0, u), u, 0, 1)", exact, rel=1e-12)
 
 
 @pytest.mark.parametrize("width", [1e-2, 1e-3, 1e-4])
-def test_a_narrow_peak_anywhere_in_the_bracket_is_integrated(tmp_path, width):
+def test_a_narrow_peak_anywhere_in_the_bracket_is_integrated(sheet_from, width):
     """exp(-((x - a)/w)^2) on [0, 10] for centres a across the bracket, near its ends too
     (where a peak inside one end box was integrated to 0 or 1.8e-45), against erf in mpmath;
     every value within its estimate."""
     centres = np.concatenate([np.linspace(0, 10, 81), [0.035, 0.225, 0.35, 0.6, 1.025, 9.65]])
-    path = tmp_path / "peak.toml"
-    path.write_text(
+    s = sheet_from(
         '[arguments]\nx = { unit = "" }\na = { unit = "" }\n[definitions]\n'
         f'"q(a)" = "integral(exp(-((x - a)/{width})^2), x, 0, 10)"\n',
-        encoding="utf-8",
+        name="peak",
     )
-    s = workbook.load(path)
     got = s.evaluate("q", centres).magnitude
     estimate = max(float(np.max(r.error)) for _, r in s.evaluator.records if r.error.size)
     w = mpmath.mpf(width)
@@ -517,17 +509,19 @@ def test_a_narrow_peak_anywhere_in_the_bracket_is_integrated(tmp_path, width):
     assert np.max(error) <= 1.01 * estimate + 1e-300
 
 
-def test_a_kink_anywhere_in_the_bracket_is_integrated(tmp_path):
+def test_a_kink_anywhere_in_the_bracket_is_integrated(sheet_from):
     """sqrt(|x - a|) on [0, 10] for kinks a across the bracket: the kink search and the
     feature search found the same point one ulp apart, and the piece between them stopped
     the integral as not finite (a = 2.375); against the closed form."""
     centres = np.linspace(0, 10, 161)
-    path = tmp_path / "kink.toml"
-    path.write_text(
-        '[arguments]\nx = { unit = "" }\na = { unit = "" }\n[definitions]\n'
-        '"q(a)" = "integral(sqrt(abs(x - a)), x, 0, 10)"\n',
-        encoding="utf-8",
+    got = (
+        sheet_from(
+            '[arguments]\nx = { unit = "" }\na = { unit = "" }\n[definitions]\n'
+            '"q(a)" = "integral(sqrt(abs(x - a)), x, 0, 10)"\n',
+            name="kink",
+        )
+        .evaluate("q", centres)
+        .magnitude
     )
-    got = workbook.load(path).evaluate("q", centres).magnitude
     exact = 2 / 3 * (centres**1.5 + (10 - centres) ** 1.5)
     assert got == pytest.approx(exact, rel=1e-12)

@@ -4,22 +4,17 @@ Exact values from mpmath at 50 digits."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import mpmath
 import numpy as np
 import pytest
 
-import workbook
 from workbook.functions.numerical import NumericsError
 
 mpmath.mp.dps = 50
 
 
-def _value(tmp_path: Path, expr: str):
-    path = tmp_path / "s.toml"
-    path.write_text(f'[definitions]\ny = "{expr}"\n', encoding="utf-8")
-    s = workbook.load(path)
+def _value(sheet_from, expr: str):
+    s = sheet_from(f'[definitions]\ny = "{expr}"\n')
     v = s.evaluate("y").magnitude
     return float(v), max(float(np.max(r.error)) for _, r in s.evaluator.records)
 
@@ -35,11 +30,11 @@ def _value(tmp_path: Path, expr: str):
         ("integral(1/x^3, x, -1, 1)", "0"),
     ],
 )
-def test_a_principal_value_is_not_an_integral(tmp_path, expr, at):
+def test_a_principal_value_is_not_an_integral(sheet_from, expr, at):
     with pytest.raises(
         NumericsError, match=f"singular at x = {at}, inside the interval.*principal"
     ):
-        _value(tmp_path, expr)
+        _value(sheet_from, expr)
 
 
 @pytest.mark.parametrize(
@@ -60,8 +55,8 @@ def test_a_principal_value_is_not_an_integral(tmp_path, expr, at):
         ("integral(x/sqrt(abs(x^2 - 0.25)), x, -1, 1)", lambda: mpmath.mpf(0)),
     ],
 )
-def test_integrable_singularities_are_integrated(tmp_path, expr, exact):
-    v, est = _value(tmp_path, expr)
+def test_integrable_singularities_are_integrated(sheet_from, expr, exact):
+    v, est = _value(sheet_from, expr)
     want = float(exact())
     assert abs(v - want) <= max(10 * est, 1e-15), (v, want, est)
     assert abs(v - want) <= 1e-7 * max(abs(want), 1.0)

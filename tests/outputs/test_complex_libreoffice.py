@@ -9,7 +9,6 @@ import pytest
 from helpers.recalc import cell_values, formula_values, recalculate, soffice
 from helpers.sheets import AC
 
-import workbook
 from workbook.functions.complexes import parse_text
 
 if soffice() is None and os.environ.get("CI"):
@@ -42,11 +41,8 @@ def _agree(got, cached) -> bool:
 
 
 @pytest.fixture(scope="module")
-def ac(tmp_path_factory):
-    path = tmp_path_factory.mktemp("ac") / "ac.toml"
-    text = AC.replace("\n[[tables]]", EXTRA + "\n[[tables]]")
-    path.write_text(text, encoding="utf-8")
-    return workbook.load(path)
+def ac(load_text):
+    return load_text(AC.replace("\n[[tables]]", EXTRA + "\n[[tables]]"), name="ac")
 
 
 def test_every_complex_cell_recalculates_to_the_engine_value(tmp_path, ac):

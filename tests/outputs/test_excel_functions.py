@@ -11,7 +11,6 @@ import pytest
 import xlsxwriter
 from openpyxl.utils.formulas import FORMULAE
 
-import workbook
 from workbook.functions import excel_names
 from workbook.functions.excel_functions import CLASSIC, FUNCTIONS, stored
 from workbook.functions.excel_names import BUILTIN_NAMES, ExcelNames
@@ -94,10 +93,8 @@ Extract = "Auto_Open*Print_Area*Criteria*Database*rate*Sheet_Title"
 """
 
 
-def test_reserved_names_are_renamed_in_the_written_workbook(tmp_path):
-    path = tmp_path / "reserved.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    sheet = workbook.load(path)
+def test_reserved_names_are_renamed_in_the_written_workbook(sheet_from, tmp_path):
+    sheet = sheet_from(SHEET, name="reserved")
     out = tmp_path / "reserved.xlsx"
     sheet.write_xlsx(out)
     book = openpyxl.load_workbook(out)

@@ -16,9 +16,7 @@ import re
 import formulas
 import pytest
 from helpers.recalc import formula_values
-from helpers.sheets import write_template
 
-import workbook
 from workbook.functions.distributions import NAMES as DISTRIBUTIONS
 from workbook.functions.special import NAMES as SPECIAL
 from workbook.numerics.registry import REGISTRY
@@ -122,13 +120,13 @@ columns = { """
 
 
 @pytest.fixture(scope="module")
-def golden(tmp_path_factory):
+def golden(load_text, tmp_path_factory):
     """The sheet, its formula cells {(sheet, cell): (formula, engine value)}, the values
     `formulas` computes {(SHEET, cell): value} and the Definitions rows {name: row}."""
     import openpyxl
 
     tmp = tmp_path_factory.mktemp("golden")
-    sheet = workbook.load(write_template(tmp, TEMPLATE, "golden.toml"))
+    sheet = load_text(TEMPLATE, name="golden")
     path = sheet.write_xlsx(tmp / "golden.xlsx")
     cells = formula_values(path)
     defs = openpyxl.load_workbook(path)["Definitions"]

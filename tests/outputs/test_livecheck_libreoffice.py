@@ -101,10 +101,8 @@ columns = {{ {columns} }}
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(text=sheets())
-def test_composed_built_ins_recalculate_to_the_engine(tmp_path, text):
-    path = tmp_path / "composed.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(path)
+def test_composed_built_ins_recalculate_to_the_engine(sheet_from, tmp_path, text):
+    sheet = sheet_from(text, name="composed")
     out = sheet.write_xlsx(tmp_path / "composed.xlsx", force=True)
     bad = differences(out, recalculate(out, tmp_path / "lo"))
     assert not bad, f"{text}\n{len(bad)} formula cells differ, e.g. {bad[:5]}"

@@ -9,7 +9,6 @@ import re
 import pytest
 from helpers.sheets import write_template
 
-import workbook
 from workbook.cli import main, matrix_lines
 from workbook.compute.computed import compute
 from workbook.outputs.report import render
@@ -58,7 +57,7 @@ def _text(fragment: str) -> str:
 
 
 @pytest.fixture(scope="module")
-def report(tmp_path_factory):
+def report(load_text):
     text = """
 [sheet]
 title = "a wall"
@@ -74,7 +73,7 @@ R = "4.7 ohm"
 dT = "T_in - T_out"
 q = { expr = "h*dT", unit = "W/m^2" }
 """
-    sheet = workbook.load(write_template(tmp_path_factory.mktemp("wall"), text))
+    sheet = load_text(text, name="t")
     return render(compute(sheet))
 
 

@@ -174,10 +174,8 @@ def _acot(x):
     return float(mpmath.acot(mpmath.mpf(x)))
 
 
-def test_a_new_builtin_needs_only_its_entry_and_its_docs_line(tmp_path, acotan):
-    path = tmp_path / "acotan.toml"
-    path.write_text(SHEET, encoding="utf-8")
-    sheet = workbook.load(path)  # the typer read the entry
+def test_a_new_builtin_needs_only_its_entry_and_its_docs_line(sheet_from, tmp_path, acotan):
+    sheet = sheet_from(SHEET, name="acotan")  # the typer read the entry
     assert isinstance(sheet.typer.function("f").body, ty.T)
     # numpy
     assert sheet.evaluate("y").to("m").magnitude == pytest.approx(2 * _acot(0.7), rel=1e-15)

@@ -288,7 +288,7 @@ def test_pump_worn_speed_is_the_derivative_of_the_worn_lift(pump):
     assert float(mag(pump.evaluate("dphi_gn"), "deg")) > 0
 
 
-def test_printed_formula_7_is_refused_by_units(tmp_path):
+def test_printed_formula_7_is_refused_by_units(sheet_from):
     text = """
 [inputs]
 n = "1000 rpm"
@@ -300,10 +300,8 @@ dh = "1.8 mm"
 c7 = '''-J*phi_c/(12*n) + sqrt(J^2*phi_c^2/(144*n)
       + (J^2/(36*n^2))*(phi_c^2*Jz^2)/(J + Jz)^2 - phi_c^2/4 - 2*dh*J)'''
 """
-    path = tmp_path / "seven.toml"
-    path.write_text(text, encoding="utf-8")
     with pytest.raises(UnitError):
-        workbook.load(path)
+        sheet_from(text, name="seven")
 
 
 # -- brake ---------------------------------------------------------------------------------------

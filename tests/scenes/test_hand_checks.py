@@ -110,14 +110,11 @@ def test_check_lists_every_relation(concave):
     assert "largest discrepancy at phi = 52 deg" in text
 
 
-def _with(tmp_path, extra: str):
+def _with(load_text, extra: str):
+    """concave-cam with EXTRA added to its text, its data files read where the template is."""
     src = workbook.load("concave-cam").spec.path
     text = src.read_text(encoding="utf-8") + extra
-    path = tmp_path / "concave-cam.toml"
-    path.write_text(text, encoding="utf-8")
-    for csv in src.parent.glob("concave-cam.*.csv"):
-        (tmp_path / csv.name).write_text(csv.read_text(encoding="utf-8"), encoding="utf-8")
-    return workbook.load(str(path))
+    return load_text(text, name="concave-cam", folder=src.parent)
 
 
 @pytest.mark.parametrize(
@@ -127,8 +124,8 @@ def _with(tmp_path, extra: str):
         ('relation = "v1 = R1 * d(h1)/d(phi)"', "units do not work out"),
     ],
 )
-def test_a_relation_that_cannot_be_evaluated_fails_the_check(tmp_path, relation, message):
-    sheet = _with(tmp_path, f"\n[[relations]]\n{relation}\n")
+def test_a_relation_that_cannot_be_evaluated_fails_the_check(load_text, relation, message):
+    sheet = _with(load_text, f"\n[[relations]]\n{relation}\n")
     report = sheet.check()
     assert not report.ok
     failed = [f for f in report.findings if f.verdict == "fail"]
@@ -163,15 +160,13 @@ def test_joins_of_h_v_j(concave):
     assert j22.jumps[0] == pytest.approx(-378.998 - 1341.423, abs=1e-2)
 
 
-def test_gaps_and_overlaps_are_found(tmp_path):
+def test_gaps_and_overlaps_are_found(sheet_from):
     text = (
         '[arguments]\nx = { unit = "" }\n[definitions]\n'
         '"f(x)" = ["1 if 0 <= x <= 1", "2 if 2 <= x <= 3", "3 if 2.5 <= x <= 4"]\n'
         "[sheet]\nhand_checks = true\n"
     )
-    path = tmp_path / "gaps.toml"
-    path.write_text(text, encoding="utf-8")
-    sheet = workbook.load(str(path))
+    sheet = sheet_from(text, name="gaps")
     (r,) = analysis.join_results(sheet)
     assert r.gaps == ["Interval.open(1, 2)"]
     assert r.overlaps == [("2", "3", "Interval(5/2, 3)")]
