@@ -114,9 +114,8 @@ def test_vector_blocks_split_around_failing_cases(concave, monkeypatch):
         pd.testing.assert_frame_equal(res.table, serial, check_exact=True)
 
 
-def test_a_table_aggregate_is_not_vectorised(tmp_path):
-    path = write_template(tmp_path, SINE_TABLE)
-    sheet = workbook.load(path)
+def test_a_table_aggregate_is_not_vectorised(sheet_from):
+    sheet = sheet_from(SINE_TABLE)
     res = sw.sweep(sheet, {"R": "10mm,20mm"}, {"top": "max_over(t, y)"})
     assert res.mode == "serial"
     assert res.table["top [mm]"].tolist() == pytest.approx([10.0, 20.0], rel=1e-15)

@@ -340,9 +340,8 @@ columns = { f = "" }
     assert "not a finite number" in doc.get_element_by_id("table-bad").text_content()
 
 
-def test_long_tables_show_their_ends(tmp_path):
-    path = write_template(tmp_path, SINE_TABLE.replace("0, 10 .. 90", "0, 0.05 .. 90"))
-    sheet = workbook.load(path)
+def test_long_tables_show_their_ends(sheet_from):
+    sheet = sheet_from(SINE_TABLE.replace("0, 10 .. 90", "0, 0.05 .. 90"))
     doc = rp.parse(render(compute(sheet)))
     rows = doc.get_element_by_id("table-t").xpath(".//tbody/tr")
     assert len(rows) == 21 and "1,781 rows not shown" in rows[10].text_content()
@@ -387,9 +386,8 @@ def test_pdf_without_chromium_is_a_clear_error(tmp_path, monkeypatch, capsys):
     assert not out.exists() and not out.with_suffix(".pdf").exists()
 
 
-def test_a_failed_write_keeps_the_old_file(tmp_path, monkeypatch):
-    path = write_template(tmp_path, SINE_TABLE)
-    sheet = workbook.load(path)
+def test_a_failed_write_keeps_the_old_file(sheet_from, tmp_path, monkeypatch):
+    sheet = sheet_from(SINE_TABLE)
     out = sheet.report(tmp_path / "r.html")
     before = out.read_text(encoding="utf-8")
 
