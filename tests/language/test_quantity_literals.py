@@ -280,7 +280,7 @@ def test_a_units_name_gets_both_hints_when_the_sheet_has_a_name_like_it(sheet_fr
     """``P1 + kW`` beside an input ``k``: the sheet's name like it, and how a unit is written
     (the second hint was lost when the first was found)."""
     text = '[inputs]\nk = "2"\nP1 = "3 kW"\n[definitions]\nP = "P1 + kW"\n'
-    with pytest.raises(workbook.WorkbookError) as err:
+    with pytest.raises(WorkbookError) as err:
         sheet_from(text)
     assert "unknown name 'kW' (did you mean k?; a unit is written after a number: 1 kW)" in str(
         err.value
