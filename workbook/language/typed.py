@@ -317,6 +317,19 @@ def children(t: T) -> tuple[T, ...]:
     return _CHILDREN.visit(t)
 
 
+def with_calls(defs, t: T):
+    """Every node of ``t`` and of the bodies of the sheet functions it calls, each body once
+    (``defs.function(name)`` gives a call's typed function)."""
+    stack, seen = [t], set()
+    while stack:
+        n = stack.pop()
+        yield n
+        if isinstance(n, TCall) and n.name not in seen:
+            seen.add(n.name)
+            stack.append(defs.function(n.name).body)
+        stack.extend(children(n))
+
+
 def parameters(t: T) -> set[str]:
     """Names of the parameters (function arguments, bound variables) that ``t`` refers to."""
     out, stack = set(), [t]

@@ -201,15 +201,9 @@ def inlined_size(defs, body: ty.T) -> int:
 def _leaves(defs, body: ty.T) -> dict[str, ty.T]:
     """Parameters and references of ``body``, also inside the sheet functions it calls."""
     out: dict[str, ty.T] = {}
-    stack, seen = [body], set()
-    while stack:
-        n = stack.pop()
+    for n in ty.with_calls(defs, body):
         if isinstance(n, (ty.TParam, ty.TRef)):
             out.setdefault(n.name, n)
-        if isinstance(n, ty.TCall) and n.name not in seen:
-            seen.add(n.name)
-            stack.append(defs.function(n.name).body)
-        stack.extend(ty.children(n))
     return out
 
 

@@ -120,18 +120,12 @@ _REFUSAL = _Refusal()
 def refusal(typer, t: ty.T) -> str | None:
     """Why ``t`` (with the sheet functions it calls) has no symbolic form, or None; inputs and
     definitions it refers to count as symbols. No SymPy is imported."""
-    stack, seen = [t], set()
-    while stack:
-        n = stack.pop()
+    for n in ty.with_calls(typer, t):  # a call's body is read after the call is checked
         why = _REFUSAL.visit(n, {}, {})
         if why:
             return why
         if isinstance(n, ty.TCall) and n.name in typer.recursive:
             return f"{n.name.split('@')[0]}() calls itself"
-        if isinstance(n, ty.TCall) and n.name not in seen:
-            seen.add(n.name)
-            stack.append(typer.function(n.name).body)
-        stack.extend(ty.children(n))
     return None
 
 
