@@ -150,13 +150,14 @@ class Builtins:
     constants: dict[str, Any]  # name -> workbook.functions.constants.Constant
     home: str = ""  # "module:name" of the one instance, by which it pickles (a typer does)
 
-    def refuse_functions_named(self, names: dict[str, int | None]) -> None:
-        """A sheet's function, block, column, unknown or ODE state (``names``: name -> line)
-        may not have a built-in function's name."""
+    def refuse_functions_named(self, names: dict[str, int | None], file: str) -> None:
+        """A sheet's function, block, column, unknown or ODE state (``names``: name -> line
+        in ``file``) may not have a built-in function's name."""
         for name, line in names.items():
             if name in self.functions:
                 raise TemplateError(
                     f"'{name}' shadows the built-in function {name}(); choose another name",
+                    file=file,
                     line=line,
                     definition=name,
                 )

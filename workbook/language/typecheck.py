@@ -73,7 +73,7 @@ class Typer(ArrayTyping, UnitRules, Visitor):
     ):
         self.spec = spec
         self.builtins = builtins
-        builtins.refuse_functions_named(spec.function_names)
+        builtins.refuse_functions_named(spec.function_names, str(spec.path))
         self.input_units = input_units
         # the typed trees, kept where the compute stage reads them without the typer
         self.defs = TypedDefinitions(self, spec)
