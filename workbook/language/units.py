@@ -256,7 +256,8 @@ def reduced(u: pint.Unit) -> pint.Unit:
     names = to_units_container(u)
     scales = [n for n in names if _is_scale(n)]
     if scales and (len(names) > 1 or any(names[n] != 1 for n in scales)):
-        u = ureg.Unit(_without(names, scales))
+        for name in scales:
+            u = u / ureg.Unit(name) ** names[name]
         names = to_units_container(u)
     if not u.dimensionality or len(names) < 2:
         return u
@@ -272,12 +273,6 @@ def _is_scale(name: str) -> bool:
     """A unit that is a pure number times a scale (percent, permille, ppm), not an angle."""
     factor, root = registry().get_root_units(name)
     return root == registry().dimensionless and factor != 1
-
-
-def _without(names, dropped: list[str]) -> str:
-    """The unit text of ``names`` (a units container) without the units ``dropped``."""
-    kept = [f"{n}**{p}" for n, p in names.items() if n not in dropped]
-    return "*".join(kept) or "dimensionless"
 
 
 #: How a worksheet spells a unit where pint's symbol is not what it types: pint's liter is l.
