@@ -546,6 +546,11 @@ class FormulaTranslator:
         ref = self.ref_of(args[0][2])
         if not ref.single:
             raise FormulaProblem("OFFSET of a range")
+        from .lookups import offset_by_match
+
+        chain = offset_by_match(self, ref, args[1], args[2])
+        if chain is not None:
+            return chain
         guards, moves = [], []
         for a in args[1:3]:
             value = self.static(a)

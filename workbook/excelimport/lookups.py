@@ -7,7 +7,9 @@ strictly: elsewhere, and where nothing matches (#N/A), the value is an error. Ke
 cells; texts are compared by Excel's rule (without case) only where x is a text written in the
 formula or a constant text cell (whose case and patterns, ``*`` ``?`` ``~``, are then known);
 an empty key cell never matches. ``INDEX(range, i[, j])`` is the cell at (i, j), a chain over
-i and j: an index outside the range is an error (#REF!). ``HLOOKUP`` is VLOOKUP by rows."""
+i and j: an index outside the range is an error (#REF!). ``HLOOKUP`` is VLOOKUP by rows.
+``OFFSET(cell, MATCH(...) + k, m)`` (or the MATCH in the columns) is the same chain over the
+cells the offset reaches at each position."""
 
 from __future__ import annotations
 
@@ -173,6 +175,57 @@ def index(ft, args) -> str:
             cond += f" and {j} == {dc}"
         text = f"({name} if {cond} otherwise {text})"
     return text
+
+
+def _match_plus(node) -> tuple[tuple, float] | None:
+    """``MATCH(...)``, ``MATCH(...) + k`` or ``MATCH(...) - k`` (k written): (the MATCH's
+    arguments, k); None for another offset."""
+    if node[0] == "fn" and node[1].upper() == "MATCH":
+        return node[2], 0.0
+    if node[0] == "op" and node[1] in ("+", "-") and len(node[2]) == 2:
+        a, b = node[2]
+        k = written_number(b)
+        if k is not None and a[0] == "fn" and a[1].upper() == "MATCH":
+            return a[2], k if node[1] == "+" else -k
+        k = written_number(a)
+        if k is not None and node[1] == "+" and b[0] == "fn" and b[1].upper() == "MATCH":
+            return b[2], k
+    return None
+
+
+def offset_by_match(ft, base: Ref, rows, cols) -> str | None:
+    """``OFFSET(base, rows, cols)`` where one offset is ``MATCH(x, keys, type) + k`` and the
+    other a written number: a chain over the keys whose results are the cells reached at each
+    position (outside the sheet an error, #REF!); None where the offsets are otherwise."""
+    found = [(i, _match_plus(a)) for i, a in enumerate((rows, cols))]
+    moving = [(i, m) for i, m in found if m is not None]
+    fixed = [written_number(a) for i, a in enumerate((rows, cols)) if found[i][1] is None]
+    if len(moving) != 1 or len(fixed) != 1 or fixed[0] is None or fixed[0] != int(fixed[0]):
+        return None
+    along, (m, k) = moving[0]
+    if k != int(k) or len(m) not in (2, 3):
+        return None
+    kind = 1.0 if len(m) == 2 else written_number(m[2])
+    if kind not in (-1.0, 0.0, 1.0):
+        raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
+    keys_ref = _range(ft, m[1], "MATCH")
+    if keys_ref.r1 != keys_ref.r2 and keys_ref.c1 != keys_ref.c2:
+        raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
+    keys = _keys(ft, keys_ref, m[0], exact=kind == 0)
+    results, kinds = [], set()
+    for p in range(1, len(keys) + 1):
+        step = (p + int(k), int(fixed[0]))
+        row, col = base.r1 + step[along], base.c1 + step[1 - along]
+        if row < 1 or col < 1:
+            results.append("1/0")
+            continue
+        cell = ft.book.cell(base.sheet, row, col)
+        kinds.add(isinstance(getattr(cell, "value", None), str))
+        ft.out.refs.append(Ref(base.sheet, row, col, row, col))
+        results.append(ft.name_of(base.sheet, row, col))
+    if kinds == {True, False}:
+        raise FormulaProblem("OFFSET by a MATCH to cells of texts and numbers")
+    return _chain(ft, m[0], keys, kind, results, "num2str(1/0)" if kinds == {True} else "1/0")
 
 
 def hlookup(ft, args) -> str:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..errors import WorkbookError
 from ..language.csvcells import csv_text as spreadsheet_text
+from ..language.csvcells import unescaped
 from ..language.spec import SheetSpec
 from ..mathcad.writer import ABS_TOLERANCE, REL_TOLERANCE
 from ..mathcad.writer import write as write_files
@@ -62,11 +63,15 @@ def csv_text(text: str) -> str:
 
 
 def uncompared(text: str) -> str | None:
-    """Why a cached text is not compared (None: it is): one that a spreadsheet would read as a
-    formula or that spans lines (written escaped, so the comparison would be with the escaped
-    text), or one that the printed values would read as a number."""
-    if spreadsheet_text(text) != text or "\n" in text or "\r" in text:
-        return "a text a spreadsheet reads as a formula: escaped, not compared"
+    """Why a cached text is not compared (None: it is): one that spans lines (written on one
+    line), one that the CSV's escape does not give back (an apostrophe before = + - @, which
+    the reader of printed values takes for the escape), or one that the printed values would
+    read as a number. A text escaped for spreadsheets (``'=x``, ``' + F``) is read back
+    without its apostrophe, so it is compared."""
+    if "\n" in text or "\r" in text:
+        return "a text over several lines: written on one line, not compared"
+    if unescaped(spreadsheet_text(text)) != text:
+        return "a text with an apostrophe the CSV's escape would take for its own: not compared"
     try:
         float(text)
     except ValueError:
