@@ -47,6 +47,25 @@ def test_the_determinant_operator_is_det(tmp_path, capsys):
 
 
 @pytest.mark.slow
+def test_inverse_and_reciprocal_hyperbolic_functions_against_mpmath(tmp_path, capsys):
+    import mpmath
+
+    mpmath.mp.dps = 50
+    x = mpmath.mpf("0.3")
+    calls = {
+        "asinh": mpmath.asinh(x), "acosh": mpmath.acosh(1 + x), "atanh": mpmath.atanh(x),
+        "coth": mpmath.coth(x), "sech": mpmath.sech(x), "csch": mpmath.csch(x),
+    }  # fmt: skip
+    regions = [define(1, ident("x"), real(0.3))]
+    for k, (name, value) in enumerate(calls.items(), start=2):
+        arg = apply("plus", real(1.0), ident("x")) if name == "acosh" else ident("x")
+        regions.append(define(k, ident(f"y_{name}"), shown(call(name, arg), real(float(value)))))
+    text = import_sheet(tmp_path, capsys, "hyperbolic", *regions)
+    assert 'expr = "asinh(x)"' in text and 'expr = "acosh(1 + x)"' in text
+    assert check_sheet(tmp_path, capsys, "hyperbolic")["reproduced"] == len(calls)
+
+
+@pytest.mark.slow
 def test_rkfixed_is_mathcad_runge_kutta(tmp_path, capsys):
     """u := rkfixed(y0, 0, 2, 10, D) with D(x, y) := [y1; -y0 - 0.3 y1 + sin x]: against the
     classical fourth-order Runge-Kutta written out here (x added step by step)."""

@@ -56,6 +56,8 @@ CASES = [
     ("sign_abs", "sign(a - x) + abs(a - x)", None),
     ("exp_ln", "exp(-a) + ln(b) + log10(c)", None),
     ("hyperbolic", "sinh(a/b) + cosh(a/b) - tanh(a/b)", None),
+    ("hyperbolic_reciprocal", "coth(a/b) + sech(a/b) - csch(-a/b)", None),
+    ("inverse_hyperbolic", "asinh(-a/b) + acosh(b/a + 1) + atanh(a/c)", None),
     ("inverse_trig", "asin(a/c) + acos(a/c) + atan(b/c)", None),
     ("sqrt_of_sum", "sqrt(a + b + c)", None),
     # complex numbers: the parts and angle of IM* results are numbers

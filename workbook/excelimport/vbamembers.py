@@ -100,6 +100,14 @@ class Members:
                 return f"rows({src})*cols({src})" if arr.is_range else f"rows({src})"
             if low in ("cells", "item") and args:
                 return f"{src}[{self.indices(obj[1].lower(), args)}]"
+        if (  # r.Cells(i, j).Value, r.Item(i).Value: the element itself
+            low in ("value", "value2")
+            and not args
+            and obj[0] == "call"
+            and strip(obj[1])[0] == "mem"
+            and strip(obj[1])[2].lower() in ("cells", "item")
+        ):
+            return self.member(strip(obj[1]), obj[2])
         if obj[0] == "mem" and low == "count" and obj[2].lower() in ("rows", "columns"):
             inner = strip(obj[1])
             if inner[0] == "id" and inner[1].lower() in self.arrays:

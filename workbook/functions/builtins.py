@@ -341,6 +341,54 @@ _simple(
     mathcad=("tanh",),
     excel_import=("TANH",),
 )
+for _name, _of, _excel, _what in (
+    ("coth", np.tanh, "TANH", "hyperbolic cotangent"),
+    ("sech", np.cosh, "COSH", "hyperbolic secant"),
+    ("csch", np.sinh, "SINH", "hyperbolic cosecant"),
+):
+    _simple(
+        _name,
+        lambda x, of=_of: 1 / of(x),
+        _reciprocal(_excel),
+        lambda sp, x, name=_name: getattr(sp, name)(x),
+        f"{_what}, 1/{_excel.lower()}(x)",
+        mpmath=_name,
+        mathcad=(_name,),
+    )
+_simple(
+    "asinh",
+    np.arcsinh,
+    "ASINH",
+    lambda sp, x: sp.asinh(x),
+    "inverse hyperbolic sine",
+    mpmath="asinh",
+    mathcad=("asinh",),
+    excel_import=("ASINH",),
+)
+_simple(
+    "acosh",
+    np.arccosh,
+    "ACOSH",
+    lambda sp, x: sp.acosh(x),
+    "inverse hyperbolic cosine (of x >= 1)",
+    domain=(Domain("acosh of a value below 1", lambda v: v < 1, "acosh({})"),),
+    mpmath="acosh",
+    mathcad=("acosh",),
+    excel_import=("ACOSH",),
+)
+_simple(
+    "atanh",
+    np.arctanh,
+    "ATANH",
+    lambda sp, x: sp.atanh(x),
+    "inverse hyperbolic tangent (of -1 < x < 1)",
+    domain=(
+        Domain("atanh of a value not between -1 and 1", lambda v: np.abs(v) >= 1, "atanh({})"),
+    ),
+    mpmath="atanh",
+    mathcad=("atanh",),
+    excel_import=("ATANH",),
+)
 _simple(
     "sqrt",
     np.sqrt,
