@@ -171,8 +171,9 @@ def test_offset_by_a_match_is_the_cell_each_key_reaches(tmp_path, capsys):
     ws = wb.add_worksheet("O")
     for r, row in enumerate([(0, 0, 0), (3, 0.375, 0.11), (4, 0.5, 0.2), (5, 0.625, 0.31)]):
         ws.write_row(r, 0, row)  # A1:C4: bar sizes, diameters, areas
+    ws.write_row(4, 0, ["p1", 1, 1])  # A5: a text key, which a number never equals
     ws.write_number("E1", 4)
-    ws.write_formula("F1", "=OFFSET($A$1,MATCH(E1,$A$1:$A$4,0)-1,2)", None, 0.2)
+    ws.write_formula("F1", "=OFFSET($A$1,MATCH(E1,$A$1:$A$5,0)-1,2)", None, 0.2)
     ws.write_formula("F2", "=OFFSET($A$1,1,MATCH(0.375,$A$2:$C$2,0)-1)", None, 0.375)
     ws.write_formula("F3", "=2*OFFSET($A$1,MATCH(E1,$A$1:$A$4)-1,1)", None, 1.0)
     wb.close()
@@ -183,7 +184,7 @@ def test_offset_by_a_match_is_the_cell_each_key_reaches(tmp_path, capsys):
     sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
     names = {d.note.split(": ", 1)[-1]: n for n, d in sheet.spec.definitions.items()}
     size = next(n for n, i in sheet.spec.inputs.items() if "E1" in i.note)
-    first = names["=OFFSET($A$1,MATCH(E1,$A$1:$A$4,0)-1,2)"]
+    first = names["=OFFSET($A$1,MATCH(E1,$A$1:$A$5,0)-1,2)"]
     for bar, area in ((5, 0.31), (3, 0.11)):
         assert sheet.with_inputs(**{size: bar}).evaluate(first).magnitude == area
     with pytest.raises(workbook.WorkbookError, match="not a finite number"):

@@ -215,6 +215,36 @@ def test_a_difference_of_nearly_equal_numbers_has_their_tolerance(tmp_path, caps
     assert [f["name"] for f in report["failures"]] == ["C2"]
 
 
+@pytest.mark.slow
+def test_the_inverse_of_a_matrix_of_cancelling_cells_carries_their_error(tmp_path):
+    """MINVERSE's elements carry |A^-1| size(A) |A^-1|: a matrix whose element is a
+    difference of nearly equal numbers (a finite difference) gives an inverse whose cached
+    elements are compared with that tolerance, not their own size's."""
+    xlsxwriter = pytest.importorskip("xlsxwriter")
+    import numpy as np
+
+    from workbook.excelimport.cancellation import decade
+    from workbook.excelimport.reader import read_book
+
+    path = tmp_path / "inverse.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("S")
+    ws.write_row("D1", [12345678.9, 12345678.5])
+    a = np.array([[2.0, 1.0], [1.0, 0.4000000008]])  # B2 = D1 - E1, cached 0.4000000008
+    ws.write_row("A1", a[0])
+    ws.write("A2", 1.0)
+    ws.write_formula("B2", "=D1-E1", None, a[1, 1])
+    inverse = np.linalg.inv(a)
+    ws.write_array_formula("A4:B5", "{=MINVERSE(A1:B2)}", None, inverse[0, 0])
+    wb.close()
+    book = read_book(path)
+    assert decade(book, "S!B2", a[1, 1]) == 8  # made of numbers of 1.2e7
+    own = [decade(book, f"S!{c}", v) for c, v in zip(("A4", "B5"), inverse.diagonal())]
+    # |A^-1[i, 1]| * 2.5e7 * |A^-1[1, j]| against elements of size 2 to 10
+    sizes = np.abs(inverse)[:, [1]] * 2.47e7 * np.abs(inverse)[[1], :]
+    assert own == [int(np.ceil(np.log10(sizes[k, k]))) for k in (0, 1)]
+
+
 def test_vba_functions_of_thisworkbook_and_what_is_refused():
     from workbook.excelimport.book import translate_vba
 

@@ -1,7 +1,8 @@
 """Differences of nearly equal numbers: a cell's value carries the rounding error of the
 numbers it is computed from, not of its own size (``=ABS(M602-V602)`` of two azimuths near
 236 that agree to 1e-11; ``=F140+F141*B136`` that Excel shows as 0). First-order error
-propagation through the formula (+, -, *, /, ^, SUM, MAX, MIN, ABS, SQRT), from Excel's
+propagation through the formula (+, -, *, /, ^, SUM, MAX, MIN, ABS, SQRT, the elements of
+MINVERSE), from Excel's
 cached values of the cells it reads, gives that size; where it is more than CANCELS times the
 value, the cached value is compared with an absolute tolerance of the printed values' relative
 tolerance times that size (each of the numbers it is made of is compared so); every other
@@ -34,7 +35,10 @@ def scale(book, cell, depth: int = 0, seen: dict | None = None) -> float:
 
     try:
         tree = parse_formula(cell.formula).tree
-        _, err = _propagate(book, cell.sheet, tree, depth, seen)
+        if cell.array is not None and cell.array_master is not None:
+            err = _inverse_element(book, cell, tree, depth, seen)
+        else:
+            _, err = _propagate(book, cell.sheet, tree, depth, seen)
     except (FormulaProblem, _Unknown, ArithmeticError, ValueError, OverflowError):
         return own
     seen[key] = max(own, err) if math.isfinite(err) else own
@@ -107,6 +111,46 @@ def _propagate(book, sheet: str, node, depth: int, seen: dict) -> tuple[float, f
         a, ea = _propagate(book, sheet, payload[0], depth, seen)
         return math.sqrt(a), ea / (2 * math.sqrt(a)) if a > 0 else math.inf
     raise _Unknown()
+
+
+def _inverse_element(book, cell, tree, depth: int, seen: dict) -> float:
+    """The error size of an element of ``MINVERSE(range)`` (a cell of the array formula):
+    first order, d(A^-1) = -A^-1 dA A^-1, so element (i, j) carries
+    sum over k, l of |A^-1[i, k]| size(A[k, l]) |A^-1[l, j]|, from Excel's cached values."""
+    import numpy as np
+
+    kind, name, payload = tree
+    if kind != "fn" or name.upper() != "MINVERSE" or len(payload) != 1:
+        raise _Unknown()
+    arg = payload[0]
+    if arg[0] != "leaf" or arg[1] != "Range" or "r1" not in arg[2].attr:
+        raise _Unknown()
+    attr = arg[2].attr
+    if attr.get("sheet_id"):
+        raise _Unknown()
+    from openpyxl.utils import column_index_from_string
+
+    r1, r2 = int(attr["r1"]), int(attr["r2"])
+    c1, c2 = (column_index_from_string(str(attr[k])) for k in ("c1", "c2"))
+    n = r2 - r1 + 1
+    if n != c2 - c1 + 1 or n * n > MAX_CELLS:
+        raise _Unknown()
+    key = ("MINVERSE", cell.sheet, *cell.array_master)
+    if key not in seen:
+        values, sizes = np.zeros((n, n)), np.zeros((n, n))
+        for i in range(n):
+            for j in range(n):
+                other = book.cell(cell.sheet, r1 + i, c1 + j)
+                if other is None or not _number(other.value):
+                    raise _Unknown()
+                values[i, j] = float(other.value)
+                sizes[i, j] = scale(book, other, depth + 1, seen)
+        inverse = np.abs(np.linalg.inv(values))
+        seen[key] = inverse @ sizes @ inverse
+    i, j = cell.row - cell.array_master[0], cell.col - cell.array_master[1]
+    if not (0 <= i < n and 0 <= j < n):
+        raise _Unknown()
+    return float(seen[key][i, j])
 
 
 def _cells_of(book, sheet: str, node, depth: int, seen: dict) -> list[tuple[float, float]]:

@@ -6,7 +6,8 @@ where the keys ascend (descend), so those chains are guarded by the keys ascendi
 strictly: elsewhere, and where nothing matches (#N/A), the value is an error. Keys are constant
 cells; texts are compared by Excel's rule (without case) only where x is a text written in the
 formula or a constant text cell (whose case and patterns, ``*`` ``?`` ``~``, are then known);
-an empty key cell never matches. ``INDEX(range, i[, j])`` is the cell at (i, j), a chain over
+an empty key cell never matches, nor does a text key an exact match of a number written in the
+formula or held by a constant cell. ``INDEX(range, i[, j])`` is the cell at (i, j), a chain over
 i and j: an index outside the range is an error (#REF!). ``HLOOKUP`` is VLOOKUP by rows.
 ``OFFSET(cell, MATCH(...) + k, m)`` (or the MATCH in the columns) is the same chain over the
 cells the offset reaches at each position."""
@@ -64,6 +65,9 @@ def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
         value = cell.value
         if isinstance(value, bool):
             raise FormulaProblem("a lookup whose keys hold TRUE/FALSE")
+        if isinstance(value, str) and seen is None and exact and _known_number(ft, x_node):
+            out.append((k, None))  # a text never equals a number: as an empty cell
+            continue
         if isinstance(value, str):
             if not exact or seen is None:
                 raise FormulaProblem(
@@ -82,6 +86,23 @@ def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
         ft.out.refs.append(Ref(ref.sheet, r, c, r, c))
         out.append((k, ft.name_of(ref.sheet, r, c)))
     return out
+
+
+def _known_number(ft, node) -> bool:
+    """x is a number whatever the inputs: written in the formula, or a constant number cell
+    (an input of the translation, which stays a number)."""
+    if written_number(node) is not None:
+        return True
+    if node[0] == "leaf" and node[1] == "Range" and not ft.is_name_formula(node[2]):
+        ref = ft.ref_of(node[2])
+        cell = ft.book.cell(ref.sheet, ref.r1, ref.c1) if ref.single else None
+        return (
+            cell is not None
+            and cell.formula is None
+            and isinstance(cell.value, (int, float))
+            and not isinstance(cell.value, bool)
+        )
+    return False
 
 
 def _known_text(ft, node) -> str | None:
