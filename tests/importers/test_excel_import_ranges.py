@@ -72,6 +72,23 @@ End Function
 Function Doubled(loads As Range) As Double
     Doubled = loads(1, 2) * 2
 End Function
+
+Function Weighted(xs As Range) As Double
+    Dim v() As Variant, i As Long, t As Double
+    If xs.Rows.Count = 1 And xs.Columns.Count = 1 Then
+        ReDim v(1 To 1) As Variant
+        v(1) = xs.Cells(1, 1).Value
+    Else
+        v = Application.Transpose(xs)
+    End If
+    If xs.Columns.Count > xs.Rows.Count Then
+        v = Application.Transpose(Application.Transpose(xs))
+    End If
+    For i = 1 To UBound(v)
+        t = t + i * v(i)
+    Next i
+    Weighted = t
+End Function
 """
 
 LOADS = [(1.5, "D"), (2.0, "L"), (4.0, "d"), (3.0, "=B2")]  # B5 reads B2's text
@@ -122,6 +139,10 @@ def build(folder):
     ws.write_formula("E19", "=Halve(8)", None, 0.5)  # lo is read while Empty: 0
     ws.write_formula("E20", "=Coef(1)", None, 3)  # arrays of two sizes in one local
     ws.write_formula("E21", "=Coef(2)", None, 5)
+    # a column and a row made 1-D arrays by Application.Transpose, and one cell
+    ws.write_formula("E22", "=Weighted(A2:A5)", None, 1.5 + 2 * 2.0 + 3 * 4.0 + 4 * 3.0)
+    ws.write_formula("E23", "=Weighted(A8:C8)", None, 1 + 2 * 2 + 3 * 5)
+    ws.write_formula("E24", "=Weighted(D13)", None, 25)
     wb.close()
     bas = folder / "Loads.bas"
     bas.write_text(MODULE, encoding="utf-8")
@@ -142,11 +163,11 @@ def test_every_cached_number_is_reproduced(imported, capsys):
     # exit 1: Dens(-1) has no value (a division by zero), as E18 holds #VALUE! in Excel
     assert main(["check", str(imported), "--json"]) == 1
     report = json.loads(capsys.readouterr().out)
-    # E2, E3, E5, E6, E11, E13, E14, E17, E19, E20, E21, F8, F9, the two cells of the MMULT,
+    # E2, E3, E5, E6, E11, E13, E14, E17, E19 to E24, F8, F9, the two cells of the MMULT,
     # the four of the MINVERSE and B5's text; E4 and E18 show #VALUE! (not compared)
     assert {k: report[k] for k in ("printed", "reproduced", "failed", "not_computable")} == {
-        "printed": 20,
-        "reproduced": 20,
+        "printed": 23,
+        "reproduced": 23,
         "failed": 0,
         "not_computable": 0,
     }

@@ -11,6 +11,14 @@ from .functions import EXCEL, EXCEL_VARIADIC
 from .vbaexpr import strip
 
 
+def is_transpose(node) -> bool:
+    """``Application.Transpose(...)`` or ``WorksheetFunction.Transpose(...)``."""
+    if node[0] != "call" or strip(node[1])[0] != "mem":
+        return False
+    member = strip(node[1])
+    return member[2].lower() == "transpose" and strip(member[1])[0] in ("id", "mem")
+
+
 class NotTranslated(Exception):
     """A construct this translation does not take (the reason is the message)."""
 
@@ -90,6 +98,8 @@ class Members:
             fn = chain[-1].upper()
             if chain[0].lower() == "math":
                 return self.call(("call", ("id", chain[-1]), args))
+            if fn == "TRANSPOSE":
+                raise NotTranslated("Transpose other than assigned to a variable")
             return self.excel_call(fn, args)
         if obj[0] == "id" and obj[1].lower() in self.arrays:
             arr = self.arrays[obj[1].lower()]
@@ -116,6 +126,26 @@ class Members:
         if obj[0] == "id" and low in {f for f in self.functions}:  # Module.Function(...)
             return self._call_function(low, args)
         raise NotTranslated(f"{'.'.join(chain) or attr}: an object or a property")
+
+    def transpose_into(self, target: str, node, indent: int) -> None:
+        """``target = Application.Transpose(x)`` of a range or an array, as VBA gives it: a
+        1-D array (the language's column, indexed from 1) where the result has one row, so
+        that a column range becomes a 1-D array, a row range a column (2-D) and that column
+        again a 1-D array; a 1-D array, read as a row, becomes a column (2-D). In every case
+        the language's value is x where x has one column, else transpose(x)."""
+        args = node[2]
+        arg = strip(args[0]) if len(args) == 1 and args[0] is not None else None
+        if arg is not None and is_transpose(arg):
+            src = self.temp("t")
+            self.transpose_into(src, arg, indent)
+        elif arg is not None and arg[0] == "id" and arg[1].lower() in self.arrays:
+            src = self.value(arg)
+        else:
+            raise NotTranslated("Transpose of other than a range argument or an array")
+        self.emit(indent, f"if cols({src}) == 1")
+        self.emit(indent + 1, f"{target} := {src}")
+        self.emit(indent, "otherwise")
+        self.emit(indent + 1, f"{target} := transpose({src})")
 
     def excel_call(self, fn: str, args) -> str:
         if fn in EXCEL_VARIADIC:

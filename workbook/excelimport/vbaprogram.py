@@ -16,7 +16,7 @@ from .functions import VBA
 from .vba import Procedure, split_top
 from .vbaerrors import cut_error_handler, raised_errors
 from .vbaexpr import VbaSyntax, parse, strip
-from .vbamembers import Members, NotTranslated
+from .vbamembers import Members, NotTranslated, is_transpose
 
 INTEGER_TYPES = {"integer", "long", "byte", "longlong", "longptr"}
 NUMBER_TYPES = INTEGER_TYPES | {"double", "single", "currency", "decimal"}
@@ -269,6 +269,10 @@ class Translator(Members):
                 raise NotTranslated(f"assigns to the name of another function {target[1]}")
             if key in self.arrays and self.arrays[key].is_range:
                 raise NotTranslated(f"{target[1]} is a range given as an argument: writes cells")
+            if is_transpose(rhs):  # Application.Transpose(...): an array from 1
+                self.transpose_into(self.local(target[1]), rhs, indent)
+                self.arrays[key] = _Array(1, 0)
+                return i + 1
             callee = strip(rhs[1]) if rhs[0] == "call" else None
             if callee is not None and callee[0] == "id" and callee[1].lower() == "cverr":
                 # an error value in a local: VBA stops at its next use (a type mismatch), so
