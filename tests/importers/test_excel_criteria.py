@@ -110,3 +110,19 @@ def test_an_uncertain_criterion_is_listed(imported):
     head = imported.read_text(encoding="utf-8").split("[sheet]")[0].replace("\n# ", " ")
     for formula, reason in UNCERTAIN:
         assert f"{formula}: {reason}" in head
+
+
+def test_countif_not_empty_counts_the_cells_that_hold_something(tmp_path, capsys):
+    path = tmp_path / "filled.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("F")
+    ws.write_column("A1", [0, 0.17, None, "p1", None, 3])  # A3, A5 empty
+    ws.write_number("B1", 2)
+    ws.write_formula("B2", "=B1*2", None, 4)  # a formula that gives a number: not empty
+    ws.write_formula("C1", '=COUNTIF(A1:A6,"<>")', None, 4)
+    ws.write_formula("C2", '=COUNTIF(A1:B2,"<>")', None, 4)
+    ws.write_formula("B3", '=IF(B1>1,"","x")', None, "")
+    ws.write_formula("C3", '=COUNTIF(B1:B3,"<>")', None, 2)  # B3 gives "": listed
+    wb.close()
+    status, counts = check_counts(import_book(path), capsys)
+    assert counts == {"printed": 4, "reproduced": 3, "failed": 0, "not_computable": 1}

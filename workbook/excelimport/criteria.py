@@ -11,7 +11,9 @@ pattern ``* ? ~``). Which cells of a criteria range match is Excel's rule:
   Excel compares as that number) are refused;
 - a text matches a text equal to it without case, found here (the texts never change: constant
   cells, or plain references to them, ``=D63``); a number or an empty cell never equals a text
-  and always differs from it.
+  and always differs from it;
+- ``"<>"`` alone matches every cell that is not empty: a constant, or a formula that gives a
+  number (one that gives a text may give the empty text: refused).
 
 SUMIF adds the matching cells of the sum range that hold numbers (an empty cell, a text or
 TRUE/FALSE adds nothing); a formula cell of the sum range that gives other than a number is
@@ -147,6 +149,8 @@ def _written(upper: str, text: str) -> tuple:
     """The criterion of a text as Excel reads it: an operator, then a number or a text."""
     m = re.fullmatch(r"(<>|<=|>=|=|<|>)?(.*)", text, re.S)
     op, rest = m.group(1) or "", m.group(2)
+    if text == "<>":  # Excel's "not empty"
+        return ("filled", "!=", "")
     if re.fullmatch(r"\s*" + _NUMBER + r"\s*", rest):
         return ("number", _OPS[op], repr(float(rest)))
     if not rest or re.search(r"[*?~]", rest) or rest.strip() != rest:
@@ -181,6 +185,15 @@ def _reads_as_number(text: str) -> bool:
 def _matches(ft, upper: str, sheet: str, row: int, col: int, test: tuple):
     """True or False where the cell's match never changes, else the condition (a text)."""
     what, op, rhs = test
+    if what == "filled":  # "<>": a cell that is not empty
+        cell = ft.book.cell(sheet, row, col)
+        if cell is None or cell.formula is None:
+            return cell is not None and cell.value is not None and cell.value != ""
+        from .kinds import cell_kind_in
+
+        if cell_kind_in(ft, cell, 0) != "number":  # a formula may give the empty text
+            raise FormulaProblem(f'{upper} "<>" over a formula that gives no number')
+        return True
     if what == "text":
         value = ft.constant_behind(sheet, row, col)
         same = isinstance(value, str) and value.casefold() == rhs
