@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 from helpers.excel_import import import_and_check
 
@@ -294,3 +295,43 @@ def test_a_handler_branch_for_an_error_value_no_raise_gives_is_never_taken(raise
     assert (info.problem is not None) == listed
     if listed:
         assert "does more than give an error value" in info.problem
+
+
+@pytest.mark.slow
+def test_an_aggregate_of_if_in_an_array_formula_leaves_out_the_false_elements(tmp_path, capsys):
+    formulas = pytest.importorskip("formulas")
+    path = tmp_path / "select.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("A")
+    values = [3.0, -1.0, 0.5, 7.0, -4.0]
+    ws.write_column("A1", values)
+    ws.write_column("B1", [1, 0, 1, 1, 0])
+    ws.write_number("D1", 10)
+    cases = {
+        "C1": "{=D1-MIN(IF(A1:A5>0,A1:A5))}",
+        "C2": "{=MAX(IF(B1:B5=0,A1:A5))}",
+        "C3": "{=SUM(IF(A1:A5>1,A1:A5))}",
+        "C4": "{=AVERAGE(IF(B1:B5=1,A1:A5))}",
+        "C5": "{=COUNT(IF(A1:A5<0,A1:A5))}",
+        "C6": "{=MIN(IF(A1:A5>100,A1:A5))}",  # none selected: 0
+    }
+    expected = {}
+    for cell, formula in cases.items():
+        fn = formulas.Parser().ast(formula[1:-1])[1].compile()
+        inputs = {
+            "A1:A5": np.array([[v] for v in values]),
+            "B1:B5": np.array([[v] for v in [1, 0, 1, 1, 0]]),
+            "D1": np.array([[10.0]]),
+        }
+        expected[cell] = float(np.asarray(fn(*[inputs[k] for k in fn.inputs])).ravel()[0])
+        ws.write_array_formula(f"{cell}:{cell}", formula, None, expected[cell])
+    wb.close()
+    assert expected == {"C1": 9.5, "C2": -1.0, "C3": 10.0, "C4": 3.5, "C5": 2.0, "C6": 0.0}
+    report, text = import_and_check(path, tmp_path, capsys)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (6, 6, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    first = next(n for n, i in sheet.spec.inputs.items() if i.note.endswith("A1"))
+    names = {d.note.split(": ", 1)[0].split("!")[-1]: n for n, d in sheet.spec.definitions.items()}
+    assert sheet.with_inputs(**{first: 0.25}).evaluate(names["C1"]).magnitude == 9.75

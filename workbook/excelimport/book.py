@@ -118,6 +118,7 @@ def translate_book(path: Path, vba_files: list[Path]) -> Translation:
                     book.names,
                     _block(cell),
                     seen={cell_kind(cell)},
+                    in_array=cell.in_array,
                 ).translate(parsed[_key(cell)].tree)
             except FormulaProblem:
                 pass
@@ -703,6 +704,7 @@ def _translate_cells(tr: Translation, cells: list[Cell], parsed) -> None:
                 moving=run.moving if run is not None else None,
                 seen={cell_kind(book.cell(*k)) for k in (run.keys() if run else [key])},
                 rows=run.count if run is not None else 1,
+                in_array=cell.in_array,
             )
             d.text = ft.translate(parsed[key].tree).text
             if parsed[key].linked:

@@ -104,8 +104,10 @@ class FormulaTranslator:
         moving: dict | None = None,
         seen: set | None = None,
         rows: int = 1,
+        in_array: bool = False,
     ) -> None:
         self.book = book
+        self.in_array = in_array or block is not None  # Excel computes it as an array formula
         # the kinds ("number", "text", ...) of Excel's cached values of the cells this formula
         # computes (each row of a filled-down column), and the rows it is filled down over
         self.seen = seen
@@ -116,6 +118,9 @@ class FormulaTranslator:
         self.moving = moving or {}
         self.depth = 0  # defined names whose formula is being translated, one in another
         self.block = block  # (rows, columns) of the cells of a multi-cell array formula
+        # ((rows, columns), k) while one element of an array formula's ranges is translated:
+        # every range of that shape reads its k-th cell (aggregates.py, IF inside MIN)
+        self.element: tuple[tuple[int, int], int] | None = None
         # {matrix literal: name}: a range that formulas read is one definition, named here
         self.ranges = ranges
         self.sheet = sheet
@@ -233,6 +238,13 @@ class FormulaTranslator:
         if self.is_name_formula(token):
             return self.name_formula(token)
         ref = self.ref_of(token)
+        if self.element is not None and not ref.single:
+            shape, k = self.element
+            if (ref.r2 - ref.r1 + 1, ref.c2 - ref.c1 + 1) != shape:
+                raise FormulaProblem("an array formula over ranges of different sizes")
+            r, c = ref.r1 + k // shape[1], ref.c1 + k % shape[1]
+            self.out.refs.append(Ref(ref.sheet, r, c, r, c))
+            return self.name_of(ref.sheet, r, c)
         self.out.refs.append(ref)
         if ref.single:
             return self.single(ref, token)

@@ -26,6 +26,7 @@ class Cell:
     number_format: str = "General"
     array: str | None = None  # "B10:E10" for every cell of a multi-cell array formula
     array_master: tuple[int, int] | None = None
+    in_array: bool = False  # a cell of an array formula, of one cell or more
 
     @property
     def address(self) -> str:
@@ -141,9 +142,11 @@ def _read_xlsx(book: Book, path: Path) -> Book:
                     raise LimitError(f"{path} has more than {MAX_CELLS:,} cells")
                 formula = None
                 v = c.value
+                in_array = False
                 if hasattr(v, "text") and hasattr(v, "ref"):  # an ArrayFormula
                     formula = str(v.text or "").lstrip("=")
                     ref = str(v.ref)
+                    in_array = True
                     if ":" in ref:
                         for cells_row in ws[ref]:
                             for part in cells_row:
@@ -152,14 +155,20 @@ def _read_xlsx(book: Book, path: Path) -> Book:
                     formula = v[1:]
                 value = values.cell(c.row, c.column).value if formula is not None else v
                 cells[(c.row, c.column)] = Cell(
-                    ws.title, c.row, c.column, formula, value, c.number_format or "General"
+                    ws.title,
+                    c.row,
+                    c.column,
+                    formula,
+                    value,
+                    c.number_format or "General",
+                    in_array=in_array,
                 )
         for (r, col), (ref, master) in arrays.items():
             cell = cells.get((r, col))
             value = values.cell(r, col).value
             if cell is None:
                 cell = cells[(r, col)] = Cell(ws.title, r, col, None, value)
-            cell.array, cell.array_master = ref, master
+            cell.array, cell.array_master, cell.in_array = ref, master, True
             if (r, col) != master:
                 cell.formula = cells[master].formula
                 cell.value = value
