@@ -270,3 +270,71 @@ def test_a_date_or_a_text_with_a_quote_is_listed_never_a_stand_in(tmp_path, caps
     # B3 reproduced; B1 and B2, not translated, are counted as not computable with the reason
     assert (report["printed"], report["reproduced"], report["failed"]) == (3, 1, 0)
     assert report["not_computable"] == 2
+
+
+BOUNDS = """Attribute VB_Name = "Bounds"
+Function First(v() As Variant) As Double
+    First = v(1)
+End Function
+
+Function Second(v) As Double
+    Second = v(2)
+End Function
+
+Function Mixed(v() As Variant) As Double
+    Mixed = v(1)
+End Function
+
+Function FromOne(x As Double) As Double
+    Dim a(1 To 3) As Variant
+    a(1) = x
+    a(2) = 2 * x
+    a(3) = 3 * x
+    FromOne = First(a) + 10 * Second(a) + 100 * Mixed(a)
+End Function
+
+Function FromZero(x As Double) As Double
+    Dim b(2) As Variant
+    b(0) = x
+    b(1) = 2 * x
+    b(2) = 3 * x
+    FromZero = Mixed(b)
+End Function
+
+Function OnlyOne(x As Double) As Double
+    Dim c(1 To 2) As Variant
+    c(1) = x
+    c(2) = 5 * x
+    OnlyOne = First(c) + Second(c)
+End Function
+"""
+
+
+def test_an_array_parameter_takes_the_lower_bound_its_callers_give(tmp_path, capsys):
+    """VBA indexes an array argument by the bounds the caller gave it: v(1) of an array
+    dimensioned (1 To 3) is its first element, of one dimensioned (2) its second. A
+    parameter given arrays of one lower bound is indexed from it; one given arrays of
+    different lower bounds (Mixed) is listed, never indexed from a guessed bound."""
+    path = tmp_path / "bounds.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("B")
+    ws.write_number("A1", 1.5)
+    ws.write_formula("B1", "=OnlyOne(A1)", None, 1.5 + 7.5)  # c(1) + c(2)
+    ws.write_formula("B2", "=FromOne(A1)", None, 1.5 + 10 * 3.0 + 100 * 1.5)
+    ws.write_formula("B3", "=FromZero(A1)", None, 3.0)  # b(1) of b(0 To 2)
+    wb.close()
+    bas = tmp_path / "Bounds.bas"
+    bas.write_text(BOUNDS, encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    text = (out / "bounds.toml").read_text(encoding="utf-8")
+    assert "the array parameter v is given arrays of different" in text.replace("\n# ", " ")
+    capsys.readouterr()
+    main(["check", str(out / "bounds.toml"), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    # B1 reproduced; B2 and B3 call Mixed, not translated
+    assert {k: report[k] for k in ("printed", "reproduced", "failed")} == {
+        "printed": 3,
+        "reproduced": 1,
+        "failed": 0,
+    }

@@ -599,12 +599,23 @@ def _name_params(tr: Translation, reserved: set[str]) -> None:
                 info.given[final] = flag
 
 
+#: rounds of translating the VBA functions at most (each knows the array bounds of the last)
+MAX_ROUNDS = 5
+
+
 def _translate_functions(tr: Translation, reserved: set[str]) -> None:
     sheet_names = {n.lower() for n in tr.cell_names.values()}
     all_params = {
         p.lower() for i in tr.functions.values() for p in list(i.params) + list(i.given.values())
     }
-    for _round in range(2):  # the second knows the lower bound of the arrays callees give
+    # the second round knows the lower bound of the arrays callees give, and of the arrays
+    # callers give each array parameter; more rounds until those bounds settle
+    for _round in range(MAX_ROUNDS):
+        settled = _round > 0 and all(i.arg_bases == i.used_bases for i in tr.functions.values())
+        if settled and _round >= 2:
+            break
+        for info in tr.functions.values():
+            info.used_bases, info.arg_bases = info.arg_bases, {}
         for info in tr.functions.values():
             own = {p.lower() for p in list(info.params) + list(info.given.values())}
             block = (
@@ -630,6 +641,9 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
                 info.problem = str(exc)
             except Exception as exc:  # noqa: BLE001 - a construct the reader did not foresee
                 info.problem = f"not translated ({type(exc).__name__}: {exc})"
+    for info in tr.functions.values():
+        if info.arg_bases != info.used_bases and not info.problem:
+            info.problem = "the lower bounds of the arrays its callers give do not settle"
     changed = True
     while changed:  # a function that calls one not translated is not translated either
         changed = False

@@ -43,6 +43,11 @@ class FunctionInfo:
     volatile: bool = False
     calls: set[str] = field(default_factory=set)  # lower-case VBA names it calls
     result_base: int = 0  # the lower bound of the array it gives
+    # {parameter index: lower bounds of the arrays VBA callers give it (None: not an array
+    # this translation knows)}, collected while the callers are translated, and the ones the
+    # function's own translation read (from the round before)
+    arg_bases: dict[int, set] = field(default_factory=dict)
+    used_bases: dict[int, set] = field(default_factory=dict)
     dropped: set[str] = field(default_factory=set)  # statements without effect on the value
 
     @property
@@ -80,13 +85,25 @@ class Translator(Members):
         self.option_base = 0
         self.declared_numbers: list[str] = []
         self.prefix: list[tuple[int, str]] = []  # module-level Const lines it uses
+        self.param_problem: str | None = None
         for i, p in enumerate(self.proc.params):
             self.names[p.name.lower()] = info.params[i]
             self.types[p.name.lower()] = p.type.lower()
-            if p.type.lower() == "range" or p.array:
-                self.arrays[p.name.lower()] = _Array(
-                    1 if p.type.lower() == "range" else 0, 0, p.type.lower() == "range"
-                )
+            bases = info.used_bases.get(i, set())
+            if p.type.lower() == "range":
+                self.arrays[p.name.lower()] = _Array(1, 0, True)
+            elif p.array:
+                # the lower bound of the arrays its callers give (0 where no VBA caller does)
+                known = {b for b in bases if b is not None}
+                if None in bases or len(known) > 1:
+                    self.param_problem = (
+                        f"the array parameter {p.name} is given arrays of different or "
+                        "unknown lower bounds"
+                    )
+                self.arrays[p.name.lower()] = _Array(min(known) if known else 0, 0)
+            elif p.type.lower() == "variant" and len(bases) == 1 and None not in bases:
+                # a Variant every VBA caller gives an array of one lower bound
+                self.arrays[p.name.lower()] = _Array(next(iter(bases)), 0)
         self.ret = self.local(self.proc.name + "_value", fresh=True)
         self.record_types = getattr(info, "record_types", {})
         self.records_of: dict[str, list] = {}  # local (lower case) -> its Type's fields
@@ -113,6 +130,8 @@ class Translator(Members):
 
     # -- statements --------------------------------------------------------------------
     def translate(self) -> str:
+        if self.param_problem:
+            raise NotTranslated(self.param_problem)
         raised = raised_errors(f.proc for f in self.functions.values())
         body = list(self.prefix) + cut_error_handler(self.proc.name, list(self.proc.lines), raised)
         self.body = body
@@ -942,6 +961,11 @@ class Translator(Members):
                 texts.append(default_text(p))
             else:
                 texts.append(self.value(a))
+                if p.array or p.type.lower() == "variant":
+                    node = strip(a)
+                    arr = self.arrays.get(node[1].lower()) if node[0] == "id" else None
+                    base = None if arr is None or arr.is_range else arr.base
+                    info.arg_bases.setdefault(k, set()).add(base)
             if info.params[k] in info.given:
                 flags.append("1" if given else "0")
         if not texts + flags:  # a function without arguments is a definition
