@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 xlsxwriter = pytest.importorskip("xlsxwriter")
 
@@ -338,3 +340,47 @@ def test_an_array_parameter_takes_the_lower_bound_its_callers_give(tmp_path, cap
         "reproduced": 1,
         "failed": 0,
     }
+
+
+@pytest.mark.slow
+@settings(
+    max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    base=st.integers(-2, 3),
+    size=st.integers(1, 4),
+    data=st.data(),
+)
+def test_array_bounds_across_calls_are_vbas(tmp_path_factory, base, size, data):
+    """Random lower bounds and indices of an array one VBA function dimensions and another
+    reads: the value is VBA's (element i of an array dimensioned base To base + size - 1)."""
+    pick = data.draw(st.integers(base, base + size - 1))
+    module = (
+        'Attribute VB_Name = "Pick"\n'
+        "Function Element(v() As Variant, i As Long) As Double\n"
+        "    Element = v(i)\nEnd Function\n\n"
+        "Function Make(x As Double, i As Long) As Double\n"
+        f"    Dim a({base} To {base + size - 1}) As Variant, k As Long\n"
+        f"    For k = {base} To {base + size - 1}\n"
+        f"        a(k) = x * (k - ({base}) + 1)\n"
+        "    Next k\n"
+        "    Make = Element(a, i) + 1000 * LBound(a)\nEnd Function\n"
+    )
+    expected = 2.5 * (pick - base + 1) + 1000 * base
+    folder = tmp_path_factory.mktemp("bounds")
+    path = folder / "pick.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("P")
+    ws.write_number("A1", 2.5)
+    ws.write_number("A2", pick)
+    ws.write_formula("B1", "=Make(A1,A2)", None, expected)
+    wb.close()
+    bas = folder / "Pick.bas"
+    bas.write_text(module, encoding="utf-8")
+    out = folder / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    import workbook
+
+    sheet = workbook.load(str(out / "pick.toml"))
+    name = next(n for n, d in sheet.spec.definitions.items() if "=Make" in d.note)
+    assert sheet.evaluate(name).magnitude == pytest.approx(expected, rel=1e-12)
