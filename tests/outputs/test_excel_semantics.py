@@ -175,6 +175,7 @@ def test_a_cached_text_that_reads_as_a_formula_is_escaped(tmp_path, capsys):
     ws.write("A1", 2)
     ws.write_formula("B1", '=IF(A1>1,"=cmd| /C calc!A0","y")', None, "=cmd| /C calc!A0")
     ws.write_formula("B4", '=IF(A1>1,"x","y")', None, "'=x")  # an apostrophe: not compared
+    ws.write_formula("B5", "=A1*4", None, "=A1*4")  # its own formula: saved uncomputed
     ws.write_formula("B2", "=A1*3", None, 6)
     ws.write_formula("B3", '=CONVERT(A1,"m","ft")', None, "+cmd|' /C calc'!A0")
     wb.close()
@@ -187,8 +188,9 @@ def test_a_cached_text_that_reads_as_a_formula_is_escaped(tmp_path, capsys):
     code, report = _check(tmp_path / "o" / "evil.toml", capsys)
     # B1 (its text escaped in the CSV, read back without the escape) and B2 reproduced; B3
     # failed (the formula gives a number, its cached value is a text); B4 (a text the escape
-    # would not give back) not computable
-    assert (report["printed"], report["reproduced"], report["failed"]) == (4, 2, 1)
+    # would not give back) and B5 (its cached value is its own formula) not computable
+    assert (report["printed"], report["reproduced"], report["failed"]) == (5, 2, 1)
+    assert any("own formula" in f["name"] for f in report["failures"])
     assert code == 1
     assert any("apostrophe" in f["name"] for f in report["failures"])
 

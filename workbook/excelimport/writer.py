@@ -79,6 +79,17 @@ def uncompared(text: str) -> str | None:
     return "a text that reads as a number: not compared"
 
 
+def _own_formula(tr: Translation, ref: str, text: str) -> bool:
+    """Whether the cached text of the formula cell ``ref`` is its own formula (``=A1*2``): a
+    workbook saved before Excel computed the cell, whose value is no result to compare."""
+    from openpyxl.utils.cell import column_index_from_string, coordinate_from_string
+
+    sheet, _, address = ref.rpartition("!")
+    letters, row = coordinate_from_string(address)
+    cell = tr.book.cell(sheet, row, column_index_from_string(letters))
+    return cell is not None and cell.formula is not None and text.strip() == "=" + cell.formula
+
+
 def _cached(value) -> tuple[str, str] | None:
     """(kind, CSV text) of a cached value: a number, a text, an error; None if empty.
     TRUE and FALSE are the numbers 1 and 0, as a comparison gives them."""
@@ -305,6 +316,12 @@ def _printed_files(tr: Translation, name: str, skip: dict, rows, at_rows, run_ro
                 continue
             if kind == "text" and uncompared(text):
                 reasons[ref] = uncompared(text)
+                continue
+            if kind == "text" and _own_formula(tr, ref, text):
+                reasons[ref] = (
+                    "Excel's cached value is the cell's own formula as a text (not computed): "
+                    "not compared"
+                )
                 continue
             out.write(f"# {csv_text(ref)}\n")
             w.writerow([n, at, csv_text(text) if kind == "text" else text, ""])
