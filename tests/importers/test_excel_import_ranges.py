@@ -5,6 +5,7 @@ criterion, MMULT in an array formula, and cells that read one cell of an array f
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -384,3 +385,29 @@ def test_array_bounds_across_calls_are_vbas(tmp_path_factory, base, size, data):
     sheet = workbook.load(str(out / "pick.toml"))
     name = next(n for n, d in sheet.spec.definitions.items() if "=Make" in d.note)
     assert sheet.evaluate(name).magnitude == pytest.approx(expected, rel=1e-12)
+
+
+def test_a_vba_local_named_as_a_filled_down_column_is_renamed(tmp_path, capsys):
+    """A filled-down column named x (its header) and a VBA local x: the local is another
+    name of the program, so both are computed."""
+    path = tmp_path / "column.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("C")
+    ws.write_string("A1", "x")
+    for r in range(1, 4):
+        ws.write_formula(r, 0, f"=B{r + 1}*2", None, 2.0 * r)
+        ws.write_number(r, 1, r)
+    ws.write_formula("C2", "=Shape(B2,B3)", None, 2.0 + math.log(0.5))
+    wb.close()
+    bas = tmp_path / "Shape.bas"
+    bas.write_text(
+        'Attribute VB_Name = "S"\nPublic Function Shape(ByVal w, ByVal l)\n'
+        "x = Log(w / l)\nShape = x + 2\nEnd Function\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    capsys.readouterr()
+    main(["check", str(out / "column.toml"), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert (report["printed"], report["reproduced"]) == (4, 4)

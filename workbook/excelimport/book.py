@@ -604,7 +604,10 @@ MAX_ROUNDS = 5
 
 
 def _translate_functions(tr: Translation, reserved: set[str]) -> None:
-    sheet_names = {n.lower() for n in tr.cell_names.values()}
+    # the sheet's names: cells, filled-down columns (``x(0)`` is the column x) and the
+    # vectors of their constant columns
+    sheet_names = {n.split("(")[0].lower() for n in tr.cell_names.values()}
+    sheet_names |= {v.lower() for v in tr.vectors}
     all_params = {
         p.lower() for i in tr.functions.values() for p in list(i.params) + list(i.given.values())
     }
