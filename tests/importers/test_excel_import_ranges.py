@@ -411,3 +411,65 @@ def test_a_vba_local_named_as_a_filled_down_column_is_renamed(tmp_path, capsys):
     main(["check", str(out / "column.toml"), "--json"])
     report = json.loads(capsys.readouterr().out)
     assert (report["printed"], report["reproduced"]) == (4, 4)
+
+
+@pytest.mark.slow
+@settings(
+    max_examples=16, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    how=st.sampled_from(["ByVal ", "ByRef ", ""]),
+    changes=st.booleans(),
+    through=st.booleans(),
+    passes=st.sampled_from(["y", "y + 0", "w(1)"]),
+)
+def test_arguments_passed_by_reference_are_never_a_wrong_number(
+    tmp_path_factory, how, changes, through, passes
+):
+    """VBA passes a variable by reference unless the parameter is ByVal: a callee that
+    changes its parameter (itself, or through another function it passes it on to) changes
+    the caller's variable. Random such programs: the cell is VBA's value or not computable,
+    never another number."""
+    change = "    v = v * 3\n" if changes else ""
+    inner = f"Function Inner({how}v As Double) As Double\n{change}    Inner = v + 1\nEnd Function\n"
+    outer = (
+        f"Function Outer({how}v As Double) As Double\n    Outer = Inner(v)\nEnd Function\n"
+        if through
+        else ""
+    )
+    called = "Outer" if through else "Inner"
+    module = (
+        'Attribute VB_Name = "R"\n' + inner + outer + "Function Caller(x As Double) As Double\n"
+        "    Dim y As Double, z As Double, w(1 To 2) As Double\n"
+        "    y = x\n    w(1) = x\n"
+        f"    z = {called}({passes})\n"
+        "    Caller = y + 10 * w(1) + 100 * z\nEnd Function\n"
+    )
+    x = 1.5
+    by_ref = how != "ByVal " and passes != "y + 0"
+    after = x * 3 if changes else x  # the callee's v after its change
+    seen = after if by_ref else x  # what the caller's variable holds after the call
+    y = seen if passes == "y" else x
+    w1 = seen if passes == "w(1)" else x
+    expected = y + 10 * w1 + 100 * (after + 1)
+    folder = tmp_path_factory.mktemp("byref")
+    path = folder / "r.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("R")
+    ws.write_number("A1", x)
+    ws.write_formula("B1", "=Caller(A1)", None, expected)
+    wb.close()
+    bas = folder / "R.bas"
+    bas.write_text(module, encoding="utf-8")
+    out = folder / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    import contextlib
+    import io
+
+    with contextlib.redirect_stdout(io.StringIO()) as text:
+        main(["check", str(out / "r.toml"), "--json"])
+    report = json.loads(text.getvalue())
+    assert report["failed"] == 0, (module, report["failures"])
+    assert report["reproduced"] + report["not_computable"] == 1
+    if not (changes and by_ref):  # nothing changes the caller's variable: translated
+        assert report["reproduced"] == 1, module

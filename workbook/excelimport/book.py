@@ -13,7 +13,7 @@ from .kinds import cell_kind
 from .reader import Book, Cell, read_book
 from .runs import ROW, Run, find_runs
 from .subwrites import cells_written
-from .vba import Module, is_event, read_modules
+from .vba import Module, changed_by_reference, is_event, read_modules
 from .vbamembers import NotTranslated, record_types
 from .vbaprogram import KEYWORDS, FunctionInfo, Translator
 
@@ -613,6 +613,7 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
     }
     # the second round knows the lower bound of the arrays callees give, and of the arrays
     # callers give each array parameter; more rounds until those bounds settle
+    changed = changed_by_reference([i.proc for i in tr.functions.values()])
     for _round in range(MAX_ROUNDS):
         settled = _round > 0 and all(i.arg_bases == i.used_bases for i in tr.functions.values())
         if settled and _round >= 2:
@@ -628,6 +629,7 @@ def _translate_functions(tr: Translation, reserved: set[str]) -> None:
                 | {i.final.lower() for i in tr.functions.values()}
             )
             t = Translator(info, tr.functions, block)
+            t.changed_params = changed
             t.option_base = info.option_base  # type: ignore[attr-defined]
             body = "\n".join(x for _, x in info.proc.lines)
             info.problem, info.calls, info.dropped = None, set(), set()

@@ -35,6 +35,7 @@ class Param:
     default: str | None = None
     array: bool = False  # declared name() (an array)
     rest: bool = False  # ParamArray: the arguments from here on, as one array from 0
+    byval: bool = False  # declared ByVal (VBA passes every other argument by reference)
 
 
 @dataclass
@@ -146,11 +147,13 @@ def parse_params(text: str) -> list[Param]:
         part = part.strip()
         if not part:
             continue
-        optional = is_rest = False
+        optional = is_rest = byval = False
         words = part.split()
         while words and words[0].lower() in ("optional", "byval", "byref", "paramarray"):
             if words[0].lower() == "optional":
                 optional = True
+            if words[0].lower() == "byval":
+                byval = True
             if words[0].lower() == "paramarray":
                 optional = is_rest = True
             words.pop(0)
@@ -162,7 +165,15 @@ def parse_params(text: str) -> list[Param]:
         if not m:
             continue
         out.append(
-            Param(m.group(1), m.group(3) or "Variant", optional, default, bool(m.group(2)), is_rest)
+            Param(
+                m.group(1),
+                m.group(3) or "Variant",
+                optional,
+                default,
+                bool(m.group(2)),
+                is_rest,
+                byval,
+            )
         )
     return out
 
@@ -242,3 +253,62 @@ def _split_colons(line: str) -> list[str]:
 
 def is_event(proc: Procedure) -> bool:
     return bool(_EVENT.search(proc.name))
+
+
+def _assigns(text: str, name: str) -> bool:
+    """Whether a logical line gives the variable ``name`` (or an element of it) a value: an
+    assignment at the start of a statement, a For loop over it, a ReDim of it."""
+    n = re.escape(name)
+    start = r"(?:^|:|\bThen\b|\bElse\b)\s*(?:(?:Let|Set)\s+)?"
+    return bool(
+        re.search(start + n + r"\s*(?:\([^=]*\))?\s*=(?!=)", text, re.I)
+        or re.search(r"\bFor\s+(?:Each\s+)?" + n + r"\b", text, re.I)
+        or re.search(r"\bReDim\s+(?:Preserve\s+)?" + n + r"\b", text, re.I)
+    )
+
+
+def _call_arguments(text: str, callee: str) -> list[list[str]]:
+    """The argument texts of every call ``callee(...)`` in a line (split at top-level commas)."""
+    out = []
+    for m in re.finditer(r"\b" + re.escape(callee) + r"\s*\(", text, re.I):
+        depth, i = 1, m.end()
+        while i < len(text) and depth:
+            depth += {"(": 1, ")": -1}.get(text[i], 0)
+            i += 1
+        out.append([a.strip() for a in split_top(text[m.end() : i - 1], ",")])
+    return out
+
+
+def changed_by_reference(procedures: list[Procedure]) -> dict[str, set[int]]:
+    """{lower-case procedure name: the positions of its parameters passed by reference (not
+    ByVal) that it changes}: assigned in its body, or passed on as a variable to such a
+    parameter of another procedure. VBA's caller sees those changes in its own variable."""
+    out = {
+        p.name.lower(): {
+            k
+            for k, q in enumerate(p.params)
+            if not q.byval and any(_assigns(t, q.name) for _, t in p.lines)
+        }
+        for p in procedures
+    }
+    by_name = {p.name.lower(): p for p in procedures}
+    changed = True
+    while changed:
+        changed = False
+        for p in procedures:
+            mine = out[p.name.lower()]
+            for k, q in enumerate(p.params):
+                if k in mine or q.byval:
+                    continue
+                for callee, positions in out.items():
+                    if not positions or callee == p.name.lower():
+                        continue
+                    for _, text in p.lines:
+                        for args in _call_arguments(text, by_name[callee].name):
+                            if any(
+                                j < len(args) and args[j].lower() == q.name.lower()
+                                for j in positions
+                            ):
+                                mine.add(k)
+                                changed = True
+    return out

@@ -86,6 +86,8 @@ class Translator(Members):
         self.declared_numbers: list[str] = []
         self.prefix: list[tuple[int, str]] = []  # module-level Const lines it uses
         self.param_problem: str | None = None
+        # {function: positions of its by-reference parameters it changes} (vba.py)
+        self.changed_params: dict[str, set[int]] = {}
         for i, p in enumerate(self.proc.params):
             self.names[p.name.lower()] = info.params[i]
             self.types[p.name.lower()] = p.type.lower()
@@ -955,6 +957,15 @@ class Translator(Members):
             if a is not None and a[0] == "named":
                 raise NotTranslated("named arguments")
             given = a is not None
+            if given and k in self.changed_params.get(key, ()):
+                node = strip(a)
+                element = node[0] == "call" and strip(node[1])[0] == "id"
+                if node[0] == "id" or (element and strip(node[1])[1].lower() in self.arrays):
+                    raise NotTranslated(
+                        f"passes a variable to {info.proc.name}, which changes its parameter "
+                        f"{p.name} (by reference): the caller's variable changes, which is not "
+                        "translated"
+                    )
             if not given:
                 if not p.optional:
                     raise NotTranslated(f"{info.proc.name} called without {p.name}")
