@@ -2,8 +2,8 @@
 lsp``.
 
 Exit status: 0 success, 1 printed values not reproduced (check), 2 bad input
-(template, units, values, paths), 3 internal error (a bug), 130 interrupted. No traceback
-unless --debug.
+(template, units, values, paths), 3 internal error (a bug), 130 interrupted, 141 the reader
+of the output closed it (``| head``). No traceback unless --debug.
 """
 
 from __future__ import annotations
@@ -665,6 +665,12 @@ def run_command(handler, args) -> int:
         else:
             print("workbook: interrupted; no output file was changed", file=sys.stderr)
         return 143 if isinstance(exc, Terminated) else 130
+    except BrokenPipeError:  # the reader of the output went away (``workbook check | head``)
+        # as the Python documentation says: stdout to devnull, so that the flush at exit
+        # does not fail again; 141 is a shell's status of a command ended by SIGPIPE
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 141
     except Exception as exc:  # a bug of the engine or of a solver block, not of the worksheet
         if args.debug:
             raise

@@ -1157,3 +1157,22 @@ def test_a_report_names_a_huge_array_instead_of_showing_it(tmp_path):
     assert "not shown" in mm.matrix_box(nested, "").xml
     small = mm.matrix_box(np.arange(6.0).reshape(3, 2), "m").xml
     assert small.count("<mtd>") == 6 and "not shown" not in small
+
+
+def test_a_reader_that_closes_the_output_ends_the_command_quietly():
+    """``workbook list | head -1``: the pipe closed early is no internal error (141, as a
+    shell's status of a command ended by SIGPIPE), and nothing is printed about it."""
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from workbook.cli import main; sys.exit(main(['list']))",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)),
+    )
+    proc.stdout.close()  # before the command writes: every write then fails
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 141, err
+    assert b"internal error" not in err and b"Traceback" not in err
