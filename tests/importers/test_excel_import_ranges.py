@@ -473,3 +473,5 @@ def test_arguments_passed_by_reference_are_never_a_wrong_number(
     assert report["reproduced"] + report["not_computable"] == 1
     if not (changes and by_ref):  # nothing changes the caller's variable: translated
         assert report["reproduced"] == 1, module
+    if passes == "y":  # z = Inner(y): y takes Inner's v after the call (Outer's, Inner's)
+        assert report["reproduced"] == 1, module

@@ -52,7 +52,8 @@ def test_a_remembered_error_is_raised_as_it_was_made(monkeypatch, sheet_from):
     err, _ = _typings(monkeypatch, sheet_from, text + '"f(P)" = "P[0]*nosuch"\n')
     assert err.message == (
         "no formula calls f() with a vector or matrix; with numbers: P is not a vector or "
-        "matrix; it cannot be indexed; with arrays: unknown name 'nosuch' (did you mean cosh?)"
+        "matrix; it cannot be indexed; with arrays: unknown name 'nosuch' (did you mean sech, "
+        "csch, cosh?)"
     )
 
 

@@ -5,6 +5,8 @@ in the formula counts as it is."""
 
 from __future__ import annotations
 
+from .formula_terms import FormulaProblem, holds_number
+
 #: Excel function -> (the language's form of the list ``{0}``, its value when the list is empty
 #: (None: Excel's #DIV/0!), the fewest values it takes (fewer: #DIV/0!))
 AGGREGATES: dict[str, tuple[str, str | None, int]] = {
@@ -86,15 +88,13 @@ def _selected(ft, upper: str, node) -> str | None:
     shape = _range_shape(ft, values)
     if shape is None or shape == (1, 1):
         return None
-    from .cells import _holds_number
-    from .formula_terms import FormulaProblem
 
     names = ft.cells_of(values)
     ref = ft.ref_of(values[2])
     for r in range(ref.r1, ref.r2 + 1):
         for c in range(ref.c1, ref.c2 + 1):
             cell = ft.book.cell(ref.sheet, r, c)
-            if not _holds_number(cell) or isinstance(cell.value, str):
+            if not holds_number(cell) or isinstance(cell.value, str):
                 raise FormulaProblem(f"{upper}(IF(...)) over a range of other than numbers")
     conditions = []
     for k in range(len(names)):

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from .aggregates import AGGREGATES, aggregate
 from .criteria import FUNCTIONS as CRITERIA
 from .criteria import criteria_function
-from .formula_terms import FormulaProblem, Ref, row_relative, text_problem
+from .formula_terms import FormulaProblem, Ref, holds_number, row_relative, text_problem
 from .functions import EXCEL, VOLATILE
 from .information import INFORMATION, information
 from .joins import TEXT_PARTS, text_part
@@ -322,7 +322,7 @@ class FormulaTranslator:
             names = []
             for r in range(ref.r1, ref.r2 + 1):
                 for c in range(ref.c1, ref.c2 + 1):
-                    if numbers_only and not _holds_number(self.book.cell(ref.sheet, r, c)):
+                    if numbers_only and not holds_number(self.book.cell(ref.sheet, r, c)):
                         continue
                     names.append(self.name_of(ref.sheet, r, c))
             return names
@@ -790,16 +790,6 @@ class FormulaTranslator:
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
-
-
-def _holds_number(cell) -> bool:
-    """Whether Excel counts the cell in SUM, AVERAGE, MIN, MAX, COUNT over a reference: a
-    number, or an error value (which the function then gives); not empty, text, TRUE/FALSE."""
-    if cell is None or cell.value is None or isinstance(cell.value, bool):
-        return False
-    if isinstance(cell.value, str):
-        return cell.formula is not None and cell.value.startswith("#")
-    return isinstance(cell.value, (int, float))
 
 
 def _br(text: str, level: int, ctx: int) -> str:

@@ -52,3 +52,13 @@ def written_number(node) -> float | None:
         inner = written_number(node[2][0])
         return None if inner is None else -inner
     return None
+
+
+def holds_number(cell) -> bool:
+    """Whether Excel counts the cell in SUM, AVERAGE, MIN, MAX, COUNT over a reference: a
+    number, or an error value (which the function then gives); not empty, text, TRUE/FALSE."""
+    if cell is None or cell.value is None or isinstance(cell.value, bool):
+        return False
+    if isinstance(cell.value, str):
+        return cell.formula is not None and cell.value.startswith("#")
+    return isinstance(cell.value, (int, float))

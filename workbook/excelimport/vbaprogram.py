@@ -43,6 +43,7 @@ class FunctionInfo:
     volatile: bool = False
     calls: set[str] = field(default_factory=set)  # lower-case VBA names it calls
     result_base: int = 0  # the lower bound of the array it gives
+    refs: list[int] = field(default_factory=list)  # parameters its callers read back (refs_name)
     # {parameter index: lower bounds of the arrays VBA callers give it (None: not an array
     # this translation knows)}, collected while the callers are translated, and the ones the
     # function's own translation read (from the round before)
@@ -84,6 +85,8 @@ class Translator(Members):
         self.counter = 0
         self.option_base = 0
         self.declared_numbers: list[str] = []
+        self.written: set[str] = set()  # the locals the lines so far give a value
+        self.read_empty: list[str] = []  # undeclared locals read before any value: Empty, 0
         self.prefix: list[tuple[int, str]] = []  # module-level Const lines it uses
         self.param_problem: str | None = None
         # {function: positions of its by-reference parameters it changes} (vba.py)
@@ -168,6 +171,7 @@ class Translator(Members):
         self.block(body, 0, 0, ())
         # VBA gives every declared number 0 when the function starts (Dim does not run)
         inits = [f"{self.names[k]} := 0" for k in self.declared_numbers if k in self.names]
+        inits += [f"{n} := 0" for n in dict.fromkeys(self.read_empty) if f"{n} := 0" not in inits]
         self.lines[start:start] = inits
         if self.error_flag is not None:
             inits.append(f"{self.error_flag} := 0")
@@ -179,6 +183,9 @@ class Translator(Members):
 
     def emit(self, indent: int, text: str) -> None:
         self.lines.append("    " * indent + text)
+        m = re.match(r"(\w+)\s*(?:\[[^\]]*\])?\s*:=", text)
+        if m:
+            self.written.add(m.group(1))
 
     def block(self, lines, i: int, indent: int, stop: tuple[str, ...]) -> int:
         """Translate statements from lines[i] until one that starts with a word of ``stop``
@@ -290,6 +297,8 @@ class Translator(Members):
                 raise NotTranslated(f"assigns to the name of another function {target[1]}")
             if key in self.arrays and self.arrays[key].is_range:
                 raise NotTranslated(f"{target[1]} is a range given as an argument: writes cells")
+            if self._assign_by_reference(target, rhs, indent):
+                return i + 1
             if is_transpose(rhs):  # Application.Transpose(...): an array from 1
                 self.transpose_into(self.local(target[1]), rhs, indent)
                 self.arrays[key] = _Array(1, 0)
@@ -344,9 +353,47 @@ class Translator(Members):
                 return i + 1
         raise NotTranslated(f"{left} = ...: writes to a cell, a property or an object")
 
+    def _assign_by_reference(self, target, rhs, indent: int) -> bool:
+        """``x = G(a, b, ...)`` where G changes parameters passed by reference (VBA's default)
+        and the caller gives variables there: G's program is also written as ``G_refs``, whose
+        value is ``[value, the changed parameters...]``, and the caller's variables take those
+        values after the call, as VBA's do (False where the call is not of that form)."""
+        own = target[1].lower() == self.proc.name.lower()  # FunctionName = G(...)
+        if rhs[0] != "call" or strip(rhs[1])[0] != "id" or (own and self.text_function):
+            return False
+        key = strip(rhs[1])[1].lower()
+        positions = sorted(self.changed_params.get(key, ()))
+        if key not in self.functions or not positions or key in self.arrays:
+            return False
+        args = rhs[2]
+        given = [(k, strip(args[k])) for k in positions if k < len(args) and args[k] is not None]
+        if any(n[0] != "id" or n[1].lower() not in self.names for _, n in given):
+            return False  # an element or a name not yet a local: the refusal of the call
+        names = [n[1].lower() for _, n in given]
+        if len(set(names)) != len(names):
+            raise NotTranslated(f"passes one variable twice to {self.functions[key].proc.name}")
+        text = self._call_function(key, args, refs=positions)
+        values = self.temp("refs")
+        self.emit(indent, f"{values} := {text}")
+        for k, node in given:
+            self.emit(indent, f"{self.local(node[1])} := {values}[{positions.index(k) + 1}]")
+        if not own:
+            self.emit(indent, f"{self.local(target[1])} := {values}[0]")
+            return True
+        value = f"{values}[0]"
+        if self.proc.returns.lower() in INTEGER_TYPES:
+            value = bankers(value)  # VBA rounds the value of an Integer function
+        self.emit(indent, f"{self.ret} := {value}")
+        if self.error_flag is not None:
+            self.emit(indent, f"{self.error_flag} := 0")
+        self.assigned = True
+        return True
+
     def assign_result(self, rhs, indent: int, i: int, lines) -> int:
         """``FunctionName = value``: the function's value (a text, or an error value, only
         where nothing runs after it: it is then what the function gives)."""
+        if self._assign_by_reference(("id", self.proc.name), rhs, indent):
+            return i + 1
         at = i if lines is self.body else self.at
         tail = self._tail(at)
         is_error = rhs[0] == "call" and rhs[1][0] == "id" and rhs[1][1].lower() == "cverr"
@@ -860,7 +907,10 @@ class Translator(Members):
         if key in ("pi",):
             raise NotTranslated("Pi is not a VBA name (an undeclared variable)")
         # an undeclared variable (VBA makes it Empty: 0 until given a value)
-        return self.local(vba)
+        local = self.local(vba)
+        if local not in self.written:
+            self.read_empty.append(local)
+        return local
 
     def indices(self, key: str, args) -> str:
         arr = self.arrays[key]
@@ -945,9 +995,13 @@ class Translator(Members):
         out = text.format(*[self.value(a) for a in args])
         return out if re.fullmatch(r"\w+\([^()]*\)", text) else f"({out})"
 
-    def _call_function(self, key: str, args) -> str:
+    def _call_function(self, key: str, args, refs: list[int] | None = None) -> str:
+        """The call of the VBA function ``key``; with ``refs`` (the positions of the
+        parameters it changes by reference), of its ``_refs`` program, which also gives them."""
         info = self.functions[key]
         self.info.calls.add(key)
+        if refs is not None:
+            info.refs = refs
         params = info.proc.params
         if len(args) > len(params):
             raise NotTranslated(f"{info.proc.name} called with too many arguments")
@@ -957,7 +1011,7 @@ class Translator(Members):
             if a is not None and a[0] == "named":
                 raise NotTranslated("named arguments")
             given = a is not None
-            if given and k in self.changed_params.get(key, ()):
+            if given and refs is None and k in self.changed_params.get(key, ()):
                 node = strip(a)
                 element = node[0] == "call" and strip(node[1])[0] == "id"
                 if node[0] == "id" or (element and strip(node[1])[1].lower() in self.arrays):
@@ -979,9 +1033,29 @@ class Translator(Members):
                     info.arg_bases.setdefault(k, set()).add(base)
             if info.params[k] in info.given:
                 flags.append("1" if given else "0")
+        if refs is not None:
+            return f"{refs_name(info)}({', '.join(texts + flags)})"
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
+
+
+def refs_name(info: FunctionInfo) -> str:
+    """The name of a function's program that also gives its parameters changed by reference."""
+    return f"{info.final}_refs"
+
+
+def refs_program(info: FunctionInfo) -> str:
+    """The function's program whose value is ``[value, the parameters at info.refs...]``:
+    its last line and each ``return`` give the vector."""
+    outs = ", ".join(info.params[k] for k in info.refs)
+    lines = info.program.split("\n")
+    out = []
+    for line in lines[:-1]:
+        m = re.match(r"^(\s*)return (.*?)( if .*)?$", line)
+        out.append(f"{m.group(1)}return [{m.group(2)}, {outs}]{m.group(3) or ''}" if m else line)
+    out.append(f"[{lines[-1].strip()}, {outs}]")
+    return "\n".join(out)
 
 
 def default_text(p) -> str:

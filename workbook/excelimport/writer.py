@@ -212,6 +212,15 @@ def _vba_functions(tr: Translation, skip: dict, arguments: dict, definitions: di
         for p in params:
             arguments.setdefault(p, {"unit": ""})
         key = f"{info.final}({', '.join(params)})" if params else info.final
+        if info.refs:
+            from .vbaprogram import refs_name, refs_program
+
+            changed = ", ".join(info.proc.params[k].name for k in info.refs)
+            definitions[f"{refs_name(info)}({', '.join(params)})"] = {
+                "program": refs_program(info) + "\n",
+                "note": f"VBA Function {info.proc.name} (module {info.proc.module}), with the "
+                f"parameters it changes by reference: [its value, {changed}]",
+            }
         definitions[key] = {
             "program": info.program + "\n",
             "note": f"VBA Function {info.proc.name} (module {info.proc.module})"
