@@ -352,8 +352,9 @@ EXCEL_CASES = {
     "c_pgeom": "pgeom(d, p)",
     # outside the support: 0 (or 1), where Excel's functions give #NUM!
     "c_outside": "dlnorm(-x, mu, sigma) + 2*plnorm(0, mu, sigma) + dgamma(-x, r) "
-    "+ 2*pgamma(-x, r) + dbeta(-x, r, d) + dbeta(b, r, d) + 3.5*pbeta(b, r, d) + pbeta(-x, r, d) "
-    "+ dweibull(-x, r) + pweibull(-x, r) + 0.5*qbeta(0, r, d) + 0.25*qgamma(0, r) + qlnorm(0, mu, sigma)",
+    "+ 2*pgamma(-x, r) + dbeta(-x, r, d) + dbeta(b, r, d) + 3.5*pbeta(b, r, d) "
+    "+ pbeta(-x, r, d) + dweibull(-x, r) + pweibull(-x, r) + 0.5*qbeta(0, r, d) "
+    "+ 0.25*qgamma(0, r) + qlnorm(0, mu, sigma)",
     "c_counts": "dbinom(-d, d2, p) + dbinom(d2 + 1, d2, p) + 5*pbinom(d2 + d, d2, p) "
     "+ pbinom(-d, d2, p) + 7*qbinom(0, d2, p) + dpois(-d, r) + ppois(-d, r) + dgeom(-d, p) "
     "+ pgeom(-d, p) + 0.25*pbinom(2, 6, 0.5)",
