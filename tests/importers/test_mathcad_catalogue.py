@@ -221,3 +221,33 @@ def test_linfit_is_the_least_squares_combination(tmp_path, capsys):
     assert "geninv(stack(transpose(F(vx[0]))" in text
     result = check_sheet(tmp_path, capsys, "linfit")
     assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
+
+
+@pytest.mark.slow
+def test_distributions_dbinom_plnorm_qweibull_against_scipy(tmp_path, capsys):
+    """dbinom(k, n, p), plnorm(x, mu, sigma) and qweibull(p, s) of a Mathcad 15 worksheet
+    become the language's of the same names; the values stored are SciPy's."""
+    import scipy.stats
+
+    def seq(*args):
+        return f"<ml:sequence>{''.join(args)}</ml:sequence>"
+
+    calls = {
+        "dbinom": (seq(ident("k"), ident("n"), ident("p")), scipy.stats.binom.pmf(3, 10, 0.3)),
+        "plnorm": (
+            seq(real(2.5), real(0.3), real(1.7)),
+            scipy.stats.lognorm.cdf(2.5, 1.7, 0, math.exp(0.3)),
+        ),
+        "qweibull": (seq(real(0.9), real(2.5)), scipy.stats.weibull_min.ppf(0.9, 2.5)),
+    }
+    regions = [define(1, ident("k"), real(3)), define(2, ident("n"), real(10))]
+    regions.append(define(3, ident("p"), real(0.3)))
+    for rid, (name, (args, value)) in enumerate(calls.items(), start=4):
+        regions.append(
+            define(rid, ident(f"y_{name}"), shown(call(name, args), real(repr(float(value)))))
+        )
+    text = import_sheet(tmp_path, capsys, "distributions", *regions)
+    assert 'expr = "dbinom(k, n, p)"' in text and 'expr = "qweibull(0.9, 2.5)"' in text
+    assert 'expr = "plnorm(2.5, 0.3, 1.7)"' in text
+    result = check_sheet(tmp_path, capsys, "distributions")
+    assert (result["printed"], result["reproduced"]) == (3, 3), result["failures"]
