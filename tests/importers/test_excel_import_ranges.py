@@ -475,3 +475,31 @@ def test_arguments_passed_by_reference_are_never_a_wrong_number(
         assert report["reproduced"] == 1, module
     if passes == "y":  # z = Inner(y): y takes Inner's v after the call (Outer's, Inner's)
         assert report["reproduced"] == 1, module
+
+
+def test_undeclared_variables_given_by_reference_take_the_values_the_callee_gives(tmp_path, capsys):
+    """``State = SetTwo(x, A1, B1)`` with A1 and B1 never declared (Empty): SetTwo's values
+    of its ByRef parameters are the caller's A1 and B1 after the call."""
+    path = tmp_path / "outs.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("O")
+    ws.write_number("A1", 1.5)
+    ws.write_formula("B1", "=UseTwo(A1)", None, 3.0 + 10 * 4.5)
+    wb.close()
+    bas = tmp_path / "Outs.bas"
+    bas.write_text(
+        'Attribute VB_Name = "O"\n'
+        "Private Function SetTwo(ByVal x, ByRef a, ByRef b) As Boolean\n"
+        "    a = 2 * x\n    b = 3 * x\n    SetTwo = True\nEnd Function\n\n"
+        "Function UseTwo(x)\n    State = SetTwo(x, A1, B1)\n    UseTwo = A1 + 10 * B1\n"
+        "End Function\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out"
+    assert main(["import", str(path), "--vba", str(bas), "--out", str(out)]) == 0
+    text = (out / "outs.toml").read_text(encoding="utf-8")
+    assert '"SetTwo_refs(x, a, b)"' in text
+    capsys.readouterr()
+    main(["check", str(out / "outs.toml"), "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (1, 1, 0)

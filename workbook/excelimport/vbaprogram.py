@@ -367,11 +367,17 @@ class Translator(Members):
             return False
         args = rhs[2]
         given = [(k, strip(args[k])) for k in positions if k < len(args) and args[k] is not None]
-        if any(n[0] != "id" or n[1].lower() not in self.names for _, n in given):
-            return False  # an element or a name not yet a local: the refusal of the call
+        special = {"true", "false", "empty", "vbnullstring", "pi", self.proc.name.lower()}
+        if any(
+            n[0] != "id" or n[1].lower() in special or n[1].lower() in self.functions
+            for _, n in given
+        ):
+            return False  # an element, a constant, a function: the refusal of the call
         names = [n[1].lower() for _, n in given]
         if len(set(names)) != len(names):
             raise NotTranslated(f"passes one variable twice to {self.functions[key].proc.name}")
+        for _, node in given:
+            self.name(node[1])  # an undeclared variable is a local (Empty, 0, until set)
         text = self._call_function(key, args, refs=positions)
         values = self.temp("refs")
         self.emit(indent, f"{values} := {text}")
