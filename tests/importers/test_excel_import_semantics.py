@@ -210,11 +210,17 @@ def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_pa
     ws.write_formula("D4", "=IFERROR(SQRT(-A1),5)", None, 5)  # a root of a negative number
     ws.write_formula("D5", "=IFERROR(LN(B1)*2+C1^-1,7)", None, 7)  # a logarithm of 0
     ws.write_formula("D6", "=IFERROR(B1^0,9)", None, 9)  # 0^0 is #NUM! in Excel
-    ws.write_formula("D7", "=IFERROR(ACOS(A1),5)", None, 5)  # other errors: listed
+    ws.write_formula("D7", "=IFERROR(ACOS(A1),5)", None, 5)  # an arc cosine beyond 1
+    ws.write_formula("D8", "=IFERROR(ATAN(A1/B1)*180/PI(),0)", None, 0)
+    ws.write_formula("D9", "=IFERROR(ASIN(C1/A1),5)", None, math.asin(0.5))
+    ws.write_formula("D10", "=IFERROR(ATAN2(B1,B1),7)", None, 7)  # #DIV/0! at the origin
+    ws.write_formula("D11", "=IFERROR(EXP(A1*200),1)", None, 1)  # beyond the largest number
+    ws.write_formula("D12", "=IFERROR(SIN(C1)+COS(A1)+TAN(B1),2)", None, math.sin(3) + math.cos(6))
+    ws.write_formula("D13", "=IFERROR(FACT(A1),5)", None, 720)  # other functions: listed
     wb.close()
     report, text = import_and_check(path, tmp_path, capsys)
     assert "the language has no error value to catch" in text.replace("\n# ", " ")
-    assert (report["printed"], report["reproduced"], report["failed"]) == (7, 6, 0)
+    assert (report["printed"], report["reproduced"], report["failed"]) == (13, 12, 0)
     import workbook
 
     sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
@@ -225,6 +231,8 @@ def test_iferror_of_a_division_is_its_alternative_where_a_divisor_is_zero(tmp_pa
     assert sheet.with_inputs(B1=2).evaluate(name).magnitude == pytest.approx(expected)
     name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR(B1^0" in d.note)
     assert sheet.with_inputs(B1=2).evaluate(name).magnitude == 1.0
+    name = next(n for n, d in sheet.spec.definitions.items() if "=IFERROR(ATAN(" in d.note)
+    assert sheet.with_inputs(B1=6).evaluate(name).magnitude == pytest.approx(45.0)
 
 
 SUB = """Attribute VB_Name = "Macros"

@@ -532,18 +532,26 @@ class FormulaTranslator:
             if name == "/":
                 errors.append(f"{self.value(payload[1], 3)} == 0")
             return
-        guards = {"SQRT": "{} < 0", "LN": "{} <= 0", "LOG10": "{} <= 0", "ABS": None}
         upper = name.upper() if kind == "fn" else ""
         if upper == "LOG" and len(payload) == 1:
             upper = "LOG10"
-        if upper in guards and len(payload) == 1:
+        if upper in ERROR_WHERE and len(payload) == 1:
             self.arithmetic_only(payload[0], errors)
-            if guards[upper]:
-                errors.append(guards[upper].format(self.value(payload[0], 3)))
+            if ERROR_WHERE[upper]:
+                errors.append(ERROR_WHERE[upper].format(self.value(payload[0], 3)))
+            return
+        if upper == "PI" and not payload:
+            return
+        if upper == "ATAN2" and len(payload) == 2:  # #DIV/0! at the origin
+            for a in payload:
+                self.arithmetic_only(a, errors)
+            x, y = (self.value(a, 3) for a in payload)
+            errors.append(f"{x} == 0 and {y} == 0")
             return
         raise FormulaProblem(
-            "IFERROR of other than + - * /, ^ by a number, SQRT, LN, LOG10, ABS of numbers and "
-            "cells (the language has no error value to catch)"
+            "IFERROR of other than + - * /, ^ by a number, "
+            + ", ".join(ERROR_WHERE)
+            + ", ATAN2, PI() of numbers and cells (the language has no error value to catch)"
         )
 
     def offset(self, args) -> str:
@@ -790,6 +798,25 @@ class FormulaTranslator:
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
+
+
+#: Excel's functions of one number inside IFERROR, and where each gives an error value
+#: (None: never, for a number): a root of a negative number, a logarithm of one not above 0,
+#: an arc sine beyond 1, an exponential beyond the largest number, and the sine, cosine and
+#: tangent of 2^27 or more, which Excel refuses (#NUM!)
+ERROR_WHERE = {
+    "SQRT": "{} < 0",
+    "LN": "{} <= 0",
+    "LOG10": "{} <= 0",
+    "ABS": None,
+    "ATAN": None,
+    "ASIN": "abs({}) > 1",
+    "ACOS": "abs({}) > 1",
+    "EXP": "{} > 709.782712893384",
+    "SIN": "abs({}) >= 134217728",
+    "COS": "abs({}) >= 134217728",
+    "TAN": "abs({}) >= 134217728",
+}
 
 
 def _br(text: str, level: int, ctx: int) -> str:
