@@ -369,10 +369,16 @@ class Translator(Members):
         given = [(k, strip(args[k])) for k in positions if k < len(args) and args[k] is not None]
         special = {"true", "false", "empty", "vbnullstring", "pi", self.proc.name.lower()}
         if any(
-            n[0] != "id" or n[1].lower() in special or n[1].lower() in self.functions
+            n[0] == "call" and strip(n[1])[0] == "id" and strip(n[1])[1].lower() in self.arrays
             for _, n in given
         ):
-            return False  # an element, a constant, a function: the refusal of the call
+            return False  # an array element: the refusal of the call
+        # an expression is passed as a temporary: only variables take the values back
+        given = [
+            (k, n)
+            for k, n in given
+            if n[0] == "id" and n[1].lower() not in special and n[1].lower() not in self.functions
+        ]
         names = [n[1].lower() for _, n in given]
         if len(set(names)) != len(names):
             raise NotTranslated(f"passes one variable twice to {self.functions[key].proc.name}")
