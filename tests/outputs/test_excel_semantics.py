@@ -260,6 +260,11 @@ def test_vba_functions_of_thisworkbook_and_what_is_refused():
     )
     assert found["Twice"].problem is None
     found = translate_vba(
+        "Function Angle(x As Double, y As Double) As Double\n"
+        "    Angle = ThisWorkbook.Application.WorksheetFunction.Atan2(x, y)\nEnd Function\n"
+    )
+    assert found["Angle"].problem is None  # ThisWorkbook's Application is the Application
+    found = translate_vba(
         "Private calls As Long\n\nSub Reset()\n    calls = 0\nEnd Sub\n\n"
         "Function Counted(x As Double) As Double\n    calls = calls + 1\n    Counted = x * calls\n"
         "End Function\n\nFunction Ratio(a As Double, b As Double) As Double\n"

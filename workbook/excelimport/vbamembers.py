@@ -174,5 +174,13 @@ def _chain(node) -> list[str]:
         node = strip(node[1])
     if node[0] == "id":
         out.append(node[1])
-        return out[::-1]
+        chain = out[::-1]
+        # ThisWorkbook.Application.WorksheetFunction.Max: the same Application
+        if (
+            len(chain) > 2
+            and chain[0].lower() == "thisworkbook"
+            and chain[1].lower() == "application"
+        ):
+            chain = chain[1:]
+        return chain
     return []
