@@ -55,6 +55,7 @@ def test_inverse_and_reciprocal_hyperbolic_functions_against_mpmath(tmp_path, ca
     calls = {
         "asinh": mpmath.asinh(x), "acosh": mpmath.acosh(1 + x), "atanh": mpmath.atanh(x),
         "coth": mpmath.coth(x), "sech": mpmath.sech(x), "csch": mpmath.csch(x),
+        "asech": mpmath.asech(x), "acsch": mpmath.acsch(x),
     }  # fmt: skip
     regions = [define(1, ident("x"), real(0.3))]
     for k, (name, value) in enumerate(calls.items(), start=2):

@@ -58,6 +58,7 @@ CASES = [
     ("hyperbolic", "sinh(a/b) + cosh(a/b) - tanh(a/b)", None),
     ("hyperbolic_reciprocal", "coth(a/b) + sech(a/b) - csch(-a/b)", None),
     ("inverse_hyperbolic", "asinh(-a/b) + acosh(b/a + 1) + atanh(a/c)", None),
+    ("inverse_reciprocal", "asec(c/a) + acsc(-c/b) + acoth(c/a) + asech(a/c) + acsch(-b)", None),
     ("inverse_trig", "asin(a/c) + acos(a/c) + atan(b/c)", None),
     ("sqrt_of_sum", "sqrt(a + b + c)", None),
     # complex numbers: the parts and angle of IM* results are numbers

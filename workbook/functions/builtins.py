@@ -389,6 +389,39 @@ _simple(
     mathcad=("atanh",),
     excel_import=("ATANH",),
 )
+
+
+def _asech(x):
+    """ln((1 + sqrt(1 - x^2))/x): acosh(1/x) loses digits near 1 (the rounding of 1/x)."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.log1p(np.sqrt((1 - x) * (1 + x))) - np.log(x)
+
+
+def _of_reciprocal(inverse: str, excel: str) -> Callable[[list[str]], tuple[str, int]]:
+    """ACOS(1/x): Excel has no ASEC, ACSC, ACOTH (2013), ASECH or ACSCH."""
+    return lambda args: (f"{excel}(1/({args[0]}))", PREC["atom"])
+
+
+for _name, _of, _excel, _what, _bad, _outside in (
+    ("asec", np.arccos, "ACOS", "arc secant", lambda v: np.abs(v) < 1, "between -1 and 1"),
+    ("acsc", np.arcsin, "ASIN", "arc cosecant", lambda v: np.abs(v) < 1, "between -1 and 1"),
+    ("acoth", np.arctanh, "ATANH", "inverse hyperbolic cotangent", lambda v: np.abs(v) <= 1,
+     "from -1 to 1"),
+    ("asech", np.arccosh, "ACOSH", "inverse hyperbolic secant", lambda v: (v <= 0) | (v > 1),
+     "not in (0, 1]"),
+    ("acsch", np.arcsinh, "ASINH", "inverse hyperbolic cosecant", lambda v: v == 0, "0"),
+):  # fmt: skip
+    _simple(
+        _name,
+        _asech if _name == "asech" else (lambda x, of=_of: of(1 / x)),
+        _of_reciprocal(_name, _excel),
+        lambda sp, x, name=_name: getattr(sp, name)(x),
+        f"{_what}, {_excel.lower()}(1/x)",
+        domain=(Domain(f"{_name} of a value {_outside}", _bad, _name + "({})"),),
+        mpmath=_name,
+        mathcad=(_name,),
+    )
 _simple(
     "sqrt",
     np.sqrt,
