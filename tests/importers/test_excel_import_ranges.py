@@ -503,3 +503,27 @@ def test_undeclared_variables_given_by_reference_take_the_values_the_callee_give
     main(["check", str(out / "outs.toml"), "--json"])
     report = json.loads(capsys.readouterr().out)
     assert (report["printed"], report["reproduced"], report["failed"]) == (1, 1, 0)
+
+
+def test_the_refs_program_gives_the_changed_parameters_at_every_exit():
+    from workbook.excelimport.vba import Procedure
+    from workbook.excelimport.vbaprogram import FunctionInfo, refs_program
+
+    proc = Procedure("Function", "G", "M", [], "Double", False, [])
+    info = FunctionInfo(proc, "G", ["x", "a", "b"], refs=[1, 2])
+    info.program = "\n".join(
+        [
+            "G_value := 0",
+            "return 1/0 if flag != 0",
+            "return (x if x > 0 otherwise -x)",
+            "a := 2*x",
+            "G_value",
+        ]
+    )
+    assert refs_program(info).split("\n") == [
+        "G_value := 0",
+        "return [1/0, a, b] if flag != 0",
+        "return [(x if x > 0 otherwise -x), a, b]",
+        "a := 2*x",
+        "[G_value, a, b]",
+    ]

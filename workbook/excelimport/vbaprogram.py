@@ -1064,10 +1064,25 @@ def refs_program(info: FunctionInfo) -> str:
     lines = info.program.split("\n")
     out = []
     for line in lines[:-1]:
-        m = re.match(r"^(\s*)return (.*?)( if .*)?$", line)
-        out.append(f"{m.group(1)}return [{m.group(2)}, {outs}]{m.group(3) or ''}" if m else line)
+        m = re.match(r"^(\s*)return (.*)$", line)
+        if not m:
+            out.append(line)
+            continue
+        value, guard = _statement_guard(m.group(2))
+        out.append(f"{m.group(1)}return [{value}, {outs}]{guard}")
     out.append(f"[{lines[-1].strip()}, {outs}]")
     return "\n".join(out)
+
+
+def _statement_guard(text: str) -> tuple[str, str]:
+    """``1/0 if flag != 0`` -> (``1/0``, `` if flag != 0``): the condition of a statement,
+    at the top level (an ``if`` inside brackets is part of the value)."""
+    depth = 0
+    for i, ch in enumerate(text):
+        depth += {"(": 1, "[": 1, ")": -1, "]": -1}.get(ch, 0)
+        if depth == 0 and text.startswith(" if ", i):
+            return text[:i], text[i:]
+    return text, ""
 
 
 def default_text(p) -> str:
