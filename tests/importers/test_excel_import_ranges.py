@@ -507,7 +507,8 @@ def test_undeclared_variables_given_by_reference_take_the_values_the_callee_give
 
 def test_the_refs_program_gives_the_changed_parameters_at_every_exit():
     from workbook.excelimport.vba import Procedure
-    from workbook.excelimport.vbaprogram import FunctionInfo, refs_program
+    from workbook.excelimport.vbaprogram import FunctionInfo
+    from workbook.excelimport.vbarefs import refs_program
 
     proc = Procedure("Function", "G", "M", [], "Double", False, [])
     info = FunctionInfo(proc, "G", ["x", "a", "b"], refs=[1, 2])

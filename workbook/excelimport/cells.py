@@ -757,7 +757,7 @@ class FormulaTranslator:
         texts, flags = [], []
         from .vbaexpr import VbaSyntax
         from .vbamembers import NotTranslated
-        from .vbaprogram import default_text
+        from .vbatypes import default_text
 
         for k, p in enumerate(params):
             a = args[k] if k < len(args) else None

@@ -17,9 +17,9 @@ from .vba import Procedure, split_top
 from .vbaerrors import cut_error_handler, raised_errors
 from .vbaexpr import VbaSyntax, parse, strip
 from .vbamembers import Members, NotTranslated, is_transpose
+from .vbarefs import ByReference, refs_name
+from .vbatypes import INTEGER_TYPES, NUMBER_TYPES, bankers, default_text
 
-INTEGER_TYPES = {"integer", "long", "byte", "longlong", "longptr"}
-NUMBER_TYPES = INTEGER_TYPES | {"double", "single", "currency", "decimal"}
 #: the language's words, which cannot be names
 KEYWORDS = {
     "if", "else", "elif", "otherwise", "for", "in", "while", "break", "continue", "return",
@@ -56,13 +56,6 @@ class FunctionInfo:
         return len(self.params) + len(self.given)
 
 
-def bankers(text: str) -> str:
-    """VBA's rounding to an integer (half to even) as an expression of the language."""
-    f = f"floor({text} + 0.5)"
-    # an odd f at a half goes down: mod keeps the sign of f, so mod(-1, 2) is -1, not 1
-    return f"({f} - 1 if {f} == {text} + 0.5 and mod({f}, 2) != 0 otherwise {f})"
-
-
 @dataclass
 class _Array:
     base: int
@@ -70,7 +63,7 @@ class _Array:
     is_range: bool = False
 
 
-class Translator(Members):
+class Translator(Members, ByReference):
     """One VBA Function to program text (raises NotTranslated with the reason)."""
 
     def __init__(self, info: FunctionInfo, functions: dict[str, FunctionInfo], reserved: set):
@@ -297,7 +290,7 @@ class Translator(Members):
                 raise NotTranslated(f"assigns to the name of another function {target[1]}")
             if key in self.arrays and self.arrays[key].is_range:
                 raise NotTranslated(f"{target[1]} is a range given as an argument: writes cells")
-            if self._assign_by_reference(target, rhs, indent):
+            if self.assign_by_reference(target, rhs, indent):
                 return i + 1
             if is_transpose(rhs):  # Application.Transpose(...): an array from 1
                 self.transpose_into(self.local(target[1]), rhs, indent)
@@ -353,58 +346,10 @@ class Translator(Members):
                 return i + 1
         raise NotTranslated(f"{left} = ...: writes to a cell, a property or an object")
 
-    def _assign_by_reference(self, target, rhs, indent: int) -> bool:
-        """``x = G(a, b, ...)`` where G changes parameters passed by reference (VBA's default)
-        and the caller gives variables there: G's program is also written as ``G_refs``, whose
-        value is ``[value, the changed parameters...]``, and the caller's variables take those
-        values after the call, as VBA's do (False where the call is not of that form)."""
-        own = target[1].lower() == self.proc.name.lower()  # FunctionName = G(...)
-        if rhs[0] != "call" or strip(rhs[1])[0] != "id" or (own and self.text_function):
-            return False
-        key = strip(rhs[1])[1].lower()
-        positions = sorted(self.changed_params.get(key, ()))
-        if key not in self.functions or not positions or key in self.arrays:
-            return False
-        args = rhs[2]
-        given = [(k, strip(args[k])) for k in positions if k < len(args) and args[k] is not None]
-        special = {"true", "false", "empty", "vbnullstring", "pi", self.proc.name.lower()}
-        if any(
-            n[0] == "call" and strip(n[1])[0] == "id" and strip(n[1])[1].lower() in self.arrays
-            for _, n in given
-        ):
-            return False  # an array element: the refusal of the call
-        # an expression is passed as a temporary: only variables take the values back
-        given = [
-            (k, n)
-            for k, n in given
-            if n[0] == "id" and n[1].lower() not in special and n[1].lower() not in self.functions
-        ]
-        names = [n[1].lower() for _, n in given]
-        if len(set(names)) != len(names):
-            raise NotTranslated(f"passes one variable twice to {self.functions[key].proc.name}")
-        for _, node in given:
-            self.name(node[1])  # an undeclared variable is a local (Empty, 0, until set)
-        text = self._call_function(key, args, refs=positions)
-        values = self.temp("refs")
-        self.emit(indent, f"{values} := {text}")
-        for k, node in given:
-            self.emit(indent, f"{self.local(node[1])} := {values}[{positions.index(k) + 1}]")
-        if not own:
-            self.emit(indent, f"{self.local(target[1])} := {values}[0]")
-            return True
-        value = f"{values}[0]"
-        if self.proc.returns.lower() in INTEGER_TYPES:
-            value = bankers(value)  # VBA rounds the value of an Integer function
-        self.emit(indent, f"{self.ret} := {value}")
-        if self.error_flag is not None:
-            self.emit(indent, f"{self.error_flag} := 0")
-        self.assigned = True
-        return True
-
     def assign_result(self, rhs, indent: int, i: int, lines) -> int:
         """``FunctionName = value``: the function's value (a text, or an error value, only
         where nothing runs after it: it is then what the function gives)."""
-        if self._assign_by_reference(("id", self.proc.name), rhs, indent):
+        if self.assign_by_reference(("id", self.proc.name), rhs, indent):
             return i + 1
         at = i if lines is self.body else self.at
         tail = self._tail(at)
@@ -1050,54 +995,3 @@ class Translator(Members):
         if not texts + flags:  # a function without arguments is a definition
             return info.final
         return f"{info.final}({', '.join(texts + flags)})"
-
-
-def refs_name(info: FunctionInfo) -> str:
-    """The name of a function's program that also gives its parameters changed by reference."""
-    return f"{info.final}_refs"
-
-
-def refs_program(info: FunctionInfo) -> str:
-    """The function's program whose value is ``[value, the parameters at info.refs...]``:
-    its last line and each ``return`` give the vector."""
-    outs = ", ".join(info.params[k] for k in info.refs)
-    lines = info.program.split("\n")
-    out = []
-    for line in lines[:-1]:
-        m = re.match(r"^(\s*)return (.*)$", line)
-        if not m:
-            out.append(line)
-            continue
-        value, guard = _statement_guard(m.group(2))
-        out.append(f"{m.group(1)}return [{value}, {outs}]{guard}")
-    out.append(f"[{lines[-1].strip()}, {outs}]")
-    return "\n".join(out)
-
-
-def _statement_guard(text: str) -> tuple[str, str]:
-    """``1/0 if flag != 0`` -> (``1/0``, `` if flag != 0``): the condition of a statement,
-    at the top level (an ``if`` inside brackets is part of the value)."""
-    depth = 0
-    for i, ch in enumerate(text):
-        depth += {"(": 1, "[": 1, ")": -1, "]": -1}.get(ch, 0)
-        if depth == 0 and text.startswith(" if ", i):
-            return text[:i], text[i:]
-    return text, ""
-
-
-def default_text(p) -> str:
-    """The value VBA gives an Optional argument left out."""
-    if p.default is not None:
-        node = strip(parse(p.default))
-        if node[0] == "num":
-            return node[1]
-        if node[0] == "un" and node[1] == "-" and strip(node[2])[0] == "num":
-            return "-" + strip(node[2])[1]
-        if node[0] == "id" and node[1].lower() in ("true", "false"):
-            return "-1" if node[1].lower() == "true" else "0"
-        if node[0] == "str" and '"' not in node[1]:
-            return f'"{node[1]}"'
-        raise NotTranslated(f"the default {p.default!r} of {p.name}")
-    if p.type.lower() in NUMBER_TYPES or p.type.lower() == "boolean":
-        return "0"
-    return "0"  # a Variant left out: tested with IsMissing (the flag), else Empty (0)

@@ -213,7 +213,7 @@ def _vba_functions(tr: Translation, skip: dict, arguments: dict, definitions: di
             arguments.setdefault(p, {"unit": ""})
         key = f"{info.final}({', '.join(params)})" if params else info.final
         if info.refs:
-            from .vbaprogram import refs_name, refs_program
+            from .vbarefs import refs_name, refs_program
 
             changed = ", ".join(info.proc.params[k].name for k in info.refs)
             definitions[f"{refs_name(info)}({', '.join(params)})"] = {
