@@ -35,18 +35,23 @@ def _cells(ref: Ref) -> list[tuple[int, int]]:
     return [(r, c) for r in range(ref.r1, ref.r2 + 1) for c in range(ref.c1, ref.c2 + 1)]
 
 
-def match(ft, args) -> str:
-    """``MATCH(x, keys[, type])`` as a chain giving the position (from 1)."""
-    if len(args) not in (2, 3):
-        raise FormulaProblem(f"MATCH with {len(args)} arguments")
+def _match_keys(ft, args) -> tuple[float, list[tuple[int, str | None]]]:
+    """(type, keys) of ``MATCH(x, keys[, type])``'s arguments (of 2 or 3)."""
     kind = 1.0 if len(args) == 2 else written_number(args[2])
     if kind not in (-1.0, 0.0, 1.0):
         raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
     ref = _range(ft, args[1], "MATCH")
     if ref.r1 != ref.r2 and ref.c1 != ref.c2:
         raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
-    keys = _keys(ft, ref, args[0], exact=kind == 0)
-    return _chain(ft, args[0], keys, kind, [str(k) for k in range(1, len(_cells(ref)) + 1)])
+    return kind, _keys(ft, ref, args[0], exact=kind == 0)
+
+
+def match(ft, args) -> str:
+    """``MATCH(x, keys[, type])`` as a chain giving the position (from 1)."""
+    if len(args) not in (2, 3):
+        raise FormulaProblem(f"MATCH with {len(args)} arguments")
+    kind, keys = _match_keys(ft, args)
+    return _chain(ft, args[0], keys, kind, [str(k) for k in range(1, len(keys) + 1)])
 
 
 def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
@@ -172,13 +177,7 @@ def index(ft, args) -> str:
     pos = args[1]
     if len(args) == 2 and pos[0] == "fn" and pos[1].upper() == "MATCH" and len(pos[2]) in (2, 3):
         m = pos[2]  # INDEX(range, MATCH(x, keys, type)): one chain over the keys
-        kind = 1.0 if len(m) == 2 else written_number(m[2])
-        if kind not in (-1.0, 0.0, 1.0):
-            raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
-        keys_ref = _range(ft, m[1], "MATCH")
-        if keys_ref.r1 != keys_ref.r2 and keys_ref.c1 != keys_ref.c2:
-            raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
-        keys = _keys(ft, keys_ref, m[0], exact=kind == 0)
+        kind, keys = _match_keys(ft, m)
         return _chain(ft, m[0], keys, kind, cells, _no_value(ft, ref))
     fixed = [written_number(a) for a in args[1:]]
     if None not in fixed:  # INDEX(range, 3, 2): the cell itself
@@ -226,13 +225,7 @@ def offset_by_match(ft, base: Ref, rows, cols) -> str | None:
     along, (m, k) = moving[0]
     if k != int(k) or len(m) not in (2, 3):
         return None
-    kind = 1.0 if len(m) == 2 else written_number(m[2])
-    if kind not in (-1.0, 0.0, 1.0):
-        raise FormulaProblem("MATCH whose type is not written as -1, 0 or 1")
-    keys_ref = _range(ft, m[1], "MATCH")
-    if keys_ref.r1 != keys_ref.r2 and keys_ref.c1 != keys_ref.c2:
-        raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
-    keys = _keys(ft, keys_ref, m[0], exact=kind == 0)
+    kind, keys = _match_keys(ft, m)
     results, kinds = [], set()
     for p in range(1, len(keys) + 1):
         step = (p + int(k), int(fixed[0]))

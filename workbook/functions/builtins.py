@@ -238,21 +238,29 @@ def _reciprocal(excel: str) -> Callable[[list[str]], tuple[str, int]]:
     return lambda args: (f"1/{excel}({args[0]})", PREC["/"])
 
 
-for _name, _of, _excel, _what in (
-    ("sec", np.cos, "COS", "secant"),
-    ("csc", np.sin, "SIN", "cosecant"),
-    ("cot", np.tan, "TAN", "cotangent"),
-):
-    _simple(
-        _name,
-        lambda x, of=_of: 1 / of(x),
-        _reciprocal(_excel),
-        lambda sp, x, name=_name: getattr(sp, name)(x),
-        f"{_what}, 1/{_excel.lower()}(x)",
-        mpmath=_name,
-        mathcad=(_name,),
-        **_TRIG,
-    )
+def _reciprocals(table, **display) -> None:
+    """sec = 1/cos and the others of ``table``: (name, numpy function, Excel's, what it is)."""
+    for name, of, excel, what in table:
+        _simple(
+            name,
+            lambda x, of=of: 1 / of(x),
+            _reciprocal(excel),
+            lambda sp, x, name=name: getattr(sp, name)(x),
+            f"{what}, 1/{excel.lower()}(x)",
+            mpmath=name,
+            mathcad=(name,),
+            **display,
+        )
+
+
+_reciprocals(
+    (
+        ("sec", np.cos, "COS", "secant"),
+        ("csc", np.sin, "SIN", "cosecant"),
+        ("cot", np.tan, "TAN", "cotangent"),
+    ),
+    **_TRIG,
+)
 _simple(
     "asin",
     np.arcsin,
@@ -341,20 +349,13 @@ _simple(
     mathcad=("tanh",),
     excel_import=("TANH",),
 )
-for _name, _of, _excel, _what in (
-    ("coth", np.tanh, "TANH", "hyperbolic cotangent"),
-    ("sech", np.cosh, "COSH", "hyperbolic secant"),
-    ("csch", np.sinh, "SINH", "hyperbolic cosecant"),
-):
-    _simple(
-        _name,
-        lambda x, of=_of: 1 / of(x),
-        _reciprocal(_excel),
-        lambda sp, x, name=_name: getattr(sp, name)(x),
-        f"{_what}, 1/{_excel.lower()}(x)",
-        mpmath=_name,
-        mathcad=(_name,),
+_reciprocals(
+    (
+        ("coth", np.tanh, "TANH", "hyperbolic cotangent"),
+        ("sech", np.cosh, "COSH", "hyperbolic secant"),
+        ("csch", np.sinh, "SINH", "hyperbolic cosecant"),
     )
+)
 _simple(
     "asinh",
     np.arcsinh,
