@@ -306,6 +306,34 @@ def test_a_handler_branch_for_an_error_value_no_raise_gives_is_never_taken(raise
 
 
 @pytest.mark.slow
+def test_a_lookup_that_finds_no_key_is_the_alternative_of_iferror(tmp_path, capsys):
+    path = tmp_path / "miss.xlsx"
+    wb = xlsxwriter.Workbook(str(path))
+    ws = wb.add_worksheet("M")
+    for r, (key, value) in enumerate([(10, 1.5), (20, 2.5), (30, 3.5), ("x", 9.0)]):
+        ws.write_row(r, 0, [key, value])  # A1:B4
+    ws.write_number("D1", 20)
+    ws.write_number("D2", 25)
+    ws.write_formula("E1", "=IFERROR(VLOOKUP(D1,$A$1:$B$4,2,FALSE),-1)", None, 2.5)
+    ws.write_formula("E2", "=IFERROR(VLOOKUP(D2,$A$1:$B$4,2,FALSE),-1)", None, -1)
+    ws.write_formula("E3", "=IF(ISERROR(MATCH(D2,A1:A4,0)),0,MATCH(D2,A1:A4,0))", None, 0)
+    ws.write_formula("E4", '=IFERROR(VLOOKUP("x",$A$1:$B$4,2,FALSE),0)', None, 9)
+    ws.write_formula("E5", "=IFERROR(VLOOKUP(D1,$A$1:$B$4,2,TRUE),0)", None, 2.5)  # listed
+    ws.write_formula("E6", "=IF(ISERR(VLOOKUP(D2,$A$1:$B$4,2,FALSE)),1,0)", None, 0)  # listed
+    wb.close()
+    report, text = import_and_check(path, tmp_path, capsys)
+    # E1 to E4 reproduced; E5 (an approximate lookup) and E6 (ISERR: #N/A is none) listed
+    assert (report["printed"], report["reproduced"], report["failed"]) == (6, 4, 0)
+    import workbook
+
+    sheet = workbook.load(str(next((tmp_path / "out").glob("*.toml"))))
+    names = {d.note.split(": ", 1)[0].split("!")[-1]: n for n, d in sheet.spec.definitions.items()}
+    d2 = next(n for n, i in sheet.spec.inputs.items() if i.note.endswith("D2"))
+    assert sheet.with_inputs(**{d2: 30}).evaluate(names["E2"]).magnitude == 3.5
+    assert sheet.with_inputs(**{d2: 30}).evaluate(names["E3"]).magnitude == 3
+
+
+@pytest.mark.slow
 def test_an_aggregate_of_if_in_an_array_formula_leaves_out_the_false_elements(tmp_path, capsys):
     formulas = pytest.importorskip("formulas")
     path = tmp_path / "select.xlsx"

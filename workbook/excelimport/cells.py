@@ -542,6 +542,17 @@ class FormulaTranslator:
             return
         if upper == "PI" and not payload:
             return
+        if upper in ("VLOOKUP", "HLOOKUP", "MATCH"):  # #N/A where no key is x
+            from .lookups import lookup_misses
+
+            if upper != "MATCH":
+                self.arithmetic_only(payload[2], errors)  # the column (row) k
+            if payload and payload[0][:2] != ("leaf", "String"):
+                self.arithmetic_only(payload[0], errors)
+            missed = lookup_misses(self, upper, payload)
+            if missed is not None:
+                errors.append(missed)
+            return
         if upper == "ATAN2" and len(payload) == 2:  # #DIV/0! at the origin
             for a in payload:
                 self.arithmetic_only(a, errors)
@@ -551,7 +562,8 @@ class FormulaTranslator:
         raise FormulaProblem(
             "IFERROR of other than + - * /, ^ by a number, "
             + ", ".join(ERROR_WHERE)
-            + ", ATAN2, PI() of numbers and cells (the language has no error value to catch)"
+            + ", ATAN2, PI(), exact VLOOKUP, HLOOKUP and MATCH of numbers and cells (the "
+            "language has no error value to catch)"
         )
 
     def offset(self, args) -> str:
@@ -677,6 +689,7 @@ class FormulaTranslator:
         conditions on x. The approximate match (the default) takes the last row whose first
         cell is at most x, which is Excel's answer where that column ascends: the chain is
         guarded by the column ascending, and x below the first row is an error (#N/A)."""
+        from .lookups import known_number
         from .statics import found, guarded, position
 
         if len(args) not in (3, 4) or args[1][0] != "leaf" or args[1][1] != "Range":
@@ -706,6 +719,8 @@ class FormulaTranslator:
             cell = self.book.cell(ref.sheet, r, ref.c1)
             if cell is None or cell.value is None or cell.formula is not None:
                 raise FormulaProblem("VLOOKUP whose first column holds other than constants")
+            if isinstance(cell.value, str) and exact and known_number(self, args[0]):
+                continue  # a text never equals a number: passed over
             if not isinstance(cell.value, (int, float)) or isinstance(cell.value, bool):
                 raise FormulaProblem("VLOOKUP whose first column holds texts")
             self.out.refs.append(Ref(ref.sheet, r, ref.c1, r, ref.c1))

@@ -79,15 +79,24 @@ def _error(ft, upper: str, node) -> str:
     IFERROR takes: the conditions under which x is an error value, then x itself, so that a
     cell of x that has no value leaves the formula without one (never FALSE in its place)."""
     errors: list[str] = []
+    if upper == "ISERR" and _calls_lookup(node):
+        raise FormulaProblem("ISERR of a lookup (its #N/A is no error to ISERR)")
     try:
         ft.arithmetic_only(node, errors)
     except FormulaProblem:
         raise FormulaProblem(
-            f"{upper} of other than + - * /, ^ by a number, SQRT, LN, LOG10, ABS of numbers and "
-            "cells (where else Excel's value is an error is not known here)"
+            f"{upper} of other than + - * /, ^ by a number, the functions IFERROR takes and exact "
+            "lookups of numbers and cells (where else Excel's value is an error is not known here)"
         ) from None
     x = ft.value(node, 3)
     return " or ".join([f"({e})" for e in dict.fromkeys(errors)] + [f"{x} != {x}"])
+
+
+def _calls_lookup(node) -> bool:
+    kind, name, payload = node
+    if kind == "fn" and name.upper() in ("VLOOKUP", "HLOOKUP", "MATCH"):
+        return True
+    return kind in ("fn", "op") and any(_calls_lookup(a) for a in payload)
 
 
 def _sure_kind(ft, node, depth: int) -> str | None:

@@ -70,7 +70,7 @@ def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
         value = cell.value
         if isinstance(value, bool):
             raise FormulaProblem("a lookup whose keys hold TRUE/FALSE")
-        if isinstance(value, str) and seen is None and exact and _known_number(ft, x_node):
+        if isinstance(value, str) and seen is None and exact and known_number(ft, x_node):
             out.append((k, None))  # a text never equals a number: as an empty cell
             continue
         if isinstance(value, str):
@@ -93,7 +93,7 @@ def _keys(ft, ref: Ref, x_node, exact: bool) -> list[tuple[int, str | None]]:
     return out
 
 
-def _known_number(ft, node) -> bool:
+def known_number(ft, node) -> bool:
     """x is a number whatever the inputs: written in the formula, or a constant number cell
     (an input of the translation, which stays a number)."""
     if written_number(node) is not None:
@@ -279,3 +279,48 @@ def hlookup(ft, args) -> str:
         results.append(ft.name_of(ref.sheet, row, c))
     none = _no_value(ft, Ref(ref.sheet, row, ref.c1, row, ref.c2))
     return _chain(ft, args[0], keys, 0.0 if exact else 1.0, results, none)
+
+
+def lookup_misses(ft, upper: str, args) -> str | None:
+    """Where an exact ``VLOOKUP(x, table, k, FALSE)``, ``HLOOKUP(x, table, k, FALSE)`` or
+    ``MATCH(x, keys, 0)`` finds no key (Excel's #N/A), as a condition (``"1 == 1"``: never
+    found; None: always found), for IFERROR and ISERROR around it: x a text that never changes
+    (found here) or a number, over keys that are constant cells (a text key never equals a
+    number). Else FormulaProblem."""
+    from .statics import found
+
+    if upper == "MATCH":
+        if len(args) != 3 or written_number(args[2]) != 0:
+            raise FormulaProblem("IFERROR of a MATCH other than an exact one")
+        ref = _range(ft, args[1], "MATCH")
+        if ref.r1 != ref.r2 and ref.c1 != ref.c2:
+            raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
+        cells = _cells(ref)
+    else:
+        if len(args) != 4 or written_number(args[3]) != 0:
+            raise FormulaProblem(f"IFERROR of a {upper} other than an exact one")
+        ref = _range(ft, args[1], upper)
+        first = [(r, ref.c1) for r in range(ref.r1, ref.r2 + 1)]
+        cells = first if upper == "VLOOKUP" else [(ref.r1, c) for c in range(ref.c1, ref.c2 + 1)]
+    at = found(ft, args[0], [(ref.sheet, r, c) for r, c in cells])
+    if at is not None:
+        return "1 == 1" if at < 0 else None
+    x = ft.value(args[0], 3)
+    equal = []
+    for r, c in cells:
+        cell = ft.book.cell(ref.sheet, r, c)
+        if cell is None or cell.value is None:
+            continue  # an empty key never matches
+        if cell.formula is not None:
+            raise FormulaProblem("a lookup whose keys are formula cells")
+        if isinstance(cell.value, bool):
+            raise FormulaProblem("a lookup whose keys hold TRUE/FALSE")
+        if isinstance(cell.value, str):
+            if not known_number(ft, args[0]):
+                raise FormulaProblem("a lookup of other than a known number over text keys")
+            continue
+        ft.out.refs.append(Ref(ref.sheet, r, c, r, c))
+        equal.append(f"{x} == {ft.name_of(ref.sheet, r, c)}")
+    if not equal:
+        return "1 == 1"
+    return "not (" + " or ".join(equal) + ")"
