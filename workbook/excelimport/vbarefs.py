@@ -5,14 +5,20 @@ value is ``[value, the changed parameters...]``, and the caller's variables take
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from .vbaexpr import strip
 from .vbamembers import NotTranslated
 from .vbatypes import INTEGER_TYPES, bankers
 
-if TYPE_CHECKING:
-    from .vbaprogram import FunctionInfo
+
+class Translated(Protocol):
+    """What the ``_refs`` program reads of a translated function (vbaprogram's FunctionInfo)."""
+
+    final: str
+    params: list[str]
+    refs: list[int]
+    program: str
 
 
 class ByReference:
@@ -68,12 +74,12 @@ class ByReference:
         return True
 
 
-def refs_name(info: FunctionInfo) -> str:
+def refs_name(info: Translated) -> str:
     """The name of a function's program that also gives its parameters changed by reference."""
     return f"{info.final}_refs"
 
 
-def refs_program(info: FunctionInfo) -> str:
+def refs_program(info: Translated) -> str:
     """The function's program whose value is ``[value, the parameters at info.refs...]``:
     its last line and each ``return`` give the vector."""
     outs = ", ".join(info.params[k] for k in info.refs)
