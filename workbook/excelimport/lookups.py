@@ -285,42 +285,24 @@ def lookup_misses(ft, upper: str, args) -> str | None:
     """Where an exact ``VLOOKUP(x, table, k, FALSE)``, ``HLOOKUP(x, table, k, FALSE)`` or
     ``MATCH(x, keys, 0)`` finds no key (Excel's #N/A), as a condition (``"1 == 1"``: never
     found; None: always found), for IFERROR and ISERROR around it: x a text that never changes
-    (found here) or a number, over keys that are constant cells (a text key never equals a
-    number). Else FormulaProblem."""
+    (found here) or a number, over the keys a lookup takes (:func:`_keys`). Else
+    FormulaProblem."""
     from .statics import found
 
+    exact = len(args) == (3 if upper == "MATCH" else 4) and written_number(args[-1]) == 0
+    if not exact:
+        raise FormulaProblem(f"IFERROR of a {upper} other than an exact one")
     if upper == "MATCH":
-        if len(args) != 3 or written_number(args[2]) != 0:
-            raise FormulaProblem("IFERROR of a MATCH other than an exact one")
-        ref = _range(ft, args[1], "MATCH")
-        if ref.r1 != ref.r2 and ref.c1 != ref.c2:
+        keys_ref = _range(ft, args[1], "MATCH")
+        if keys_ref.r1 != keys_ref.r2 and keys_ref.c1 != keys_ref.c2:
             raise FormulaProblem("MATCH in a block of rows and columns (#N/A in Excel)")
-        cells = _cells(ref)
-    else:
-        if len(args) != 4 or written_number(args[3]) != 0:
-            raise FormulaProblem(f"IFERROR of a {upper} other than an exact one")
-        ref = _range(ft, args[1], upper)
-        first = [(r, ref.c1) for r in range(ref.r1, ref.r2 + 1)]
-        cells = first if upper == "VLOOKUP" else [(ref.r1, c) for c in range(ref.c1, ref.c2 + 1)]
-    at = found(ft, args[0], [(ref.sheet, r, c) for r, c in cells])
+    else:  # the first column (row) of the table
+        t = _range(ft, args[1], upper)
+        last = (t.r2, t.c1) if upper == "VLOOKUP" else (t.r1, t.c2)
+        keys_ref = Ref(t.sheet, t.r1, t.c1, *last)
+    at = found(ft, args[0], [(keys_ref.sheet, r, c) for r, c in _cells(keys_ref)])
     if at is not None:
         return "1 == 1" if at < 0 else None
     x = ft.value(args[0], 3)
-    equal = []
-    for r, c in cells:
-        cell = ft.book.cell(ref.sheet, r, c)
-        if cell is None or cell.value is None:
-            continue  # an empty key never matches
-        if cell.formula is not None:
-            raise FormulaProblem("a lookup whose keys are formula cells")
-        if isinstance(cell.value, bool):
-            raise FormulaProblem("a lookup whose keys hold TRUE/FALSE")
-        if isinstance(cell.value, str):
-            if not known_number(ft, args[0]):
-                raise FormulaProblem("a lookup of other than a known number over text keys")
-            continue
-        ft.out.refs.append(Ref(ref.sheet, r, c, r, c))
-        equal.append(f"{x} == {ft.name_of(ref.sheet, r, c)}")
-    if not equal:
-        return "1 == 1"
-    return "not (" + " or ".join(equal) + ")"
+    equal = [f"{x} == {name}" for _, name in _keys(ft, keys_ref, args[0], exact=True) if name]
+    return "not (" + " or ".join(equal) + ")" if equal else "1 == 1"
